@@ -1,0 +1,28 @@
+"""verimono — verification and property testing for evolution inclusions with maximal monotone operators.
+
+``x'(t) ∈ -F(t, x) + f(x) + u(t)``, with ``F(t,·)`` maximal monotone for every ``t``, solved by the
+proximal scheme of Camlibel, Iannelli and Tanwani and checked against the laws and bounds of their paper.
+Data flow one way: Problem → stepper → Trajectory → checks → results → report / gate.
+"""
+
+from .errors import (InfeasibleStep, InvalidGrid, InvalidProblem, NotMonotone, OutsideDomain,
+                     SolverFailure, VerimonoError)
+from .grids import graded_grid, random_grid, refine, uniform_grid, validate_grid
+from .operators import (L1Subdifferential, Linear, LogBarrier, NormalCone, NormSubdifferential, Operator,
+                        Shifted, operator_from_resolvent)
+from .problem import Order, Problem
+from .results import CheckResult, Report
+from .stepping import Trajectory, solve
+from . import sets
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "VerimonoError", "InvalidProblem", "InvalidGrid", "OutsideDomain", "NotMonotone", "InfeasibleStep",
+    "SolverFailure",
+    "Operator", "operator_from_resolvent", "Linear", "NormSubdifferential", "L1Subdifferential",
+    "NormalCone", "Shifted", "LogBarrier", "sets",
+    "Problem", "Order", "Trajectory", "solve",
+    "uniform_grid", "graded_grid", "random_grid", "refine", "validate_grid",
+    "CheckResult", "Report",
+]

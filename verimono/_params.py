@@ -1,0 +1,56 @@
+"""Parameters that are either constants or callables of time ``t``."""
+
+from __future__ import annotations
+
+from typing import Any, Callable
+
+import numpy as np
+
+from .errors import InvalidProblem
+
+
+class Param:
+    """A parameter ``p(t)``: a constant (array or scalar) or a callable of ``t``.
+
+    ``Param(c)(t)`` returns a float64 array.  Constants are converted once and
+    returned as the same read-only array on every call, so there is no per-step cost.
+    """
+
+    __slots__ = ("_fn", "_value", "name")
+
+    def __init__(self, value: Any, name: str = "parameter") -> None:
+        self.name = name
+        if isinstance(value, Param):
+            self._fn, self._value = value._fn, value._value
+        elif callable(value):
+            self._fn, self._value = value, None
+        else:
+            arr = np.array(value, dtype=float)
+            if not np.all(np.isfinite(arr)):
+                raise InvalidProblem(f"{name} must be finite, got {value!r}")
+            arr.setflags(write=False)
+            self._fn, self._value = None, arr
+
+    @property
+    def constant(self) -> bool:
+        """True when the parameter does not depend on ``t``."""
+        return self._fn is None
+
+    def __call__(self, t: float) -> np.ndarray:
+        if self._fn is None:
+            return self._value
+        return np.asarray(self._fn(t), dtype=float)
+
+    def describe(self) -> str:
+        if self._fn is None:
+            return np.array2string(self._value, precision=4, threshold=6)
+        return getattr(self._fn, "__name__", "f") + "(t)"
+
+
+def as_param(value: Any, name: str = "parameter") -> Param:
+    """Wrap a constant or a callable of ``t`` as a :class:`Param`."""
+    return value if isinstance(value, Param) else Param(value, name)
+
+
+def scalar_or_call(fn: Callable[[float], Any] | None, t: float) -> Any:
+    return None if fn is None else fn(t)

@@ -1,0 +1,165 @@
+"""Evolution inclusions ``x'(t) ∈ -F(t, x) + f(x) + u(t)``, ``x(0) = x0``, on ``[0, T]``."""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any, Callable, Sequence
+
+import numpy as np
+
+from .errors import InvalidProblem, OutsideDomain
+from .tolerances import tolerance
+
+
+@dataclasses.dataclass(frozen=True)
+class Order:
+    """Expected convergence order of a scheme on a problem, with where the claim comes from.
+
+    ``value`` is the exponent ``p`` in ``error ≈ C h^p``; ``exact=True`` means the scheme reproduces
+    the solution at the grid points up to round-off.  ``constant`` is the leading error constant ``C``
+    in the sup norm when it is known in closed form.
+    """
+
+    value: float | None
+    source: str
+    exact: bool = False
+    constant: float | None = None
+
+    @classmethod
+    def exact_at_nodes(cls, source: str) -> "Order":
+        return cls(None, source, exact=True)
+
+    def __str__(self) -> str:
+        return "exact" if self.exact else f"{self.value:g}"
+
+
+def _as_order(order: Any) -> Order | None:
+    if order is None or isinstance(order, Order):
+        return order
+    if order == "exact":
+        return Order.exact_at_nodes("stated by the caller")
+    try:
+        return Order(float(order), "stated by the caller")
+    except (TypeError, ValueError):
+        raise InvalidProblem(f"order must be a number, 'exact' or an Order, got {order!r}") from None
+
+
+def _finite_array(value: Any, what: str) -> np.ndarray:
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InvalidProblem(f"{what} must be numeric: {exc}") from None
+    if not np.all(np.isfinite(arr)):
+        raise InvalidProblem(f"{what} must be finite, got {value!r}")
+    return arr
+
+
+class Problem:
+    """``x' ∈ -F(t, x) + f(x) + u(t)`` on ``[0, T]`` with ``x(0) = x0``.
+
+    Parameters
+    ----------
+    operator : Operator
+        ``F``, maximal monotone for each ``t`` (assumption (A1)).
+    x0 : array (n,) or (B, n)
+        Initial point in ``cl dom F(0,·)``; a batch ``(B, n)`` solves ``B`` initial conditions at once.
+    T : float
+        Final time, ``T > 0``.
+    f : callable, optional
+        Lipschitz vector field ``f(x)`` (Section 6); treated explicitly by the scheme.
+    u : callable, optional
+        Integrable input ``u(t)`` (Section 6); enters through ``∫_{t_k}^{t_{k+1}} u``.
+    exact : callable, optional
+        The exact solution ``t ↦ x(t)`` when known.
+    order : float, "exact" or Order, optional
+        Expected convergence order of the proximal scheme, with its source.
+    name : str, optional
+
+    Keyword-only extras used by checks and references: ``U`` (primitive ``∫_0^t u``, used instead of
+    quadrature when given), ``lipschitz`` (the Lipschitz constant of ``f``), ``phi``/``sigma``/``theta``
+    (the functions of assumptions (A3), (LG), (YB) when known), ``steps`` (step sizes for which the
+    expected order is asymptotic), ``initial_jump`` (allow ``x0 ∉ cl dom F(0)``: the catching-up
+    scheme then jumps to the projection in its first step), ``notes``.
+    """
+
+    def __init__(self, operator: Any, x0: Any, T: float, *, f: Callable | None = None,
+                 u: Callable | None = None, exact: Callable | None = None, order: Any = None,
+                 name: str | None = None, U: Callable | None = None, lipschitz: float | None = None,
+                 phi: Callable | None = None, sigma: Callable | None = None, theta: Callable | None = None,
+                 steps: Sequence[float] | None = None, initial_jump: bool = False, notes: str = "") -> None:
+        if not hasattr(operator, "resolvent") or not hasattr(operator, "dim"):
+            raise InvalidProblem(f"operator must be a verimono.Operator (with .dim and .resolvent), got {operator!r}")
+        x0 = _finite_array(x0, "x0")
+        n = operator.dim
+        if x0.ndim not in (1, 2) or x0.shape[-1] != n:
+            raise InvalidProblem(f"x0 must have shape ({n},) or (B, {n}) for an operator on R^{n}, got {x0.shape}")
+        try:
+            T = float(T)
+        except (TypeError, ValueError):
+            raise InvalidProblem(f"T must be a number, got {T!r}") from None
+        if not np.isfinite(T) or T <= 0:
+            raise InvalidProblem(f"T must be positive and finite, got T = {T!r}")
+        for what, fn in (("f", f), ("u", u), ("exact", exact), ("U", U)):
+            if fn is not None and not callable(fn):
+                raise InvalidProblem(f"{what} must be callable, got {fn!r}")
+        self.operator, self.x0, self.T = operator, x0, T
+        self.f, self.u, self.U, self.exact = f, u, U, exact
+        self.order = _as_order(order)
+        self.name = name or f"{getattr(operator, 'name', 'F')} problem"
+        self.lipschitz, self.phi, self.sigma, self.theta = lipschitz, phi, sigma, theta
+        self.steps = None if steps is None else [float(h) for h in steps]
+        self.initial_jump = bool(initial_jump)
+        self.notes = notes
+        if f is not None:
+            fx = _finite_array(f(x0), "f(x0)")
+            if fx.shape != x0.shape:
+                raise InvalidProblem(f"f(x0) must have the shape of x0 {x0.shape}, got {fx.shape}")
+        for what, fn in (("u(0)", u), ("U(0)", U)):
+            if fn is not None:
+                val = _finite_array(fn(0.0), what)
+                if val.shape != (n,):
+                    raise InvalidProblem(f"{what} must have shape ({n},), got {val.shape}")
+        if not initial_jump:
+            self._check_initial_point()
+
+    @property
+    def dim(self) -> int:
+        return self.operator.dim
+
+    @property
+    def batched(self) -> bool:
+        return self.x0.ndim == 2
+
+    def _check_initial_point(self) -> None:
+        try:
+            p = np.asarray(self.operator.project_domain(self.x0, 0.0))
+        except NotImplementedError:
+            return  # cannot be checked; the operator laws report the missing member
+        dist = float(np.max(np.abs(p - self.x0)))
+        if dist > tolerance(self.x0):
+            raise OutsideDomain(f"x0 = {self.x0} lies outside cl dom F(0,·) (distance {dist:.3g} to its "
+                                "projection); pass initial_jump=True to start with the catching-up jump")
+
+    def input_increments(self, t: np.ndarray) -> np.ndarray | None:
+        """``∫_{t_k}^{t_{k+1}} u`` for every cell: exact from ``U`` or 3-point Gauss–Legendre (order 6)."""
+        if self.U is not None:
+            Ut = np.array([np.asarray(self.U(s), dtype=float) for s in t])
+            return np.diff(Ut, axis=0)
+        if self.u is None:
+            return None
+        nodes, weights = np.polynomial.legendre.leggauss(3)
+        h = np.diff(t)
+        mid = 0.5 * (t[:-1] + t[1:])
+        total = np.zeros((h.size, self.dim))
+        for xi, w in zip(nodes, weights):
+            vals = np.array([np.asarray(self.u(s), dtype=float) for s in (mid + 0.5 * h * xi).tolist()])
+            total += (0.5 * w) * h[:, None] * vals
+        if not np.all(np.isfinite(total)):
+            raise InvalidProblem("u(t) returned non-finite values on the grid")
+        return total
+
+    def __repr__(self) -> str:
+        return f"Problem({self.name!r}, n={self.dim}, T={self.T:g}, order={self.order})"
+
+
+__all__ = ["Problem", "Order"]

@@ -1,0 +1,152 @@
+"""Result records: what every check returns.
+
+Checks never print or assert.  Each returns :class:`CheckResult` records — the check's name, its
+subject, a status (``passed``, ``failed``, ``skipped``, ``xfail``), the worst observed ratio against the
+check's bound, and a counterexample that reproduces a failure.  pytest, the HTML report and the CI gate
+are thin consumers of these records, collected in a :class:`Report`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections import Counter
+from typing import Any, Iterable, Iterator
+
+import numpy as np
+
+PASSED, FAILED, SKIPPED, XFAIL = "passed", "failed", "skipped", "xfail"
+STATUSES = (PASSED, FAILED, SKIPPED, XFAIL)
+
+
+def to_jsonable(value: Any) -> Any:
+    """Convert numpy values (recursively) to plain JSON types; non-finite floats become strings."""
+    if isinstance(value, dict):
+        return {str(k): to_jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [to_jsonable(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return to_jsonable(value.tolist())
+    if isinstance(value, (np.bool_, bool)):
+        return bool(value)
+    if isinstance(value, (np.integer,)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        v = float(value)
+        return v if math.isfinite(v) else repr(v)
+    if value is None or isinstance(value, (int, str)):
+        return value
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return to_jsonable(dataclasses.asdict(value))
+    return repr(value)
+
+
+@dataclasses.dataclass
+class CheckResult:
+    """One check of one subject.
+
+    ``worst`` is the worst observed value of the check's ratio, ``bound`` the value it must not exceed
+    (so a check passes when ``worst <= bound``); both are ``None`` for checks without a ratio.
+    ``counterexample`` holds the inputs that reproduce a failure (points, step sizes, times, seed).
+    """
+
+    check: str
+    subject: str
+    status: str
+    worst: float | None = None
+    bound: float | None = None
+    counterexample: dict[str, Any] | None = None
+    message: str = ""
+    seed: int | None = None
+    details: dict[str, Any] = dataclasses.field(default_factory=dict)
+    duration: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.status not in STATUSES:
+            raise ValueError(f"status must be one of {STATUSES}, got {self.status!r}")
+
+    @property
+    def ok(self) -> bool:
+        """True unless the check failed (skips and expected failures are not failures)."""
+        return self.status != FAILED
+
+    @property
+    def key(self) -> str:
+        """Stable identity of the record: ``check[subject]``."""
+        return f"{self.check}[{self.subject}]"
+
+    def to_dict(self) -> dict[str, Any]:
+        return to_jsonable(dataclasses.asdict(self))
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> "CheckResult":
+        fields = {f.name for f in dataclasses.fields(cls)}
+        kw = {k: v for k, v in data.items() if k in fields}
+        for name in ("worst", "bound", "duration"):
+            if isinstance(kw.get(name), str):
+                kw[name] = float(kw[name])
+        return cls(**kw)
+
+    def __str__(self) -> str:
+        ratio = ""
+        if self.worst is not None:
+            ratio = f" worst={self.worst:.4g}" + (f" bound={self.bound:.4g}" if self.bound is not None else "")
+        msg = f" — {self.message}" if self.message else ""
+        return f"{self.status.upper():7s} {self.key}{ratio}{msg}"
+
+
+class Report:
+    """An ordered collection of :class:`CheckResult` records, plus convergence studies.
+
+    Iterates over records; ``counts`` tallies statuses; ``ok`` is True when nothing failed.
+    """
+
+    def __init__(self, results: Iterable[CheckResult] = (), studies: Iterable[Any] = (),
+                 meta: dict[str, Any] | None = None) -> None:
+        self.results: list[CheckResult] = list(results)
+        self.studies: list[Any] = list(studies)
+        self.meta: dict[str, Any] = dict(meta or {})
+
+    def __iter__(self) -> Iterator[CheckResult]:
+        return iter(self.results)
+
+    def __len__(self) -> int:
+        return len(self.results)
+
+    def __getitem__(self, i: int) -> CheckResult:
+        return self.results[i]
+
+    def add(self, result: CheckResult) -> CheckResult:
+        self.results.append(result)
+        return result
+
+    def extend(self, other: "Report | Iterable[CheckResult]") -> "Report":
+        if isinstance(other, Report):
+            self.results.extend(other.results)
+            self.studies.extend(other.studies)
+        else:
+            self.results.extend(other)
+        return self
+
+    @property
+    def counts(self) -> dict[str, int]:
+        c = Counter(r.status for r in self.results)
+        return {s: c.get(s, 0) for s in STATUSES}
+
+    @property
+    def ok(self) -> bool:
+        return all(r.ok for r in self.results)
+
+    @property
+    def failures(self) -> list[CheckResult]:
+        return [r for r in self.results if r.status == FAILED]
+
+    def by_check(self, name: str) -> list[CheckResult]:
+        return [r for r in self.results if r.check == name]
+
+    def summary(self) -> str:
+        c = self.counts
+        return ", ".join(f"{c[s]} {s}" for s in STATUSES)
+
+    def __repr__(self) -> str:
+        return f"Report({self.summary()})"
