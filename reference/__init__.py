@@ -1,0 +1,41 @@
+"""Analytic reference problems: each a :class:`verimono.Problem` with its exact solution, the expected
+order of the proximal scheme on it and where that order comes from (``problem.order.source``).
+
+``catalog()`` returns them all; ``get(name)`` one by name.
+"""
+
+from __future__ import annotations
+
+from verimono.problem import Problem
+
+from . import linear, subdifferential, sweeping
+
+_BUILDERS = [
+    lambda: subdifferential.t_norm((1.0,)),
+    lambda: subdifferential.t_norm((0.6, -0.8, 0.5)),
+    subdifferential.log_barrier,
+    sweeping.static_inside,
+    sweeping.static_outside,
+    sweeping.play_smooth,
+    sweeping.play_piecewise_linear,
+    sweeping.moving_half_space,
+    sweeping.moving_box,
+    sweeping.translating_ball,
+    linear.linear,
+    linear.lipschitz_input,
+]
+
+
+def catalog() -> list[Problem]:
+    """Every analytic reference problem, freshly built."""
+    return [build() for build in _BUILDERS]
+
+
+def get(name: str) -> Problem:
+    for p in catalog():
+        if p.name == name:
+            return p
+    raise KeyError(f"no reference named {name!r}; known: {[p.name for p in catalog()]}")
+
+
+__all__ = ["catalog", "get"]

@@ -1,0 +1,57 @@
+"""References for subdifferential flows ``x' ∈ -∂g(t, x)``.
+
+* ``t_norm``: the paper's example ``g(t, x) = t|x|`` (Section 4, ``sec:convexSubdiff``).  With
+  ``r = |x0|`` the solution is ``x(t) = max(1 - t²/(2r), 0) x0`` (``|x|' = -t`` until extinction at
+  ``t* = sqrt(2r)``).  On a uniform grid the scheme shrinks ``|x_{k+1}| = max(|x_k| - h t_{k+1}, 0)``,
+  so ``|x_k| = r - t_k²/2 - h t_k/2`` before extinction: the error ``h t_k/2`` peaks near ``t*`` at
+  ``h sqrt(r/2) + O(h²)`` — order 1 with constant ``sqrt(r/2)`` (derived here, checked in tests).
+* ``log_barrier``: ``g = -c ln x`` on ``(0, ∞)``, ``x' = c/x``, ``x0 = 0 ∈ cl dom``: ``x = sqrt(2ct)``.
+  The first step gives ``x_1 = sqrt(ch)`` against ``sqrt(2ch)``: sup error ``(√2 - 1) sqrt(ch)``, order
+  exactly 1/2 (derived here; consistent with the O(h^{1/2}) of Rulla 1996 for ``x0`` in the closure of
+  the domain).  The harness must never certify order 1 here.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from verimono import LogBarrier, NormSubdifferential, Order, Problem
+
+
+def _tnorm_c(t):
+    return t
+
+
+def t_norm(x0=(1.0,), T: float = 2.0) -> Problem:
+    """``x' ∈ -∂(t|x|)(x)`` (any dimension): exact solution and order-1 error constant sqrt(r/2)."""
+    x0 = np.asarray(x0, dtype=float)
+    r = float(np.linalg.norm(x0))
+
+    def exact(t):
+        return max(1.0 - t * t / (2.0 * r), 0.0) * x0
+
+    n = x0.size
+    return Problem(
+        NormSubdifferential(_tnorm_c, dim=n), x0, T, exact=exact,
+        order=Order(1.0, "derived in verimono.reference.subdifferential: |x_k| = r - t_k^2/2 - h t_k/2 "
+                         "before extinction, sup error h sqrt(r/2) + O(h^2); paper Section 4 example "
+                         "g(t,x)=t|x| satisfies (YB') with theta(s)=s", constant=math.sqrt(r / 2.0)),
+        name=f"t|x| (n={n})", steps=[T / k for k in (40, 80, 160, 320, 640)],
+        theta=lambda s: s, sigma=lambda s: s,
+        notes="extinction at t* = sqrt(2|x0|) lies inside [0, T]")
+
+
+def log_barrier(c: float = 1.0, T: float = 1.0) -> Problem:
+    """``x' = c/x`` from ``x0 = 0``: ``x = sqrt(2ct)``, error ``(√2-1) sqrt(ch)`` — order exactly 1/2."""
+    def exact(t):
+        return np.array([math.sqrt(2.0 * c * t)])
+
+    return Problem(
+        LogBarrier(c), [0.0], T, exact=exact,
+        order=Order(0.5, "derived in verimono.reference.subdifferential: x_1 = sqrt(ch) vs sqrt(2ch), "
+                         "sup error (sqrt 2 - 1) sqrt(c h); cf. Rulla 1996, O(h^1/2) for x0 in cl D(A)",
+                    constant=(math.sqrt(2.0) - 1.0) * math.sqrt(c)),
+        name="x' = c/x from 0 (order 1/2)", steps=[T / k for k in (100, 200, 400, 800, 1600)],
+        notes="(LG) fails: |F^0(x)| = c/x is unbounded near the boundary of the domain")
