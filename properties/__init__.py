@@ -1,0 +1,1 @@
+"""Property suites (pytest + hypothesis), one module per family of laws; installed as verimono.properties."""

@@ -1,0 +1,188 @@
+"""Catalog operators: resolvents against closed forms and against independent computations.
+
+The independent computation is the proximal problem itself: for ``F = ∂g``,
+``J_λ x = argmin_z g(z) + |z - x|²/(2λ)``, solved here by scipy's minimiser (or a scalar root-finder),
+never by the code under test.  Tolerances: closed forms are compared at ``tolerance()`` (RTOL scaled to
+the inputs); the generic minimiser is accurate to about 1e-6, which is the tolerance used with it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq, minimize
+
+import verimono as vm
+from verimono.sets import Ball, Box, HalfSpace, Polyhedron
+from verimono.tolerances import tolerance
+
+RNG = np.random.default_rng(20261122)
+MINIMIZER_TOL = 1e-5
+
+
+def prox_by_minimisation(g, x, lam):
+    res = minimize(lambda z: g(z) + np.sum((z - x) ** 2) / (2 * lam), x, method="Nelder-Mead",
+                   options=dict(xatol=1e-10, fatol=1e-14, maxiter=20000, maxfev=40000))
+    return res.x
+
+
+@pytest.mark.parametrize("t", [0.0, 0.7, 2.5])
+def test_norm_subdifferential_is_prox_of_c_norm(t):
+    op = vm.NormSubdifferential(lambda s: 1.0 + s, dim=3)
+    for _ in range(5):
+        x, lam = RNG.normal(size=3) * 2, RNG.uniform(0.05, 1.5)
+        J = op.resolvent(x, lam, t)
+        ref = prox_by_minimisation(lambda z: (1 + t) * np.linalg.norm(z), x, lam)
+        assert np.allclose(J, ref, atol=MINIMIZER_TOL)
+        # closed form: block soft thresholding
+        assert np.allclose(J, max(1 - lam * (1 + t) / np.linalg.norm(x), 0) * x, atol=tolerance(x))
+
+
+def test_norm_subdifferential_min_norm_and_membership():
+    op = vm.NormSubdifferential(2.0, dim=2)
+    x = np.array([3.0, 4.0])
+    assert np.allclose(op.min_norm(x), [1.2, 1.6])
+    assert op.contains(x, [1.2, 1.6]) and not op.contains(x, [1.0, 1.6])
+    assert op.contains(np.zeros(2), [1.0, -1.5]) and not op.contains(np.zeros(2), [2.0, 1.0])
+    assert np.allclose(op.min_norm(np.zeros(2)), 0.0)
+
+
+def test_l1_resolvent_is_soft_thresholding_and_prox():
+    c = np.array([0.5, 1.0, 0.0])
+    op = vm.L1Subdifferential(c, dim=3)
+    x, lam = np.array([1.0, -0.3, 2.0]), 0.8
+    J = op.resolvent(x, lam)
+    assert np.allclose(J, [0.6, 0.0, 2.0])
+    ref = prox_by_minimisation(lambda z: np.sum(c * np.abs(z)), x, lam)
+    assert np.allclose(J, ref, atol=MINIMIZER_TOL)
+    assert op.contains(J, (x - J) / lam)
+
+
+def test_linear_resolvent_solves_the_linear_system_and_is_cached():
+    M = np.array([[1.0, 2.0], [-2.0, 0.0]])  # M + Mᵀ = diag(2, 0) ⪰ 0, not symmetric
+    op = vm.Linear(M)
+    x, lam = np.array([1.0, -2.0]), 0.3
+    J = op.resolvent(x, lam)
+    assert np.allclose((np.eye(2) + lam * M) @ J, x, atol=tolerance(x))
+    first = op._cache_inv
+    op.resolvent(x, lam)
+    assert op._cache_inv is first  # the factor is reused for the same step
+
+
+def test_linear_time_dependent_and_batched():
+    op = vm.Linear(lambda t: np.array([[t, 1.0], [-1.0, t]]))
+    X = RNG.normal(size=(4, 2))
+    for t in (0.0, 1.5):
+        J = op.resolvent(X, 0.5, t)
+        for xi, Ji in zip(X, J):
+            assert np.allclose((np.eye(2) + 0.5 * op.M(t)) @ Ji, xi)
+
+
+def test_linear_rejects_non_monotone():
+    with pytest.raises(vm.NotMonotone, match="positive semidefinite"):
+        vm.Linear([[1.0, 0.0], [0.0, -0.5]])
+
+
+def test_normal_cone_resolvent_is_projection_for_every_lambda():
+    S = Ball([1.0, 0.0], 0.5)
+    op = vm.NormalCone(S)
+    x = np.array([3.0, 0.0])
+    for lam in (0.01, 1.0, 100.0):
+        assert np.allclose(op.resolvent(x, lam), [1.5, 0.0])
+    assert op.contains([1.5, 0.0], [2.0, 0.0]) and not op.contains([1.5, 0.0], [0.0, 1.0])
+    assert op.contains([1.2, 0.1], [0.0, 0.0]) and not op.contains([1.2, 0.1], [0.1, 0.0])
+    with pytest.raises(vm.OutsideDomain):
+        op.min_norm(np.array([5.0, 0.0]))
+
+
+def test_shifted_resolvent_and_input_shift_identity():
+    """G(t, x) = F(t, x + Φ(t)): J^G(x) = J^F(x + Φ) - Φ (lemma l:extinput)."""
+    F = vm.NormSubdifferential(1.0, dim=2)
+    Phi = lambda t: np.array([t, -2 * t])  # noqa: E731
+    G = vm.Shifted(F, Phi)
+    x, t = np.array([0.5, 0.5]), 0.8
+    assert np.allclose(G.resolvent(x, 0.3, t), F.resolvent(x + Phi(t), 0.3, t) - Phi(t))
+    y = G.yosida(x, 0.3, t)
+    assert G.contains(G.resolvent(x, 0.3, t), y, t)
+
+
+def test_log_barrier_resolvent_solves_quadratic_without_cancellation():
+    op = vm.LogBarrier(2.0)
+    for x in (-1e8, -3.0, 0.0, 0.5, 1e6):
+        lam = 0.1
+        z = op.resolvent(np.array([x]), lam)[0]
+        assert z > 0
+        root = brentq(lambda s: s - 2.0 * lam / s - x, 1e-300, max(abs(x), 1.0) * 4 + 10)
+        assert z == pytest.approx(root, rel=1e-12)
+    with pytest.raises(vm.OutsideDomain):
+        op.min_norm(np.array([0.0]))
+
+
+@pytest.mark.parametrize("make", [
+    lambda: Ball([0.5, -0.5], 1.5),
+    lambda: Box([-1.0, 0.0], [0.5, np.inf]),
+    lambda: HalfSpace([1.0, 2.0], 0.5),
+    lambda: Polyhedron([[1.0, 1.0], [-1.0, 0.0], [0.0, -1.0]], [1.0, 0.0, 0.0]),
+    lambda: Polyhedron([[1.0, 1.0, 0.0]], [1.0], A=[[0.0, 0.0, 1.0]], b=[0.25]),
+])
+@pytest.mark.filterwarnings("ignore:delta_grad == 0.0:UserWarning")
+def test_projections_match_a_generic_constrained_minimiser(make):
+    """proj_S(x) = argmin |z - x|² over S, checked against SLSQP (independent of verimono's QP path)."""
+    from scipy.optimize import LinearConstraint, NonlinearConstraint
+
+    S = make()
+    for _ in range(6):
+        x = RNG.normal(size=S.dim) * 3
+        p = S.project(x)
+        assert S.contains(p)
+        if isinstance(S, Ball):
+            cons = [NonlinearConstraint(lambda z: np.sum((z - S.center()) ** 2), -np.inf, S.radius() ** 2)]
+        elif isinstance(S, Box):
+            lo, hi = np.broadcast_arrays(S.lower(), S.upper())
+            cons = [LinearConstraint(np.eye(S.dim), lo, hi)]
+        elif isinstance(S, HalfSpace):
+            cons = [LinearConstraint(S.normal()[None, :], -np.inf, S.offset())]
+        else:
+            G, h, A, b = S.data()
+            cons = [LinearConstraint(G, -np.inf, h)] + ([LinearConstraint(A, b, b)] if A is not None else [])
+        ref = minimize(lambda z: np.sum((z - x) ** 2), x * 0, constraints=cons, method="trust-constr",
+                       options=dict(xtol=1e-12, gtol=1e-12, maxiter=5000)).x
+        assert np.allclose(p, ref, atol=1e-5), (x, p, ref)
+        # variational inequality: <x - p, z - p> <= 0 for points z of S (sampled by projection)
+        for _ in range(5):
+            z = S.project(RNG.normal(size=S.dim) * 3)
+            assert (x - p) @ (z - p) <= tolerance(x, z)
+
+
+def test_moving_sets_depend_on_time():
+    S = Ball(lambda t: np.array([t, 0.0]), lambda t: 1.0 + t)
+    assert np.allclose(S.project(np.array([5.0, 0.0]), t=2.0), [5.0, 0.0])
+    assert np.allclose(S.project(np.array([5.0, 0.0]), t=0.0), [1.0, 0.0])
+    H = HalfSpace([0.0, 1.0], lambda t: -t)
+    assert np.allclose(H.project(np.array([1.0, 0.0]), t=1.0), [1.0, -1.0])
+    B = Box(lambda t: np.array([t]), lambda t: np.array([t + 1]))
+    assert B.project(np.array([0.0]), 3.0)[0] == 3.0
+
+
+def test_batched_points_give_rowwise_results():
+    X = RNG.normal(size=(7, 3))
+    for op in (vm.NormSubdifferential(0.7, dim=3), vm.L1Subdifferential(0.3, dim=3),
+               vm.NormalCone(Ball(np.zeros(3), 1.0)), vm.NormalCone(Box(-np.ones(3), np.ones(3))),
+               vm.NormalCone(HalfSpace([1.0, 0.0, 1.0], 0.2)), vm.Linear(np.eye(3)),
+               vm.NormalCone(Polyhedron(np.eye(3), np.ones(3) * 0.1)), vm.LogBarrier(1.0, dim=3)):
+        J = op.resolvent(X, 0.4, 0.0)
+        assert J.shape == X.shape
+        assert np.allclose(J, np.stack([op.resolvent(x, 0.4, 0.0) for x in X]))
+
+
+def test_operator_from_resolvent_missing_members_raise_not_implemented():
+    op = vm.operator_from_resolvent(lambda x, lam, t: x / (1 + lam), 2, name="identity flow")
+    assert np.allclose(op.resolvent(np.array([2.0, 4.0]), 1.0), [1.0, 2.0])
+    assert np.allclose(op.yosida(np.array([2.0, 4.0]), 1.0), [1.0, 2.0])
+    for call in (lambda: op.min_norm(np.ones(2)), lambda: op.project_domain(np.ones(2)),
+                 lambda: op.contains(np.ones(2), np.ones(2))):
+        with pytest.raises(NotImplementedError):
+            call()
+    op2 = vm.operator_from_resolvent(lambda x, lam, t: x / (1 + lam), 2,
+                                     contains=lambda x, y, t: np.allclose(x, y))
+    assert op2.contains(np.ones(2), np.ones(2))
