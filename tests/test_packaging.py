@@ -26,6 +26,8 @@ def wheel(tmp_path_factory) -> Path:
 
 def test_wheel_contains_the_mapped_packages(wheel):
     names = zipfile.ZipFile(wheel).namelist()
+    for init in (REPO / "verimono").rglob("__init__.py"):  # every subpackage of the source tree ships
+        assert init.relative_to(REPO).as_posix() in names, f"{init} is missing from the wheel"
     for required in ("verimono/__init__.py", "verimono/reference/__init__.py", "verimono/reference/sweeping.py",
                      "verimono/properties/__init__.py"):
         assert required in names, required
