@@ -186,3 +186,16 @@ def test_operator_from_resolvent_missing_members_raise_not_implemented():
     op2 = vm.operator_from_resolvent(lambda x, lam, t: x / (1 + lam), 2,
                                      contains=lambda x, y, t: np.allclose(x, y))
     assert op2.contains(np.ones(2), np.ones(2))
+
+
+@pytest.mark.parametrize("t", [0.0, 1.3])
+def test_time_dependent_l1_and_log_barrier_against_independent_solves(t):
+    l1 = vm.L1Subdifferential(lambda s: np.array([0.2 + s, 1.0]), dim=2)
+    x, lam = np.array([1.7, -0.4]), 0.6
+    ref = prox_by_minimisation(lambda z: (0.2 + t) * abs(z[0]) + abs(z[1]), x, lam)
+    assert np.allclose(l1.resolvent(x, lam, t), ref, atol=MINIMIZER_TOL)
+    lb = vm.LogBarrier(lambda s: 1.0 + s * s)
+    c = 1.0 + t * t
+    root = brentq(lambda s: s - lam * c / s - 0.3, 1e-12, 10.0)
+    assert lb.resolvent(np.array([0.3]), lam, t)[0] == pytest.approx(root, rel=1e-12)
+    assert lb.contains(np.array([root]), np.array([-c / root]), t)
