@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from verimono.problem import Problem
 
-from . import linear, subdifferential, sweeping
+from . import lcs_example, linear, subdifferential, sweeping
 
 _BUILDERS = [
     lambda: subdifferential.t_norm((1.0,)),
@@ -23,6 +23,8 @@ _BUILDERS = [
     sweeping.translating_ball,
     linear.linear,
     linear.lipschitz_input,
+    lcs_example.ramp_problem,
+    lcs_example.sine_problem,
 ]
 
 

@@ -13,7 +13,8 @@ from .operators import (L1Subdifferential, Linear, LogBarrier, NormalCone, NormS
 from .problem import Order, Problem
 from .results import CheckResult, Report
 from .stepping import Trajectory, solve
-from . import sets
+from .pseudo_distance import pseudo_distance_lower_bound
+from . import lcs, sets
 
 __version__ = "0.1.0"
 
@@ -24,5 +25,5 @@ __all__ = [
     "NormalCone", "Shifted", "LogBarrier", "sets",
     "Problem", "Order", "Trajectory", "solve",
     "uniform_grid", "graded_grid", "random_grid", "refine", "validate_grid",
-    "CheckResult", "Report",
+    "CheckResult", "Report", "pseudo_distance_lower_bound", "lcs",
 ]

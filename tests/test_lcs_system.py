@@ -1,0 +1,104 @@
+"""LinearRelationSystem: H as an Operator, its resolvent = the one-step problem, errors on bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from verimono import (InfeasibleStep, InvalidProblem, NormalCone, NotMonotone, operator_from_resolvent, solve,
+                      uniform_grid)
+from verimono.lcs import Complementarity, LinearRelationSystem, OperatorRelation, Relay, check_hypotheses
+from verimono.sets import Box
+
+
+def random_passive(rng, n=3, m=2):
+    """Passive with K = I: A + Aᵀ ⪯ 0, C = Bᵀ, D + Dᵀ ⪰ 0 (Q(I) = blockdiag(A + Aᵀ, −(D + Dᵀ)))."""
+    S = rng.normal(size=(n, n))
+    A = (S - S.T) - 0.3 * np.diag(rng.uniform(size=n))
+    B = rng.normal(size=(n, m))
+    R = rng.normal(size=(1, m))
+    Dk = rng.normal(size=(m, m))
+    D = R.T @ R + (Dk - Dk.T)
+    return A, B, B.T.copy(), D
+
+
+def test_theta_one_is_the_proximal_scheme_on_H():
+    rng = np.random.default_rng(1)
+    A, B, C, D = random_passive(rng)
+    sys = LinearRelationSystem(A, B, C, D, Complementarity(), v=lambda t: np.array([np.sin(t), -0.5]))
+    t = uniform_grid(1.0, steps=50)
+    x0 = [1.0, -0.5, 0.3]
+    tr = sys.simulate(x0, t)
+    ref = solve(sys.problem(x0, 1.0), t)
+    np.testing.assert_allclose(tr.x, ref.x, rtol=0, atol=1e-12)
+    # (z, w) of every step are complementary and reproduce the state update
+    z, w = tr.extras["z"], tr.extras["w"]
+    assert z.min() >= 0 and w.min() >= -1e-10 and np.abs(np.sum(z * w, 1)).max() <= 1e-10
+    h = 1 / 50
+    np.testing.assert_allclose((tr.x[1:] - tr.x[:-1]) / h, tr.x[1:] @ A.T + z @ B.T, atol=1e-9)
+
+
+def test_operator_laws_on_random_passive_systems():
+    rng = np.random.default_rng(2)
+    for _ in range(5):
+        A, B, C, D = random_passive(rng)
+        H = LinearRelationSystem(A, B, C, D, Complementarity(), v=rng.normal(size=2)).operator()
+        assert check_hypotheses(H.system, 1.0).by_check("lcs.passivity")[0].status == "passed"
+        X = rng.normal(size=(12, 3)) * 2
+        for lam in (0.1, 1.0):
+            J = np.array([H.resolvent(x, lam) for x in X])
+            Y = (X - J) / lam
+            for i in range(len(X)):
+                assert H.contains(J[i], Y[i], tol=1e-7)        # Y_λ x ∈ H(J_λ x)
+                hn = H.min_norm(J[i])
+                assert np.linalg.norm(hn) <= np.linalg.norm(Y[i]) + 1e-7   # |H^0| ≤ |y| for y ∈ H
+                for j in range(i):                             # firm nonexpansiveness (monotone H)
+                    d = J[i] - J[j]
+                    assert d @ d <= d @ (X[i] - X[j]) + 1e-9 * (1 + np.abs(X).max())
+
+
+def test_generic_operator_relation_matches_relay():
+    sysR = LinearRelationSystem(np.zeros((2, 2)), 2 * np.eye(2), np.eye(2), np.zeros((2, 2)), Relay())
+    # Relay −w ∈ N_[−1,1](z) is 𝓜 = N_[−1,1] as (−z, w) ∈ graph 𝓜
+    sysO = LinearRelationSystem(np.zeros((2, 2)), 2 * np.eye(2), np.eye(2), np.zeros((2, 2)),
+                                NormalCone(Box([-1, -1], [1, 1])))
+    assert isinstance(sysO.relation, OperatorRelation)
+    t = np.arange(301) * 1e-3
+    a, b = sysR.simulate([1, -1], t, theta=0.5), sysO.simulate([1, -1], t, theta=0.5)
+    np.testing.assert_allclose(a.x, b.x, atol=1e-8)
+
+
+def test_bad_input_and_non_monotone_relations_are_typed():
+    with pytest.raises(InvalidProblem, match="B must have n = 2 rows"):
+        LinearRelationSystem(np.zeros((2, 2)), np.ones((3, 1)), np.ones((1, 2)), [[0]], Complementarity())
+    with pytest.raises(InvalidProblem, match="D must have shape"):
+        LinearRelationSystem(np.zeros((2, 2)), np.ones((2, 1)), np.ones((1, 2)), np.eye(2), Complementarity())
+    with pytest.raises(InvalidProblem, match="finite"):
+        LinearRelationSystem([[np.inf]], [[1]], [[1]], [[0]], Complementarity())
+    with pytest.raises(InvalidProblem, match="relation must be"):
+        LinearRelationSystem([[0]], [[1]], [[1]], [[0]], "relay")
+    with pytest.raises(NotMonotone, match="lower .* exceeds upper"):
+        Relay(lower=1, upper=-1)
+    expanding = operator_from_resolvent(lambda x, lam, t: 2.0 * np.asarray(x), 1, name="expanding")
+    with pytest.raises(NotMonotone, match="not firmly nonexpansive"):
+        LinearRelationSystem([[0]], [[1]], [[1]], [[0]], expanding)
+    sys = LinearRelationSystem([[0]], [[1]], [[1]], [[0]], Complementarity())
+    with pytest.raises(InvalidProblem, match="x0 must be"):
+        sys.simulate([1.0, 2.0], [0, 1])
+
+
+def test_infeasible_step_and_failing_hypothesis():
+    # w = 0·x + 0·z − 1 ≥ 0 is impossible: LCP(−1, 0) is infeasible, and im C ∩ ri(im(𝓟 + D) − v) = ∅
+    sys = LinearRelationSystem([[0.0]], [[1.0]], [[0.0]], [[0.0]], Complementarity(), v=[-1.0])
+    with pytest.raises(InfeasibleStep, match="q ∉ Q_M"):
+        sys.simulate([0.0], [0.0, 0.1])
+    rep = check_hypotheses(sys, 1.0)
+    assert rep.by_check("lcs.rel_int")[0].status == "failed"
+    assert rep.by_check("lcs.A1")[0].status == "skipped"
+
+
+def test_non_passive_system_fails_the_check():
+    sys = LinearRelationSystem([[1.0]], [[1.0]], [[1.0]], [[0.0]], Complementarity())
+    rep = check_hypotheses(sys, 1.0)
+    assert rep.by_check("lcs.passivity")[0].status == "failed" and not rep.ok
+    assert all(r.status == "skipped" for r in rep.by_check("lcs.A1"))

@@ -1,0 +1,440 @@
+"""Linear complementarity problems ``LCP(q, M)``: find ``z ≥ 0`` with ``w = Mz + q ≥ 0`` and ``⟨z, w⟩ = 0``.
+
+The paper's one-step problem for complementarity systems (Section 7, ``e:lcp``).  For a positive
+semidefinite (not necessarily symmetric) ``M`` Proposition ``p:lcp2`` gives: ``LCP(q, M)`` is solvable iff
+it is feasible iff ``q ∈ Q_M^+``, and there is a unique **least-norm** solution ``z*(q)`` (item iv; Han,
+Tiwari, Camlibel, Pang 2009).  It is computed in two phases:
+
+1. *any* solution ``z̄`` — Lemke's complementary pivoting (exact, and for PSD ``M``, which is
+   copositive-plus, ray termination proves infeasibility: Cottle–Pang–Stone (CPS) Thm 4.4.13), then the
+   convex QP ``min ½zᵀ(M+Mᵀ)z + qᵀz`` over ``FEA(q, M)`` (value 0 exactly at solutions), and for
+   non-PSD ``M`` enumeration of complementary pieces when ``n ≤ ENUM_MAX``;
+2. the least-norm one: for PSD ``M`` (CPS Thm 3.1.7)
+
+       SOL(q, M) = {z ≥ 0 : Mz + q ≥ 0, (M + Mᵀ)(z − z̄) = 0, qᵀ(z − z̄) = 0},
+
+   a polyhedron, so ``z*`` is the projection of 0 onto it, a strictly convex QP (:func:`verimono.qp.solve_qp`).
+   (Proof: for ``z ∈ SOL`` and ``d = z − z̄``, complementarity and feasibility give ``dᵀMd ≤ 0``, so
+   ``(M+Mᵀ)d = 0``, hence ``zᵀMz = z̄ᵀMz̄`` and ``qᵀz = −zᵀMz = qᵀz̄``; conversely those equalities make
+   ``zᵀ(Mz + q) = z̄ᵀ(Mz̄ + q) = 0``.)  The QP is skipped when ``SOL`` is provably a singleton: every
+   other solution differs by ``d ∈ ker(M+Mᵀ)`` with ``d_i = 0`` where ``w̄_i > 0`` and ``(Md)_i = 0``
+   where ``z̄_i > 0`` (the cross-complementarity ``zᵀw̄ = z̄ᵀw = 0``), so a trivial kernel of those rows
+   certifies uniqueness.
+
+No back-end's status is trusted: every candidate is checked by the natural residual
+``‖min(z, Mz + q)‖∞`` (zero exactly at solutions) against ``QP_RTOL`` relative to the data, polished by
+one principal pivot solve when already close (``POLISH_RTOL``), and the next back-end is tried otherwise.
+
+Box-constrained counterpart (relay): :func:`solve_box` finds ``λ ∈ [l, u]`` with ``−(Mλ + q) ∈ N_[l,u](λ)``
+through an equivalent LCP of size ``m + #{u < ∞}``, least-norm in ``λ``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+from typing import Callable
+
+import numpy as np
+from scipy.optimize import linprog
+
+from ..errors import InfeasibleStep, InvalidProblem, SolverFailure, VerimonoError
+from ..qp import solve_qp
+from ..tolerances import POLISH_RTOL, QP_RTOL, RTOL
+
+#: largest n for which complementary pieces are enumerated (2^n pieces)
+ENUM_MAX = 12
+
+
+@dataclasses.dataclass
+class LCPResult:
+    """A verified solution ``z`` of ``LCP(q, M)`` with ``w = Mz + q`` and how it was obtained.
+
+    ``residual`` is ``‖min(z, w)‖∞`` and ``scale`` the data size it is measured against
+    (``residual ≤ QP_RTOL·scale``).  ``least_norm`` is True when ``z`` is certified the least-norm solution
+    (uniqueness certificate or least-norm QP); ``unique`` is True/False when decided, None otherwise.
+    """
+
+    z: np.ndarray
+    w: np.ndarray
+    residual: float
+    scale: float
+    backend: str
+    psd: bool
+    unique: bool | None
+    least_norm: bool
+    reasons: list[str] = dataclasses.field(default_factory=list)
+
+    @property
+    def relative_residual(self) -> float:
+        return self.residual / self.scale
+
+
+# --- validation and measures ---------------------------------------------------------------------------
+def _validate(M, q) -> tuple[np.ndarray, np.ndarray]:
+    try:
+        M = np.array(M, dtype=float, ndmin=2)
+        q = np.array(q, dtype=float).reshape(-1)
+    except (TypeError, ValueError) as exc:
+        raise InvalidProblem(f"LCP data must be numeric: {exc}") from None
+    if M.ndim != 2 or M.shape[0] != M.shape[1]:
+        raise InvalidProblem(f"LCP matrix M must be square, got shape {M.shape}")
+    if q.shape != (M.shape[0],):
+        raise InvalidProblem(f"LCP vector q must have shape ({M.shape[0]},) to match M {M.shape}, got {q.shape}")
+    if not (np.all(np.isfinite(M)) and np.all(np.isfinite(q))):
+        raise InvalidProblem("LCP data M and q must be finite")
+    return M, q
+
+
+def lcp_residual(M: np.ndarray, q: np.ndarray, z: np.ndarray) -> float:
+    """Natural residual ``‖min(z, Mz + q)‖∞``: zero iff ``z ∈ SOL(q, M)``."""
+    return float(np.max(np.abs(np.minimum(z, M @ z + q)), initial=0.0))
+
+
+def lcp_scale(M: np.ndarray, q: np.ndarray, z: np.ndarray | None = None) -> float:
+    """Size of the data a residual is measured against: ``1 + max(|q|∞, ‖M‖∞|z|∞)``."""
+    mz = 0.0 if z is None else float(np.abs(M).sum(axis=1).max(initial=0.0) * np.abs(z).max(initial=0.0))
+    return 1.0 + max(float(np.abs(q).max(initial=0.0)), mz)
+
+
+def is_psd(M: np.ndarray, rtol: float = RTOL) -> bool:
+    """``M + Mᵀ ⪰ 0`` up to ``rtol`` relative to ``max |M|`` (``M`` need not be symmetric)."""
+    if M.size == 0:
+        return True
+    return bool(np.linalg.eigvalsh(M + M.T)[0] >= -rtol * (1.0 + np.abs(M).max()))
+
+
+def _verified(M, q, z, scale=None) -> tuple[bool, float, float]:
+    res = lcp_residual(M, q, z)
+    s = lcp_scale(M, q, z) if scale is None else scale
+    return res <= QP_RTOL * s, res, s
+
+
+def principal_solve(M: np.ndarray, q: np.ndarray, alpha: np.ndarray) -> np.ndarray:
+    """``z_α = −M_αα^{-1} q_α`` (least squares when singular), ``z = 0`` off ``α``: the active-set step."""
+    z = np.zeros(q.shape[0])
+    idx = np.flatnonzero(alpha)
+    if idx.size:
+        z[idx] = np.linalg.lstsq(M[np.ix_(idx, idx)], -q[idx], rcond=None)[0]
+    return z
+
+
+def _polish(M, q, z):
+    """One principal pivot solve on the support guessed from ``z`` (``z_i > w_i``)."""
+    return principal_solve(M, q, z > M @ z + q)
+
+
+# --- back-ends: each returns (candidate or None, status text) -----------------------------------------
+def lemke(M: np.ndarray, q: np.ndarray, max_iter: int | None = None) -> tuple[np.ndarray | None, str]:
+    """Lemke's complementary pivoting with covering vector ``d = 1`` and a lexicographic ratio test.
+
+    Returns ``(z, "solved")`` or ``(None, "ray termination")`` / ``(None, "iteration limit")``.
+    For copositive-plus (e.g. PSD) ``M`` ray termination proves ``LCP(q, M)`` infeasible (CPS Thm 4.4.13).
+    """
+    n = q.shape[0]
+    if np.all(q >= 0):
+        return np.zeros(n), "solved"
+    T = np.hstack([np.eye(n), -M, -np.ones((n, 1)), q[:, None]])
+    basis = np.arange(n)
+    piv_tol = 1e-12 * max(1.0, float(np.abs(M).max(initial=0.0)))
+    entering = 2 * n
+    r = int(np.argmin(q))
+    max_iter = max_iter or 1000 + 100 * n
+    for _ in range(max_iter):
+        T[r] /= T[r, entering]
+        col = T[:, entering].copy()
+        col[r] = 0.0
+        T -= np.outer(col, T[r])
+        leaving, basis[r] = basis[r], entering
+        if leaving == 2 * n:
+            break
+        entering = leaving + n if leaving < n else leaving - n
+        c = T[:, entering]
+        cand = np.flatnonzero(c > piv_tol)
+        if cand.size == 0:
+            return None, "ray termination"
+        # lexicographic minimum of (rhs, B^{-1}) rows scaled by the pivot column
+        for j in [T.shape[1] - 1] + list(range(n)):
+            ratios = T[cand, j] / c[cand]
+            best = ratios.min()
+            cand = cand[ratios <= best + 1e-12 * max(1.0, abs(best))]
+            if cand.size == 1:
+                break
+        r = int(cand[0])
+    else:
+        return None, "iteration limit"
+    z = np.zeros(n)
+    for i, b in enumerate(basis):
+        if n <= b < 2 * n:
+            z[b - n] = max(T[i, -1], 0.0)
+    return z, "solved"
+
+
+def _qp_backend(M, q):
+    """Phase-1 QP for PSD ``M``: ``min ½zᵀ(M+Mᵀ)z + qᵀz`` over ``FEA(q, M)`` (objective ``zᵀ(Mz + q) ≥ 0``)."""
+    n = q.shape[0]
+    try:
+        z = solve_qp(M + M.T, q, np.vstack([-np.eye(n), -M]), np.concatenate([np.zeros(n), q]))
+    except VerimonoError as exc:
+        return None, f"{type(exc).__name__}: {exc}"
+    return z, "solved"
+
+
+def _pieces(n: int):
+    for k in range(n + 1):
+        for alpha in itertools.combinations(range(n), k):
+            mask = np.zeros(n, bool)
+            mask[list(alpha)] = True
+            yield mask
+
+
+def _piece_point(M, q, alpha, P=None, c=None):
+    """Least ``½zᵀPz + cᵀz`` point of the piece ``{z_ᾱ = 0, z_α ≥ 0, w_α = 0, w_ᾱ ≥ 0}``, or None."""
+    n = q.shape[0]
+    idx = np.flatnonzero(alpha)
+    Maa = M[np.ix_(idx, idx)]
+    if idx.size == 0 or np.linalg.cond(Maa) < 1e12:
+        z = principal_solve(M, q, alpha)
+        ok, _, _ = _verified(M, q, z)
+        return z if ok else None
+    zp = principal_solve(M, q, alpha)  # w_α = 0 needs −q_α ∈ im M_αα: a cheap emptiness test
+    if np.max(np.abs(M[alpha] @ zp + q[alpha])) > RTOL * lcp_scale(M, q, zp):
+        return None
+    Aeq = np.vstack([np.eye(n)[~alpha], M[alpha]])
+    beq = np.concatenate([np.zeros(n - idx.size), -q[alpha]])
+    G = np.vstack([-np.eye(n)[alpha], -M[~alpha]])
+    h = np.concatenate([np.zeros(idx.size), q[~alpha]])
+    try:
+        z = solve_qp(np.eye(n) if P is None else P, np.zeros(n) if c is None else c, G, h, Aeq, beq)
+    except VerimonoError:
+        return None
+    ok, _, _ = _verified(M, q, z)
+    return z if ok else None
+
+
+def _enum_backend(M, q, least_norm=False):
+    """Enumerate the ``2^n`` complementary pieces (``n ≤ ENUM_MAX``); exact for any ``M``."""
+    n = q.shape[0]
+    if n > ENUM_MAX:
+        return None, f"n = {n} > ENUM_MAX = {ENUM_MAX}"
+    best = None
+    for alpha in _pieces(n):
+        z = _piece_point(M, q, alpha)
+        if z is not None:
+            if not least_norm:
+                return z, "solved"
+            if best is None or z @ z < best @ best:
+                best = z
+    return (best, "solved") if best is not None else (None, "no piece contains a solution")
+
+
+#: phase-1 back-ends by name (tests may replace one to check that a wrong status is caught)
+BACKENDS: dict[str, Callable] = {"lemke": lemke, "qp": _qp_backend, "enumerate": _enum_backend}
+PSD_BACKENDS = ("lemke", "qp")
+GENERAL_BACKENDS = ("lemke", "enumerate")
+
+
+# --- infeasibility -----------------------------------------------------------------------------------
+def _feasible(M, q) -> bool:
+    """Whether ``FEA(q, M) = {z ≥ 0, Mz + q ≥ 0}`` is nonempty (linear programming)."""
+    n = q.shape[0]
+    res = linprog(np.zeros(n), A_ub=-M, b_ub=q, bounds=[(0, None)] * n, method="highs")
+    return res.status != 2
+
+
+def _infeasibility_certificate(M, q) -> np.ndarray | None:
+    """``ζ ∈ Q_M = {ζ ≥ 0, Mζ ≥ 0, (M+Mᵀ)ζ = 0}`` with ``qᵀζ < 0`` (so ``q ∉ Q_M^+``), for PSD ``M``."""
+    n = q.shape[0]
+    A_eq = np.vstack([M + M.T, np.ones((1, n))])
+    b_eq = np.concatenate([np.zeros(n), [1.0]])
+    res = linprog(q, A_ub=-M, b_ub=np.zeros(n), A_eq=A_eq, b_eq=b_eq, bounds=[(0, None)] * n, method="highs")
+    if res.status == 0 and res.fun < 0:
+        return res.x
+    return None
+
+
+def _raise_infeasible(M, q, psd, reasons):
+    if psd:
+        zeta = _infeasibility_certificate(M, q)
+        cert = "" if zeta is None else (f"; certificate ζ = {np.array2string(zeta, precision=4)} ∈ Q_M "
+                                        f"has ⟨q, ζ⟩ = {q @ zeta:.3g} < 0")
+        raise InfeasibleStep(f"LCP(q, M) has no solution: q ∉ Q_M^+ (no z ≥ 0 with Mz + q ≥ 0; "
+                             f"Proposition p:lcp2){cert}")
+    raise InfeasibleStep("LCP(q, M) has no solution: " + "; ".join(reasons))
+
+
+# --- least-norm / selection over SOL(q, M) for PSD M ------------------------------------------------------
+def _row_basis(E: np.ndarray) -> np.ndarray:
+    """Orthonormal basis (rows) of the row space of ``E``, rank decided at ``RTOL`` relative."""
+    if E.size == 0:
+        return E
+    _, s, Vt = np.linalg.svd(E, full_matrices=False)
+    r = int(np.sum(s > RTOL * max(s[0], 1e-300)))
+    return Vt[:r]
+
+
+def sol_polyhedron(M, q, zbar):
+    """``SOL(q, M)`` for PSD ``M`` as ``(G, h, A, b)``: ``Gz ≤ h``, ``Az = b`` (CPS Thm 3.1.7)."""
+    n = q.shape[0]
+    A = _row_basis(np.vstack([M + M.T, q[None, :]]))
+    return np.vstack([-np.eye(n), -M]), np.concatenate([np.zeros(n), q]), A, A @ zbar
+
+
+def select_over_sol(M, q, zbar, P, c) -> np.ndarray:
+    """Minimise ``½zᵀPz + cᵀz`` over ``SOL(q, M)`` (PSD ``M``; ``z̄`` any solution), KKT-verified."""
+    G, h, A, b = sol_polyhedron(M, q, zbar)
+    return solve_qp(P, c, G, h, A if len(A) else None, b if len(A) else None)
+
+
+def unique_certificate(M, q, z, w, scale) -> bool:
+    """True when ``SOL(q, M)`` is provably ``{z}`` (PSD ``M``): the rows ``M+Mᵀ``, ``e_i (w_i > 0)``,
+    ``M_i (z_i > 0)`` have full column rank (see the module docstring)."""
+    n = q.shape[0]
+    tau = RTOL * scale
+    rows = np.vstack([M + M.T, np.eye(n)[w > tau], M[z > tau]])
+    s = np.linalg.svd(rows, compute_uv=False)
+    return bool(s.size >= n and s[n - 1] > RTOL * max(s[0], 1.0))
+
+
+# --- the public solver -----------------------------------------------------------------------------------
+def solve_lcp(M, q, *, least_norm: bool = True, backends: tuple[str, ...] | None = None,
+              info: bool = False):
+    """Solve ``LCP(q, M)``; return its least-norm solution ``z`` (or an :class:`LCPResult` with ``info``).
+
+    For PSD ``M`` the least-norm solution of Proposition ``p:lcp2`` item iv is returned.  For other ``M``
+    ``SOL(q, M)`` need not be convex; with ``least_norm`` and ``n ≤ ENUM_MAX`` the least-norm point over all
+    complementary pieces is returned, otherwise a verified solution (``LCPResult.least_norm`` False).
+
+    Raises :class:`verimono.InfeasibleStep` when there is no solution (for PSD ``M``: ``q ∉ Q_M^+``, with a
+    certificate ``ζ ∈ Q_M``, ``⟨q, ζ⟩ < 0``), :class:`verimono.SolverFailure` when solutions exist but no
+    back-end produced one that passes the residual check.
+    """
+    M, q = _validate(M, q)
+    n = q.shape[0]
+    psd = is_psd(M)
+    reasons: list[str] = []
+    if np.all(q >= 0):  # z = 0 solves it and has the least norm
+        res = LCPResult(np.zeros(n), q.copy(), 0.0, lcp_scale(M, q), "trivial (q ≥ 0)", psd, None, True)
+        return res if info else res.z
+    zbar, used, lemke_ray = None, None, False
+    for name in backends or (PSD_BACKENDS if psd else GENERAL_BACKENDS):
+        try:
+            z, status = BACKENDS[name](M, q)
+        except (ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
+            reasons.append(f"{name}: raised {type(exc).__name__}: {exc}")
+            continue
+        if z is None:
+            reasons.append(f"{name}: {status}")
+            lemke_ray |= name == "lemke" and status == "ray termination"
+            continue
+        z = np.asarray(z, dtype=float).reshape(-1)
+        if z.shape != (n,) or not np.all(np.isfinite(z)):
+            reasons.append(f"{name}: returned a non-finite or misshapen point with status {status!r}")
+            continue
+        ok, res, scale = _verified(M, q, z)
+        if not ok and res <= POLISH_RTOL * scale:
+            zp = _polish(M, q, z)
+            okp, resp, _ = _verified(M, q, zp)
+            if okp:
+                z, ok = zp, True
+        elif ok:
+            zp = _polish(M, q, z)
+            if _verified(M, q, zp)[0] and lcp_residual(M, q, zp) < res:
+                z = zp
+        if ok:
+            zbar, used = z, name
+            break
+        reasons.append(f"{name}: status {status!r} but residual ‖min(z, Mz+q)‖∞ = {res:.3g} "
+                       f"> {QP_RTOL:g}·{scale:.3g}")
+    if zbar is None:
+        if not _feasible(M, q):
+            _raise_infeasible(M, q, True if psd else False, reasons + ["FEA(q, M) is empty (linear programming)"])
+        if psd:
+            raise SolverFailure("LCP(q, M) with PSD M is feasible, hence solvable (Proposition p:lcp2), but no "
+                                "back-end produced a verified solution: " + "; ".join(reasons))
+        if n <= ENUM_MAX and "enumerate" in (backends or GENERAL_BACKENDS):
+            _raise_infeasible(M, q, False, reasons + [f"none of the 2^{n} complementary pieces holds a solution"])
+        raise SolverFailure("no back-end produced a verified solution of LCP(q, M) (non-PSD M, undecided): "
+                            + "; ".join(reasons))
+    w = M @ zbar + q
+    scale = lcp_scale(M, q, zbar)
+    unique, certified = None, False
+    if psd:
+        unique = unique_certificate(M, q, zbar, w, scale)
+        certified = unique
+    z = zbar
+    if least_norm and not certified:
+        if psd:
+            zl = select_over_sol(M, q, zbar, np.eye(n), np.zeros(n))
+            ok, _, _ = _verified(M, q, zl)
+            if not ok:
+                zp = _polish(M, q, zl)
+                ok, _, _ = _verified(M, q, zp)
+                zl = zp if ok and abs(zp @ zp - zl @ zl) <= RTOL * (1 + zl @ zl) else zl
+            if not ok:
+                raise SolverFailure("least-norm QP over SOL(q, M) returned a point that fails the LCP residual check")
+            z, certified, used = zl, True, used + "+least-norm QP"
+        elif n <= ENUM_MAX:
+            zl, status = _enum_backend(M, q, least_norm=True)
+            if zl is not None and zl @ zl <= z @ z:
+                z = zl
+            certified, used = zl is not None, used + "+enumeration"
+    w = M @ z + q
+    res = LCPResult(z, w, lcp_residual(M, q, z), lcp_scale(M, q, z), used, psd, unique, certified, reasons)
+    return res if info else z
+
+
+# --- box-constrained counterpart (relay) --------------------------------------------------------------------
+def _box_lcp(M, q, lower, upper):
+    """The LCP of size ``m + f`` equivalent to the box problem: ``λ = l + z``, ``s = (−y)⁺`` on finite ``u``."""
+    m = q.shape[0]
+    fin = np.flatnonzero(np.isfinite(upper))
+    E = np.eye(m)[:, fin]
+    big = np.block([[M, E], [-E.T, np.zeros((fin.size, fin.size))]])
+    qq = np.concatenate([M @ lower + q, (upper - lower)[fin]])
+    return big, qq, fin
+
+
+def box_residual(M, q, lam, lower, upper) -> float:
+    """Natural residual ``‖λ − proj_[l,u](λ − (Mλ + q))‖∞``: zero iff ``−(Mλ+q) ∈ N_[l,u](λ)``."""
+    y = M @ lam + q
+    return float(np.max(np.abs(lam - np.clip(lam - y, lower, upper)), initial=0.0))
+
+
+def solve_box(M, q, lower, upper, *, least_norm: bool = True, info: bool = False):
+    """Find ``λ ∈ [l, u]`` with ``−(Mλ + q) ∈ N_[l,u](λ)`` (the relay law ``λ ∈ −sgn(y)`` for ``[−1, 1]``).
+
+    Solved as the equivalent LCP (``l`` finite, ``u`` may be ``+∞``); with ``least_norm`` and PSD ``M`` the
+    least-norm ``λ`` over the (polyhedral) solution set.  Returns ``λ`` or an :class:`LCPResult` whose ``z``
+    is ``λ`` and ``w`` is ``y = Mλ + q``.
+    """
+    M, q = _validate(M, q)
+    m = q.shape[0]
+    lower = np.broadcast_to(np.asarray(lower, float), (m,)).copy()
+    upper = np.broadcast_to(np.asarray(upper, float), (m,)).copy()
+    if not np.all(np.isfinite(lower)) or np.any(np.isnan(upper)) or np.any(lower > upper):
+        raise InvalidProblem(f"box bounds must satisfy -inf < lower <= upper <= inf, got lower={lower}, upper={upper}")
+    big, qq, fin = _box_lcp(M, q, lower, upper)
+    r = solve_lcp(big, qq, least_norm=False, info=True)
+    lam = lower + r.z[:m]
+    psd = is_psd(M)
+    certified = r.unique is True
+    if least_norm and psd and not certified:
+        P = np.zeros((big.shape[0],) * 2)
+        P[:m, :m] = np.eye(m)
+        c = np.concatenate([lower, np.zeros(fin.size)])
+        zz = select_over_sol(big, qq, r.z, P, c)
+        if _verified(big, qq, zz)[0]:
+            lam, certified = lower + zz[:m], True
+        else:
+            raise SolverFailure("least-norm QP over the relay solution set failed the residual check")
+    res_val = box_residual(M, q, lam, lower, upper)
+    scale = lcp_scale(M, q, lam) + float(np.abs(lower).max(initial=0.0))
+    if res_val > QP_RTOL * scale:
+        raise SolverFailure(f"box problem residual {res_val:.3g} exceeds {QP_RTOL:g}·{scale:.3g}")
+    out = LCPResult(lam, M @ lam + q, res_val, scale, r.backend, psd, r.unique, certified, r.reasons)
+    return out if info else lam
+
+
+__all__ = ["solve_lcp", "solve_box", "LCPResult", "lcp_residual", "box_residual", "lemke", "is_psd",
+           "BACKENDS", "ENUM_MAX", "select_over_sol", "sol_polyhedron", "principal_solve"]

@@ -1,0 +1,219 @@
+"""Maximal monotone relations ``(−z, w) ∈ graph 𝓜`` closing the linear system of Section 7 (``e:lin+rel``).
+
+* :class:`Complementarity` — the paper's ``𝓟``: ``w ∈ 𝓟(−z)`` iff ``0 ≤ z ⊥ w ≥ 0`` (Siconos' ``0 ≤ y ⊥ λ ≥ 0``).
+* :class:`Relay` — ``−w ∈ N_[l,u](z)`` (Siconos' relay ``−y ∈ N_[−1,1](λ)``), i.e. ``𝓜 = N_[−u,−l]``.
+* :class:`OperatorRelation` — any maximal monotone ``𝓜`` given as a :class:`verimono.Operator` on ``R^m``.
+
+Each solves the one-step problem ``w = Mz + q``, ``(−z, w) ∈ graph 𝓜`` for a matrix ``M`` (the system's
+``D + h C W^{-1} B``): :meth:`Relation.solve` from scratch (least-norm ``z`` for box relations with PSD
+``M``) and :meth:`Relation.stepper` for a constant ``M``, which reuses the factorisation of ``M_II`` for the
+last active pattern (``I`` the components strictly inside the box) and falls back to :meth:`solve` when the
+pattern changes.  A pattern solution that is strictly complementary with ``M_II`` nonsingular is the unique
+solution for PSD ``M`` (the solution set is convex, and moving inside it keeps the pattern), hence the
+least-norm one.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+
+from ..errors import InvalidProblem, NotMonotone, SolverFailure
+from ..operators import Operator
+from ..tolerances import QP_RTOL, RTOL, tolerance
+from .lcp import LCPResult, lcp_scale, solve_box, solve_lcp
+
+
+class Relation:
+    """Base class: a maximal monotone ``𝓜: R^m ⇉ R^m`` used as ``(−z, w) ∈ graph 𝓜``."""
+
+    name = "relation"
+
+    def solve(self, M: np.ndarray, q: np.ndarray) -> LCPResult:
+        """Solve ``w = Mz + q``, ``(−z, w) ∈ graph 𝓜`` from scratch; ``result.z``, ``result.w``."""
+        raise NotImplementedError
+
+    def stepper(self, M: np.ndarray):
+        """A callable ``q ↦ (z, w)`` for a constant ``M`` (default: :meth:`solve` every time)."""
+        def step(q):
+            r = self.solve(M, q)
+            return r.z, r.w
+        return step
+
+    def check_dim(self, m: int) -> None:
+        pass
+
+    def __repr__(self) -> str:
+        return self.name
+
+
+class BoxRelation(Relation):
+    """``−w ∈ N_[l,u](z)`` componentwise, ``l`` finite, ``u ≤ ∞`` (complementarity is ``[0, ∞)``)."""
+
+    def __init__(self, lower, upper, name: str) -> None:
+        lo, hi = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+        if np.any(np.isnan(lo)) or np.any(np.isnan(hi)) or not np.all(np.isfinite(lo)):
+            raise InvalidProblem(f"{name}: lower bounds must be finite and upper bounds not NaN, got {lo}, {hi}")
+        if np.any(lo > hi):
+            raise NotMonotone(f"{name}: lower {lo} exceeds upper {hi}; the box is empty and the relation "
+                              "would not be maximal monotone (its graph would be empty)")
+        self.lower_, self.upper_, self.name = lo, hi, name
+
+    def bounds(self, m: int) -> tuple[np.ndarray, np.ndarray]:
+        return (np.broadcast_to(self.lower_, (m,)).astype(float), np.broadcast_to(self.upper_, (m,)).astype(float))
+
+    def check_dim(self, m: int) -> None:
+        for b in (self.lower_, self.upper_):
+            if b.ndim and b.shape != (m,):
+                raise InvalidProblem(f"{self.name}: bounds must be scalars or have shape ({m},), got {b.shape}")
+
+    @property
+    def is_lcp(self) -> bool:
+        return bool(np.all(self.lower_ == 0.0) and np.all(np.isinf(self.upper_)))
+
+    def solve(self, M, q):
+        if self.is_lcp:
+            return solve_lcp(M, q, info=True)
+        lo, hi = self.bounds(q.shape[0])
+        return solve_box(M, q, lo, hi, info=True)
+
+    def stepper(self, M):
+        return _BoxStepper(self, np.asarray(M, dtype=float))
+
+
+class Complementarity(BoxRelation):
+    """The paper's ``𝓟(ζ) = {η ≥ 0 : ζ ≤ 0, ⟨η, ζ⟩ = 0}``: ``(−z, w) ∈ graph 𝓟`` iff ``0 ≤ z ⊥ w ≥ 0``."""
+
+    def __init__(self) -> None:
+        super().__init__(0.0, np.inf, "Complementarity")
+
+
+class Relay(BoxRelation):
+    """Relay ``−w ∈ N_[lower,upper](z)`` (``z ∈ −sgn(w)`` for ``[−1, 1]``); ``𝓜 = N_[−upper,−lower]``."""
+
+    def __init__(self, lower=-1.0, upper=1.0) -> None:
+        super().__init__(lower, upper, "Relay")
+        if not np.all(np.isfinite(self.upper_)):
+            raise InvalidProblem("Relay bounds must be finite (use Complementarity for [0, ∞))")
+
+
+class _BoxStepper:
+    """``q ↦ (z, w)`` for a constant ``M``: the last pattern's factorisation first, a full solve otherwise."""
+
+    def __init__(self, rel: BoxRelation, M: np.ndarray) -> None:
+        self.rel, self.M = rel, M
+        self.lo, self.hi = rel.bounds(M.shape[0])
+        self.cache: dict[bytes, tuple] = {}
+        self.last: bytes | None = None
+        self.full_solves = 0
+
+    def _entry(self, pat: bytes):
+        e = self.cache.get(pat)
+        if e is None:
+            s = np.frombuffer(pat, dtype=np.int8)
+            I = np.flatnonzero(s == 1)
+            fixed = np.where(s == 2, self.hi, self.lo)
+            fixed[I] = 0.0
+            lu = None
+            if I.size:
+                MII = self.M[np.ix_(I, I)]
+                if np.linalg.cond(MII) < 1e12:
+                    lu = sla.lu_factor(MII)
+                else:
+                    lu = False
+            e = (s, I, fixed, self.M[:, I] if I.size else None, lu, self.M @ fixed)
+            self.cache[pat] = e
+        return e
+
+    def _try(self, pat: bytes, q: np.ndarray):
+        s, I, fixed, _, lu, Mfixed = self._entry(pat)
+        if lu is False:
+            return None
+        lam = fixed.copy()
+        if I.size:
+            lam[I] = sla.lu_solve(lu, -(q[I] + Mfixed[I]))
+        y = self.M @ lam + q
+        tau = RTOL * lcp_scale(self.M, q, lam)
+        if I.size and (np.any(lam[I] - self.lo[I] <= tau) or np.any(self.hi[I] - lam[I] <= tau)):
+            return None
+        if np.any(y[s == 0] <= tau) or np.any(y[s == 2] >= -tau):
+            return None
+        return lam, y
+
+    def __call__(self, q):
+        if self.last is not None:
+            out = self._try(self.last, q)
+            if out is not None:
+                return out
+        r = self.rel.solve(self.M, q)
+        self.full_solves += 1
+        lam = r.z
+        tau = RTOL * lcp_scale(self.M, q, lam)
+        s = np.where(lam - self.lo <= tau, 0, np.where(self.hi - lam <= tau, 2, 1)).astype(np.int8)
+        self.last = s.tobytes()
+        return r.z, r.w
+
+
+class OperatorRelation(Relation):
+    """A maximal monotone ``𝓜`` given as a :class:`verimono.Operator` on ``R^m`` (static in ``t``).
+
+    The one-step problem ``q − Mζ ∈ 𝓜(ζ)``, ``ζ = −z`` (``0 ∈ 𝓜(ζ) + Mζ − q``, both monotone for PSD ``M``)
+    is solved by Douglas–Rachford splitting with the exact resolvents ``J_{γ𝓜}`` and ``(I + γM)^{-1}``,
+    stopped on the natural residual ``|ζ − J_γ𝓜(ζ − γ(Mζ − q))|`` at ``QP_RTOL`` relative.  It returns *a*
+    solution (not necessarily the least-norm one); the system's state update ``Bz`` is the same for all of
+    them when ``H`` is maximal monotone.  A sampled firm-nonexpansiveness test of the resolvent at
+    construction rejects operators that are visibly not monotone (:class:`verimono.NotMonotone`).
+    """
+
+    MAX_ITER = 20_000
+
+    def __init__(self, op: Operator, *, samples: int = 32, seed: int = 0) -> None:
+        if not isinstance(op, Operator):
+            raise InvalidProblem(f"relation must be Complementarity(), Relay(...) or a verimono.Operator, got {op!r}")
+        self.op, self.name = op, f"OperatorRelation({op.name})"
+        rng = np.random.default_rng(seed)
+        X, Y = rng.normal(size=(2, samples, op.dim)) * 2.0
+        for x, y in zip(X, Y):
+            jx, jy = op.resolvent(x, 1.0), op.resolvent(y, 1.0)
+            d = jx - jy
+            if d @ d > d @ (x - y) + tolerance(x, y, jx, jy):
+                raise NotMonotone(f"{op.name} is not monotone: its resolvent is not firmly nonexpansive at "
+                                  f"x = {x}, y = {y} (|Jx − Jy|² = {d @ d:.4g} > ⟨Jx − Jy, x − y⟩ = {d @ (x - y):.4g})")
+
+    def check_dim(self, m: int) -> None:
+        if self.op.dim != m:
+            raise InvalidProblem(f"{self.name} acts on R^{self.op.dim}; the system has m = {m}")
+
+    def solve(self, M, q):
+        M, q = np.asarray(M, float), np.asarray(q, float)
+        m = q.shape[0]
+        gamma = 1.0 / max(np.linalg.norm(M, 2), 1e-12)
+        lu = sla.lu_factor(np.eye(m) + gamma * M)
+        s = np.zeros(m)
+        scale = 1.0 + np.abs(q).max(initial=0.0)
+        for _ in range(self.MAX_ITER):
+            zeta = sla.lu_solve(lu, s + gamma * q)
+            s = s + self.op.resolvent(2 * zeta - s, gamma) - zeta
+            nat = zeta - self.op.resolvent(zeta - gamma * (M @ zeta - q), gamma)
+            if np.abs(nat).max() <= QP_RTOL * gamma * scale:
+                break
+        else:
+            raise SolverFailure(f"Douglas–Rachford for {self.name} did not reach residual {QP_RTOL:g} "
+                                f"in {self.MAX_ITER} iterations (last {np.abs(nat).max():.3g})")
+        z = -zeta
+        return LCPResult(z, M @ z + q, float(np.abs(nat).max()), scale, "douglas-rachford", True, None, False)
+
+
+def as_relation(rel, m: int) -> Relation:
+    """A :class:`Relation` from a Relation or a :class:`verimono.Operator`, checked against ``m``."""
+    if isinstance(rel, Relation):
+        out = rel
+    elif isinstance(rel, Operator):
+        out = OperatorRelation(rel)
+    else:
+        raise InvalidProblem(f"relation must be Complementarity(), Relay(...) or a verimono.Operator, got {rel!r}")
+    out.check_dim(m)
+    return out
+
+
+__all__ = ["Relation", "BoxRelation", "Complementarity", "Relay", "OperatorRelation", "as_relation"]
