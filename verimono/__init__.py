@@ -14,7 +14,10 @@ from .problem import Order, Problem
 from .results import CheckResult, Report
 from .stepping import Trajectory, solve
 from .pseudo_distance import pseudo_distance_lower_bound
-from . import lcs, sets
+from .checks import check_operator, check_stepper, operator_checks
+from .checks.assumptions import check_assumptions
+from .convergence import ConvergenceStudy, convergence_study
+from . import lcs, sets, strategies
 
 __version__ = "0.1.0"
 
@@ -25,5 +28,7 @@ __all__ = [
     "NormalCone", "Shifted", "LogBarrier", "sets",
     "Problem", "Order", "Trajectory", "solve",
     "uniform_grid", "graded_grid", "random_grid", "refine", "validate_grid",
-    "CheckResult", "Report", "pseudo_distance_lower_bound", "lcs",
+    "CheckResult", "Report", "pseudo_distance_lower_bound", "lcs", "strategies",
+    "convergence_study", "ConvergenceStudy", "check_stepper", "check_operator", "operator_checks",
+    "check_assumptions",
 ]

@@ -1,51 +1,325 @@
-"""Command line: ``verimono run`` — solve every analytic reference and verify its convergence order."""
+"""Command line of verimono.
+
+    verimono run [--profile dev|ci|thorough] [--out DIR] [--stage NAME ...] [--seed N] [--data DIR]
+                 [--baseline FILE]
+        The whole verification (every registered stage, see ``verimono.stages``); writes DIR/results.json
+        and DIR/report.html (DIR defaults to reports/).  Exit 0 when every check holds, 1 when one fails.
+    verimono check MODULE:OBJECT [--profile P] [--out DIR] [--seed N]
+        The operator battery on an operator, or the stepper battery on a stepper ``f(problem, t_grid)``.
+    verimono baseline [--out reports/baseline.json] [--from RESULTS] [run options]
+        Record the current results (runs the verification, or copies RESULTS) as the gate's baseline.
+    verimono gate --baseline FILE [--results reports/results.json]
+        Exit 1 and print why on a regression; exit 2 when either file is missing, garbled or incompatible.
+    verimono report [--results reports/results.json] [--out reports/report.html] [--baseline FILE]
+        Re-render the HTML report from a results file.
+
+Exit status 2 always means "could not decide" (bad usage, unreadable input); it is never a pass.
+"""
 
 from __future__ import annotations
 
 import argparse
-import json
+import importlib
+import os
+import shutil
 import sys
+import time
 from pathlib import Path
+from typing import Any, Callable, TextIO
 
-from .checks.orders import check_stepper
-from .stepping import solve
+from .errors import VerimonoError
+from .profiles import PROFILES, active_profile, get_profile, load_hypothesis_profile
+from .results import SKIPPED, Report
+
+EXIT_OK, EXIT_FAILED, EXIT_UNDECIDED = 0, 1, 2
 
 
-def _run(args: argparse.Namespace) -> int:
-    from verimono.reference import catalog
+class BadTarget(VerimonoError, ValueError):
+    """``MODULE:OBJECT`` does not name an importable operator or stepper."""
 
-    problems = catalog()
-    report = check_stepper(solve, problems)
-    rows = [("problem", "expected", "measured order [95% interval]", "verdict")]
-    for p, rec in zip(problems, report):
-        study = rec.details.get("study", {})
-        fit = study.get("fits", {}).get("sup", {})
-        if fit.get("exact"):
-            measured = "exact (round-off)"
-        elif fit:
-            measured = f"{float(fit['slope']):.3f} [{float(fit['low']):.3f}, {float(fit['high']):.3f}]"
-        else:
-            measured = "-"
-        rows.append((p.name, str(p.order), measured, rec.status.upper()))
-    widths = [max(len(r[i]) for r in rows) for i in range(4)]
-    for r in rows:
-        print("  ".join(c.ljust(w) for c, w in zip(r, widths)))
-    print(report.summary())
+
+# -- progress ----------------------------------------------------------------------------------------
+
+
+class Progress:
+    """A one-line progress bar on a terminal; one plain line per finished stage otherwise."""
+
+    def __init__(self, stream: TextIO | None = None, enabled: bool | None = None) -> None:
+        self.stream = stream or sys.stderr
+        self.tty = self.stream.isatty() if enabled is None else enabled
+        self.stage, self.index, self.total = "", 0, 1
+        self.width = min(shutil.get_terminal_size((100, 20)).columns, 120)
+
+    def start(self, stage: Any, index: int, total: int) -> None:
+        self.stage, self.index, self.total = stage.name, index, total
+        self.within(0, 1, "")
+
+    def within(self, done: int, total: int, label: str) -> None:
+        if not self.tty:
+            return
+        frac = (self.index + (done / total if total else 1.0)) / self.total
+        bar_w = 24
+        fill = int(round(frac * bar_w))
+        text = (f"\r[{'#' * fill}{'-' * (bar_w - fill)}] {frac * 100:3.0f}%  stage {self.index + 1}/{self.total} "
+                f"{self.stage}  {done}/{total} {label}")
+        self.stream.write(text[: self.width - 1].ljust(self.width - 1))
+        self.stream.flush()
+
+    def done(self, stage: Any, report: Report, info: dict) -> None:
+        line = (f"[{self.index + 1}/{self.total}] {stage.name}: {info['status']} — "
+                f"{info['records']} records, {info['duration']:.1f} s"
+                + (f" ({info['message']})" if info["status"] in ("skipped", "error") else f" ({report.summary()})"))
+        if self.tty:
+            self.stream.write("\r" + " " * (self.width - 1) + "\r")
+        self.stream.write(line + "\n")
+        self.stream.flush()
+
+
+# -- running -----------------------------------------------------------------------------------------
+
+
+def execute(*, command: str, profile_name: str, stages: list[str] | None, context: Any, target: str | None = None,
+            progress: Progress | None = None) -> Report:
+    """Run ``stages`` with ``context`` under a profile and return the merged, fully annotated report."""
+    from .report.schema import environment
+    from .stages import calibrate, run_stages
+
+    profile = get_profile(profile_name)
+    load_hypothesis_profile(profile_name)
+    progress = progress or Progress(enabled=False)
+    context.progress = progress.within
+    cal = calibrate()
+    start = time.perf_counter()
+    report = run_stages(stages, profile, context, on_start=progress.start, on_done=progress.done)
+    selection = {"stages": stages, "references": None if context.problems is None else
+                 [p.name for p in context.problems]}
+    report.meta.update({"command": command, "target": target, "profile": profile_name, "seed": context.seed,
+                        "selection": selection,
+                        "calibration": cal, "duration": time.perf_counter() - start,
+                        "data_dir": None if context.data_dir is None else str(context.data_dir),
+                        "environment": environment()})
+    return report
+
+
+def _context(args: argparse.Namespace, **kw: Any) -> Any:
+    from .stages import RunContext, StageUnavailable, locate_data
+
+    try:
+        data = locate_data(getattr(args, "data", None))
+    except StageUnavailable as exc:
+        raise BadTarget(str(exc)) from None
+    problems = None
+    if getattr(args, "reference", None):
+        from verimono.reference import get
+
+        try:
+            problems = [get(name) for name in args.reference]
+        except KeyError as exc:
+            raise BadTarget(str(exc.args[0])) from None
+    return RunContext(seed=getattr(args, "seed", None), data_dir=data, problems=problems, **kw)
+
+
+def _baseline_for(args: argparse.Namespace) -> Report | None:
+    """The baseline to show changes against: ``--baseline`` (must load) or reports/baseline.json if present."""
+    from .report.schema import load
+
+    path = getattr(args, "baseline", None)
+    if path:
+        return load(path)
+    default = Path("reports/baseline.json")
+    if default.is_file():
+        try:
+            return load(default)
+        except VerimonoError as exc:
+            print(f"verimono: ignoring {default}: {exc}", file=sys.stderr)
+    return None
+
+
+def _changes(baseline: Report | None, report: Report) -> Any:
+    if baseline is None:
+        return None
+    from .gate import IncompatibleBaseline, check_runs_compatible, compare
+
+    try:
+        check_runs_compatible(baseline, report)
+    except IncompatibleBaseline as exc:
+        print(f"verimono: not comparing with the baseline: {exc}", file=sys.stderr)
+        return None
+    return compare(baseline, report)
+
+
+def _finish(report: Report, out: Path, baseline: Report | None) -> int:
+    from .report import write
+
+    changes = _changes(baseline, report)
+    paths = write(report, out, changes=changes)
+    for r in report.failures:
+        print(f"  {r}")
+    line = f"verimono: {report.summary()}"
+    if changes is not None:
+        line += f"; against the baseline: {changes.summary()}"
+    print(line)
+    print(f"verimono: wrote {paths['html']} and {paths['json']}")
+    return EXIT_OK if report.ok else EXIT_FAILED
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    baseline = _baseline_for(args)
+    report = execute(command="run", profile_name=args.profile, stages=args.stage, context=_context(args),
+                     progress=Progress())
+    return _finish(report, Path(args.out), baseline)
+
+
+def load_target(spec: str) -> Any:
+    """Import ``MODULE:OBJECT`` (``MODULE`` may be a dotted name or a ``.py`` path; ``OBJECT`` dotted)."""
+    module_name, sep, attr = spec.partition(":")
+    if not sep or not module_name or not attr:
+        raise BadTarget(f"expected MODULE:OBJECT (e.g. mypackage.solvers:my_stepper), got {spec!r}")
+    if module_name.endswith(".py"):
+        path = Path(module_name).resolve()
+        if not path.is_file():
+            raise BadTarget(f"{path} does not exist")
+        sys.path.insert(0, str(path.parent))
+        module_name = path.stem
+    elif "" not in sys.path and os.getcwd() not in sys.path:
+        sys.path.insert(0, os.getcwd())
+    try:
+        obj: Any = importlib.import_module(module_name)
+    except ImportError as exc:
+        raise BadTarget(f"cannot import {module_name!r}: {exc}") from None
+    for part in attr.split("."):
+        try:
+            obj = getattr(obj, part)
+        except AttributeError:
+            raise BadTarget(f"{module_name!r} has no attribute {attr!r}") from None
+    return obj
+
+
+def _cmd_check(args: argparse.Namespace) -> int:
+    obj = load_target(args.target)
+    if hasattr(obj, "resolvent") and hasattr(obj, "dim") and not isinstance(obj, type):
+        stages, ctx = ["operator_laws"], _context(args, operators=[(args.target, obj)])
+        kind = "operator"
+    elif callable(obj) and not isinstance(obj, type):
+        stages, ctx = ["convergence", "trajectory_laws"], _context(args, stepper=obj)
+        kind = "stepper"
+    else:
+        raise BadTarget(f"{args.target} is neither an operator (with .dim and .resolvent) nor a stepper "
+                        "callable(problem, t_grid)")
+    print(f"verimono: checking {args.target} as a {kind}", file=sys.stderr)
+    report = execute(command="check", profile_name=args.profile, stages=stages, context=ctx,
+                     target=args.target, progress=Progress())
+    if report.results and all(r.status == SKIPPED for r in report.results):
+        _finish(report, Path(args.out), None)
+        print(f"verimono: no {kind} battery could run here: " +
+              "; ".join(r.message for r in report.results), file=sys.stderr)
+        return EXIT_UNDECIDED
+    return _finish(report, Path(args.out), _baseline_for(args))
+
+
+def _cmd_baseline(args: argparse.Namespace) -> int:
+    from .report.schema import load
+
+    if args.from_results:
+        report = load(args.from_results)
+    else:
+        report = execute(command="run", profile_name=args.profile, stages=args.stage, context=_context(args),
+                         progress=Progress())
+    report.trajectories = []  # plot samples only: the gate never reads them, and they are half the size
+    path = report.save(args.out)
+    print(f"verimono: baseline of {report.summary()} (profile {report.meta.get('profile')}) written to {path}")
+    if not report.ok:
+        print("verimono: warning: the baseline records failing checks; the gate will only catch new ones",
+              file=sys.stderr)
+    return EXIT_OK
+
+
+def _cmd_gate(args: argparse.Namespace) -> int:
+    from .gate import gate
+
+    comparison = gate(args.baseline, args.results)
+    for c in comparison.regressions:
+        print(f"  {c}")
+    if args.verbose:
+        for c in comparison.others:
+            print(f"  {c}")
+    print(f"verimono gate: {comparison.summary()} against {args.baseline}")
+    return EXIT_OK if comparison.ok else EXIT_FAILED
+
+
+def _cmd_report(args: argparse.Namespace) -> int:
+    from .report.html import render
+    from .report.schema import load
+
+    report = load(args.results)
+    changes = _changes(load(args.baseline), report) if args.baseline else None
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "results.json").write_text(json.dumps({"results": [r.to_dict() for r in report]}, indent=1))
-    return 0 if report.ok else 1
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(render(report, changes=changes), encoding="utf-8")
+    print(f"verimono: wrote {out}")
+    return EXIT_OK
+
+
+def build_parser() -> argparse.ArgumentParser:
+    from .stages import STAGES
+
+    parser = argparse.ArgumentParser(prog="verimono", description=__doc__.split("\n\n")[0],
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    def run_options(p: argparse.ArgumentParser) -> None:
+        p.add_argument("--profile", choices=PROFILES, default=active_profile() if active_profile() in PROFILES
+                       else "dev", help="effort and hypothesis profile (default: ci when $CI is set, else dev)")
+        p.add_argument("--stage", action="append", choices=list(STAGES), metavar="NAME",
+                       help="run only this stage (repeatable); stages: " + ", ".join(STAGES))
+        p.add_argument("--seed", type=int, default=None, help="seed for the randomized batteries")
+        p.add_argument("--data", default=None, help="shared data folder (Siconos references); default ../shared")
+        p.add_argument("--reference", action="append", metavar="NAME",
+                       help="use only this analytic reference (repeatable; default: the whole catalog)")
+
+    run = sub.add_parser("run", help="run the whole verification and write the report")
+    run_options(run)
+    run.add_argument("--out", default="reports", help="output folder (default reports/)")
+    run.add_argument("--baseline", default=None, help="show changes against this baseline (default "
+                     "reports/baseline.json when present)")
+    run.set_defaults(func=_cmd_run)
+
+    check = sub.add_parser("check", help="run the operator or stepper battery on MODULE:OBJECT")
+    check.add_argument("target", metavar="MODULE:OBJECT")
+    run_options(check)
+    check.add_argument("--out", default="reports/check", help="output folder (default reports/check/)")
+    check.add_argument("--baseline", default=None, help="show changes against this baseline")
+    check.set_defaults(func=_cmd_check, stage=None)
+
+    base = sub.add_parser("baseline", help="record the current results as the gate's baseline")
+    run_options(base)
+    base.add_argument("--out", default="reports/baseline.json")
+    base.add_argument("--from", dest="from_results", default=None, metavar="RESULTS",
+                      help="copy this results.json instead of running")
+    base.set_defaults(func=_cmd_baseline)
+
+    g = sub.add_parser("gate", help="exit 1 on a regression against the baseline, 2 if undecidable")
+    g.add_argument("--baseline", required=True)
+    g.add_argument("--results", default="reports/results.json")
+    g.add_argument("-v", "--verbose", action="store_true", help="also list changes that are not regressions")
+    g.set_defaults(func=_cmd_gate)
+
+    rep = sub.add_parser("report", help="render report.html from a results.json")
+    rep.add_argument("--results", default="reports/results.json")
+    rep.add_argument("--out", default="reports/report.html")
+    rep.add_argument("--baseline", default=None)
+    rep.set_defaults(func=_cmd_report)
+    return parser
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="verimono", description=__doc__)
-    sub = parser.add_subparsers(dest="command", required=True)
-    run = sub.add_parser("run", help="verify the convergence orders of the analytic references")
-    run.add_argument("--profile", choices=["dev", "ci", "thorough"], default="dev")
-    run.add_argument("--out", default="reports")
-    run.set_defaults(func=_run)
-    args = parser.parse_args(argv)
-    return args.func(args)
+    args = build_parser().parse_args(argv)
+    func: Callable[[argparse.Namespace], int] = args.func
+    try:
+        return func(args)
+    except VerimonoError as exc:
+        print(f"verimono {args.command}: {exc}", file=sys.stderr)
+        return EXIT_UNDECIDED
 
 
 if __name__ == "__main__":

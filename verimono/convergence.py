@@ -11,13 +11,25 @@ The order in each norm is the slope of ``log e`` against ``log |Δ|`` (``|Δ| = 
 squares — valid for any step ratio — with a 95% Student-t confidence interval.  Errors at the round-off
 floor (``ROUNDOFF_FACTOR · ε · scale``) are dropped; if every error is there the scheme is exact on the
 grid.  Data whose local slopes spread by more than ``ASYMPTOTIC_SPREAD`` are flagged pre-asymptotic.
+
+Performance: the grids run as independent jobs, in parallel through any ``concurrent.futures.Executor``
+(``executor=``; a ``dask.distributed`` client's ``get_executor()`` works the same), or a process pool
+chosen automatically for large studies.  When the problem has an exact solution each job returns only
+its three errors: with :func:`verimono.solve` as the stepper the states stream through an
+:class:`ErrorAccumulator` block by block (:func:`verimono.stepping.stream`), so no job holds a
+trajectory at all; any other stepper's trajectory is held by its job only while its errors are computed.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
+import multiprocessing
+import os
+import pickle
+import sys
 import time
+from concurrent.futures import ProcessPoolExecutor
 from typing import Any, Callable, Sequence
 
 import numpy as np
@@ -162,11 +174,60 @@ def exact_on(problem: Problem, t: np.ndarray) -> np.ndarray:
     return np.array([np.asarray(problem.exact(s), dtype=float) for s in t.tolist()])
 
 
+def _pointwise(x: np.ndarray, ref: np.ndarray) -> np.ndarray:
+    """``|x_k - ref_k|`` per grid point (the largest over a batch)."""
+    diff = (np.asarray(x) - ref).reshape(ref.shape[0], -1, ref.shape[-1])
+    return np.linalg.norm(diff, axis=-1).max(axis=1)
+
+
 def grid_errors(t: np.ndarray, x: np.ndarray, ref: np.ndarray) -> dict[str, float]:
-    """Sup, discrete-L2 and final errors of ``x`` against ``ref`` at the grid times ``t``."""
-    d = np.linalg.norm((np.asarray(x) - ref).reshape(len(t), -1, ref.shape[-1]), axis=-1).max(axis=1)
+    """Sup, discrete-L2 and final errors of ``x`` against ``ref`` at the grid times ``t``.
+
+    The L2 sum is exactly rounded (``math.fsum``), so :class:`ErrorAccumulator` fed the same data in
+    blocks gives the same bits.
+    """
+    d = _pointwise(x, ref)
     h = np.diff(t)
-    return {"sup": float(d.max()), "l2": float(np.sqrt(np.sum(h * d[1:] ** 2))), "final": float(d[-1])}
+    return {"sup": float(d.max()), "l2": math.sqrt(math.fsum((h * d[1:] ** 2).tolist())), "final": float(d[-1])}
+
+
+class ErrorAccumulator:
+    """Streaming :func:`grid_errors` against ``problem.exact``: feed ``(t_block, x_block)`` pieces in order.
+
+    Holds ``O(1)`` data besides the current block.  ``errors()`` equals ``grid_errors`` on the whole
+    trajectory: ``sup`` and ``final`` bit for bit, ``l2`` to within one rounding (its sum is carried as an
+    exactly rounded double-double, error ≤ 2^-106 relative before the final rounding, so in practice
+    bit for bit).  ``scale`` is ``max |x(t_k)|`` of the exact solution.
+    """
+
+    def __init__(self, problem: Problem) -> None:
+        if problem.exact is None:
+            raise InvalidProblem(f"{problem.name} has no exact solution")
+        self.problem = problem
+        self.sup = 0.0
+        self.final = math.nan
+        self.scale = 0.0
+        self._l2 = [0.0, 0.0]      # running L2 sum as hi + lo (double-double, exactly rounded parts)
+        self._t_last: float | None = None
+
+    def update(self, t: np.ndarray, x: np.ndarray) -> None:
+        ref = exact_on(self.problem, t)
+        d = _pointwise(x, ref)
+        self.sup = max(self.sup, float(d.max()))
+        self.final = float(d[-1])
+        self.scale = max(self.scale, float(np.max(np.abs(ref))))
+        if self._t_last is None:
+            h, dd = np.diff(t), d[1:]
+        else:
+            h, dd = np.diff(t, prepend=self._t_last), d
+        terms = self._l2 + (h * dd ** 2).tolist()
+        hi = math.fsum(terms)
+        terms.append(-hi)
+        self._l2 = [hi, math.fsum(terms)]
+        self._t_last = float(t[-1])
+
+    def errors(self) -> dict[str, float]:
+        return {"sup": self.sup, "l2": math.sqrt(math.fsum(self._l2)), "final": self.final}
 
 
 def _name(obj: Any) -> str:
@@ -180,37 +241,195 @@ def convergence_study(stepper: Callable, problem: Problem, steps: Sequence[Any] 
     ``steps`` are step sizes (uniform grids of ``[0, T]``) or explicit grids; by default the problem's
     recommended ``steps``.  Without an exact solution the reference is the same stepper on a uniform
     grid ``reference_refinement`` times finer than the finest one, interpolated linearly where the grid
-    points do not coincide.  ``executor`` (any ``concurrent.futures.Executor``) runs the grids in
-    parallel.
+    points do not coincide.
+
+    ``executor`` runs the grids (and the fine reference) as parallel jobs: any
+    ``concurrent.futures.Executor`` — a process pool, a thread pool, ``dask.distributed``'s
+    ``Client.get_executor()`` — or ``"process"`` (a process pool of ``os.cpu_count()`` workers) or
+    ``"serial"``.  ``None`` picks ``"process"`` for studies of at least :data:`PARALLEL_MIN_STEPS`
+    steps in all on a multi-core machine, else ``"serial"``.  Problems and steppers built from
+    lambdas and closures (the reference catalog's) need no pickling with verimono's own process pool
+    (forked workers inherit them); for other executors they travel by pickle, else by name from
+    :mod:`verimono.reference` (a catalog problem), else by ``cloudpickle`` when installed.
     """
     steps = problem.steps if steps is None else steps
     if not steps or len(steps) < 2:
         raise InvalidProblem("a convergence study needs at least two step sizes or grids")
     grids = [validate_grid(s, problem.T) if np.ndim(s) else uniform_grid(problem.T, float(s)) for s in steps]
-    mapper = executor.map if executor is not None else map
-    runs = list(mapper(_timed_run, [stepper] * len(grids), [problem] * len(grids), grids))
-    if problem.exact is not None:
-        refs = [exact_on(problem, g) for g in grids]
-        reference = "exact solution"
-    else:
+    exact = problem.exact is not None
+    jobs = [(g, "errors" if exact else "values") for g in grids]
+    if not exact:
         hmin = min(float(np.min(np.diff(g))) for g in grids)
         fine_t = uniform_grid(problem.T, steps=int(math.ceil(problem.T / hmin)) * reference_refinement)
-        fine_x = np.asarray(stepper(problem, fine_t), dtype=float)
-        flat = fine_x.reshape(len(fine_t), -1)
-        refs = [np.stack([np.interp(g, fine_t, flat[:, j]) for j in range(flat.shape[1])], axis=-1)
-                .reshape((len(g),) + fine_x.shape[1:]) for g in grids]
-        reference = f"fine-grid solution of the same stepper (h = {problem.T / (len(fine_t) - 1):.3g})"
+        jobs.append((fine_t, "values"))
+    results = _run_jobs(stepper, problem, jobs, executor)
     errors = {n: [] for n in NORMS}
     scale = 1.0
-    for g, (x, _), ref in zip(grids, runs, refs):
-        for n, v in grid_errors(g, x, ref).items():
-            errors[n].append(v)
-        scale = max(scale, float(np.max(np.abs(ref))))
+    if exact:
+        reference = "exact solution"
+        for errs, sc, _ in results:
+            for n in NORMS:
+                errors[n].append(errs[n])
+            scale = max(scale, sc)
+    else:
+        fine_x = results[-1][0]
+        flat = fine_x.reshape(len(fine_t), -1)
+        for g, (x, _, _) in zip(grids, results):
+            ref = (np.stack([np.interp(g, fine_t, flat[:, j]) for j in range(flat.shape[1])], axis=-1)
+                   .reshape((len(g),) + fine_x.shape[1:]))
+            for n, v in grid_errors(g, x, ref).items():
+                errors[n].append(v)
+            scale = max(scale, float(np.max(np.abs(ref))))
+        reference = f"fine-grid solution of the same stepper (h = {problem.T / (len(fine_t) - 1):.3g})"
     floor = ROUNDOFF_FACTOR * EPS * scale
     mesh = [float(np.max(np.diff(g))) for g in grids]
     fits = {n: fit_order(mesh, errors[n], floor) for n in NORMS}
     return ConvergenceStudy(problem.name, _name(stepper), mesh, [len(g) - 1 for g in grids], errors, fits,
-                            problem.order, reference, floor, [dt for _, dt in runs])
+                            problem.order, reference, floor, [r[-1] for r in results[:len(grids)]])
+
+
+#: a study of at least this many steps in all runs in a process pool when ``executor=None``
+PARALLEL_MIN_STEPS = 200_000
+
+
+def _job(stepper, problem, grid, want):
+    """One grid: ``(errors, scale, seconds)`` when ``want == "errors"``, else ``(values, None, seconds)``.
+
+    ``seconds`` is the stepper's own time (streaming: the blocks' production, not the error sums).
+    """
+    stepper, problem = _unwrap(stepper), _unwrap(problem)
+    if want == "errors" and stepper is _solve():
+        from .stepping import stream
+
+        acc = ErrorAccumulator(problem)
+        spent = 0.0
+        it = stream(problem, grid)
+        while True:
+            start = time.perf_counter()
+            piece = next(it, None)
+            spent += time.perf_counter() - start
+            if piece is None:
+                break
+            acc.update(*piece)
+        return acc.errors(), acc.scale, spent
+    x, spent = _timed_run(stepper, problem, grid)
+    if want == "values":
+        return x, None, spent
+    acc = ErrorAccumulator(problem)
+    for i in range(0, len(grid), 8192):     # the exact solution in blocks: one trajectory held, not two
+        acc.update(grid[i:i + 8192], x[i:i + 8192])
+    return acc.errors(), acc.scale, spent
+
+
+def _solve():
+    from .stepping import solve
+    return solve
+
+
+def _run_jobs(stepper, problem, jobs, executor):
+    """Results of :func:`_job` for every ``(grid, want)``, in order (largest jobs submitted first)."""
+    if executor is None:
+        total = sum(len(g) for g, _ in jobs)
+        executor = "process" if total >= PARALLEL_MIN_STEPS and (os.cpu_count() or 1) > 1 else "serial"
+    if executor == "serial":
+        return [_job(stepper, problem, g, w) for g, w in jobs]
+    order = sorted(range(len(jobs)), key=lambda i: -len(jobs[i][0]))
+    if executor == "process":
+        workers = max(1, min(len(jobs), os.cpu_count() or 1))
+        if "fork" in multiprocessing.get_all_start_methods() and sys.platform.startswith("linux"):
+            # forked workers inherit the registry: closures and lambdas need no pickling
+            token = id(jobs)
+            _REGISTRY[token] = (stepper, problem)
+            try:
+                with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork")) as pool:
+                    futures = {i: pool.submit(_registered_job, token, jobs[i][0], jobs[i][1]) for i in order}
+                    return [futures[i].result() for i in range(len(jobs))]
+            finally:
+                _REGISTRY.pop(token, None)
+        with ProcessPoolExecutor(workers) as pool:
+            return _submit_all(pool, stepper, problem, jobs, order)
+    if not hasattr(executor, "submit"):
+        raise InvalidProblem(f"executor must be a concurrent.futures.Executor, 'process', 'serial' or None, "
+                             f"got {executor!r}")
+    return _submit_all(executor, stepper, problem, jobs, order)
+
+
+def _submit_all(executor, stepper, problem, jobs, order):
+    s, p = _Portable(stepper), _Portable(problem)
+    futures = {i: executor.submit(_job, s, p, jobs[i][0], jobs[i][1]) for i in order}
+    return [futures[i].result() for i in range(len(jobs))]
+
+
+_REGISTRY: dict[int, tuple[Any, Any]] = {}
+
+
+def _registered_job(token, grid, want):
+    stepper, problem = _REGISTRY[token]
+    return _job(stepper, problem, grid, want)
+
+
+class _Portable:
+    """Wraps a stepper or problem for executors that pickle their tasks.
+
+    Pickles as the object itself when it pickles; else, for a problem of the reference catalog, as its
+    name (rebuilt from :mod:`verimono.reference` in the worker); else through ``cloudpickle`` when it is
+    installed.  Executors that do not pickle (threads) hand the wrapper over as is; :func:`_unwrap`.
+    """
+
+    __slots__ = ("obj",)
+
+    def __init__(self, obj: Any) -> None:
+        self.obj = obj
+
+    def __reduce__(self):
+        obj = self.obj
+        try:
+            pickle.dumps(obj)
+            return (_identity, (obj,))
+        except Exception:
+            pass
+        name = _catalog_name(obj)
+        if name is not None:
+            return (_from_catalog, (name,))
+        try:
+            import cloudpickle
+        except ImportError:
+            raise InvalidProblem(f"cannot send {_name(obj)} to the executor's workers: it does not pickle (lambdas "
+                                 "or closures?), is not a reference-catalog problem and cloudpickle is not "
+                                 "installed; use executor='process' (forked workers) or install cloudpickle") from None
+        return (pickle.loads, (cloudpickle.dumps(obj),))
+
+
+def _identity(obj):
+    return obj
+
+
+def _unwrap(obj):
+    return obj.obj if isinstance(obj, _Portable) else obj
+
+
+def _from_catalog(name):
+    from .reference import get
+    return get(name)
+
+
+def _catalog_name(obj) -> str | None:
+    """The name of the reference-catalog problem ``obj`` is a fresh copy of, if any.
+
+    Same name, operator type, ``x0``, ``T`` and the same code behind its exact solution.
+    """
+    if not isinstance(obj, Problem):
+        return None
+    try:
+        from .reference import get
+        ref = get(obj.name)
+    except Exception:
+        return None
+    same = (type(ref.operator) is type(obj.operator) and ref.T == obj.T and np.array_equal(ref.x0, obj.x0)
+            and getattr(ref.exact, "__code__", None) is getattr(obj.exact, "__code__", None)
+            and getattr(ref.f, "__code__", None) is getattr(obj.f, "__code__", None)
+            and getattr(ref.u, "__code__", None) is getattr(obj.u, "__code__", None))
+    return obj.name if same else None
 
 
 def _timed_run(stepper, problem, grid):
@@ -222,4 +441,5 @@ def _timed_run(stepper, problem, grid):
     return x, time.perf_counter() - start
 
 
-__all__ = ["convergence_study", "ConvergenceStudy", "OrderFit", "fit_order", "grid_errors", "exact_on"]
+__all__ = ["convergence_study", "ConvergenceStudy", "OrderFit", "fit_order", "grid_errors", "exact_on",
+           "ErrorAccumulator"]

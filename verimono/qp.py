@@ -87,11 +87,12 @@ def solve_qp(P, q, G=None, h=None, A=None, b=None, *, backends=None) -> np.ndarr
     """
     import qpsolvers
 
-    P = np.asarray(P, float); q = np.asarray(q, float)
-    G = None if G is None or len(G) == 0 else np.atleast_2d(np.asarray(G, float))
-    h = None if G is None else np.atleast_1d(np.asarray(h, float))
-    A = None if A is None or len(A) == 0 else np.atleast_2d(np.asarray(A, float))
-    b = None if A is None else np.atleast_1d(np.asarray(b, float))
+    # writable copies: back-ends such as DAQP reject read-only buffers (constant parameters are read-only)
+    P = np.array(P, float); q = np.array(q, float)
+    G = None if G is None or len(G) == 0 else np.atleast_2d(np.array(G, float))
+    h = None if G is None else np.atleast_1d(np.array(h, float))
+    A = None if A is None or len(A) == 0 else np.atleast_2d(np.array(A, float))
+    b = None if A is None else np.atleast_1d(np.array(b, float))
     reasons = []
     got_point = False
     for name in backends or BACKENDS:

@@ -11,7 +11,9 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections import Counter
-from typing import Any, Iterable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any, Callable, Iterable, Iterator
 
 import numpy as np
 
@@ -102,10 +104,13 @@ class Report:
     """
 
     def __init__(self, results: Iterable[CheckResult] = (), studies: Iterable[Any] = (),
-                 meta: dict[str, Any] | None = None) -> None:
+                 meta: dict[str, Any] | None = None, trajectories: Iterable[dict[str, Any]] = ()) -> None:
         self.results: list[CheckResult] = list(results)
         self.studies: list[Any] = list(studies)
         self.meta: dict[str, Any] = dict(meta or {})
+        #: sampled trajectories next to the exact solution, for plots: dicts with ``problem``,
+        #: ``stepper``, ``h``, ``t`` (list), ``x`` (list of states), ``exact`` (list of states or None)
+        self.trajectories: list[dict[str, Any]] = list(trajectories)
 
     def __iter__(self) -> Iterator[CheckResult]:
         return iter(self.results)
@@ -124,6 +129,7 @@ class Report:
         if isinstance(other, Report):
             self.results.extend(other.results)
             self.studies.extend(other.studies)
+            self.trajectories.extend(other.trajectories)
         else:
             self.results.extend(other)
         return self
@@ -150,3 +156,68 @@ class Report:
 
     def __repr__(self) -> str:
         return f"Report({self.summary()})"
+
+    # -- serialization (schema: verimono.report.schema) ------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        """The versioned JSON document of this report (see :mod:`verimono.report.schema`)."""
+        from .report.schema import report_to_dict
+
+        return report_to_dict(self)
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> "Report":
+        """Inverse of :meth:`to_dict`; raises :class:`verimono.report.schema.SchemaError` on bad input."""
+        from .report.schema import report_from_dict
+
+        return report_from_dict(data)
+
+    def to_json(self, indent: int | None = 1) -> str:
+        import json
+
+        return json.dumps(self.to_dict(), indent=indent, allow_nan=False)
+
+    @classmethod
+    def from_json(cls, text: str) -> "Report":
+        from .report.schema import loads
+
+        return loads(text)
+
+    def save(self, path: str | Path) -> Path:
+        """Write :meth:`to_json` to ``path`` (parents created); returns the path."""
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(self.to_json(), encoding="utf-8")
+        return path
+
+    @classmethod
+    def load(cls, path: str | Path) -> "Report":
+        """Read a report written by :meth:`save`; :class:`SchemaError` if missing, garbled or incompatible."""
+        from .report.schema import load
+
+        return load(path)
+
+
+# -- listeners: how records reach consumers that did not call the check (the pytest plugin) -------------
+_LISTENERS: list[Callable[[Any], None]] = []
+
+
+def emit(item: "CheckResult | Report") -> "CheckResult | Report":
+    """Hand a record (or a whole report) to every active listener; returns ``item`` unchanged.
+
+    Producers that run checks on a consumer's behalf (``verimono.testing.parametrize_with_checks``)
+    call this once per record *before* turning a failure into a pytest failure, so the pytest plugin
+    can put every record in its report.  Without listeners it does nothing.
+    """
+    for fn in list(_LISTENERS):
+        fn(item)
+    return item
+
+
+@contextmanager
+def listening(fn: Callable[[Any], None]) -> Iterator[None]:
+    """Call ``fn`` with everything :func:`emit`-ted inside the ``with`` block."""
+    _LISTENERS.append(fn)
+    try:
+        yield
+    finally:
+        _LISTENERS.remove(fn)

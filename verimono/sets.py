@@ -3,15 +3,27 @@
 Each set has ``.dim``, ``.project(x, t=0.0)`` (the Euclidean projection, for ``x`` of shape ``(n,)`` or
 ``(B, n)``) and ``.contains(x, t=0.0, tol=None)``.  Every parameter is a constant or a callable of ``t``;
 a set with callable parameters is a moving set, the normal cone of which gives the sweeping process.
+
+Batches of sets: ``Ball(center, radius)`` with ``center`` of shape ``(B, n)`` and/or ``radius`` of shape
+``(B,)``, and ``Box(lower, upper)`` with bounds of shape ``(B, n)``, are ``B`` sets projecting the rows of
+a ``(B, n)`` batch of points one each (one vectorized call).
+
+Performance: projections are written without ``np.errstate`` and with inner products by the BLAS
+``dot`` of each row (:func:`verimono.operators.dot_rows`), so a batch ``(B, n)`` and its rows one by one
+give identical bits;
+``_kernel`` returns a private fast path for :func:`verimono.solve` (constants prebound, scalar work in
+Python floats — the same IEEE operations).
 """
 
 from __future__ import annotations
 
-from typing import Any
+import math
+from typing import Any, Callable
 
 import numpy as np
 
 from ._params import as_param
+from .operators import dot_rows
 from .errors import InvalidProblem
 from .tolerances import tolerance
 
@@ -35,12 +47,35 @@ class ConvexSet:
         tol = tolerance(x) if tol is None else tol
         return bool(np.max(np.abs(self.project(x, t) - x), initial=0.0) <= tol)
 
+    def _kernel(self, x0: np.ndarray) -> Callable | None:
+        """A fast ``step(x, lam, t) = proj_{S(t)} x`` (``lam`` ignored) for float arrays shaped like
+        ``x0``, returning exactly what :meth:`project` returns; ``None`` means use :meth:`project`."""
+        return None
+
     def __repr__(self) -> str:
         return f"{self.name}(dim={self.dim})"
 
 
+_ar = np.add.reduce
+_mx, _mn = np.maximum, np.minimum
+_sqrt = math.sqrt
+_TINY = float(np.finfo(float).smallest_subnormal)
+
+
 def _all_static(*params) -> bool:
     return all(p.constant for p in params)
+
+
+def _own(obj: Any, cls: type) -> bool:
+    return type(obj).project is cls.project
+
+
+def _fast(param) -> Callable[[float], np.ndarray]:
+    """``t -> param(t)``; a constant is bound once."""
+    if param.constant:
+        v = param(0.0)
+        return lambda t: v
+    return param
 
 
 class Ball(ConvexSet):
@@ -50,26 +85,62 @@ class Ball(ConvexSet):
         self._c = as_param(center, "center")
         self._r = as_param(radius, "radius")
         c0 = np.atleast_1d(self._c(0.0))
-        super().__init__(c0.shape[0], name or "Ball")
-        if np.any(self._r(0.0) < 0):
-            raise InvalidProblem(f"radius must be nonnegative, got {self._r(0.0)}")
+        super().__init__(c0.shape[-1], name or "Ball")
+        r0 = self._r(0.0)
+        if c0.ndim > 2 or r0.ndim > 1:
+            raise InvalidProblem(f"Ball takes a center (n,) or (B, n) and a radius () or (B,), got "
+                                 f"{c0.shape} and {r0.shape}")
+        if np.any(r0 < 0):
+            raise InvalidProblem(f"radius must be nonnegative, got {r0}")
         self.static = _all_static(self._c, self._r)
 
     def center(self, t: float = 0.0) -> np.ndarray:
         return self._c(t)
 
     def radius(self, t: float = 0.0) -> float:
-        return float(self._r(t))
+        r = self._r(t)
+        return float(r) if r.ndim == 0 else r
 
     def project(self, x, t=0.0):
+        # points inside are returned unchanged (not as c + (x - c), which may differ in the last bit)
         x = np.asarray(x, dtype=float)
         c = self._c(t)
         d = x - c
-        nrm = np.sqrt(np.sum(d * d, axis=-1, keepdims=True))
+        nrm = np.sqrt(dot_rows(d, d))[..., None]
         r = self._r(t)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            scale = np.where(nrm > r, r / nrm, 1.0)
-        return c + scale * d
+        if r.ndim == 1 and x.ndim > 1:
+            r = r[:, None]
+        outside = nrm > r
+        if not outside.any():  # the common case along a trajectory: nothing to project
+            return x.copy()
+        # where nrm > r (>= 0) the divisor is nrm; elsewhere it keeps r/divisor <= 1 (no inf*0 warnings)
+        return np.where(outside, c + d * (r / _mx(nrm, _mx(r, _TINY))), x)
+
+    def _kernel(self, x0):
+        if not _own(self, Ball) or x0.ndim != 1 or self._r(0.0).ndim or self._c(0.0).ndim != 1:
+            return None
+        if self.static:
+            c, r = self._c(0.0), float(self._r(0.0))
+
+            def step(x, lam, t):
+                d = x - c
+                nrm = _sqrt(d.dot(d))
+                if nrm > r:
+                    return c + d * (r / nrm)
+                return x
+            return step
+        center = _fast(self._c)
+        rfn = self._r
+
+        def step(x, lam, t):
+            c = center(t)
+            d = x - c
+            nrm = _sqrt(d.dot(d))
+            r = float(rfn(t))
+            if nrm > r:
+                return c + d * (r / nrm)
+            return x
+        return step
 
 
 class Box(ConvexSet):
@@ -80,7 +151,9 @@ class Box(ConvexSet):
         self._hi = as_param(upper, "upper") if callable(upper) else _bound(upper, "upper")
         lo, hi = np.atleast_1d(self._lo(0.0)), np.atleast_1d(self._hi(0.0))
         lo, hi = np.broadcast_arrays(lo, hi)
-        super().__init__(lo.shape[0], name or "Box")
+        if lo.ndim > 2:
+            raise InvalidProblem(f"Box bounds must have shape (n,) or (B, n), got {lo.shape}")
+        super().__init__(lo.shape[-1], name or "Box")
         if np.any(lo > hi):
             raise InvalidProblem(f"Box is empty: lower {lo} exceeds upper {hi}")
         self.static = _all_static(self._lo, self._hi)
@@ -92,7 +165,21 @@ class Box(ConvexSet):
         return self._hi(t)
 
     def project(self, x, t=0.0):
-        return np.minimum(np.maximum(np.asarray(x, dtype=float), self._lo(t)), self._hi(t))
+        return _mn(_mx(np.asarray(x, dtype=float), self._lo(t)), self._hi(t))
+
+    def _kernel(self, x0):
+        if not _own(self, Box):
+            return None
+        lo, hi = _fast(self._lo), _fast(self._hi)
+        if self._lo.constant and self._hi.constant:
+            lo0, hi0 = lo(0.0), hi(0.0)
+
+            def step(x, lam, t):
+                return _mn(_mx(x, lo0), hi0)
+        else:
+            def step(x, lam, t):
+                return _mn(_mx(x, lo(t)), hi(t))
+        return step
 
 
 def _bound(value, name):
@@ -129,10 +216,32 @@ class HalfSpace(ConvexSet):
         return float(self._b(t))
 
     def project(self, x, t=0.0):
+        # inner products row by row (dot_rows, not x @ a): the same summation for a point and a batch row
         x = np.asarray(x, dtype=float)
         a, b = self._a(t), self._b(t)
-        excess = np.maximum(x @ a - b, 0.0) / (a @ a)
-        return x - np.multiply.outer(excess, a) if x.ndim > 1 else x - excess * a
+        excess = _mx(dot_rows(x, a)[..., None] - b, 0.0) / a.dot(a)
+        return x - excess * a
+
+    def _kernel(self, x0):
+        if not _own(self, HalfSpace) or x0.ndim != 1 or self._b(0.0).ndim:
+            return None
+        normal = _fast(self._a)
+        if self._a.constant:
+            aa0 = float(self._a(0.0).dot(self._a(0.0)))
+            norm2 = lambda a: aa0  # noqa: E731
+        else:
+            norm2 = lambda a: float(a.dot(a))  # noqa: E731
+        if self._b.constant:
+            b0 = float(self._b(0.0))
+            offset = lambda t: b0  # noqa: E731
+        else:
+            bfn = self._b
+            offset = lambda t: float(bfn(t))  # noqa: E731
+
+        def step(x, lam, t):
+            a = normal(t)
+            return x - (max(float(x.dot(a)) - offset(t), 0.0) / norm2(a)) * a
+        return step
 
 
 class Polyhedron(ConvexSet):
@@ -169,16 +278,36 @@ class Polyhedron(ConvexSet):
             ok = ok and np.all(np.abs(x @ A.T - b) <= tol)
         return bool(ok)
 
+    @staticmethod
+    def _inside(x, G, h, A, b):
+        """Rows of ``x`` (shape (..., n)) lying in the set, by the same arithmetic for a point and a batch."""
+        ok = np.all(dot_rows(x[..., None, :], G) <= h, axis=-1)
+        if A is not None:
+            ok &= np.all(dot_rows(x[..., None, :], A) == b, axis=-1)
+        return ok
+
     def project(self, x, t=0.0):
+        """Points inside are returned as they are; the others by a KKT-verified QP each.
+
+        A batch ``(B, n)`` tests membership for all rows at once and solves QPs only for the rows
+        outside, each exactly as for the point alone (identical results).
+        """
         from .qp import solve_qp
 
         x = np.asarray(x, dtype=float)
         G, h, A, b = self.data(t)
-        if x.ndim > 1:
-            return np.stack([self.project(xi, t) for xi in x])
-        if np.all(G @ x <= h) and (A is None or np.all(A @ x == b)):
-            return x.copy()
-        return solve_qp(np.eye(self.dim), -x, G, h, A, b)
+        inside = self._inside(x, G, h, A, b)
+        if x.ndim == 1:
+            if inside:
+                return x.copy()
+            return solve_qp(np.eye(self.dim), -x, G, h, A, b)
+        out = np.array(x, dtype=float)
+        flat, ins = out.reshape(-1, self.dim), inside.reshape(-1)
+        if not ins.all():
+            P = np.eye(self.dim)
+            for i in np.flatnonzero(~ins).tolist():
+                flat[i] = solve_qp(P, -flat[i], G, h, A, b)
+        return out
 
 
 class Translated(ConvexSet):
@@ -196,6 +325,21 @@ class Translated(ConvexSet):
     def project(self, x, t=0.0):
         c = self._c(t)
         return self.S.project(np.asarray(x, dtype=float) - c, t) + c
+
+    def _kernel(self, x0):
+        if not _own(self, Translated):
+            return None
+        kern = getattr(self.S, "_kernel", None)
+        inner = kern(x0) if kern is not None else None
+        if inner is None:
+            project = self.S.project
+            inner = lambda x, lam, t: project(x, t)  # noqa: E731
+        shift = _fast(self._c)
+
+        def step(x, lam, t):
+            c = shift(t)
+            return inner(x - c, lam, t) + c
+        return step
 
 
 __all__ = ["ConvexSet", "Ball", "Box", "HalfSpace", "Polyhedron", "Translated"]

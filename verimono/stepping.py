@@ -18,12 +18,13 @@ converts with ``np.asarray``.
 
 from __future__ import annotations
 
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
 import numpy as np
 
 from .errors import InvalidProblem, SolverFailure
 from .grids import validate_grid
+from .operators import resolvent_kernel
 from .problem import Problem
 
 
@@ -107,40 +108,111 @@ def solve(problem: Problem, t_grid: Any) -> Trajectory:
     Raises :class:`verimono.InvalidGrid` for a grid that is not an increasing partition of
     ``[0, problem.T]`` and :class:`verimono.SolverFailure` when the resolvent returns a value of the
     wrong shape or a non-finite value (reported with its step).
+
+    A batch ``problem.x0`` of shape ``(B, n)`` is solved in one vectorized run (values of shape
+    ``(len(t_grid), B, n)``), identical to ``B`` separate solves for the catalog operators.
+
+    Performance: the grid is validated once; the loop calls a resolvent kernel prebound to the
+    operator's constant parameters (:func:`verimono.operators.resolvent_kernel`), with the steps and
+    times as Python floats, and writes into one preallocated array; finiteness is checked once at the
+    end, vectorized.  :func:`stream` runs the same loop in blocks without keeping the trajectory.
     """
     if not isinstance(problem, Problem):
         raise InvalidProblem(f"solve expects a verimono.Problem, got {type(problem).__name__}")
     t = validate_grid(t_grid, problem.T)
+    x = None
+    for _, x in _march(problem, t, t.size):
+        pass
+    return Trajectory(t, x, problem)
+
+
+#: rows per block of :func:`stream` (1 MiB of states for n = 16)
+STREAM_BLOCK = 8192
+
+
+def stream(problem: Problem, t_grid: Any, *, block: int = STREAM_BLOCK) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """Run :func:`solve`'s scheme without storing the trajectory: yield ``(t_block, x_block)`` pieces.
+
+    The pieces cover the grid in order (``x_block[i]`` is the state at ``t_block[i]``, the first piece
+    starts with ``x_0``), with at most ``block`` rows each; the values are bit-identical to
+    ``solve(problem, t_grid).x``.  ``x_block`` is a buffer reused for the next piece: copy what you keep.
+    Memory is ``O(block)`` whatever the number of steps — e.g. for streaming error accumulation in
+    convergence studies.  Errors as for :func:`solve`.
+    """
+    if not isinstance(problem, Problem):
+        raise InvalidProblem(f"stream expects a verimono.Problem, got {type(problem).__name__}")
+    if int(block) < 2:
+        raise InvalidProblem(f"block must be at least 2 rows, got {block!r}")
+    t = validate_grid(t_grid, problem.T)
+    for start, xb in _march(problem, t, int(block)):
+        yield t[start:start + xb.shape[0]], xb
+
+
+def _march(problem: Problem, t: np.ndarray, block: int) -> Iterator[tuple[int, np.ndarray]]:
+    """The scheme's loop on the validated grid ``t``, yielding ``(first index, rows)`` per block.
+
+    With ``block >= len(t)`` there is one block: the whole trajectory in a fresh array.
+    """
     h = np.diff(t)
     K = h.size
     x0 = problem.x0
-    x = np.empty((K + 1,) + x0.shape)
-    x[0] = x0
-    resolvent = problem.operator.resolvent
+    op = problem.operator
+    step = resolvent_kernel(op, x0)
     f = problem.f
     dU = problem.input_increments(t)
     if dU is not None and x0.ndim == 2:
         dU = dU[:, None, :]
-    hs, ts = h.tolist(), t[1:].tolist()
-    first = np.asarray(resolvent(_drift(x0, hs[0], f, dU, 0), hs[0], ts[0]), dtype=float)
+    block = min(block, K + 1)
+    # steps and times as Python floats (cheap to index and to multiply), converted block by block so
+    # that streaming holds O(block) of them
+    hs, ts = h[:block].tolist(), t[1:block + 1].tolist()
+    buf = np.empty((block,) + x0.shape)
+    buf[0] = x0
+    first = np.asarray(step(_drift(x0, hs[0], f, dU, 0), hs[0], ts[0]), dtype=float)
     if first.shape != x0.shape:
-        raise SolverFailure(f"the resolvent of {problem.operator.name} returned shape {first.shape} "
+        raise SolverFailure(f"the resolvent of {op.name} returned shape {first.shape} "
                             f"for a point of shape {x0.shape}")
-    x[1] = first
+    buf[1] = first
     xk = first
-    if f is None and dU is None:
-        for k in range(1, K):
-            xk = resolvent(xk, hs[k], ts[k])
-            x[k + 1] = xk
-    else:
-        for k in range(1, K):
-            xk = resolvent(_drift(xk, hs[k], f, dU, k), hs[k], ts[k])
-            x[k + 1] = xk
-    if not np.all(np.isfinite(x)):
-        bad = int(np.flatnonzero(~np.all(np.isfinite(x.reshape(K + 1, -1)), axis=1))[0])
-        raise SolverFailure(f"non-finite state at step {bad} (t = {t[bad]:g}) of {problem.name}: the resolvent "
-                            f"of {problem.operator.name} returned {x[bad]} from x = {x[bad - 1]}")
-    return Trajectory(t, x, problem)
+    row, k, start = 2, 1, 0     # next free row of buf; next step computes x_{k+1}; grid index of buf[0]
+    before = x0                 # the state preceding buf[0] (for error messages across blocks)
+    plain = f is None and dU is None
+    base = 0                    # hs[i], ts[i] hold h[base + i], t[base + 1 + i]
+    while True:
+        m = min(block - row, K - k)
+        if m > 0:
+            if k + m > base + len(hs):  # this block's steps are not all converted yet
+                base = k
+                hs, ts = h[k:k + block].tolist(), t[k + 1:k + 1 + block].tolist()
+            lo = k - base
+            if plain:
+                for i, hk, tk in zip(range(row, row + m), hs[lo:lo + m], ts[lo:lo + m]):
+                    xk = step(xk, hk, tk)
+                    buf[i] = xk
+            else:
+                for i, j in zip(range(row, row + m), range(k, k + m)):
+                    xk = step(_drift(xk, hs[j - base], f, dU, j), hs[j - base], ts[j - base])
+                    buf[i] = xk
+            k += m
+            row += m
+        out = buf[:row]
+        _check_finite(out, start, before, t, problem)
+        yield start, out
+        if k >= K:
+            return
+        before = out[-1].copy()
+        start += row
+        row = 0
+
+
+def _check_finite(out, start, before, t, problem):
+    if np.isfinite(out).all():
+        return
+    bad = int(np.flatnonzero(~np.isfinite(out.reshape(out.shape[0], -1)).all(axis=1))[0])
+    prev = out[bad - 1] if bad > 0 else before
+    k = start + bad
+    raise SolverFailure(f"non-finite state at step {k} (t = {t[k]:g}) of {problem.name}: the resolvent "
+                        f"of {problem.operator.name} returned {out[bad]} from x = {prev}")
 
 
 def _drift(xk, hk, f, dU, k):
@@ -152,4 +224,4 @@ def _drift(xk, hk, f, dU, k):
     return z
 
 
-__all__ = ["Trajectory", "solve"]
+__all__ = ["Trajectory", "solve", "stream"]

@@ -43,18 +43,25 @@ def check_convergence_order(stepper: Callable, problem: Problem, steps=None, exe
                        duration=time.perf_counter() - start)
 
 
-def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, *, executor=None) -> Report:
-    """Result records saying for each reference whether ``stepper`` reaches the expected order.
+def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, *, executor=None,
+                  laws: bool | Iterable[str] = True, seed: int = 0, generated: int = 4,
+                  orders: bool = True) -> Report:
+    """Result records for ``stepper``: convergence orders on the references, then the trajectory laws.
 
-    ``problems=None`` means the whole catalog of :mod:`verimono.reference`.
+    ``problems=None`` means the whole catalog of :mod:`verimono.reference` (orders and laws) plus
+    ``generated`` seeded sample problems (laws only).  The records come first per problem for the
+    convergence orders (in the order of ``problems``), then one record per (problem, law) of
+    :mod:`verimono.checks.trajectory_laws`; ``laws=False`` keeps the orders only, a list of law names
+    selects laws, ``orders=False`` keeps the laws only.  The records are those of :func:`verimono.checks.trajectory_laws.stepper_checks`,
+    the same generator :func:`verimono.testing.parametrize_with_checks` turns into pytest cases.
     """
-    if problems is None:
-        from verimono.reference import catalog
+    from .trajectory_laws import LAWS, stepper_checks
 
-        problems = catalog()
+    selected = () if laws is False else (LAWS if laws is True else tuple(laws))
     report = Report()
-    for p in problems:
-        rec = check_convergence_order(stepper, p, executor=executor)
+    for _name_, check in stepper_checks(stepper, problems, seed=seed, generated=generated, laws=selected,
+                                        orders=orders, executor=executor):
+        rec = check(stepper)
         report.add(rec)
         if "study" in rec.details:
             from ..convergence import ConvergenceStudy

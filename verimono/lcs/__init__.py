@@ -11,10 +11,11 @@ from .lcp import LCPResult, box_residual, lcp_residual, lemke, solve_box, solve_
 from .passivity import PassivityResult, is_passive
 from .relations import Complementarity, OperatorRelation, Relation, Relay
 from .siconos import read_lcp, read_ref
+from .siconos_cases import check_siconos
 from .system import LCSOperator, LinearRelationSystem
 
 __all__ = [
     "LinearRelationSystem", "LCSOperator", "Relation", "Complementarity", "Relay", "OperatorRelation",
     "solve_lcp", "solve_box", "LCPResult", "lcp_residual", "box_residual", "lemke",
-    "is_passive", "PassivityResult", "check_hypotheses", "read_ref", "read_lcp",
+    "is_passive", "PassivityResult", "check_hypotheses", "read_ref", "read_lcp", "check_siconos",
 ]

@@ -1,0 +1,72 @@
+"""check_assumptions: evidence for (A1), (A3), (LG), (YB) — passing where the paper's assumptions hold,
+failing on a non-monotone operator, on understated φ/σ/θ, and flagging (LG) for the log barrier and
+(YB) for moving sets (where the paper says they fail)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from verimono import Problem, operator_from_resolvent
+from verimono.checks.assumptions import EVIDENCE, check_assumptions
+from verimono.checks.sample_problems import sample_problem
+from verimono.checks.trajectory_laws import with_changes
+from verimono.reference import get
+from verimono.results import FAILED, PASSED
+
+NAMES = ["assumption_A1", "assumption_A3", "assumption_LG", "assumption_YB"]
+
+
+def _by(report):
+    return {r.check: r for r in report}
+
+
+def test_records_are_labelled_evidence():
+    rep = check_assumptions(get("t|x| (n=1)"))
+    assert [r.check for r in rep] == NAMES and rep.ok
+    assert all(r.details.get("evidence") == EVIDENCE for r in rep)
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_stated_functions_of_sample_problems_survive(seed):
+    rep = _by(check_assumptions(sample_problem(seed), seed=seed))
+    for name in ("assumption_A1", "assumption_A3", "assumption_LG"):
+        assert rep[name].status == PASSED, str(rep[name])
+
+
+def test_non_monotone_operator_fails_A1():
+    # F = -x/2 (not monotone): J_λ x = x/(1 - λ/2) for λ < 2
+    op = operator_from_resolvent(lambda x, lam, t: np.asarray(x) / (1.0 - 0.5 * lam), 2, name="minus_half")
+    rec = _by(check_assumptions(Problem(op, [0.5, 0.2], 1.0)))["assumption_A1"]
+    assert rec.status == FAILED and rec.counterexample["inner"] < 0
+
+
+def test_understated_phi_sigma_theta_are_contradicted():
+    ball = get("translating ball")                          # moves at |v| = sqrt(1.25)
+    rec = _by(check_assumptions(with_changes(ball, phi=lambda t: 0.5 * t)))["assumption_A3"]
+    assert rec.status == FAILED and rec.counterexample["dist"] > 0
+    tn = get("t|x| (n=1)")                                  # |F^0(t,x)| = t, |Y_λ(s+λ)| - |Y_λ(s)| ≤ λ
+    rep = _by(check_assumptions(with_changes(tn, sigma=lambda t: 0.3 * t, theta=lambda t: 0.5 * t)))
+    assert rep["assumption_LG"].status == FAILED and rep["assumption_YB"].status == FAILED
+
+
+def test_stated_phi_of_moving_set_is_tight():
+    rec = _by(check_assumptions(get("translating ball")))["assumption_A3"]
+    assert rec.status == PASSED and 0.9 < rec.worst <= 1.0        # φ(t) = |v| t is attained
+    speed = np.hypot(1.0, 0.5)                                      # sampled sup ≤ the true one
+    assert 0.99 * speed <= rec.details["max_rate"] <= speed * (1 + 1e-9)
+
+
+def test_paper_failures_are_flagged():
+    lg = _by(check_assumptions(get("x' = c/x from 0 (order 1/2)")))["assumption_LG"]
+    assert lg.status == FAILED and "evidence that (LG) fails" in lg.message     # |F^0| = c/x unbounded
+    yb = _by(check_assumptions(get("moving box")))["assumption_YB"]
+    assert yb.status == FAILED and "YB" in yb.message                            # moving domain
+    assert _by(check_assumptions(get("moving box")))["assumption_LG"].status == PASSED  # σ ≡ 0 for N_S
+
+
+def test_static_operator_has_constant_theta_and_estimated_sigma():
+    rep = _by(check_assumptions(get("linear x' = -Mx")))
+    assert rep["assumption_YB"].details["theta_hat_slope"] <= 1e-6                # Prop. vi
+    M = np.array([[1.0, 3.0], [-3.0, 0.5]])
+    assert max(rep["assumption_LG"].details["sigma_hat"]) <= np.linalg.norm(M, 2) + 1e-9

@@ -1,0 +1,161 @@
+"""The command line: run, check, baseline, gate, report — exit statuses and what they print."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+from verimono.cli import main
+from verimono.report.schema import load
+
+REF = ["--reference", "moving box", "--reference", "t|x| (n=1)"]
+
+BROKEN = '''
+"""A stepper that evaluates the moving set at the start of each step instead of its end."""
+import numpy as np
+from verimono.stepping import solve as _solve
+
+
+def solve(problem, t_grid):
+    t = np.asarray(t_grid, dtype=float)
+    lagged = np.concatenate([[0.0], t[:-1]])
+    op = problem.operator
+    x = [np.array(problem.x0, dtype=float)]
+    for k in range(1, len(t)):
+        x.append(np.asarray(op.resolvent(x[-1], t[k] - t[k - 1], lagged[k]), dtype=float))
+    return np.array(x)
+'''
+
+
+@pytest.fixture(scope="module")
+def steppers(tmp_path_factory):
+    d = tmp_path_factory.mktemp("steppers")
+    (d / "lagged.py").write_text(textwrap.dedent(BROKEN))
+    (d / "good.py").write_text("from verimono.stepping import solve\n")
+    return d
+
+
+@pytest.fixture(scope="module")
+def good_check(steppers, tmp_path_factory):
+    out = tmp_path_factory.mktemp("good")
+    code = main(["check", str(steppers / "good.py") + ":solve", "--profile", "ci", "--out", str(out), *REF])
+    assert code == 0
+    return out
+
+
+def test_run_writes_report_and_results_and_exits_0(tmp_path, capsys):
+    code = main(["run", "--profile", "ci", "--stage", "convergence", *REF, "--out", str(tmp_path)])
+    out = capsys.readouterr()
+    assert code == 0
+    assert (tmp_path / "report.html").stat().st_size > 10_000
+    rep = load(tmp_path / "results.json")
+    assert len(rep) == 2 and rep.ok and rep.meta["profile"] == "ci"
+    assert "[1/1] convergence: passed" in out.err  # plain lines when not on a terminal
+    assert "2 passed, 0 failed" in out.out
+
+
+def test_baseline_then_gate_is_green(good_check, tmp_path, capsys):
+    base = tmp_path / "baseline.json"
+    assert main(["baseline", "--from", str(good_check / "results.json"), "--out", str(base)]) == 0
+    assert main(["gate", "--baseline", str(base), "--results", str(good_check / "results.json")]) == 0
+    assert "no regressions" in capsys.readouterr().out
+
+
+def test_a_broken_stepper_fails_check_and_gate_with_reasons(steppers, good_check, tmp_path, capsys):
+    base = tmp_path / "baseline.json"
+    main(["baseline", "--from", str(good_check / "results.json"), "--out", str(base)])
+    capsys.readouterr()
+    # the same name ("solve") from another module: compare it as the same target
+    bad_out = tmp_path / "bad"
+    code = main(["check", str(steppers / "lagged.py") + ":solve", "--profile", "ci", "--out", str(bad_out), *REF])
+    assert code == 1
+    bad = load(bad_out / "results.json")
+    bad.meta["target"] = load(base).meta["target"]
+    bad.save(bad_out / "results.json")
+    capsys.readouterr()
+    code = main(["gate", "--baseline", str(base), "--results", str(bad_out / "results.json")])
+    out = capsys.readouterr().out
+    assert code == 1
+    assert "convergence_order[solve on moving box]: passed → failed" in out
+    assert "below the theoretical order 2" in out
+    assert "regression" in out
+
+
+def test_lowered_order_and_removed_check_fail_the_gate(good_check, tmp_path, capsys):
+    base = tmp_path / "baseline.json"
+    main(["baseline", "--from", str(good_check / "results.json"), "--out", str(base)])
+    doc = json.loads((good_check / "results.json").read_text())
+    study = next(s for s in doc["studies"] if s["problem"] == "moving box")
+    study["fits"]["sup"].update(slope=1.5, low=1.45, high=1.55)
+    doc["results"] = [r for r in doc["results"] if r["check"] != "contraction" or "t|x|" not in r["subject"]]
+    changed = tmp_path / "changed.json"
+    changed.write_text(json.dumps(doc))
+    capsys.readouterr()
+    assert main(["gate", "--baseline", str(base), "--results", str(changed)]) == 1
+    out = capsys.readouterr().out
+    assert "sup-norm order fell from 2.000" in out
+    assert "removed  contraction[solve on t|x| (n=1)]" in out
+    assert "contraction: executed records fell" in out
+
+
+@pytest.mark.parametrize("content, message", [
+    (None, "does not exist"),
+    ("{ garbled", "not valid JSON"),
+    ('{"schema": "verimono.results", "schema_version": "0.1", "results": [], "studies": [], "meta": {}}',
+     "incompatible schema version"),
+])
+def test_missing_garbled_or_incompatible_baseline_exits_2(good_check, tmp_path, capsys, content, message):
+    base = tmp_path / "baseline.json"
+    if content is not None:
+        base.write_text(content)
+    assert main(["gate", "--baseline", str(base), "--results", str(good_check / "results.json")]) == 2
+    assert message in capsys.readouterr().err
+
+
+def test_baseline_of_another_profile_exits_2(good_check, tmp_path, capsys):
+    doc = json.loads((good_check / "results.json").read_text())
+    doc["meta"]["profile"] = "thorough"
+    base = tmp_path / "baseline.json"
+    base.write_text(json.dumps(doc))
+    assert main(["gate", "--baseline", str(base), "--results", str(good_check / "results.json")]) == 2
+    assert "profile" in capsys.readouterr().err
+
+
+def test_check_runs_the_operator_battery_on_an_operator(tmp_path, capsys):
+    mod = tmp_path / "myops.py"
+    mod.write_text("import verimono as vm\nOP = vm.NormSubdifferential(lambda t: 1.0 + t, dim=2)\n")
+    code = main(["check", f"{mod}:OP", "--profile", "dev", "--seed", "3", "--out", str(tmp_path / "o")])
+    assert code == 0, capsys.readouterr()
+    rep = load(tmp_path / "o" / "results.json")
+    assert len({r.check for r in rep}) >= 10 and all(r.subject == f"{mod}:OP" for r in rep)
+    assert rep.meta["command"] == "check" and rep.meta["seed"] == 3
+
+
+@pytest.mark.parametrize("target", ["no_such_module_xyz:thing", "verimono:no_such_thing", "verimono",
+                                    "verimono.sets:Ball"])
+def test_bad_targets_exit_2(target, tmp_path, capsys):
+    assert main(["check", target, "--out", str(tmp_path)]) == 2
+    assert "verimono check:" in capsys.readouterr().err
+
+
+def test_unknown_reference_exits_2(tmp_path, capsys):
+    assert main(["run", "--reference", "nope", "--out", str(tmp_path)]) == 2
+    assert "no reference named 'nope'" in capsys.readouterr().err
+
+
+def test_console_entry_exit_status_propagates(good_check, tmp_path):
+    base = tmp_path / "b.json"
+    base.write_text("garbage")
+    proc = subprocess.run([sys.executable, "-m", "verimono.cli", "gate", "--baseline", str(base),
+                           "--results", str(good_check / "results.json")], capture_output=True, text=True)
+    assert proc.returncode == 2 and "not valid JSON" in proc.stderr
+
+
+def test_report_rerenders_from_results(good_check, tmp_path):
+    out = tmp_path / "r.html"
+    assert main(["report", "--results", str(good_check / "results.json"), "--out", str(out)]) == 0
+    assert out.read_text().count("<svg") >= 4

@@ -1,0 +1,92 @@
+"""The operator laws fail on the broken zoo (with a reproducing, shrunk counterexample) and pass on every
+correct catalog operator over several seeds; skips are counted, never passed."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import zoo
+from verimono import Report, operator_from_resolvent
+from verimono.checks import LAWS, OPERATOR_CHECKS, check_operator, operator_checks, run_law
+from verimono.strategies import catalog
+
+ZOO_CASES = [(member, law) for member, laws in zoo.BREAKS.items() for law in laws]
+
+
+def test_every_law_is_broken_by_some_zoo_member():
+    broken = {law for _, law in ZOO_CASES}
+    assert broken == set(LAWS), set(LAWS) - broken
+
+
+@pytest.mark.parametrize("member,law", ZOO_CASES, ids=[f"{m}-{lw}" for m, lw in ZOO_CASES])
+def test_law_fails_on_zoo_member(member, law):
+    op = zoo.build(member)
+    r = OPERATOR_CHECKS[law](op, seed=0, examples=40)
+    assert r.status == "failed", str(r)
+    assert r.worst is not None and not r.worst <= r.bound
+    cex = r.counterexample
+    assert cex["seed"] == 0 and {"x1", "x2", "lam", "mu", "nu", "t"} <= set(cex)
+    assert r.check == law and r.subject == member and r.seed == 0
+    # the shrunk counterexample reproduces on a fresh operator, without hypothesis
+    again = OPERATOR_CHECKS[law](zoo.build(member), sample=cex)
+    assert again.status == "failed", str(again)
+
+
+def test_counterexamples_are_shrunk():
+    """Hypothesis shrinks: a nonexpansiveness failure of the explicit step is reported on simple inputs."""
+    r = OPERATOR_CHECKS["resolvent_nonexpansive"](zoo.build("explicit_step"), seed=1, examples=40)
+    cex = r.counterexample
+    assert r.status == "failed"
+    assert np.count_nonzero(cex["x1"]) + np.count_nonzero(cex["x2"]) <= 2
+    assert all(float(v).is_integer() for v in cex["x1"] + cex["x2"])
+
+
+@pytest.mark.parametrize("op", catalog(2) + catalog(3)[:3], ids=lambda op: f"{op.name}/{op.dim}")
+def test_no_law_fails_on_catalog_operator(op):
+    for seed in (0, 1):
+        report = check_operator(op, seed=seed, examples=6)
+        assert isinstance(report, Report) and len(report) == len(LAWS)
+        assert report.ok, "\n".join(str(r) for r in report.failures)
+        assert report.counts["skipped"] == 0, [str(r) for r in report if r.status == "skipped"]
+
+
+def test_unsupported_members_are_skipped_not_passed():
+    op = operator_from_resolvent(lambda x, lam, t: np.asarray(x) / (1.0 + lam), 2, name="scaled")
+    report = check_operator(op, seed=0, examples=5)
+    skipped = {r.check for r in report if r.status == "skipped"}
+    assert skipped == {"resolvent_in_domain", "yosida_in_graph", "yosida_bounded_by_min_norm", "yosida_limit",
+                       "min_norm_in_graph", "min_norm_least"}
+    assert all(r.message for r in report if r.status == "skipped")
+    assert report.counts["passed"] == len(LAWS) - len(skipped)
+
+
+def test_exceptions_and_nonfinite_values_are_failures():
+    def raising(x, lam, t):
+        if np.asarray(x)[0] > 1.0:
+            raise ValueError("no convergence")
+        return np.asarray(x) / (1.0 + lam)
+    r = run_law("resolvent_nonexpansive", operator_from_resolvent(raising, 1, name="raising"), seed=0, examples=30)
+    assert r.status == "failed" and "ValueError" in r.message
+    nan = operator_from_resolvent(lambda x, lam, t: np.full_like(np.asarray(x, float), np.nan), 1, name="nan")
+    r = run_law("resolvent_single_valued", nan, seed=0, examples=5)
+    assert r.status == "failed" and "non-finite" in r.message
+
+
+def test_registry_names_are_stable_and_seeded_runs_reproduce():
+    names = [name for name, _ in operator_checks()]
+    assert names == list(LAWS) == list(OPERATOR_CHECKS)
+    assert all(OPERATOR_CHECKS[n].__name__ == f"check_{n}" for n in names)
+    op = catalog(2)[0]
+    a = check_operator(op, seed=123, examples=5)
+    b = check_operator(op, seed=123, examples=5)
+    assert [r.worst for r in a] == [r.worst for r in b]
+    assert a.meta["seed"] == 123 and all(r.seed == 123 for r in a)
+    c = check_operator(op, examples=3)           # no seed: a fresh one is drawn and recorded
+    assert isinstance(c.meta["seed"], int) and all(r.seed == c.meta["seed"] for r in c)
+    assert [r.check for r in c] == names
+
+
+def test_nondeterministic_operator_does_not_escape_as_an_exception():
+    r = run_law("resolvent_single_valued", zoo.build("nondeterministic"), seed=5, examples=20)
+    assert r.status == "failed"

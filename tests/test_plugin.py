@@ -1,0 +1,102 @@
+"""The pytest plugin in a fresh project that only has verimono installed (pytester, separate processes)."""
+
+from __future__ import annotations
+
+import json
+from importlib import metadata
+
+import pytest
+
+pytest_plugins = ["pytester"]
+
+
+def _plugin_args() -> list[str]:
+    """``-p verimono.plugin`` unless the ``pytest11`` entry point already loads it."""
+    eps = metadata.entry_points(group="pytest11")
+    registered = any(ep.value.split(":")[0] == "verimono.plugin" for ep in eps)
+    return [] if registered else ["-p", "verimono.plugin"]
+
+
+PROJECT_TEST = '''
+import pytest
+import verimono as vm
+from verimono.checks.orders import check_convergence_order
+from verimono.reference import get
+from verimono.results import CheckResult, emit
+
+
+def test_order_of_the_scheme(verimono_report):
+    rec = verimono_report.add(check_convergence_order(vm.solve, get("t|x| (n=1)")))
+    assert rec.ok
+
+
+def test_emitted_record_is_collected():
+    emit(CheckResult("my_law", "my operator", "{status}", worst=0.5, bound=1.0))
+
+
+def test_plain_test_without_records():
+    assert 1 + 1 == 2
+
+
+@pytest.mark.xfail(strict=True, reason="declared broken")
+def test_declared_failure():
+    emit(CheckResult("known_bad", "op", "failed", worst=2.0, bound=1.0))
+    raise AssertionError("known_bad failed")
+'''
+
+
+def run(pytester: pytest.Pytester, *args: str, status: str = "passed", **env: str) -> pytest.RunResult:
+    pytester.makepyfile(test_project=PROJECT_TEST.format(status=status))
+    for k, v in env.items():
+        pytester._monkeypatch.setenv(k, v)
+    return pytester.runpytest_subprocess(*_plugin_args(), "-p", "no:cacheprovider", *args)
+
+
+def test_report_option_writes_the_report_and_baseline_option_gates(pytester):
+    first = run(pytester, "--verimono-report", "base")
+    first.assert_outcomes(passed=3, xfailed=1)
+    first.stdout.fnmatch_lines(["*verimono*", "3 verimono records: 2 passed, 0 failed, 0 skipped, 1 xfail*"])
+    doc = json.loads((pytester.path / "base" / "results.json").read_text())
+    assert doc["meta"]["command"] == "pytest"
+    keys = {r["check"]: r for r in doc["results"]}
+    assert set(keys) == {"convergence_order", "my_law", "known_bad"}
+    assert keys["known_bad"]["status"] == "xfail" and "declared broken" in keys["known_bad"]["message"]
+    assert keys["my_law"]["details"]["pytest_nodeid"] == "test_project.py::test_emitted_record_is_collected"
+    assert len(doc["studies"]) == 1
+    html = (pytester.path / "base" / "report.html").read_text()
+    assert "<svg" in html and 'id="laws"' in html
+
+    baseline = pytester.path / "base" / "results.json"
+    green = run(pytester, f"--verimono-baseline={baseline}")
+    assert green.ret == 0
+    green.stdout.fnmatch_lines(["verimono gate: no regressions*"])
+    # every test still passes, but a record that passed in the baseline now fails: the session goes red
+    red = run(pytester, f"--verimono-baseline={baseline}", status="failed")
+    red.assert_outcomes(passed=3, xfailed=1)
+    assert red.ret == 1
+    red.stdout.fnmatch_lines(["*REGRESSION status   my_law?my operator?: passed → failed: worst 0.5 within bound 1*",
+                              "verimono gate: 1 regression*"])
+
+
+def test_garbled_baseline_is_a_usage_error(pytester):
+    (pytester.path / "garbled.json").write_text("{not json")
+    result = run(pytester, "--verimono-baseline=garbled.json")
+    assert result.ret == pytest.ExitCode.USAGE_ERROR
+    result.stderr.fnmatch_lines(["*verimono baseline unusable*not valid JSON*"])
+
+
+def test_hypothesis_profiles_follow_the_environment(pytester):
+    pytester.makepyfile(test_profile='''
+        from hypothesis import settings
+
+        def test_profile():
+            s = settings.default
+            print("PROFILE", s.derandomize, s.deadline, s.database, s.max_examples)
+    ''')
+    pytester._monkeypatch.setenv("CI", "1")
+    pytester._monkeypatch.delenv("HYPOTHESIS_PROFILE", raising=False)
+    ci = pytester.runpytest_subprocess(*_plugin_args(), "-s", "-p", "no:cacheprovider")
+    ci.stdout.fnmatch_lines(["*PROFILE True None None 50*"])
+    pytester._monkeypatch.setenv("HYPOTHESIS_PROFILE", "thorough")
+    thorough = pytester.runpytest_subprocess(*_plugin_args(), "-s", "-p", "no:cacheprovider")
+    thorough.stdout.fnmatch_lines(["*PROFILE False None * 500*"])

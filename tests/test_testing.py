@@ -1,0 +1,108 @@
+"""verimono.testing.parametrize_with_checks, run inside pytest sessions (pytester): stable ids, ``-k``
+selection, strict expected failures, counted skips, loud errors for a shrinking battery, and the
+three-line user battery."""
+
+from __future__ import annotations
+
+import re
+
+from verimono.checks.trajectory_laws import LAWS
+from verimono.reference import get
+from verimono.testing import check_id, checks_for
+
+pytest_plugins = ["pytester"]
+
+STEPPER_FILE = '''
+import sys
+sys.path.insert(0, {tests!r})
+from verimono.reference import get
+from verimono.testing import parametrize_with_checks
+from zoo_steppers import amplifier
+
+PROBLEMS = [get("t|x| (n=1)"), get("static ball, x0 outside (jump)")]
+
+@parametrize_with_checks([amplifier], problems=PROBLEMS, expected_failed_checks={xfail!r}{extra})
+def test_battery(subject, check):
+    check(subject)
+'''
+
+
+def _write(pytester, xfail, extra=""):
+    import pathlib
+
+    tests = str(pathlib.Path(__file__).parent)
+    pytester.makepyfile(test_battery=STEPPER_FILE.format(tests=tests, xfail=xfail, extra=extra))
+
+
+def _ids(result):
+    return [line.split("::", 1)[1] for line in result.outlines if "::test_battery[" in line]
+
+
+def test_ids_are_stable_readable_and_selectable(pytester):
+    _write(pytester, {})
+    first = _ids(pytester.runpytest_inprocess("--collect-only", "-q", "-p", "verimono.testing"))
+    second = _ids(pytester.runpytest_inprocess("--collect-only", "-q", "-p", "verimono.testing"))
+    assert first == second and len(first) == 2 * (1 + len(LAWS))
+    assert "test_battery[amplifier-contraction-t_x_n=1]" in first
+    assert all(re.fullmatch(r"test_battery\[[\w.=+-]+\]", i) for i in first)
+    res = pytester.runpytest_inprocess("-q", "-p", "verimono.testing", "-k", "in_domain and t_x")
+    res.assert_outcomes(passed=1)
+
+
+def test_strict_xfail_skips_counted_and_summary(pytester):
+    # amplifier on t|x|: contraction fails (expected), in_domain passes (wrongly expected -> XPASS strict)
+    _write(pytester, {"contraction[t|x| (n=1)]": "amplifies differences",
+                      "amplifier-in_domain-t_x_n=1": "wrongly expected to fail"})
+    res = pytester.runpytest_inprocess("-q", "-rsxX", "-p", "verimono.testing")
+    truth = {}
+    for p in (get("t|x| (n=1)"), get("static ball, x0 outside (jump)")):
+        from zoo_steppers import amplifier
+        for name, fn in checks_for(amplifier, problems=[p]):
+            truth[name] = fn(amplifier).status
+    failed = sum(s == "failed" for s in truth.values()) - 1          # contraction[t|x|] is an xfail
+    skipped = sum(s == "skipped" for s in truth.values())
+    passed = sum(s == "passed" for s in truth.values()) - 1          # in_domain[t|x|] is an xpass(strict)
+    assert skipped >= 3
+    res.assert_outcomes(passed=passed, failed=failed + 1, skipped=skipped, xfailed=1)
+    out = res.stdout.str()
+    assert "[XPASS(strict)] wrongly expected to fail" in out
+    assert "verimono checks" in out
+    assert f"{len(truth)} collected, {len(truth)} ran: {passed} passed, {failed} failed, {skipped} skipped, " \
+           f"1 xfailed (expected), 1 xpassed" in out
+    assert "skipped x1: x0 is outside cl dom F(0,·) (catching-up jump)" in out
+    assert "counterexample: problem='t|x| (n=1)'" in out          # failing records print their counterexample
+
+
+def test_unknown_expected_failure_is_an_error(pytester):
+    _write(pytester, {"no_such_law": "typo"})
+    res = pytester.runpytest_inprocess("-q")
+    assert res.ret != 0 and "names checks that do not exist: ['no_such_law']" in res.stdout.str()
+
+
+def test_shrinking_battery_is_an_error(pytester):
+    _write(pytester, {}, extra=", min_checks=100")
+    res = pytester.runpytest_inprocess("-q")
+    assert res.ret != 0 and "checks were lost" in res.stdout.str()
+
+
+def test_user_operator_in_three_lines(pytester):
+    pytester.makepyfile(test_mine='''
+import numpy as np
+from verimono import operator_from_resolvent
+my_operator = operator_from_resolvent(lambda x, lam, t: np.asarray(x) / (1.0 + lam), 2, name="identity_map")
+
+from verimono.testing import parametrize_with_checks
+@parametrize_with_checks([my_operator], examples=10)
+def test_my_operator(subject, check): check(subject)
+''')
+    res = pytester.runpytest_inprocess("-q", "-p", "verimono.testing")
+    n = len(checks_for(__import__("verimono").operator_from_resolvent(lambda x, l, t: x, 2)))
+    outcomes = res.parseoutcomes()
+    assert outcomes.get("failed", 0) == 0 and outcomes.get("passed", 0) + outcomes.get("skipped", 0) == n
+    assert outcomes.get("skipped", 0) >= 1            # no min_norm / contains: those laws are skipped, counted
+    assert f"{n} collected, {n} ran" in res.stdout.str()
+
+
+def test_check_id():
+    assert check_id("selections[t|x| (n=1)]") == "selections-t_x_n=1"
+    assert check_id("monotone") == "monotone"

@@ -1,0 +1,116 @@
+"""The trajectory laws: each seen failing on a broken stepper of the zoo (with a shrunk, reproducing
+counterexample), none failing on verimono.solve over the reference catalog and 20 seeded problems, and
+the bounds computed exactly as the paper's lemmas define them."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from verimono import Problem, solve, uniform_grid
+from verimono.checks.orders import check_stepper
+from verimono.checks.sample_problems import sample_problem
+from verimono.checks.trajectory_laws import (CHECKS, LAWS, LGBounds, YBBounds, check_contraction,
+                                             check_in_domain, reproduce, stepper_checks)
+from verimono.reference import catalog, get
+from verimono.results import FAILED, PASSED, SKIPPED
+
+from zoo_steppers import BREAKS, ZOO, amplifier, drops_input, lagged_step, wrong_time
+
+STEP_LOCAL = [law for law in LAWS if law != "unique_limit"]
+
+
+@pytest.mark.parametrize("law", LAWS)
+def test_every_law_fails_on_a_zoo_member(law):
+    member, ref, _ = BREAKS[law]
+    problem = get(ref)
+    rec = CHECKS[law](member, problem)
+    assert rec.status == FAILED, str(rec)
+    assert rec.worst > rec.bound == 1.0
+    cx = rec.counterexample
+    assert cx["problem"] == ref and "x0" in cx
+    again = reproduce(member, problem, rec)            # the counterexample alone reproduces the failure
+    assert again.status == FAILED, str(again)
+    if law in STEP_LOCAL:
+        assert cx["shrunk"] is True                   # shrunk to the shortest failing prefix [0, t_k]
+        assert len(cx["grid"]) == cx["k"] + 1 <= 41 and cx["T"] == pytest.approx(cx["grid"][-1])
+        assert reproduce(solve, problem, rec).status != FAILED   # same inputs, correct stepper: no failure
+    else:
+        assert len(cx["distances"]) == len(cx["levels"]) and cx["distances"][-1] > 0.5 * max(cx["distances"][:-1])
+
+
+def test_other_zoo_members_are_caught_too():
+    assert check_in_domain(wrong_time, get("translating ball")).status == FAILED
+    assert CHECKS["selections"](drops_input, get("Lipschitz field and input")).status == FAILED
+    # h_k instead of h_{k+1}: invisible on a uniform partition, caught on a nonuniform one
+    p = get("linear x' = -Mx")
+    assert CHECKS["selections"](lagged_step, p, grids={"uniform": uniform_grid(p.T, steps=40)}).status == PASSED
+    assert CHECKS["selections"](lagged_step, p).status == FAILED
+    for member in ZOO:   # every member of the zoo is caught by some law on some reference
+        assert any(CHECKS[law](member, q).status == FAILED for q in catalog()[:12] for law in LAWS), member
+
+
+@pytest.fixture(scope="module")
+def solve_on_catalog():
+    return check_stepper(solve, catalog(), orders=False)
+
+
+def test_no_false_alarm_on_the_catalog(solve_on_catalog):
+    assert solve_on_catalog.ok, "\n".join(map(str, solve_on_catalog.failures))
+    assert len(solve_on_catalog) == len(catalog()) * len(LAWS)
+    for law in LAWS:     # every law actually ran on some reference (not all skipped)
+        assert any(r.status == PASSED for r in solve_on_catalog.by_check(law)), law
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_no_false_alarm_on_generated_problems(seed):
+    p = sample_problem(seed)
+    recs = [CHECKS[law](solve, p, seed=seed) for law in LAWS]
+    assert not [r for r in recs if r.status == FAILED], [str(r) for r in recs if r.status == FAILED]
+    assert sum(r.status == PASSED for r in recs) >= 4
+
+
+def test_lemma_constants_are_the_papers():
+    # t|x| from x0 = 1 on [0, 2]: φ ≡ 0, σ(s) = s: α = 1, ∫σ = 2, β = 1 + 2·2 = 5, γ = 5, ψ(t) = t + 3t²
+    lg = LGBounds(1.0, lambda s: 0.0, lambda s: s, 2.0)
+    assert (lg.alpha, lg.beta, lg.gamma) == pytest.approx((1.0, 5.0, 5.0))
+    assert lg.psi_nodes(np.array([0.0, 1.0, 2.0])) == pytest.approx([0.0, 4.0, 14.0])
+    # (YB) with θ(s) = s: α = 2(θ(2) - θ(0)) + |F^0(0, x0)| = 4 + 0, β = 1 + 4·2, ψ(t) = 4t
+    p = get("t|x| (n=1)")
+    yb = YBBounds(p.x0, p.theta, p.operator, p.T)
+    assert (yb.alpha, yb.beta) == pytest.approx((4.0, 9.0))
+    # with an input (lemma l:extinput): φ̄ = φ + ∫|u|, σ̄ = σ(1 + ∫_0^T|u|)
+    lgu = LGBounds(1.0, lambda s: 0.0, lambda s: 1.0, 1.0, absu=lambda s: 2.0)
+    assert lgu.alpha == pytest.approx(3.0) and lgu.beta == pytest.approx(3.0 + 2.0 + 4.0 * 3.0)
+
+
+def test_contraction_with_lipschitz_field_uses_exp_Lt():
+    p = get("Lipschitz field and input")
+    rec = check_contraction(solve, p)
+    assert rec.status == PASSED and rec.details["L"] == p.lipschitz
+    # the explicit f contracts with factor (1 + hL) <= e^{hL}; an undeclared expansion breaks it
+    assert rec.details["global_ratio"] <= 1.0
+    bad = Problem(p.operator, p.x0, p.T, f=p.f, u=p.u, lipschitz=0.0, name="L understated")
+    assert check_contraction(solve, bad).status in (PASSED, FAILED)   # runs; L = 0 is a claim it may refute
+    assert check_contraction(amplifier, p).status == FAILED
+
+
+def test_psi_interpolant_hits_the_nodes():
+    p = get("t|x| (n=1)")
+    t = uniform_grid(p.T, steps=10)
+    tr = solve(p, t)
+    psi = lambda s: s + 3 * s * s  # noqa: E731
+    assert tr.interpolate(t, kind="psi", psi=psi) == pytest.approx(tr.x)     # e:x delta at tk
+
+
+def test_skips_say_why():
+    rec = CHECKS["bounds_lg"](solve, get("static ball, x0 outside (jump)"))
+    assert rec.status == SKIPPED and "closure" in rec.message
+
+
+def test_battery_generator_is_the_runners():
+    names = [n for n, _ in stepper_checks(solve, [get("t|x| (n=1)")])]
+    assert names == ["convergence_order[t|x| (n=1)]"] + [f"{law}[t|x| (n=1)]" for law in LAWS]
+    rep = check_stepper(amplifier, [get("t|x| (n=1)")])
+    assert [r.check for r in rep] == ["convergence_order"] + list(LAWS)
+    assert {r.check for r in rep.failures} >= {"contraction", "bounds_lg", "bounds_yb", "selections"}

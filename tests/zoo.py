@@ -1,0 +1,151 @@
+"""A zoo of deliberately broken operators: each one is wrong in a way a real implementation can be, and
+``BREAKS[name]`` lists the operator laws (:data:`verimono.checks.LAWS`) it must be seen failing.
+
+Every member is built from correct catalog pieces plus one bug, so a law failing on it is evidence that
+the law detects that bug (a property test must be seen failing before it is trusted).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from verimono import L1Subdifferential, Linear, NormalCone, NormSubdifferential, operator_from_resolvent, sets
+from verimono.operators import Operator
+
+#: a monotone, non-symmetric matrix with ‖M‖ = √10: large λ make an explicit step expand
+_M = np.array([[3.0, 1.0], [-1.0, 1.0]])
+
+
+def explicit_step() -> Operator:
+    """``x - λMx`` (forward Euler) passed off as ``(I + λM)^{-1}x``: not firmly nonexpansive, expansive for
+    ``λ|M| > 2``, its "Yosida" ``Mx`` is not in ``F(J_λx) = {M(x - λMx)}``, the resolvent identity fails,
+    and ``(J_λx, Mx)`` are not monotone pairs of the graph."""
+    L = Linear(_M)
+    return operator_from_resolvent(lambda x, lam, t: x - lam * (x @ _M.T), 2, min_norm=L.min_norm,
+                                   project_domain=L.project_domain, contains=L.contains, name="explicit_step")
+
+
+def wrong_lambda() -> Operator:
+    """The resolvent of ``2λ`` returned for ``λ`` (a factor-2 bug): its Yosida value ``2Y_{2λ}`` is not in
+    ``F(J)`` and exceeds ``|F^0|`` in the limit.  Every λ-free law (nonexpansive, identity, …) holds."""
+    F = NormSubdifferential(1.0, 2)
+    return operator_from_resolvent(lambda x, lam, t: F.resolvent(x, 2 * lam, t), 2, min_norm=F.min_norm,
+                                   project_domain=F.project_domain, contains=F.contains, name="wrong_lambda")
+
+
+def shifted_projection() -> Operator:
+    """``N_S`` for ``S`` the unit ball whose "resolvent" projects onto ``S + (1/2, 0)``: ``J_λx`` leaves
+    ``dom F = S`` and ``Y_λx`` is not normal to ``S`` at ``J_λx``."""
+    S, e = sets.Ball([0.0, 0.0], 1.0), np.array([0.5, 0.0])
+    N = NormalCone(S)
+    return operator_from_resolvent(lambda x, lam, t: S.project(np.asarray(x) - e, t) + e, 2, min_norm=N.min_norm,
+                                   project_domain=N.project_domain, contains=N.contains, name="shifted_projection")
+
+
+def non_monotone_linear() -> Operator:
+    """``(I + λM)^{-1}`` for ``M = [[-1/2, 1/2], [-1/2, -1/2]]`` (``M + Mᵀ = -I``; eigenvalues
+    ``-1/2 ± i/2`` so ``I + λM`` is invertible for every λ): a correct resolvent of a non-monotone map.
+    With ``|1 + λm|² = 1 - λ + λ²/2``: expansive for ``λ < 2``, ``λ|Y_λ| > 1`` for ``λ > 1``, ``|Y_λx|``
+    increasing on ``λ < 1``; monotonicity of the graph and of ``Y_λ`` fail everywhere."""
+    M = np.array([[-0.5, 0.5], [-0.5, -0.5]])
+    return operator_from_resolvent(lambda x, lam, t: np.linalg.solve(np.eye(2) + lam * M, np.asarray(x)), 2,
+                                   min_norm=lambda x, t: M @ np.asarray(x),
+                                   project_domain=lambda x, t: np.array(x, dtype=float),
+                                   name="non_monotone_linear")
+
+
+def min_norm_not_least() -> Operator:
+    """``∂|·|`` on R² whose ``min_norm(0)`` returns ``(1, 0) ∈ F(0) = B`` instead of ``0``: an element of
+    the graph, but not the least-norm one."""
+    F = NormSubdifferential(1.0, 2)
+
+    def min_norm(x, t):
+        x = np.asarray(x, dtype=float)
+        return F.min_norm(x, t) if np.any(x) else np.array([1.0, 0.0])
+    return operator_from_resolvent(F.resolvent, 2, min_norm=min_norm, project_domain=F.project_domain,
+                                   contains=F.contains, name="min_norm_not_least")
+
+
+def min_norm_outside_graph() -> Operator:
+    """``∂‖·‖₁`` whose ``min_norm`` returns ``c·sgn(x)/2`` (a halved weight): outside ``F(x)`` wherever
+    ``x ≠ 0``, and smaller than ``|Y_λx| → c``."""
+    F = L1Subdifferential(1.0, 2)
+    return operator_from_resolvent(F.resolvent, 2, min_norm=lambda x, t: 0.5 * np.sign(np.asarray(x, dtype=float)),
+                                   project_domain=F.project_domain, contains=F.contains,
+                                   name="min_norm_outside_graph")
+
+
+def nondeterministic() -> Operator:
+    """A linear resolvent with random perturbations of size 1e-6 (e.g. an iterative solver with a random
+    start and a loose stopping rule): two calls at the same point disagree."""
+    L, rng = Linear(_M), np.random.default_rng(0)
+    return operator_from_resolvent(lambda x, lam, t: L.resolvent(x, lam, t) + 1e-6 * rng.standard_normal(2), 2,
+                                   min_norm=L.min_norm, project_domain=L.project_domain, contains=L.contains,
+                                   name="nondeterministic")
+
+
+def mutates_input() -> Operator:
+    """A soft-thresholding resolvent computed in place: correct value, but it overwrites the caller's ``x``."""
+    F = L1Subdifferential(1.0, 2)
+
+    def resolvent(x, lam, t):
+        x[...] = F.resolvent(x, lam, t)
+        return x
+    return operator_from_resolvent(resolvent, 2, min_norm=F.min_norm, project_domain=F.project_domain,
+                                   contains=F.contains, name="mutates_input")
+
+
+def ignores_time() -> Operator:
+    """The sweeping process of a ball moving along ``(2t, 0)`` whose resolvent always projects onto the
+    ball at ``t = 0`` (the set evaluated at the wrong time): wrong for every ``t > 0``."""
+    S = sets.Ball(lambda t: np.array([2.0 * t, 0.0]), 1.0)
+    N = NormalCone(S)
+    return operator_from_resolvent(lambda x, lam, t: S.project(x, 0.0), 2, min_norm=N.min_norm,
+                                   project_domain=N.project_domain, contains=N.contains, name="ignores_time")
+
+
+def stale_cache() -> Operator:
+    """A linear resolvent caching ``(I + λM)^{-1}`` for the first λ it sees and reusing it for every λ (a
+    cache keyed on nothing): the resolvent identity between two step sizes fails."""
+    L = Linear(_M)
+    cache: dict[str, np.ndarray] = {}
+
+    def resolvent(x, lam, t):
+        if "inv" not in cache:
+            cache["inv"] = np.linalg.inv(np.eye(2) + lam * _M)
+        return np.asarray(x, dtype=float) @ cache["inv"].T
+    return operator_from_resolvent(resolvent, 2, min_norm=L.min_norm, project_domain=L.project_domain,
+                                   contains=L.contains, name="stale_cache")
+
+
+def ignores_lambda() -> Operator:
+    """``(I + M)^{-1}`` returned whatever λ is (λ hard-coded to 1): it does not tend to the identity as
+    ``λ → 0`` on ``dom F`` (item iii)."""
+    L = Linear(_M)
+    return operator_from_resolvent(lambda x, lam, t: L.resolvent(x, 1.0, t), 2, min_norm=L.min_norm,
+                                   project_domain=L.project_domain, contains=L.contains, name="ignores_lambda")
+
+
+#: member name → (constructor, laws it must break)
+ZOO = {
+    "explicit_step": (explicit_step, ["resolvent_nonexpansive", "resolvent_firmly_nonexpansive", "resolvent_identity",
+                                      "monotone", "yosida_lipschitz", "yosida_in_graph"]),
+    "wrong_lambda": (wrong_lambda, ["yosida_in_graph", "yosida_bounded_by_min_norm", "yosida_limit"]),
+    "shifted_projection": (shifted_projection, ["resolvent_in_domain", "yosida_in_graph"]),
+    "non_monotone_linear": (non_monotone_linear, ["monotone", "resolvent_nonexpansive",
+                                                  "resolvent_firmly_nonexpansive", "yosida_lipschitz",
+                                                  "yosida_monotone", "yosida_nonincreasing"]),
+    "min_norm_not_least": (min_norm_not_least, ["min_norm_least", "yosida_limit"]),
+    "min_norm_outside_graph": (min_norm_outside_graph, ["min_norm_in_graph", "yosida_bounded_by_min_norm"]),
+    "nondeterministic": (nondeterministic, ["resolvent_single_valued"]),
+    "mutates_input": (mutates_input, ["resolvent_single_valued"]),
+    "ignores_time": (ignores_time, ["resolvent_in_domain", "yosida_in_graph"]),
+    "stale_cache": (stale_cache, ["resolvent_identity"]),
+    "ignores_lambda": (ignores_lambda, ["resolvent_limit", "resolvent_identity"]),
+}
+
+BREAKS = {name: laws for name, (_, laws) in ZOO.items()}
+
+
+def build(name: str) -> Operator:
+    return ZOO[name][0]()

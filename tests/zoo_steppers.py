@@ -1,0 +1,101 @@
+"""Deliberately broken steppers: each is a plausible mistake in implementing the paper's scheme
+
+    x_{k+1} = (I + h_{k+1} F(t_{k+1}, ·))^{-1}(x_k + h_{k+1} f(x_k) + ∫_{t_k}^{t_{k+1}} u)     (eq:iteration)
+
+and every trajectory law of :mod:`verimono.checks.trajectory_laws` must catch at least one of them.
+``BREAKS`` says which law each member is shown to break, on which reference problem and partition.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from verimono.errors import OutsideDomain
+from verimono.grids import validate_grid
+
+
+def _scheme(problem, t_grid, *, time=lambda t, k: t[k + 1], step=lambda h, k: h[k], drift_u=True,
+            post=None, explicit=False):
+    """The proximal scheme with one ingredient swapped out (the correct one by default)."""
+    t = validate_grid(t_grid, problem.T)
+    h = np.diff(t)
+    op, f = problem.operator, problem.f
+    dU = problem.input_increments(t) if drift_u else None
+    x = np.empty((len(t),) + problem.x0.shape)
+    x[0] = problem.x0
+    for k in range(len(h)):
+        z = x[k]
+        if f is not None:
+            z = z + h[k] * np.asarray(f(x[k]), dtype=float)
+        if dU is not None:
+            z = z + dU[k]
+        if explicit:
+            try:
+                y = np.asarray(op.min_norm(x[k], t[k]), dtype=float)
+            except OutsideDomain:
+                y = np.zeros_like(x[k])     # an explicit step knows nothing about the constraint
+            x[k + 1] = z - h[k] * y
+        else:
+            x[k + 1] = op.resolvent(z, step(h, k), time(t, k))
+        if post is not None:
+            x[k + 1] = post(problem, t, k, z, x[k + 1])
+    return x
+
+
+def wrong_time(problem, t_grid):
+    """Evaluates the operator at ``t_k`` instead of ``t_{k+1}`` (a lagged catching-up step)."""
+    return _scheme(problem, t_grid, time=lambda t, k: t[k])
+
+
+def drops_input(problem, t_grid):
+    """Forgets the input term ``∫u`` (keeps ``f``)."""
+    return _scheme(problem, t_grid, drift_u=False)
+
+
+def lagged_step(problem, t_grid):
+    """Uses the previous step ``h_k`` instead of ``h_{k+1}`` (the same on uniform partitions)."""
+    return _scheme(problem, t_grid, step=lambda h, k: h[max(k - 1, 0)])
+
+
+def mean_step(problem, t_grid):
+    """Uses the mean step ``T/K`` on every cell (right on uniform partitions only)."""
+    return _scheme(problem, t_grid, step=lambda h, k: float(np.mean(h)))
+
+
+def double_step(problem, t_grid):
+    """Uses ``2h`` — the inclusion ``x' ∈ -2F(t, x)`` instead of ``x' ∈ -F(t, x)``."""
+    return _scheme(problem, t_grid, step=lambda h, k: 2.0 * h[k])
+
+
+def explicit_euler(problem, t_grid):
+    """An explicit step ``x_{k+1} = x_k - h F^0(t_k, x_k)`` passed off as the proximal one."""
+    return _scheme(problem, t_grid, explicit=True)
+
+
+def leaves_domain(problem, t_grid):
+    """Pushes every iterate ``1e-3 (1 + |x|)`` beyond the resolvent's output, out of ``cl dom F``."""
+    def post(problem, t, k, z, x):
+        d = x - z                              # the correction the resolvent applied (inward normal)
+        nrm = float(np.linalg.norm(d))
+        push = d / nrm if nrm > 0 else np.ones_like(x) / np.sqrt(x.size)
+        return x + 1e-3 * (1.0 + float(np.linalg.norm(x))) * push * (-1.0 if nrm > 0 else 1.0)
+    return _scheme(problem, t_grid, post=post)
+
+
+def amplifier(problem, t_grid):
+    """Multiplies every iterate by ``1 + 5h`` — an undeclared expanding field ``f(x) = 5x``."""
+    return _scheme(problem, t_grid, post=lambda p, t, k, z, x: (1.0 + 5.0 * (t[k + 1] - t[k])) * x)
+
+
+ZOO = [wrong_time, drops_input, lagged_step, mean_step, double_step, explicit_euler, leaves_domain, amplifier]
+
+#: law -> (zoo member, reference name, partition kind) on which the law is shown to fail
+BREAKS = {
+    "contraction": (amplifier, "linear x' = -Mx", "uniform"),
+    "unique_limit": (mean_step, "t|x| (n=1)", "uniform/random/graded"),
+    "in_domain": (leaves_domain, "moving box", "uniform"),
+    "bounds_lg": (amplifier, "t|x| (n=1)", "uniform"),
+    "bounds_yb": (double_step, "linear x' = -Mx", "uniform"),
+    "psi_interpolation": (double_step, "linear x' = -Mx", "uniform"),
+    "selections": (wrong_time, "t|x| (n=1)", "uniform"),
+}

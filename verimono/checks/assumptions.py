@@ -1,0 +1,270 @@
+"""Evidence — never proof — for the assumptions of the paper's Theorem ``thm:main`` on a problem.
+
+``check_assumptions(problem)`` samples times ``s < t`` in ``[0, T]``, points ``p`` around ``x0`` and step
+sizes ``λ``, and uses only the operator's resolvent (plus ``min_norm``/``project_domain`` when provided):
+``z = J_λ p ∈ dom F(t,·)`` with ``Y_λ p ∈ F(t, z)`` (Prop. ``prop:maxmon-resolvent-Yosida`` v) gives graph
+points without knowing the domain.  One record per assumption:
+
+* ``assumption_A1`` — monotonicity ``⟨z1 - z2, y1 - y2⟩ ≥ 0`` on sampled graph pairs (resolvent pairs and
+  ``(z, F^0(z))``).  A violation disproves (A1).
+* ``assumption_A3`` — ``D(s,t) = max_z dist(z, dom F(t))`` over sampled ``z ∈ dom F(s)`` (``project_domain``);
+  the least nondecreasing ``φ̂`` with ``φ̂(t) - φ̂(s) ≥ D(s,t)`` on the sampled times is reported.  A stated
+  ``problem.phi`` below a sample disproves it.
+* ``assumption_LG`` — ``σ̂(t) = max |F^0(t,z)|/(1 + |z|)``; a stated ``problem.sigma`` below a sample is
+  disproved; without one, growth of the ratio by more than ``GROWTH_FLAG`` as ``λ`` (and with it ``z``'s
+  distance to the boundary of the domain) shrinks 1000-fold is reported as evidence that (LG) fails.
+* ``assumption_YB`` — ``D_λ(s) = |Y_λ(s+λ, z)| - |F^0(s, z)|`` (YB) and ``|Y_λ(s+λ, z)| - |Y_λ(s, z)|``
+  (YB'); the estimate ``θ̂(t) = ρ t`` with ``ρ = max D/λ``; a stated ``problem.theta`` with
+  ``θ(s+λ) - θ(s) < D`` is disproved; ``ρ(λ)`` growing like ``1/λ`` is evidence that (YB) fails (a moving
+  domain: ``|Y_λ(s+λ, z)| ≈ dist(z, dom F(s+λ))/λ``).
+
+Status ``passed`` means "no sample contradicts the assumption" (the message and ``details["evidence"]``
+say so); ``failed`` means a sample contradicts it (or the stated function) or the growth evidence above.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+
+from ..errors import OutsideDomain, VerimonoError
+from ..problem import Problem
+from ..results import FAILED, PASSED, SKIPPED, CheckResult, Report
+from ..tolerances import GROWTH_FLAG, RTOL, quotient_tolerance, tolerance
+
+EVIDENCE = "evidence from samples, not a proof"
+#: step sizes λ (relative to T) used to reach points of dom F(t,·) ever closer to its boundary
+LAMBDAS = (1.0, 1e-1, 1e-2, 1e-3)
+
+
+def _subject(problem: Problem) -> str:
+    return f"{problem.name}"
+
+
+class _Samples:
+    def __init__(self, problem: Problem, seed: int, points: int, times: int) -> None:
+        rng = np.random.default_rng(seed)
+        x0 = problem.x0[0] if problem.batched else problem.x0
+        self.problem, self.op, self.T = problem, problem.operator, problem.T
+        r = 1.0 + float(np.linalg.norm(x0))
+        base = rng.standard_normal((points, problem.dim))
+        scales = np.where(np.arange(points) % 2 == 0, 1.0, 3.0)[:, None] * r
+        self.points = np.vstack([x0[None, :], x0 + scales * base / np.linalg.norm(base, axis=1, keepdims=True)])
+        self.times = np.linspace(0.0, problem.T, times)
+        self.lambdas = [lam * problem.T for lam in LAMBDAS]
+
+    def graph(self, t: float, lam: float):
+        """``(z, y, p)`` with ``z = J_λ p ∈ dom F(t)``, ``y = Y_λ p ∈ F(t, z)``."""
+        J = np.array([np.asarray(self.op.resolvent(p, lam, t), dtype=float) for p in self.points])
+        return J, (self.points - J) / lam, self.points
+
+
+def _min_norm(op, z, t):
+    try:
+        return np.asarray(op.min_norm(z, t), dtype=float)
+    except OutsideDomain:
+        return None
+
+
+def _a1(S: _Samples) -> CheckResult:
+    worst, counter, pairs = -np.inf, None, 0
+    for t in S.times:
+        Z, Y, P = [], [], []
+        for lam in S.lambdas:
+            z, y, p = S.graph(float(t), lam)
+            Z.append(z), Y.append(y), P.append(np.abs(p).max(axis=1) / lam)
+        try:   # minimal sections at the sampled domain points
+            z = np.vstack(Z)
+            f0 = [_min_norm(S.op, zi, float(t)) for zi in z]
+            keep = [i for i, v in enumerate(f0) if v is not None]
+            Z.append(z[keep]), Y.append(np.array([f0[i] for i in keep]).reshape(-1, S.problem.dim))
+            P.append(np.abs(Y[-1]).max(axis=1) if keep else np.zeros(0))
+        except NotImplementedError:
+            pass
+        Z, Y, P = np.vstack(Z), np.vstack(Y), np.concatenate(P)
+        i, j = np.triu_indices(len(Z), 1)
+        dz, dy = Z[i] - Z[j], Y[i] - Y[j]
+        inner = np.sum(dz * dy, axis=1)
+        nz, ny = np.linalg.norm(dz, axis=1), np.linalg.norm(dy, axis=1)
+        tol = RTOL * (nz * (1.0 + np.maximum(P[i], P[j])) + ny * (1.0 + np.maximum(np.abs(Z[i]).max(1),
+                                                                                      np.abs(Z[j]).max(1))))
+        ratio = -inner / (tol + 1e-300)
+        pairs += len(i)
+        m = int(np.argmax(ratio))
+        if ratio[m] > worst:
+            worst = float(ratio[m])
+            counter = {"t": t, "z1": Z[i[m]], "y1": Y[i[m]], "z2": Z[j[m]], "y2": Y[j[m]], "inner": inner[m]}
+    status = FAILED if worst > 1.0 else PASSED
+    msg = (f"<z1 - z2, y1 - y2> = {counter['inner']:.3g} < 0 for graph points of F(t = {counter['t']:.4g})"
+           if status == FAILED else f"no non-monotone pair among {pairs} sampled graph pairs ({EVIDENCE})")
+    return CheckResult("assumption_A1", _subject(S.problem), status, worst=max(worst, 0.0), bound=1.0,
+                       counterexample=counter if status == FAILED else None, message=msg,
+                       details={"evidence": EVIDENCE, "pairs": pairs})
+
+
+def _a3(S: _Samples) -> CheckResult:
+    op, ts = S.op, S.times
+    n = len(ts)
+    D = np.zeros((n, n))
+    arg: dict[tuple[int, int], Any] = {}
+    for a in range(n):
+        Z = np.array([op.project_domain(p, float(ts[a])) for p in S.points])
+        for b in range(a + 1, n):
+            Q = np.array([op.project_domain(z, float(ts[b])) for z in Z])
+            d = np.linalg.norm(Z - Q, axis=1)
+            m = int(np.argmax(d))
+            D[a, b], arg[(a, b)] = float(d[m]), Z[m]
+    phi_hat = np.zeros(n)
+    for b in range(1, n):
+        phi_hat[b] = max(phi_hat[b - 1], max(phi_hat[a] + D[a, b] for a in range(b)))
+    rate = max((D[a, b] / (ts[b] - ts[a]) for a in range(n) for b in range(a + 1, n)), default=0.0)
+    details = {"evidence": EVIDENCE, "times": ts, "phi_hat": phi_hat, "max_rate": rate, "stated": S.problem.phi is not None}
+    if S.problem.phi is None:
+        return CheckResult("assumption_A3", _subject(S.problem), PASSED, details=details,
+                           message=f"estimated least φ: φ̂(T) - φ̂(0) = {phi_hat[-1]:.4g}, max rate {rate:.4g} ({EVIDENCE})")
+    phi = np.array([float(S.problem.phi(float(s))) for s in ts])
+    worst, counter = 0.0, None
+    for a in range(n):
+        for b in range(a + 1, n):
+            rhs = phi[b] - phi[a]
+            r = D[a, b] / (max(rhs, 0.0) + tolerance(D[a, b], phi[a], phi[b]))
+            if rhs < -tolerance(phi[a], phi[b]):
+                r = max(r, 2.0)        # a decreasing φ is not allowed by (A3)
+            if r > worst:
+                worst, counter = r, {"s": ts[a], "t": ts[b], "z": arg[(a, b)], "dist": D[a, b], "phi_s": phi[a],
+                                     "phi_t": phi[b]}
+    details["phi_stated"] = phi
+    status = FAILED if worst > 1.0 else PASSED
+    msg = (f"dist(z, dom F(t)) = {counter['dist']:.4g} > φ(t) - φ(s) = {counter['phi_t'] - counter['phi_s']:.4g} "
+           f"for z in dom F(s), s = {counter['s']:.4g}, t = {counter['t']:.4g}: the stated φ is contradicted"
+           if status == FAILED else f"stated φ bounds every sampled domain motion ({EVIDENCE})")
+    return CheckResult("assumption_A3", _subject(S.problem), status, worst=worst, bound=1.0, message=msg,
+                       counterexample=counter if status == FAILED else None, details=details)
+
+
+def _f0_norm(op, z, t, mu):
+    """``|F^0(t, z)|``, or the lower estimate ``|Y_μ z|`` when the operator has no ``min_norm``."""
+    try:
+        v = _min_norm(op, z, t)
+        return None if v is None else float(np.linalg.norm(v)), "min_norm"
+    except NotImplementedError:
+        return float(np.linalg.norm(op.yosida(z, mu, t))), "yosida lower estimate"
+
+
+def _lg(S: _Samples) -> CheckResult:
+    op, sigma = S.op, S.problem.sigma
+    by_lam = {}
+    worst, counter, how = 0.0, None, "min_norm"
+    sig_hat = np.zeros(len(S.times))
+    for lam in S.lambdas:
+        best = 0.0
+        for ti, t in enumerate(S.times):
+            z_all, _, _ = S.graph(float(t), lam)
+            for z in z_all:
+                val, how = _f0_norm(op, z, float(t), 1e-6 * S.T)
+                if val is None:
+                    continue
+                r = val / (1.0 + float(np.linalg.norm(z)))
+                best = max(best, r)
+                sig_hat[ti] = max(sig_hat[ti], r)
+                if sigma is not None:
+                    rhs = float(sigma(float(t))) * (1.0 + float(np.linalg.norm(z)))
+                    q = val / (rhs + tolerance(rhs, val))
+                    if q > worst:
+                        worst, counter = q, {"t": t, "z": z, "F0_norm": val, "sigma_t": float(sigma(float(t)))}
+        by_lam[lam] = best
+    lams = sorted(by_lam, reverse=True)
+    growth = by_lam[lams[-1]] / max(by_lam[lams[0]], 1e-12) if by_lam[lams[-1]] > 1e-9 else 1.0
+    details = {"evidence": EVIDENCE, "times": S.times, "sigma_hat": sig_hat, "sup_ratio_by_lambda": by_lam,
+               "growth": growth, "F0": how, "stated": sigma is not None}
+    if sigma is not None:
+        status = FAILED if worst > 1.0 else PASSED
+        msg = (f"|F^0(t,z)| = {counter['F0_norm']:.4g} > σ(t)(1 + |z|) at t = {counter['t']:.4g}: the stated σ is "
+               "contradicted" if status == FAILED else f"stated σ bounds every sample ({EVIDENCE})")
+        return CheckResult("assumption_LG", _subject(S.problem), status, worst=worst, bound=1.0, message=msg,
+                           counterexample=counter if status == FAILED else None, details=details)
+    if growth > GROWTH_FLAG:
+        return CheckResult("assumption_LG", _subject(S.problem), FAILED, worst=growth, bound=GROWTH_FLAG,
+                           details=details, counterexample={"sup_ratio_by_lambda": by_lam},
+                           message=f"sup |F^0(t,z)|/(1+|z|) grows {growth:.3g}-fold as z approaches the boundary "
+                                   f"of dom F: evidence that (LG) fails")
+    return CheckResult("assumption_LG", _subject(S.problem), PASSED, details=details,
+                       message=f"estimated σ̂ ≤ {float(np.max(sig_hat)):.4g} ({EVIDENCE}; F^0 by {how})")
+
+
+def _yb(S: _Samples) -> CheckResult:
+    op, theta, T = S.op, S.problem.theta, S.T
+    rates: dict[float, dict[str, float]] = {}
+    worst, counter = 0.0, None
+    has_f0 = True
+    for lam in S.lambdas[1:]:
+        rates[lam] = {"YB": 0.0, "YB'": 0.0}
+        for s in S.times:
+            s = float(s)
+            if s + lam > T + 1e-12:
+                continue
+            Z = np.array([np.asarray(op.resolvent(p, 0.1 * T, s), dtype=float) for p in S.points])  # z ∈ dom F(s)
+            for z in Z:
+                y_next = float(np.linalg.norm(op.yosida(z, lam, s + lam)))
+                y_now = float(np.linalg.norm(op.yosida(z, lam, s)))
+                tol = quotient_tolerance(lam, z)
+                cands = {"YB'": y_next - y_now}
+                if has_f0:
+                    try:
+                        f0 = _min_norm(op, z, s)
+                        if f0 is not None:
+                            cands["YB"] = y_next - float(np.linalg.norm(f0))
+                    except NotImplementedError:
+                        has_f0 = False
+                for key, d in cands.items():
+                    rates[lam][key] = max(rates[lam][key], d / lam)
+                    if theta is not None:
+                        rhs = float(theta(s + lam)) - float(theta(s))
+                        q = d / (max(rhs, 0.0) + tol) if d > 0 else 0.0
+                        if q > worst:
+                            worst, counter = q, {"form": key, "s": s, "lambda": lam, "z": z, "lhs": d, "rhs": rhs}
+    lams = sorted(rates, reverse=True)
+    key = "YB" if has_f0 else "YB'"
+    small, big = rates[lams[-1]][key], rates[lams[0]][key]
+    growth = small / max(big, 1e-12) if small > 1e-9 else 1.0
+    rho = max(r[key] for r in rates.values())
+    details = {"evidence": EVIDENCE, "rate_by_lambda": rates, "theta_hat_slope": rho, "growth": growth,
+               "form": key, "stated": theta is not None}
+    if theta is not None:
+        status = FAILED if worst > 1.0 else PASSED
+        msg = (f"{counter['form']}: |Y_λ(s+λ,z)| exceeds θ(s+λ) - θ(s) + ... by {counter['lhs'] - counter['rhs']:.3g} "
+               f"at s = {counter['s']:.4g}, λ = {counter['lambda']:.3g}: the stated θ is contradicted"
+               if status == FAILED else f"stated θ bounds every sampled Yosida increment ({EVIDENCE})")
+        return CheckResult("assumption_YB", _subject(S.problem), status, worst=worst, bound=1.0, message=msg,
+                           counterexample=counter if status == FAILED else None, details=details)
+    if growth > GROWTH_FLAG:
+        return CheckResult("assumption_YB", _subject(S.problem), FAILED, worst=growth, bound=GROWTH_FLAG,
+                           details=details, counterexample={"rate_by_lambda": rates},
+                           message=f"the Yosida increment per unit time grows {growth:.3g}-fold as λ shrinks "
+                                   f"1000-fold (like 1/λ: a moving domain): evidence that ({key}) fails")
+    return CheckResult("assumption_YB", _subject(S.problem), PASSED, details=details,
+                       message=f"estimated θ̂(t) = {rho:.4g} t ({key}; {EVIDENCE})")
+
+
+def check_assumptions(problem: Problem, *, seed: int = 0, points: int = 12, times: int = 7) -> Report:
+    """Sampled evidence for (A1), (A3), (LG) and (YB)/(YB') on ``problem`` (see the module docstring)."""
+    S = _Samples(problem, seed, points, times)
+    report = Report(meta={"subject": _subject(problem), "seed": seed, "evidence": EVIDENCE})
+    for name, fn in (("assumption_A1", _a1), ("assumption_A3", _a3), ("assumption_LG", _lg),
+                     ("assumption_YB", _yb)):
+        start = time.perf_counter()
+        try:
+            rec = fn(S)
+        except NotImplementedError as exc:
+            rec = CheckResult(name, _subject(problem), SKIPPED, message=f"not available: {exc}")
+        except (VerimonoError, ArithmeticError, ValueError) as exc:
+            rec = CheckResult(name, _subject(problem), FAILED, message=f"{type(exc).__name__}: {exc}")
+        rec.seed = seed
+        rec.duration = time.perf_counter() - start
+        report.add(rec)
+    return report
+
+
+__all__ = ["check_assumptions", "EVIDENCE", "LAMBDAS"]

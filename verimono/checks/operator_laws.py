@@ -1,0 +1,591 @@
+"""Operator laws: the paper's Proposition ``prop:maxmon-resolvent-Yosida`` (items i–vi) as checks.
+
+Every law is an inequality ``lhs ≤ rhs`` that holds exactly for a maximal monotone ``F(t,·)``; in
+floating point it is accepted when ``lhs ≤ rhs + slack``, with ``slack`` built from
+:func:`verimono.tolerances.tolerance` of the magnitudes involved (divided by ``λ`` where a Yosida value
+``(x - J_λ x)/λ`` amplifies the resolvent's error).  The recorded ratio of a sample is
+``lhs / (rhs + slack)`` and every check's bound is 1: ratios near 1 mean "tight" (e.g.
+``|J_λx - J_λy|² / ⟨J_λx - J_λy, x - y⟩`` for firm nonexpansiveness), and for laws with ``rhs = 0``
+(identities, membership) the ratio counts violations in units of the stated tolerance.
+
+Samples ``(x1, x2, λ, μ, ν, t)`` are drawn by hypothesis (:func:`law_samples`), which climbs toward
+violations through :func:`hypothesis.target` on the ratio and shrinks a failing sample.  Points known to
+lie in ``dom F(t,·)`` are produced as ``x = J_ν x1``, which comes with the graph element
+``y0 = Y_ν x1 ∈ F(t, x)`` (item v) — so the minimal-section laws need no knowledge of the domain.
+
+Each ``check_<law>(op, *, seed=None, examples=None, horizon=1.0, sample=None)`` returns one
+:class:`verimono.CheckResult`; it never prints or asserts.  A member the operator does not provide
+(``NotImplementedError``) makes the check *skipped*; an exception on a sample is a failure of that sample.
+``sample=`` evaluates one given :class:`Sample` (or its dict from a counterexample) without hypothesis,
+which is how a failure is replayed and how outer ``@given`` tests drive the laws.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+import random
+import time
+from typing import Any, Callable, Iterator
+
+import numpy as np
+import hypothesis
+import hypothesis.errors
+from hypothesis import HealthCheck, Phase, Verbosity, given, settings
+from hypothesis import strategies as st
+
+from ..operators import Operator
+from ..results import FAILED, PASSED, SKIPPED, CheckResult, Report
+from ..strategies import points, step_sizes, times
+from ..tolerances import LIMIT_FLOOR, RTOL, STALL_RATIO, STALL_WINDOW, tolerance
+
+#: hypothesis examples per law when ``examples`` is not given
+DEFAULT_EXAMPLES = 50
+#: every law's ratio ``lhs / (rhs + slack)`` must not exceed this
+BOUND = 1.0
+#: ratios handed to hypothesis.target are clipped to this (observations must be finite)
+_TARGET_CAP = 1e12
+#: tolerance multiples tried when grading a failed membership test ``y ∈ F(t, x)``
+_GRADES = tuple(10.0 ** k for k in range(0, 13, 2))
+
+
+# -- samples ----------------------------------------------------------------------------------------
+
+@dataclasses.dataclass(frozen=True)
+class Sample:
+    """Inputs of one evaluation: points ``x1, x2``, step sizes ``λ = lam, μ = mu, ν = nu`` and time ``t``."""
+
+    x1: np.ndarray
+    x2: np.ndarray
+    lam: float
+    mu: float
+    nu: float
+    t: float
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"x1": self.x1.tolist(), "x2": self.x2.tolist(), "lam": self.lam, "mu": self.mu,
+                "nu": self.nu, "t": self.t}
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> "Sample":
+        return cls(np.asarray(d["x1"], dtype=float), np.asarray(d["x2"], dtype=float), float(d["lam"]),
+                   float(d["mu"]), float(d["nu"]), float(d["t"]))
+
+    def __repr__(self) -> str:
+        f = lambda a: np.array2string(a, precision=17, separator=", ")  # noqa: E731 - exact replay
+        return (f"Sample(x1={f(self.x1)}, x2={f(self.x2)}, lam={self.lam!r}, mu={self.mu!r}, "
+                f"nu={self.nu!r}, t={self.t!r})")
+
+
+def law_samples(n: int, horizon: float = 1.0) -> st.SearchStrategy[Sample]:
+    """Samples for the laws on ``R^n``: ``x1`` from :func:`verimono.strategies.points`, ``x2`` either
+    independent or within ``10^-2`` of ``x1`` (local violations), ``λ, μ, ν ∈ [10^-3, 10]`` and
+    ``t ∈ [0, horizon]``; everything shrinks toward 0, 1 and ``t = 0``."""
+    @st.composite
+    def _draw(draw):
+        x1 = draw(points(n), label="x1")
+        if draw(st.booleans(), label="x2 near x1"):
+            x2 = x1 + draw(points(n, 1e-2), label="x2 - x1")
+        else:
+            x2 = draw(points(n), label="x2")
+        lam, mu, nu = (draw(step_sizes(), label=k) for k in ("lam", "mu", "nu"))
+        return Sample(x1, x2, lam, mu, nu, draw(times(horizon), label="t"))
+    return _draw()
+
+
+# -- evaluation helpers -----------------------------------------------------------------------------
+
+class _BadOutput(Exception):
+    """An operator member returned something that is not a finite point of the right shape."""
+
+
+@dataclasses.dataclass
+class _Eval:
+    """``lhs ≤ rhs + slack`` for one sample, with what was compared (for the message) and values."""
+
+    lhs: float
+    rhs: float
+    slack: float
+    what: str
+    info: dict[str, Any] = dataclasses.field(default_factory=dict)
+
+    @property
+    def ratio(self) -> float:
+        den = self.rhs + self.slack
+        if not (math.isfinite(self.lhs) and math.isfinite(den)):
+            return math.inf
+        if den > 0.0:
+            return self.lhs / den
+        return 0.0 if self.lhs <= 0.0 else math.inf
+
+
+def _point(value: Any, like: np.ndarray, member: str) -> np.ndarray:
+    y = np.asarray(value, dtype=float)
+    if y.shape != like.shape:
+        raise _BadOutput(f"{member} returned shape {y.shape} for a point of shape {like.shape}")
+    if not np.all(np.isfinite(y)):
+        raise _BadOutput(f"{member} returned non-finite values {y}")
+    return y
+
+
+def _J(op: Operator, x: np.ndarray, lam: float, t: float) -> np.ndarray:
+    return _point(op.resolvent(x.copy(), lam, t), x, "resolvent")
+
+
+def _F0(op: Operator, x: np.ndarray, t: float) -> np.ndarray:
+    return _point(op.min_norm(x.copy(), t), x, "min_norm")
+
+
+def _nrm(v: np.ndarray) -> float:
+    return float(np.linalg.norm(v))
+
+
+def _tol(*arrays: Any) -> float:
+    return tolerance(*arrays)
+
+
+def _graded_membership(op: Operator, x: np.ndarray, y: np.ndarray, t: float, tol: float) -> float:
+    """Smallest tried multiple ``g`` of ``tol`` with ``y ∈ F(t, x)`` up to ``g·tol`` (``inf`` if none)."""
+    for g in _GRADES:
+        if op.contains(x.copy(), y.copy(), t, g * tol):
+            return g
+    return math.inf
+
+
+def _domain_pair(op: Operator, s: Sample) -> tuple[np.ndarray, np.ndarray, float]:
+    """``x = J_ν x1 ∈ dom F(t,·)`` with ``y0 = Y_ν x1 ∈ F(t, x)`` and the tolerance of ``x``."""
+    x = _J(op, s.x1, s.nu, s.t)
+    return x, (s.x1 - x) / s.nu, _tol(s.x1, x)
+
+
+# -- the laws ---------------------------------------------------------------------------------------
+
+def _resolvent_single_valued(op, s):
+    x = s.x1.copy()
+    a = _point(op.resolvent(x, s.lam, s.t), s.x1, "resolvent")
+    moved = _nrm(x - s.x1)
+    b = _J(op, s.x1, s.lam, s.t)
+    tau = _tol(s.x1, a, b)
+    return _Eval(_nrm(a - b) + (math.inf if moved > 0 else 0.0), 0.0, tau,
+                 "|J_λx - J_λx| over two calls" + (f" (the call modified its input by {moved:.3g})" if moved else ""),
+                 {"J_first": a.tolist(), "J_second": b.tolist(), "input_modified_by": moved})
+
+
+def _resolvent_nonexpansive(op, s):
+    a, b = _J(op, s.x1, s.lam, s.t), _J(op, s.x2, s.lam, s.t)
+    tau = _tol(s.x1, s.x2, a, b)
+    return _Eval(_nrm(a - b), _nrm(s.x1 - s.x2), 4 * tau, "|J_λx1 - J_λx2| ≤ |x1 - x2|",
+                 {"J1": a.tolist(), "J2": b.tolist()})
+
+
+def _resolvent_firmly_nonexpansive(op, s):
+    a, b = _J(op, s.x1, s.lam, s.t), _J(op, s.x2, s.lam, s.t)
+    dJ, dx = a - b, s.x1 - s.x2
+    tau = _tol(s.x1, s.x2, a, b)
+    return _Eval(float(dJ @ dJ), float(dJ @ dx), 4 * tau * (_nrm(dJ) + _nrm(dx) + tau),
+                 "|J_λx1 - J_λx2|² ≤ ⟨J_λx1 - J_λx2, x1 - x2⟩", {"J1": a.tolist(), "J2": b.tolist()})
+
+
+def _resolvent_in_domain(op, s):
+    a = _J(op, s.x1, s.lam, s.t)
+    p = _point(op.project_domain(a.copy(), s.t), a, "project_domain")
+    return _Eval(_nrm(p - a), 0.0, 2 * _tol(s.x1, a), "dist(J_λx, cl dom F(t,·)) = 0",
+                 {"J": a.tolist(), "proj_dom_J": p.tolist()})
+
+
+def _resolvent_identity(op, s):
+    a = _J(op, s.x1, s.lam, s.t)
+    r = s.mu / s.lam
+    z = r * s.x1 + (1.0 - r) * a
+    b = _J(op, z, s.mu, s.t)
+    tau = _tol(s.x1, a, z)
+    return _Eval(_nrm(a - b), 0.0, tau * (4.0 + abs(1.0 - r)),
+                 "J_λx = J_μ((μ/λ)x + (1 - μ/λ)J_λx)", {"J_lam": a.tolist(), "J_mu_of_z": b.tolist(), "z": z.tolist()})
+
+
+def _resolvent_limit(op, s):
+    x, y0, tau = _domain_pair(op, s)
+    worst = None
+    for k in range(6):
+        lam = s.lam * 4.0 ** (-k)
+        d = _nrm(_J(op, x, lam, s.t) - x)
+        ev = _Eval(d, lam * _nrm(y0), tau * (4.0 + lam / s.nu), "|J_λx - x| ≤ λ|y| for x = J_νx1, y = Y_νx1 ∈ F(x)",
+                   {"x": x.tolist(), "y": y0.tolist(), "lam_at_worst": lam})
+        if worst is None or not ev.ratio <= worst.ratio:
+            worst = ev
+    return worst
+
+
+def _monotone(op, s):
+    a, b = _J(op, s.x1, s.lam, s.t), _J(op, s.x2, s.mu, s.t)
+    ya, yb = (s.x1 - a) / s.lam, (s.x2 - b) / s.mu
+    dx, dy = a - b, ya - yb
+    ex = 2 * _tol(s.x1, s.x2, a, b)
+    ey = ex * (1.0 / s.lam + 1.0 / s.mu)
+    return _Eval(-float(dx @ dy), 0.0, 2 * (ex * _nrm(dy) + ey * _nrm(dx) + ex * ey),
+                 "⟨x_a - x_b, y_a - y_b⟩ ≥ 0 for (x_a, y_a) = (J_λx1, Y_λx1), (x_b, y_b) = (J_μx2, Y_μx2)",
+                 {"xa": a.tolist(), "ya": ya.tolist(), "xb": b.tolist(), "yb": yb.tolist()})
+
+
+def _yosida_lipschitz(op, s):
+    a, b = _J(op, s.x1, s.lam, s.t), _J(op, s.x2, s.lam, s.t)
+    dY = ((s.x1 - a) - (s.x2 - b)) / s.lam
+    return _Eval(s.lam * _nrm(dY), _nrm(s.x1 - s.x2), 4 * _tol(s.x1, s.x2, a, b),
+                 "λ|Y_λx1 - Y_λx2| ≤ |x1 - x2|", {"J1": a.tolist(), "J2": b.tolist()})
+
+
+def _yosida_monotone(op, s):
+    a, b = _J(op, s.x1, s.lam, s.t), _J(op, s.x2, s.lam, s.t)
+    dx = s.x1 - s.x2
+    dY = (dx - (a - b)) / s.lam
+    return _Eval(-float(dY @ dx), 0.0, 4 * _tol(s.x1, s.x2, a, b) * _nrm(dx) / s.lam,
+                 "⟨Y_λx1 - Y_λx2, x1 - x2⟩ ≥ 0", {"J1": a.tolist(), "J2": b.tolist()})
+
+
+def _yosida_in_graph(op, s):
+    a = _J(op, s.x1, s.lam, s.t)
+    y = (s.x1 - a) / s.lam
+    tol = _tol(s.x1, a, s.lam * y) * (2.0 + 2.0 / s.lam)
+    g = _graded_membership(op, a, y, s.t, tol)
+    return _Eval(g, 0.0, 1.0, "Y_λx ∈ F(t, J_λx) (ratio: tolerance multiple needed)",
+                 {"J": a.tolist(), "Y": y.tolist(), "tol": tol})
+
+
+def _yosida_nonincreasing(op, s):
+    lo, hi = sorted((s.lam, s.mu))
+    if hi == lo:
+        hi = 2.0 * lo
+    a, b = _J(op, s.x1, lo, s.t), _J(op, s.x1, hi, s.t)
+    ylo, yhi = (s.x1 - a) / lo, (s.x1 - b) / hi
+    tau = _tol(s.x1, a, b)
+    return _Eval(_nrm(yhi), _nrm(ylo), 4 * tau * (1.0 / lo + 1.0 / hi),
+                 "|Y_μx| ≤ |Y_λx| for λ ≤ μ", {"lam": lo, "mu": hi, "Y_lam": ylo.tolist(), "Y_mu": yhi.tolist()})
+
+
+def _yosida_bounded_by_min_norm(op, s):
+    x, _, tau = _domain_pair(op, s)
+    f0 = _F0(op, x, s.t)
+    a = _J(op, x, s.lam, s.t)
+    y = (x - a) / s.lam
+    return _Eval(_nrm(y), _nrm(f0), 4 * _tol(x, a) / s.lam + 2 * tau / s.lam + _tol(f0),
+                 "|Y_λx| ≤ |F^0(t, x)| for x = J_νx1 ∈ dom F", {"x": x.tolist(), "Y": y.tolist(), "F0": f0.tolist()})
+
+
+def _yosida_limit(op, s):
+    x, _, tau = _domain_pair(op, s)
+    f0 = _nrm(_F0(op, x, s.t))
+    tx = _tol(x)
+    floor = 2 * LIMIT_FLOOR * tx / (1.0 + f0)
+    lam = max(s.lam, floor)
+    gaps, lams = [], []
+    while True:
+        a = _J(op, x, lam, s.t)
+        y = _nrm((x - a) / lam)
+        gap, slack = abs(f0 - y), _tol(f0, y) + 2 * tx / lam
+        gaps.append(gap)
+        lams.append(lam)
+        info = {"x": x.tolist(), "|F0|": f0, "lams": lams, "gaps": gaps}
+        if gap <= slack:
+            return _Eval(gap, 0.0, slack, "|Y_λx| → |F^0(t, x)| as λ → 0 (gap within tolerance)", info)
+        if lam / 2 < floor:
+            break
+        lam /= 2
+    w = min(STALL_WINDOW, len(gaps) - 1)
+    if w == 0:
+        return _Eval(gaps[-1], gaps[-1], slack, "|Y_λx| → |F^0(t, x)| (no room to halve λ)", info)
+    # the gap exceeds the rounding floor: it must at least still be shrinking
+    return _Eval(gaps[-1], STALL_RATIO * gaps[-1 - w], _tol(gaps[-1], gaps[-1 - w]),
+                 f"|Y_λx| → |F^0(t, x)|: gap ||F^0| - |Y_λx|| above tolerance {slack:.3g} must still shrink over "
+                 f"the last {w} halvings down to λ = {lams[-1]:.3g}", info)
+
+
+def _min_norm_in_graph(op, s):
+    x, _, _ = _domain_pair(op, s)
+    f0 = _F0(op, x, s.t)
+    tol = 2 * _tol(x, f0)
+    g = _graded_membership(op, x, f0, s.t, tol)
+    return _Eval(g, 0.0, 1.0, "F^0(t, x) ∈ F(t, x) (ratio: tolerance multiple needed)",
+                 {"x": x.tolist(), "F0": f0.tolist(), "tol": tol})
+
+
+def _min_norm_least(op, s):
+    x, y0, tau = _domain_pair(op, s)
+    f0 = _F0(op, x, s.t)
+    info = {"x": x.tolist(), "y": y0.tolist(), "F0": f0.tolist()}
+    try:   # y0 must be certified in F(t, x) where that can be tested (else yosida_in_graph fails)
+        if not op.contains(x.copy(), y0.copy(), s.t, _tol(x, y0) * (2.0 + 2.0 / s.nu)):
+            return _Eval(0.0, 0.0, 1.0, "uncertified y0 ∉ F(t, x): comparison skipped", info)
+    except NotImplementedError:
+        pass
+    return _Eval(_nrm(f0), _nrm(y0), 4 * tau / s.nu + _tol(f0),
+                 "|F^0(t, x)| ≤ |y| for x = J_νx1 and y = Y_νx1 ∈ F(t, x)", info)
+
+
+@dataclasses.dataclass(frozen=True)
+class Law:
+    """A law: stable ``name`` (the record's ``check``), its evaluator and the paper item it states."""
+
+    name: str
+    evaluate: Callable[[Operator, Sample], _Eval]
+    item: str
+
+
+LAWS: dict[str, Law] = {law.name: law for law in [
+    Law("resolvent_single_valued", _resolvent_single_valued, "prop:maxmon-resolvent-Yosida i–ii"),
+    Law("resolvent_nonexpansive", _resolvent_nonexpansive, "prop:maxmon-resolvent-Yosida ii"),
+    Law("resolvent_firmly_nonexpansive", _resolvent_firmly_nonexpansive, "prop:maxmon-resolvent-Yosida ii (A1)"),
+    Law("resolvent_in_domain", _resolvent_in_domain, "range J_λ = dom F"),
+    Law("resolvent_identity", _resolvent_identity, "resolvent identity"),
+    Law("resolvent_limit", _resolvent_limit, "prop:maxmon-resolvent-Yosida iii"),
+    Law("monotone", _monotone, "(A1)"),
+    Law("yosida_lipschitz", _yosida_lipschitz, "prop:maxmon-resolvent-Yosida iv"),
+    Law("yosida_monotone", _yosida_monotone, "prop:maxmon-resolvent-Yosida iv"),
+    Law("yosida_in_graph", _yosida_in_graph, "prop:maxmon-resolvent-Yosida v"),
+    Law("yosida_nonincreasing", _yosida_nonincreasing, "prop:maxmon-resolvent-Yosida vi"),
+    Law("yosida_bounded_by_min_norm", _yosida_bounded_by_min_norm, "prop:maxmon-resolvent-Yosida vi"),
+    Law("yosida_limit", _yosida_limit, "prop:maxmon-resolvent-Yosida vi"),
+    Law("min_norm_in_graph", _min_norm_in_graph, "minimal section F^0 = proj(0, F(x))"),
+    Law("min_norm_least", _min_norm_least, "minimal section F^0 = proj(0, F(x))"),
+]}
+
+
+# -- the driver -------------------------------------------------------------------------------------
+
+class _Violation(Exception):
+    """Raised inside the hypothesis test when a sample breaks the law (so hypothesis shrinks it)."""
+
+
+@dataclasses.dataclass
+class _State:
+    runs: int = 0
+    worst: float = -math.inf
+    worst_sample: Sample | None = None
+    worst_eval: _Eval | None = None
+    fail_sample: Sample | None = None
+    fail_eval: _Eval | None = None
+    unsupported: str | None = None
+
+
+def _evaluate(law: Law, op: Operator, s: Sample) -> _Eval:
+    try:
+        return law.evaluate(op, s)
+    except NotImplementedError:
+        raise
+    except Exception as exc:  # an operator that raises on a valid input fails that input
+        return _Eval(math.inf, 0.0, 1.0, f"raised {type(exc).__name__}: {exc}")
+
+
+def fresh_seed() -> int:
+    """A new 32-bit seed (recorded in every result so that a run can be repeated)."""
+    return random.SystemRandom().getrandbits(32)
+
+
+def _subject(op: Operator) -> str:
+    return getattr(op, "name", None) or repr(op)
+
+
+def run_law(law: Law | str, op: Operator, *, seed: int | None = None, examples: int | None = None,
+            horizon: float = 1.0, sample: Sample | dict | None = None) -> CheckResult:
+    """Check one law on ``op`` by hypothesis search (or on one given ``sample``)."""
+    law = LAWS[law] if isinstance(law, str) else law
+    start = time.perf_counter()
+    if sample is None:  # the search is seeded (a fresh recorded seed when none is given)
+        seed = fresh_seed() if seed is None else int(seed)
+    examples = DEFAULT_EXAMPLES if examples is None else int(examples)
+    state = _State()
+
+    def body(s: Sample, search: bool = True) -> None:
+        try:
+            ev = _evaluate(law, op, s)
+        except NotImplementedError as exc:
+            state.unsupported = str(exc) or type(exc).__name__
+            return
+        state.runs += 1
+        r = ev.ratio
+        if state.worst_eval is None or not r <= state.worst:
+            state.worst, state.worst_sample, state.worst_eval = r, s, ev
+        if search:  # climb toward violations (only inside the search, never in an outer test)
+            hypothesis.target(min(r, _TARGET_CAP) if r == r else _TARGET_CAP, label=law.name)
+        if not r <= BOUND:
+            state.fail_sample, state.fail_eval = s, ev
+            raise _Violation(law.name)
+
+    def searched(s: Sample) -> None:
+        body(s, True)
+
+    flaky = ""
+    if sample is not None:
+        s = Sample.from_dict(sample) if isinstance(sample, dict) else sample
+        try:
+            body(s, search=False)
+        except _Violation:
+            pass
+    else:
+        test = settings(database=None, max_examples=max(1, examples), deadline=None, derandomize=False,
+                        verbosity=Verbosity.quiet, print_blob=False, suppress_health_check=list(HealthCheck),
+                        phases=(Phase.generate, Phase.target, Phase.shrink))(
+            given(law_samples(op.dim, horizon))(searched))
+        test = hypothesis.seed(seed)(test)
+        try:
+            test()
+        except _Violation:
+            pass
+        except hypothesis.errors.Flaky as exc:  # a failure that did not reproduce on replay
+            flaky = f" (not reproducible on replay: {type(exc).__name__}; the operator is not deterministic)"
+    duration = time.perf_counter() - start
+    subject = _subject(op)
+    base = dict(check=law.name, subject=subject, seed=seed, duration=duration)
+    details = {"item": law.item, "examples": examples, "evaluations": state.runs, "horizon": horizon}
+
+    if state.fail_eval is None and state.unsupported is not None:
+        return CheckResult(status=SKIPPED, message=f"needs a member the operator lacks: {state.unsupported} "
+                                                   f"({state.runs} samples evaluated before)",
+                           details=details, **base)
+    if state.fail_eval is not None:
+        ev, s = state.fail_eval, state.fail_sample
+        cex = {**s.to_dict(), "seed": seed, "examples": examples, "horizon": horizon, "operator": repr(op),
+               "ratio": ev.ratio, "lhs": ev.lhs, "rhs": ev.rhs, "slack": ev.slack, **ev.info}
+        msg = (f"{ev.what}: lhs {ev.lhs:.6g} > rhs {ev.rhs:.6g} + slack {ev.slack:.3g} "
+               f"at {s!r}{flaky}")
+        return CheckResult(status=FAILED, worst=max(state.worst, ev.ratio), bound=BOUND, counterexample=cex,
+                           message=msg, details=details, **base)
+    if state.worst_sample is not None:
+        details["worst_sample"] = state.worst_sample.to_dict()
+        details["worst_info"] = {"what": state.worst_eval.what, "lhs": state.worst_eval.lhs,
+                                 "rhs": state.worst_eval.rhs, "slack": state.worst_eval.slack}
+    worst = state.worst if state.runs else None
+    return CheckResult(status=PASSED, worst=worst, bound=BOUND,
+                       message=f"{state.runs} samples" + (f"; {flaky}" if flaky else ""), details=details, **base)
+
+
+def check_resolvent_single_valued(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
+    """Items i–ii: ``J_λ`` is defined on all of ``R^n`` and single-valued — two calls on the same ``x``
+    return the same finite point of shape ``(n,)`` and leave ``x`` unchanged (ratio: |difference|/tol)."""
+    return run_law("resolvent_single_valued", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
+
+
+def check_resolvent_nonexpansive(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
+    """Item ii: ``|J_λx1 - J_λx2| ≤ |x1 - x2|`` (ratio ``|ΔJ| / (|Δx| + slack)``)."""
+    return run_law("resolvent_nonexpansive", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
+
+
+def check_resolvent_firmly_nonexpansive(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
+    """Item ii sharpened (equivalent to monotonicity of ``F``, (A1)):
+    ``|J_λx1 - J_λx2|² ≤ ⟨J_λx1 - J_λx2, x1 - x2⟩`` (ratio ``|ΔJ|² / (⟨ΔJ, Δx⟩ + slack)``)."""
+    return run_law("resolvent_firmly_nonexpansive", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
+
+
+def check_resolvent_in_domain(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
+    """``J_λx ∈ dom F(t,·)`` (``x = J_λx + λy`` with ``y ∈ F(t, J_λx)``): the projection onto
+    ``cl dom F(t,·)`` leaves ``J_λx`` in place (needs ``project_domain``; ratio: distance/tol)."""
+    return run_law("resolvent_in_domain", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
+
+
+def check_resolvent_identity(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
+    """Resolvent identity ``J_λx = J_μ((μ/λ)x + (1 - μ/λ)J_λx)`` for all ``λ, μ > 0`` (it holds because
+    ``x - J_λx ∈ λF(J_λx)``); catches resolvents with a wrong or stale step size (ratio: |difference|/tol)."""
+    return run_law("resolvent_identity", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
+
+
+def check_resolvent_limit(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
+    """Item iii, quantitatively: for ``x ∈ dom F`` and ``y ∈ F(x)``, ``|J_λx - x| ≤ λ|y|`` (nonexpansiveness
+    at ``J_λ(x + λy) = x``), hence ``J_λx → x`` as ``λ → 0``.  Tested at ``x = J_νx1``, ``y = Y_νx1`` over
+    ``λ, λ/4, …, λ/4^5`` (ratio ``|J_λx - x| / (λ|y| + slack)``)."""
+    return run_law("resolvent_limit", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
+
+
+def check_monotone(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
+    """(A1): the graph of ``F(t,·)`` is monotone, ``⟨x_a - x_b, y_a - y_b⟩ ≥ 0``, sampled through the
+    resolvent: ``(J_λx1, Y_λx1)`` and ``(J_μx2, Y_μx2)`` are graph elements (item v) for different step
+    sizes (ratio ``-⟨Δx, Δy⟩ / slack``)."""
+    return run_law("monotone", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
+
+
+def check_yosida_lipschitz(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
+    """Item iv: ``Y_λ`` is ``1/λ``-Lipschitz, ``λ|Y_λx1 - Y_λx2| ≤ |x1 - x2|``
+    (ratio ``λ|ΔY| / (|Δx| + slack)``)."""
+    return run_law("yosida_lipschitz", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
+
+
+def check_yosida_monotone(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
+    """Item iv: ``Y_λ`` is (maximal) monotone, ``⟨Y_λx1 - Y_λx2, x1 - x2⟩ ≥ 0``
+    (ratio ``-⟨ΔY, Δx⟩ / slack``)."""
+    return run_law("yosida_monotone", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
+
+
+def check_yosida_in_graph(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
+    """Item v: ``Y_λx ∈ F(t, J_λx)`` through ``contains`` (ratio: the smallest power-of-100 multiple of the
+    tolerance at which membership is accepted; 1 when it is accepted at the tolerance)."""
+    return run_law("yosida_in_graph", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
+
+
+def check_yosida_nonincreasing(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
+    """Item vi: ``λ ↦ |Y_λx|`` is nonincreasing, ``|Y_μx| ≤ |Y_λx|`` for ``λ ≤ μ`` (stated in the paper for
+    ``x ∈ dom F``; it holds for every ``x`` since ``Y_μ = (Y_λ)_{μ-λ}``) (ratio ``|Y_μx| / (|Y_λx| + slack)``)."""
+    return run_law("yosida_nonincreasing", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
+
+
+def check_yosida_bounded_by_min_norm(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
+    """Item vi: ``|Y_λx| ≤ |F^0(x)|`` for ``x ∈ dom F`` (at ``x = J_νx1``; needs ``min_norm``)
+    (ratio ``|Y_λx| / (|F^0(x)| + slack)``)."""
+    return run_law("yosida_bounded_by_min_norm", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
+
+
+def check_yosida_limit(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
+    """Item vi: ``|Y_λx| → |F^0(x)|`` as ``λ → 0`` for ``x ∈ dom F`` (needs ``min_norm``).  ``λ`` is halved
+    until the gap ``||F^0(x)| - |Y_λx||`` is within tolerance, or down to the rounding floor where the gap must
+    still be shrinking (``tolerances.STALL_RATIO`` over ``STALL_WINDOW`` halvings); a stalled positive gap
+    means ``min_norm`` is not the least-norm element or ``J_λ`` has the wrong ``λ``."""
+    return run_law("yosida_limit", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
+
+
+def check_min_norm_in_graph(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
+    """The minimal section lies in the graph: ``F^0(t, x) ∈ F(t, x)`` for ``x = J_νx1 ∈ dom F`` (needs
+    ``min_norm`` and ``contains``; ratio as for :func:`check_yosida_in_graph`)."""
+    return run_law("min_norm_in_graph", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
+
+
+def check_min_norm_least(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
+    """The minimal section has least norm, ``|F^0(t, x)| ≤ |y|`` for every ``y ∈ F(t, x)``: compared with
+    ``y = Y_νx1`` at ``x = J_νx1`` (item v; certified by ``contains`` when available)
+    (ratio ``|F^0(x)| / (|y| + slack)``)."""
+    return run_law("min_norm_least", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
+
+
+#: the registry: stable law name → check function, in the order they run
+OPERATOR_CHECKS: dict[str, Callable[..., CheckResult]] = {
+    name: globals()[f"check_{name}"] for name in LAWS
+}
+
+
+def operator_checks(op: Operator | None = None, *, seed: int | None = None, examples: int | None = None,
+                    horizon: float = 1.0) -> Iterator[tuple[str, Callable[[Operator], CheckResult]]]:
+    """Yield ``(name, check)`` for every operator law, ``check(op) -> CheckResult`` with the given settings
+    bound (like scikit-learn's ``_yield_all_checks``).  Names are stable and unique; the same generator
+    feeds :func:`check_operator` and the pytest integration.  ``op`` is accepted for symmetry with other
+    subjects' generators (all laws apply to every operator; unsupported members give skips)."""
+    for name, fn in OPERATOR_CHECKS.items():
+        check = functools.partial(fn, seed=seed, examples=examples, horizon=horizon)
+        functools.update_wrapper(check, fn)
+        yield name, check
+
+
+def check_operator(op: Operator, *, seed: int | None = None, examples: int | None = None,
+                   horizon: float = 1.0) -> Report:
+    """Run every operator law on ``op`` and return the :class:`verimono.Report` of their records.
+
+    ``seed`` makes the search reproducible (one fresh seed is drawn and recorded when ``None``);
+    ``examples`` is the number of hypothesis examples per law (default ``DEFAULT_EXAMPLES``); times are
+    sampled in ``[0, horizon]``.
+    """
+    seed = fresh_seed() if seed is None else int(seed)
+    report = Report(meta={"subject": _subject(op), "seed": seed,
+                          "examples": DEFAULT_EXAMPLES if examples is None else examples, "horizon": horizon})
+    for _, check in operator_checks(op, seed=seed, examples=examples, horizon=horizon):
+        report.add(check(op))
+    return report
+
+
+__all__ = ["Sample", "law_samples", "Law", "LAWS", "run_law", "fresh_seed", "OPERATOR_CHECKS", "operator_checks",
+           "check_operator", "DEFAULT_EXAMPLES", "BOUND"] + [f"check_{name}" for name in LAWS]

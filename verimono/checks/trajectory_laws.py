@@ -1,0 +1,709 @@
+"""Trajectory laws: properties every discrete solution of the paper's scheme must have.
+
+A *stepper* is a callable ``stepper(problem, t_grid)`` returning ``x_0, ..., x_K`` (shape ``(K+1, n)``);
+:func:`verimono.solve` is the reference one.  Each ``check_<law>(stepper, problem, ...)`` runs the stepper
+on a few partitions and returns one :class:`~verimono.results.CheckResult` whose ``worst`` is the largest
+observed ``lhs / (rhs + tol)`` (``bound = 1``) and whose ``counterexample`` reproduces a failure: the
+problem, the partition (shrunk to the shortest prefix ``[0, t_k]`` that still fails, re-verified), the
+initial points and the offending step.  :func:`reproduce` re-runs a law from a record.
+
+Laws (labels of the paper, Camlibel–Iannelli–Tanwani):
+
+* ``contraction`` — uniqueness argument (monotonicity of ``F(t,·)``, (A1)) and the Lipschitz-perturbation
+  theorem of Section 6: ``|x_k - x'_k| ≤ e^{L h_k} |x_{k-1} - x'_{k-1}|``, hence
+  ``|x_k - x'_k| ≤ e^{L t_k}|x_0 - x'_0|`` (``L = 0`` without ``f``; the scheme's explicit ``f`` gives
+  the factor ``1 + hL ≤ e^{hL}``; the input ``u`` cancels).
+* ``unique_limit`` — solutions on different (uniform, random, graded) partitions approach each other
+  as ``|Δ| → 0`` (the limit of ``x_Δ`` in Section 5.4 is the unique solution).
+* ``in_domain`` — ``x_k ∈ cl dom F(t_k, ·)`` (``e:x k+1 props.1``).
+* ``bounds_lg`` — lemma ``lem:bndSeq`` under (A3) and (LG): ``|x_k| ≤ β`` and
+  ``|x_k - x_{k-1}| ≤ ψ(t_k) - ψ(t_{k-1})`` with ``β, ψ`` of ``e:only beta``, ``eq:defPsi``; with an
+  input ``u``, applied to ``ξ_k = x_k - Φ(t_k)`` through lemma ``l:extinput`` (``φ̄ = φ + ∫|u|``,
+  ``σ̄ = σ (1 + ∫_0^T |u|)``).
+* ``bounds_yb`` — lemma ``lem:bndSeqYB`` under (YB): ``β = |x0| + αT``, ``ψ(t) = αt``,
+  ``α = 2(θ(T) - θ(0)) + |F^0(0, x0)|``.
+* ``psi_interpolation`` — lemma ``lem:bndEquiCont``: the ψ-interpolant ``x_Δ`` of ``e:x delta`` obeys
+  ``|x_Δ(τ̄) - x_Δ(τ)| ≤ ψ(τ̄) - ψ(τ)``.
+* ``selections`` — ``eq:iteration``: ``y_{k+1} = (x_k + h f(x_k) + ∫u - x_{k+1})/h_{k+1} ∈
+  F(t_{k+1}, x_{k+1})``, tested with ``operator.contains`` and with the resolvent characterisation
+  ``J_μ(x + μy) = x`` at ``μ = h/2`` (a different step than the scheme's).
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any, Callable, Iterable, Iterator, Sequence
+
+import numpy as np
+from scipy import integrate
+
+from ..errors import OutsideDomain, VerimonoError
+from ..grids import graded_grid, random_grid, uniform_grid, validate_grid
+from ..operators import L1Subdifferential, Linear, NormSubdifferential, Operator
+from ..problem import Problem
+from ..results import FAILED, PASSED, SKIPPED, CheckResult
+from ..stepping import Trajectory
+from ..tolerances import LIMIT_SHRINK, quotient_tolerance, tolerance
+
+#: cells of the default partitions (fine enough for the lemmas' bounds, fast enough for a battery)
+DEFAULT_CELLS = 40
+#: nonuniformity of the default random partition (cell lengths vary by a factor up to 4)
+RANDOM_SPREAD = 0.6
+#: cells of the three refinement levels of ``unique_limit`` (|Δ| shrinks 16-fold)
+LIMIT_LEVELS = (10, 40, 160)
+
+LAWS = ("contraction", "unique_limit", "in_domain", "bounds_lg", "bounds_yb", "psi_interpolation",
+        "selections")
+
+
+class _Skip(Exception):
+    """The law does not apply to this problem (the reason is the record's message)."""
+
+
+# -- helpers ----------------------------------------------------------------------------------------
+
+def _name(obj: Any) -> str:
+    return getattr(obj, "__name__", None) or getattr(obj, "name", None) or type(obj).__name__
+
+
+def with_changes(problem: Problem, **changes: Any) -> Problem:
+    """A copy of ``problem`` with some constructor arguments replaced (``x0``, ``T``, ``name``, ...)."""
+    kw = dict(f=problem.f, u=problem.u, exact=problem.exact, order=problem.order, name=problem.name,
+              U=problem.U, lipschitz=problem.lipschitz, phi=problem.phi, sigma=problem.sigma,
+              theta=problem.theta, steps=problem.steps, initial_jump=problem.initial_jump,
+              notes=problem.notes)
+    args = dict(operator=problem.operator, x0=problem.x0, T=problem.T)
+    for k, v in changes.items():
+        (args if k in args else kw)[k] = v
+    return Problem(args["operator"], args["x0"], args["T"], **kw)
+
+
+def _single(problem: Problem) -> Problem:
+    """The laws are stated per initial point: a batch is checked through its first row."""
+    return with_changes(problem, x0=problem.x0[0]) if problem.batched else problem
+
+
+def run_stepper(stepper: Callable, problem: Problem, grid: np.ndarray) -> np.ndarray:
+    """``stepper(problem, grid)`` as a float array of shape ``(K+1, n)``, finite (else ValueError)."""
+    x = np.asarray(stepper(problem, grid), dtype=float)
+    if x.shape != (len(grid),) + problem.x0.shape:
+        raise ValueError(f"stepper {_name(stepper)} returned shape {x.shape}, expected "
+                         f"{(len(grid),) + problem.x0.shape}")
+    if not np.all(np.isfinite(x)):
+        raise ValueError(f"stepper {_name(stepper)} returned non-finite states")
+    return x
+
+
+def default_grids(problem: Problem, seed: int = 0, cells: int = DEFAULT_CELLS) -> dict[str, np.ndarray]:
+    """A uniform and a random (nonuniform) partition of ``[0, T]`` with ``cells`` cells."""
+    return {"uniform": uniform_grid(problem.T, steps=cells),
+            "random": random_grid(problem.T, cells, seed=seed, spread=RANDOM_SPREAD)}
+
+
+def _as_grids(grids: Any, problem: Problem, seed: int) -> dict[str, np.ndarray]:
+    if grids is None:
+        return default_grids(problem, seed)
+    if isinstance(grids, dict):
+        return {k: validate_grid(g, problem.T) for k, g in grids.items()}
+    return {f"grid{i}": validate_grid(g, problem.T) for i, g in enumerate(grids)}
+
+
+def _norms(a: np.ndarray) -> np.ndarray:
+    return np.sqrt(np.sum(np.asarray(a, dtype=float) ** 2, axis=-1))
+
+
+def _vals(fn: Callable, t: Iterable[float]) -> np.ndarray:
+    return np.array([float(fn(float(s))) for s in t])
+
+
+def _cell_integrals(fn: Callable, t: np.ndarray) -> np.ndarray:
+    """``∫_{t_k}^{t_{k+1}} fn`` on every cell (adaptive quadrature; ``fn`` may be non-smooth)."""
+    return np.array([integrate.quad(lambda s: float(fn(s)), a, b, limit=100)[0] for a, b in zip(t[:-1], t[1:])])
+
+
+def _cumulative(fn: Callable, t: np.ndarray) -> np.ndarray:
+    return np.concatenate([[0.0], np.cumsum(_cell_integrals(fn, t))])
+
+
+class _Outcome:
+    """What one evaluation of a law on one partition found."""
+
+    def __init__(self, worst: float, k: int | None = None, counter: dict | None = None,
+                 details: dict | None = None) -> None:
+        self.worst, self.k, self.counter, self.details = float(worst), k, counter or {}, details or {}
+
+    @property
+    def failed(self) -> bool:
+        return not self.worst <= 1.0
+
+
+def _drive(law: str, stepper: Callable, problem: Problem, grids: dict[str, np.ndarray],
+           evaluate: Callable[[Problem, np.ndarray], _Outcome], *, shrink: bool = True,
+           message_ok: str = "", extra: dict | None = None) -> CheckResult:
+    """Run ``evaluate`` on every partition, keep the worst, shrink a failure to its shortest prefix."""
+    subject = f"{_name(stepper)} on {problem.name}"
+    start = time.perf_counter()
+    try:
+        problem = _single(problem)
+        outcomes = {g: evaluate(problem, t) for g, t in grids.items()}
+    except _Skip as exc:
+        return CheckResult(law, subject, SKIPPED, message=str(exc), duration=time.perf_counter() - start)
+    except NotImplementedError as exc:
+        return CheckResult(law, subject, SKIPPED, message=f"not available: {exc}",
+                           duration=time.perf_counter() - start)
+    except (VerimonoError, ArithmeticError, ValueError) as exc:
+        return CheckResult(law, subject, FAILED, message=f"{type(exc).__name__}: {exc}",
+                           counterexample={"problem": problem.name, "x0": problem.x0,
+                                           "grids": {g: t for g, t in grids.items()}},
+                           duration=time.perf_counter() - start)
+    gname = max(outcomes, key=lambda g: outcomes[g].worst)
+    out = outcomes[gname]
+    details = {"worst_by_grid": {g: o.worst for g, o in outcomes.items()}, **out.details, **(extra or {})}
+    if not out.failed:
+        return CheckResult(law, subject, PASSED, worst=out.worst, bound=1.0, message=message_ok,
+                           details=details, duration=time.perf_counter() - start)
+    grid = grids[gname]
+    counter = {"problem": problem.name, "T": problem.T, "x0": problem.x0, "grid": grid, "grid_kind": gname,
+               **out.counter, "shrunk": False}
+    if shrink and out.k is not None and 1 <= out.k < len(grid) - 1:
+        t_k = float(grid[out.k])
+        try:
+            small = with_changes(problem, T=t_k)
+            prefix = grid[:out.k + 1].copy()
+            again = evaluate(small, prefix)
+        except (_Skip, NotImplementedError, VerimonoError, ArithmeticError, ValueError):
+            again = None
+        if again is not None and again.failed:
+            counter = {"problem": problem.name, "T": t_k, "x0": problem.x0, "grid": prefix,
+                       "grid_kind": f"{gname} prefix [0, t_{out.k}]", **again.counter, "shrunk": True}
+    msg = counter.pop("message", "") or f"{law} violated"
+    return CheckResult(law, subject, FAILED, worst=out.worst, bound=1.0, counterexample=counter,
+                       message=msg, details=details, duration=time.perf_counter() - start)
+
+
+# -- contraction ------------------------------------------------------------------------------------
+
+def _lipschitz(problem: Problem) -> float:
+    if problem.f is None:
+        return 0.0
+    if problem.lipschitz is None:
+        raise _Skip("f is given without its Lipschitz constant (Problem(lipschitz=...)); the bound "
+                    "e^{L t} needs L")
+    return float(problem.lipschitz)
+
+
+def perturbed_starts(problem: Problem, seed: int = 0, scales: Sequence[float] = (1e-2, 1e-1, 1.0)
+                     ) -> list[np.ndarray]:
+    """Second initial points ``x0'`` at distances ``~ s (1 + |x0|)`` in ``cl dom F(0,·)``.
+
+    Projected with ``project_domain`` (or mapped into ``dom F(0,·)`` by a resolvent when the operator has
+    no projection); unconstrained when the problem starts with the catching-up jump.
+    """
+    rng = np.random.default_rng(seed)
+    x0, op = problem.x0, problem.operator
+    scale = 1.0 + float(np.linalg.norm(x0))
+    out = []
+    for s in scales:
+        d = rng.standard_normal(x0.shape)
+        z = x0 + s * scale * d / np.linalg.norm(d)
+        if not problem.initial_jump:
+            try:
+                z = np.asarray(op.project_domain(z, 0.0), dtype=float)
+            except NotImplementedError:
+                z = np.asarray(op.resolvent(z, 1e-3 * problem.T, 0.0), dtype=float)
+        if np.linalg.norm(z - x0) > tolerance(x0, z) * 10:
+            out.append(z)
+    return out
+
+
+def check_contraction(stepper: Callable, problem: Problem, *, grids: Any = None, x0_primes: Any = None,
+                      seed: int = 0) -> CheckResult:
+    """Two discrete solutions never move apart faster than ``e^{L t}`` (uniqueness argument, Section 6).
+
+    Checks ``|x_k - x'_k| ≤ e^{L h_k}|x_{k-1} - x'_{k-1}|`` step by step, which gives
+    ``|x_k - x'_k| ≤ e^{L t_k}|x_0 - x'_0|``; ``L = 0`` (nonexpansive resolvents) without ``f``.
+    """
+    grids = _as_grids(grids, problem, seed)
+
+    def evaluate(p: Problem, t: np.ndarray) -> _Outcome:
+        L = _lipschitz(p)
+        starts = perturbed_starts(p, seed) if x0_primes is None else [np.asarray(z, float) for z in x0_primes]
+        if not starts:
+            raise _Skip("no second initial point distinct from x0 in cl dom F(0)")
+        x = run_stepper(stepper, p, t)
+        growth = np.exp(L * np.diff(t))
+        worst, best = -np.inf, None
+        glob = 0.0
+        for z in starts:
+            y = run_stepper(stepper, with_changes(p, x0=z), t)
+            d = _norms(x - y)
+            tol = tolerance(x, y)
+            ratio = d[1:] / (growth * d[:-1] + tol)
+            glob = max(glob, float(np.max(d / (np.exp(L * t) * d[0] + tol))))
+            bad = np.flatnonzero(ratio > 1.0)
+            k = int(bad[0]) + 1 if bad.size else int(np.argmax(ratio)) + 1
+            r = float(np.max(ratio))
+            if r > worst:
+                worst = r
+                best = {"x0_prime": z, "k": k, "t_k": t[k], "x_k": x[k], "x_prime_k": y[k],
+                        "x_k_minus_1": x[k - 1], "x_prime_k_minus_1": y[k - 1],
+                        "lhs": d[k], "rhs": growth[k - 1] * d[k - 1], "L": L,
+                        "message": f"|x_k - x'_k| = {d[k]:.6g} > e^(L h)|x_(k-1) - x'_(k-1)| = "
+                                   f"{growth[k - 1] * d[k - 1]:.6g} at k = {k}, t_k = {t[k]:.6g}"}
+        return _Outcome(worst, best["k"], best, {"global_ratio": glob, "pairs": len(starts), "L": L})
+
+    return _drive("contraction", stepper, problem, grids, evaluate,
+                  message_ok="|x_k - x'_k| <= e^{L h_k}|x_{k-1} - x'_{k-1}| at every step")
+
+
+# -- uniqueness of the limit ------------------------------------------------------------------------
+
+def _interp(t: np.ndarray, x: np.ndarray, tau: np.ndarray) -> np.ndarray:
+    return np.stack([np.interp(tau, t, x[:, j]) for j in range(x.shape[1])], axis=-1)
+
+
+def limit_grids(T: float, K: int, seed: int = 0) -> dict[str, np.ndarray]:
+    """Uniform, random and graded (``t_k = T (k/K)²``) partitions with ``K`` cells."""
+    return {"uniform": uniform_grid(T, steps=K), "random": random_grid(T, K, seed=seed, spread=RANDOM_SPREAD),
+            "graded": graded_grid(T, K, 2.0)}
+
+
+def check_unique_limit(stepper: Callable, problem: Problem, *, levels: Sequence[int] = LIMIT_LEVELS,
+                       seed: int = 0) -> CheckResult:
+    """Solutions on different partitions approach each other as ``|Δ| → 0`` (unique limit, Section 5.4).
+
+    ``D(K) = max`` over pairs of partitions (uniform, random, graded, ``K`` cells each) of the sup over
+    their nodes of the distance between the piecewise-linear interpolants (after the first node when the
+    problem starts with a jump).  Law: ``D(K_last) ≤ LIMIT_SHRINK · max(D(K_0), D(K_1)) + tol``.
+    """
+    subject = f"{_name(stepper)} on {problem.name}"
+    start = time.perf_counter()
+    try:
+        p = _single(problem)
+        D, where = [], []
+        scale = float(np.max(np.abs(p.x0)))
+        for K in levels:
+            gs = limit_grids(p.T, K, seed)
+            sols = {g: run_stepper(stepper, p, t) for g, t in gs.items()}
+            scale = max(scale, max(float(np.max(np.abs(x))) for x in sols.values()))
+            names = list(gs)
+            best, info = 0.0, None
+            for i in range(len(names)):
+                for j in range(i + 1, len(names)):
+                    a, b = names[i], names[j]
+                    tau = np.union1d(gs[a], gs[b])
+                    if p.initial_jump:
+                        tau = tau[tau >= max(gs[a][1], gs[b][1])]
+                    dist = _norms(_interp(gs[a], sols[a], tau) - _interp(gs[b], sols[b], tau))
+                    m = int(np.argmax(dist))
+                    if dist[m] >= best:
+                        best, info = float(dist[m]), {"pair": [a, b], "tau": tau[m],
+                                                      "x_a": _interp(gs[a], sols[a], tau[m:m + 1])[0],
+                                                      "x_b": _interp(gs[b], sols[b], tau[m:m + 1])[0]}
+            D.append(best)
+            where.append(info)
+    except NotImplementedError as exc:
+        return CheckResult("unique_limit", subject, SKIPPED, message=f"not available: {exc}",
+                           duration=time.perf_counter() - start)
+    except (VerimonoError, ArithmeticError, ValueError) as exc:
+        return CheckResult("unique_limit", subject, FAILED, message=f"{type(exc).__name__}: {exc}",
+                           counterexample={"problem": problem.name, "levels": list(levels), "seed": seed},
+                           duration=time.perf_counter() - start)
+    tol = tolerance(scale)
+    rhs = LIMIT_SHRINK * max(D[:-1])
+    worst = D[-1] / (rhs + tol)
+    details = {"levels": list(levels), "distances": D, "mesh": [p.T / K for K in levels]}
+    if worst <= 1.0:
+        return CheckResult("unique_limit", subject, PASSED, worst=worst, bound=1.0, details=details,
+                           message=f"distance between partitions {D[0]:.3g} -> {D[-1]:.3g}",
+                           duration=time.perf_counter() - start)
+    counter = {"problem": problem.name, "T": p.T, "x0": p.x0, "levels": list(levels), "seed": seed,
+               "distances": D, "grid_kinds": list(limit_grids(p.T, levels[0], seed)), **where[-1]}
+    return CheckResult("unique_limit", subject, FAILED, worst=worst, bound=1.0, counterexample=counter,
+                       details=details, duration=time.perf_counter() - start,
+                       message=f"solutions on different partitions do not approach each other: distances "
+                               f"{', '.join(f'{d:.3g}' for d in D)} for K = {list(levels)} (worst pair "
+                               f"{where[-1]['pair']} at t = {where[-1]['tau']:.4g})")
+
+
+# -- domain -----------------------------------------------------------------------------------------
+
+def check_in_domain(stepper: Callable, problem: Problem, *, grids: Any = None, seed: int = 0) -> CheckResult:
+    """``x_k ∈ cl dom F(t_k,·)`` for every node (``e:x k+1 props.1``; from ``k = 1`` after a jump)."""
+    grids = _as_grids(grids, problem, seed)
+
+    def evaluate(p: Problem, t: np.ndarray) -> _Outcome:
+        x = run_stepper(stepper, p, t)
+        first = 1 if p.initial_jump else 0
+        ratios = np.zeros(len(t))
+        dists = np.zeros(len(t))
+        for k in range(first, len(t)):
+            q = np.asarray(p.operator.project_domain(x[k], float(t[k])), dtype=float)
+            dists[k] = float(np.linalg.norm(q - x[k]))
+            ratios[k] = dists[k] / tolerance(x[k], q)
+        bad = np.flatnonzero(ratios > 1.0)
+        k = int(bad[0]) if bad.size else int(np.argmax(ratios))
+        counter = {"k": k, "t_k": t[k], "x_k": x[k], "distance": dists[k],
+                   "projection": p.operator.project_domain(x[k], float(t[k])),
+                   "message": f"x_k = {np.array2string(x[k], precision=6)} is at distance {dists[k]:.3g} "
+                              f"from cl dom F(t_k) at k = {k}, t_k = {t[k]:.6g}"}
+        return _Outcome(float(np.max(ratios)), k, counter, {"max_distance": float(np.max(dists))})
+
+    return _drive("in_domain", stepper, problem, grids, evaluate, message_ok="x_k in cl dom F(t_k) at every node")
+
+
+# -- a-priori bounds --------------------------------------------------------------------------------
+
+_FULL_DOMAIN = (Linear, NormSubdifferential, L1Subdifferential)
+
+
+def _phi_of(problem: Problem) -> tuple[Callable[[float], float], str]:
+    """φ of (A3): the problem's, or ``φ ≡ 0`` when ``dom F(t,·)`` cannot move (static or all of R^n)."""
+    if problem.phi is not None:
+        return problem.phi, "stated"
+    op = problem.operator
+    if isinstance(op, _FULL_DOMAIN) or getattr(op, "static", False):
+        return (lambda t: 0.0), "derived: dom F(t) does not move"
+    raise _Skip("the problem states no φ of (A3) and the domain of F may move")
+
+
+def _sigma_of(problem: Problem) -> tuple[Callable[[float], float], str]:
+    """σ of (LG): the problem's, or derived from the catalog operator — ``N_S``: ``F^0 = 0``, ``σ ≡ 0``;
+    ``Linear``: ``|M(t)x| ≤ ‖M(t)‖₂|x|``; ``∂(c|·|)``, ``∂(Σc_i|x_i|)``: ``|F^0(t,x)| ≤ |F^0(t, 1)|``."""
+    from ..operators import NormalCone
+
+    if problem.sigma is not None:
+        return problem.sigma, "stated"
+    op = problem.operator
+    if isinstance(op, NormalCone):
+        return (lambda t: 0.0), "derived: F^0 = 0 for a normal cone"
+    if isinstance(op, Linear):
+        return (lambda t: float(np.linalg.norm(op.M(t), 2))), "derived: ||M(t)||_2"
+    if isinstance(op, (NormSubdifferential, L1Subdifferential)):
+        one = np.ones(op.dim)
+        return (lambda t: float(np.linalg.norm(op.min_norm(one, t)))), "derived: |F^0(t, 1)| = |c(t)|"
+    raise _Skip("the problem states no σ of (LG)")
+
+
+def _theta_of(problem: Problem) -> tuple[Callable[[float], float], str]:
+    """θ of (YB): the problem's, or ``θ ≡ 0`` for a static operator (Prop. ``prop:maxmon-resolvent-Yosida``
+    vi: ``|Y_λ x| ≤ |F^0(x)|``; the paper's remark after Theorem ``thm:main``)."""
+    if problem.theta is not None:
+        return problem.theta, "stated"
+    if getattr(problem.operator, "static", False):
+        return (lambda t: 0.0), "derived: static operator, theta constant"
+    raise _Skip("the problem states no θ of (YB)")
+
+
+class LGBounds:
+    """β, γ and ψ of lemma ``lem:bndSeq`` (``e:only beta``, ``eq:defPsi``, ``e:alpha and r alpha``,
+    ``e:gamma and r gamma``) for ``|x0|``, ``φ`` and ``σ`` on ``[0, T]``.
+
+    With an input (lemma ``l:extinput``) pass ``absu = |u|``: then ``φ̄ = φ + ∫_0^t |u|`` and
+    ``σ̄ = σ (1 + ∫_0^T |u|)`` are used.
+    """
+
+    def __init__(self, x0_norm: float, phi: Callable, sigma: Callable, T: float,
+                 absu: Callable | None = None) -> None:
+        self.phi0, self.sigma0, self.T, self.absu = phi, sigma, T, absu
+        self.u_total = 0.0 if absu is None else integrate.quad(absu, 0.0, T, limit=200)[0]
+        dphi = float(phi(T)) - float(phi(0.0))
+        if dphi < -tolerance(phi(T), phi(0.0)):
+            raise _Skip(f"φ must be nondecreasing; φ(T) - φ(0) = {dphi:.3g}")
+        dphi += self.u_total
+        int_sigma = (1.0 + self.u_total) * integrate.quad(lambda s: float(sigma(s)), 0.0, T, limit=200)[0]
+        self.alpha = x0_norm + dphi
+        self.beta = self.alpha + dphi + (1.0 + self.alpha) * int_sigma
+        self.gamma = self.beta + dphi
+
+    def psi_nodes(self, t: np.ndarray) -> np.ndarray:
+        """``ψ`` at the increasing points ``t`` (``t_0 = 0`` or not), by quadrature cell by cell."""
+        t = np.asarray(t, dtype=float)
+        pts = np.concatenate([[0.0], t]) if t[0] > 0 else t
+        phi = _vals(self.phi0, pts)
+        if self.absu is not None:
+            phi = phi + _cumulative(self.absu, pts)
+        out = pts + 2.0 * phi + (1.0 + self.gamma) * (1.0 + self.u_total) * _cumulative(self.sigma0, pts)
+        return out[1:] if t[0] > 0 else out
+
+    def psi_function(self, points: np.ndarray) -> Callable[[float], float]:
+        """``ψ`` tabulated at ``points`` (exact there), for :meth:`Trajectory.interpolate`."""
+        pts = np.unique(np.asarray(points, dtype=float))
+        table = dict(zip(pts.tolist(), self.psi_nodes(pts).tolist()))
+        return lambda s: table[float(s)] if float(s) in table else float(self.psi_nodes(np.array([s]))[-1])
+
+    def constants(self) -> dict:
+        return {"alpha": self.alpha, "beta": self.beta, "gamma": self.gamma}
+
+
+class YBBounds:
+    """β and ψ of lemma ``lem:bndSeqYB``: ``α = 2(θ(T) - θ(0)) + |F^0(0, x0)|``, ``β = |x0| + αT``,
+    ``ψ(t) = αt`` (``eq:betaYB``, ``eq:defPsiYB``)."""
+
+    def __init__(self, x0: np.ndarray, theta: Callable, op: Operator, T: float) -> None:
+        try:
+            f0 = float(np.linalg.norm(op.min_norm(x0, 0.0)))
+        except OutsideDomain:
+            raise _Skip("x0 is not in dom F(0,·) (lem:bndSeqYB needs |F^0(0, x0)|)") from None
+        self.alpha = 2.0 * (float(theta(T)) - float(theta(0.0))) + f0
+        self.beta = float(np.linalg.norm(x0)) + self.alpha * T
+        self.f0 = f0
+
+    def psi_nodes(self, t: np.ndarray) -> np.ndarray:
+        return self.alpha * np.asarray(t, dtype=float)
+
+    def psi_function(self, points: np.ndarray) -> Callable[[float], float]:
+        return lambda s: self.alpha * float(s)
+
+    def constants(self) -> dict:
+        return {"alpha": self.alpha, "beta": self.beta, "F0_at_x0": self.f0}
+
+
+def _lg_setup(p: Problem, t: np.ndarray):
+    """Bounds of lem:bndSeq and the sequence they bound (``ξ_k = x_k - Φ(t_k)`` with an input)."""
+    if p.initial_jump:
+        raise _Skip("x0 is outside cl dom F(0,·) (catching-up jump): lem:bndSeq assumes x0 in the closure")
+    if p.f is not None:
+        raise _Skip("the bounds of the Lipschitz-perturbation theorem involve a constant C_1 that is not "
+                    "explicit; lem:bndSeq covers f = 0")
+    (phi, phi_src), (sigma, sigma_src) = _phi_of(p), _sigma_of(p)
+    shift = np.zeros((len(t), p.dim))
+    extra = {"phi": phi_src, "sigma": sigma_src}
+    absu = None
+    if p.u is not None or p.U is not None:
+        # lemma l:extinput: ξ = x - Φ solves the scheme of G(t, ξ) = F(t, ξ + Φ(t)), which satisfies (A3)
+        # with φ̄ = φ + ∫|u| and (LG) with σ (1 + |Φ|) ≤ σ (1 + ∫_0^T |u|)
+        if p.u is None:
+            raise _Skip("an input given only by its primitive U: ∫|u| is not available")
+        shift = np.concatenate([np.zeros((1, p.dim)), np.cumsum(p.input_increments(t), axis=0)])
+        absu = lambda s: float(np.linalg.norm(p.u(s)))  # noqa: E731
+        extra["via"] = "l:extinput (xi_k = x_k - Phi(t_k))"
+    return LGBounds(float(np.linalg.norm(p.x0)), phi, sigma, p.T, absu), shift, extra
+
+
+def _yb_setup(p: Problem, t: np.ndarray):
+    if p.initial_jump:
+        raise _Skip("x0 is outside dom F(0,·) (catching-up jump): lem:bndSeqYB assumes x0 in dom F(0,·)")
+    if p.f is not None:
+        raise _Skip("lem:bndSeqYB covers f = 0 (the Lipschitz theorem's constants are not explicit)")
+    if p.u is not None or p.U is not None:
+        raise _Skip("with an input, (YB) for G holds with θ + M_u where M_u is not explicit (l:extinput)")
+    theta, src = _theta_of(p)
+    return YBBounds(p.x0, theta, p.operator, p.T), np.zeros((len(t), p.dim)), {"theta": src}
+
+
+def _bounds_evaluate(stepper: Callable, setup: Callable, label: str):
+    def evaluate(p: Problem, t: np.ndarray) -> _Outcome:
+        bounds, shift, extra = setup(p, t)
+        x = run_stepper(stepper, p, t)
+        xi = x - shift
+        psi = bounds.psi_nodes(t)
+        nx = _norms(xi)
+        steps = _norms(np.diff(xi, axis=0))
+        dpsi = np.diff(psi)
+        r_beta = nx / (bounds.beta + tolerance(bounds.beta, nx))
+        r_step = steps / (dpsi + tolerance(xi, psi))
+        ratios = np.maximum(r_beta[1:], r_step)
+        bad = np.flatnonzero(ratios > 1.0)
+        k = int(bad[0]) + 1 if bad.size else int(np.argmax(ratios)) + 1
+        which = "|x_k| <= beta" if r_beta[k] >= r_step[k - 1] else "|x_k - x_(k-1)| <= psi(t_k) - psi(t_(k-1))"
+        counter = {"k": k, "t_k": t[k], "x_k": xi[k], "x_k_minus_1": xi[k - 1], "bound": which,
+                   "norm_x_k": nx[k], "step": steps[k - 1], "psi_increment": dpsi[k - 1], **bounds.constants(),
+                   **extra,
+                   "message": f"{label}: {which} fails at k = {k}, t_k = {t[k]:.6g}: |x_k| = {nx[k]:.6g}, "
+                              f"beta = {bounds.beta:.6g}, |x_k - x_(k-1)| = {steps[k - 1]:.6g}, "
+                              f"psi increment = {dpsi[k - 1]:.6g}"}
+        details = {**bounds.constants(), **extra, "max_ratio_beta": float(np.max(r_beta)),
+                   "max_ratio_psi": float(np.max(r_step))}
+        return _Outcome(float(np.max(ratios)), k, counter, details)
+    return evaluate
+
+
+def check_bounds_lg(stepper: Callable, problem: Problem, *, grids: Any = None, seed: int = 0) -> CheckResult:
+    """Lemma ``lem:bndSeq`` (under (A3), (LG)): ``|x_k| ≤ β``, ``|x_k - x_{k-1}| ≤ ψ(t_k) - ψ(t_{k-1})``.
+
+    ``β = α + φ(T) - φ(0) + (1 + α)∫_0^T σ``, ``ψ(t) = t + 2φ(t) + (1 + γ)∫_0^t σ``, ``α = |x0| + φ(T) -
+    φ(0)``, ``γ = β + φ(T) - φ(0)``.  For non-constant σ the lemma holds on fine enough partitions (the
+    proof's piecewise-constant approximation); the default partitions have 40 cells.
+    """
+    return _drive("bounds_lg", stepper, problem, _as_grids(grids, problem, seed),
+                  _bounds_evaluate(stepper, _lg_setup, "lem:bndSeq"),
+                  message_ok="|x_k| <= beta and |x_k - x_(k-1)| <= psi(t_k) - psi(t_(k-1)) (lem:bndSeq)")
+
+
+def check_bounds_yb(stepper: Callable, problem: Problem, *, grids: Any = None, seed: int = 0) -> CheckResult:
+    """Lemma ``lem:bndSeqYB`` (under (YB), ``|Δ| < Λ``): ``|x_k| ≤ |x0| + αT`` and
+    ``|x_k - x_{k-1}| ≤ α h_k`` with ``α = 2(θ(T) - θ(0)) + |F^0(0, x0)|``."""
+    return _drive("bounds_yb", stepper, problem, _as_grids(grids, problem, seed),
+                  _bounds_evaluate(stepper, _yb_setup, "lem:bndSeqYB"),
+                  message_ok="|x_k| <= |x0| + alpha T and |x_k - x_(k-1)| <= alpha h_k (lem:bndSeqYB)")
+
+
+# -- ψ-interpolation --------------------------------------------------------------------------------
+
+def check_psi_interpolation(stepper: Callable, problem: Problem, *, grids: Any = None, seed: int = 0,
+                            samples: int = 40) -> CheckResult:
+    """Lemma ``lem:bndEquiCont``: ``|x_Δ(τ̄) - x_Δ(τ)| ≤ ψ(τ̄) - ψ(τ)`` for the ψ-interpolant ``e:x delta``.
+
+    ``ψ`` from lem:bndSeq and/or lem:bndSeqYB (whichever applies); ``x_Δ`` from
+    :meth:`verimono.Trajectory.interpolate` with ``kind="psi"``; all pairs among the nodes, cell
+    midpoints and ``samples`` random times.
+    """
+    grids = _as_grids(grids, problem, seed)
+
+    def evaluate(p: Problem, t: np.ndarray) -> _Outcome:
+        setups = []
+        reasons = []
+        for label, setup in (("lem:bndSeq", _lg_setup), ("lem:bndSeqYB", _yb_setup)):
+            try:
+                setups.append((label,) + setup(p, t))
+            except _Skip as exc:
+                reasons.append(f"{label}: {exc}")
+        setups = [s for s in setups if not (isinstance(s[1], YBBounds) and s[1].alpha <= 0.0)]
+        if not setups:
+            raise _Skip("no ψ available — " + "; ".join(reasons) if reasons else "ψ ≡ 0 (α = 0)")
+        x = run_stepper(stepper, p, t)
+        rng = np.random.default_rng(seed)
+        tau = np.unique(np.concatenate([t, 0.5 * (t[:-1] + t[1:]), rng.uniform(0.0, p.T, samples)]))
+        worst, best, det = -np.inf, None, {}
+        for label, bounds, shift, extra in setups:
+            traj = Trajectory(t, x - shift, None)
+            psi = bounds.psi_function(np.union1d(t, tau))
+            X = traj.interpolate(tau, kind="psi", psi=psi)
+            P = np.array([psi(s) for s in tau])
+            i, j = np.triu_indices(len(tau), 1)
+            lhs = _norms(X[j] - X[i])
+            rhs = P[j] - P[i]
+            ratio = lhs / (rhs + tolerance(X, P))
+            m = int(np.argmax(ratio))
+            det[label] = float(ratio[m])
+            if ratio[m] > worst:
+                worst = float(ratio[m])
+                k = int(np.searchsorted(t, tau[j[m]], side="left"))
+                best = {"k": max(1, min(k, len(t) - 1)), "lemma": label, "tau_low": tau[i[m]],
+                        "tau_high": tau[j[m]], "x_low": X[i[m]], "x_high": X[j[m]], "lhs": lhs[m], "rhs": rhs[m],
+                        **bounds.constants(),
+                        "message": f"{label}/lem:bndEquiCont: |x_D(tau') - x_D(tau)| = {lhs[m]:.6g} > "
+                                   f"psi(tau') - psi(tau) = {rhs[m]:.6g} for tau = {tau[i[m]]:.6g}, "
+                                   f"tau' = {tau[j[m]]:.6g}"}
+        return _Outcome(worst, best["k"], best, {"worst_by_lemma": det, "pairs": len(tau) * (len(tau) - 1) // 2})
+
+    return _drive("psi_interpolation", stepper, problem, grids, evaluate,
+                  message_ok="|x_D(tau') - x_D(tau)| <= psi(tau') - psi(tau) (lem:bndEquiCont)")
+
+
+# -- selections -------------------------------------------------------------------------------------
+
+def check_selections(stepper: Callable, problem: Problem, *, grids: Any = None, seed: int = 0) -> CheckResult:
+    """``y_{k+1} = (z_k - x_{k+1})/h_{k+1} ∈ F(t_{k+1}, x_{k+1})`` (``eq:iteration``), ``z_k = x_k + h f(x_k)
+    + ∫u``: through ``operator.contains`` and through ``J_μ(x_{k+1} + μ y_{k+1}) = x_{k+1}`` at ``μ = h/2``.
+
+    Tolerance: :func:`verimono.tolerances.quotient_tolerance` (a difference quotient divides the
+    round-off of the states by ``h``).
+    """
+    grids = _as_grids(grids, problem, seed)
+    has_contains = type(problem.operator).contains is not Operator.contains
+
+    def evaluate(p: Problem, t: np.ndarray) -> _Outcome:
+        x = run_stepper(stepper, p, t)
+        y = Trajectory(t, x, p).selections
+        h = np.diff(t)
+        op = p.operator
+        ratios = np.zeros(len(h))
+        member = np.ones(len(h), dtype=bool)
+        contains_available = True
+        for k in range(len(h)):
+            xk1, yk, tk1 = x[k + 1], y[k], float(t[k + 1])
+            mu = 0.5 * h[k]
+            back = np.asarray(op.resolvent(xk1 + mu * yk, mu, tk1), dtype=float)
+            ratios[k] = float(np.linalg.norm(back - xk1)) / tolerance(xk1, mu * yk, x[k])
+            if contains_available:
+                try:
+                    member[k] = op.contains(xk1, yk, tk1, tol=quotient_tolerance(h[k], x[k], xk1, h[k] * yk))
+                except NotImplementedError:
+                    contains_available = False
+        worst = float(np.max(ratios))
+        if contains_available and not member.all():
+            worst = max(worst, 1.0 + float(np.sum(~member)))   # membership is boolean: count the misses
+        bad = np.flatnonzero((ratios > 1.0) | ~member)
+        k = int(bad[0]) if bad.size else int(np.argmax(ratios))
+        counter = {"k": k + 1, "t_k": t[k + 1], "x_k": x[k], "x_k_plus_1": x[k + 1], "h": h[k], "selection": y[k],
+                   "contains": bool(member[k]), "resolvent_residual_ratio": ratios[k],
+                   "message": f"y = (x_k - x_(k+1))/h = {np.array2string(y[k], precision=6)} is not in "
+                              f"F(t_(k+1), x_(k+1)) at k+1 = {k + 1}, t = {t[k + 1]:.6g} "
+                              f"(contains: {bool(member[k])}, |J(x + mu y) - x|/tol = {ratios[k]:.3g})"}
+        return _Outcome(worst, k + 1, counter, {"contains_used": contains_available,
+                                                "misses": int(np.sum(~member))})
+
+    return _drive("selections", stepper, problem, grids, evaluate,
+                  message_ok="(x_k - x_(k+1))/h in F(t_(k+1), x_(k+1)) at every step"
+                             + ("" if has_contains else " (resolvent characterisation only: no contains)"))
+
+
+# -- registry ---------------------------------------------------------------------------------------
+
+CHECKS: dict[str, Callable[..., CheckResult]] = {
+    "contraction": check_contraction,
+    "unique_limit": check_unique_limit,
+    "in_domain": check_in_domain,
+    "bounds_lg": check_bounds_lg,
+    "bounds_yb": check_bounds_yb,
+    "psi_interpolation": check_psi_interpolation,
+    "selections": check_selections,
+}
+
+
+def reproduce(stepper: Callable, problem: Problem, record: CheckResult) -> CheckResult:
+    """Re-run the law of ``record`` on exactly the inputs of its counterexample."""
+    cx = record.counterexample or {}
+    law = CHECKS[record.check]
+    if record.check == "unique_limit":
+        return law(stepper, problem, levels=cx["levels"], seed=cx["seed"])
+    p = with_changes(_single(problem), T=float(cx["T"]))
+    kw: dict[str, Any] = {"grids": [np.asarray(cx["grid"], dtype=float)]}
+    if "x0_prime" in cx:
+        kw["x0_primes"] = [np.asarray(cx["x0_prime"], dtype=float)]
+    return law(stepper, p, **kw)
+
+
+def law_checks(problems: Iterable[Problem], laws: Sequence[str] = LAWS, seed: int = 0
+               ) -> Iterator[tuple[str, Callable[[Callable], CheckResult]]]:
+    """``(name, check)`` pairs: ``name = "<law>[<problem>]"``, ``check(stepper) -> CheckResult``."""
+    for p in problems:
+        for law in laws:
+            fn = CHECKS[law]
+            yield f"{law}[{p.name}]", (lambda stepper, _fn=fn, _p=p: _fn(stepper, _p, seed=seed))
+
+
+def stepper_checks(stepper: Callable | None = None, problems: Iterable[Problem] | None = None, *,
+                   seed: int = 0, generated: int = 4, laws: Sequence[str] = LAWS, orders: bool = True,
+                   executor: Any = None) -> Iterator[tuple[str, Callable[[Callable], CheckResult]]]:
+    """The battery of a stepper, as ``(name, check)`` pairs — one source for
+    :func:`verimono.check_stepper` and :func:`verimono.testing.parametrize_with_checks`.
+
+    ``problems=None``: the reference catalog (convergence orders and laws) plus ``generated`` sampled
+    problems (:func:`verimono.checks.sample_problems.sample_problems`, laws only).  ``stepper`` is unused
+    (the battery does not depend on it); it is accepted for the protocol ``stepper_checks(stepper)``.
+    """
+    from .orders import check_convergence_order
+
+    if problems is None:
+        from verimono.reference import catalog
+
+        from .sample_problems import sample_problems
+
+        refs = catalog()
+        extra = sample_problems(seed, generated)
+    else:
+        refs, extra = list(problems), []
+    if orders:
+        for p in refs:
+            yield (f"convergence_order[{p.name}]",
+                   lambda s, _p=p: check_convergence_order(s, _p, executor=executor))
+    yield from law_checks(list(refs) + list(extra), laws, seed)
+
+
+__all__ = ["LAWS", "CHECKS", "check_contraction", "check_unique_limit", "check_in_domain", "check_bounds_lg",
+           "check_bounds_yb", "check_psi_interpolation", "check_selections", "stepper_checks", "law_checks",
+           "reproduce", "run_stepper", "with_changes", "perturbed_starts", "default_grids", "limit_grids",
+           "LGBounds", "YBBounds"]

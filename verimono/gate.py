@@ -1,0 +1,241 @@
+"""Regression gating: compare a run's records with a committed baseline.
+
+``compare(baseline, current)`` lists every :class:`Change`; those with ``regression=True`` make
+``verimono gate`` exit 1.  A regression is
+
+* **status** — a record that passed (or was an expected failure) now fails, or a record that passed is
+  now skipped (a battery that stopped running verifies nothing);
+* **removed** — a record of the baseline is absent now;
+* **count** — the number of executed (non-skipped) records of a check, or in total, shrinks;
+* **order** — a convergence order estimate falls below its theoretical order (interval's upper end plus
+  ``ORDER_SLACK`` below the expected order), below the baseline's estimate by more than the wider of the
+  two intervals' half-widths and ``ORDER_DROP_FLOOR``, or a study exact at the nodes no longer is;
+* **error** — an error against a reference (each grid of a convergence study; a record's
+  ``details["error"]``, e.g. Siconos agreement) grows by more than ``ERROR_GROWTH``;
+* **timing** — a stage's duration divided by the calibration workload measured in the same job (or a
+  record's ``details["timing_ratio"]``, a same-job ratio) grows by more than ``TIMING_GROWTH``.
+
+Baseline and results must come from the same kind of run (command, target, profile and the selected
+stages and references) and a readable
+schema version; otherwise :class:`IncompatibleBaseline` — the gate fails closed with exit status 2.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections import Counter
+from pathlib import Path
+from typing import Any
+
+from .convergence import ORDER_SLACK
+from .report.schema import SchemaError, load
+from .results import FAILED, PASSED, SKIPPED, XFAIL, Report
+
+#: smallest drop of a fitted slope that counts as a regression when both intervals are narrower: slopes
+#: are refitted on the same grids, so they reproduce to round-off on one machine and to ~1e-3 across
+#: platforms, while a lost order drops the slope by 0.5 or more
+ORDER_DROP_FLOOR = 0.05
+#: allowed growth of an error against a reference on the same grid: errors are deterministic, so only
+#: round-off (near the floor) or a QP tolerance change moves them, by far less than 1.5x; a stepper
+#: bug that keeps the order (wrong time of evaluation, dropped input) changes the constant by more
+ERROR_GROWTH = 1.5
+#: errors below this absolute size are round-off in every study and are not compared
+ERROR_IGNORE_BELOW = 1e-11
+#: allowed growth of a duration relative to the calibration workload of the same job: on a shared
+#: 2-core runner these ratios vary by up to ~40% between runs (measured); 2x flags real slowdowns such
+#: as a lost vectorisation or a per-step re-validation, which cost 3x and more
+TIMING_GROWTH = 2.0
+#: stages shorter than this (seconds, in both runs) are not timed: start-up noise dominates them
+TIMING_MIN_SECONDS = 0.5
+#: the norms whose order estimates are gated against the baseline (the final-time error of several
+#: references sits at round-off on some grids, so its slope is not a stable statistic)
+GATED_NORMS = ("sup", "l2")
+#: run facts that must agree between a baseline and the results it gates (``selection``: the stages and
+#: references chosen with --stage / --reference; a battery that is selected but skipped still regresses)
+COMPATIBLE_KEYS = ("command", "target", "profile", "selection")
+
+
+class IncompatibleBaseline(SchemaError):
+    """The baseline records a different kind of run (command, target or profile) than the results."""
+
+
+@dataclasses.dataclass
+class Change:
+    """One difference between baseline and results; ``regression`` ones fail the gate."""
+
+    kind: str
+    key: str
+    message: str
+    regression: bool
+
+    def __str__(self) -> str:
+        tag = "REGRESSION" if self.regression else "change"
+        return f"{tag:10s} {self.kind:8s} {self.key}: {self.message}"
+
+
+@dataclasses.dataclass
+class Comparison:
+    """All changes between a baseline and a run, with what was compared."""
+
+    changes: list[Change]
+    compared: int
+    baseline_meta: dict[str, Any]
+
+    @property
+    def regressions(self) -> list[Change]:
+        return [c for c in self.changes if c.regression]
+
+    @property
+    def others(self) -> list[Change]:
+        return [c for c in self.changes if not c.regression]
+
+    @property
+    def ok(self) -> bool:
+        return not self.regressions
+
+    def summary(self) -> str:
+        n = len(self.regressions)
+        head = (f"{n} regression{'s' if n != 1 else ''}" if n else "no regressions") + \
+            f" ({self.compared} baseline records compared, {len(self.others)} other changes)"
+        return head
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"ok": self.ok, "compared": self.compared, "changes": [dataclasses.asdict(c) for c in self.changes]}
+
+
+def check_runs_compatible(baseline: Report, current: Report) -> None:
+    """Raise :class:`IncompatibleBaseline` if the two reports are not the same kind of run."""
+    diffs = [f"{k}: baseline {baseline.meta.get(k)!r}, results {current.meta.get(k)!r}"
+             for k in COMPATIBLE_KEYS if baseline.meta.get(k) != current.meta.get(k)]
+    if diffs:
+        raise IncompatibleBaseline("baseline and results come from different runs (" + "; ".join(diffs) +
+                                   "); regenerate the baseline with the same command and profile")
+
+
+def _fmt(x: Any) -> str:
+    return f"{x:.4g}" if isinstance(x, float) else str(x)
+
+
+def _why(rec: Any) -> str:
+    if isinstance(rec.worst, (int, float)) and isinstance(rec.bound, (int, float)):
+        rel = "exceeds" if rec.worst > rec.bound else "within"
+        return f"worst {rec.worst:.4g} {rel} bound {rec.bound:.4g}"
+    return "no message"
+
+
+def _compare_records(base: Report, cur: Report, out: list[Change]) -> None:
+    now = {r.key: r for r in cur.results}
+    before = {r.key: r for r in base.results}
+    for key, b in before.items():
+        c = now.get(key)
+        if c is None:
+            out.append(Change("removed", key, f"was {b.status} in the baseline, absent now",
+                              b.status != SKIPPED))
+            continue
+        if b.status in (PASSED, XFAIL) and c.status == FAILED:
+            out.append(Change("status", key, f"{b.status} → failed: {c.message or _why(c)}", True))
+        elif b.status == PASSED and c.status == SKIPPED:
+            out.append(Change("status", key, f"passed → skipped: {c.message}", True))
+        elif b.status != c.status:
+            out.append(Change("status", key, f"{b.status} → {c.status}", False))
+        be, ce = b.details.get("error"), c.details.get("error")
+        if isinstance(be, (int, float)) and isinstance(ce, (int, float)):
+            if ce > ERROR_GROWTH * be and ce > ERROR_IGNORE_BELOW:
+                out.append(Change("error", key, f"error grew from {be:.3g} to {ce:.3g} "
+                                  f"(> {ERROR_GROWTH}x)", True))
+        bt, ct = b.details.get("timing_ratio"), c.details.get("timing_ratio")
+        if isinstance(bt, (int, float)) and isinstance(ct, (int, float)) and ct > TIMING_GROWTH * bt:
+            out.append(Change("timing", key, f"same-job timing ratio grew from {bt:.3g} to {ct:.3g} "
+                              f"(> {TIMING_GROWTH}x)", True))
+    for key, c in now.items():
+        if key not in before:
+            out.append(Change("new", key, f"new record ({c.status})", False))
+    executed = lambda rep: Counter(r.check for r in rep.results if r.status != SKIPPED)  # noqa: E731
+    bc, cc = executed(base), executed(cur)
+    for check, n in bc.items():
+        if cc.get(check, 0) < n:
+            out.append(Change("count", check, f"executed records fell from {n} to {cc.get(check, 0)}", True))
+    if sum(cc.values()) < sum(bc.values()):
+        out.append(Change("count", "total", f"executed records fell from {sum(bc.values())} to "
+                          f"{sum(cc.values())}", True))
+
+
+def _compare_studies(base: Report, cur: Report, out: list[Change]) -> None:
+    now = {(s.problem, s.stepper): s for s in cur.studies if hasattr(s, "fits")}
+    for s in cur.studies:
+        if not hasattr(s, "fits"):
+            continue
+        exp, fit = s.expected, s.fits["sup"]
+        if exp is not None and not exp.exact and exp.value is not None and not fit.exact:
+            if not (fit.high + ORDER_SLACK >= exp.value):  # also catches nan intervals
+                out.append(Change("order", f"{s.stepper} on {s.problem}",
+                                  f"sup-norm order {fit} below the theoretical order {exp.value:g}", True))
+    for b in base.studies:
+        if not hasattr(b, "fits"):
+            continue
+        s = now.get((b.problem, b.stepper))
+        if s is None:
+            continue  # the record rules report the missing study
+        key = f"{b.stepper} on {b.problem}"
+        for norm in GATED_NORMS:
+            bf, cf = b.fits.get(norm), s.fits.get(norm)
+            if bf is None or cf is None:
+                continue
+            if bf.exact and not cf.exact:
+                out.append(Change("order", key, f"{norm}: exact at the nodes in the baseline, now {cf}", True))
+                continue
+            if bf.exact or cf.exact or not all(map(math.isfinite, (bf.slope, cf.slope))):
+                continue
+            half = lambda f: (f.high - f.low) / 2 if math.isfinite(f.high - f.low) else 0.0  # noqa: E731
+            allowed = max(half(bf), half(cf), ORDER_DROP_FLOOR)
+            if cf.slope < bf.slope - allowed:
+                out.append(Change("order", key, f"{norm}-norm order fell from {bf} to {cf} "
+                                  f"(more than {allowed:.3g})", True))
+        floor = max(ERROR_IGNORE_BELOW, float(s.floor or 0.0))
+        for norm in GATED_NORMS:
+            for h, be in zip(b.mesh, b.errors.get(norm, [])):
+                match = [i for i, hc in enumerate(s.mesh) if math.isclose(hc, h, rel_tol=1e-9)]
+                if not match:
+                    continue
+                ce = s.errors[norm][match[0]]
+                if ce > ERROR_GROWTH * be and ce > floor:
+                    out.append(Change("error", key, f"{norm} error at h={h:.3g} grew from {be:.3g} to "
+                                      f"{ce:.3g} (> {ERROR_GROWTH}x)", True))
+
+
+def _compare_timings(base: Report, cur: Report, out: list[Change]) -> None:
+    bcal, ccal = base.meta.get("calibration"), cur.meta.get("calibration")
+    if not (isinstance(bcal, (int, float)) and isinstance(ccal, (int, float)) and bcal > 0 and ccal > 0):
+        return
+    before = {s["name"]: s for s in base.meta.get("stages", []) if isinstance(s, dict)}
+    for s in cur.meta.get("stages", []):
+        b = before.get(s.get("name"))
+        if not b or min(b.get("duration", 0), s.get("duration", 0)) < TIMING_MIN_SECONDS:
+            continue
+        rb, rc = b["duration"] / bcal, s["duration"] / ccal
+        if rc > TIMING_GROWTH * rb:
+            out.append(Change("timing", f"stage {s['name']}",
+                              f"{rc:.1f}x the calibration workload, baseline {rb:.1f}x (> {TIMING_GROWTH}x "
+                              f"growth; {s['duration']:.2f} s now)", True))
+
+
+def compare(baseline: Report, current: Report) -> Comparison:
+    """Every change from ``baseline`` to ``current`` (see the module docstring for what regresses)."""
+    changes: list[Change] = []
+    _compare_records(baseline, current, changes)
+    _compare_studies(baseline, current, changes)
+    _compare_timings(baseline, current, changes)
+    return Comparison(changes, len(baseline.results), dict(baseline.meta))
+
+
+def gate(baseline: str | Path | Report, results: str | Path | Report) -> Comparison:
+    """Load both documents (fail closed: :class:`SchemaError` / :class:`IncompatibleBaseline`) and compare."""
+    base = baseline if isinstance(baseline, Report) else load(baseline)
+    cur = results if isinstance(results, Report) else load(results)
+    check_runs_compatible(base, cur)
+    return compare(base, cur)
+
+
+__all__ = ["Change", "Comparison", "compare", "gate", "check_runs_compatible", "IncompatibleBaseline",
+           "ORDER_DROP_FLOOR", "ERROR_GROWTH", "TIMING_GROWTH", "TIMING_MIN_SECONDS"]

@@ -1,0 +1,204 @@
+"""pytest plugin of verimono (entry point ``pytest11: verimono = verimono.plugin``).
+
+* Registers the hypothesis profiles ``dev``, ``ci``, ``thorough`` (:mod:`verimono.profiles`) and loads
+  ``$HYPOTHESIS_PROFILE``, else ``ci`` when ``$CI`` is set, else ``dev`` — unless ``--hypothesis-profile``
+  was given, which wins.
+* ``--verimono-report DIR`` collects the result records of the session — every record a test hands to
+  the ``verimono_report`` fixture, every record :func:`verimono.results.emit`-ted during a test (as
+  ``verimono.testing.parametrize_with_checks`` does), and every record a ``verimono`` check passed in as
+  a test argument returns — and writes ``DIR/results.json`` and ``DIR/report.html``, the same report as
+  ``verimono run``.
+* ``--verimono-baseline FILE`` gates the session on those records: a regression against ``FILE`` turns a
+  green session red (exit status 1) with the reasons in the terminal summary.  A missing, garbled or
+  incompatible baseline is a usage error (exit status 4): the gate fails closed.
+"""
+
+from __future__ import annotations
+
+import functools
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from .results import FAILED, XFAIL, CheckResult, Report, listening
+
+_KEY = pytest.StashKey["_Collector"]()
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    group = parser.getgroup("verimono", "verimono verification report and regression gate")
+    group.addoption("--verimono-report", metavar="DIR", default=None,
+                    help="write the session's verimono records to DIR/results.json and DIR/report.html")
+    group.addoption("--verimono-baseline", metavar="FILE", default=None,
+                    help="fail the session when its verimono records regress against this baseline")
+
+
+def _load_profile(config: pytest.Config) -> str | None:
+    from .profiles import load_hypothesis_profile, register_hypothesis_profiles
+
+    register_hypothesis_profiles()
+    explicit = config.getoption("hypothesis_profile", default=None)
+    if explicit:
+        return explicit
+    try:
+        return load_hypothesis_profile()
+    except Exception as exc:  # an unknown $HYPOTHESIS_PROFILE is the user's error: say so
+        raise pytest.UsageError(f"verimono: {exc}") from None
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line("markers", "verimono: a test whose result records feed the verimono report")
+    profile = _load_profile(config)
+    out = config.getoption("verimono_report")
+    baseline_path = config.getoption("verimono_baseline")
+    if not out and not baseline_path:
+        return
+    baseline = None
+    if baseline_path:
+        from .report.schema import SchemaError, load
+
+        try:
+            baseline = load(baseline_path)
+        except SchemaError as exc:
+            raise pytest.UsageError(f"verimono baseline unusable: {exc}") from None
+    collector = _Collector(Path(out) if out else None, baseline, profile)
+    config.stash[_KEY] = collector
+    config.pluginmanager.register(collector, "verimono-collector")
+
+
+class _Collector:
+    """Session-wide sink of result records (registered only with ``--verimono-report/-baseline``)."""
+
+    def __init__(self, out: Path | None, baseline: Report | None, profile: str | None) -> None:
+        self.out, self.baseline, self.profile = out, baseline, profile
+        self.report = Report(meta={"command": "pytest", "target": None, "profile": profile, "seed": None})
+        self.nodeid: str | None = None
+        self.seen: set[int] = set()
+        self.by_node: dict[str, list[CheckResult]] = {}
+        self.comparison: Any = None
+        self.gate_error: str | None = None
+        self.start = time.perf_counter()
+
+    def add(self, item: Any) -> None:
+        records = item.results if isinstance(item, Report) else [item]
+        for r in records:
+            if not isinstance(r, CheckResult) or id(r) in self.seen:
+                continue
+            self.seen.add(id(r))
+            if self.nodeid:
+                r.details.setdefault("pytest_nodeid", self.nodeid)
+                self.by_node.setdefault(self.nodeid, []).append(r)
+            self.report.add(r)
+            if isinstance(r.details.get("study"), dict) and not isinstance(item, Report):
+                from .convergence import ConvergenceStudy
+
+                self.report.studies.append(ConvergenceStudy.from_dict(r.details["study"]))
+        if isinstance(item, Report):
+            known = {id(s) for s in self.report.studies}
+            self.report.studies.extend(s for s in item.studies if id(s) not in known)
+            self.report.trajectories.extend(item.trajectories)
+
+    @pytest.hookimpl(hookwrapper=True)
+    def pytest_runtest_call(self, item: pytest.Item):
+        self.nodeid = item.nodeid
+        with listening(self.add):
+            yield
+        self.nodeid = None
+
+    def pytest_runtest_logreport(self, report: pytest.TestReport) -> None:
+        """A test marked xfail that failed as declared: its failed records are expected failures."""
+        wasxfail = getattr(report, "wasxfail", None)
+        if report.when == "call" and report.skipped and wasxfail is not None:
+            for r in self.by_node.get(report.nodeid, []):
+                if r.status == FAILED:
+                    r.status = XFAIL
+                    r.message = f"expected failure ({wasxfail}): {r.message}"
+
+    @pytest.hookimpl(tryfirst=True)
+    def pytest_pyfunc_call(self, pyfuncitem: pytest.Function) -> None:
+        """Wrap verimono checks passed in as arguments so the records they return are collected."""
+        for name, value in list(pyfuncitem.funcargs.items()):
+            if _is_verimono_check(value):
+                pyfuncitem.funcargs[name] = _recording(value, self.add)
+
+    def pytest_sessionfinish(self, session: pytest.Session, exitstatus: int) -> None:
+        from .report.schema import environment
+
+        self.report.meta.update({"duration": time.perf_counter() - self.start, "environment": environment()})
+        if self.baseline is not None:
+            from .gate import IncompatibleBaseline, check_runs_compatible, compare
+
+            try:
+                check_runs_compatible(self.baseline, self.report)
+                self.comparison = compare(self.baseline, self.report)
+            except IncompatibleBaseline as exc:
+                self.gate_error = str(exc)
+            if (self.gate_error or not self.comparison.ok) and session.exitstatus == pytest.ExitCode.OK:
+                session.exitstatus = pytest.ExitCode.TESTS_FAILED
+        if self.out is not None:
+            from .report import write
+
+            self.paths = write(self.report, self.out, changes=self.comparison)
+
+    def pytest_terminal_summary(self, terminalreporter: Any) -> None:
+        tr = terminalreporter
+        tr.section("verimono")
+        tr.write_line(f"{len(self.report)} verimono records: {self.report.summary()} "
+                      f"(hypothesis profile {self.profile})")
+        if self.out is not None:
+            tr.write_line(f"report: {self.out / 'report.html'}  records: {self.out / 'results.json'}")
+        if self.gate_error:
+            tr.write_line(f"verimono gate: cannot compare: {self.gate_error}", red=True)
+        elif self.comparison is not None:
+            for c in self.comparison.regressions:
+                tr.write_line(f"  {c}", red=True)
+            tr.write_line(f"verimono gate: {self.comparison.summary()}",
+                          green=self.comparison.ok, red=not self.comparison.ok)
+
+
+def _is_verimono_check(value: Any) -> bool:
+    fn = value.func if isinstance(value, functools.partial) else value
+    module = getattr(fn, "__module__", "") or ""
+    return (callable(value) and not isinstance(value, type) and module.startswith("verimono.")
+            and (getattr(fn, "__name__", "") or "").startswith("check"))
+
+
+def _recording(check: Any, sink: Any) -> Any:
+    @functools.wraps(check)
+    def recorded(*args: Any, **kwargs: Any) -> Any:
+        try:
+            out = check(*args, **kwargs)
+        except BaseException as exc:  # a check wrapper that fails the test may carry its record
+            for attr in ("result", "record", "report"):
+                if isinstance(getattr(exc, attr, None), (CheckResult, Report)):
+                    sink(getattr(exc, attr))
+            raise
+        if isinstance(out, (CheckResult, Report)):
+            sink(out)
+        return out
+
+    return recorded
+
+
+class RecordSink:
+    """What the ``verimono_report`` fixture gives a test: ``add(record_or_report)`` collects it."""
+
+    def __init__(self, collector: _Collector | None) -> None:
+        self._collector = collector
+        self.report = Report()
+
+    def add(self, item: CheckResult | Report) -> CheckResult | Report:
+        if not isinstance(item, (CheckResult, Report)):
+            raise TypeError(f"verimono_report.add takes a CheckResult or a Report, got {type(item).__name__}")
+        self.report.extend(item) if isinstance(item, Report) else self.report.add(item)
+        if self._collector is not None:
+            self._collector.add(item)
+        return item
+
+
+@pytest.fixture
+def verimono_report(request: pytest.FixtureRequest) -> RecordSink:
+    """Hand result records to the session's verimono report: ``verimono_report.add(check_operator(op))``."""
+    return RecordSink(request.config.stash.get(_KEY, None))

@@ -1,0 +1,101 @@
+"""Run profiles ``dev``, ``ci`` and ``thorough``: one name chooses how hard every battery searches.
+
+The same name selects the hypothesis settings profile (registered here, loaded by the pytest plugin and
+by ``verimono run``) and the effort of the non-hypothesis stages (how many generated subjects, seeds).
+
+* ``dev``      — quick feedback while editing: few examples, random seeds, local example database.
+* ``ci``       — reproducible: derandomized, no deadline (shared runners have noisy clocks), no example
+  database (a CI job must not depend on files left by an earlier one).  Baselines are made with it.
+* ``thorough`` — a long search before a release: many examples, no deadline.
+
+``active_profile()`` is ``$HYPOTHESIS_PROFILE`` if set, else ``ci`` when ``$CI`` is set, else ``dev``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+
+from .errors import VerimonoError
+
+PROFILES = ("dev", "ci", "thorough")
+
+
+@dataclasses.dataclass(frozen=True)
+class Profile:
+    """Effort of one profile.
+
+    ``max_examples``: the hypothesis profile's examples per test (pytest suites); ``law_examples``:
+    examples per operator law in ``verimono run`` (which runs every law on many operators, so fewer);
+    ``generated_subjects``: operators and problems drawn from ``verimono.strategies`` per run;
+    ``derandomize``: fixed seeds (0 unless ``--seed``), so every job produces the same records.
+    """
+
+    name: str
+    max_examples: int
+    law_examples: int
+    generated_subjects: int
+    derandomize: bool
+
+
+_EFFORT = {
+    "dev": Profile("dev", max_examples=25, law_examples=10, generated_subjects=3, derandomize=False),
+    "ci": Profile("ci", max_examples=50, law_examples=20, generated_subjects=6, derandomize=True),
+    "thorough": Profile("thorough", max_examples=500, law_examples=200, generated_subjects=30,
+                        derandomize=False),
+}
+
+
+class UnknownProfile(VerimonoError, ValueError):
+    """A profile name other than ``dev``, ``ci`` or ``thorough``."""
+
+
+def get_profile(name: str) -> Profile:
+    """The :class:`Profile` called ``name``."""
+    try:
+        return _EFFORT[name]
+    except KeyError:
+        raise UnknownProfile(f"unknown profile {name!r}; expected one of {PROFILES}") from None
+
+
+def active_profile() -> str:
+    """``$HYPOTHESIS_PROFILE``, else ``ci`` when ``$CI`` is set (non-empty, not ``false``/``0``), else ``dev``."""
+    env = os.environ.get("HYPOTHESIS_PROFILE")
+    if env:
+        return env
+    ci = os.environ.get("CI", "").strip().lower()
+    return "ci" if ci and ci not in ("0", "false", "no") else "dev"
+
+
+def register_hypothesis_profiles() -> None:
+    """Register the hypothesis settings profiles ``dev``, ``ci`` and ``thorough`` (idempotent)."""
+    from hypothesis import HealthCheck, settings
+
+    # parent: hypothesis' own defaults, not whatever profile is loaded now (hypothesis auto-loads a CI
+    # profile of its own when $CI is set; our dev/thorough must not inherit its derandomize)
+    base = settings.get_profile("default")
+    settings.register_profile("dev", base, max_examples=_EFFORT["dev"].max_examples, derandomize=False)
+    settings.register_profile("ci", base, max_examples=_EFFORT["ci"].max_examples, derandomize=True,
+                              deadline=None, database=None, print_blob=True,
+                              suppress_health_check=[HealthCheck.too_slow])
+    settings.register_profile("thorough", base, max_examples=_EFFORT["thorough"].max_examples,
+                              derandomize=False, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+
+
+def load_hypothesis_profile(name: str | None = None) -> str:
+    """Register the profiles and load ``name`` (default :func:`active_profile`); returns the name loaded."""
+    from hypothesis import settings
+
+    register_hypothesis_profiles()
+    name = name or active_profile()
+    if name not in PROFILES:
+        try:
+            settings.get_profile(name)  # a user's own registered profile
+        except Exception:
+            raise UnknownProfile(f"unknown hypothesis profile {name!r}; expected one of {PROFILES}") from None
+    settings.load_profile(name)
+    return name
+
+
+__all__ = ["PROFILES", "Profile", "UnknownProfile", "get_profile", "active_profile",
+           "register_hypothesis_profiles", "load_hypothesis_profile"]

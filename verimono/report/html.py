@@ -1,0 +1,357 @@
+"""The HTML report: one self-contained file (inline CSS and SVG, no scripts, no network).
+
+Sections, in order (each a ``<section id=...>``): ``summary`` (counts and stages), ``changes`` (against
+the baseline), ``convergence`` (log-log plots per reference), ``trajectories`` (scheme against exact
+solution), ``laws`` (every check with its worst ratio and bound), ``failures`` (counterexample and a
+copy-paste reproduction each), ``timings`` and ``environment``.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import math
+import shlex
+from collections import defaultdict
+from html import escape
+from typing import Any
+
+from ..results import FAILED, PASSED, SKIPPED, STATUSES, XFAIL, CheckResult, Report
+
+SECTIONS = ("summary", "changes", "convergence", "trajectories", "laws", "failures", "timings", "environment")
+_TITLES = {"summary": "Summary", "changes": "Changes against the baseline", "convergence": "Convergence orders",
+           "trajectories": "Trajectories against exact solutions", "laws": "Laws and checks",
+           "failures": "Failures and how to reproduce them", "timings": "Timings", "environment": "Environment"}
+
+CSS = """
+:root { --ok:#2e7d32; --bad:#c62828; --skip:#757575; --xf:#b26a00; --ink:#1d2330; --mute:#5b6475;
+        --line:#dde1e8; --bg:#f6f7f9; }
+* { box-sizing: border-box; }
+body { margin:0; font: 14px/1.45 system-ui, -apple-system, "Segoe UI", Roboto, "Helvetica Neue", Arial, sans-serif;
+       color:var(--ink); background:var(--bg); }
+header { background:#1d2330; color:#fff; padding:18px 32px 12px; }
+header h1 { margin:0 0 4px; font-size:22px; font-weight:600; }
+header .sub { color:#c3c9d6; font-size:13px; }
+nav { position:sticky; top:0; z-index:5; background:#fff; border-bottom:1px solid var(--line); padding:8px 32px; }
+nav a { color:#1f5fbf; text-decoration:none; margin-right:18px; font-size:13px; white-space:nowrap; }
+main { padding:8px 32px 48px; max-width:1500px; }
+section { background:#fff; border:1px solid var(--line); border-radius:8px; padding:16px 20px; margin:18px 0; }
+h2 { margin:0 0 12px; font-size:18px; }
+h3 { font-size:15px; margin:18px 0 8px; }
+p.note { color:var(--mute); margin:4px 0 10px; }
+.verdict { font-size:17px; font-weight:600; padding:10px 14px; border-radius:6px; margin-bottom:14px; }
+.verdict.ok { background:#e8f5e9; color:var(--ok); } .verdict.bad { background:#ffebee; color:var(--bad); }
+.cards { display:flex; gap:12px; flex-wrap:wrap; margin-bottom:14px; }
+.card { min-width:130px; padding:10px 16px; border-radius:8px; border:1px solid var(--line); background:#fafbfc; }
+.card .n { font-size:28px; font-weight:700; } .card .l { color:var(--mute); font-size:12px; text-transform:uppercase; letter-spacing:.04em; }
+.card.passed .n { color:var(--ok); } .card.failed .n { color:var(--bad); } .card.skipped .n { color:var(--skip); }
+.card.xfail .n { color:var(--xf); } .card.regressions .n { color:var(--bad); }
+table { border-collapse:collapse; width:100%; font-size:13px; }
+th, td { text-align:left; padding:5px 8px; border-bottom:1px solid var(--line); vertical-align:top; }
+th { background:#f0f2f5; font-weight:600; position:sticky; top:37px; }
+td.num, th.num { text-align:right; font-variant-numeric:tabular-nums; white-space:nowrap; }
+tr.failed td { background:#fff5f5; }
+.badge { display:inline-block; padding:1px 7px; border-radius:10px; font-size:11px; font-weight:600; color:#fff; text-transform:uppercase; }
+.badge.passed { background:var(--ok); } .badge.failed, .badge.error, .badge.regression { background:var(--bad); }
+.badge.skipped { background:var(--skip); } .badge.xfail { background:var(--xf); } .badge.change { background:#1f5fbf; }
+.grid { display:grid; grid-template-columns:repeat(auto-fill, minmax(420px, 1fr)); gap:14px; }
+figure { margin:0; border:1px solid var(--line); border-radius:6px; padding:6px; background:#fff; }
+figure svg { width:100%; height:auto; display:block; }
+figcaption { font-size:12px; color:var(--mute); padding:4px 4px 0; }
+figcaption b.passed { color:var(--ok); } figcaption b.failed { color:var(--bad); }
+pre { background:#f3f4f7; border:1px solid var(--line); border-radius:6px; padding:8px 10px; overflow-x:auto;
+      font: 12px/1.4 ui-monospace, SFMono-Regular, Menlo, Consolas, monospace; white-space:pre; }
+details { margin:6px 0; } summary { cursor:pointer; color:#1f5fbf; }
+.failure { border-left:4px solid var(--bad); padding:6px 12px; margin:12px 0; background:#fffafa; }
+.failure h3 { margin:2px 0 6px; }
+.bar { background:#eceff3; border-radius:3px; height:8px; width:110px; display:inline-block; vertical-align:middle; }
+.bar span { display:block; height:8px; border-radius:3px; }
+.kv td:first-child { color:var(--mute); width:220px; }
+.muted { color:var(--mute); }
+"""
+
+
+def _e(x: Any) -> str:
+    return escape("" if x is None else str(x))
+
+
+def _num(x: Any, fmt: str = ".4g") -> str:
+    if x is None:
+        return "–"
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        return _e(x)
+    if not math.isfinite(v):
+        return _e(v)
+    return format(int(v), fmt) if fmt == "d" else format(v, fmt)
+
+
+def _badge(status: str) -> str:
+    return f'<span class="badge {_e(status)}">{_e(status)}</span>'
+
+
+def _ratio(rec: CheckResult) -> float | None:
+    try:
+        w, b = float(rec.worst), float(rec.bound)
+    except (TypeError, ValueError):
+        return None
+    if not math.isfinite(w) or not math.isfinite(b):
+        return math.inf if w == math.inf else None
+    return w / b if b > 0 else None
+
+
+def _bar(ratio: float | None) -> str:
+    if ratio is None:
+        return ""
+    frac = 1.0 if not math.isfinite(ratio) else max(0.0, min(ratio, 1.0))
+    color = "#c62828" if ratio > 1 else "#2e7d32"
+    return f'<span class="bar" title="worst/bound = {_num(ratio)}"><span style="width:{frac * 100:.0f}%;background:{color}"></span></span>'
+
+
+def _table(head: list[str], rows: list[list[str]], num_cols: tuple[int, ...] = (), row_class=None) -> str:
+    th = "".join(f'<th class="num">{h}</th>' if i in num_cols else f"<th>{h}</th>" for i, h in enumerate(head))
+    body = []
+    for k, r in enumerate(rows):
+        cls = f' class="{row_class[k]}"' if row_class and row_class[k] else ""
+        body.append(f"<tr{cls}>" + "".join(f'<td class="num">{c}</td>' if i in num_cols else f"<td>{c}</td>"
+                                           for i, c in enumerate(r)) + "</tr>")
+    return f"<table><thead><tr>{th}</tr></thead><tbody>{''.join(body)}</tbody></table>"
+
+
+def reproduction(rec: CheckResult, meta: dict[str, Any]) -> str:
+    """A copy-paste reproduction of one record: the check's own ``details["reproduce"]`` if it gave one,
+    a hypothesis ``@example`` from ``details["example"]``, a script for a convergence order, or the
+    command with the record's seed and stage."""
+    if rec.details.get("reproduce"):
+        return str(rec.details["reproduce"])
+    target = meta.get("target") or "verimono.stepping:solve"
+    if rec.details.get("example"):
+        return f"@example({rec.details['example']})  # add above the failing @given test, or:\n" + \
+            _command(rec, meta)
+    study = rec.details.get("study")
+    if rec.check == "convergence_order" and isinstance(study, dict):
+        module, _, obj = target.partition(":")
+        return ("python - <<'EOF'\n"
+                "from verimono.reference import get\n"
+                "from verimono.checks.orders import check_convergence_order\n"
+                f"from {module} import {obj} as stepper\n"
+                f"print(check_convergence_order(stepper, get({study['problem']!r})))\n"
+                "EOF")
+    return _command(rec, meta)
+
+
+@functools.lru_cache(maxsize=1)
+def _catalog_names() -> frozenset[str]:
+    try:
+        from verimono.reference import catalog
+
+        return frozenset(p.name for p in catalog())
+    except Exception:  # the report renders without the catalog too
+        return frozenset()
+
+
+def _command(rec: CheckResult, meta: dict[str, Any]) -> str:
+    cmd = ["verimono", meta.get("command") or "run"]
+    if meta.get("command") == "check" and meta.get("target"):
+        cmd.append(str(meta["target"]))
+    cmd += ["--profile", str(meta.get("profile") or "ci")]
+    seed = rec.seed if rec.seed is not None else meta.get("seed")
+    if seed is not None:
+        cmd += ["--seed", str(seed)]
+    if rec.details.get("stage") and meta.get("command", "run") == "run":
+        cmd += ["--stage", str(rec.details["stage"])]
+    refs = (meta.get("selection") or {}).get("references")
+    cx = rec.counterexample if isinstance(rec.counterexample, dict) else {}
+    if isinstance(cx.get("problem"), str) and cx["problem"] in _catalog_names():
+        refs = [cx["problem"]]  # the one reference the counterexample needs
+    for name in refs or []:
+        cmd += ["--reference", shlex.quote(str(name))]
+    return " ".join(cmd)
+
+
+# -- sections --------------------------------------------------------------------------------------
+
+
+def _summary(report: Report, changes: Any) -> str:
+    c = report.counts
+    ok = report.ok
+    nreg = len(changes.regressions) if changes is not None else None
+    verdict = ("All checks hold" if ok else f"{c[FAILED]} check{'s' if c[FAILED] != 1 else ''} failed")
+    if nreg:
+        verdict += f" · {nreg} regression{'s' if nreg != 1 else ''} against the baseline"
+    cards = "".join(f'<div class="card {s}"><div class="n">{c[s]}</div><div class="l">{s}</div></div>'
+                    for s in STATUSES)
+    if changes is not None:
+        cls = "regressions" if nreg else "passed"
+        cards += f'<div class="card {cls}"><div class="n">{nreg}</div><div class="l">regressions</div></div>'
+    stages = report.meta.get("stages") or []
+    rows = [[_e(s.get("name")), _badge(s.get("status", "")), _num(s.get("records"), "d"),
+             _num(s.get("duration"), ".2f"), _e(s.get("message"))] for s in stages]
+    stage_html = ("<h3>Stages</h3>" + _table(["stage", "status", "records", "seconds", "outcome"], rows, (2, 3))
+                  if rows else "")
+    return (f'<div class="verdict {"ok" if ok and not nreg else "bad"}">{_e(verdict)}</div>'
+            f'<div class="cards">{cards}</div>{stage_html}')
+
+
+def _changes(changes: Any) -> str:
+    if changes is None:
+        return ('<p class="note">No baseline was given, so nothing is compared. '
+                "<code>verimono run --baseline reports/baseline.json</code> fills this section; "
+                "<code>verimono gate</code> fails a CI job on a regression.</p>")
+    meta = changes.baseline_meta or {}
+    head = (f'<p class="note">Baseline created {_e(meta.get("created"))}, profile {_e(meta.get("profile"))}, '
+            f"verimono {_e(((meta.get('environment') or {}).get('versions') or {}).get('verimono'))}. "
+            f"{_e(changes.summary())}.</p>")
+    reg = [[_badge("regression"), _e(c.kind), _e(c.key), _e(c.message)] for c in changes.regressions]
+    other = [[_badge("change"), _e(c.kind), _e(c.key), _e(c.message)] for c in changes.others]
+    out = head
+    if reg:
+        out += _table(["", "rule", "subject", "what changed"], reg)
+    else:
+        out += '<p><b style="color:var(--ok)">No regressions.</b></p>'
+    if other:
+        out += (f"<details><summary>{len(other)} other changes (new records, improvements)</summary>"
+                + _table(["", "kind", "subject", "what changed"], other) + "</details>")
+    return out
+
+
+def _convergence(report: Report) -> str:
+    from .plots import convergence_plot
+
+    studies = [s for s in report.studies if hasattr(s, "fits")]
+    if not studies:
+        return '<p class="note">No convergence studies in this run.</p>'
+    figs, rows = [], []
+    for s in studies:
+        ok, msg = s.verdict()
+        status = PASSED if ok else FAILED
+        figs.append(f"<figure>{convergence_plot(s)}<figcaption><b class=\"{status}\">{status.upper()}</b> "
+                    f"{_e(s.stepper)} — {_e(msg)}. Reference: {_e(s.reference)}.</figcaption></figure>")
+        f = s.fits["sup"]
+        rows.append([_e(s.problem), _e(s.expected), _e(f), _e(s.fits["l2"]), _e(s.fits["final"]),
+                     "yes" if f.pre_asymptotic else "", _badge(status)])
+    table = _table(["reference", "expected", "sup-norm order [95%]", "L2 order", "final-time order",
+                    "pre-asymptotic", "verdict"], rows)
+    return ('<p class="note">Least-squares slope of log error against log mesh, with its 95% Student-t '
+            "interval (shaded) and the order the theory predicts (dashed). Errors at the round-off floor "
+            "(dotted) are not fitted.</p>" + table + f'<div class="grid" style="margin-top:14px">{"".join(figs)}</div>')
+
+
+def _trajectories(report: Report) -> str:
+    from .plots import trajectory_plot
+
+    if not report.trajectories:
+        return '<p class="note">No trajectory samples in this run.</p>'
+    figs = [f"<figure>{trajectory_plot(s)}<figcaption>{_e(s.get('stepper'))} on the coarsest grid of the "
+            f"study (markers) against the exact solution (lines).</figcaption></figure>"
+            for s in report.trajectories]
+    return f'<div class="grid">{"".join(figs)}</div>'
+
+
+def _laws(report: Report) -> str:
+    if not report.results:
+        return '<p class="note">No records.</p>'
+    groups: dict[str, list[CheckResult]] = defaultdict(list)
+    for r in report.results:
+        groups[r.check].append(r)
+    rows, classes, detail_blocks = [], [], []
+    for check, recs in groups.items():
+        counts = {s: sum(r.status == s for r in recs) for s in STATUSES}
+        rated = [(r, _ratio(r)) for r in recs if _ratio(r) is not None]
+        worst_rec, worst_ratio = max(rated, key=lambda p: p[1]) if rated else (None, None)
+        rows.append([f'<a href="#law-{_e(check)}">{_e(check)}</a>', _num(len(recs), "d"),
+                     _num(counts[PASSED], "d"), _num(counts[FAILED], "d"), _num(counts[SKIPPED], "d"),
+                     _num(counts[XFAIL], "d"),
+                     _num(worst_rec.worst) if worst_rec else "–", _num(worst_rec.bound) if worst_rec else "–",
+                     _bar(worst_ratio), _e(worst_rec.subject) if worst_rec else ""])
+        classes.append("failed" if counts[FAILED] else "")
+        sub = [[_e(r.subject), _badge(r.status), _num(r.worst), _num(r.bound), _bar(_ratio(r)),
+                _num(r.seed, "d") if r.seed is not None else "", _e(r.message)] for r in recs]
+        detail_blocks.append(
+            f'<details id="law-{_e(check)}"><summary>{_e(check)}: {len(recs)} records</summary>'
+            + _table(["subject", "status", "worst", "bound", "worst/bound", "seed", "message"], sub, (2, 3, 5),
+                     ["failed" if r.status == FAILED else "" for r in recs]) + "</details>")
+    table = _table(["check (law)", "records", "passed", "failed", "skipped", "xfail", "worst observed",
+                    "bound", "worst/bound", "worst subject"], rows, (1, 2, 3, 4, 5, 6, 7), classes)
+    return ('<p class="note">A check passes when its worst observed ratio stays within its bound. One row per '
+            "law; open a law below for every record.</p>" + table + "<h3>Every record</h3>" +
+            "".join(detail_blocks))
+
+
+def _failures(report: Report) -> str:
+    bad = [r for r in report.results if r.status == FAILED]
+    if not bad:
+        return '<p><b style="color:var(--ok)">No failures.</b></p>'
+    out = []
+    for r in bad:
+        ce = json.dumps(r.counterexample, indent=1, default=str) if r.counterexample is not None else "—"
+        tb = r.details.get("traceback")
+        out.append(
+            f'<div class="failure"><h3>{_e(r.key)}</h3><p>{_e(r.message)}</p>'
+            f"<p class=\"muted\">worst {_num(r.worst)} against bound {_num(r.bound)}"
+            f"{'' if r.seed is None else f', seed {r.seed}'}</p>"
+            f"<b>Counterexample</b><pre>{_e(ce)}</pre>"
+            f"<b>Reproduce</b><pre>{_e(reproduction(r, report.meta))}</pre>"
+            + (f"<details><summary>traceback</summary><pre>{_e(tb)}</pre></details>" if tb else "") + "</div>")
+    return "".join(out)
+
+
+def _timings(report: Report) -> str:
+    cal = report.meta.get("calibration")
+    stages = report.meta.get("stages") or []
+    rows = [[_e(s.get("name")), _num(s.get("duration"), ".3f"),
+             _num(s["duration"] / cal, ".1f") if isinstance(cal, (int, float)) and cal > 0 else "–",
+             _num(s.get("records"), "d")] for s in stages]
+    out = (f'<p class="note">Calibration workload (fixed NumPy loop, same job): {_num(cal, ".4f")} s. The gate '
+           "compares durations as multiples of it, never absolute seconds.</p>")
+    if rows:
+        out += _table(["stage", "seconds", "× calibration", "records"], rows, (1, 2, 3))
+    timed = sorted((r for r in report.results if isinstance(r.duration, (int, float))),
+                   key=lambda r: -r.duration)[:12]
+    if timed:
+        out += "<h3>Slowest records</h3>" + _table(
+            ["record", "seconds"], [[_e(r.key), _num(r.duration, ".3f")] for r in timed], (1,))
+    studies = [s for s in report.studies if hasattr(s, "timings")]
+    if studies:
+        srows = [[_e(s.problem), ", ".join(str(k) for k in s.steps), _num(sum(s.timings), ".3f")] for s in studies]
+        out += "<h3>Convergence studies</h3>" + _table(["reference", "steps per grid", "solve seconds"], srows, (2,))
+    return out
+
+
+def _environment(report: Report) -> str:
+    env = report.meta.get("environment") or {}
+    versions = env.get("versions") or {}
+    machine = env.get("machine") or {}
+    run = {k: report.meta.get(k) for k in ("command", "target", "profile", "seed", "created", "data_dir")}
+    kv = lambda d: '<table class="kv">' + "".join(  # noqa: E731
+        f"<tr><td>{_e(k)}</td><td>{_e(v if v is not None else '—')}</td></tr>" for k, v in d.items()) + "</table>"
+    return (f'<div class="grid"><div><h3>Run</h3>{kv(run)}</div><div><h3>Versions</h3>{kv(versions)}</div>'
+            f"<div><h3>Machine</h3>{kv(machine)}</div></div>")
+
+
+def render(report: Report, *, changes: Any = None, title: str = "verimono report") -> str:
+    """The complete HTML document for ``report`` (``changes``: a :class:`verimono.gate.Comparison`)."""
+    if "environment" not in report.meta:
+        from .schema import environment
+
+        report.meta["environment"] = environment()
+    bodies = {
+        "summary": _summary(report, changes), "changes": _changes(changes),
+        "convergence": _convergence(report), "trajectories": _trajectories(report), "laws": _laws(report),
+        "failures": _failures(report), "timings": _timings(report), "environment": _environment(report),
+    }
+    nav = "".join(f'<a href="#{s}">{_TITLES[s]}</a>' for s in SECTIONS)
+    sections = "".join(f'<section id="{s}"><h2>{_TITLES[s]}</h2>{bodies[s]}</section>' for s in SECTIONS)
+    m = report.meta
+    sub = " · ".join(_e(x) for x in (
+        f"verimono {m.get('command') or ''} {m.get('target') or ''}".strip(), f"profile {m.get('profile')}",
+        m.get("created") or "", report.summary()) if x)
+    return (f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
+            f'<meta name="viewport" content="width=device-width, initial-scale=1">'
+            f"<title>{_e(title)}</title><style>{CSS}</style></head><body>"
+            f"<header><h1>{_e(title)}</h1><div class=\"sub\">{sub}</div></header><nav>{nav}</nav>"
+            f"<main>{sections}</main></body></html>\n")
+
+
+__all__ = ["render", "reproduction", "SECTIONS"]

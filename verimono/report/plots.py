@@ -1,0 +1,141 @@
+"""Inline SVG plots for the HTML report, drawn with matplotlib's object API (no pyplot global state).
+
+Every function returns an ``<svg>`` element as a string: no XML prolog, no metadata, no external
+references, element ids salted per figure so several plots can share one HTML document.
+"""
+
+from __future__ import annotations
+
+import io
+import itertools
+import math
+import re
+from typing import Any
+
+import numpy as np
+
+_COUNTER = itertools.count()
+#: colours of the norms / components (matplotlib's default cycle, readable on white and in grey print)
+COLORS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e")
+
+
+def _svg(fig: Any) -> str:
+    import matplotlib
+
+    buf = io.StringIO()
+    salt = f"vm{next(_COUNTER)}"
+    with matplotlib.rc_context({"svg.hashsalt": salt, "svg.fonttype": "none"}):
+        fig.savefig(buf, format="svg", bbox_inches="tight",
+                    metadata={"Creator": None, "Date": None, "Format": None, "Type": None})
+    text = buf.getvalue()
+    text = text[text.index("<svg"):]                       # drop the XML prolog and DOCTYPE
+    text = re.sub(r"<metadata>.*?</metadata>", "", text, flags=re.S)
+    # give ids that matplotlib does not salt (figure_1, axes_1, patch_1, ...) a per-figure prefix
+    text = re.sub(r'id="((?:figure|axes|patch|line2d|text|legend|matplotlib|xtick|ytick|'
+                  r'PolyCollection|FillBetween)[^"]*)"', rf'id="{salt}-\1"', text)
+    text = re.sub(r'<svg ', '<svg role="img" class="plot" ', text, count=1)
+    return text
+
+
+def _figure(width: float = 4.4, height: float = 3.1) -> Any:
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(width, height), dpi=96)
+    fig.set_layout_engine("constrained")
+    return fig
+
+
+def _num(v: Any) -> float:
+    return float(v) if isinstance(v, (int, float, str)) else math.nan
+
+
+def convergence_plot(study: Any) -> str:
+    """Log-log errors against ``|Δ|`` for each norm, the fitted sup-norm slope with its 95% interval as a
+    shaded wedge, the expected slope dashed, and the round-off floor dotted."""
+    from matplotlib.ticker import NullLocator
+
+    fig = _figure()
+    ax = fig.add_subplot()
+    h = np.asarray(study.mesh, float)
+    floor = float(study.floor)
+    positive = []
+    for (norm, errs), color, marker in zip(study.errors.items(), COLORS, "osd"):
+        e = np.asarray([_num(v) for v in errs])
+        if not np.any(e > 0):
+            ax.plot([], [], ls="none", marker=marker, color=color, label=f"{norm} error: 0 on every grid")
+            continue
+        positive.append(e[e > 0])
+        shown = np.where(e > 0, e, np.nan)  # exact zeros cannot be drawn on a log axis
+        ax.loglog(h, shown, marker=marker, color=color, lw=1.0 if norm == "sup" else 0.8,
+                  alpha=1.0 if norm == "sup" else 0.55, ms=5 if norm == "sup" else 4, label=f"{norm} error")
+    fit = study.fits["sup"]
+    e = np.asarray([_num(v) for v in study.errors["sup"]])
+    used = [i for i in fit.used if e[i] > 0]
+    hh = np.geomspace(h.min(), h.max(), 50)
+    if used and not fit.exact and math.isfinite(fit.slope):
+        lh, le = np.log(h[used]), np.log(e[used])
+        ch, ce = lh.mean(), le.mean()  # the fit passes through the centroid of the used points
+        line = np.exp(ce + fit.slope * (np.log(hh) - ch))
+        label = f"fit slope {fit.slope:.3f}"
+        if math.isfinite(fit.low) and math.isfinite(fit.high):
+            label += f" [{fit.low:.3f}, {fit.high:.3f}]"
+            lo = np.exp(ce + fit.low * (np.log(hh) - ch))
+            hi = np.exp(ce + fit.high * (np.log(hh) - ch))
+            ax.fill_between(hh, np.minimum(lo, hi), np.maximum(lo, hi), color=COLORS[0], alpha=0.15, lw=0,
+                            label="95% interval")
+        ax.loglog(hh, line, color="black", lw=1.2, label=label)
+        exp = study.expected
+        if exp is not None and exp.value is not None and not exp.exact:
+            ax.loglog(hh, np.exp(ce + exp.value * (np.log(hh) - ch)), color="#555555", ls="--", lw=1.2,
+                      label=f"expected slope {exp.value:g}")
+    elif fit.exact:
+        ax.text(0.04, 0.9, "exact at the nodes: every error at round-off", transform=ax.transAxes,
+                fontsize=8, color="#2ca02c")
+    lo = min((float(p.min()) for p in positive), default=floor) / 3
+    hi = max((float(p.max()) for p in positive), default=floor) * 3
+    if fit.exact or floor >= lo / 10:  # the floor matters here: show it
+        ax.axhline(floor, color="#888888", ls=":", lw=1.0, label=f"round-off floor {floor:.1e}")
+        lo, hi = min(lo, floor / 3), max(hi, floor * 3)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_ylim(lo, hi)
+    ax.set_xlim(h.min() / 1.25, h.max() * 1.25)
+    ax.set_xticks(h, [f"{v:.2g}" for v in h])  # label the studied meshes themselves
+    ax.xaxis.set_minor_locator(NullLocator())
+    for label in ax.get_xticklabels():
+        label.set_rotation(30)
+        label.set_fontsize(7.5)
+    ax.set_xlabel("mesh |Δ| = max step")
+    ax.set_ylabel("error")
+    ax.set_title(study.problem, fontsize=10)
+    ax.grid(True, which="major", alpha=0.3)
+    ax.legend(fontsize=6.5, loc="lower right", framealpha=0.85)
+    return _svg(fig)
+
+
+def trajectory_plot(sample: dict[str, Any]) -> str:
+    """The discrete solution (markers) against the exact one (lines), component by component (≤ 4)."""
+    fig = _figure()
+    ax = fig.add_subplot()
+    t = np.asarray(sample["t"], float)
+    x = np.asarray([[_num(v) for v in np.atleast_1d(row)] for row in sample["x"]])
+    ncomp = min(x.shape[1], 4)
+    exact = sample.get("exact")
+    te = np.asarray(sample.get("t_exact") or [], float)
+    ex = np.asarray([[_num(v) for v in np.atleast_1d(row)] for row in exact]) if exact else None
+    every = max(1, len(t) // 60)  # at most ~60 markers per component
+    for j in range(ncomp):
+        color = COLORS[j % len(COLORS)]
+        if ex is not None:
+            ax.plot(te, ex[:, j], color=color, lw=1.4, alpha=0.8, label=f"exact x{j + 1}" if ncomp > 1 else "exact")
+        ax.plot(t[::every], x[::every, j], ls="none", marker="o", ms=3.2, mfc="none", color=color,
+                label=f"scheme x{j + 1}" if ncomp > 1 else "scheme")
+    ax.set_xlabel("t")
+    ax.set_ylabel("x(t)")
+    ax.set_title(f"{sample['problem']} (h = {float(sample['h']):.3g})", fontsize=10)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=6.5, loc="best", framealpha=0.85, ncol=2 if ncomp > 2 else 1)
+    return _svg(fig)
+
+
+__all__ = ["convergence_plot", "trajectory_plot"]

@@ -1,0 +1,407 @@
+"""The verification run as a list of *stages*: a small registry ``name → callable(profile, context) → Report``.
+
+``verimono run`` runs every registered stage in order (or those named with ``--stage``), merges their
+reports and records, per stage, its status, record count and duration in ``report.meta["stages"]``.
+
+A stage never prints and never raises: :func:`run_stages` turns an exception into one *failed* record
+``stage[<name>]`` (a crash fails the run) and :class:`StageUnavailable` — a battery whose module is not
+installed, or data that are absent — into one *skipped* record, so a missing battery is counted and the
+gate sees the count of checks shrink.
+
+To add a battery::
+
+    from verimono.stages import register_stage
+
+    @register_stage("my_laws", "what it verifies")
+    def my_laws(profile, context):          # profile: verimono.profiles.Profile; context: RunContext
+        return check_something(context.stepper, seed=context.seed)     # a verimono.Report
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib
+import os
+import time
+import traceback
+from pathlib import Path
+from typing import Any, Callable, Iterable
+
+import numpy as np
+
+from .errors import VerimonoError
+from .profiles import Profile
+from .results import FAILED, PASSED, SKIPPED, XFAIL, CheckResult, Report
+
+#: how many points of a trajectory the report keeps for its plot (enough for a smooth curve)
+TRAJECTORY_SAMPLES = 400
+
+
+class StageUnavailable(VerimonoError):
+    """A stage cannot run here (its module is not installed yet, or its data are absent)."""
+
+
+class UnknownStage(VerimonoError, ValueError):
+    """A stage name that is not registered."""
+
+
+@dataclasses.dataclass
+class RunContext:
+    """What every stage may use.
+
+    ``stepper`` is the time-stepper under test (``verimono.solve`` for ``verimono run``); ``problems``
+    the references (``None``: the whole catalog); ``operators`` extra operators to verify (``verimono
+    check`` on an operator); ``data_dir`` the shared data folder (Siconos references) or ``None``;
+    ``progress(done, total, label)`` reports progress within a stage.
+    """
+
+    stepper: Callable | None = None
+    problems: list[Any] | None = None
+    operators: list[tuple[str, Any]] | None = None
+    seed: int | None = None
+    data_dir: Path | None = None
+    progress: Callable[[int, int, str], None] = lambda done, total, label: None
+
+    _catalog: list[Any] | None = dataclasses.field(default=None, repr=False)
+
+    def catalog(self) -> list[Any]:
+        """``problems`` if given, else the reference catalog (built once per run)."""
+        if self.problems is not None:
+            return self.problems
+        if self._catalog is None:
+            from verimono.reference import catalog
+
+            self._catalog = catalog()
+        return self._catalog
+
+    def seed_for(self, profile: Profile) -> int | None:
+        """The seed a randomized battery uses: ``seed`` if given, else 0 under a derandomized profile
+        (``ci``: the same records in every job), else ``None`` (a fresh seed, recorded in each record)."""
+        if self.seed is not None:
+            return self.seed
+        return 0 if profile.derandomize else None
+
+
+@dataclasses.dataclass(frozen=True)
+class Stage:
+    name: str
+    fn: Callable[[Profile, RunContext], Report]
+    description: str = ""
+
+
+STAGES: dict[str, Stage] = {}
+
+
+def register_stage(name: str, description: str = "") -> Callable:
+    """Decorator registering ``fn(profile, context) -> Report`` as the stage ``name`` (replaces same name)."""
+
+    def deco(fn: Callable[[Profile, RunContext], Report]) -> Callable:
+        STAGES[name] = Stage(name, fn, description or (fn.__doc__ or "").strip().split("\n")[0])
+        return fn
+
+    return deco
+
+
+def optional_module(name: str) -> Any:
+    """Import ``name``; :class:`StageUnavailable` if that module (not one of its imports) is missing."""
+    try:
+        return importlib.import_module(name)
+    except ModuleNotFoundError as exc:
+        if exc.name and (name == exc.name or name.startswith(exc.name + ".")):
+            raise StageUnavailable(f"{name} is not installed in this version of verimono") from None
+        raise
+
+
+def _stage_record(name: str, status: str, message: str, duration: float) -> CheckResult:
+    return CheckResult("stage", name, status, message=message, duration=duration)
+
+
+def run_stages(names: Iterable[str] | None, profile: Profile, context: RunContext,
+               on_start: Callable[[Stage, int, int], None] | None = None,
+               on_done: Callable[[Stage, Report, dict], None] | None = None) -> Report:
+    """Run the stages ``names`` (``None``: all, in registration order) and merge their reports."""
+    names = list(STAGES) if names is None else list(names)
+    for n in names:
+        if n not in STAGES:
+            raise UnknownStage(f"unknown stage {n!r}; registered stages: {', '.join(STAGES)}")
+    total = Report(meta={"stages": []})
+    for i, n in enumerate(names):
+        stage = STAGES[n]
+        if on_start:
+            on_start(stage, i, len(names))
+        start = time.perf_counter()
+        try:
+            rep = stage.fn(profile, context)
+            if not isinstance(rep, Report):
+                raise TypeError(f"stage {n} returned {type(rep).__name__}, expected a verimono.Report")
+            status, message = ("failed" if not rep.ok else "passed"), rep.summary()
+        except StageUnavailable as exc:
+            rep = Report([_stage_record(n, SKIPPED, str(exc), time.perf_counter() - start)])
+            status, message = "skipped", str(exc)
+        except Exception as exc:  # a crash is a failure of the run, recorded, never swallowed
+            tb = traceback.format_exc(limit=6)
+            rec = _stage_record(n, FAILED, f"{type(exc).__name__}: {exc}", time.perf_counter() - start)
+            rec.details["traceback"] = tb
+            rep = Report([rec])
+            status, message = "error", f"{type(exc).__name__}: {exc}"
+        duration = time.perf_counter() - start
+        info = {"name": n, "status": status, "records": len(rep), "duration": duration, "message": message}
+        for r in rep.results:
+            r.details.setdefault("stage", n)
+        total.extend(rep)
+        total.meta["stages"].append(info)
+        if on_done:
+            on_done(stage, rep, info)
+    return total
+
+
+def calibrate(repeats: int = 3) -> float:
+    """Seconds of a fixed NumPy-and-Python workload like the harness's (best of ``repeats``).
+
+    Stage durations divided by this number are comparable between jobs on different machines: the gate
+    compares these ratios, measured in the same job, never absolute seconds.
+    """
+    best = float("inf")
+    for _ in range(repeats):
+        x, lo, hi = np.array([0.3, -0.2, 0.9]), -np.ones(3) * 0.5, np.ones(3) * 0.5
+        start = time.perf_counter()
+        for k in range(20000):
+            x = np.clip(x - 1e-3 * np.sin(k * 1e-3) * x, lo, hi)
+        np.linalg.solve(np.eye(60) * 4.0 + np.ones((60, 60)), np.ones(60))
+        best = min(best, time.perf_counter() - start)
+    return best
+
+
+def locate_data(explicit: str | os.PathLike | None = None) -> Path | None:
+    """The shared data folder: ``explicit``, else ``$VERIMONO_SHARED``, else ``../shared`` beside the
+    current directory or beside the verimono checkout; ``None`` when none exists."""
+    if explicit is not None:
+        path = Path(explicit)
+        if not path.is_dir():
+            raise StageUnavailable(f"data folder {path} does not exist")
+        return path
+    candidates = []
+    if os.environ.get("VERIMONO_SHARED"):
+        candidates.append(Path(os.environ["VERIMONO_SHARED"]))
+    candidates += [Path.cwd().parent / "shared", Path(__file__).resolve().parents[1].parent / "shared"]
+    return next((c for c in candidates if c.is_dir()), None)
+
+
+def _name(obj: Any) -> str:
+    return getattr(obj, "__name__", None) or getattr(obj, "name", None) or type(obj).__name__
+
+
+# ---------------------------------------------------------------------------------------------------
+# the stages verimono ships
+
+
+def sample_trajectory(stepper: Callable, problem: Any, h: float | None = None) -> dict[str, Any]:
+    """A plot sample: ``stepper`` on a uniform grid of step ``h`` (default: the problem's coarsest
+    recommended step) next to the exact solution, thinned to :data:`TRAJECTORY_SAMPLES` points."""
+    from .grids import uniform_grid
+
+    h = h or (max(problem.steps) if problem.steps else problem.T / 50)
+    t = uniform_grid(problem.T, h)
+    x = np.asarray(stepper(problem, t), dtype=float)
+    keep = np.unique(np.linspace(0, len(t) - 1, min(len(t), TRAJECTORY_SAMPLES)).round().astype(int))
+    fine = np.linspace(0.0, problem.T, TRAJECTORY_SAMPLES)
+    exact = None
+    if problem.exact is not None:
+        exact = np.array([np.asarray(problem.exact(s), dtype=float) for s in fine])
+    first = (lambda a: a[:, 0] if a.ndim == 3 else a)  # a batch: plot its first member
+    from .results import to_jsonable
+
+    return to_jsonable({"problem": problem.name, "stepper": _name(stepper), "h": float(h),
+                        "t": t[keep], "x": first(x)[keep],
+                        "t_exact": fine if exact is not None else None,
+                        "exact": first(exact) if exact is not None else None})
+
+
+@register_stage("convergence", "every analytic reference's convergence study against its expected order")
+def convergence_stage(profile: Profile, context: RunContext) -> Report:
+    """Every analytic reference's convergence study, plus a trajectory sample for the report's plots."""
+    from .checks.orders import check_convergence_order
+    from .convergence import ConvergenceStudy
+
+    stepper = context.stepper
+    if stepper is None:
+        from .stepping import solve as stepper
+    problems = context.catalog()
+    report = Report()
+    for i, p in enumerate(problems):
+        context.progress(i, len(problems), p.name)
+        rec = report.add(check_convergence_order(stepper, p))
+        if "study" in rec.details:
+            report.studies.append(ConvergenceStudy.from_dict(rec.details["study"]))
+        try:
+            report.trajectories.append(sample_trajectory(stepper, p))
+        except (VerimonoError, ArithmeticError, ValueError) as exc:
+            rec.details["trajectory_error"] = f"{type(exc).__name__}: {exc}"
+    context.progress(len(problems), len(problems), "")
+    return report
+
+
+def _catalog_operators(context: RunContext) -> list[tuple[str, Any]]:
+    """Distinct operators of the reference catalog, named by their problem."""
+    seen, out = set(), []
+    for p in context.catalog():
+        key = (type(p.operator).__name__, getattr(p.operator, "name", ""), p.dim)
+        if key not in seen:
+            seen.add(key)
+            out.append((f"{getattr(p.operator, 'name', type(p.operator).__name__)} ({p.name})", p.operator))
+    return out
+
+
+def _generated_operators(profile: Profile, seed: int | None) -> list[tuple[str, Any]]:
+    """``profile.generated_subjects`` operators drawn from ``verimono.strategies.maximal_monotone_operators``
+    in dimensions 1-3 (reproducibly from ``seed``; a fresh draw when ``seed`` is None)."""
+    strategies = optional_module("verimono.strategies")
+    family = getattr(strategies, "maximal_monotone_operators", None)
+    if family is None:
+        raise StageUnavailable("verimono.strategies has no maximal_monotone_operators")
+    from hypothesis import HealthCheck, Phase, given, settings
+    from hypothesis import seed as hseed
+
+    drawn: list[tuple[int, Any]] = []
+    dims = (1, 2, 3)
+    per_dim = max(1, profile.generated_subjects // len(dims))
+    for n in dims:
+        # skip hypothesis' first, simplest example (the zero operator) so the draws exercise real cases
+        @settings(max_examples=per_dim + 1, derandomize=False, database=None, phases=[Phase.generate],
+                  deadline=None, suppress_health_check=list(HealthCheck))
+        @given(family(n))
+        def collect(op):
+            drawn.append((op.dim, op))
+
+        if seed is not None:
+            collect = hseed(seed * 7919 + n)(collect)
+        before = len(drawn)
+        collect()
+        del drawn[before]
+    def label(i: int, n: int, op: Any) -> str:
+        name = str(getattr(op, "name", type(op).__name__))
+        return f"generated #{i} (n={n}, seed {seed}): " + (name if len(name) <= 70 else name[:67] + "...")
+
+    return [(label(i, n, op), op) for i, (n, op) in enumerate(drawn)]
+
+
+@register_stage("operator_laws", "resolvent and Yosida laws on the catalog operators and generated families")
+def operator_laws_stage(profile: Profile, context: RunContext) -> Report:
+    """``check_operator`` on each catalog operator (or the user's) and on generated families.
+
+    Records are renamed ``subject = <label>`` (the operator's problem or draw) so keys stay unique."""
+    laws = optional_module("verimono.checks.operator_laws")
+    report = Report()
+    if context.operators is not None:
+        subjects = list(context.operators)
+    else:
+        subjects = _catalog_operators(context)
+        try:
+            subjects += _generated_operators(profile, context.seed_for(profile))
+        except StageUnavailable as exc:
+            report.add(CheckResult("stage", "operator_laws: generated families", SKIPPED, message=str(exc)))
+    for i, (label, op) in enumerate(subjects):
+        context.progress(i, len(subjects), label)
+        rep = laws.check_operator(op, seed=context.seed_for(profile), examples=profile.law_examples)
+        for r in rep.results:
+            r.details.setdefault("operator", r.subject)
+            r.subject = label
+        report.extend(rep)
+    context.progress(len(subjects), len(subjects), "")
+    return report
+
+
+@register_stage("trajectory_laws", "contraction, uniqueness of the limit, domain, a-priori bounds, selections")
+def trajectory_laws_stage(profile: Profile, context: RunContext) -> Report:
+    """The trajectory laws of the stepper under test on every reference (and, without a user-given
+    problem list, on ``profile.generated_subjects`` sampled problems)."""
+    mod = optional_module("verimono.checks.trajectory_laws")
+    stepper = context.stepper
+    if stepper is None:
+        from .stepping import solve as stepper
+    seed = context.seed_for(profile)
+    checks = list(mod.stepper_checks(stepper, context.problems, seed=0 if seed is None else seed,
+                                     generated=profile.generated_subjects, orders=False))
+    report = Report()
+    for i, (name, check) in enumerate(checks):
+        context.progress(i, len(checks), name)
+        report.add(check(stepper))
+    return report
+
+
+@register_stage("assumptions", "sampled evidence for (A1), (A3), (LG), (YB) on every reference")
+def assumptions_stage(profile: Profile, context: RunContext) -> Report:
+    """``check_assumptions(problem)`` on every reference (evidence, never proof).
+
+    Theorem ``thm:main`` needs (A1), (A3) and *one of* (LG) or (YB).  So when exactly one of the two
+    alternatives has evidence against it, that record becomes an expected failure (``xfail``, saying
+    which alternative holds), and one record ``assumptions_thm_main`` per problem states whether the
+    theorem's hypotheses as a whole have evidence for them."""
+    mod = optional_module("verimono.checks.assumptions")
+    seed = context.seed_for(profile)
+    report = Report()
+    problems = context.catalog()
+    for i, p in enumerate(problems):
+        context.progress(i, len(problems), p.name)
+        rep = mod.check_assumptions(p, seed=0 if seed is None else seed)
+        by = {r.check: r for r in rep.results}
+        lg, yb = by.get("assumption_LG"), by.get("assumption_YB")
+        for this, other, name in ((lg, yb, "(YB)"), (yb, lg, "(LG)")):
+            if this is not None and other is not None and this.status == FAILED and other.status == PASSED:
+                this.status = XFAIL
+                this.message = f"the alternative hypothesis {name} has evidence for it; {this.message}"
+        bad = [r.check for r in rep.results if r.status == FAILED]
+        report.extend(rep)
+        report.add(CheckResult(
+            "assumptions_thm_main", p.name, FAILED if bad else PASSED, seed=seed,
+            message=("evidence against " + ", ".join(bad)) if bad else
+            "no sample contradicts (A1), (A3) and (LG) or (YB) — evidence, not proof"))
+    return report
+
+
+@register_stage("section7", "the paper's complementarity example: orders, trajectories, hypotheses")
+def section7_stage(profile: Profile, context: RunContext) -> Report:
+    """The complementarity systems of the paper (``verimono.reference.lcs_example``): convergence order
+    of the stepper under test on each, a trajectory sample, and the evidence for the hypotheses of the
+    Section 7 theorems (``verimono.lcs.check_hypotheses``)."""
+    example = optional_module("verimono.reference.lcs_example")
+    lcs = optional_module("verimono.lcs")
+    from .checks.orders import check_convergence_order
+    from .convergence import ConvergenceStudy
+
+    stepper = context.stepper
+    if stepper is None:
+        from .stepping import solve as stepper
+    report = Report()
+    in_catalog = {p.name for p in context.catalog()}  # already studied by the convergence stage
+    problems = [p for p in (example.ramp_problem(), example.sine_problem()) if p.name not in in_catalog]
+    for i, p in enumerate(problems):
+        context.progress(i, len(problems) + 1, p.name)
+        rec = report.add(check_convergence_order(stepper, p))
+        if "study" in rec.details:
+            report.studies.append(ConvergenceStudy.from_dict(rec.details["study"]))
+        report.trajectories.append(sample_trajectory(stepper, p))
+    seed = context.seed_for(profile)
+    for label, v in (("v = (−t, 0)", lambda t: np.array([-t, 0.0])),
+                     ("v = (sin t, 0)", lambda t: np.array([np.sin(t), 0.0]))):
+        rep = lcs.check_hypotheses(example.example_system(v), 2.0, seed=0 if seed is None else seed)
+        for r in rep.results:
+            r.subject = f"{r.subject} ({label})"
+        report.extend(rep)
+    return report
+
+
+@register_stage("siconos", "agreement with the Siconos reference trajectories in the shared data folder")
+def siconos_stage(profile: Profile, context: RunContext) -> Report:
+    """Agreement with the Siconos reference trajectories (needs ``../shared`` or ``--data DIR``)."""
+    mod = optional_module("verimono.lcs")
+    fn = getattr(mod, "check_siconos", None)
+    if fn is None:
+        raise StageUnavailable("verimono.lcs has no check_siconos(data_dir)")
+    if context.data_dir is None:
+        raise StageUnavailable("Siconos reference data not found: pass --data DIR or set VERIMONO_SHARED")
+    return fn(Path(context.data_dir))
+
+
+__all__ = ["STAGES", "Stage", "RunContext", "StageUnavailable", "UnknownStage", "register_stage",
+           "run_stages", "calibrate", "locate_data", "optional_module", "sample_trajectory"]
