@@ -55,6 +55,12 @@ def closed_form_H(x, v1, v2):
     return (-np.inf, top) if x == -v2 else (top, top)
 
 
+def _static_domain(t):
+    """(A3) with φ = 0: ``dom H(t,·) = [−v2(t), ∞) = [0, ∞)`` does not move when ``v2 = 0``; and (LG) holds
+    with ``σ(t) = max(−v1(t), 0)``, since ``|H^0(t, x)| = max(−v1(t), 0)`` on the whole domain."""
+    return 0.0
+
+
 def ramp_problem(x0: float = 0.5, T: float = 2.0) -> Problem:
     """``v = (−t, 0)``: ``x = x0 + t²/2``, proximal-scheme error exactly ``hT/2``."""
     if x0 < 0:
@@ -63,7 +69,8 @@ def ramp_problem(x0: float = 0.5, T: float = 2.0) -> Problem:
     return sys.problem([x0], T, exact=lambda t: np.array([x0 + 0.5 * t * t]),
                        order=Order(1.0, "Example ex, v = (−t, 0): x_k = x0 + t_k²/2 + h t_k/2 (derived in "
                                    "reference/lcs_example.py)", constant=T / 2.0),
-                       steps=[T / 8, T / 16, T / 32, T / 64], name="Example ex, v = (−t, 0)")
+                       steps=[T / 8, T / 16, T / 32, T / 64], name="Example ex, v = (−t, 0)",
+                       phi=_static_domain, sigma=lambda t: t)
 
 
 def _sine_exact(x0):
@@ -82,7 +89,8 @@ def sine_problem(x0: float = 0.0, T: float = 3 * np.pi) -> Problem:
     return sys.problem([x0], T, exact=_sine_exact(x0),
                        order=Order(1.0, "Example ex, v = (sin t, 0): right Riemann sum of the Lipschitz "
                                    "max(−sin t, 0)", constant=0.5),
-                       steps=[T / 64, T / 128, T / 256, T / 512], name="Example ex, v = (sin t, 0)")
+                       steps=[T / 64, T / 128, T / 256, T / 512], name="Example ex, v = (sin t, 0)",
+                       phi=_static_domain, sigma=lambda t: max(-np.sin(t), 0.0))
 
 
 def pseudo_distance_demo(rhos=(0.0, 1.0, 10.0, 100.0, 1000.0), lams=(0.5, 1.0, 2.0)):
@@ -99,5 +107,39 @@ def pseudo_distance_demo(rhos=(0.0, 1.0, 10.0, 100.0, 1000.0), lams=(0.5, 1.0, 2
     return out
 
 
+def check_closed_form_resolvent(samples: int = 200, seed: int = 0):
+    """Record: the system's one-step solve equals ``max(x + h max(−v1, 0), −v2)`` at random (x, h, v)."""
+    from verimono.results import FAILED, PASSED, CheckResult
+    from verimono.tolerances import tolerance
+
+    rng = np.random.default_rng(seed)
+    worst, counter = 0.0, None
+    for _ in range(samples):
+        x, h, v1, v2 = rng.uniform(-3, 3), rng.uniform(1e-3, 2.0), rng.uniform(-2, 2), rng.uniform(-2, 2)
+        got = float(example_system(np.array([v1, v2])).operator().resolvent(np.array([x]), h, 0.0)[0])
+        want = float(closed_form_resolvent(x, h, v1, v2))
+        ratio = abs(got - want) / tolerance(x, h, v1, v2)
+        if ratio > worst:
+            worst, counter = ratio, {"x": x, "h": h, "v": [v1, v2], "got": got, "closed_form": want}
+    ok = worst <= 1.0
+    return CheckResult("example_resolvent_closed_form", "paper Example ex", PASSED if ok else FAILED, worst=worst,
+                       bound=1.0, counterexample=None if ok else counter, seed=seed,
+                       message=f"{samples} one-step LCP solves against max(x + h max(-v1, 0), -v2)")
+
+
+def check_pseudo_distance_unbounded(rhos=(0.0, 1.0, 10.0, 100.0, 1000.0)):
+    """Record: sampled lower bounds of ``dis(H(t1,·), H(t2,·))`` reach ``(ρ+1)/2`` for every ``ρ`` — the
+    pseudo-distance is unbounded, so Vladimirov's absolute continuity (``d:vlad``) fails for the Example."""
+    from verimono.results import FAILED, PASSED, CheckResult
+
+    pairs = [(rho, float(bound)) for rho, bound in pseudo_distance_demo(rhos)]
+    worst = max((rho + 1.0) / 2.0 / bound for rho, bound in pairs)
+    ok = worst <= 1.0 + 1e-12
+    return CheckResult("example_pseudo_distance_unbounded", "paper Example ex", PASSED if ok else FAILED,
+                       worst=worst, bound=1.0, details={"rho": [r for r, _ in pairs], "bound": [b for _, b in pairs]},
+                       message="dis(H(0,·), H(1,·)) ≥ " + ", ".join(f"{b:.4g}" for _, b in pairs)
+                       + f" for ρ = {', '.join(f'{r:g}' for r, _ in pairs)}: at least (ρ+1)/2, unbounded")
+
+
 __all__ = ["example_system", "closed_form_resolvent", "closed_form_H", "ramp_problem", "sine_problem",
-           "pseudo_distance_demo"]
+           "pseudo_distance_demo", "check_closed_form_resolvent", "check_pseudo_distance_unbounded"]

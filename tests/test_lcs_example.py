@@ -80,3 +80,18 @@ def test_pseudo_distance_tool_on_explicit_graph_points():
     b2 = pseudo_distance_lower_bound((np.array([[rho + 1]]), np.array([[-1.0]])),
                                      (np.array([[0.0]]), np.array([[0.0]])), None)
     assert b2.value == pytest.approx(b.value)
+
+
+def test_example_records_for_the_run_stage(monkeypatch):
+    """The records `verimono run` shows: closed-form resolvent and unbounded pseudo-distance."""
+    from verimono.reference import lcs_example
+
+    assert lcs_example.check_closed_form_resolvent(samples=50).status == "passed"
+    rec = lcs_example.check_pseudo_distance_unbounded()
+    assert rec.status == "passed"
+    assert all(b >= (r + 1) / 2 for r, b in zip(rec.details["rho"], rec.details["bound"]))
+    # seen failing: a closed form with the wrong sign of v1 is caught with its counterexample
+    monkeypatch.setattr(lcs_example, "closed_form_resolvent",
+                        lambda x, h, v1, v2: np.maximum(np.asarray(x, float) + h * max(v1, 0.0), -v2))
+    bad = lcs_example.check_closed_form_resolvent(samples=50)
+    assert bad.status == "failed" and {"x", "h", "v"} <= set(bad.counterexample)

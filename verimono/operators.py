@@ -338,7 +338,8 @@ class NormSubdifferential(Operator):
     def min_norm(self, x, t=0.0):
         x = np.asarray(x, dtype=float)
         nrm = _norm(x)
-        return self._col(t, x) * x / _mx(nrm, _TINY)
+        # 0 where |x| is 0 or underflows (x·x < tiny): F^0(0) = 0; the max only avoids a 0/0 warning
+        return np.where(nrm > 0.0, self._col(t, x) * x / _mx(nrm, _TINY), 0.0)
 
     def project_domain(self, x, t=0.0):
         return np.array(x, dtype=float)

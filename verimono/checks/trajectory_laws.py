@@ -404,26 +404,39 @@ class LGBounds:
     """
 
     def __init__(self, x0_norm: float, phi: Callable, sigma: Callable, T: float,
-                 absu: Callable | None = None) -> None:
+                 absu: Callable | None = None, grid: np.ndarray | None = None) -> None:
         self.phi0, self.sigma0, self.T, self.absu = phi, sigma, T, absu
+        self.grid = None if grid is None else np.asarray(grid, dtype=float)
+        if self.grid is not None:
+            # the proof uses (LG) only at the nodes, |F^0(t_k, ξ)| ≤ σ(t_k)(1 + |ξ|): on this partition ∫σ
+            # becomes the right Riemann sum Σ h_k σ(t_k) (exact for σ piecewise constant on the cells; the
+            # paper reaches ∫σ only along specially chosen partitions, via Lakshmikantham–Leela 3.3.1)
+            h = np.diff(self.grid)
+            self._sigma_nodes = np.concatenate([[0.0], np.cumsum(h * _vals(sigma, self.grid[1:]))])
         self.u_total = 0.0 if absu is None else integrate.quad(absu, 0.0, T, limit=200)[0]
         dphi = float(phi(T)) - float(phi(0.0))
         if dphi < -tolerance(phi(T), phi(0.0)):
             raise _Skip(f"φ must be nondecreasing; φ(T) - φ(0) = {dphi:.3g}")
         dphi += self.u_total
-        int_sigma = (1.0 + self.u_total) * integrate.quad(lambda s: float(sigma(s)), 0.0, T, limit=200)[0]
+        int_sigma = (1.0 + self.u_total) * float(self._sigma_cumulative(np.array([0.0, T]))[-1])
         self.alpha = x0_norm + dphi
         self.beta = self.alpha + dphi + (1.0 + self.alpha) * int_sigma
         self.gamma = self.beta + dphi
 
+    def _sigma_cumulative(self, pts: np.ndarray) -> np.ndarray:
+        """``∫_0^s σ`` at the increasing ``pts`` (from 0), or its Riemann-sum version on the partition."""
+        if self.grid is None:
+            return _cumulative(self.sigma0, pts)
+        return np.interp(pts, self.grid, self._sigma_nodes)
+
     def psi_nodes(self, t: np.ndarray) -> np.ndarray:
-        """``ψ`` at the increasing points ``t`` (``t_0 = 0`` or not), by quadrature cell by cell."""
+        """``ψ`` at the increasing points ``t`` (``t_0 = 0`` or not)."""
         t = np.asarray(t, dtype=float)
         pts = np.concatenate([[0.0], t]) if t[0] > 0 else t
         phi = _vals(self.phi0, pts)
         if self.absu is not None:
             phi = phi + _cumulative(self.absu, pts)
-        out = pts + 2.0 * phi + (1.0 + self.gamma) * (1.0 + self.u_total) * _cumulative(self.sigma0, pts)
+        out = pts + 2.0 * phi + (1.0 + self.gamma) * (1.0 + self.u_total) * self._sigma_cumulative(pts)
         return out[1:] if t[0] > 0 else out
 
     def psi_function(self, points: np.ndarray) -> Callable[[float], float]:
@@ -478,7 +491,7 @@ def _lg_setup(p: Problem, t: np.ndarray):
         shift = np.concatenate([np.zeros((1, p.dim)), np.cumsum(p.input_increments(t), axis=0)])
         absu = lambda s: float(np.linalg.norm(p.u(s)))  # noqa: E731
         extra["via"] = "l:extinput (xi_k = x_k - Phi(t_k))"
-    return LGBounds(float(np.linalg.norm(p.x0)), phi, sigma, p.T, absu), shift, extra
+    return LGBounds(float(np.linalg.norm(p.x0)), phi, sigma, p.T, absu, grid=t), shift, extra
 
 
 def _yb_setup(p: Problem, t: np.ndarray):
