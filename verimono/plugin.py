@@ -50,6 +50,9 @@ def _load_profile(config: pytest.Config) -> str | None:
 
 def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line("markers", "verimono: a test whose result records feed the verimono report")
+    from .testing import pytest_configure as register_battery_counter
+
+    register_battery_counter(config)  # counts of parametrize_with_checks batteries, in every run
     profile = _load_profile(config)
     out = config.getoption("verimono_report")
     baseline_path = config.getoption("verimono_baseline")
