@@ -199,3 +199,16 @@ def test_time_dependent_l1_and_log_barrier_against_independent_solves(t):
     root = brentq(lambda s: s - lam * c / s - 0.3, 1e-12, 10.0)
     assert lb.resolvent(np.array([0.3]), lam, t)[0] == pytest.approx(root, rel=1e-12)
     assert lb.contains(np.array([root]), np.array([-c / root]), t)
+
+
+def test_membership_at_a_kink_reached_through_rounding():
+    """Shifted twice, J lands on the kink x = 0 of |x| only up to the rounding of the shifts: the
+    Yosida value must still be accepted (graph distance ≤ tol), and a wrong one still rejected."""
+    F = vm.Shifted(vm.Shifted(vm.NormSubdifferential(1.0, dim=2), [0.1, 0.7]), [0.2, -0.3])
+    x, lam = np.array([-0.25, -0.35]), 2.0            # |x + Φ| < λc: J^F lands on the kink
+    J, Y = F.resolvent(x, lam), F.yosida(x, lam)
+    assert F.contains(J, Y)
+    assert not F.contains(J, Y * 40.0)                # |40 Y| = 1.41 > c = 1: outside the ball at the kink
+    l1 = vm.Shifted(vm.L1Subdifferential(1.0, dim=2), [0.3, 0.1])
+    J, Y = l1.resolvent(np.array([-0.1, 2.0]), 1.0), l1.yosida(np.array([-0.1, 2.0]), 1.0)
+    assert l1.contains(J, Y) and not l1.contains(J, Y + np.array([0.0, 0.5]))

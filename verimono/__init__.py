@@ -12,11 +12,11 @@ from .operators import (L1Subdifferential, Linear, LogBarrier, NormalCone, NormS
                         Shifted, operator_from_resolvent)
 from .problem import Order, Problem
 from .results import CheckResult, Report
-from .stepping import Trajectory, solve
+from .stepping import Trajectory, solve, stream
 from .pseudo_distance import pseudo_distance_lower_bound
 from .checks import check_operator, check_stepper, operator_checks
 from .checks.assumptions import check_assumptions
-from .convergence import ConvergenceStudy, convergence_study
+from .convergence import ConvergenceStudy, ErrorAccumulator, convergence_study
 from . import lcs, sets, strategies
 
 __version__ = "0.1.0"
@@ -26,7 +26,7 @@ __all__ = [
     "SolverFailure",
     "Operator", "operator_from_resolvent", "Linear", "NormSubdifferential", "L1Subdifferential",
     "NormalCone", "Shifted", "LogBarrier", "sets",
-    "Problem", "Order", "Trajectory", "solve",
+    "Problem", "Order", "Trajectory", "solve", "stream", "ErrorAccumulator",
     "uniform_grid", "graded_grid", "random_grid", "refine", "validate_grid",
     "CheckResult", "Report", "pseudo_distance_lower_bound", "lcs", "strategies",
     "convergence_study", "ConvergenceStudy", "check_stepper", "check_operator", "operator_checks",

@@ -23,11 +23,11 @@ does its scalar arithmetic in Python floats (the same IEEE operations, hence the
 from __future__ import annotations
 
 import inspect
-import math
 from typing import Any, Callable
 
 import numpy as np
 
+from ._kernels import _TINY, _mx, _norm, _sqrt, dot_rows
 from ._params import as_param
 from .errors import InvalidProblem, NotMonotone, OutsideDomain
 from .tolerances import tolerance
@@ -68,7 +68,8 @@ class Operator:
         raise NotImplementedError(f"{self.name} does not provide a projection onto its domain")
 
     def contains(self, x: np.ndarray, y: np.ndarray, t: float = 0.0, tol: float | None = None) -> bool:
-        """Whether ``y ∈ F(t, x)`` up to ``tol`` (default: :func:`verimono.tolerances.tolerance`)."""
+        """Whether ``y ∈ F(t, x)`` up to ``tol`` (default: :func:`verimono.tolerances.tolerance`): some
+        ``(x', y') ∈ graph F(t,·)`` lies within ``tol`` of ``(x, y)`` in each coordinate."""
         raise NotImplementedError(f"{self.name} does not provide a membership test")
 
     # -- conveniences --------------------------------------------------------------------------
@@ -90,33 +91,6 @@ class Operator:
 
     def __repr__(self) -> str:
         return f"{self.name}(dim={self.dim})"
-
-
-_ar = np.add.reduce
-_mx, _mn = np.maximum, np.minimum
-_sqrt = math.sqrt
-#: the smallest positive double: ``max(r, _TINY) == r`` for every ``r > 0``, and ``0/_TINY == 0``
-_TINY = float(np.finfo(float).smallest_subnormal)
-
-
-if hasattr(np, "vecdot"):  # numpy >= 2
-    def dot_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        """Row-wise inner products over the last axis: the BLAS ``dot`` of each row, i.e. exactly
-        ``a_row.dot(b_row)`` for every row whatever the batch shape (batch ≡ separate, bit for bit)."""
-        return np.vecdot(a, b)
-else:  # pragma: no cover - numpy 1.x: a stack of (1, n) @ (n, 1) products, one BLAS dot per row
-    def dot_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        a, b = np.broadcast_arrays(a, b)
-        return np.matmul(a[..., None, :], b[..., :, None])[..., 0, 0]
-
-
-def _norm(x: np.ndarray) -> np.ndarray:
-    """Euclidean norm over the last axis, keeping it (works for (n,) and (B, n)).
-
-    Each row's squared norm is the BLAS dot of the row with itself (:func:`dot_rows`), exactly the
-    ``x.dot(x)`` of the single-point kernels, so a batch and its rows one by one give identical norms.
-    """
-    return np.sqrt(dot_rows(x, x))[..., None]
 
 
 def resolvent_kernel(op: "Operator", x0: np.ndarray) -> Callable:
@@ -348,9 +322,10 @@ class NormSubdifferential(Operator):
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
         c = float(self._c(t))
         tol = tolerance(c, y) if tol is None else tol
-        if np.linalg.norm(x) > 0.0:
-            return bool(np.linalg.norm(y - c * x / np.linalg.norm(x)) <= tol)
-        return bool(np.linalg.norm(y) <= c + tol)
+        nx = float(np.linalg.norm(x))
+        if nx <= tol and np.linalg.norm(y) <= c + tol:  # x within tol of 0, where F = the ball cB
+            return True
+        return bool(nx > 0.0 and np.linalg.norm(y - c * x / nx) <= tol)
 
 
 class L1Subdifferential(Operator):
@@ -400,10 +375,9 @@ class L1Subdifferential(Operator):
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
         c = np.broadcast_to(self._c(t), x.shape)
         tol = tolerance(c, y) if tol is None else tol
-        nz = x != 0.0
-        ok_nz = np.all(np.abs(y[nz] - c[nz] * np.sign(x[nz])) <= tol)
-        ok_z = np.all(np.abs(y[~nz]) <= c[~nz] + tol)
-        return bool(ok_nz and ok_z)
+        at_kink = (np.abs(x) <= tol) & (np.abs(y) <= c + tol)  # x_i within tol of 0: F_i = [-c_i, c_i]
+        on_branch = (x != 0.0) & (np.abs(y - c * np.sign(x)) <= tol)
+        return bool(np.all(at_kink | on_branch))
 
 
 class NormalCone(Operator):
@@ -496,7 +470,11 @@ class Shifted(Operator):
         return self.F.project_domain(np.asarray(x, dtype=float) + p, t) - p
 
     def contains(self, x, y, t=0.0, tol=None):
-        return self.F.contains(np.asarray(x, dtype=float) + self._Phi(t), y, t, tol)
+        p = self._Phi(t)
+        x = np.asarray(x, dtype=float)
+        # x + Φ carries the rounding of the shift: the default tolerance is scaled to |Φ| too
+        tol = tolerance(x, p, y) if tol is None else tol
+        return self.F.contains(x + p, y, t, tol)
 
 
 class LogBarrier(Operator):

@@ -39,7 +39,7 @@ def kkt_residual(P, q, G, h, A, b, z, rtol: float = QP_RTOL) -> KKTReport:
     scale = 1.0 + max(np.abs(q).max(initial=0.0), np.abs(h).max(initial=0.0) if h is not None else 0.0,
                       np.abs(b).max(initial=0.0) if b is not None else 0.0, np.abs(P @ z).max(initial=0.0))
     viol = 0.0
-    rows, signs = [], []
+    rows = []
     tol_act = 1e-7 * scale
     if G is not None and len(h):
         slack = G @ z - h
@@ -110,13 +110,13 @@ def solve_qp(P, q, G=None, h=None, A=None, b=None, *, backends=None) -> np.ndarr
             reasons.append(f"{name}: returned no solution")
             continue
         got_point = True
-        best, best_rep = None, None
+        best_rep = None
         for cand in (_polish(P, q, G, h, A, b, z), z):
             rep = kkt_residual(P, q, G, h, A, b, cand)
             if rep.ok:
                 return cand
             if best_rep is None or max(rep.primal, rep.dual) < max(best_rep.primal, best_rep.dual):
-                best, best_rep = cand, rep
+                best_rep = rep
         reasons.append(f"{name}: KKT check failed (primal {best_rep.primal:.2e}, dual {best_rep.dual:.2e})")
     if not got_point:
         raise InfeasibleStep("no back-end found a feasible point: " + "; ".join(reasons))

@@ -17,13 +17,12 @@ Python floats — the same IEEE operations).
 
 from __future__ import annotations
 
-import math
 from typing import Any, Callable
 
 import numpy as np
 
 from ._params import as_param
-from .operators import dot_rows
+from ._kernels import _TINY, _mn, _mx, _sqrt, dot_rows
 from .errors import InvalidProblem
 from .tolerances import tolerance
 
@@ -54,12 +53,6 @@ class ConvexSet:
 
     def __repr__(self) -> str:
         return f"{self.name}(dim={self.dim})"
-
-
-_ar = np.add.reduce
-_mx, _mn = np.maximum, np.minimum
-_sqrt = math.sqrt
-_TINY = float(np.finfo(float).smallest_subnormal)
 
 
 def _all_static(*params) -> bool:

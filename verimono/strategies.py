@@ -28,7 +28,7 @@ Drawn objects have readable reprs (numbers rounded to 4 digits) so counterexampl
 from __future__ import annotations
 
 import dataclasses
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 from hypothesis import strategies as st

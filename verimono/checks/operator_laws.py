@@ -38,7 +38,7 @@ from hypothesis import strategies as st
 from ..operators import Operator
 from ..results import FAILED, PASSED, SKIPPED, CheckResult, Report
 from ..strategies import points, step_sizes, times
-from ..tolerances import LIMIT_FLOOR, RTOL, STALL_RATIO, STALL_WINDOW, tolerance
+from ..tolerances import LIMIT_FLOOR, STALL_RATIO, STALL_WINDOW, tolerance
 
 #: hypothesis examples per law when ``examples`` is not given
 DEFAULT_EXAMPLES = 50
