@@ -90,3 +90,34 @@ def test_registry_names_are_stable_and_seeded_runs_reproduce():
 def test_nondeterministic_operator_does_not_escape_as_an_exception():
     r = run_law("resolvent_single_valued", zoo.build("nondeterministic"), seed=5, examples=20)
     assert r.status == "failed"
+
+
+def test_yosida_limit_at_a_kink_reached_through_rounded_shifts():
+    """x = J(0) - 0.2 - 0.1 = -0.30000000000000004 for |·| shifted by 0.1 then 0.2: x + Φ = -2.8e-17, not 0,
+    so F^0(x) has norm c while Y_λx → 0 for every observable λ.  x is a zero of F up to its own rounding:
+    the law must not fail there (a random dev-profile run found this), and a wrong λ must still fail."""
+    import numpy as np
+    import verimono as vm
+    from verimono.checks.operator_laws import Sample, check_yosida_limit
+
+    op = vm.Shifted(vm.Shifted(vm.NormSubdifferential(1.0), [0.1]), [0.2])
+    sample = Sample(np.zeros(1), np.zeros(1), 1.0, 1.0, 1.0, 0.0)
+    x = op.resolvent(np.zeros(1), 1.0)
+    assert (x + 0.2) + 0.1 != 0.0 and np.linalg.norm(op.min_norm(x)) == 1.0   # the rounding is real
+    assert check_yosida_limit(op, sample=sample).status == "passed"
+    from verimono.checks.operator_laws import check_min_norm_least
+    assert check_min_norm_least(op, sample=sample).status == "passed"
+    wrong = vm.operator_from_resolvent(lambda z, lam, t: op.resolvent(z, 2 * lam, t), 1, min_norm=op.min_norm,
+                                       project_domain=op.project_domain, name="wrong λ")
+    assert check_yosida_limit(wrong, sample=Sample(np.array([3.0]), np.zeros(1), 1.0, 1.0, 1.0, 0.0)).status == "failed"
+
+
+def test_laws_on_points_closer_than_the_square_root_of_the_smallest_double():
+    """x1 - x2 = 1.9e-250: its square underflows, and the slack of yosida_monotone must not (found by a
+    random dev-profile run on LogBarrier, where J rounds to neighbouring doubles)."""
+    import numpy as np
+    import verimono as vm
+    from verimono.checks.operator_laws import Sample, check_yosida_monotone
+
+    s = Sample(np.zeros(1), np.array([-1.882470261721448e-250]), 0.5, 1.0, 1.0, 0.0)
+    assert check_yosida_monotone(vm.LogBarrier(1.0), sample=s).status == "passed"

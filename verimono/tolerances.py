@@ -57,6 +57,10 @@ def quotient_tolerance(h: float, *scales: float, rtol: float = RTOL) -> float:
 #: the proximal scheme for ``x0 ∈ cl dom F``; a scheme converging to *different* limits on different
 #: partitions keeps an O(1) distance and fails by a factor ~2)
 LIMIT_SHRINK = 0.5
+#: further 4-fold refinements (up to 64 times the finest of the default levels) granted to a problem whose
+#: own time scale is finer than the default meshes before the unique-limit law is judged: a generated
+#: sweeping process in a ball of radius 0.002 driven by a unit input is pre-asymptotic until |Δ| < 0.002
+LIMIT_EXTRA_LEVELS = 3
 #: a sampled ratio (``|F^0(t,x)|/(1+|x|)``, a Yosida increment per unit time) that grows by more than
 #: this factor while the sampling parameter ``λ`` shrinks 1000-fold is reported as evidence that the
 #: bound (LG) / (YB) fails; bounded quantities change by O(1) over that range

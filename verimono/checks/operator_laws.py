@@ -138,7 +138,10 @@ def _F0(op: Operator, x: np.ndarray, t: float) -> np.ndarray:
 
 
 def _nrm(v: np.ndarray) -> float:
-    return float(np.linalg.norm(v))
+    """Euclidean norm without underflow: sampled points may differ by 1e-250, whose square is 0."""
+    v = np.asarray(v, dtype=float)
+    m = float(np.max(np.abs(v), initial=0.0))
+    return 0.0 if m == 0.0 or not np.isfinite(m) else m * float(np.linalg.norm(v / m))
 
 
 def _tol(*arrays: Any) -> float:
@@ -288,6 +291,9 @@ def _yosida_limit(op, s):
         info = {"x": x.tolist(), "|F0|": f0, "lams": lams, "gaps": gaps}
         if gap <= slack:
             return _Eval(gap, 0.0, slack, "|Y_λx| → |F^0(t, x)| as λ → 0 (gap within tolerance)", info)
+        if y <= 2 * tx / lam and _only_within_rounding(op, x, np.zeros_like(x), s.t, 2 * tx):
+            return _Eval(0.0, 0.0, slack, "|Y_λx| → 0: x is within rounding, not exactly at, a zero of F(t,·) "
+                         "(F^0 is ill-conditioned there; sample inconclusive)", info)
         if lam / 2 < floor:
             break
         lam /= 2
@@ -318,8 +324,22 @@ def _min_norm_least(op, s):
             return _Eval(0.0, 0.0, 1.0, "uncertified y0 ∉ F(t, x): comparison skipped", info)
     except NotImplementedError:
         pass
-    return _Eval(_nrm(f0), _nrm(y0), 4 * tau / s.nu + _tol(f0),
-                 "|F^0(t, x)| ≤ |y| for x = J_νx1 and y = Y_νx1 ∈ F(t, x)", info)
+    slack = 4 * tau / s.nu + _tol(f0)
+    if _nrm(f0) > _nrm(y0) + slack and _only_within_rounding(op, x, y0, s.t, _tol(x, y0) * (2.0 + 2.0 / s.nu)):
+        return _Eval(0.0, 0.0, 1.0, "y0 ∈ F(t, x') only for x' within rounding of x, near a jump of F^0: "
+                     "comparison inconclusive", info)
+    return _Eval(_nrm(f0), _nrm(y0), slack, "|F^0(t, x)| ≤ |y| for x = J_νx1 and y = Y_νx1 ∈ F(t, x)", info)
+
+
+def _only_within_rounding(op, x, y, t, tol) -> bool:
+    """Whether ``y ∈ F(t, x)`` holds up to ``tol`` but not exactly: ``x`` is within rounding of a point
+    where ``F`` jumps (a kink of ``|·|`` reached through rounded shifts, ``x + Φ = 1e-17``), where ``F^0`` is
+    ill-conditioned and the λ → 0 limit and least-norm laws cannot be observed.  An exact kink (``x = 0``)
+    is not such a point, so a wrong ``F^0`` there is still caught; without ``contains`` nothing is excused."""
+    try:
+        return bool(op.contains(x.copy(), y.copy(), t, tol)) and not op.contains(x.copy(), y.copy(), t, 0.0)
+    except NotImplementedError:
+        return False
 
 
 @dataclasses.dataclass(frozen=True)
