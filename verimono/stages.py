@@ -404,5 +404,14 @@ def siconos_stage(profile: Profile, context: RunContext) -> Report:
     return fn(Path(context.data_dir))
 
 
+@register_stage("performance", "verimono against bare baselines, as same-job ratios: per-step overhead, "
+                "ensembles, DiodeBridge, memory")
+def performance_stage(profile: Profile, context: RunContext) -> Report:
+    """The issue 6 targets as records (``verimono.performance``), at the sizes of ``profile``; each
+    record's ``details["timing_ratio"]`` is gated against the baseline by ratio, never by seconds."""
+    perf = optional_module("verimono.performance")
+    return perf.performance_report(perf.SIZES[profile.name], stepper=context.stepper, progress=context.progress)
+
+
 __all__ = ["STAGES", "Stage", "RunContext", "StageUnavailable", "UnknownStage", "register_stage",
            "run_stages", "calibrate", "locate_data", "optional_module", "sample_trajectory"]

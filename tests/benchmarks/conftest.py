@@ -1,10 +1,10 @@
 """Ratio gates for the performance benchmarks (issue 6).
 
-Every benchmark times verimono and a bare baseline *in the same run*, interleaved round by round (the
-baseline in pytest-benchmark's untimed ``setup``, verimono as the timed target), and gates on the median
-of the per-round ratios — never on absolute times, which vary with the machine and its load.  The ratio
-is recorded in ``benchmark.extra_info`` (``ratio``, ``target``, the per-round times), so it lands in the
-``--benchmark-json`` report.
+The measurements are :mod:`verimono.performance`'s — the same functions, baselines and targets as the
+``performance`` stage of ``verimono run`` — with pytest-benchmark timing the subject: verimono and its
+bare baseline run interleaved round by round (the baseline in pytest-benchmark's untimed ``setup``,
+verimono as the timed target), and the gate is the median of the per-round ratios, never absolute
+times.  The record's details land in ``benchmark.extra_info`` and so in the ``--benchmark-json`` report.
 
 With ``--benchmark-disable`` (the default ``addopts``: the suite then runs once inside the normal test run)
 each benchmark uses a smaller size, checks its results, and gates only on a loose sanity bound
@@ -14,11 +14,12 @@ each benchmark uses a smaller size, checks its results, and gates only on a loos
 
 from __future__ import annotations
 
-import statistics
-import time
-from typing import Callable
+from typing import Any, Callable
 
 import pytest
+
+from verimono.performance import interleave, ratio_record
+from verimono.results import CheckResult
 
 #: in un-timed runs (--benchmark-disable) the gate is loosened by this factor (a gross-regression alarm)
 SANITY_FACTOR = 3.0
@@ -36,6 +37,33 @@ class RatioGate:
         """``full`` when benchmarking, ``small`` in the normal (un-timed) test run."""
         return full if self.enabled else small
 
+    def rounds(self, full: int, small: int) -> int:
+        """Timing rounds: ``full`` when benchmarking, ``small`` in the normal test run."""
+        return self.size(full, small)
+
+    def runner(self, setup: Callable[[], Any], target: Callable[[], Any], rounds: int) -> None:
+        """A :data:`verimono.performance.Runner` timing ``target`` with pytest-benchmark."""
+        if not self.enabled:  # pedantic runs its target once when disabled: the other rounds by hand
+            for _ in range(rounds - 1):
+                setup()
+                target()
+        self.benchmark.pedantic(target, setup=setup, rounds=rounds, iterations=1, warmup_rounds=0)
+
+    def check(self, rec: CheckResult, *, sanity: bool = True) -> float:
+        """Record ``rec``'s details in ``extra_info`` and gate its ratio (loosened by ``SANITY_FACTOR``
+        when un-timed and ``sanity``); results that differ from the baseline's always fail."""
+        d = rec.details
+        self.benchmark.extra_info.update({**d, "timed": self.enabled, "status": rec.status})
+        assert d.get("identical", True), rec.message
+        ratio, target, speedup = d["ratio"], d["target"], d["direction"] == ">="
+        loose = not self.enabled and sanity
+        bound = (target / SANITY_FACTOR if speedup else target * SANITY_FACTOR) if loose else target
+        if speedup:
+            assert ratio >= bound, f"speed-up {ratio:.1f} < {bound:.1f} ({rec.message})"
+        else:
+            assert ratio <= bound, f"ratio {ratio:.3f} > {bound:.3f} ({rec.message})"
+        return ratio
+
     def measure(self, subject: Callable[[], object], baseline: Callable[[], object], *, target: float,
                 rounds: int = 5, rounds_disabled: int = 3, lower_is_better: bool = True) -> float:
         """Time ``subject`` against ``baseline`` round by round; record and gate the median ratio.
@@ -43,42 +71,9 @@ class RatioGate:
         ``target`` bounds ``subject/baseline`` from above (``lower_is_better``) or ``baseline/subject``
         from below (speed-ups: ``lower_is_better=False``).
         """
-        base_t: list[float] = []
-        subj_t: list[float] = []
-
-        def setup():
-            start = time.perf_counter()
-            baseline()
-            base_t.append(time.perf_counter() - start)
-
-        def target_fn():
-            start = time.perf_counter()
-            out = subject()
-            subj_t.append(time.perf_counter() - start)
-            return out
-
-        n = rounds if self.enabled else rounds_disabled
-        if not self.enabled:  # pedantic runs its target once when disabled: the other rounds by hand
-            for _ in range(n - 1):
-                setup()
-                target_fn()
-        self.benchmark.pedantic(target_fn, setup=setup, rounds=n, iterations=1, warmup_rounds=0)
-        if len(base_t) < len(subj_t):  # a plugin version that skips setup when disabled
-            setup()
-        pairs = list(zip(subj_t, base_t))
-        if lower_is_better:
-            ratio = statistics.median(s / b for s, b in pairs)
-        else:
-            ratio = statistics.median(b / s for s, b in pairs)
-        info = self.benchmark.extra_info
-        info.update({"ratio": ratio, "target": target, "direction": "<=" if lower_is_better else ">=",
-                     "subject_s": subj_t, "baseline_s": base_t, "timed": self.enabled})
-        bound = target if self.enabled else (target * SANITY_FACTOR if lower_is_better else target / SANITY_FACTOR)
-        if lower_is_better:
-            assert ratio <= bound, f"ratio {ratio:.3f} > {bound:.3f} (subject {subj_t}, baseline {base_t})"
-        else:
-            assert ratio >= bound, f"speed-up {ratio:.1f} < {bound:.1f} (subject {subj_t}, baseline {base_t})"
-        return ratio
+        subj_t, base_t, _ = interleave(subject, baseline, self.rounds(rounds, rounds_disabled), self.runner)
+        return self.check(ratio_record("benchmark", self.benchmark.name, subj_t, base_t, target=target,
+                                       speedup=not lower_is_better))
 
 
 @pytest.fixture

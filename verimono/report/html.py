@@ -18,10 +18,12 @@ from typing import Any
 
 from ..results import FAILED, PASSED, SKIPPED, STATUSES, XFAIL, CheckResult, Report
 
-SECTIONS = ("summary", "changes", "convergence", "trajectories", "laws", "failures", "timings", "environment")
+SECTIONS = ("summary", "changes", "convergence", "trajectories", "laws", "failures", "performance", "timings",
+            "environment")
 _TITLES = {"summary": "Summary", "changes": "Changes against the baseline", "convergence": "Convergence orders",
            "trajectories": "Trajectories against exact solutions", "laws": "Laws and checks",
-           "failures": "Failures and how to reproduce them", "timings": "Timings", "environment": "Environment"}
+           "failures": "Failures and how to reproduce them", "performance": "Performance", "timings": "Timings",
+           "environment": "Environment"}
 
 CSS = """
 :root { --ok:#2e7d32; --bad:#c62828; --skip:#757575; --xf:#b26a00; --ink:#1d2330; --mute:#5b6475;
@@ -297,6 +299,33 @@ def _failures(report: Report) -> str:
     return "".join(out)
 
 
+def _performance(report: Report) -> str:
+    recs = [r for r in report.results if r.check.startswith("performance_") and "ratio" in r.details]
+    if not recs:
+        return ('<p class="note">No performance records in this run (<code>verimono run --stage performance'
+                "</code>).</p>")
+    rows = []
+    for r in recs:
+        d = r.details
+        speedup = d.get("direction") == ">="
+        unit = "x speed-up" if speedup else "x"
+        rounds = [b / s if speedup else s / b for s, b in zip(d.get("subject_s") or [], d.get("baseline_s") or [])
+                  if isinstance(s, (int, float)) and isinstance(b, (int, float)) and s > 0 and b > 0]
+        spread = f"{_num(min(rounds), '.3g')} – {_num(max(rounds), '.3g')}" if len(rounds) > 1 else "–"
+        if "subject_bytes" in d:
+            spread = f"{_num(d['subject_bytes'] / 2**20, '.2f')} / {_num(d['baseline_bytes'] / 2**20, '.2f')} MiB"
+        rows.append([_e(r.check.removeprefix("performance_")), _e(r.subject), _badge(r.status),
+                     _num(d.get("ratio"), ".3g") + unit, f"{'≥' if speedup else '≤'} {_num(d.get('target'))}",
+                     spread, _num(d.get("rounds"), "d"), _num(d.get("timing_ratio"), ".3g"), _bar(_ratio(r))])
+    return ('<p class="note">verimono against a bare baseline doing the same work, timed in this job, '
+            "interleaved round by round; the median per-round ratio meets its target. The gate compares "
+            "the gated ratio (larger is worse) with the baseline's, never absolute seconds. Memory: peak "
+            "traced bytes of a streamed study over one trajectory's.</p>"
+            + _table(["check", "subject", "status", "measured", "target", "per-round range", "rounds",
+                      "gated ratio", "measured/target"], rows, (3, 4, 5, 6, 7),
+                     ["failed" if r.status == FAILED else "" for r in recs]))
+
+
 def _timings(report: Report) -> str:
     cal = report.meta.get("calibration")
     stages = report.meta.get("stages") or []
@@ -339,7 +368,8 @@ def render(report: Report, *, changes: Any = None, title: str = "verimono report
     bodies = {
         "summary": _summary(report, changes), "changes": _changes(changes),
         "convergence": _convergence(report), "trajectories": _trajectories(report), "laws": _laws(report),
-        "failures": _failures(report), "timings": _timings(report), "environment": _environment(report),
+        "failures": _failures(report), "performance": _performance(report), "timings": _timings(report),
+        "environment": _environment(report),
     }
     nav = "".join(f'<a href="#{s}">{_TITLES[s]}</a>' for s in SECTIONS)
     sections = "".join(f'<section id="{s}"><h2>{_TITLES[s]}</h2>{bodies[s]}</section>' for s in SECTIONS)

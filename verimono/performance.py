@@ -1,0 +1,344 @@
+"""Performance records (issue 6): verimono against bare baselines, as ratios measured in one process.
+
+Each ``check_*`` function times verimono and a bare baseline doing the same work, interleaved round by
+round (baseline, then subject), and records the median of the per-round ratios as a
+:class:`~verimono.CheckResult` with ``worst = ratio/target`` (``target/speed-up`` for speed-ups) and
+``bound = 1``.  Ratios, never absolute times: they are what survives a different or busy machine.
+``details["timing_ratio"]`` is the ratio oriented so that larger is worse, which ``verimono gate``
+compares against the baseline (``verimono.gate.TIMING_GROWTH``).
+
+The bare baselines live here, once: the ``performance`` stage of ``verimono run`` and the
+pytest-benchmark suite in ``tests/benchmarks`` both use them (the suite passes its own ``runner`` so that
+pytest-benchmark times the subject).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import statistics
+import time
+import tracemalloc
+from typing import Any, Callable
+
+import numpy as np
+
+from .results import FAILED, PASSED, CheckResult, Report
+
+#: issue 6, target 1: ``solve`` within 1.5x a bare NumPy loop doing the same arithmetic
+PER_STEP_TARGET = 1.5
+#: issue 6, target 2: a batch of 1000 at least 30x faster than 1000 separate solves
+ENSEMBLE_TARGET = 30.0
+#: issue 6, target 3: ``simulate`` within 1.5x a minimal script with everything precomputed
+LCS_TARGET = 1.5
+#: issue 6, target 6: a streamed study holds at most one trajectory's bytes
+MEMORY_TARGET = 1.0
+#: the smallest positive double (a norm of 0 divides to 0, as in the catalog's kernels)
+TINY = 5e-324
+
+#: ``runner(setup, target, rounds)``: calls ``setup(); target()`` ``rounds`` times (pytest-benchmark's
+#: ``pedantic`` in the benchmark suite)
+Runner = Callable[[Callable[[], Any], Callable[[], Any], int], None]
+
+
+@dataclasses.dataclass(frozen=True)
+class Sizes:
+    """Problem sizes of the ``performance`` stage for one run profile."""
+
+    per_step_steps: int
+    per_step_rounds: int
+    ensemble_batch: int
+    ensemble_steps: int
+    ensemble_rounds: int
+    lcs_steps: int
+    lcs_rounds: int
+    memory_steps: int
+
+
+#: ``thorough``: the issue's sizes (about 90 s); ``ci`` and ``dev``: about 8 s on 2 cores, with fewer steps
+#: (the ratios move by less than their round-to-round spread), but B = 1000 and a 10^5-step memory study
+#: (the study's fixed ~3.6 MiB of per-block buffers exceed one trajectory below ~75 000 steps at n = 10)
+_QUICK = Sizes(per_step_steps=10_000, per_step_rounds=5, ensemble_batch=1000, ensemble_steps=20,
+               ensemble_rounds=5, lcs_steps=1000, lcs_rounds=5, memory_steps=100_000)
+SIZES = {
+    "dev": _QUICK,
+    "ci": _QUICK,
+    "thorough": Sizes(per_step_steps=100_000, per_step_rounds=7, ensemble_batch=1000, ensemble_steps=200,
+                      ensemble_rounds=3, lcs_steps=5000, lcs_rounds=7, memory_steps=1_000_000),
+}
+
+PER_STEP_KINDS = ("t|x|", "box", "ball")
+PER_STEP_DIMS = (1, 3, 10)
+
+
+# -- bare baselines: the scheme's arithmetic with nothing around it ------------------------------------
+
+
+def bare_t_norm(x0, t):
+    """The scheme on ``F = ∂(t|x|)``: ``x_{k+1} = max(|x_k| - h_k t_{k+1}, 0) x_k/|x_k|``."""
+    hs, ts = np.diff(t).tolist(), t[1:].tolist()
+    x = np.empty((len(t),) + x0.shape)
+    x[0] = xk = x0
+    for k in range(len(hs)):
+        nrm = math.sqrt(xk.dot(xk))
+        xk = xk * (max(nrm - hs[k] * ts[k], 0.0) / max(nrm, TINY))
+        x[k + 1] = xk
+    return x
+
+
+def bare_box(x0, t, lo, hi):
+    """The scheme on the normal cone of the box ``[lo, hi]``: clip every step."""
+    mn, mx = np.minimum, np.maximum
+    x = np.empty((len(t),) + x0.shape)
+    x[0] = xk = x0
+    for k in range(len(t) - 1):
+        xk = mn(mx(xk, lo), hi)
+        x[k + 1] = xk
+    return x
+
+
+def bare_ball(x0, t, c, r):
+    """The scheme on the normal cone of the ball ``B(c, r)``: radial projection every step."""
+    x = np.empty((len(t),) + x0.shape)
+    x[0] = xk = x0
+    for k in range(len(t) - 1):
+        d = xk - c
+        nrm = math.sqrt(d.dot(d))
+        if nrm > r:
+            xk = c + d * (r / nrm)
+        x[k + 1] = xk
+    return x
+
+
+def per_step_case(kind: str, n: int):
+    """``(problem, bare)`` for ``kind`` in :data:`PER_STEP_KINDS`: ``bare(t)`` runs the same arithmetic."""
+    import verimono as vm
+    from .sets import Ball, Box
+
+    x0 = np.linspace(0.5, 1.0, n)
+    x0 /= np.linalg.norm(x0)
+    if kind == "t|x|":
+        return vm.Problem(vm.NormSubdifferential(lambda s: s, dim=n), x0, 2.0), lambda t: bare_t_norm(x0, t)
+    if kind == "box":
+        lo, hi = -0.3 * np.ones(n), 0.4 * np.ones(n)
+        return (vm.Problem(vm.NormalCone(Box(lo, hi)), x0, 2.0, initial_jump=True),
+                lambda t: bare_box(x0, t, lo, hi))
+    if kind == "ball":
+        c = np.zeros(n)
+        return (vm.Problem(vm.NormalCone(Ball(c, 0.5)), x0, 2.0, initial_jump=True),
+                lambda t: bare_ball(x0, t, c, 0.5))
+    raise ValueError(f"unknown kind {kind!r}; expected one of {PER_STEP_KINDS}")
+
+
+def minimal_lcs(system, sm, x0, K):
+    """The bare loop of ``simulate``: precomputed step matrices ``sm``, its warm-started one-step solver."""
+    E, G, C, D, step = sm.E, sm.G, system.C, system.D, sm.step
+    v = system.v(0.0)
+    X = np.empty((K + 1, system.n))
+    Z = np.empty((K, system.m))
+    W = np.empty((K, system.m))
+    X[0] = xk = x0
+    for k in range(K):
+        xfree = E @ xk
+        z, _ = step(C @ xfree + v)
+        xk = xfree + G @ z
+        X[k + 1] = xk
+        Z[k] = z
+        W[k] = C @ xk + D @ z + v
+    return X, Z, W
+
+
+# -- measurement --------------------------------------------------------------------------------------
+
+
+def plain_runner(setup: Callable[[], Any], target: Callable[[], Any], rounds: int) -> None:
+    for _ in range(rounds):
+        setup()
+        target()
+
+
+def interleave(subject: Callable[[], Any], baseline: Callable[[], Any], rounds: int,
+               runner: Runner | None = None) -> tuple[list[float], list[float], dict[str, Any]]:
+    """Seconds of ``subject`` and of ``baseline`` per round (baseline first), and their last outputs."""
+    subj_t: list[float] = []
+    base_t: list[float] = []
+    last: dict[str, Any] = {}
+
+    def setup():
+        start = time.perf_counter()
+        last["baseline"] = baseline()
+        base_t.append(time.perf_counter() - start)
+
+    def target():
+        start = time.perf_counter()
+        last["subject"] = subject()
+        subj_t.append(time.perf_counter() - start)
+        return last["subject"]
+
+    (runner or plain_runner)(setup, target, rounds)
+    if len(base_t) < len(subj_t):  # a runner that skipped a setup
+        setup()
+    return subj_t, base_t, last
+
+
+def ratio_record(check: str, subject: str, subj_t: list[float], base_t: list[float], *, target: float,
+                 speedup: bool = False, fail: str | None = None,
+                 details: dict[str, Any] | None = None) -> CheckResult:
+    """The record of a timed comparison: median per-round ``subject/baseline`` (or ``baseline/subject``
+    for a ``speedup``) against ``target``; ``fail`` (e.g. results that differ) fails it whatever the ratio."""
+    pairs = list(zip(subj_t, base_t))
+    ratio = statistics.median((b / s) if speedup else (s / b) for s, b in pairs)
+    worst = target / ratio if speedup else ratio / target
+    what = f"speed-up {ratio:.1f}x (target ≥ {target:g}x)" if speedup else \
+        f"{ratio:.3f}x the bare baseline (target ≤ {target:g}x)"
+    status = PASSED if worst <= 1.0 and fail is None else FAILED
+    msg = what + f", median of {len(pairs)} interleaved rounds" + (f"; {fail}" if fail else "")
+    return CheckResult(check, subject, status, worst=worst, bound=1.0, message=msg,
+                       counterexample=None if status == PASSED else {"case": subject, "ratio": ratio, **(details or {})},
+                       details={"timing_ratio": 1.0 / ratio if speedup else ratio, "ratio": ratio,
+                                "target": target, "direction": ">=" if speedup else "<=", "rounds": len(pairs),
+                                "subject_s": subj_t, "baseline_s": base_t, **(details or {})},
+                       duration=sum(subj_t) + sum(base_t))
+
+
+def _default_stepper(stepper):
+    if stepper is None:
+        from .stepping import solve as stepper
+    return stepper
+
+
+def check_per_step(kind: str, n: int, *, steps: int, rounds: int, stepper: Callable | None = None,
+                   runner: Runner | None = None) -> CheckResult:
+    """Target 1: ``stepper`` (default ``verimono.solve``) on ``kind`` in dimension ``n`` against the bare
+    loop; a result that differs from the bare loop's bits fails the record (not the same arithmetic)."""
+    from .grids import uniform_grid
+
+    stepper = _default_stepper(stepper)
+    problem, bare = per_step_case(kind, n)
+    t = uniform_grid(problem.T, steps=steps)
+    subj_t, base_t, last = interleave(lambda: stepper(problem, t), lambda: bare(t), rounds, runner)
+    same = np.array_equal(np.asarray(last["subject"]), last["baseline"])
+    return ratio_record("performance_per_step", f"{kind} n={n}", subj_t, base_t, target=PER_STEP_TARGET,
+                        fail=None if same else "results differ from the bare loop",
+                        details={"steps": steps, "n": n, "operator": kind, "identical": same})
+
+
+def ensemble_case(kind: str, n: int = 3):
+    """``(operator, problem keywords)`` of the ensemble comparison: a per-step case's operator."""
+    problem, _ = per_step_case(kind, n)
+    return problem.operator, ({"initial_jump": True} if problem.initial_jump else {})
+
+
+def check_ensemble(op, label: str, *, batch: int, steps: int, rounds: int, problem_kw: dict | None = None,
+                   seed: int = 6, stepper: Callable | None = None, runner: Runner | None = None) -> CheckResult:
+    """Target 2: one solve of ``batch`` initial conditions against ``batch`` separate solves of ``op``
+    (problems built outside the timing); the two must agree bit for bit, else the record fails."""
+    import verimono as vm
+
+    stepper = _default_stepper(stepper)
+    kw = dict(problem_kw or {})
+    X0 = np.random.default_rng(seed).normal(size=(batch, op.dim))
+    t = vm.uniform_grid(1.0, steps=steps)
+    whole = vm.Problem(op, X0, 1.0, **kw)
+    singles = [vm.Problem(op, x, 1.0, **kw) for x in X0]
+    subj_t, base_t, last = interleave(lambda: stepper(whole, t), lambda: [stepper(p, t) for p in singles],
+                                      rounds, runner)
+    xb = np.asarray(last["subject"])
+    xs = np.stack([np.asarray(x) for x in last["baseline"]], axis=1)
+    same = xb.shape == xs.shape and np.array_equal(xb, xs)
+    return ratio_record("performance_ensemble", f"{label} B={batch}", subj_t, base_t, target=ENSEMBLE_TARGET,
+                        speedup=True,
+                        fail=None if same else "the batched solve differs from the separate solves",
+                        details={"batch": batch, "steps": steps, "operator": label, "identical": same})
+
+
+def check_lcs_step(*, steps: int, rounds: int, runner: Runner | None = None) -> CheckResult:
+    """Target 3: ``DiodeBridge.simulate`` (EulerMoreauOSI, θ = 1/2, h = 1e-6) against :func:`minimal_lcs`
+    with a fresh (cold) stepper per round, built outside the timing; outputs must agree bit for bit."""
+    from .lcs.siconos_cases import diode_bridge
+
+    system = diode_bridge()
+    h, theta = 1e-6, 0.5
+    t = np.linspace(0.0, steps * h, steps + 1)
+    x0 = np.array([10.0, 0.0])
+    fresh = [system.step_matrices(h, theta) for _ in range(rounds + 1)]
+    subj_t, base_t, last = interleave(lambda: system.simulate(x0, t, theta=theta),
+                                      lambda: minimal_lcs(system, fresh.pop(), x0, steps), rounds, runner)
+    tr, (X, Z, W) = last["subject"], last["baseline"]
+    same = bool(np.array_equal(tr.x, X) and np.array_equal(tr.extras["z"], Z) and np.array_equal(tr.extras["w"], W))
+    return ratio_record("performance_lcs_step", f"DiodeBridge {steps} steps", subj_t, base_t, target=LCS_TARGET,
+                        fail=None if same else "simulate differs from the minimal script",
+                        details={"steps": steps, "h": h, "theta": theta, "identical": same})
+
+
+def peak_memory(fn: Callable[[], Any]) -> tuple[int, float, Any]:
+    """``(peak traced bytes, seconds, result)`` of ``fn()`` under :mod:`tracemalloc`."""
+    tracemalloc.start()
+    try:
+        start = time.perf_counter()
+        out = fn()
+        return tracemalloc.get_traced_memory()[1], time.perf_counter() - start, out
+    finally:
+        tracemalloc.stop()
+
+
+def check_memory(*, steps: int, n: int = 10, stepper: Callable | None = None) -> CheckResult:
+    """Target 6: peak traced memory of a serial convergence study on t|x| (grids of ``steps/4``,
+    ``steps/2`` and ``steps`` steps, streamed errors) against allocating one trajectory of ``steps``."""
+    from .convergence import convergence_study
+    from .reference import subdifferential
+
+    stepper = _default_stepper(stepper)
+    x0 = np.linspace(0.1, 1.0, n)
+    p = subdifferential.t_norm(x0 / np.linalg.norm(x0) * 0.5, T=1.0)
+    grids = [1.0 / (steps // 4), 1.0 / (steps // 2), 1.0 / steps]
+
+    def one_trajectory():
+        x = np.empty((steps + 1, n))
+        x[:] = 0.0
+
+    s_peak, s_sec, study = peak_memory(lambda: convergence_study(stepper, p, grids, executor="serial"))
+    b_peak, b_sec, _ = peak_memory(one_trajectory)
+    ratio = s_peak / b_peak
+    study_ok = bool(study.verdict()[0])
+    status = PASSED if ratio <= MEMORY_TARGET else FAILED
+    return CheckResult(
+        "performance_memory", f"t|x| n={n} {steps} steps", status, worst=ratio / MEMORY_TARGET, bound=1.0,
+        message=f"study peak {s_peak / 2**20:.2f} MiB = {ratio:.3f}x one trajectory "
+                f"({b_peak / 2**20:.2f} MiB; target ≤ {MEMORY_TARGET:g}x)",
+        counterexample=None if status == PASSED else {"case": p.name, "steps": steps, "ratio": ratio},
+        details={"timing_ratio": ratio, "ratio": ratio, "target": MEMORY_TARGET, "direction": "<=", "rounds": 1,
+                 "subject_s": [s_sec], "baseline_s": [b_sec], "subject_bytes": s_peak, "baseline_bytes": b_peak,
+                 "steps": steps, "n": n, "study_ok": study_ok},
+        duration=s_sec + b_sec)
+
+
+def performance_report(sizes: Sizes, *, stepper: Callable | None = None,
+                       progress: Callable[[int, int, str], None] = lambda done, total, label: None) -> Report:
+    """Every performance record at ``sizes``: per-step (3 kinds x n = 1, 3, 10), ensembles (the three
+    kinds at n = 3), DiodeBridge, memory."""
+    jobs: list[tuple[str, Callable[[], CheckResult]]] = []
+    for kind in PER_STEP_KINDS:
+        for n in PER_STEP_DIMS:
+            jobs.append((f"per-step {kind} n={n}", lambda kind=kind, n=n: check_per_step(
+                kind, n, steps=sizes.per_step_steps, rounds=sizes.per_step_rounds, stepper=stepper)))
+    for kind in PER_STEP_KINDS:
+        def ens(kind=kind):
+            op, kw = ensemble_case(kind)
+            return check_ensemble(op, kind, batch=sizes.ensemble_batch, steps=sizes.ensemble_steps,
+                                  rounds=sizes.ensemble_rounds, problem_kw=kw, stepper=stepper)
+        jobs.append((f"ensemble {kind}", ens))
+    jobs.append(("DiodeBridge", lambda: check_lcs_step(steps=sizes.lcs_steps, rounds=sizes.lcs_rounds)))
+    jobs.append(("memory", lambda: check_memory(steps=sizes.memory_steps, stepper=stepper)))
+    report = Report()
+    for i, (label, job) in enumerate(jobs):
+        progress(i, len(jobs), label)
+        report.add(job())
+    progress(len(jobs), len(jobs), "")
+    return report
+
+
+__all__ = ["PER_STEP_TARGET", "ENSEMBLE_TARGET", "LCS_TARGET", "MEMORY_TARGET", "SIZES", "Sizes",
+           "bare_t_norm", "bare_box", "bare_ball", "minimal_lcs", "per_step_case", "ensemble_case",
+           "interleave", "ratio_record", "check_per_step", "check_ensemble", "check_lcs_step",
+           "check_memory", "peak_memory", "performance_report"]
