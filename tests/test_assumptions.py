@@ -1,20 +1,20 @@
-"""check_assumptions: evidence for (A1), (A3), (LG), (YB) — passing where the paper's assumptions hold,
-failing on a non-monotone operator, on understated φ/σ/θ, and flagging (LG) for the log barrier and
-(YB) for moving sets (where the paper says they fail)."""
+"""check_assumptions: evidence for (A1), (A2), (A3), (LG), (YB) — passing where the paper's assumptions
+hold, failing on a non-monotone operator, on a graph that jumps right after t, on understated φ/σ/θ, and
+flagging (LG) for the log barrier and (YB) for moving sets (where the paper says they fail)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from verimono import Problem, operator_from_resolvent
+from verimono import Linear, Problem, operator_from_resolvent
 from verimono.checks.assumptions import EVIDENCE, check_assumptions
 from verimono.checks.sample_problems import sample_problem
 from verimono.checks.trajectory_laws import with_changes
 from verimono.reference import get
 from verimono.results import FAILED, PASSED
 
-NAMES = ["assumption_A1", "assumption_A3", "assumption_LG", "assumption_YB"]
+NAMES = ["assumption_A1", "assumption_A2", "assumption_A3", "assumption_LG", "assumption_YB"]
 
 
 def _by(report):
@@ -30,7 +30,7 @@ def test_records_are_labelled_evidence():
 @pytest.mark.parametrize("seed", range(8))
 def test_stated_functions_of_sample_problems_survive(seed):
     rep = _by(check_assumptions(sample_problem(seed), seed=seed))
-    for name in ("assumption_A1", "assumption_A3", "assumption_LG"):
+    for name in ("assumption_A1", "assumption_A2", "assumption_A3", "assumption_LG"):
         assert rep[name].status == PASSED, str(rep[name])
 
 
@@ -39,6 +39,30 @@ def test_non_monotone_operator_fails_A1():
     op = operator_from_resolvent(lambda x, lam, t: np.asarray(x) / (1.0 - 0.5 * lam), 2, name="minus_half")
     rec = _by(check_assumptions(Problem(op, [0.5, 0.2], 1.0)))["assumption_A1"]
     assert rec.status == FAILED and rec.counterexample["inner"] < 0
+
+
+def _scaled_identity(c):
+    """``F(t, x) = c(t) x`` on R^2: maximal monotone for each t, dom F = R^2 (so (A3) holds with φ = 0)."""
+    return Problem(Linear(lambda t: c(t) * np.eye(2)), [0.5, 0.2], 1.0)
+
+
+@pytest.mark.parametrize("after", [lambda t: 2.0, lambda t: 2.0 + (t - 0.5)], ids=["constant", "converging"])
+def test_graph_jumping_right_after_t_fails_A2(after):
+    # c = 1 up to and including t = 0.5 (a sampled time), then 2 (+ (t - 0.5)): J_λ(0.5 + δ) p → p/(1 + 2λ)
+    # ≠ J_λ(0.5) p = p/(1 + λ); "converging" reaches its limit only as δ ↓ 0 (a nonzero tail)
+    rep = _by(check_assumptions(_scaled_identity(lambda t: 1.0 if t <= 0.5 else after(t))))
+    rec = rep["assumption_A2"]
+    assert rec.status == FAILED and rec.counterexample["t"] == 0.5, str(rec)
+    c = rec.counterexample
+    np.testing.assert_allclose(c["limit"], c["p"] / (1 + 2 * c["lam"]), rtol=1e-3)
+    np.testing.assert_allclose(c["resolvent_at_t"], c["p"] / (1 + c["lam"]), rtol=1e-12)
+    assert rep["assumption_A1"].status == PASSED and rep["assumption_A3"].status == PASSED
+
+
+def test_right_continuous_jump_satisfies_A2():
+    # the same jump with c(0.5) = 2: outer semicontinuous *from the right* (the paper's (A2)) — no evidence
+    rec = _by(check_assumptions(_scaled_identity(lambda t: 1.0 if t < 0.5 else 2.0)))["assumption_A2"]
+    assert rec.status == PASSED and rec.details["unsettled"] == 0 and rec.details["sequences"] == 6 * 13
 
 
 def test_understated_phi_sigma_theta_are_contradicted():

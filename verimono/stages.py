@@ -328,11 +328,11 @@ def trajectory_laws_stage(profile: Profile, context: RunContext) -> Report:
     return report
 
 
-@register_stage("assumptions", "sampled evidence for (A1), (A3), (LG), (YB) on every reference")
+@register_stage("assumptions", "sampled evidence for (A1), (A2), (A3), (LG), (YB) on every reference")
 def assumptions_stage(profile: Profile, context: RunContext) -> Report:
     """``check_assumptions(problem)`` on every reference (evidence, never proof).
 
-    Theorem ``thm:main`` needs (A1), (A3) and *one of* (LG) or (YB).  So when exactly one of the two
+    Theorem ``thm:main`` needs (A1)–(A3) and *one of* (LG) or (YB).  So when exactly one of the two
     alternatives has evidence against it, that record becomes an expected failure (``xfail``, saying
     which alternative holds), and one record ``assumptions_thm_main`` per problem states whether the
     theorem's hypotheses as a whole have evidence for them."""
@@ -354,7 +354,7 @@ def assumptions_stage(profile: Profile, context: RunContext) -> Report:
         report.add(CheckResult(
             "assumptions_thm_main", p.name, FAILED if bad else PASSED, seed=seed,
             message=("evidence against " + ", ".join(bad)) if bad else
-            "no sample contradicts (A1), (A3) and (LG) or (YB) — evidence, not proof"))
+            "no sample contradicts (A1)–(A3) and (LG) or (YB) — evidence, not proof"))
     return report
 
 

@@ -7,6 +7,14 @@ points without knowing the domain.  One record per assumption:
 
 * ``assumption_A1`` — monotonicity ``⟨z1 - z2, y1 - y2⟩ ≥ 0`` on sampled graph pairs (resolvent pairs and
   ``(z, F^0(z))``).  A violation disproves (A1).
+* ``assumption_A2`` — outer semicontinuity from the right of ``t ↦ graph F(t,·)``, through resolvents:
+  if ``q = lim J_λ(t+δ) p`` exists as ``δ ↓ 0``, then ``(q, (p - q)/λ)`` is a limit of graph points of
+  ``F(t+δ)``, so (A2) puts it in ``graph F(t)`` and single-valuedness of the resolvent gives
+  ``q = J_λ(t) p``.  Sampled on ``δ_k = (T - t) 4^{-k}``; the limit is extrapolated from the last
+  differences (geometric tail), and a limit whose distance from ``J_λ(t) p`` stays above tolerance after
+  subtracting the tail disproves (A2).  (The Minty residual of the graph point ``(J_λ(t+δ)p, Y_λ(t+δ)p)``
+  with respect to ``graph F(t)`` is exactly ``√2 |J_λ(t+δ)p - J_λ(t)p|``.)  A sequence that has not
+  settled is no evidence either way and is counted.
 * ``assumption_A3`` — ``D(s,t) = max_z dist(z, dom F(t))`` over sampled ``z ∈ dom F(s)`` (``project_domain``);
   the least nondecreasing ``φ̂`` with ``φ̂(t) - φ̂(s) ≥ D(s,t)`` on the sampled times is reported.  A stated
   ``problem.phi`` below a sample disproves it.
@@ -35,6 +43,18 @@ from ..results import FAILED, PASSED, SKIPPED, CheckResult, Report
 from ..tolerances import GROWTH_FLAG, RTOL, quotient_tolerance, tolerance
 
 EVIDENCE = "evidence from samples, not a proof"
+#: (A2): right limits t + δ_k, δ_k = (T - t) A2_RATIO^k for k = 0, ..., A2_LEVELS (down to 1.5e-5 (T - t))
+A2_LEVELS = 8
+A2_RATIO = 0.25
+#: (A2): a sequence J_λ(t+δ_k) p whose last two differences shrink by less than this factor has not
+#: settled: its limit cannot be extrapolated, so it is no evidence either way
+A2_SETTLED = 0.9
+#: (A2): the geometric tail is an estimate (the ratio of the differences drifts when the active set
+#: changes along the sequence: it fell 0.3% short on the moving box), so it is doubled; a jump leaves an
+#: O(1) gap after a constant sequence, so the factor costs no power against real violations
+A2_TAIL_SAFETY = 2.0
+#: (A2): step sizes λ (relative to T) of the sampled resolvents (the points p already span two scales)
+A2_LAMBDAS = (1e-1,)
 #: step sizes λ (relative to T) used to reach points of dom F(t,·) ever closer to its boundary
 LAMBDAS = (1.0, 1e-1, 1e-2, 1e-3)
 
@@ -102,6 +122,57 @@ def _a1(S: _Samples) -> CheckResult:
     return CheckResult("assumption_A1", _subject(S.problem), status, worst=max(worst, 0.0), bound=1.0,
                        counterexample=counter if status == FAILED else None, message=msg,
                        details={"evidence": EVIDENCE, "pairs": pairs})
+
+
+def _limit_gap(q: np.ndarray, target: np.ndarray) -> tuple[float, float]:
+    """``(|q_K - target|, tail)`` for a sequence ``q_0, ..., q_K`` (rows of ``q``): ``tail`` estimates
+    ``|q_∞ - q_K|`` by ``A2_TAIL_SAFETY`` times the geometric series with the larger ratio of the last
+    three differences (``inf`` when they do not shrink by ``A2_SETTLED``; ``0`` when the sequence is
+    constant at its end)."""
+    d = np.linalg.norm(np.diff(q[-4:], axis=0), axis=1)     # the last three differences
+    if d[-1] == 0.0:
+        tail = 0.0
+    elif d[-2] == 0.0 or d[-3] == 0.0 or max(d[-1] / d[-2], d[-2] / d[-3]) > A2_SETTLED:
+        tail = np.inf
+    else:
+        r = max(d[-1] / d[-2], d[-2] / d[-3])
+        tail = A2_TAIL_SAFETY * float(d[-1]) * r / (1.0 - r)
+    return float(np.linalg.norm(q[-1] - target)), tail
+
+
+def _a2(S: _Samples) -> CheckResult:
+    op, T = S.op, S.T
+    worst, counter, sequences, unsettled = 0.0, None, 0, 0
+    for t in S.times[:-1]:
+        t = float(t)
+        deltas = (T - t) * A2_RATIO ** np.arange(A2_LEVELS + 1)
+        for lam in (rel * T for rel in A2_LAMBDAS):
+            for p in S.points:
+                q = np.array([np.asarray(op.resolvent(p, lam, t + d), dtype=float) for d in deltas])
+                at_t = np.asarray(op.resolvent(p, lam, t), dtype=float)
+                gap, tail = _limit_gap(q, at_t)
+                sequences += 1
+                if not np.isfinite(tail):
+                    unsettled += 1
+                    continue
+                tol = tolerance(p, q[-1], at_t)
+                ratio = max(gap - tail, 0.0) / tol
+                if ratio > worst:
+                    worst, counter = ratio, {"t": t, "lam": lam, "p": p, "delta": deltas[-1], "limit": q[-1],
+                                             "resolvent_at_t": at_t, "gap": gap, "tail": tail}
+    details = {"evidence": EVIDENCE, "sequences": sequences, "unsettled": unsettled}
+    status = FAILED if worst > 1.0 else PASSED
+    if status == FAILED:
+        c = counter
+        msg = (f"J_λ(t+δ) p → {np.array2string(c['limit'], precision=4)} as δ ↓ 0 but J_λ(t) p = "
+               f"{np.array2string(c['resolvent_at_t'], precision=4)} (gap {c['gap']:.3g}, tail ≤ {c['tail']:.3g};"
+               f" t = {c['t']:.4g}, λ = {c['lam']:.3g}): t ↦ graph F(t,·) is not outer semicontinuous from the "
+               f"right")
+    else:
+        msg = (f"every settled right limit lim J_λ(t+δ) p equals J_λ(t) p ({sequences - unsettled} of "
+               f"{sequences} sequences settled; {EVIDENCE})")
+    return CheckResult("assumption_A2", _subject(S.problem), status, worst=worst, bound=1.0, message=msg,
+                       counterexample=counter if status == FAILED else None, details=details)
 
 
 def _a3(S: _Samples) -> CheckResult:
@@ -249,11 +320,11 @@ def _yb(S: _Samples) -> CheckResult:
 
 
 def check_assumptions(problem: Problem, *, seed: int = 0, points: int = 12, times: int = 7) -> Report:
-    """Sampled evidence for (A1), (A3), (LG) and (YB)/(YB') on ``problem`` (see the module docstring)."""
+    """Sampled evidence for (A1), (A2), (A3), (LG) and (YB)/(YB') on ``problem`` (see the module docstring)."""
     S = _Samples(problem, seed, points, times)
     report = Report(meta={"subject": _subject(problem), "seed": seed, "evidence": EVIDENCE})
-    for name, fn in (("assumption_A1", _a1), ("assumption_A3", _a3), ("assumption_LG", _lg),
-                     ("assumption_YB", _yb)):
+    for name, fn in (("assumption_A1", _a1), ("assumption_A2", _a2), ("assumption_A3", _a3),
+                     ("assumption_LG", _lg), ("assumption_YB", _yb)):
         start = time.perf_counter()
         try:
             rec = fn(S)
@@ -267,4 +338,5 @@ def check_assumptions(problem: Problem, *, seed: int = 0, points: int = 12, time
     return report
 
 
-__all__ = ["check_assumptions", "EVIDENCE", "LAMBDAS"]
+__all__ = ["check_assumptions", "EVIDENCE", "LAMBDAS", "A2_LEVELS", "A2_RATIO", "A2_SETTLED",
+           "A2_TAIL_SAFETY", "A2_LAMBDAS"]
