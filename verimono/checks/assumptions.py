@@ -33,7 +33,7 @@ say so); ``failed`` means a sample contradicts it (or the stated function) or th
 from __future__ import annotations
 
 import time
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -88,6 +88,16 @@ def _min_norm(op, z, t):
         return None
 
 
+def _verdict(name: str, S: _Samples, worst: float, counter: dict | None, details: dict,
+             failed: Callable[[dict], str], passed: str) -> CheckResult:
+    """The record of a sampled ratio ``worst`` against the bound 1: failed (with ``failed(counter)`` as the
+    message and ``counter`` as the counterexample) when a sample exceeds it."""
+    bad = worst > 1.0
+    return CheckResult(name, _subject(S.problem), FAILED if bad else PASSED, worst=worst, bound=1.0,
+                       message=failed(counter) if bad else passed, counterexample=counter if bad else None,
+                       details=details)
+
+
 def _a1(S: _Samples) -> CheckResult:
     worst, counter, pairs = -np.inf, None, 0
     for t in S.times:
@@ -116,12 +126,9 @@ def _a1(S: _Samples) -> CheckResult:
         if ratio[m] > worst:
             worst = float(ratio[m])
             counter = {"t": t, "z1": Z[i[m]], "y1": Y[i[m]], "z2": Z[j[m]], "y2": Y[j[m]], "inner": inner[m]}
-    status = FAILED if worst > 1.0 else PASSED
-    msg = (f"<z1 - z2, y1 - y2> = {counter['inner']:.3g} < 0 for graph points of F(t = {counter['t']:.4g})"
-           if status == FAILED else f"no non-monotone pair among {pairs} sampled graph pairs ({EVIDENCE})")
-    return CheckResult("assumption_A1", _subject(S.problem), status, worst=max(worst, 0.0), bound=1.0,
-                       counterexample=counter if status == FAILED else None, message=msg,
-                       details={"evidence": EVIDENCE, "pairs": pairs})
+    return _verdict("assumption_A1", S, max(worst, 0.0), counter, {"evidence": EVIDENCE, "pairs": pairs},
+                    lambda c: f"<z1 - z2, y1 - y2> = {c['inner']:.3g} < 0 for graph points of F(t = {c['t']:.4g})",
+                    f"no non-monotone pair among {pairs} sampled graph pairs ({EVIDENCE})")
 
 
 def _limit_gap(q: np.ndarray, target: np.ndarray) -> tuple[float, float]:
@@ -160,19 +167,14 @@ def _a2(S: _Samples) -> CheckResult:
                 if ratio > worst:
                     worst, counter = ratio, {"t": t, "lam": lam, "p": p, "delta": deltas[-1], "limit": q[-1],
                                              "resolvent_at_t": at_t, "gap": gap, "tail": tail}
-    details = {"evidence": EVIDENCE, "sequences": sequences, "unsettled": unsettled}
-    status = FAILED if worst > 1.0 else PASSED
-    if status == FAILED:
-        c = counter
-        msg = (f"J_λ(t+δ) p → {np.array2string(c['limit'], precision=4)} as δ ↓ 0 but J_λ(t) p = "
-               f"{np.array2string(c['resolvent_at_t'], precision=4)} (gap {c['gap']:.3g}, tail ≤ {c['tail']:.3g};"
-               f" t = {c['t']:.4g}, λ = {c['lam']:.3g}): t ↦ graph F(t,·) is not outer semicontinuous from the "
-               f"right")
-    else:
-        msg = (f"every settled right limit lim J_λ(t+δ) p equals J_λ(t) p ({sequences - unsettled} of "
-               f"{sequences} sequences settled; {EVIDENCE})")
-    return CheckResult("assumption_A2", _subject(S.problem), status, worst=worst, bound=1.0, message=msg,
-                       counterexample=counter if status == FAILED else None, details=details)
+    return _verdict(
+        "assumption_A2", S, worst, counter, {"evidence": EVIDENCE, "sequences": sequences, "unsettled": unsettled},
+        lambda c: (f"J_λ(t+δ) p → {np.array2string(c['limit'], precision=4)} as δ ↓ 0 but J_λ(t) p = "
+                   f"{np.array2string(c['resolvent_at_t'], precision=4)} (gap {c['gap']:.3g}, tail ≤ "
+                   f"{c['tail']:.3g}; t = {c['t']:.4g}, λ = {c['lam']:.3g}): t ↦ graph F(t,·) is not outer "
+                   "semicontinuous from the right"),
+        f"every settled right limit lim J_λ(t+δ) p equals J_λ(t) p ({sequences - unsettled} of {sequences} "
+        f"sequences settled; {EVIDENCE})")
 
 
 def _a3(S: _Samples) -> CheckResult:
@@ -191,10 +193,12 @@ def _a3(S: _Samples) -> CheckResult:
     for b in range(1, n):
         phi_hat[b] = max(phi_hat[b - 1], max(phi_hat[a] + D[a, b] for a in range(b)))
     rate = max((D[a, b] / (ts[b] - ts[a]) for a in range(n) for b in range(a + 1, n)), default=0.0)
-    details = {"evidence": EVIDENCE, "times": ts, "phi_hat": phi_hat, "max_rate": rate, "stated": S.problem.phi is not None}
+    details = {"evidence": EVIDENCE, "times": ts, "phi_hat": phi_hat, "max_rate": rate,
+               "stated": S.problem.phi is not None}
     if S.problem.phi is None:
         return CheckResult("assumption_A3", _subject(S.problem), PASSED, details=details,
-                           message=f"estimated least φ: φ̂(T) - φ̂(0) = {phi_hat[-1]:.4g}, max rate {rate:.4g} ({EVIDENCE})")
+                           message=f"estimated least φ: φ̂(T) - φ̂(0) = {phi_hat[-1]:.4g}, max rate {rate:.4g} "
+                                   f"({EVIDENCE})")
     phi = np.array([float(S.problem.phi(float(s))) for s in ts])
     worst, counter = 0.0, None
     for a in range(n):
@@ -207,12 +211,10 @@ def _a3(S: _Samples) -> CheckResult:
                 worst, counter = r, {"s": ts[a], "t": ts[b], "z": arg[(a, b)], "dist": D[a, b], "phi_s": phi[a],
                                      "phi_t": phi[b]}
     details["phi_stated"] = phi
-    status = FAILED if worst > 1.0 else PASSED
-    msg = (f"dist(z, dom F(t)) = {counter['dist']:.4g} > φ(t) - φ(s) = {counter['phi_t'] - counter['phi_s']:.4g} "
-           f"for z in dom F(s), s = {counter['s']:.4g}, t = {counter['t']:.4g}: the stated φ is contradicted"
-           if status == FAILED else f"stated φ bounds every sampled domain motion ({EVIDENCE})")
-    return CheckResult("assumption_A3", _subject(S.problem), status, worst=worst, bound=1.0, message=msg,
-                       counterexample=counter if status == FAILED else None, details=details)
+    return _verdict("assumption_A3", S, worst, counter, details,
+                    lambda c: f"dist(z, dom F(t)) = {c['dist']:.4g} > φ(t) - φ(s) = {c['phi_t'] - c['phi_s']:.4g} "
+                              f"for z in dom F(s), s = {c['s']:.4g}, t = {c['t']:.4g}: the stated φ is contradicted",
+                    f"stated φ bounds every sampled domain motion ({EVIDENCE})")
 
 
 def _f0_norm(op, z, t, mu):
@@ -251,11 +253,10 @@ def _lg(S: _Samples) -> CheckResult:
     details = {"evidence": EVIDENCE, "times": S.times, "sigma_hat": sig_hat, "sup_ratio_by_lambda": by_lam,
                "growth": growth, "F0": how, "stated": sigma is not None}
     if sigma is not None:
-        status = FAILED if worst > 1.0 else PASSED
-        msg = (f"|F^0(t,z)| = {counter['F0_norm']:.4g} > σ(t)(1 + |z|) at t = {counter['t']:.4g}: the stated σ is "
-               "contradicted" if status == FAILED else f"stated σ bounds every sample ({EVIDENCE})")
-        return CheckResult("assumption_LG", _subject(S.problem), status, worst=worst, bound=1.0, message=msg,
-                           counterexample=counter if status == FAILED else None, details=details)
+        return _verdict("assumption_LG", S, worst, counter, details,
+                        lambda c: f"|F^0(t,z)| = {c['F0_norm']:.4g} > σ(t)(1 + |z|) at t = {c['t']:.4g}: the stated "
+                                  "σ is contradicted",
+                        f"stated σ bounds every sample ({EVIDENCE})")
     if growth > GROWTH_FLAG:
         return CheckResult("assumption_LG", _subject(S.problem), FAILED, worst=growth, bound=GROWTH_FLAG,
                            details=details, counterexample={"sup_ratio_by_lambda": by_lam},
@@ -304,12 +305,11 @@ def _yb(S: _Samples) -> CheckResult:
     details = {"evidence": EVIDENCE, "rate_by_lambda": rates, "theta_hat_slope": rho, "growth": growth,
                "form": key, "stated": theta is not None}
     if theta is not None:
-        status = FAILED if worst > 1.0 else PASSED
-        msg = (f"{counter['form']}: |Y_λ(s+λ,z)| exceeds θ(s+λ) - θ(s) + ... by {counter['lhs'] - counter['rhs']:.3g} "
-               f"at s = {counter['s']:.4g}, λ = {counter['lambda']:.3g}: the stated θ is contradicted"
-               if status == FAILED else f"stated θ bounds every sampled Yosida increment ({EVIDENCE})")
-        return CheckResult("assumption_YB", _subject(S.problem), status, worst=worst, bound=1.0, message=msg,
-                           counterexample=counter if status == FAILED else None, details=details)
+        return _verdict("assumption_YB", S, worst, counter, details,
+                        lambda c: f"{c['form']}: |Y_λ(s+λ,z)| exceeds θ(s+λ) - θ(s) + ... by "
+                                  f"{c['lhs'] - c['rhs']:.3g} at s = {c['s']:.4g}, λ = {c['lambda']:.3g}: the stated "
+                                  "θ is contradicted",
+                        f"stated θ bounds every sampled Yosida increment ({EVIDENCE})")
     if growth > GROWTH_FLAG:
         return CheckResult("assumption_YB", _subject(S.problem), FAILED, worst=growth, bound=GROWTH_FLAG,
                            details=details, counterexample={"rate_by_lambda": rates},
