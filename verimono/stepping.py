@@ -159,13 +159,18 @@ def _march(problem: Problem, t: np.ndarray, block: int) -> Iterator[tuple[int, n
     op = problem.operator
     step = resolvent_kernel(op, x0)
     f = problem.f
-    dU = problem.input_increments(t)
-    if dU is not None and x0.ndim == 2:
-        dU = dU[:, None, :]
     block = min(block, K + 1)
-    # steps and times as Python floats (cheap to index and to multiply), converted block by block so
-    # that streaming holds O(block) of them
-    hs, ts = h[:block].tolist(), t[1:block + 1].tolist()
+
+    def cells(k):
+        """Steps, times (as Python floats: cheap to index and to multiply) and input increments of the
+        cells k, ..., k + block - 1, converted block by block so that streaming holds O(block) of them
+        (the increments are computed cell by cell, so the values do not depend on the blocking)."""
+        dU = problem.input_increments(t[k:k + block + 1])
+        if dU is not None and x0.ndim == 2:
+            dU = dU[:, None, :]
+        return h[k:k + block].tolist(), t[k + 1:k + 1 + block].tolist(), dU
+
+    hs, ts, dU = cells(0)
     buf = np.empty((block,) + x0.shape)
     buf[0] = x0
     first = np.asarray(step(_drift(x0, hs[0], f, dU, 0), hs[0], ts[0]), dtype=float)
@@ -177,13 +182,13 @@ def _march(problem: Problem, t: np.ndarray, block: int) -> Iterator[tuple[int, n
     row, k, start = 2, 1, 0     # next free row of buf; next step computes x_{k+1}; grid index of buf[0]
     before = x0                 # the state preceding buf[0] (for error messages across blocks)
     plain = f is None and dU is None
-    base = 0                    # hs[i], ts[i] hold h[base + i], t[base + 1 + i]
+    base = 0                    # hs[i], ts[i], dU[i] hold h[base + i], t[base + 1 + i], ∫ u over cell base + i
     while True:
         m = min(block - row, K - k)
         if m > 0:
             if k + m > base + len(hs):  # this block's steps are not all converted yet
                 base = k
-                hs, ts = h[k:k + block].tolist(), t[k + 1:k + 1 + block].tolist()
+                hs, ts, dU = cells(k)
             lo = k - base
             if plain:
                 for i, hk, tk in zip(range(row, row + m), hs[lo:lo + m], ts[lo:lo + m]):
@@ -191,7 +196,7 @@ def _march(problem: Problem, t: np.ndarray, block: int) -> Iterator[tuple[int, n
                     buf[i] = xk
             else:
                 for i, j in zip(range(row, row + m), range(k, k + m)):
-                    xk = step(_drift(xk, hs[j - base], f, dU, j), hs[j - base], ts[j - base])
+                    xk = step(_drift(xk, hs[j - base], f, dU, j - base), hs[j - base], ts[j - base])
                     buf[i] = xk
             k += m
             row += m

@@ -100,14 +100,45 @@ def test_streaming_study_memory(gate):
     assert rec.details["study_ok"]
 
 
+INPUTS = {"u (Gauss-Legendre)": dict(u=lambda t: np.array([math.cos(t), 0.0, 0.0])),
+          "U (antiderivative)": dict(U=lambda t: np.array([math.sin(t), 0.0, t * t]))}
+X0 = {"single": [1.0, 2.0, 3.0], "batch": [[1.0, 2.0, 3.0], [-0.5, 0.0, 0.25]]}
+
+
+@pytest.mark.parametrize("x0", list(X0), ids=list(X0))
+@pytest.mark.parametrize("given", list(INPUTS), ids=list(INPUTS))
 @pytest.mark.parametrize("block", [2, 3, 64, 10_000])
-def test_stream_pieces_are_the_solve_trajectory(block):
+def test_stream_pieces_are_the_solve_trajectory(block, given, x0):
     from verimono.stepping import stream
 
-    p = vm.Problem(vm.NormSubdifferential(lambda t: 0.1 + t, dim=3), [1.0, 2.0, 3.0], 1.0,
-                   f=lambda x: -0.5 * x, u=lambda t: np.array([math.cos(t), 0.0, 0.0]))
+    p = vm.Problem(vm.NormSubdifferential(lambda t: 0.1 + t, dim=3), X0[x0], 1.0,
+                   f=lambda x: -0.5 * x, **INPUTS[given])
     t = vm.random_grid(1.0, 777, seed=2)
     pieces = [(tb.copy(), xb.copy()) for tb, xb in stream(p, t, block=block)]
     assert all(len(tb) <= block for tb, _ in pieces)
     assert np.array_equal(np.concatenate([tb for tb, _ in pieces]), t)
     assert np.array_equal(np.concatenate([xb for _, xb in pieces]), vm.solve(p, t).x)
+
+
+def test_stream_with_an_input_holds_one_block_of_increments():
+    """The input increments ∫u are computed block by block: doubling the steps of a streamed n = 10 solve
+    adds grid-sized arrays only (the validated grid and its steps: ≤ 3 floats per step), never a (K, n)
+    array of increments (10 floats per step; it added 100 MiB at 2·10^5 steps before)."""
+    import tracemalloc
+
+    n = 10
+    p = vm.Problem(vm.NormSubdifferential(1.0, dim=n), np.ones(n), 1.0, u=lambda t: np.full(n, math.cos(t)))
+
+    def peak(K):
+        t = vm.uniform_grid(1.0, steps=K)
+        tracemalloc.start()
+        try:
+            for _ in vm.stream(p, t):
+                pass
+            return tracemalloc.get_traced_memory()[1]
+        finally:
+            tracemalloc.stop()
+
+    K = 100_000
+    growth = peak(2 * K) - peak(K)
+    assert growth <= 3 * 8 * K, f"peak grew by {growth / K:.1f} bytes per added step"
