@@ -49,6 +49,12 @@ class RatioGate:
                 target()
         self.benchmark.pedantic(target, setup=setup, rounds=rounds, iterations=1, warmup_rounds=0)
 
+    def bound(self, target: float, *, speedup: bool = False) -> float:
+        """``target`` when benchmarking; loosened by ``SANITY_FACTOR`` in the un-timed normal test run."""
+        if self.enabled:
+            return target
+        return target / SANITY_FACTOR if speedup else target * SANITY_FACTOR
+
     def check(self, rec: CheckResult, *, sanity: bool = True) -> float:
         """Record ``rec``'s details in ``extra_info`` and gate its ratio (loosened by ``SANITY_FACTOR``
         when un-timed and ``sanity``); results that differ from the baseline's always fail."""
@@ -56,8 +62,7 @@ class RatioGate:
         self.benchmark.extra_info.update({**d, "timed": self.enabled, "status": rec.status})
         assert d.get("identical", True), rec.message
         ratio, target, speedup = d["ratio"], d["target"], d["direction"] == ">="
-        loose = not self.enabled and sanity
-        bound = (target / SANITY_FACTOR if speedup else target * SANITY_FACTOR) if loose else target
+        bound = self.bound(target, speedup=speedup) if sanity else target
         if speedup:
             assert ratio >= bound, f"speed-up {ratio:.1f} < {bound:.1f} ({rec.message})"
         else:

@@ -1,0 +1,59 @@
+"""Issue 6, target 5: time to a verdict — one benchmark per stage of ``verimono run``.
+
+Each stage runs in-process at the ``ci`` profile (``dev`` in the un-timed normal test run) and is measured
+in *calibration units*: its seconds over :func:`verimono.stages.calibrate` (a fixed NumPy-and-Python
+workload) timed in the same process — the unit ``verimono gate`` uses for stage times, so the figure
+transfers between machines.  Each stage has a budget of about twice its measured ratio (the gate's
+``TIMING_GROWTH``), with a floor for the sub-second stages, and the budgets add up to less than the
+issue's 120 s on the machine they were measured on.
+
+Measured (2-core EPYC under KVM, calibration 0.078 s, ``ci``): convergence 6.3, operator_laws 151,
+trajectory_laws 24, assumptions 100, section7 7.8, siconos 44, performance 93 — 427 units, 33 s.
+"""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+
+from verimono.profiles import get_profile
+from verimono.stages import STAGES, RunContext, calibrate
+
+#: budgets in calibration units (stage seconds / calibrate()), about 2x the measured ``ci`` ratios above
+STAGE_BUDGETS = {"convergence": 20.0, "operator_laws": 300.0, "trajectory_laws": 50.0, "assumptions": 200.0,
+                 "section7": 20.0, "siconos": 90.0, "performance": 190.0}
+#: calibrate() on the machine the budgets were measured on, and the issue's time to a verdict there
+REFERENCE_CALIBRATION_S = 0.0776
+VERDICT_TARGET_S = 120.0
+
+
+def test_stage_budgets_cover_every_stage_and_fit_the_time_to_verdict():
+    assert set(STAGE_BUDGETS) == set(STAGES), "a stage without a benchmark budget (or a budget without a stage)"
+    total = sum(STAGE_BUDGETS.values()) * REFERENCE_CALIBRATION_S
+    assert total <= VERDICT_TARGET_S, f"stages within budget would take {total:.0f} s > {VERDICT_TARGET_S:.0f} s"
+
+
+@pytest.mark.parametrize("name", list(STAGE_BUDGETS))
+def test_stage_time_in_calibration_units(gate, request, name):
+    profile = get_profile("ci" if gate.enabled else "dev")
+    data_dir = request.getfixturevalue("shared_dir") if name == "siconos" else None
+    context = RunContext(data_dir=data_dir)
+    seconds: list[float] = []
+
+    def run():
+        start = time.perf_counter()
+        report = STAGES[name].fn(profile, context)
+        seconds.append(time.perf_counter() - start)
+        return report
+
+    cal = calibrate()
+    report = gate.benchmark.pedantic(run, rounds=1, iterations=1, warmup_rounds=0)
+    ratio = seconds[-1] / cal
+    budget = gate.bound(STAGE_BUDGETS[name])
+    gate.benchmark.extra_info.update({"stage": name, "profile": profile.name, "seconds": seconds[-1],
+                                      "calibration_s": cal, "ratio": ratio, "budget": budget,
+                                      "records": len(report.results), "timed": gate.enabled})
+    assert len(report.results) > 0, f"stage {name} produced no records"
+    assert ratio <= budget, (f"stage {name}: {seconds[-1]:.2f} s = {ratio:.1f} calibration units "
+                             f"> budget {budget:.0f} (calibration {cal:.4f} s)")
