@@ -1,4 +1,5 @@
-"""Issue 6, target 5: time to a verdict — one benchmark per stage of ``verimono run``.
+"""Issue 6, target 5: time to a verdict — one benchmark per stage of ``verimono run``, and one for
+``pytest properties``.
 
 Each stage runs in-process at the ``ci`` profile (``dev`` in the un-timed normal test run) and is measured
 in *calibration units*: its seconds over :func:`verimono.stages.calibrate` (a fixed NumPy-and-Python
@@ -8,12 +9,17 @@ transfers between machines.  Each stage has a budget of about twice its measured
 issue's 120 s on the machine they were measured on.
 
 Measured (2-core EPYC under KVM, calibration 0.078 s, ``ci``): convergence 6.3, operator_laws 151,
-trajectory_laws 24, assumptions 100, section7 7.8, siconos 44, performance 93 — 427 units, 33 s.
+trajectory_laws 24, assumptions 100, section7 7.8, siconos 44, performance 93 — 427 units, 33 s;
+``pytest properties`` (a subprocess, ``ci`` profile) 170 units idle (13.3 s), 300 with the second core busy.
 """
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 import time
+from pathlib import Path
 
 import pytest
 
@@ -26,12 +32,16 @@ STAGE_BUDGETS = {"convergence": 20.0, "operator_laws": 300.0, "trajectory_laws":
 #: calibrate() on the machine the budgets were measured on, and the issue's time to a verdict there
 REFERENCE_CALIBRATION_S = 0.0776
 VERDICT_TARGET_S = 120.0
+#: ``pytest properties`` at the ci profile, in calibration units (about 2x idle; 1.3x with a busy core)
+PROPERTIES_BUDGET = 400.0
+PROPERTIES = Path(__file__).resolve().parents[2] / "properties"
 
 
 def test_stage_budgets_cover_every_stage_and_fit_the_time_to_verdict():
     assert set(STAGE_BUDGETS) == set(STAGES), "a stage without a benchmark budget (or a budget without a stage)"
     total = sum(STAGE_BUDGETS.values()) * REFERENCE_CALIBRATION_S
     assert total <= VERDICT_TARGET_S, f"stages within budget would take {total:.0f} s > {VERDICT_TARGET_S:.0f} s"
+    assert PROPERTIES_BUDGET * REFERENCE_CALIBRATION_S <= VERDICT_TARGET_S
 
 
 @pytest.mark.parametrize("name", list(STAGE_BUDGETS))
@@ -57,3 +67,30 @@ def test_stage_time_in_calibration_units(gate, request, name):
     assert len(report.results) > 0, f"stage {name} produced no records"
     assert ratio <= budget, (f"stage {name}: {seconds[-1]:.2f} s = {ratio:.1f} calibration units "
                              f"> budget {budget:.0f} (calibration {cal:.4f} s)")
+
+
+def test_pytest_properties_in_calibration_units(gate):
+    """The whole property suite at the ci profile when timed; in the normal test run (which runs the
+    suite itself anyway) one family, ``-k contraction``, to keep the measurement path exercised."""
+    if not PROPERTIES.is_dir():
+        pytest.fail(f"{PROPERTIES} is missing: run the benchmarks from a checkout")
+    select = [] if gate.enabled else ["-k", "contraction"]
+    cmd = [sys.executable, "-m", "pytest", str(PROPERTIES), "-q", "-p", "no:cacheprovider", *select]
+    env = dict(os.environ, HYPOTHESIS_PROFILE="ci")
+    seconds: list[float] = []
+
+    def run():
+        start = time.perf_counter()
+        done = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=PROPERTIES.parent)
+        seconds.append(time.perf_counter() - start)
+        return done
+
+    cal = calibrate()
+    done = gate.benchmark.pedantic(run, rounds=1, iterations=1, warmup_rounds=0)
+    ratio, budget = seconds[-1] / cal, gate.bound(PROPERTIES_BUDGET)
+    summary = (done.stdout.strip().splitlines() or [""])[-1]
+    gate.benchmark.extra_info.update({"seconds": seconds[-1], "calibration_s": cal, "ratio": ratio,
+                                      "budget": budget, "summary": summary, "timed": gate.enabled})
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-2000:]
+    assert ratio <= budget, (f"pytest properties: {seconds[-1]:.2f} s = {ratio:.1f} calibration units > budget "
+                             f"{budget:.0f} ({summary})")
