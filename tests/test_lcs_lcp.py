@@ -125,3 +125,49 @@ def test_relay_box_closed_form():
         np.testing.assert_allclose(lam, np.clip(-q / (2 * h), -1, 1), atol=1e-12)
     # degenerate: M = 0, q = 0: every λ ∈ [-1, 1]^2 solves it, least norm is 0; q = (0, 1): λ2 = -1
     np.testing.assert_allclose(solve_box(np.zeros((2, 2)), [0.0, 1.0], -1, 1), [0.0, -1.0], atol=1e-12)
+
+
+# -- scale: LCP(q, M) is homogeneous, z ∈ SOL(q, M) iff (β/s) z ∈ SOL(q/s, M/β) -------------------------
+PAPER_M = np.array([[0.0, 1.0], [-1.0, 1.0]])   # D + h C B of the paper's Example with h = 1 (PSD, not symmetric)
+
+
+@pytest.mark.parametrize("t", [1e-12, 1e-9, 1e-6, 1.0, 1e6])
+def test_unique_solution_at_every_scale_of_q(t):
+    # SOL(q, M) = {(t, t)} for q = (−t, 0): z2 > 0 forces w2 = 0, i.e. z1 = z2, and then z2 (z2 − t) = 0.
+    # The pair qᵀ(z − z̄) = 0 of CPS Thm 3.1.7 pins z1; a rank decision relative to |M| used to drop it
+    # for |q| ≪ 1 (SolverFailure at t = 1e-9, the wrong point (0, t) accepted at t = 1e-12).
+    r = solve_lcp(PAPER_M, np.array([-t, 0.0]), info=True)
+    np.testing.assert_allclose(r.z, [t, t], rtol=1e-9, atol=0)
+    assert r.relative_residual <= 1e-10
+
+
+def test_solutions_scale_with_the_data():
+    """Least-norm solutions of degenerate PSD LCPs (rank-deficient symmetric part, non-unique solutions)
+    scale as (s/β) z when q → s q and M → β M, from 1e-9 to 1e6."""
+    rng = np.random.default_rng(11)
+    for _ in range(12):
+        n = int(rng.integers(2, 6))
+        R, S = rng.normal(size=(n - 1, n)), rng.normal(size=(n, n))
+        M = R.T @ R + (S - S.T) * (rng.uniform() < 0.5)
+        supp = rng.uniform(size=n) < 0.5               # q = w0 - M z0 with 0 ≤ z0 ⊥ w0 ≥ 0: solvable
+        z0, w0 = np.where(supp, rng.uniform(0.5, 2, n), 0.0), np.where(supp, 0.0, rng.uniform(0, 2, n))
+        q = w0 - M @ z0
+        z = solve_lcp(M, q)
+        for s, beta in ((1e-9, 1.0), (1e6, 1.0), (1.0, 1e-7), (1e-8, 1e5)):
+            np.testing.assert_allclose(solve_lcp(beta * M, s * q) * (beta / s), z, rtol=1e-7,
+                                       atol=1e-9 * (1 + np.abs(z).max()))
+
+
+def test_relay_solutions_scale_with_the_data():
+    """λ solves the box problem (M, q, l, u) iff (s/β)λ solves (βM, s q, (s/β) l, (s/β) u): least-norm relay
+    solutions of a singular PSD M (non-unique) at data sizes from 1e-9 to 1e6."""
+    from verimono.lcs.lcp import solve_box
+
+    rng = np.random.default_rng(5)
+    for _ in range(8):
+        R = rng.normal(size=(1, 3))
+        M, q = R.T @ R, rng.normal(size=3)
+        lam = solve_box(M, q, -1.0, 1.0)
+        for s, beta in ((1e-9, 1.0), (1e6, 1.0), (1e-8, 1e5)):
+            r = s / beta
+            np.testing.assert_allclose(solve_box(beta * M, s * q, -r, r) / r, lam, rtol=1e-7, atol=1e-9)

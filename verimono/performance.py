@@ -140,7 +140,7 @@ def minimal_lcs(system, sm, x0, K):
     X[0] = xk = x0
     for k in range(K):
         xfree = E @ xk
-        z, _ = step(C @ xfree + v)
+        z, _ = step(C @ xfree + v, system.q_scale(xfree, v))
         xk = xfree + G @ z
         X[k + 1] = xk
         Z[k] = z

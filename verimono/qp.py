@@ -1,12 +1,20 @@
 """Verified solutions of small convex quadratic programs.
 
-``min ½ zᵀPz + qᵀz  s.t.  Gz ≤ h, Az = b`` with ``P ≻ 0`` is solved by the back-ends that qpsolvers
+``min ½ zᵀPz + qᵀz  s.t.  Gz ≤ h, Az = b`` with ``P ⪰ 0`` is solved by the back-ends that qpsolvers
 offers (ProxQP with tight tolerances and its duality-gap check on, then DAQP), but no back-end's status
 is trusted: each candidate is polished by re-solving the equality-constrained problem on its detected
 active set, and accepted only when verimono's own KKT check passes — primal feasibility, and a
 nonnegative multiplier combination of the active rows reproducing ``-(Pz + q)`` (a nonnegative least
 squares residual), both to ``QP_RTOL`` relative to the data.  When no candidate passes,
 :class:`verimono.SolverFailure` is raised with every back-end's reason.
+
+The problem is equilibrated first (:func:`equilibrate`): constraint rows scaled to unit length, the
+objective to ``max |P| = 1``, and the variable to ``z = s·y`` with ``s`` the size of the data
+(``max(|h|∞, |b|∞, |q|∞/max|P|)``).  None of this changes the minimiser, but it makes "relative to the
+data" mean the same at every scale: the back-ends' absolute stopping floors and the KKT check's would
+otherwise lose constraints of size 1e-9 (the one-step problems of a complementarity system near
+``t = 0``), and ProxQP 0.8 does not return at all on a linear term 1e100 times its constraints (seen
+on a membership query of the Section 7 Example).
 """
 
 from __future__ import annotations
@@ -50,10 +58,10 @@ def kkt_residual(P, q, G, h, A, b, z, rtol: float = QP_RTOL) -> KKTReport:
         viol = max(viol, float(np.max(np.abs(A @ z - b), initial=0.0)))
         rows.extend([A, -A])  # free multipliers as differences of nonnegative ones
     grad = P @ z + q
-    if rows:
-        R = np.vstack(rows)
+    R = np.vstack(rows) if rows else np.zeros((0, z.size))
+    if R.shape[0]:
         _, res = nnls(R.T, -grad, maxiter=50 * max(R.shape))
-    else:
+    else:  # no active row (an interior minimiser): SciPy's nnls aborts the process on an empty matrix
         res = float(np.linalg.norm(grad))
     primal, dual = viol / scale, res / scale
     return KKTReport(primal, dual, primal <= rtol and dual <= rtol)
@@ -78,8 +86,62 @@ def _polish(P, q, G, h, A, b, z):
     return sol[:n]
 
 
-def solve_qp(P, q, G=None, h=None, A=None, b=None, *, backends=None) -> np.ndarray:
-    """Solve the strictly convex QP and return a KKT-verified minimiser.
+@dataclasses.dataclass
+class ScaledQP:
+    """``min ½yᵀPy + qᵀy  s.t. Gy ≤ h, Ay = b`` with ``z = scale·y`` the original problem's variable."""
+    P: np.ndarray
+    q: np.ndarray
+    G: np.ndarray | None
+    h: np.ndarray | None
+    A: np.ndarray | None
+    b: np.ndarray | None
+    scale: float
+
+
+def _unit_rows(E, e, kind):
+    """Rows of ``E`` scaled to unit length (with ``e``); zero rows dropped after checking ``0 ≤ e``
+    (inequalities) or ``0 = e`` (equalities) — a zero row with the wrong sign is an empty feasible set."""
+    if E is None:
+        return None, None
+    norms = np.linalg.norm(E, axis=1)
+    zero = norms == 0.0
+    if np.any(zero):
+        bad = e[zero] < 0 if kind == "<=" else e[zero] != 0
+        if np.any(bad):
+            raise InfeasibleStep(f"the QP has a zero constraint row with right-hand side "
+                                 f"{e[zero][bad][0]:.3g} ({'0 <= h' if kind == '<=' else '0 = b'} fails)")
+        E, e, norms = E[~zero], e[~zero], norms[~zero]
+    if E.shape[0] == 0:
+        return None, None
+    return E / norms[:, None], e / norms
+
+
+def equilibrate(P, q, G, h, A, b, scale: float | None = None) -> ScaledQP:
+    """The same QP in units where its data are of size 1 (same minimiser, up to ``z = s·y``).
+
+    ``s = max(|h|∞, |b|∞, |q|∞/p, scale)`` after the rows are normalised, with ``p = max |P|``: the size of
+    the constraints' offsets and of the unconstrained minimiser.  ``scale`` is a floor for ``s``: the size
+    of the numbers the data were computed from, when their rounding errors are larger than the data (see
+    :func:`verimono.lcs.solve_lcp`).  Substituting ``z = s·y`` and dividing the objective by ``p·s²``::
+
+        min ½ yᵀ(P/p)y + (q/(p s))ᵀy   s.t.  (G/‖G_i‖)y ≤ h/(‖G_i‖ s),  (A/‖A_i‖)y = b/(‖A_i‖ s).
+    """
+    G, h = _unit_rows(G, h, "<=")
+    A, b = _unit_rows(A, b, "=")
+    p = float(np.abs(P).max(initial=0.0)) or 1.0
+    s = max(float(np.abs(h).max(initial=0.0)) if h is not None else 0.0,
+            float(np.abs(b).max(initial=0.0)) if b is not None else 0.0,
+            float(np.abs(q).max(initial=0.0)) / p, 0.0 if scale is None else float(scale))
+    if not (np.isfinite(s) and s > 0.0):
+        s = 1.0
+    return ScaledQP(P / p, q / (p * s), G, None if h is None else h / s, A, None if b is None else b / s, s)
+
+
+def solve_qp(P, q, G=None, h=None, A=None, b=None, *, backends=None, scale: float | None = None) -> np.ndarray:
+    """Solve the convex QP (``P ⪰ 0``, unique minimiser) and return a KKT-verified minimiser.
+
+    The data are equilibrated first (:func:`equilibrate`; ``scale`` as there) and the KKT check is made in
+    those units, i.e. relative to the size of the data at every scale.
 
     Raises :class:`InfeasibleStep` when the constraints admit no point (every back-end reports
     infeasibility and none returns a point), :class:`SolverFailure` when candidates exist but none
@@ -93,6 +155,7 @@ def solve_qp(P, q, G=None, h=None, A=None, b=None, *, backends=None) -> np.ndarr
     h = None if G is None else np.atleast_1d(np.array(h, float))
     A = None if A is None or len(A) == 0 else np.atleast_2d(np.array(A, float))
     b = None if A is None else np.atleast_1d(np.array(b, float))
+    S = equilibrate(P, q, G, h, A, b, scale)
     reasons = []
     got_point = False
     for name in backends or BACKENDS:
@@ -102,19 +165,19 @@ def solve_qp(P, q, G=None, h=None, A=None, b=None, *, backends=None) -> np.ndarr
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                z = qpsolvers.solve_qp(P, q, G, h, A, b, solver=name, **BACKENDS.get(name, {}))
+                y = qpsolvers.solve_qp(S.P, S.q, S.G, S.h, S.A, S.b, solver=name, **BACKENDS.get(name, {}))
         except Exception as exc:  # a back-end's own failure is one reason among others
             reasons.append(f"{name}: raised {type(exc).__name__}: {exc}")
             continue
-        if z is None or not np.all(np.isfinite(z)):
+        if y is None or not np.all(np.isfinite(y)):
             reasons.append(f"{name}: returned no solution")
             continue
         got_point = True
         best_rep = None
-        for cand in (_polish(P, q, G, h, A, b, z), z):
-            rep = kkt_residual(P, q, G, h, A, b, cand)
+        for cand in (_polish(S.P, S.q, S.G, S.h, S.A, S.b, y), y):
+            rep = kkt_residual(S.P, S.q, S.G, S.h, S.A, S.b, cand)
             if rep.ok:
-                return cand
+                return S.scale * cand
             if best_rep is None or max(rep.primal, rep.dual) < max(best_rep.primal, best_rep.dual):
                 best_rep = rep
         reasons.append(f"{name}: KKT check failed (primal {best_rep.primal:.2e}, dual {best_rep.dual:.2e})")

@@ -171,10 +171,13 @@ def lemke(M: np.ndarray, q: np.ndarray, max_iter: int | None = None) -> tuple[np
 
 
 def _qp_backend(M, q):
-    """Phase-1 QP for PSD ``M``: ``min ½zᵀ(M+Mᵀ)z + qᵀz`` over ``FEA(q, M)`` (objective ``zᵀ(Mz + q) ≥ 0``)."""
+    """Phase-1 QP for PSD ``M``: ``min ½zᵀ(M+Mᵀ)z + qᵀz`` over ``FEA(q, M)`` (objective ``zᵀ(Mz + q) ≥ 0``).
+
+    Like every back-end it receives the unit-scaled data of :func:`_solve_unit`, whose scale is 1 even
+    when ``|q|∞ < 1`` (``solve_lcp``'s ``scale`` larger than ``|q|∞``): the QP is solved in those units."""
     n = q.shape[0]
     try:
-        z = solve_qp(M + M.T, q, np.vstack([-np.eye(n), -M]), np.concatenate([np.zeros(n), q]))
+        z = solve_qp(M + M.T, q, np.vstack([-np.eye(n), -M]), np.concatenate([np.zeros(n), q]), scale=1.0)
     except VerimonoError as exc:
         return None, f"{type(exc).__name__}: {exc}"
     return z, "solved"
@@ -205,7 +208,7 @@ def _piece_point(M, q, alpha, P=None, c=None):
     G = np.vstack([-np.eye(n)[alpha], -M[~alpha]])
     h = np.concatenate([np.zeros(idx.size), q[~alpha]])
     try:
-        z = solve_qp(np.eye(n) if P is None else P, np.zeros(n) if c is None else c, G, h, Aeq, beq)
+        z = solve_qp(np.eye(n) if P is None else P, np.zeros(n) if c is None else c, G, h, Aeq, beq, scale=1.0)
     except VerimonoError:
         return None
     ok, _, _ = _verified(M, q, z)
@@ -254,36 +257,56 @@ def _infeasibility_certificate(M, q) -> np.ndarray | None:
 
 
 def _raise_infeasible(M, q, psd, reasons):
+    """Raise :class:`InfeasibleStep` for the unit-scaled data of :func:`_solve_unit` (``|q|∞ = 1``)."""
     if psd:
         zeta = _infeasibility_certificate(M, q)
         cert = "" if zeta is None else (f"; certificate ζ = {np.array2string(zeta, precision=4)} ∈ Q_M "
-                                        f"has ⟨q, ζ⟩ = {q @ zeta:.3g} < 0")
+                                        f"(normalised Σζ = 1) has ⟨q, ζ⟩/|q|∞ = {q @ zeta:.3g} < 0")
         raise InfeasibleStep(f"LCP(q, M) has no solution: q ∉ Q_M^+ (no z ≥ 0 with Mz + q ≥ 0; "
                              f"Proposition p:lcp2){cert}")
     raise InfeasibleStep("LCP(q, M) has no solution: " + "; ".join(reasons))
 
 
 # --- least-norm / selection over SOL(q, M) for PSD M ------------------------------------------------------
-def _row_basis(E: np.ndarray) -> np.ndarray:
-    """Orthonormal basis (rows) of the row space of ``E``, rank decided at ``RTOL`` relative."""
+def _row_basis(E: np.ndarray, floors: np.ndarray | None = None) -> np.ndarray:
+    """Orthonormal basis (rows) of the row space of ``E``, rank decided at ``RTOL``.
+
+    Each row is divided by ``max(|E_i|, floor_i)`` first: the rank is a property of the constraints, not
+    of their units — the row ``qᵀ`` of :func:`sol_polyhedron` is as binding at ``|q| = 1e-9`` as at
+    ``|q| = 1`` — unless the row is smaller than ``RTOL`` times the size ``floor_i`` of the numbers it
+    was computed from, when it is rounding and drops out (``floors`` default to 0)."""
+    if E.size == 0:
+        return E
+    norms = np.linalg.norm(E, axis=1)
+    if floors is not None:
+        norms = np.maximum(norms, floors)
+    E = E[norms > 0] / norms[norms > 0, None]
     if E.size == 0:
         return E
     _, s, Vt = np.linalg.svd(E, full_matrices=False)
-    r = int(np.sum(s > RTOL * max(s[0], 1e-300)))
+    r = int(np.sum(s > RTOL))     # rows of norm ≤ 1: singular values are absolute
     return Vt[:r]
 
 
-def sol_polyhedron(M, q, zbar):
-    """``SOL(q, M)`` for PSD ``M`` as ``(G, h, A, b)``: ``Gz ≤ h``, ``Az = b`` (CPS Thm 3.1.7)."""
+def sol_polyhedron(M, q, zbar, scale: float | None = None):
+    """``SOL(q, M)`` for PSD ``M`` as ``(G, h, A, b)``: ``Gz ≤ h``, ``Az = b`` (CPS Thm 3.1.7).
+
+    Each equality row is judged against the size of the numbers it was computed from (:func:`_row_basis`):
+    the rows of ``M + Mᵀ`` against ``max |M|`` (cancellation leaves ``ε max |M|`` where ``M + Mᵀ`` vanishes),
+    ``qᵀ(z − z̄) = 0`` against ``scale`` (as in :func:`solve_lcp`; ``q`` is exact by default)."""
     n = q.shape[0]
-    A = _row_basis(np.vstack([M + M.T, q[None, :]]))
+    floors = np.concatenate([np.full(n, float(np.abs(M).max(initial=0.0))), [0.0 if scale is None else float(scale)]])
+    A = _row_basis(np.vstack([M + M.T, q[None, :]]), floors)
     return np.vstack([-np.eye(n), -M]), np.concatenate([np.zeros(n), q]), A, A @ zbar
 
 
-def select_over_sol(M, q, zbar, P, c) -> np.ndarray:
-    """Minimise ``½zᵀPz + cᵀz`` over ``SOL(q, M)`` (PSD ``M``; ``z̄`` any solution), KKT-verified."""
-    G, h, A, b = sol_polyhedron(M, q, zbar)
-    return solve_qp(P, c, G, h, A if len(A) else None, b if len(A) else None)
+def select_over_sol(M, q, zbar, P, c, scale: float | None = None) -> np.ndarray:
+    """Minimise ``½zᵀPz + cᵀz`` over ``SOL(q, M)`` (PSD ``M``; ``z̄`` any solution), KKT-verified.
+
+    ``scale``: the size of the numbers ``q`` was computed from (as in :func:`solve_lcp`), a floor for the
+    units the QP is solved in (:func:`verimono.qp.equilibrate`)."""
+    G, h, A, b = sol_polyhedron(M, q, zbar, scale)
+    return solve_qp(P, c, G, h, A if len(A) else None, b if len(A) else None, scale=scale)
 
 
 def unique_certificate(M, q, z, w, scale) -> bool:
@@ -298,12 +321,19 @@ def unique_certificate(M, q, z, w, scale) -> bool:
 
 # --- the public solver -----------------------------------------------------------------------------------
 def solve_lcp(M, q, *, least_norm: bool = True, backends: tuple[str, ...] | None = None,
-              info: bool = False):
+              info: bool = False, scale: float | None = None):
     """Solve ``LCP(q, M)``; return its least-norm solution ``z`` (or an :class:`LCPResult` with ``info``).
 
     For PSD ``M`` the least-norm solution of Proposition ``p:lcp2`` item iv is returned.  For other ``M``
     ``SOL(q, M)`` need not be convex; with ``least_norm`` and ``n ≤ ENUM_MAX`` the least-norm point over all
     complementary pieces is returned, otherwise a verified solution (``LCPResult.least_norm`` False).
+
+    The problem is homogeneous — ``z ∈ SOL(q, M)`` iff ``(β/s) z ∈ SOL(q/s, M/β)`` for ``s, β > 0`` — so it
+    is solved with ``β = max |M|`` and ``s = max(|q|∞, scale)`` and scaled back: every tolerance, support
+    and rank decision is relative to the size of the data.  ``scale`` is the size of the numbers ``q`` was
+    computed from (its rounding errors are relative to them: ``q = Cx + v`` carries errors of order
+    ``ε(‖C‖|x| + |v|)`` however small ``q`` is); the default, ``|q|∞``, treats ``q`` as exact, so that a
+    one-step problem of size ``h`` or ``t`` is solved as accurately as one of size 1.
 
     Raises :class:`verimono.InfeasibleStep` when there is no solution (for PSD ``M``: ``q ∉ Q_M^+``, with a
     certificate ``ζ ∈ Q_M``, ``⟨q, ζ⟩ < 0``), :class:`verimono.SolverFailure` when solutions exist but no
@@ -311,11 +341,22 @@ def solve_lcp(M, q, *, least_norm: bool = True, backends: tuple[str, ...] | None
     """
     M, q = _validate(M, q)
     n = q.shape[0]
+    if np.all(q >= 0):  # z = 0 solves it and has the least norm
+        res = LCPResult(np.zeros(n), q.copy(), 0.0, lcp_scale(M, q), "trivial (q ≥ 0)", is_psd(M), None, True)
+        return res if info else res.z
+    s = max(float(np.abs(q).max()), 0.0 if scale is None else float(scale))   # > 0: some q_i < 0
+    beta = float(np.abs(M).max()) or 1.0
+    unit = _solve_unit(M / beta, q / s, least_norm, backends)
+    z = unit.z * (s / beta)
+    res = dataclasses.replace(unit, z=z, w=M @ z + q, residual=lcp_residual(M, q, z), scale=unit.scale * s)
+    return res if info else z
+
+
+def _solve_unit(M, q, least_norm, backends) -> LCPResult:
+    """:func:`solve_lcp` on data scaled to ``|q|∞ = 1``, ``max |M| = 1`` (``q`` not ``≥ 0``)."""
+    n = q.shape[0]
     psd = is_psd(M)
     reasons: list[str] = []
-    if np.all(q >= 0):  # z = 0 solves it and has the least norm
-        res = LCPResult(np.zeros(n), q.copy(), 0.0, lcp_scale(M, q), "trivial (q ≥ 0)", psd, None, True)
-        return res if info else res.z
     zbar, used, lemke_ray = None, None, False
     for name in backends or (PSD_BACKENDS if psd else GENERAL_BACKENDS):
         try:
@@ -365,7 +406,7 @@ def solve_lcp(M, q, *, least_norm: bool = True, backends: tuple[str, ...] | None
     z = zbar
     if least_norm and not certified:
         if psd:
-            zl = select_over_sol(M, q, zbar, np.eye(n), np.zeros(n))
+            zl = select_over_sol(M, q, zbar, np.eye(n), np.zeros(n), scale=1.0)
             ok, _, _ = _verified(M, q, zl)
             if not ok:
                 zp = _polish(M, q, zl)
@@ -380,8 +421,7 @@ def solve_lcp(M, q, *, least_norm: bool = True, backends: tuple[str, ...] | None
                 z = zl
             certified, used = zl is not None, used + "+enumeration"
     w = M @ z + q
-    res = LCPResult(z, w, lcp_residual(M, q, z), lcp_scale(M, q, z), used, psd, unique, certified, reasons)
-    return res if info else z
+    return LCPResult(z, w, lcp_residual(M, q, z), lcp_scale(M, q, z), used, psd, unique, certified, reasons)
 
 
 # --- box-constrained counterpart (relay) --------------------------------------------------------------------
@@ -401,12 +441,12 @@ def box_residual(M, q, lam, lower, upper) -> float:
     return float(np.max(np.abs(lam - np.clip(lam - y, lower, upper)), initial=0.0))
 
 
-def solve_box(M, q, lower, upper, *, least_norm: bool = True, info: bool = False):
+def solve_box(M, q, lower, upper, *, least_norm: bool = True, info: bool = False, scale: float | None = None):
     """Find ``λ ∈ [l, u]`` with ``−(Mλ + q) ∈ N_[l,u](λ)`` (the relay law ``λ ∈ −sgn(y)`` for ``[−1, 1]``).
 
     Solved as the equivalent LCP (``l`` finite, ``u`` may be ``+∞``); with ``least_norm`` and PSD ``M`` the
     least-norm ``λ`` over the (polyhedral) solution set.  Returns ``λ`` or an :class:`LCPResult` whose ``z``
-    is ``λ`` and ``w`` is ``y = Mλ + q``.
+    is ``λ`` and ``w`` is ``y = Mλ + q``.  ``scale`` as in :func:`solve_lcp`.
     """
     M, q = _validate(M, q)
     m = q.shape[0]
@@ -415,7 +455,7 @@ def solve_box(M, q, lower, upper, *, least_norm: bool = True, info: bool = False
     if not np.all(np.isfinite(lower)) or np.any(np.isnan(upper)) or np.any(lower > upper):
         raise InvalidProblem(f"box bounds must satisfy -inf < lower <= upper <= inf, got lower={lower}, upper={upper}")
     big, qq, fin = _box_lcp(M, q, lower, upper)
-    r = solve_lcp(big, qq, least_norm=False, info=True)
+    r = solve_lcp(big, qq, least_norm=False, info=True, scale=scale)
     lam = lower + r.z[:m]
     psd = is_psd(M)
     certified = r.unique is True
@@ -423,7 +463,7 @@ def solve_box(M, q, lower, upper, *, least_norm: bool = True, info: bool = False
         P = np.zeros((big.shape[0],) * 2)
         P[:m, :m] = np.eye(m)
         c = np.concatenate([lower, np.zeros(fin.size)])
-        zz = select_over_sol(big, qq, r.z, P, c)
+        zz = select_over_sol(big, qq, r.z, P, c, scale=scale)
         if _verified(big, qq, zz)[0]:
             lam, certified = lower + zz[:m], True
         else:

@@ -29,14 +29,16 @@ class Relation:
 
     name = "relation"
 
-    def solve(self, M: np.ndarray, q: np.ndarray) -> LCPResult:
-        """Solve ``w = Mz + q``, ``(−z, w) ∈ graph 𝓜`` from scratch; ``result.z``, ``result.w``."""
+    def solve(self, M: np.ndarray, q: np.ndarray, scale: float | None = None) -> LCPResult:
+        """Solve ``w = Mz + q``, ``(−z, w) ∈ graph 𝓜`` from scratch; ``result.z``, ``result.w``.
+
+        ``scale``: the size of the numbers ``q`` was computed from (see :func:`verimono.lcs.solve_lcp`)."""
         raise NotImplementedError
 
     def stepper(self, M: np.ndarray):
-        """A callable ``q ↦ (z, w)`` for a constant ``M`` (default: :meth:`solve` every time)."""
-        def step(q):
-            r = self.solve(M, q)
+        """A callable ``(q, scale=None) ↦ (z, w)`` for a constant ``M`` (default: :meth:`solve` every time)."""
+        def step(q, scale=None):
+            r = self.solve(M, q, scale)
             return r.z, r.w
         return step
 
@@ -71,11 +73,11 @@ class BoxRelation(Relation):
     def is_lcp(self) -> bool:
         return bool(np.all(self.lower_ == 0.0) and np.all(np.isinf(self.upper_)))
 
-    def solve(self, M, q):
+    def solve(self, M, q, scale=None):
         if self.is_lcp:
-            return solve_lcp(M, q, info=True)
+            return solve_lcp(M, q, info=True, scale=scale)
         lo, hi = self.bounds(q.shape[0])
-        return solve_box(M, q, lo, hi, info=True)
+        return solve_box(M, q, lo, hi, info=True, scale=scale)
 
     def stepper(self, M):
         return _BoxStepper(self, np.asarray(M, dtype=float))
@@ -140,12 +142,12 @@ class _BoxStepper:
             return None
         return lam, y
 
-    def __call__(self, q):
+    def __call__(self, q, scale=None):
         if self.last is not None:
             out = self._try(self.last, q)
             if out is not None:
                 return out
-        r = self.rel.solve(self.M, q)
+        r = self.rel.solve(self.M, q, scale)
         self.full_solves += 1
         lam = r.z
         tau = RTOL * lcp_scale(self.M, q, lam)
@@ -184,7 +186,8 @@ class OperatorRelation(Relation):
         if self.op.dim != m:
             raise InvalidProblem(f"{self.name} acts on R^{self.op.dim}; the system has m = {m}")
 
-    def solve(self, M, q):
+    def solve(self, M, q, scale=None):
+        # ``scale`` is not needed: the splitting's stopping test is already relative to the data
         M, q = np.asarray(M, float), np.asarray(q, float)
         m = q.shape[0]
         gamma = 1.0 / max(np.linalg.norm(M, 2), 1e-12)

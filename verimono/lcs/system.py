@@ -24,7 +24,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from .._params import as_param
-from ..errors import InvalidProblem, OutsideDomain
+from ..errors import InfeasibleStep, InvalidProblem, OutsideDomain
 from ..grids import validate_grid
 from ..operators import Operator
 from ..problem import Problem
@@ -100,9 +100,15 @@ class LinearRelationSystem:
         if self._v(0.0).shape != (m,):
             raise InvalidProblem(f"v(t) must have shape ({m},), got {self._v(0.0).shape}")
         self.name = name or f"LinearRelationSystem({self.relation.name}, n={n}, m={m})"
+        self._c_norm = float(np.abs(self.C).sum(axis=1).max(initial=0.0))
 
     def v(self, t: float) -> np.ndarray:
         return self._v(t)
+
+    def q_scale(self, x: np.ndarray, v: np.ndarray) -> float:
+        """``‖C‖∞|x|∞ + |v|∞``: the size of the terms the one-step data ``q = Cx + v`` is summed from, to
+        which its rounding errors are relative (the ``scale`` of :func:`verimono.lcs.solve_lcp`)."""
+        return self._c_norm * float(np.abs(x).max(initial=0.0)) + float(np.abs(v).max(initial=0.0))
 
     @property
     def v_constant(self) -> bool:
@@ -166,8 +172,8 @@ class LinearRelationSystem:
             if dU is not None:
                 xfree = xfree + sla.lu_solve(sm.lu, dU[k])
             v = vconst if vconst is not None else self.v(t[k + 1])
-            q = C @ (xfree if g == 1.0 else g * xfree + (1.0 - g) * xk) + v
-            z, _ = sm.step(q)
+            xq = xfree if g == 1.0 else g * xfree + (1.0 - g) * xk
+            z, _ = sm.step(C @ xq + v, self.q_scale(xq, v))
             X[k + 1] = xfree + sm.G @ z
             Z[k] = z
             Wout[k] = C @ X[k + 1] + D @ z + v
@@ -210,9 +216,9 @@ class LCSOperator(Operator):
             raise InvalidProblem(f"{self.name} acts on R^{self.dim}; got a point of shape {x.shape}")
         sm = self._sm(float(lam))
         s = self.system
-        q = s.C @ (sm.E @ x) + s.v(t)
-        z, _ = sm.step(q)
-        return sm.E @ x + sm.G @ z
+        xE, v = sm.E @ x, s.v(t)
+        z, _ = sm.step(s.C @ xE + v, s.q_scale(xE, v))
+        return xE + sm.G @ z
 
     # -- the set-valued H(t, x) through the multipliers of (Cx + v, D) ----------------------------------
     def _box(self):
@@ -223,20 +229,34 @@ class LCSOperator(Operator):
         return rel
 
     def _select(self, x, t, P_lam, c_lam):
-        """Minimise ``½λᵀP λ + cᵀλ`` over the multipliers ``λ`` of ``(η, D) = (Cx + v(t), D)``."""
+        """Minimise ``½λᵀP λ + cᵀλ`` over the multipliers ``λ`` of ``(η, D) = (Cx + v(t), D)``.
+
+        ``x`` is in ``dom H(t)`` when the multipliers' LCP is feasible up to the linear program's tolerance
+        (:func:`verimono.lcs.lcp._feasible`); otherwise :class:`OutsideDomain`.  Its data are solved
+        relative to their own size (``scale`` of :func:`verimono.lcs.solve_lcp`), so a point at ``t = 1e-12``
+        gets as accurate an answer as one at ``t = 1``.  A point that the program accepts but whose exact
+        data are infeasible lies outside the domain by a rounding error of the computation that produced
+        it (a resolvent of unit-size data returns ``-4e-16`` for the edge ``0`` of ``dom H = [0, ∞)``),
+        whose size ``H`` cannot know: its data are then solved relative to a unit floor, i.e. as the
+        nearest point of the domain."""
         rel, s = self._box(), self.system
-        eta = s.C @ x + s.v(t)
+        v = s.v(t)
+        eta, scale = s.C @ x + v, s.q_scale(x, v)
         lo, hi = rel.bounds(s.m)
         big, qq, fin = _box_lcp(s.D, eta, lo, hi)
         if not _feasible(big, qq):
             raise OutsideDomain(f"x = {x} is not in dom H(t={t}): Cx + v(t) ∉ im(𝓜 + D)")
-        zbar = solve_lcp(big, qq, least_norm=False)
+        try:
+            zbar = solve_lcp(big, qq, least_norm=False, scale=scale)
+        except InfeasibleStep:
+            scale = 1.0 + scale
+            zbar = solve_lcp(big, qq, least_norm=False, scale=scale)
         k = big.shape[0]
         P = np.zeros((k, k))
         P[:s.m, :s.m] = P_lam
         c = np.zeros(k)
         c[:s.m] = c_lam + P_lam @ lo
-        zz = select_over_sol(big, qq, zbar, P, c)
+        zz = select_over_sol(big, qq, zbar, P, c, scale=scale)
         return lo + zz[:s.m]
 
     def min_norm(self, x, t=0.0):

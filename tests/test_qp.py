@@ -1,0 +1,96 @@
+"""The verified QP layer (:mod:`verimono.qp`): no back-end status trusted, the same accuracy at every scale."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+import qpsolvers
+from scipy.optimize import LinearConstraint, minimize
+
+from verimono import InfeasibleStep, SolverFailure
+from verimono.qp import equilibrate, kkt_residual, solve_qp
+
+# the triangle {z1 + z2 <= 1, z >= 0} and a slab cut by an equality, as (G, h, A, b)
+TRIANGLE = (np.array([[1.0, 1.0], [-1.0, 0.0], [0.0, -1.0]]), np.array([1.0, 0.0, 0.0]), None, None)
+SLAB = (np.array([[1.0, 1.0, 0.0], [0.0, -2.0, 0.0]]), np.array([1.0, 0.5]),
+        np.array([[0.0, 0.0, 3.0]]), np.array([0.75]))
+
+
+def slsqp_projection(x, G, h, A, b):
+    """proj(x) onto {Gz <= h, Az = b} by SciPy's SLSQP: independent of every QP back-end."""
+    cons = [LinearConstraint(G, -np.inf, h)] + ([] if A is None else [LinearConstraint(A, b, b)])
+    res = minimize(lambda z: 0.5 * np.sum((z - x) ** 2), np.zeros_like(x), jac=lambda z: z - x,
+                   constraints=cons, method="SLSQP", options=dict(ftol=1e-15, maxiter=500))
+    return res.x
+
+
+@pytest.mark.parametrize("data", [TRIANGLE, SLAB], ids=["triangle", "slab"])
+def test_projection_matches_slsqp_and_scales_exactly_with_the_data(data):
+    """proj_{sS}(s x) = s proj_S(x): the same relative accuracy from s = 1e-12 to 1e12.
+
+    SLSQP's own accuracy is about 1e-8, hence the looser comparison at unit scale; the scaled answers are
+    compared with the unit one at 1e-9 relative (the QP_RTOL-verified accuracy with headroom)."""
+    G, h, A, b = data
+    rng = np.random.default_rng(7)
+    for _ in range(5):
+        x = rng.normal(size=G.shape[1]) * 2
+        z = solve_qp(np.eye(x.size), -x, G, h, A, b)
+        np.testing.assert_allclose(z, slsqp_projection(x, G, h, A, b), atol=1e-6)
+        for s in (1e-12, 1e-9, 1e-6, 1e3, 1e12):
+            zs = solve_qp(np.eye(x.size), -s * x, G, s * h, A, None if b is None else s * b)
+            np.testing.assert_allclose(zs / s, z, rtol=0, atol=1e-9 * (1 + np.abs(z).max()))
+
+
+def test_a_linear_term_far_larger_than_the_constraints_is_solved_and_returns():
+    """min ½y₂² − c y₂ over {y₁ = 0, y ≥ 0, y₂ ≥ δ} with δ = 1e-108 c: the minimiser is (0, c).
+
+    ProxQP 0.8 given these data unscaled never returns (seen in a membership query of the Section 7
+    Example), so the solve runs in a subprocess with a time limit: a regression fails, it does not hang."""
+    code = textwrap.dedent("""
+        import numpy as np
+        from verimono.qp import solve_qp
+        c = 0.7953406842482188
+        P, q = np.diag([0.0, 1.0]), np.array([0.0, -c])
+        G = np.array([[-1.0, 0.0], [0.0, -1.0], [0.0, -1.0], [1.0, 0.0]])
+        h = np.array([0.0, 0.0, -1e-108 * c, 0.0])
+        z = solve_qp(P, q, G, h, np.array([[1.0, 0.0]]), np.array([0.0]))
+        assert abs(z[0]) <= 1e-12 and abs(z[1] - c) <= 1e-12 * c, z
+        z = solve_qp(P, q * 1e100, G, h, np.array([[1.0, 0.0]]), np.array([0.0]))
+        assert abs(z[1] - c * 1e100) <= 1e-12 * c * 1e100, z
+    """)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+
+
+def test_equilibrated_data_are_of_unit_size():
+    G, h, A, b = SLAB
+    S = equilibrate(4e-7 * np.eye(3), np.array([1e-9, 0.0, 2e-9]), G * 5.0, h * 5e-9, A, b * 1e-9)
+    assert np.abs(S.P).max() == 1.0
+    np.testing.assert_allclose(np.linalg.norm(S.G, axis=1), 1.0)
+    np.testing.assert_allclose(np.linalg.norm(S.A, axis=1), 1.0)
+    assert max(np.abs(S.h).max(), np.abs(S.b).max(), np.abs(S.q).max()) == pytest.approx(1.0)
+    assert S.scale == pytest.approx(max(5e-9 / np.sqrt(2), 0.25e-9, 2e-9 / 4e-7))
+
+
+def test_zero_rows_are_dropped_or_prove_infeasibility():
+    G = np.array([[0.0, 0.0], [-1.0, 0.0]])
+    np.testing.assert_allclose(solve_qp(np.eye(2), [1.0, -1.0], G, [0.0, 0.0]), [0.0, 1.0], atol=1e-12)
+    with pytest.raises(InfeasibleStep, match="zero constraint row"):
+        solve_qp(np.eye(2), [1.0, -1.0], G, [-1.0, 0.0])
+    with pytest.raises(InfeasibleStep, match="zero constraint row"):
+        solve_qp(np.eye(2), [1.0, -1.0], None, None, np.zeros((1, 2)), [1.0])
+
+
+def test_a_back_end_reporting_a_wrong_answer_is_not_trusted(monkeypatch):
+    """Every back-end 'solves' the projection of (2, 3) onto the triangle with an interior point (the answer
+    is (0, 1)): the KKT check rejects it, and polishing on its (empty) active set does not rescue it."""
+    monkeypatch.setattr(qpsolvers, "solve_qp", lambda P, q, *args, **kwargs: np.full(q.shape, 0.1))
+    G, h, _, _ = TRIANGLE
+    with pytest.raises(SolverFailure, match="KKT check failed"):
+        solve_qp(np.eye(2), -np.array([2.0, 3.0]), G, h)
+    assert not kkt_residual(np.eye(2), -np.array([2.0, 3.0]), G, h, None, None, np.array([0.3, 0.3])).ok
+    assert kkt_residual(np.eye(2), -np.array([2.0, 3.0]), G, h, None, None, np.array([0.0, 1.0])).ok
