@@ -18,11 +18,16 @@ chosen automatically for large studies.  When the problem has an exact solution 
 its three errors: with :func:`verimono.solve` as the stepper the states stream through an
 :class:`ErrorAccumulator` block by block (:func:`verimono.stepping.stream`), so no job holds a
 trajectory at all; any other stepper's trajectory is held by its job only while its errors are computed.
+Without an exact solution the fine reference runs first and returns only its values at the studied
+grids' nodes (streamed through a :class:`Sampler` for :func:`verimono.solve`); each grid's job then
+accumulates its errors against its share of them, so neither the fine trajectory nor any grid's
+trajectory reaches the caller.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import multiprocessing
 import os
@@ -192,26 +197,36 @@ def grid_errors(t: np.ndarray, x: np.ndarray, ref: np.ndarray) -> dict[str, floa
 
 
 class ErrorAccumulator:
-    """Streaming :func:`grid_errors` against ``problem.exact``: feed ``(t_block, x_block)`` pieces in order.
+    """Streaming :func:`grid_errors`: feed ``(t_block, x_block)`` pieces in order.
 
-    Holds ``O(1)`` data besides the current block.  ``errors()`` equals ``grid_errors`` on the whole
-    trajectory: ``sup`` and ``final`` bit for bit, ``l2`` to within one rounding (its sum is carried as an
-    exactly rounded double-double, error ≤ 2^-106 relative before the final rounding, so in practice
-    bit for bit).  ``scale`` is ``max |x(t_k)|`` of the exact solution.
+    Against ``problem.exact``, or against ``reference``: the reference values at every node of the grid,
+    in order (the fine-grid reference of a study without exact solution).  Holds ``O(1)`` data besides the
+    current block (and ``reference``).  ``errors()`` equals ``grid_errors`` on the whole trajectory:
+    ``sup`` and ``final`` bit for bit, ``l2`` to within one rounding (its sum is carried as an exactly
+    rounded double-double, error ≤ 2^-106 relative before the final rounding, so in practice bit for
+    bit).  ``scale`` is ``max |x(t_k)|`` of the reference.
     """
 
-    def __init__(self, problem: Problem) -> None:
-        if problem.exact is None:
+    def __init__(self, problem: Problem, reference: np.ndarray | None = None) -> None:
+        if problem.exact is None and reference is None:
             raise InvalidProblem(f"{problem.name} has no exact solution")
         self.problem = problem
+        self.reference = reference
         self.sup = 0.0
         self.final = math.nan
         self.scale = 0.0
         self._l2 = [0.0, 0.0]      # running L2 sum as hi + lo (double-double, exactly rounded parts)
         self._t_last: float | None = None
+        self._row = 0              # grid index of the next block's first row
 
     def update(self, t: np.ndarray, x: np.ndarray) -> None:
-        ref = exact_on(self.problem, t)
+        if self.reference is None:
+            ref = exact_on(self.problem, t)
+        else:
+            ref = self.reference[self._row:self._row + len(t)]
+            if ref.shape[0] != len(t):
+                raise InvalidProblem(f"the reference has {self.reference.shape[0]} values, fewer than the grid")
+        self._row += len(t)
         d = _pointwise(x, ref)
         self.sup = max(self.sup, float(d.max()))
         self.final = float(d[-1])
@@ -228,6 +243,36 @@ class ErrorAccumulator:
 
     def errors(self) -> dict[str, float]:
         return {"sup": self.sup, "l2": math.sqrt(math.fsum(self._l2)), "final": self.final}
+
+
+class Sampler:
+    """Streaming linear interpolation of a trajectory at the increasing times ``times``.
+
+    Feed ``(t_block, x_block)`` pieces in order; ``values`` then holds ``x`` at every time, computed as
+    ``np.interp`` on the whole trajectory would (the bracketing cell and its formula do not depend on the
+    blocking).  Holds the samples and one previous row.
+    """
+
+    def __init__(self, times: np.ndarray) -> None:
+        self.times = np.asarray(times, dtype=float)
+        self.values: np.ndarray | None = None
+        self._next = 0                                   # first sample time not yet computed
+        self._prev: tuple[np.ndarray, np.ndarray] | None = None
+
+    def update(self, t: np.ndarray, x: np.ndarray) -> None:
+        if self.values is None:
+            self.values = np.empty((len(self.times),) + x.shape[1:])
+        if self._prev is not None:                       # the cell joining the previous block to this one
+            t = np.concatenate([self._prev[0], t])
+            x = np.concatenate([self._prev[1], x])
+        stop = int(np.searchsorted(self.times, t[-1], side="right"))
+        if stop > self._next:
+            tau = self.times[self._next:stop]
+            flat = x.reshape(len(t), -1)
+            vals = np.stack([np.interp(tau, t, flat[:, j]) for j in range(flat.shape[1])], axis=-1)
+            self.values[self._next:stop] = vals.reshape((len(tau),) + x.shape[1:])
+            self._next = stop
+        self._prev = (t[-1:].copy(), x[-1:].copy())
 
 
 def _name(obj: Any) -> str:
@@ -249,38 +294,27 @@ def convergence_study(stepper: Callable, problem: Problem, steps: Sequence[Any] 
     ``"serial"``.  ``None`` picks ``"process"`` for studies of at least :data:`PARALLEL_MIN_STEPS`
     steps in all on a multi-core machine, else ``"serial"``.  Problems and steppers built from
     lambdas and closures (the reference catalog's) need no pickling with verimono's own process pool
-    (forked workers inherit them); for other executors they travel by pickle, else by name from
-    :mod:`verimono.reference` (a catalog problem), else by ``cloudpickle`` when installed.
+    (forked workers inherit them); for other executors they travel by pickle, else by ``cloudpickle``
+    (by value, with the parameters their closures captured).
     """
     steps = problem.steps if steps is None else steps
     if not steps or len(steps) < 2:
         raise InvalidProblem("a convergence study needs at least two step sizes or grids")
     grids = [validate_grid(s, problem.T) if np.ndim(s) else uniform_grid(problem.T, float(s)) for s in steps]
-    exact = problem.exact is not None
-    jobs = [(g, "errors" if exact else "values") for g in grids]
-    if not exact:
-        hmin = min(float(np.min(np.diff(g))) for g in grids)
-        fine_t = uniform_grid(problem.T, steps=int(math.ceil(problem.T / hmin)) * reference_refinement)
-        jobs.append((fine_t, "values"))
-    results = _run_jobs(stepper, problem, jobs, executor)
-    errors = {n: [] for n in NORMS}
-    scale = 1.0
-    if exact:
+    if problem.exact is not None:
         reference = "exact solution"
-        for errs, sc, _ in results:
-            for n in NORMS:
-                errors[n].append(errs[n])
-            scale = max(scale, sc)
+        executor = _choose_executor(executor, sum(len(g) for g in grids))
+        results = _run_jobs(stepper, problem, [(g, "errors", None) for g in grids], executor)
     else:
-        fine_x = results[-1][0]
-        flat = fine_x.reshape(len(fine_t), -1)
-        for g, (x, _, _) in zip(grids, results):
-            ref = (np.stack([np.interp(g, fine_t, flat[:, j]) for j in range(flat.shape[1])], axis=-1)
-                   .reshape((len(g),) + fine_x.shape[1:]))
-            for n, v in grid_errors(g, x, ref).items():
-                errors[n].append(v)
-            scale = max(scale, float(np.max(np.abs(ref))))
+        fine_t = uniform_grid(problem.T, steps=_cells_finer_than(grids, problem.T) * reference_refinement)
+        executor = _choose_executor(executor, len(fine_t) + sum(len(g) for g in grids))
+        nodes = functools.reduce(np.union1d, grids)       # the fine solution is needed only there
+        at_nodes = _run_jobs(stepper, problem, [(fine_t, "sample", nodes)], executor)[0][0]
+        jobs = [(g, "errors", at_nodes[np.searchsorted(nodes, g)]) for g in grids]
+        results = _run_jobs(stepper, problem, jobs, executor)
         reference = f"fine-grid solution of the same stepper (h = {problem.T / (len(fine_t) - 1):.3g})"
+    errors = {n: [errs[n] for errs, _, _ in results] for n in NORMS}
+    scale = max([1.0] + [sc for _, sc, _ in results])
     floor = ROUNDOFF_FACTOR * EPS * scale
     mesh = [float(np.max(np.diff(g))) for g in grids]
     fits = {n: fit_order(mesh, errors[n], floor) for n in NORMS}
@@ -292,16 +326,18 @@ def convergence_study(stepper: Callable, problem: Problem, steps: Sequence[Any] 
 PARALLEL_MIN_STEPS = 200_000
 
 
-def _job(stepper, problem, grid, want):
-    """One grid: ``(errors, scale, seconds)`` when ``want == "errors"``, else ``(values, None, seconds)``.
+def _job(stepper, problem, grid, want, ref=None):
+    """One grid: ``(errors, scale, seconds)`` when ``want == "errors"`` (against the exact solution, or
+    against ``ref``, the reference values at the grid's nodes), ``(values at the times ref, None,
+    seconds)`` when ``want == "sample"``.
 
     ``seconds`` is the stepper's own time (streaming: the blocks' production, not the error sums).
     """
     stepper, problem = _unwrap(stepper), _unwrap(problem)
-    if want == "errors" and stepper is _solve():
+    sink = ErrorAccumulator(problem, ref) if want == "errors" else Sampler(ref)
+    if stepper is _solve():
         from .stepping import stream
 
-        acc = ErrorAccumulator(problem)
         spent = 0.0
         it = stream(problem, grid)
         while True:
@@ -310,15 +346,14 @@ def _job(stepper, problem, grid, want):
             spent += time.perf_counter() - start
             if piece is None:
                 break
-            acc.update(*piece)
-        return acc.errors(), acc.scale, spent
-    x, spent = _timed_run(stepper, problem, grid)
-    if want == "values":
-        return x, None, spent
-    acc = ErrorAccumulator(problem)
-    for i in range(0, len(grid), 8192):     # the exact solution in blocks: one trajectory held, not two
-        acc.update(grid[i:i + 8192], x[i:i + 8192])
-    return acc.errors(), acc.scale, spent
+            sink.update(*piece)
+    else:
+        x, spent = _timed_run(stepper, problem, grid)
+        for i in range(0, len(grid), 8192):     # in blocks, as the stream: one trajectory held, not two
+            sink.update(grid[i:i + 8192], x[i:i + 8192])
+    if want == "errors":
+        return sink.errors(), sink.scale, spent
+    return sink.values, None, spent
 
 
 def _solve():
@@ -326,13 +361,26 @@ def _solve():
     return solve
 
 
+def _cells_finer_than(grids, T: float) -> int:
+    """The fewest uniform cells of ``[0, T]`` no longer than any cell of ``grids``: ``T/h_min``, rounded
+    when it is an integer up to rounding (the steps of ``uniform_grid(T, T/K)`` fall a few ulps short of
+    ``T/K``: ``ceil`` would give ``K + 1`` and a reference grid that is not a refinement of the grids)."""
+    k = T / min(float(np.min(np.diff(g))) for g in grids)
+    return int(round(k)) if abs(k - round(k)) <= 1e-9 * k else int(math.ceil(k))
+
+
+def _choose_executor(executor, total_steps):
+    """``executor``, or for ``None`` a process pool above :data:`PARALLEL_MIN_STEPS` steps in all (on a
+    multi-core machine), else ``"serial"``."""
+    if executor is not None:
+        return executor
+    return "process" if total_steps >= PARALLEL_MIN_STEPS and (os.cpu_count() or 1) > 1 else "serial"
+
+
 def _run_jobs(stepper, problem, jobs, executor):
-    """Results of :func:`_job` for every ``(grid, want)``, in order (largest jobs submitted first)."""
-    if executor is None:
-        total = sum(len(g) for g, _ in jobs)
-        executor = "process" if total >= PARALLEL_MIN_STEPS and (os.cpu_count() or 1) > 1 else "serial"
+    """Results of :func:`_job` for every ``(grid, want, ref)``, in order (largest jobs submitted first)."""
     if executor == "serial":
-        return [_job(stepper, problem, g, w) for g, w in jobs]
+        return [_job(stepper, problem, *job) for job in jobs]
     order = sorted(range(len(jobs)), key=lambda i: -len(jobs[i][0]))
     if executor == "process":
         workers = max(1, min(len(jobs), os.cpu_count() or 1))
@@ -342,7 +390,7 @@ def _run_jobs(stepper, problem, jobs, executor):
             _REGISTRY[token] = (stepper, problem)
             try:
                 with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork")) as pool:
-                    futures = {i: pool.submit(_registered_job, token, jobs[i][0], jobs[i][1]) for i in order}
+                    futures = {i: pool.submit(_registered_job, token, *jobs[i]) for i in order}
                     return [futures[i].result() for i in range(len(jobs))]
             finally:
                 _REGISTRY.pop(token, None)
@@ -356,24 +404,24 @@ def _run_jobs(stepper, problem, jobs, executor):
 
 def _submit_all(executor, stepper, problem, jobs, order):
     s, p = _Portable(stepper), _Portable(problem)
-    futures = {i: executor.submit(_job, s, p, jobs[i][0], jobs[i][1]) for i in order}
+    futures = {i: executor.submit(_job, s, p, *jobs[i]) for i in order}
     return [futures[i].result() for i in range(len(jobs))]
 
 
 _REGISTRY: dict[int, tuple[Any, Any]] = {}
 
 
-def _registered_job(token, grid, want):
+def _registered_job(token, grid, want, ref=None):
     stepper, problem = _REGISTRY[token]
-    return _job(stepper, problem, grid, want)
+    return _job(stepper, problem, grid, want, ref)
 
 
 class _Portable:
     """Wraps a stepper or problem for executors that pickle their tasks.
 
-    Pickles as the object itself when it pickles; else, for a problem of the reference catalog, as its
-    name (rebuilt from :mod:`verimono.reference` in the worker); else through ``cloudpickle`` when it is
-    installed.  Executors that do not pickle (threads) hand the wrapper over as is; :func:`_unwrap`.
+    Pickles as the object itself when it pickles, else through ``cloudpickle`` (the catalog's problems and
+    most users' are built from lambdas and closures, which it serialises by value, captured parameters
+    included).  Executors that do not pickle (threads) hand the wrapper over as is; :func:`_unwrap`.
     """
 
     __slots__ = ("obj",)
@@ -388,16 +436,14 @@ class _Portable:
             return (_identity, (obj,))
         except Exception:
             pass
-        name = _catalog_name(obj)
-        if name is not None:
-            return (_from_catalog, (name,))
+        import cloudpickle
+
         try:
-            import cloudpickle
-        except ImportError:
-            raise InvalidProblem(f"cannot send {_name(obj)} to the executor's workers: it does not pickle (lambdas "
-                                 "or closures?), is not a reference-catalog problem and cloudpickle is not "
-                                 "installed; use executor='process' (forked workers) or install cloudpickle") from None
-        return (pickle.loads, (cloudpickle.dumps(obj),))
+            return (pickle.loads, (cloudpickle.dumps(obj),))
+        except Exception as exc:
+            raise InvalidProblem(f"cannot send {_name(obj)} to the executor's workers: cloudpickle cannot "
+                                 f"serialise it ({type(exc).__name__}: {exc}); use executor='process' (forked "
+                                 "workers inherit it) or 'serial'") from None
 
 
 def _identity(obj):
@@ -406,30 +452,6 @@ def _identity(obj):
 
 def _unwrap(obj):
     return obj.obj if isinstance(obj, _Portable) else obj
-
-
-def _from_catalog(name):
-    from .reference import get
-    return get(name)
-
-
-def _catalog_name(obj) -> str | None:
-    """The name of the reference-catalog problem ``obj`` is a fresh copy of, if any.
-
-    Same name, operator type, ``x0``, ``T`` and the same code behind its exact solution.
-    """
-    if not isinstance(obj, Problem):
-        return None
-    try:
-        from .reference import get
-        ref = get(obj.name)
-    except Exception:
-        return None
-    same = (type(ref.operator) is type(obj.operator) and ref.T == obj.T and np.array_equal(ref.x0, obj.x0)
-            and getattr(ref.exact, "__code__", None) is getattr(obj.exact, "__code__", None)
-            and getattr(ref.f, "__code__", None) is getattr(obj.f, "__code__", None)
-            and getattr(ref.u, "__code__", None) is getattr(obj.u, "__code__", None))
-    return obj.name if same else None
 
 
 def _timed_run(stepper, problem, grid):
@@ -442,4 +464,4 @@ def _timed_run(stepper, problem, grid):
 
 
 __all__ = ["convergence_study", "ConvergenceStudy", "OrderFit", "fit_order", "grid_errors", "exact_on",
-           "ErrorAccumulator"]
+           "ErrorAccumulator", "Sampler"]
