@@ -7,8 +7,10 @@
   ``h sqrt(r/2) + O(h²)`` — order 1 with constant ``sqrt(r/2)`` (derived here, checked in tests).
 * ``log_barrier``: ``g = -c ln x`` on ``(0, ∞)``, ``x' = c/x``, ``x0 = 0 ∈ cl dom``: ``x = sqrt(2ct)``.
   The first step gives ``x_1 = sqrt(ch)`` against ``sqrt(2ch)``: sup error ``(√2 - 1) sqrt(ch)``, order
-  exactly 1/2 (derived here; consistent with the O(h^{1/2}) of Rulla 1996 for ``x0`` in the closure of
-  the domain).  The harness must never certify order 1 here.
+  exactly 1/2 (derived here).  The O(h^{1/2}) results of the literature notes do not cover this start:
+  Crandall–Liggett and Rulla 1996 ask ``x0 ∈ D(A)`` or ``x0 ∈ D(φ)``, and here ``x0 = 0`` lies only in
+  the closure (``φ(0) = -c ln 0 = +∞``); the derivation shows the rate 1/2 holds there too, and is
+  sharp.  The harness must never certify order 1 here.
 """
 
 from __future__ import annotations
@@ -51,7 +53,8 @@ def log_barrier(c: float = 1.0, T: float = 1.0) -> Problem:
     return Problem(
         LogBarrier(c), [0.0], T, exact=exact,
         order=Order(0.5, "derived in verimono.reference.subdifferential: x_1 = sqrt(ch) vs sqrt(2ch), "
-                         "sup error (sqrt 2 - 1) sqrt(c h); cf. Rulla 1996, O(h^1/2) for x0 in cl D(A)",
+                         "sup error (sqrt 2 - 1) sqrt(c h), exactly; x0 = 0 is outside D(phi), beyond Rulla 1996's "
+                         "O(h^1/2) for x0 in D(phi)",
                     constant=(math.sqrt(2.0) - 1.0) * math.sqrt(c)),
         name="x' = c/x from 0 (order 1/2)", steps=[T / k for k in (100, 200, 400, 800, 1600)],
         notes="(LG) fails: |F^0(x)| = c/x is unbounded near the boundary of the domain")

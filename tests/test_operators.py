@@ -175,6 +175,20 @@ def test_batched_points_give_rowwise_results():
         assert np.allclose(J, np.stack([op.resolvent(x, 0.4, 0.0) for x in X]))
 
 
+def test_a_batch_of_operators_needs_a_batch_of_points():
+    """c of shape (B,) is B operators, one per row of a (B, n) batch; against one point (n,) it would
+    broadcast silently when B = n (operators mixed with coordinates), so it is an InvalidProblem."""
+    op = vm.NormSubdifferential(np.array([0.1, 0.2, 0.3]), dim=3)
+    X = RNG.normal(size=(3, 3))
+    rows = [vm.NormSubdifferential(c, dim=3).resolvent(x, 0.5) for c, x in zip([0.1, 0.2, 0.3], X)]
+    np.testing.assert_array_equal(op.resolvent(X, 0.5), np.stack(rows))
+    ball = Ball(np.zeros(2), np.array([1.0, 2.0]))
+    for call in (lambda: op.resolvent(np.ones(3), 0.5), lambda: op.min_norm(np.ones(3)),
+                 lambda: op.resolvent(np.ones((2, 3)), 0.5), lambda: ball.project(np.ones(2) * 3)):
+        with pytest.raises(vm.InvalidProblem, match="batch of"):
+            call()
+
+
 def test_operator_from_resolvent_missing_members_raise_not_implemented():
     op = vm.operator_from_resolvent(lambda x, lam, t: x / (1 + lam), 2, name="identity flow")
     assert np.allclose(op.resolvent(np.array([2.0, 4.0]), 1.0), [1.0, 2.0])

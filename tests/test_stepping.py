@@ -73,7 +73,10 @@ def test_batched_initial_points_match_separate_solves():
 def test_trajectory_converts_and_interpolates():
     p = vm.Problem(vm.Linear([[1.0]]), [1.0], 1.0)
     tr = vm.solve(p, vm.uniform_grid(1.0, 0.5))
-    assert np.asarray(tr).shape == (3, 1)
+    assert np.asarray(tr).shape == (3, 1) and np.asarray(tr) is tr.x       # a view, as np.asarray promises
+    copied = np.array(tr)                                                    # a copy, as np.array promises
+    copied[:] = 99.0
+    assert not np.any(tr.x == 99.0)
     mid = tr.interpolate(0.25)
     assert mid == pytest.approx(0.5 * (tr.x[0] + tr.x[1]))
     # ψ-interpolation (label e:x delta) with ψ(t) = t² puts τ = 0.25 at weight ψ-fraction 1/4

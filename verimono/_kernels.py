@@ -11,6 +11,8 @@ import math
 
 import numpy as np
 
+from .errors import InvalidProblem
+
 _ar = np.add.reduce
 _mx, _mn = np.maximum, np.minimum
 _sqrt = math.sqrt
@@ -38,3 +40,18 @@ def _norm(x: np.ndarray) -> np.ndarray:
     return np.sqrt(dot_rows(x, x))[..., None]
 
 
+
+
+def batch_column(p: np.ndarray, x: np.ndarray, what: str) -> np.ndarray:
+    """A per-operator scalar parameter ``p`` shaped to broadcast against the rows of ``x``.
+
+    A scalar is returned as is; a batch ``(B,)`` — one value per operator of a batch — applies row by row
+    and needs points of shape ``(B, n)``: anything else would broadcast silently (``(B,)`` against a
+    point ``(n,)`` with ``B = n`` mixes operators and coordinates), so it is an :class:`InvalidProblem`.
+    """
+    if p.ndim == 0:
+        return p
+    if x.ndim != 2 or x.shape[0] != p.shape[0]:
+        raise InvalidProblem(f"{what} is a batch of {p.shape[0]} values (one per operator): it applies to "
+                             f"points of shape ({p.shape[0]}, n), got a point of shape {x.shape}")
+    return p[:, None]

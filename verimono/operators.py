@@ -27,7 +27,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ._kernels import _TINY, _mx, _norm, _sqrt, dot_rows
+from ._kernels import _TINY, _mx, _norm, _sqrt, batch_column, dot_rows
 from ._params import as_param
 from .errors import InvalidProblem, NotMonotone, OutsideDomain
 from .tolerances import tolerance
@@ -290,8 +290,7 @@ class NormSubdifferential(Operator):
 
     def _col(self, t, x):
         """``c(t)`` shaped to broadcast against the norms ``(..., 1)`` of ``x`` (a batch ``(B,)`` per row)."""
-        c = self._c(t)
-        return c[:, None] if c.ndim == 1 and x.ndim > 1 else c
+        return batch_column(self._c(t), x, "c")
 
     def resolvent(self, x, lam, t=0.0):
         # J x = x max(|x| - λc, 0)/|x|, written so that x = 0 gives 0 without a 0/0

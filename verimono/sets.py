@@ -22,7 +22,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ._params import as_param
-from ._kernels import _TINY, _mn, _mx, _sqrt, dot_rows
+from ._kernels import _TINY, _mn, _mx, _sqrt, batch_column, dot_rows
 from .errors import InvalidProblem
 from .tolerances import tolerance
 
@@ -100,9 +100,7 @@ class Ball(ConvexSet):
         c = self._c(t)
         d = x - c
         nrm = np.sqrt(dot_rows(d, d))[..., None]
-        r = self._r(t)
-        if r.ndim == 1 and x.ndim > 1:
-            r = r[:, None]
+        r = batch_column(self._r(t), x, "radius")
         outside = nrm > r
         if not outside.any():  # the common case along a trajectory: nothing to project
             return x.copy()

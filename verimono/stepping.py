@@ -47,7 +47,12 @@ class Trajectory:
         self.extras = dict(extras or {})
 
     def __array__(self, dtype=None, copy=None):
-        return self.x if dtype is None else self.x.astype(dtype)
+        # numpy's protocol: copy=True must not hand out the trajectory's own buffer
+        if dtype is None or np.dtype(dtype) == self.x.dtype:
+            return self.x.copy() if copy else self.x
+        if copy is False:
+            raise ValueError(f"a {self.x.dtype} trajectory cannot be viewed as {np.dtype(dtype)} without a copy")
+        return self.x.astype(dtype)
 
     def __len__(self) -> int:
         return self.t.shape[0]
@@ -74,7 +79,8 @@ class Trajectory:
         """Values at times ``tau``: piecewise linear in ``t``, or in ``ψ`` (the paper's ``e:x delta``).
 
         ``kind="psi"`` gives ``x_Δ(τ) = ((ψ(t_{k+1}) - ψ(τ)) x_k + (ψ(τ) - ψ(t_k)) x_{k+1}) /
-        (ψ(t_{k+1}) - ψ(t_k))`` for a strictly increasing ``ψ`` (``problem.psi`` when not given).
+        (ψ(t_{k+1}) - ψ(t_k))`` for a given strictly increasing ``ψ`` (the check ``psi_interpolation`` passes the ψ of the
+        bounds lemmas ``lem:bndSeq`` / ``lem:bndSeqYB``).
         """
         tau = np.asarray(tau, dtype=float)
         scalar = tau.ndim == 0
@@ -85,7 +91,6 @@ class Trajectory:
         if kind == "linear":
             a, b, s = self.t[k], self.t[k + 1], tau
         elif kind == "psi":
-            psi = psi or getattr(self.problem, "psi", None)
             if psi is None:
                 raise InvalidProblem("kind='psi' needs a strictly increasing function psi")
             ps = np.vectorize(lambda s: float(psi(s)))
@@ -125,6 +130,9 @@ def solve(problem: Problem, t_grid: Any) -> Trajectory:
         pass
     return Trajectory(t, x, problem)
 
+
+#: solve accepts a batch ``x0`` of shape ``(B, n)`` (checks may run many initial points in one call)
+solve.batched = True
 
 #: rows per block of :func:`stream` (1 MiB of states for n = 16)
 STREAM_BLOCK = 8192
