@@ -112,6 +112,27 @@ def test_yosida_limit_at_a_kink_reached_through_rounded_shifts():
     assert check_yosida_limit(wrong, sample=Sample(np.array([3.0]), np.zeros(1), 1.0, 1.0, 1.0, 0.0)).status == "failed"
 
 
+def test_yosida_limit_next_to_a_kink_closer_than_the_rounding_floor():
+    """∂|·|₁ shifted by Φ(t) = (t, t) at t = 1, x + Φ = (1, 1e-8): |Y_λx| = √(1 + (1e-8/λ)²) for λ > 1e-8
+    reaches |F^0| = √2 only below λ = 1e-8, under the sweep's rounding floor (4.8e-7).  The gap closes ever
+    faster there, so the sample is inconclusive, not a failure (found by a thorough run).  Inconclusive for
+    any operator: the decrements are those of |Y_λx| alone, so a wrong F^0 (1.5 times too long) looks the same
+    there until λ passes the kink; it fails at a point away from kinks."""
+    import numpy as np
+    import verimono as vm
+    from verimono.checks.operator_laws import Sample, check_yosida_limit
+
+    op = vm.Shifted(vm.L1Subdifferential(1.0, dim=2), lambda t: np.array([t, t]))
+    s = Sample(np.array([1.0, 1e-8]), np.zeros(2), 1.0, 1.0, 1.0, 1.0)
+    assert check_yosida_limit(op, sample=s).status == "passed"
+    too_big = vm.operator_from_resolvent(op.resolvent, 2, min_norm=lambda z, t: 1.5 * op.min_norm(z, t),
+                                         project_domain=op.project_domain, name="F^0 too long")
+    assert check_yosida_limit(too_big, sample=s).status == "passed"          # inconclusive at this sample
+    away = Sample(np.array([3.0, 2.0]), np.zeros(2), 1.0, 1.0, 1.0, 1.0)
+    assert check_yosida_limit(op, sample=away).status == "passed"
+    assert check_yosida_limit(too_big, sample=away).status == "failed"
+
+
 def test_laws_on_points_closer_than_the_square_root_of_the_smallest_double():
     """x1 - x2 = 1.9e-250: its square underflows, and the slack of yosida_monotone must not (found by a
     random dev-profile run on LogBarrier, where J rounds to neighbouring doubles)."""

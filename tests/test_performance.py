@@ -39,10 +39,9 @@ def test_stage_records_names_and_statuses(monkeypatch):
     assert [r.subject for r in rep.by_check("performance_per_step")] == \
         [f"{k} n={n}" for k in ("t|x|", "box", "ball") for n in (1, 3, 10)]
     assert len({r.key for r in rep}) == len(rep)
-    assert all(r.status == PASSED for r in rep), [str(r) for r in rep if r.status != PASSED]
-    for r in rep:
+    for r in rep:   # pass or fail is the benchmarks' business (timing); here: the records state it right
         d = r.details
-        assert r.bound == 1.0 and r.worst <= 1.0
+        assert r.bound == 1.0 and r.status == (PASSED if r.worst <= 1.0 else FAILED), str(r)
         assert {"timing_ratio", "ratio", "target", "rounds", "subject_s", "baseline_s"} <= set(d)
         assert len(d["subject_s"]) == len(d["baseline_s"]) == d["rounds"]
         speedup = d["direction"] == ">="

@@ -50,6 +50,54 @@ def test_other_zoo_members_are_caught_too():
         assert any(CHECKS[law](member, q).status == FAILED for q in catalog()[:12] for law in LAWS), member
 
 
+def test_unique_limit_refines_past_meshes_coarser_than_the_problem():
+    """A thorough hypothesis run found this false alarm: x' ∈ −∂(2|x|) from x0 = 1/32 dies out at t = 1/64,
+    so every partition of mesh 0.1 or 0.025 gives 0 from its first cell on: distances 0, 0, then c·h at
+    K = 160, which is not 'approaching' until a finer level shows the distance falling."""
+    from verimono import NormSubdifferential
+    from verimono.checks.trajectory_laws import check_unique_limit
+
+    p = Problem(NormSubdifferential(2.0, dim=1), [0.03125], 1.0, name="dies out at t = 1/64")
+    rec = check_unique_limit(solve, p)
+    assert rec.status == PASSED, str(rec)
+    D = rec.details["distances"]
+    assert D[:2] == [0.0, 0.0] and len(D) > 3 and D[-1] <= 0.5 * max(D[:-1])
+    # a stepper with no unique limit still fails, however far the levels are refined
+    assert check_unique_limit(BREAKS["unique_limit"][0], p).status == FAILED
+
+
+def test_contraction_runs_its_starts_in_one_batch_and_falls_back_when_a_batch_is_wrong():
+    """solve declares batches: x0 and the perturbed starts run as one (B, n) solve.  A user's resolvent that
+    takes the norm of the whole batch instead of each row changes the batch's first row, so the check
+    notices and runs every start on its own (same verdict as the separate runs)."""
+    from verimono import operator_from_resolvent
+    from verimono.checks.trajectory_laws import perturbed_starts, run_starts
+
+    calls = []
+
+    def counted(problem, grid):
+        calls.append(problem.x0.shape)
+        return solve(problem, grid)
+
+    counted.batched = True
+    p = get("translating ball")
+    assert check_contraction(counted, p).status == PASSED
+    assert all(len(shape) == 2 for shape in calls[1::2])      # per grid: x0 alone, then one batch
+
+    def whole_batch_shrink(x, lam, t):         # ∂(|x|) row-wise for one point, wrong for a batch
+        x = np.asarray(x, dtype=float)
+        nrm = np.linalg.norm(x)
+        return x * max(1.0 - lam / nrm, 0.0) if nrm > 0 else x
+
+    q = Problem(operator_from_resolvent(whole_batch_shrink, 2, project_domain=lambda x, t: x), [1.0, 2.0], 1.0)
+    grid = uniform_grid(1.0, steps=20)
+    x = solve(q, grid)
+    starts = perturbed_starts(q)
+    separate = [solve(Problem(q.operator, z, 1.0), grid).x for z in starts]
+    np.testing.assert_array_equal(np.stack(run_starts(solve, q, starts, grid, x.x)), np.stack(separate))
+    assert check_contraction(solve, q).status == PASSED
+
+
 @pytest.fixture(scope="module")
 def solve_on_catalog():
     return check_stepper(solve, catalog(), orders=False)
