@@ -56,6 +56,9 @@ def test_run_writes_report_and_results_and_exits_0(tmp_path, capsys):
     assert len(rep) == 2 and rep.ok and rep.meta["profile"] == "ci"
     assert "[1/1] convergence: passed" in out.err  # plain lines when not on a terminal
     assert "2 passed, 0 failed" in out.out
+    table = [line.split() for line in out.out.splitlines() if line.startswith("  ")]
+    assert table[0][:2] == ["reference", "expected"]
+    assert ["moving", "box", "2", "2.000", "[2.000,", "2.000]", "ok"] in table      # the order table
 
 
 def test_baseline_then_gate_is_green(good_check, tmp_path, capsys):
@@ -73,6 +76,8 @@ def test_a_broken_stepper_fails_check_and_gate_with_reasons(steppers, good_check
     bad_out = tmp_path / "bad"
     code = main(["check", str(steppers / "lagged.py") + ":solve", "--profile", "ci", "--out", str(bad_out), *REF])
     assert code == 1
+    assert any(line.split()[:3] == ["moving", "box", "2"] and line.endswith("MISSED")
+               for line in capsys.readouterr().out.splitlines())
     bad = load(bad_out / "results.json")
     bad.meta["target"] = load(base).meta["target"]
     bad.save(bad_out / "results.json")

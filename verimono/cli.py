@@ -148,11 +148,31 @@ def _changes(baseline: Report | None, report: Report) -> Any:
     return compare(baseline, report)
 
 
+def order_table(report: Report) -> list[str]:
+    """One line per convergence study: reference, expected order, measured sup-norm order with its 95%
+    interval, verdict (``missed`` when the stepper does not reach the expected order)."""
+    from .convergence import ConvergenceStudy
+
+    rows = []
+    for s in report.studies:
+        s = ConvergenceStudy.from_dict(s) if isinstance(s, dict) else s
+        exp = "-" if s.expected is None else ("exact" if s.expected.exact else f"{s.expected.value:g}")
+        rows.append((s.problem, exp, str(s.order), "ok" if s.verdict()[0] else "MISSED"))
+    if not rows:
+        return []
+    head = ("reference", "expected", "measured sup-norm order [95%]", "verdict")
+    w = [max(len(r[i]) for r in rows + [head]) for i in range(4)]
+    fmt = "  {:<%d}  {:<%d}  {:<%d}  {}" % (w[0], w[1], w[2])
+    return [fmt.format(*head)] + [fmt.format(*r) for r in rows]
+
+
 def _finish(report: Report, out: Path, baseline: Report | None) -> int:
     from .report import write
 
     changes = _changes(baseline, report)
     paths = write(report, out, changes=changes)
+    for line in order_table(report):
+        print(line)
     for r in report.failures:
         print(f"  {r}")
     line = f"verimono: {report.summary()}"

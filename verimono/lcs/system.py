@@ -231,8 +231,8 @@ class LCSOperator(Operator):
     def _select(self, x, t, P_lam, c_lam):
         """Minimise ``½λᵀP λ + cᵀλ`` over the multipliers ``λ`` of ``(η, D) = (Cx + v(t), D)``.
 
-        ``x`` is in ``dom H(t)`` when the multipliers' LCP is feasible up to the linear program's tolerance
-        (:func:`verimono.lcs.lcp._feasible`); otherwise :class:`OutsideDomain`.  Its data are solved
+        ``x`` is in ``dom H(t)`` when the multipliers' LCP has a solution, or is feasible up to the linear
+        program's tolerance (:func:`verimono.lcs.lcp._feasible`); otherwise :class:`OutsideDomain`.  Its data are solved
         relative to their own size (``scale`` of :func:`verimono.lcs.solve_lcp`), so a point at ``t = 1e-12``
         gets as accurate an answer as one at ``t = 1``.  A point that the program accepts but whose exact
         data are infeasible lies outside the domain by a rounding error of the computation that produced
@@ -244,11 +244,11 @@ class LCSOperator(Operator):
         eta, scale = s.C @ x + v, s.q_scale(x, v)
         lo, hi = rel.bounds(s.m)
         big, qq, fin = _box_lcp(s.D, eta, lo, hi)
-        if not _feasible(big, qq):
-            raise OutsideDomain(f"x = {x} is not in dom H(t={t}): Cx + v(t) ∉ im(𝓜 + D)")
-        try:
+        try:   # a solution proves x ∈ dom H(t): the linear program is needed only when there is none
             zbar = solve_lcp(big, qq, least_norm=False, scale=scale)
         except InfeasibleStep:
+            if not _feasible(big, qq):
+                raise OutsideDomain(f"x = {x} is not in dom H(t={t}): Cx + v(t) ∉ im(𝓜 + D)") from None
             scale = 1.0 + scale
             zbar = solve_lcp(big, qq, least_norm=False, scale=scale)
         k = big.shape[0]
