@@ -2,24 +2,51 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
 from verimono import solve, uniform_grid
-from verimono.lcs import check_hypotheses, solve_lcp
+from verimono.lcs import check_hypotheses
 from verimono.pseudo_distance import pseudo_distance_lower_bound
 from verimono.reference import lcs_example as E
 
 
+def _enumerated_least_norm_lcp(M, q, tol=1e-12):
+    """Least-norm solution of LCP(q, M) by enumerating the 2^m complementary pieces, independently of
+    verimono: on a support α, z_α solves M_αα z_α = −q_α, z = 0 off α; keep it when z ≥ 0 and w = Mz + q ≥ 0.
+    A singular M_αα must be inconsistent (its piece empty) — else the piece is a continuum this helper
+    does not handle, and it says so."""
+    m = q.size
+    sols = []
+    for mask in itertools.product([False, True], repeat=m):
+        a = np.flatnonzero(mask)
+        z = np.zeros(m)
+        if a.size:
+            Maa = M[np.ix_(a, a)]
+            if abs(np.linalg.det(Maa)) < 1e-12:
+                za = np.linalg.lstsq(Maa, -q[a], rcond=None)[0]
+                assert np.abs(Maa @ za + q[a]).max() > 1e-9, f"singular consistent piece {mask}: not handled"
+                continue
+            z[a] = np.linalg.solve(Maa, -q[a])
+        w = M @ z + q
+        if z.min() >= -tol and w.min() >= -tol:
+            sols.append(np.maximum(z, 0.0))
+    assert sols, "LCP(q, M) has no solution"
+    return min(sols, key=lambda z: z @ z)
+
+
 def test_resolvent_closed_form_against_brute_force_one_step():
+    """One step of the proximal scheme: J_{hH}(x) = x + hBz with z the least-norm solution of
+    LCP(Cx + v, D + hCB) (A = 0, so W = I), found by enumeration — not by the solve_lcp under test."""
     rng = np.random.default_rng(0)
     for _ in range(200):
         v1, v2 = rng.normal(size=2) * 2
         x, h = rng.normal() * 3, rng.uniform(0.01, 2.0)
         H = E.example_system([v1, v2]).operator()
-        # brute force: the one-step LCP(q, D + h C Bᵀ... ) solved from scratch, then x⁺ = x + h B z
         q = E.C[:, 0] * x + np.array([v1, v2])
-        z = solve_lcp(E.D + h * E.C @ E.B, q)
+        z = _enumerated_least_norm_lcp(E.D + h * E.C @ E.B, q)
         brute = x + h * (E.B @ z)[0]
         closed = E.closed_form_resolvent(x, h, v1, v2)
         assert abs(H.resolvent(np.array([x]), h)[0] - closed) <= 1e-12 * (1 + abs(closed))
@@ -27,16 +54,30 @@ def test_resolvent_closed_form_against_brute_force_one_step():
 
 
 def test_H_closed_form_min_norm_membership_and_domain():
-    for v1, v2 in [(0.0, 0.0), (-1.0, 0.5), (2.0, -1.0)]:
+    """H.min_norm, H.contains and the domain against reference closed_form_H = −max(−v1, 0) + N_[−v2, ∞)(x)."""
+    from verimono import OutsideDomain
+
+    rng = np.random.default_rng(3)
+    cases = [(0.0, 0.0), (-1.0, 0.5), (2.0, -1.0)] + [tuple(rng.normal(size=2) * 2) for _ in range(12)]
+    for v1, v2 in cases:
         H = E.example_system([v1, v2]).operator()
-        top = -max(-v1, 0.0)
-        inner, edge = np.array([-v2 + 1.0]), np.array([-v2])
-        assert H.min_norm(inner)[0] == pytest.approx(top, abs=1e-12)      # H(x) = {top} inside
-        assert H.min_norm(edge)[0] == pytest.approx(top, abs=1e-12)       # least-norm of (−∞, top]
-        assert H.contains(edge, np.array([top - 5.0])) and not H.contains(inner, np.array([top - 5.0]))
-        assert H.contains(inner, np.array([top])) and not H.contains(edge, np.array([top + 0.5]))
-        np.testing.assert_allclose(H.project_domain(np.array([-v2 - 2.0])), edge, atol=1e-9)
-        assert H.project_domain(inner)[0] == inner[0]
+        for x in [-v2, -v2 + 1.0, -v2 + abs(rng.normal()) * 3, -v2 - 0.5 - abs(rng.normal())]:
+            interval = E.closed_form_H(x, v1, v2)
+            X = np.array([x])
+            if interval is None:                                   # outside dom H = [−v2, ∞)
+                with pytest.raises(OutsideDomain):
+                    H.min_norm(X)
+                assert not H.contains(X, np.array([-max(-v1, 0.0)]))
+                continue
+            lo, hi = interval
+            least = min(max(0.0, lo), hi)                          # the least-norm element of [lo, hi]
+            assert H.min_norm(X)[0] == pytest.approx(least, abs=1e-12)
+            for y in (hi, hi - 0.5, hi - 5.0, hi + 0.5, lo if np.isfinite(lo) else hi - 1e3):
+                assert H.contains(X, np.array([y])) == (lo <= y <= hi), (x, v1, v2, y, interval)
+            assert H.project_domain(X)[0] == x
+    for v1, v2 in [(0.0, 0.0), (-1.0, 0.5), (2.0, -1.0)]:   # the projection onto dom H = [−v2, ∞)
+        H = E.example_system([v1, v2]).operator()
+        np.testing.assert_allclose(H.project_domain(np.array([-v2 - 2.0])), [-v2], atol=1e-9)
 
 
 @pytest.mark.parametrize("scale", [1e-12, 1e-9, 1e-6, 1.0, 1e3])
@@ -100,6 +141,78 @@ def test_pseudo_distance_grows_without_bound_while_hypotheses_hold():
         assert b.value >= (rho + 1) / 2 - 1e-12
     rep = check_hypotheses(E.example_system(lambda t: np.array([-t, 0.0])), T=2.0)
     assert rep.ok and all(r.status == "passed" for r in rep), [str(r) for r in rep if r.status != "passed"]
+
+
+def _jump(t):
+    return np.array([0.0, -1.0 if t >= 1.0 else 0.0])
+
+
+@pytest.mark.parametrize("v", [lambda t: np.array([-t, 0.0]), lambda t: np.array([np.sin(t), 0.0])],
+                         ids=["ramp", "sine"])
+def test_example_hypotheses_hold_for_continuous_inputs(v):
+    rep = check_hypotheses(E.example_system(v), T=2.0)
+    assert rep.ok and all(r.status == "passed" for r in rep), [str(r) for r in rep if r.status != "passed"]
+    (ac,) = rep.by_check("lcs.v_ac")
+    # the largest grid increment of a Lipschitz v halves with the mesh: |v'| ≤ 1 gives ≤ 2/N
+    assert all(d <= 2.0 / int(n) + 1e-15 for n, d in ac.details["largest_increment"].items())
+
+
+def test_a_jump_in_v_fails_v_ac_and_the_derived_A2_A3_are_not_established():
+    """v = (0, −1 if t ≥ 1 else 0): dom H(t,·) = [−v2(t), ∞) jumps from [0, ∞) to [1, ∞) at t = 1, so (A3)
+    fails (closed_form_H below).  Seen failing: v_ac, A2 and A3 all passed (the total variation of a step
+    is the same on every grid)."""
+    assert E.closed_form_H(0.5, *_jump(1.0 - 1e-9)) is not None and E.closed_form_H(0.5, *_jump(1.0)) is None
+    rep = check_hypotheses(E.example_system(_jump), T=2.0)
+    (ac,) = rep.by_check("lcs.v_ac")
+    assert ac.status == "failed" and "jumps by 1" in ac.message
+    assert ac.counterexample["t"] == pytest.approx(1.0, abs=1e-9) and ac.counterexample["jump"] == pytest.approx(1.0)
+    assert ac.counterexample["v_left"] == [0.0, 0.0] and ac.counterexample["v_right"] == [0.0, -1.0]
+    for name in ("lcs.A2", "lcs.A3"):      # as lcs.A1/lcs.LG on a failed item: skipped, with the reason
+        (r,) = rep.by_check(name)
+        assert r.status == "skipped" and "lcs.v_ac (failed)" in r.message
+    assert rep.by_check("lcs.A1")[0].status == "passed" and not rep.ok
+
+
+@pytest.mark.parametrize("v, jump_at", [
+    (lambda t: np.array([np.tanh(1e3 * (t - 1.0)), 0.0]), None),                   # steep, continuous
+    (lambda t: np.array([np.sqrt(abs(t - 1.0000123)), 0.0]), None),               # Hölder 1/2, AC
+    (lambda t: np.array([-100 * t * t + (0.01 if t > 1.3 else 0.0), 0.0]), 1.3),  # small jump against a slope
+    (lambda t: np.array([0.0, -1.0 if t > np.pi / 3 else 0.0]), np.pi / 3),       # between grid points
+])
+def test_v_ac_tells_steep_continuous_inputs_from_jumps(v, jump_at):
+    (ac,) = check_hypotheses(E.example_system(v), T=2.0).by_check("lcs.v_ac")
+    if jump_at is None:
+        assert ac.status == "passed", ac.message
+    else:
+        assert ac.status == "failed" and ac.counterexample["t"] == pytest.approx(jump_at, abs=1e-9), ac.message
+
+
+def test_least_norm_growth_constant_of_the_example():
+    """LCP(q, D), D = [[0, 1], [−1, 0]]: solvable iff q2 ≥ 0 (Q_D^+), z*(q) = (0, max(−q1, 0)) (the case
+    analysis of reference/lcs_example.py), so α = sup |z*(q)|/|q| = 1, attained at q = (−1, 0)."""
+    (r,) = check_hypotheses(E.example_system(lambda t: np.array([-t, 0.0])), T=2.0).by_check("lcs.least_norm_growth")
+    assert r.status == "passed" and r.worst <= r.bound
+    assert r.details["alpha"] == pytest.approx(1.0, abs=1e-12)
+    assert r.details["least_norm_checked"] == r.details["samples"]
+
+
+@pytest.mark.parametrize("offset, law", [(lambda q: 1.0, "not homogeneous"),                  # fixed element
+                                         (lambda q: float(np.linalg.norm(q)), "not the least-norm")])  # ∝ |q|
+def test_least_norm_growth_fails_on_a_wrong_selection(monkeypatch, offset, law):
+    """Adding an element of the recession direction (0, 1) of SOL(q, D) (q2 = 0) keeps a solution but not
+    the least-norm one: in absolute units it breaks z*(sq) = s z*(q) (|z|/|q| ~ 1/s), proportional to |q|
+    it is caught by the shorter solution.  Seen failing: the old record passed whatever solve_lcp returned."""
+    from verimono.lcs import hypotheses, solve_lcp
+
+    def wrong(M, q, **kw):
+        z = solve_lcp(M, q, **kw)
+        return z + offset(q) * np.array([0.0, 1.0]) if q[1] == 0.0 else z
+
+    monkeypatch.setattr(hypotheses, "solve_lcp", wrong)
+    rep = check_hypotheses(E.example_system(lambda t: np.array([-t, 0.0])), T=2.0)
+    (r,) = rep.by_check("lcs.least_norm_growth")
+    assert r.status == "failed" and law in r.message and r.worst > r.bound and r.counterexample["q"][1] == 0.0
+    assert rep.by_check("lcs.LG")[0].status == "skipped"
 
 
 def test_pseudo_distance_tool_on_explicit_graph_points():

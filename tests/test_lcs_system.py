@@ -102,3 +102,32 @@ def test_non_passive_system_fails_the_check():
     rep = check_hypotheses(sys, 1.0)
     assert rep.by_check("lcs.passivity")[0].status == "failed" and not rep.ok
     assert all(r.status == "skipped" for r in rep.by_check("lcs.A1"))
+
+
+@pytest.mark.parametrize("T", [1e-6, 1.0, 1e4])
+def test_v_ac_is_invariant_under_a_change_of_time_scale(T):
+    """v(t) = V(t/T) on [0, T]: a jump of V at 0.3 is found at 0.3 T, a smooth V passes, at every T (the
+    bisection floor and the grid are relative to T)."""
+    def record(V):
+        sys = LinearRelationSystem([[-1.0]], [[1.0]], [[1.0]], [[1.0]], Complementarity(),
+                                   v=lambda t: np.array([V(t / T)]))
+        return check_hypotheses(sys, T).by_check("lcs.v_ac")[0]
+
+    jump = record(lambda s: 1.0 if s >= 0.3 else 0.0)
+    assert jump.status == "failed" and jump.counterexample["t"] == pytest.approx(0.3 * T, rel=1e-9)
+    assert record(lambda s: np.sin(6 * s)).status == "passed"
+
+
+def test_least_norm_growth_on_random_passive_systems():
+    """Proposition p:lcp2 iv–v on D = RᵀR + skew (ker(D + Dᵀ) ≠ {0}, so SOL(q, D) need not be a singleton):
+    homogeneous and least-norm on every sample; a bounded box relation needs no sampling."""
+    rng = np.random.default_rng(5)
+    for _ in range(3):
+        A, B, C, D = random_passive(rng)
+        sys = LinearRelationSystem(A, B, C, D, Complementarity(), v=rng.normal(size=2))
+        (r,) = check_hypotheses(sys, 1.0, samples=32).by_check("lcs.least_norm_growth")
+        assert r.status == "passed" and r.worst <= r.bound and r.details["least_norm_checked"] == 32
+        assert 0 < r.details["alpha"] < np.inf
+    (r,) = check_hypotheses(LinearRelationSystem([[-1.0]], [[1.0]], [[1.0]], [[1.0]], Relay()), 1.0
+                            ).by_check("lcs.least_norm_growth")
+    assert r.status == "passed" and "exact" in r.message

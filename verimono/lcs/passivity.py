@@ -5,9 +5,11 @@
     Q(K) = [[AᵀK + KA, KB − Cᵀ], [BᵀK − C, −(D + Dᵀ)]] ⪯ 0.
 
 With ``K`` given (the paper's theorems use ``K = I``) this is an eigenvalue test of ``Q(K)``; with ``K``
-unknown an SDP ``min λ_max(Q(K))`` over ``K ⪰ 0, tr K ≤ κ`` (cvxpy with Clarabel, an optional dependency,
-imported lazily), whose answer is re-verified by eigenvalues.  The consequences of Proposition ``p:pass``
-are checked too: ``D + Dᵀ ⪰ 0`` and ``(KB − Cᵀ) ker(D + Dᵀ) = {0}``.
+unknown the feasibility SDP ``min tr K`` s.t. ``Q(K) ⪯ 0, K ⪰ 0`` (cvxpy with Clarabel, an optional
+dependency, imported lazily) — no bound on ``K`` — whose answer is re-verified by eigenvalues: a ``K``
+proves passivity, a Farkas certificate proves the opposite, anything else is reported as undecided
+(:class:`verimono.SolverFailure`).  The consequences of Proposition ``p:pass`` are checked too:
+``D + Dᵀ ⪰ 0`` and ``(KB − Cᵀ) ker(D + Dᵀ) = {0}``.
 """
 
 from __future__ import annotations
@@ -16,8 +18,8 @@ import dataclasses
 
 import numpy as np
 
-from ..errors import InvalidProblem, VerimonoError
-from ..tolerances import RTOL, SDP_RTOL
+from ..errors import InvalidProblem, SolverFailure, VerimonoError
+from ..tolerances import RTOL, SDP_RTOL, tolerance
 
 
 class MissingOptionalDependency(VerimonoError, ImportError):
@@ -28,10 +30,11 @@ class MissingOptionalDependency(VerimonoError, ImportError):
 class PassivityResult:
     """``passive`` iff ``margin = −λ_max(Q(K)) ≥ −tol`` and ``K ⪰ 0``; ``D_psd`` and ``kernel_ok`` are the
     consequences i and ii of Proposition ``p:pass`` (``kernel_residual = ‖(KB − Cᵀ)N‖``, ``N`` an orthonormal
-    basis of ``ker(D + Dᵀ)``)."""
+    basis of ``ker(D + Dᵀ)``).  When the SDP proves that no storage exists, ``K`` is None, ``margin = −∞``
+    and ``certificate`` holds the verified Farkas certificate (see :func:`is_passive`)."""
 
     passive: bool
-    K: np.ndarray
+    K: np.ndarray | None
     margin: float
     tol: float
     D_psd: bool
@@ -39,6 +42,7 @@ class PassivityResult:
     kernel_residual: float
     method: str
     message: str = ""
+    certificate: dict | None = None
 
     def __bool__(self) -> bool:
         return self.passive
@@ -63,11 +67,16 @@ def _check(A, B, C, D):
 
 
 def _verdict(A, B, C, D, K, method, rtol):
+    """Eigenvalue test of ``e:lmis`` for one ``K``, at ``rtol`` relative to the size of the terms ``Q(K)`` is
+    summed from (``|Aᵀ||K| + |K||A|``, ``|K||B|``, ``|C|``, ``|D|`` entrywise; ``K ⪰ 0`` relative to ``|K|``):
+    a storage matrix of size 100 for an input matrix of size 0.01 is judged in the units of ``KB``."""
     Q = kyp_matrix(A, B, C, D, K)
-    scale = 1.0 + max(np.abs(Q).max(initial=0.0), np.abs(K).max(initial=0.0) * (1 + np.abs(A).max(initial=0.0)))
-    tol = rtol * scale
+    aK, aA = np.abs(K), np.abs(A)
+    terms = [aA.T @ aK + aK @ aA, aK @ np.abs(B), np.abs(C), np.abs(D)]
+    tol = tolerance(*terms, rtol=rtol)
+    tol_k = tolerance(K, rtol=rtol)
     margin = -float(np.linalg.eigvalsh(0.5 * (Q + Q.T))[-1])
-    k_psd = bool(np.linalg.eigvalsh(0.5 * (K + K.T))[0] >= -tol and np.abs(K - K.T).max(initial=0.0) <= tol)
+    k_psd = bool(np.linalg.eigvalsh(0.5 * (K + K.T))[0] >= -tol_k and np.abs(K - K.T).max(initial=0.0) <= tol_k)
     S = D + D.T
     ev, V = np.linalg.eigh(S)
     D_psd = bool(ev[0] >= -tol)
@@ -80,12 +89,18 @@ def _verdict(A, B, C, D, K, method, rtol):
     return PassivityResult(passive, K, margin, tol, D_psd, kernel_ok, kres, method, msg)
 
 
-def is_passive(A, B, C, D, K=None, *, trace_bound: float | None = None) -> PassivityResult:
-    """Whether ``Σ(A, B, C, D)`` is passive; with ``K`` given, for the storage ``½xᵀKx``.
+def is_passive(A, B, C, D, K=None) -> PassivityResult:
+    """Whether ``Σ(A, B, C, D)`` is passive (the KYP LMIs ``e:lmis``); with ``K`` given, for the storage ``½xᵀKx``.
 
-    ``K=None`` searches ``K ⪰ 0`` by an SDP (needs the optional ``sdp`` extra: cvxpy, clarabel) with
-    ``tr K ≤ trace_bound`` (default ``n``, a normalisation: the LMI is not homogeneous in ``K``, so a
-    system needing a larger ``K`` should pass a larger bound).  The result is truthy iff passive.
+    ``K=None`` decides whether *some* ``K ⪰ 0`` solves ``Q(K) ⪯ 0`` by the SDP ``min tr K`` subject to
+    ``Q(K) ⪯ 0, K ⪰ 0`` (optional ``sdp`` extra: cvxpy, clarabel) — no bound on ``K``, so no storage is
+    excluded by a normalisation, and a non-strict LMI (no interior, e.g. ``K = 100`` the only solution)
+    is decided too.  The solver's answer is never trusted: a ``K`` is accepted only if the eigenvalues of
+    ``Q(K)`` and ``K`` pass at ``SDP_RTOL`` relative to the data (``passive=True``); "not passive" only
+    with a Farkas certificate ``Z ⪰ 0``, ``L*(Z) ⪰ 0``, ``⟨Z, Q(0)⟩ > 0`` (``L(K) = Q(K) − Q(0)``) that
+    passes the same eigenvalue checks (``passive=False``, ``certificate`` set).  Anything else is
+    inconclusive and raises :class:`verimono.SolverFailure` with the solver's status — never a ``False``.
+    The result is truthy iff passive.
     """
     A, B, C, D = _check(A, B, C, D)
     n = A.shape[0]
@@ -100,20 +115,84 @@ def is_passive(A, B, C, D, K=None, *, trace_bound: float | None = None) -> Passi
         raise MissingOptionalDependency("is_passive(K=None) solves the KYP LMI as an SDP and needs the optional "
                                         "extra 'sdp' (pip install cvxpy clarabel); pass K explicitly "
                                         "(e.g. K=np.eye(n)) for the eigenvalue test") from None
+    if "CLARABEL" not in cp.installed_solvers():
+        raise MissingOptionalDependency("is_passive(K=None) needs the Clarabel SDP solver (optional extra 'sdp': "
+                                        "pip install clarabel); pass K explicitly for the eigenvalue test")
     m = B.shape[1]
     Kv = cp.Variable((n, n), symmetric=True)
-    t = cp.Variable()
     Q = cp.bmat([[A.T @ Kv + Kv @ A, Kv @ B - C.T], [B.T @ Kv - C, -(D + D.T)]])
-    cons = [Kv >> 0, 0.5 * (Q + Q.T) << t * np.eye(n + m), cp.trace(Kv) <= (trace_bound or float(n))]
-    prob = cp.Problem(cp.Minimize(t), cons)
+    lmi = 0.5 * (Q + Q.T) << 0
+    prob = cp.Problem(cp.Minimize(cp.trace(Kv)), [Kv >> 0, lmi])
     try:
         prob.solve(solver="CLARABEL")
-    except Exception as exc:  # the solver's own failure becomes a typed one
-        raise MissingOptionalDependency(f"the KYP SDP could not be solved by Clarabel: {exc}") from None
-    if Kv.value is None:
-        raise VerimonoError(f"the KYP SDP returned no K (status {prob.status})")
-    Kval = 0.5 * (Kv.value + Kv.value.T)
-    return _verdict(A, B, C, D, Kval, f"SDP (cvxpy/Clarabel, status {prob.status})", SDP_RTOL)
+    except Exception as exc:  # the solver's own failure becomes a typed one, with its status
+        raise SolverFailure(f"the KYP SDP (min tr K s.t. Q(K) ⪯ 0, K ⪰ 0) failed in Clarabel "
+                            f"(status {prob.status}): {type(exc).__name__}: {exc}") from None
+    status = prob.status
+    method = f"SDP min tr K s.t. Q(K) ⪯ 0, K ⪰ 0 (cvxpy/Clarabel, status {status}), verified by eigenvalues"
+    found = None
+    if Kv.value is not None and np.all(np.isfinite(Kv.value)):
+        found = _verdict(A, B, C, D, 0.5 * (Kv.value + Kv.value.T), method, SDP_RTOL)
+        if found.passive:
+            return found
+    Z = lmi.dual_value
+    if Z is not None and np.all(np.isfinite(Z)):
+        cert = _farkas(A, B, C, D, np.array(Z, float, ndmin=2).reshape(n + m, n + m))
+        if cert["verified"]:
+            return _not_passive(A, B, C, D, cert, method)
+    else:
+        cert = None
+    raise SolverFailure(
+        f"passivity of Σ(A, B, C, D) is undecided: Clarabel status {status!r}; "
+        + (f"the K it returned fails the eigenvalue check ({found.message}); " if found is not None else
+           "no K returned; ")
+        + (f"its infeasibility certificate fails verification ({cert['message']})" if cert is not None else
+           "no infeasibility certificate"))
+
+
+def _adjoint(A, B, Z) -> np.ndarray:
+    """``L*(Z)`` for ``L(K) = [[AᵀK + KA, KB], [BᵀK, 0]]``: ``⟨Z, L(K)⟩ = ⟨L*(Z), K⟩`` (``K`` symmetric)."""
+    n = A.shape[0]
+    Z11, Z12 = Z[:n, :n], Z[:n, n:]
+    S = A @ Z11 + Z11 @ A.T + B @ Z12.T + Z12 @ B.T
+    return 0.5 * (S + S.T)
+
+
+def _farkas(A, B, C, D, Z) -> dict:
+    """Verify a Farkas certificate of infeasibility of ``e:lmis`` by eigenvalues.
+
+    ``Z`` is projected onto the PSD cone and normalised to ``⟨Z, Q(0)⟩ = 1``.  For any ``K ⪰ 0`` with
+    ``Q(K) ⪯ 0``: ``0 ≤ ⟨Z, −Q(K)⟩ = −1 − ⟨L*(Z), K⟩ ≤ −1 + δ tr K`` with ``δ = max(0, −λ_min(L*(Z)))``,
+    so no storage has ``tr K < 1/δ`` (none at all when ``δ = 0``).  Verified when ``δ`` is within
+    ``SDP_RTOL`` of the size of the terms ``L*(Z)`` is summed from.
+    """
+    Z = 0.5 * (Z + Z.T)
+    ev, V = np.linalg.eigh(Z)
+    Zp = (V * np.clip(ev, 0.0, None)) @ V.T
+    g = float(np.sum(Zp * kyp_matrix(A, B, C, D, np.zeros((A.shape[0],) * 2))))
+    if not np.isfinite(g) or g <= 0.0:
+        return {"verified": False, "message": f"⟨Z, Q(0)⟩ = {g:.3g} is not positive"}
+    Zp = Zp / g
+    S = _adjoint(A, B, Zp)
+    lam_min = float(np.linalg.eigvalsh(S)[0]) if S.size else 0.0
+    delta = max(0.0, -lam_min)
+    znorm = float(np.linalg.norm(Zp, 2))
+    tol = tolerance(2.0 * (np.linalg.norm(A, 2) + np.linalg.norm(B, 2)) * znorm, rtol=SDP_RTOL)
+    kappa = np.inf if delta == 0.0 else 1.0 / delta
+    ok = delta <= tol
+    return {"verified": ok, "Z": Zp, "delta": delta, "tol": tol, "trace_lower_bound": kappa,
+            "message": f"Z ⪰ 0, ⟨Z, Q(0)⟩ = 1, λ_min(L*(Z)) = {lam_min:.3g} (tolerance {tol:.2g}): "
+                       f"no K ⪰ 0 with tr K < {kappa:.3g} satisfies e:lmis"}
+
+
+def _not_passive(A, B, C, D, cert, method) -> PassivityResult:
+    """The result for a verified infeasibility certificate: no ``K`` (``K=None``, ``margin = −∞``)."""
+    tol = cert["tol"]
+    S = D + D.T
+    D_psd = bool(np.linalg.eigvalsh(S)[0] >= -tolerance(S, rtol=SDP_RTOL)) if S.size else True
+    msg = (f"not passive, certified: {cert['message']}; D + Dᵀ {'⪰ 0' if D_psd else 'is not ⪰ 0'}")
+    return PassivityResult(False, None, float("-inf"), tol, D_psd, False, float("inf"), method, msg,
+                           certificate=cert)
 
 
 __all__ = ["is_passive", "PassivityResult", "kyp_matrix", "MissingOptionalDependency"]
