@@ -122,3 +122,98 @@ def test_incompatible_runs_fail_closed(base, tmp_path):
     (tmp_path / "garbled.json").write_text('{"schema": "verimono.results", "schema_')
     with pytest.raises(SchemaError):
         gate(tmp_path / "garbled.json", cur)
+
+
+# -- fail closed: every missing, garbled or incompatible document exits 2 --------------------------------
+
+def _study(doc: dict) -> dict:
+    return next(s for s in doc["studies"] if s["problem"] == "moving box")
+
+
+def _record(doc: dict) -> dict:
+    return next(r for r in doc["results"] if r["subject"] == "DiodeBridge")
+
+
+#: (what is wrong, how to break a valid document, the reason the gate must give)
+GARBLED = [
+    ("record is a string", lambda d: d["results"].__setitem__(0, "passed"), "result record 0"),
+    ("record details null", lambda d: _record(d).update(details=None), "details"),
+    ("record details a list", lambda d: _record(d).update(details=[1]), "details"),
+    ("record subject not a string", lambda d: _record(d).update(subject=3), "subject"),
+    ("record status unknown", lambda d: _record(d).update(status="ok"), "status"),
+    ("record worst not a number", lambda d: _record(d).update(worst=[0.1]), "worst"),
+    ("study is a string", lambda d: d["studies"].__setitem__(0, "moving box"), "convergence study 0"),
+    ("study errors a string", lambda d: _study(d).update(errors="x"), "errors"),
+    ("study errors of a norm not a list", lambda d: _study(d)["errors"].update(sup=0.1), "errors"),
+    ("study error list shorter than mesh", lambda d: _study(d)["errors"]["sup"].pop(), "errors"),
+    ("study error not a number", lambda d: _study(d)["errors"]["l2"].__setitem__(0, "big"), "errors"),
+    ("study norm missing", lambda d: _study(d)["errors"].pop("l2"), "errors"),
+    ("study steps shorter than mesh", lambda d: _study(d)["steps"].pop(), "steps"),
+    ("study fits null", lambda d: _study(d).update(fits=None), "fits"),
+    ("study fit without slope", lambda d: _study(d)["fits"]["sup"].pop("slope"), "fits"),
+    ("study expected order a string", lambda d: _study(d).update(expected="2"), "expected"),
+    ("meta.stages a string", lambda d: d["meta"].update(stages="operator_laws"), "stages"),
+    ("meta.stages entry a string", lambda d: d["meta"].update(stages=["operator_laws"]), "stages"),
+    ("stage duration a string", lambda d: d["meta"]["stages"][0].update(duration="4 s"), "stages"),
+    ("meta.calibration a string", lambda d: d["meta"].update(calibration="fast"), "calibration"),
+]
+
+
+def _write(tmp_path, name: str, doc: dict):
+    import json
+
+    path = tmp_path / name
+    path.write_text(json.dumps(doc))
+    return path
+
+
+@pytest.mark.parametrize("role", ["baseline", "results"])
+@pytest.mark.parametrize("what, breaks, reason", GARBLED, ids=[g[0] for g in GARBLED])
+def test_a_garbled_document_exits_2(base, tmp_path, capsys, role, what, breaks, reason):
+    from verimono.cli import main
+
+    good = _write(tmp_path, "good.json", base.to_dict())
+    doc = copy.deepcopy(base.to_dict())
+    breaks(doc)
+    bad = _write(tmp_path, "bad.json", doc)
+    files = {"baseline": good, "results": good, role: bad}
+    assert main(["gate", "--baseline", str(files["baseline"]), "--results", str(files["results"])]) == 2
+    err = capsys.readouterr().err
+    assert "bad.json" in err and reason in err
+
+
+@pytest.mark.parametrize("keep", ["nothing", "skipped records only"])
+def test_a_baseline_without_executed_records_exits_2(base, tmp_path, capsys, keep):
+    from verimono.cli import main
+
+    doc = copy.deepcopy(base.to_dict())
+    doc["studies"] = []
+    if keep == "nothing":
+        doc["results"] = []
+    else:
+        for r in doc["results"]:
+            r["status"] = "skipped"
+    empty = _write(tmp_path, "empty.json", doc)
+    results = _write(tmp_path, "results.json", base.to_dict())
+    assert main(["gate", "--baseline", str(empty), "--results", str(results)]) == 2
+    assert "no executed records" in capsys.readouterr().err
+
+
+# -- a non-finite value where the baseline had a finite one is a regression --------------------------------
+
+@pytest.mark.parametrize("bad", ["nan", None, "inf"])
+def test_a_non_finite_current_error_regresses(base, bad):
+    doc = fresh(base).to_dict()
+    _study(doc)["errors"]["sup"][1] = bad
+    _record(doc)["details"]["error"] = bad
+    msgs = reasons(base, Report.from_dict(doc))
+    assert any("moving box" in m and "sup error at h=" in m and "not a finite number" in m for m in msgs)
+    assert any("DiodeBridge" in m and "error" in m and "not a finite number" in m for m in msgs)
+
+
+@pytest.mark.parametrize("bad", ["nan", None])
+def test_a_non_finite_current_order_regresses(base, bad):
+    doc = fresh(base).to_dict()
+    _study(doc)["fits"]["l2"].update(slope=bad, low=bad, high=bad)
+    msgs = reasons(base, Report.from_dict(doc))
+    assert any("moving box" in m and "l2-norm order" in m and "not a finite number" in m for m in msgs)

@@ -100,3 +100,35 @@ def test_hypothesis_profiles_follow_the_environment(pytester):
     pytester._monkeypatch.setenv("HYPOTHESIS_PROFILE", "thorough")
     thorough = pytester.runpytest_subprocess(*_plugin_args(), "-s", "-p", "no:cacheprovider")
     thorough.stdout.fnmatch_lines(["*PROFILE False None * 500*"])
+
+
+
+def _baseline_doc(command: str = "pytest") -> dict:
+    """A small valid baseline document of one executed record, to be broken by the tests below."""
+    from verimono.results import CheckResult, Report
+
+    rec = CheckResult("my_law", "my operator", "passed", worst=0.5, bound=1.0)
+    return Report([rec], meta={"command": command, "target": None, "profile": "dev", "seed": None}).to_dict()
+
+
+@pytest.mark.parametrize("breaks, reason", [
+    (lambda d: d["results"].__setitem__(0, "passed"), "result record 0"),
+    (lambda d: d["results"][0].update(details=None), "details"),
+    (lambda d: d["meta"].update(stages="convergence"), "stages"),
+    (lambda d: d.update(results=[], studies=[]), "no executed records"),
+], ids=["record a string", "details null", "stages a string", "no executed records"])
+def test_unusable_baseline_is_a_usage_error(pytester, breaks, reason):
+    doc = _baseline_doc()
+    breaks(doc)
+    (pytester.path / "bad.json").write_text(json.dumps(doc))
+    result = run(pytester, "--verimono-baseline=bad.json")
+    assert result.ret == pytest.ExitCode.USAGE_ERROR
+    result.stderr.fnmatch_lines([f"*verimono baseline unusable*{reason}*"])
+
+
+def test_baseline_of_another_kind_of_run_is_a_usage_error(pytester):
+    (pytester.path / "run.json").write_text(json.dumps(_baseline_doc(command="run")))
+    result = run(pytester, "--verimono-baseline=run.json")
+    result.assert_outcomes(passed=3, xfailed=1)
+    assert result.ret == pytest.ExitCode.USAGE_ERROR
+    result.stdout.fnmatch_lines(["verimono gate: cannot compare*command: baseline 'run', results 'pytest'*"])

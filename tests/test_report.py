@@ -139,3 +139,105 @@ def test_reproduction_of_a_convergence_record_is_a_runnable_script(small_report)
 def test_html_without_baseline_says_so():
     html = render(Report([CheckResult("a", "b", "passed")], meta={"profile": "dev"}))
     assert "No baseline was given" in html and "All checks hold" in html
+
+
+def test_schema_docstring_lists_every_meta_key_a_run_writes(small_report):
+    from verimono.report import schema
+
+    for key in small_report.to_dict()["meta"]:
+        assert f'"{key}"' in schema.__doc__, key
+
+
+def test_environment_records_optional_solvers_and_blas():
+    env = environment()
+    for dist in ("cvxpy", "clarabel"):
+        assert env["versions"][dist], dist  # a version, or "not installed"
+    blas = env["blas"]
+    assert blas and all(b["internal_api"] and b["version"] is not None for b in blas)
+
+
+def test_a_document_of_an_older_minor_version_is_read(small_report):
+    doc = small_report.to_dict()
+    doc["schema_version"] = SCHEMA_VERSION.split(".")[0] + ".0"
+    assert Report.from_dict(doc).to_dict()["results"] == doc["results"]
+
+
+def _python_of(snippet: str) -> str:
+    """The Python source of a reproduction (the body of its ``python - <<'EOF'`` heredoc, if any)."""
+    lines = snippet.splitlines()
+    if lines and lines[0].startswith("python - <<"):
+        lines = lines[1:lines.index("EOF")]
+    return "\n".join(lines)
+
+
+@pytest.mark.parametrize("target", ["mypkg.steppers:euler", "mypkg.steppers:Schemes.euler",
+                                    "/tmp/x/lagged.py:solve", "steppers/my lagged.py:solve"])
+def test_reproduction_of_a_convergence_record_compiles_for_every_target_kind(small_report, target):
+    rec = next(r for r in small_report if r.check == "convergence_order")
+    script = _python_of(reproduction(rec, {"target": target, "command": "check"}))
+    compile(script, "<repro>", "exec")
+    assert repr(target) in script or f"from {target.partition(':')[0]} import" in script
+
+
+def _section(html: str, name: str) -> str:
+    return re.search(rf'<section id="{name}">(.*?)</section>', html, re.S).group(1)
+
+
+def _law_row(html: str, check: str) -> str:
+    return re.search(rf'<tr[^>]*><td><a href="#law-{check}">.*?</tr>', _section(html, "laws"), re.S).group(0)
+
+
+def test_laws_table_ranks_worst_among_passed_and_failed_and_shows_xfail_apart():
+    rep = Report([CheckResult("assumption_LG", "a", "passed", worst=2.0, bound=10.0),
+                  CheckResult("assumption_LG", "b", "xfail", worst=1183.0, bound=10.0, message="declared")])
+    row = _law_row(render(rep), "assumption_LG")
+    cells = re.findall(r"<td[^>]*>(.*?)</td>", row, re.S)
+    assert cells[6:8] == ["2", "10"] and "1183" not in "".join(cells[6:10])   # worst, bound, bar, subject
+    assert "#c62828" not in row                                                # no red bar: nothing failed
+    assert "1183" in row and "xfail" in row                                   # shown apart, labelled
+
+
+def test_negative_zero_is_shown_as_zero():
+    html = render(Report([CheckResult("monotone", "op", "passed", worst=-0.0, bound=1.0)]))
+    assert ">-0<" not in html and ">0<" in _law_row(html, "monotone")
+
+
+def test_counterexamples_are_compact_and_as_precise_in_memory_as_from_json():
+    rec = CheckResult("firmly_nonexpansive", "op", "failed", worst=3.0, bound=1.0, message="m",
+                      counterexample={"x": np.array([1 / 3, -2.0, 1e-20]), "lam": np.float64(0.25),
+                                      "A": np.eye(2), "t": 0.0})
+    rep = Report([rec])
+    live = _section(render(rep), "failures")
+    again = _section(render(Report.from_dict(rep.to_dict())), "failures")
+    assert live == again
+    ce = re.search(r"<b>Counterexample</b>.*?<pre>(.*?)</pre>", live, re.S).group(1)
+    assert "&quot;x&quot;: [0.333333, -2, 1e-20]" in ce                     # a vector on one line
+    assert "&quot;A&quot;: [[1, 0], [0, 1]]" in ce
+    assert len(ce.splitlines()) == 6                                         # braces + one line a key
+
+
+def test_siconos_error_the_gate_checks_is_in_the_laws_table():
+    rep = Report([CheckResult("siconos_agreement", "DiodeBridge.ref", "passed", worst=4.27e-4, bound=1.0,
+                              message="max relative state error 4.27e-14", details={"error": 4.274e-14})])
+    html = render(rep)
+    assert "4.274e-14" in _law_row(html, "siconos_agreement")
+    block = re.search(r'<details id="law-siconos_agreement">.*?</details>', html, re.S).group(0)
+    assert re.search(r'<td class="num">4.274e-14</td>', block)
+
+
+def test_changes_are_grouped_per_subject():
+    from verimono.gate import Change, Comparison
+
+    broken = "solve on moving box"
+    changes = [Change("status", f"convergence_order[{broken}]", "passed → failed", True),
+               Change("status", f"contraction[{broken}]", "passed → failed", True),
+               Change("order", broken, "sup-norm order fell", True)]
+    changes += [Change("error", broken, f"sup error at h={h} grew", True) for h in (0.1, 0.05, 0.025)]
+    changes += [Change("status", "monotone[Ball]", "passed → failed", True)]
+    html = _section(render(Report([CheckResult("a", "b", "passed")]),
+                           changes=Comparison(changes, 10, {})), "changes")
+    table = re.search(r"<table>.*?</table>", html, re.S).group(0)
+    rows = re.findall(r"<tr[ >].*?</tr>", table.split("<tbody>")[1], re.S)
+    assert len(rows) == 2                                   # the broken study, and monotone[Ball]
+    assert broken in rows[0] and "6 regressions" in rows[0]
+    assert all(_e in html for _e in ("sup error at h=0.025 grew", "sup-norm order fell"))

@@ -12,12 +12,16 @@
   two intervals' half-widths and ``ORDER_DROP_FLOOR``, or a study exact at the nodes no longer is;
 * **error** — an error against a reference (each grid of a convergence study; a record's
   ``details["error"]``, e.g. Siconos agreement) grows by more than ``ERROR_GROWTH``;
+* **non-finite** — an error or order estimate is now ``nan``, ``inf`` or ``null`` where the baseline's
+  was finite (reported as an error / order regression: NaN compares false against every threshold);
 * **timing** — a stage's duration divided by the calibration workload measured in the same job (or a
   record's ``details["timing_ratio"]``, a same-job ratio) grows by more than ``TIMING_GROWTH``.
 
 Baseline and results must come from the same kind of run (command, target, profile and the selected
-stages and references) and a readable
-schema version; otherwise :class:`IncompatibleBaseline` — the gate fails closed with exit status 2.
+stages and references), be well-formed documents of a readable schema version
+(:mod:`verimono.report.schema` type-checks every field the gate reads), and the baseline must hold at
+least one executed record; otherwise :class:`IncompatibleBaseline` / ``SchemaError`` — the gate fails
+closed with exit status 2.
 """
 
 from __future__ import annotations
@@ -57,7 +61,8 @@ COMPATIBLE_KEYS = ("command", "target", "profile", "selection")
 
 
 class IncompatibleBaseline(SchemaError):
-    """The baseline records a different kind of run (command, target or profile) than the results."""
+    """The baseline records a different kind of run (command, target, profile, selection) than the
+    results, or no executed record at all."""
 
 
 @dataclasses.dataclass
@@ -104,8 +109,18 @@ class Comparison:
         return {"ok": self.ok, "compared": self.compared, "changes": [dataclasses.asdict(c) for c in self.changes]}
 
 
+def check_baseline(baseline: Report) -> None:
+    """Raise :class:`IncompatibleBaseline` unless ``baseline`` has executed (non-skipped) records: a
+    baseline without any vouches for nothing, and every run would pass against it."""
+    if not any(r.status != SKIPPED for r in baseline.results):
+        raise IncompatibleBaseline(f"the baseline has no executed records ({len(baseline.results)} records, "
+                                   "all skipped or none); regenerate it with `verimono baseline`")
+
+
 def check_runs_compatible(baseline: Report, current: Report) -> None:
-    """Raise :class:`IncompatibleBaseline` if the two reports are not the same kind of run."""
+    """Raise :class:`IncompatibleBaseline` if the baseline is empty (:func:`check_baseline`) or the two
+    reports are not the same kind of run."""
+    check_baseline(baseline)
     diffs = [f"{k}: baseline {baseline.meta.get(k)!r}, results {current.meta.get(k)!r}"
              for k in COMPATIBLE_KEYS if baseline.meta.get(k) != current.meta.get(k)]
     if diffs:
@@ -115,6 +130,10 @@ def check_runs_compatible(baseline: Report, current: Report) -> None:
 
 def _fmt(x: Any) -> str:
     return f"{x:.4g}" if isinstance(x, float) else str(x)
+
+
+def _finite(x: Any) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
 
 
 def _why(rec: Any) -> str:
@@ -140,7 +159,10 @@ def _compare_records(base: Report, cur: Report, out: list[Change]) -> None:
         elif b.status != c.status:
             out.append(Change("status", key, f"{b.status} → {c.status}", False))
         be, ce = b.details.get("error"), c.details.get("error")
-        if isinstance(be, (int, float)) and isinstance(ce, (int, float)):
+        if _finite(be) and c.status != SKIPPED and not _finite(ce):  # a skipped record regresses above
+            out.append(Change("error", key, f"error is now {ce!r}, not a finite number (baseline {be:.3g})",
+                              True))
+        elif _finite(be) and _finite(ce):
             if ce > ERROR_GROWTH * be and ce > ERROR_IGNORE_BELOW:
                 out.append(Change("error", key, f"error grew from {be:.3g} to {ce:.3g} "
                                   f"(> {ERROR_GROWTH}x)", True))
@@ -185,6 +207,10 @@ def _compare_studies(base: Report, cur: Report, out: list[Change]) -> None:
             if bf.exact and not cf.exact:
                 out.append(Change("order", key, f"{norm}: exact at the nodes in the baseline, now {cf}", True))
                 continue
+            if not (bf.exact or cf.exact) and math.isfinite(bf.slope) and not math.isfinite(cf.slope):
+                out.append(Change("order", key, f"{norm}-norm order is now {cf}, not a finite number "
+                                  f"(baseline {bf})", True))
+                continue
             if bf.exact or cf.exact or not all(map(math.isfinite, (bf.slope, cf.slope))):
                 continue
             half = lambda f: (f.high - f.low) / 2 if math.isfinite(f.high - f.low) else 0.0  # noqa: E731
@@ -194,12 +220,15 @@ def _compare_studies(base: Report, cur: Report, out: list[Change]) -> None:
                                   f"(more than {allowed:.3g})", True))
         floor = max(ERROR_IGNORE_BELOW, float(s.floor or 0.0))
         for norm in GATED_NORMS:
-            for h, be in zip(b.mesh, b.errors.get(norm, [])):
+            for h, be in zip(b.mesh, b.errors[norm], strict=True):  # lengths checked by the schema
                 match = [i for i, hc in enumerate(s.mesh) if math.isclose(hc, h, rel_tol=1e-9)]
                 if not match:
                     continue
                 ce = s.errors[norm][match[0]]
-                if ce > ERROR_GROWTH * be and ce > floor:
+                if math.isfinite(be) and not math.isfinite(ce):
+                    out.append(Change("error", key, f"{norm} error at h={h:.3g} is now {ce}, not a finite "
+                                      f"number (baseline {be:.3g})", True))
+                elif ce > ERROR_GROWTH * be and ce > floor:
                     out.append(Change("error", key, f"{norm} error at h={h:.3g} grew from {be:.3g} to "
                                       f"{ce:.3g} (> {ERROR_GROWTH}x)", True))
 
@@ -208,8 +237,8 @@ def _compare_timings(base: Report, cur: Report, out: list[Change]) -> None:
     bcal, ccal = base.meta.get("calibration"), cur.meta.get("calibration")
     if not (isinstance(bcal, (int, float)) and isinstance(ccal, (int, float)) and bcal > 0 and ccal > 0):
         return
-    before = {s["name"]: s for s in base.meta.get("stages", []) if isinstance(s, dict)}
-    for s in cur.meta.get("stages", []):
+    before = {s["name"]: s for s in base.meta.get("stages") or [] if isinstance(s, dict)}
+    for s in cur.meta.get("stages") or []:
         b = before.get(s.get("name"))
         if not b or min(b.get("duration", 0), s.get("duration", 0)) < TIMING_MIN_SECONDS:
             continue
@@ -237,5 +266,5 @@ def gate(baseline: str | Path | Report, results: str | Path | Report) -> Compari
     return compare(base, cur)
 
 
-__all__ = ["Change", "Comparison", "compare", "gate", "check_runs_compatible", "IncompatibleBaseline",
-           "ORDER_DROP_FLOOR", "ERROR_GROWTH", "TIMING_GROWTH", "TIMING_MIN_SECONDS"]
+__all__ = ["Change", "Comparison", "compare", "gate", "check_baseline", "check_runs_compatible",
+           "IncompatibleBaseline", "ORDER_DROP_FLOOR", "ERROR_GROWTH", "TIMING_GROWTH", "TIMING_MIN_SECONDS"]

@@ -9,8 +9,11 @@
   a test argument returns — and writes ``DIR/results.json`` and ``DIR/report.html``, the same report as
   ``verimono run``.
 * ``--verimono-baseline FILE`` gates the session on those records: a regression against ``FILE`` turns a
-  green session red (exit status 1) with the reasons in the terminal summary.  A missing, garbled or
-  incompatible baseline is a usage error (exit status 4): the gate fails closed.
+  green session red (exit status 1) with the reasons in the terminal summary.  A baseline the gate cannot
+  use fails closed with pytest's usage-error status 4 (``pytest.ExitCode.USAGE_ERROR``): a missing,
+  garbled or empty one (no executed record) before any test runs, with the reason on stderr; one from
+  another kind of run (e.g. ``verimono run`` rather than pytest, another profile) at the end of the
+  session, which then exits 4 — even if tests failed — with the reason in the terminal summary.
 """
 
 from __future__ import annotations
@@ -60,10 +63,12 @@ def pytest_configure(config: pytest.Config) -> None:
         return
     baseline = None
     if baseline_path:
+        from .gate import check_baseline
         from .report.schema import SchemaError, load
 
         try:
             baseline = load(baseline_path)
+            check_baseline(baseline)
         except SchemaError as exc:
             raise pytest.UsageError(f"verimono baseline unusable: {exc}") from None
     collector = _Collector(Path(out) if out else None, baseline, profile)
@@ -131,14 +136,17 @@ class _Collector:
 
         self.report.meta.update({"duration": time.perf_counter() - self.start, "environment": environment()})
         if self.baseline is not None:
-            from .gate import IncompatibleBaseline, check_runs_compatible, compare
+            from .gate import check_runs_compatible, compare
+            from .report.schema import SchemaError
 
             try:
                 check_runs_compatible(self.baseline, self.report)
                 self.comparison = compare(self.baseline, self.report)
-            except IncompatibleBaseline as exc:
+            except SchemaError as exc:  # IncompatibleBaseline: the gate cannot decide, so it fails closed
                 self.gate_error = str(exc)
-            if (self.gate_error or not self.comparison.ok) and session.exitstatus == pytest.ExitCode.OK:
+            if self.gate_error and session.exitstatus in (pytest.ExitCode.OK, pytest.ExitCode.TESTS_FAILED):
+                session.exitstatus = pytest.ExitCode.USAGE_ERROR
+            elif not self.gate_error and not self.comparison.ok and session.exitstatus == pytest.ExitCode.OK:
                 session.exitstatus = pytest.ExitCode.TESTS_FAILED
         if self.out is not None:
             from .report import write
@@ -153,7 +161,7 @@ class _Collector:
         if self.out is not None:
             tr.write_line(f"report: {self.out / 'report.html'}  records: {self.out / 'results.json'}")
         if self.gate_error:
-            tr.write_line(f"verimono gate: cannot compare: {self.gate_error}", red=True)
+            tr.write_line(f"verimono gate: cannot compare: {self.gate_error} (exit status 4)", red=True)
         elif self.comparison is not None:
             for c in self.comparison.regressions:
                 tr.write_line(f"  {c}", red=True)

@@ -10,13 +10,15 @@ from __future__ import annotations
 
 import functools
 import json
+import keyword
 import math
+import re
 import shlex
-from collections import defaultdict
+from collections import Counter, defaultdict
 from html import escape
 from typing import Any
 
-from ..results import FAILED, PASSED, SKIPPED, STATUSES, XFAIL, CheckResult, Report
+from ..results import FAILED, PASSED, SKIPPED, STATUSES, XFAIL, CheckResult, Report, to_jsonable
 
 SECTIONS = ("summary", "changes", "convergence", "trajectories", "laws", "failures", "performance", "timings",
             "environment")
@@ -86,7 +88,49 @@ def _num(x: Any, fmt: str = ".4g") -> str:
         return _e(x)
     if not math.isfinite(v):
         return _e(v)
-    return format(int(v), fmt) if fmt == "d" else format(v, fmt)
+    return _unsigned_zero(format(int(v), fmt) if fmt == "d" else format(v, fmt))
+
+
+def _unsigned_zero(text: str) -> str:
+    """``-0``, ``-0.00``, ``-0e+00`` (a negative zero, or a tiny negative rounded away) as ``0...``."""
+    try:
+        return text[1:] if text.startswith("-") and float(text) == 0 else text
+    except ValueError:
+        return text
+
+
+#: a list or object whose one-line form is at most this long is written on one line (lists of numbers
+#: always are: a vector reads best as one row)
+_INLINE_WIDTH = 100
+_NON_FINITE = ("inf", "-inf", "nan")
+
+
+def _compact(value: Any, level: int = 0) -> str:
+    """JSON-like text of a counterexample (already :func:`to_jsonable`): numbers to 6 significant digits,
+    vectors and short lists or objects on one line, the top-level object one key a line."""
+    if isinstance(value, dict):
+        items = [f"{json.dumps(str(k), ensure_ascii=False)}: {_compact(v, level + 1)}"
+                 for k, v in value.items()]
+        opening, closing = "{", "}"
+    elif isinstance(value, list):
+        items = [_compact(v, level + 1) for v in value]
+        opening, closing = "[", "]"
+    elif isinstance(value, bool) or value is None:
+        return json.dumps(value)
+    elif isinstance(value, int):
+        return str(value)
+    elif isinstance(value, float):
+        return _unsigned_zero(format(value, ".6g"))
+    elif isinstance(value, str) and value in _NON_FINITE:
+        return value  # a non-finite number, as to_jsonable writes it
+    else:
+        return json.dumps(str(value), ensure_ascii=False)
+    flat = opening + ", ".join(items) + closing
+    scalars = isinstance(value, list) and not any(isinstance(v, (list, dict)) for v in value)
+    if "\n" not in flat and level > 0 and (scalars or len(flat) <= _INLINE_WIDTH) or not items:
+        return flat
+    pad = " " * (level + 1)
+    return opening + "\n" + ",\n".join(pad + it for it in items) + "\n" + " " * level + closing
 
 
 def _badge(status: str) -> str:
@@ -133,14 +177,22 @@ def reproduction(rec: CheckResult, meta: dict[str, Any]) -> str:
             _command(rec, meta)
     study = rec.details.get("study")
     if rec.check == "convergence_order" and isinstance(study, dict):
-        module, _, obj = target.partition(":")
         return ("python - <<'EOF'\n"
                 "from verimono.reference import get\n"
                 "from verimono.checks.orders import check_convergence_order\n"
-                f"from {module} import {obj} as stepper\n"
+                f"{_import_stepper(str(target))}\n"
                 f"print(check_convergence_order(stepper, get({study['problem']!r})))\n"
                 "EOF")
     return _command(rec, meta)
+
+
+def _import_stepper(target: str) -> str:
+    """Python binding ``stepper`` to ``MODULE:OBJECT``: a plain import for a dotted module and a single
+    name, else :func:`verimono.cli.load_target` (``.py`` paths, dotted objects), as ``verimono check`` does."""
+    module, _, obj = target.partition(":")
+    if all(p.isidentifier() and not keyword.iskeyword(p) for p in [*module.split("."), obj]):
+        return f"from {module} import {obj} as stepper"
+    return f"from verimono.cli import load_target\nstepper = load_target({target!r})"
 
 
 @functools.lru_cache(maxsize=1)
@@ -196,6 +248,30 @@ def _summary(report: Report, changes: Any) -> str:
             f'<div class="cards">{cards}</div>{stage_html}')
 
 
+def _subject(key: str) -> str:
+    """The subject a change is about: ``convergence_order[solve on box]`` and ``solve on box`` alike."""
+    m = re.fullmatch(r"[^\[\]]+\[(.*)\]", key)
+    return m.group(1) if m else key
+
+
+def _grouped(changes: list[Any], badge: str) -> str:
+    """One row per subject: how many changes of which rule, and every message (long lists folded)."""
+    groups: dict[str, list[Any]] = defaultdict(list)
+    for c in changes:
+        groups[_subject(c.key)].append(c)
+    rows = []
+    for subject, cs in groups.items():
+        kinds = ", ".join(f"{k} ×{n}" if n > 1 else k for k, n in Counter(c.kind for c in cs).items())
+        word = "regression" if badge == "regression" else "change"
+        head = f"{len(cs)} {word}{'s' if len(cs) != 1 else ''}: {kinds}"
+        items = [f"<li>{_e(c.key + ': ' if c.key != subject else '')}{_e(c.message)}</li>" for c in cs]
+        shown, folded = (items, []) if len(items) <= 4 else (items[:3], items[3:])
+        more = f"<details><summary>{len(folded)} more</summary><ul>{''.join(folded)}</ul></details>"
+        shown = "<ul>" + "".join(shown) + "</ul>" + (more if folded else "")
+        rows.append([_badge(badge), _e(subject), _e(head), shown])
+    return _table(["", "subject", "rules", "what changed"], rows)
+
+
 def _changes(changes: Any) -> str:
     if changes is None:
         return ('<p class="note">No baseline was given, so nothing is compared. '
@@ -204,17 +280,15 @@ def _changes(changes: Any) -> str:
     meta = changes.baseline_meta or {}
     head = (f'<p class="note">Baseline created {_e(meta.get("created"))}, profile {_e(meta.get("profile"))}, '
             f"verimono {_e(((meta.get('environment') or {}).get('versions') or {}).get('verimono'))}. "
-            f"{_e(changes.summary())}.</p>")
-    reg = [[_badge("regression"), _e(c.kind), _e(c.key), _e(c.message)] for c in changes.regressions]
-    other = [[_badge("change"), _e(c.kind), _e(c.key), _e(c.message)] for c in changes.others]
+            f"{_e(changes.summary())}{', one row per subject' if changes.changes else ''}.</p>")
     out = head
-    if reg:
-        out += _table(["", "rule", "subject", "what changed"], reg)
+    if changes.regressions:
+        out += _grouped(changes.regressions, "regression")
     else:
         out += '<p><b style="color:var(--ok)">No regressions.</b></p>'
-    if other:
-        out += (f"<details><summary>{len(other)} other changes (new records, improvements)</summary>"
-                + _table(["", "kind", "subject", "what changed"], other) + "</details>")
+    if changes.others:
+        out += (f"<details><summary>{len(changes.others)} other changes (new records, improvements)</summary>"
+                + _grouped(changes.others, "change") + "</details>")
     return out
 
 
@@ -251,6 +325,17 @@ def _trajectories(report: Report) -> str:
     return f'<div class="grid">{"".join(figs)}</div>'
 
 
+def _error(rec: CheckResult) -> float | None:
+    """``details["error"]``: the absolute error against a reference (e.g. Siconos) the gate compares."""
+    e = rec.details.get("error") if isinstance(rec.details, dict) else None
+    return float(e) if isinstance(e, (int, float)) and not isinstance(e, bool) else None
+
+
+def _worst(recs: list[CheckResult]) -> tuple[CheckResult | None, float | None]:
+    rated = [(r, _ratio(r)) for r in recs if _ratio(r) is not None]
+    return max(rated, key=lambda p: p[1]) if rated else (None, None)
+
+
 def _laws(report: Report) -> str:
     if not report.results:
         return '<p class="note">No records.</p>'
@@ -260,25 +345,34 @@ def _laws(report: Report) -> str:
     rows, classes, detail_blocks = [], [], []
     for check, recs in groups.items():
         counts = {s: sum(r.status == s for r in recs) for s in STATUSES}
-        rated = [(r, _ratio(r)) for r in recs if _ratio(r) is not None]
-        worst_rec, worst_ratio = max(rated, key=lambda p: p[1]) if rated else (None, None)
+        # the worst ratio among records that had to hold; expected failures are shown apart
+        worst_rec, worst_ratio = _worst([r for r in recs if r.status in (PASSED, FAILED)])
+        xf_rec, _ = _worst([r for r in recs if r.status == XFAIL])
+        errors = [e for e in map(_error, recs) if e is not None]
         rows.append([f'<a href="#law-{_e(check)}">{_e(check)}</a>', _num(len(recs), "d"),
                      _num(counts[PASSED], "d"), _num(counts[FAILED], "d"), _num(counts[SKIPPED], "d"),
                      _num(counts[XFAIL], "d"),
                      _num(worst_rec.worst) if worst_rec else "–", _num(worst_rec.bound) if worst_rec else "–",
-                     _bar(worst_ratio), _e(worst_rec.subject) if worst_rec else ""])
+                     _bar(worst_ratio), _e(worst_rec.subject) if worst_rec else "",
+                     _num(max(errors)) if errors else "",
+                     (f'{_badge(XFAIL)} <span class="muted">{_num(xf_rec.worst)} / {_num(xf_rec.bound)} '
+                      f"{_e(xf_rec.subject)}</span>") if xf_rec else ""])
         classes.append("failed" if counts[FAILED] else "")
         sub = [[_e(r.subject), _badge(r.status), _num(r.worst), _num(r.bound), _bar(_ratio(r)),
+                _num(_error(r)) if _error(r) is not None else "",
                 _num(r.seed, "d") if r.seed is not None else "", _e(r.message)] for r in recs]
         detail_blocks.append(
             f'<details id="law-{_e(check)}"><summary>{_e(check)}: {len(recs)} records</summary>'
-            + _table(["subject", "status", "worst", "bound", "worst/bound", "seed", "message"], sub, (2, 3, 5),
-                     ["failed" if r.status == FAILED else "" for r in recs]) + "</details>")
+            + _table(["subject", "status", "worst", "bound", "worst/bound", "error", "seed", "message"], sub,
+                     (2, 3, 5, 6), ["failed" if r.status == FAILED else "" for r in recs]) + "</details>")
     table = _table(["check (law)", "records", "passed", "failed", "skipped", "xfail", "worst observed",
-                    "bound", "worst/bound", "worst subject"], rows, (1, 2, 3, 4, 5, 6, 7), classes)
+                    "bound", "worst/bound", "worst subject", "error (max)", "worst expected failure"],
+                   rows, (1, 2, 3, 4, 5, 6, 7, 10), classes)
     return ('<p class="note">A check passes when its worst observed ratio stays within its bound. One row per '
-            "law; open a law below for every record.</p>" + table + "<h3>Every record</h3>" +
-            "".join(detail_blocks))
+            "law: the worst ratio among passed and failed records; expected failures (xfail) are listed "
+            "apart. <i>error</i> is the absolute error against a reference (e.g. Siconos) that the gate "
+            "compares with the baseline's. Open a law below for every record.</p>" + table +
+            "<h3>Every record</h3>" + "".join(detail_blocks))
 
 
 def _failures(report: Report) -> str:
@@ -287,13 +381,14 @@ def _failures(report: Report) -> str:
         return '<p><b style="color:var(--ok)">No failures.</b></p>'
     out = []
     for r in bad:
-        ce = json.dumps(r.counterexample, indent=1, default=str) if r.counterexample is not None else "—"
+        ce = _compact(to_jsonable(r.counterexample)) if r.counterexample is not None else "—"
         tb = r.details.get("traceback")
         out.append(
             f'<div class="failure"><h3>{_e(r.key)}</h3><p>{_e(r.message)}</p>'
             f"<p class=\"muted\">worst {_num(r.worst)} against bound {_num(r.bound)}"
             f"{'' if r.seed is None else f', seed {r.seed}'}</p>"
-            f"<b>Counterexample</b><pre>{_e(ce)}</pre>"
+            f"<b>Counterexample</b> <span class=\"muted\">(6 significant digits; full precision in "
+            f"results.json)</span><pre>{_e(ce)}</pre>"
             f"<b>Reproduce</b><pre>{_e(reproduction(r, report.meta))}</pre>"
             + (f"<details><summary>traceback</summary><pre>{_e(tb)}</pre></details>" if tb else "") + "</div>")
     return "".join(out)
@@ -352,11 +447,20 @@ def _environment(report: Report) -> str:
     env = report.meta.get("environment") or {}
     versions = env.get("versions") or {}
     machine = env.get("machine") or {}
-    run = {k: report.meta.get(k) for k in ("command", "target", "profile", "seed", "created", "data_dir")}
+    run = {k: report.meta.get(k) for k in ("command", "target", "profile", "seed", "selection", "created",
+                                           "duration", "data_dir")}
+    if isinstance(run["selection"], dict):
+        run["selection"] = _compact(to_jsonable(run["selection"]), 1)
+    if isinstance(run["duration"], (int, float)):
+        run["duration"] = f"{run['duration']:.1f} s"
     kv = lambda d: '<table class="kv">' + "".join(  # noqa: E731
         f"<tr><td>{_e(k)}</td><td>{_e(v if v is not None else '—')}</td></tr>" for k, v in d.items()) + "</table>"
+    blas = {f"BLAS {i + 1}" if len(env.get("blas") or []) > 1 else "BLAS":
+            f"{b.get('internal_api')} {b.get('version')} ({b.get('architecture')}, {b.get('threading_layer')}, "
+            f"{b.get('num_threads')} threads) {b.get('prefix')}"
+            for i, b in enumerate(b for b in env.get("blas") or [] if isinstance(b, dict))}
     return (f'<div class="grid"><div><h3>Run</h3>{kv(run)}</div><div><h3>Versions</h3>{kv(versions)}</div>'
-            f"<div><h3>Machine</h3>{kv(machine)}</div></div>")
+            f"<div><h3>Machine</h3>{kv({**machine, **blas})}</div></div>")
 
 
 def render(report: Report, *, changes: Any = None, title: str = "verimono report") -> str:
