@@ -94,3 +94,18 @@ def test_static_operator_has_constant_theta_and_estimated_sigma():
     assert rep["assumption_YB"].details["theta_hat_slope"] <= 1e-6                # Prop. vi
     M = np.array([[1.0, 3.0], [-3.0, 0.5]])
     assert max(rep["assumption_LG"].details["sigma_hat"]) <= np.linalg.norm(M, 2) + 1e-9
+
+
+def test_a_stated_theta_is_judged_on_YB_not_on_the_stronger_YB_prime():
+    """F(t, x) = (1 + t)x with θ ≡ 0.  (YB): |Y_λ(s+λ, z)| = (1+s+λ)|z|/(1 + λ(1+s+λ)) ≤ (1+s)|z| = |F^0(s, z)|
+    holds; (YB'), against |Y_λ(s, z)| = (1+s)|z|/(1 + λ(1+s)), does not.  θ ≡ 0 satisfies the paper's
+    assumption and must not be reported contradicted (an audit found it was); the same θ against a
+    faster-growing F(t, x) = (1 + 5t)x, where (YB) fails too, is."""
+    import verimono as vm
+
+    ok = vm.Problem(vm.Linear(lambda t: np.array([[1.0 + t]])), [1.0], 1.0, theta=lambda s: 0.0, name="(1+t)x")
+    rec = check_assumptions(ok).by_check("assumption_YB")[0]
+    assert rec.status == PASSED and rec.details["form"] == "YB", str(rec)
+    bad = vm.Problem(vm.Linear(lambda t: np.array([[1.0 + 5.0 * t]])), [1.0], 1.0, theta=lambda s: 0.0,
+                     name="(1+5t)x")
+    assert check_assumptions(bad).by_check("assumption_YB")[0].status == FAILED

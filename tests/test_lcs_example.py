@@ -75,9 +75,11 @@ def test_H_closed_form_min_norm_membership_and_domain():
             for y in (hi, hi - 0.5, hi - 5.0, hi + 0.5, lo if np.isfinite(lo) else hi - 1e3):
                 assert H.contains(X, np.array([y])) == (lo <= y <= hi), (x, v1, v2, y, interval)
             assert H.project_domain(X)[0] == x
-    for v1, v2 in [(0.0, 0.0), (-1.0, 0.5), (2.0, -1.0)]:   # the projection onto dom H = [−v2, ∞)
-        H = E.example_system([v1, v2]).operator()
-        np.testing.assert_allclose(H.project_domain(np.array([-v2 - 2.0])), [-v2], atol=1e-9)
+    for v1, v2 in cases:   # the projection onto dom H = [−v2, ∞): −v2 to the QP layer's relative accuracy
+        H = E.example_system([v1, v2]).operator()          # (it was 5e-7 off for v1 < 0 before the KKT check
+        for d in (1e-3, 0.5, 2.0, 40.0):                     # demanded complementary slackness)
+            x = -v2 - d
+            assert H.project_domain(np.array([x]))[0] == pytest.approx(-v2, rel=1e-10, abs=1e-10 * (1 + abs(x)))
 
 
 @pytest.mark.parametrize("scale", [1e-12, 1e-9, 1e-6, 1.0, 1e3])

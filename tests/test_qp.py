@@ -94,3 +94,18 @@ def test_a_back_end_reporting_a_wrong_answer_is_not_trusted(monkeypatch):
         solve_qp(np.eye(2), -np.array([2.0, 3.0]), G, h)
     assert not kkt_residual(np.eye(2), -np.array([2.0, 3.0]), G, h, None, None, np.array([0.3, 0.3])).ok
     assert kkt_residual(np.eye(2), -np.array([2.0, 3.0]), G, h, None, None, np.array([0.0, 1.0])).ok
+
+
+def test_a_point_near_a_bound_that_its_multipliers_treat_as_active_is_rejected():
+    """Projection of x = -2 onto dom H = [0.464, ∞) of the paper's Example with v = (-4.04, -0.464), as the
+    QP over (x', z): min ½(x' - x)² s.t. z ≥ 0, D z + C x' + v ≥ 0 (P singular in z).  ProxQP returned
+    z1 = 2.5e-7, forcing x' = 0.4640005; with -z1 ≤ 0 counted active the multipliers explained the gradient
+    (dual residual 0), and only complementary slackness (μ1 z1 = 2.5 μ1e-7 ≠ 0) shows it is not optimal."""
+    G = np.array([[0.0, -1.0, 0.0], [0.0, 0.0, -1.0], [0.0, 0.0, -1.0], [-1.0, 1.0, 0.0]])
+    h = np.array([0.0, 0.0, -4.04, -0.464])
+    P, q = np.diag([1.0, 0.0, 0.0]), np.array([2.0, 0.0, 0.0])
+    near = np.array([0.4640005008383915, 2.502493740e-07, 7.28822407])
+    rep = kkt_residual(P, q, G, h, None, None, near)
+    assert rep.primal <= 1e-12 and rep.dual <= 1e-12 and rep.comp > 1e-8 and not rep.ok
+    z = solve_qp(P, q, G, h)
+    assert z[0] == pytest.approx(0.464, rel=1e-12) and abs(z[1]) <= 1e-12

@@ -35,36 +35,53 @@ BACKENDS: dict[str, dict] = {
 }
 
 
+#: rows whose slack is within this (relative) of zero are candidates for the active set of the KKT check;
+#: complementary slackness then decides: a row with a multiplier must have (almost) no slack
+ACTIVE_RTOL = 1e-7
+
+
 @dataclasses.dataclass
 class KKTReport:
     primal: float   # max constraint violation, relative
     dual: float     # stationarity residual of the best nonnegative multipliers, relative
+    comp: float     # complementary slackness max_i μ_i |slack_i|, relative
     ok: bool
 
 
 def kkt_residual(P, q, G, h, A, b, z, rtol: float = QP_RTOL) -> KKTReport:
-    """Verify optimality of ``z`` for the strictly convex QP independently of any solver."""
+    """Verify optimality of ``z`` for the convex QP independently of any solver.
+
+    The KKT conditions: primal feasibility; stationarity ``Pz + q + Gᵀμ + Aᵀν = 0`` with ``μ ≥ 0`` on the
+    rows within ``ACTIVE_RTOL`` of their bound (the best such ``μ`` by nonnegative least squares); and
+    complementary slackness ``μ_i (h - Gz)_i = 0`` — without it a point at distance 1e-8 from a bound that
+    the multipliers treat as active passes, while the optimum is on the bound (ProxQP returned such a
+    point, 5e-7 off, for the projection onto the domain of the Example's H).  All three to ``rtol``
+    relative to the data.
+    """
     scale = 1.0 + max(np.abs(q).max(initial=0.0), np.abs(h).max(initial=0.0) if h is not None else 0.0,
                       np.abs(b).max(initial=0.0) if b is not None else 0.0, np.abs(P @ z).max(initial=0.0))
     viol = 0.0
-    rows = []
-    tol_act = 1e-7 * scale
+    rows, gaps = [], np.zeros(0)
     if G is not None and len(h):
         slack = G @ z - h
         viol = max(viol, float(np.max(slack, initial=0.0)))
-        active = slack >= -tol_act
+        active = slack >= -ACTIVE_RTOL * scale
         rows.append(G[active])
+        gaps = -slack[active]                    # ≥ 0 up to the violation, 0 on the bound
     if A is not None and len(b):
         viol = max(viol, float(np.max(np.abs(A @ z - b), initial=0.0)))
         rows.extend([A, -A])  # free multipliers as differences of nonnegative ones
     grad = P @ z + q
     R = np.vstack(rows) if rows else np.zeros((0, z.size))
+    comp = 0.0
     if R.shape[0]:
-        _, res = nnls(R.T, -grad, maxiter=50 * max(R.shape))
+        mu, res = nnls(R.T, -grad, maxiter=50 * max(R.shape))
+        if gaps.size:
+            comp = float(np.max(mu[:gaps.size] * np.abs(gaps), initial=0.0)) / (1.0 + float(np.max(mu, initial=0.0)))
     else:  # no active row (an interior minimiser): SciPy's nnls aborts the process on an empty matrix
         res = float(np.linalg.norm(grad))
-    primal, dual = viol / scale, res / scale
-    return KKTReport(primal, dual, primal <= rtol and dual <= rtol)
+    primal, dual, comp = viol / scale, res / scale, comp / scale
+    return KKTReport(primal, dual, comp, primal <= rtol and dual <= rtol and comp <= rtol)
 
 
 def _polish(P, q, G, h, A, b, z):
@@ -72,7 +89,7 @@ def _polish(P, q, G, h, A, b, z):
     scale = 1.0 + np.abs(z).max(initial=0.0)
     blocks, rhs = [], []
     if G is not None and len(h):
-        act = G @ z - h >= -1e-7 * scale
+        act = G @ z - h >= -ACTIVE_RTOL * scale
         blocks.append(G[act]); rhs.append(h[act])
     if A is not None and len(b):
         blocks.append(A); rhs.append(b)
@@ -178,9 +195,11 @@ def solve_qp(P, q, G=None, h=None, A=None, b=None, *, backends=None, scale: floa
             rep = kkt_residual(S.P, S.q, S.G, S.h, S.A, S.b, cand)
             if rep.ok:
                 return S.scale * cand
-            if best_rep is None or max(rep.primal, rep.dual) < max(best_rep.primal, best_rep.dual):
+            if best_rep is None or max(rep.primal, rep.dual, rep.comp) < max(best_rep.primal, best_rep.dual,
+                                                                                best_rep.comp):
                 best_rep = rep
-        reasons.append(f"{name}: KKT check failed (primal {best_rep.primal:.2e}, dual {best_rep.dual:.2e})")
+        reasons.append(f"{name}: KKT check failed (primal {best_rep.primal:.2e}, dual {best_rep.dual:.2e}, "
+                       f"complementarity {best_rep.comp:.2e})")
     if not got_point:
         raise InfeasibleStep("no back-end found a feasible point: " + "; ".join(reasons))
     raise SolverFailure("no QP back-end produced a verified solution: " + "; ".join(reasons))
