@@ -164,3 +164,19 @@ def test_report_rerenders_from_results(good_check, tmp_path):
     out = tmp_path / "r.html"
     assert main(["report", "--results", str(good_check / "results.json"), "--out", str(out)]) == 0
     assert out.read_text().count("<svg") >= 4
+
+
+def test_a_py_target_is_the_file_itself_not_a_module_of_the_same_name(tmp_path):
+    """load_target("…/types.py:solve") imported the standard library's types (already in sys.modules), and
+    a second lagged.py the first one: the file named is the module loaded."""
+    from verimono.cli import BadTarget, load_target
+
+    (tmp_path / "types.py").write_text("def solve(problem, t):\n    return 'mine'\n")
+    assert load_target(f"{tmp_path}/types.py:solve")(None, None) == "mine"
+    for i in (1, 2):
+        d = tmp_path / f"copy{i}"
+        d.mkdir()
+        (d / "lagged.py").write_text(f"def solve(problem, t):\n    return {i}\n")
+        assert load_target(f"{d}/lagged.py:solve")(None, None) == i
+    with pytest.raises(BadTarget, match="does not exist"):
+        load_target(f"{tmp_path}/missing.py:solve")

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -170,13 +171,41 @@ def _python_of(snippet: str) -> str:
     return "\n".join(lines)
 
 
-@pytest.mark.parametrize("target", ["mypkg.steppers:euler", "mypkg.steppers:Schemes.euler",
-                                    "/tmp/x/lagged.py:solve", "steppers/my lagged.py:solve"])
-def test_reproduction_of_a_convergence_record_compiles_for_every_target_kind(small_report, target):
+@pytest.mark.parametrize("target", ["mypkg.steppers:euler", "mypkg.steppers:Schemes.euler", "lagged.py:solve",
+                                    "{tmp}/x/lagged.py:solve", "{tmp}/my steppers/lagged.py:solve"])
+def test_reproduction_binds_the_target_stepper_for_every_target_kind(small_report, target, tmp_path, monkeypatch):
+    """The reproduction's import lines, run from the directory `verimono check` ran in, bind exactly the
+    target (``lagged.py:solve`` once became ``from lagged.py import solve``: it compiles, and imports a
+    submodule ``py`` of a package ``lagged``)."""
+    import textwrap
+
+    target = target.format(tmp=tmp_path)
+    module, _, obj = target.partition(":")
+    if module.endswith(".py"):
+        path = tmp_path / module if not module.startswith("/") else Path(module)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(f"def solve(problem, t):\n    return {target!r}\n")
+        expect = target
+    else:
+        pkg = tmp_path / "mypkg"
+        pkg.mkdir(exist_ok=True)
+        (pkg / "__init__.py").write_text("")
+        (pkg / "steppers.py").write_text(textwrap.dedent("""
+            def euler(problem, t):
+                return "euler"
+            class Schemes:
+                euler = staticmethod(lambda problem, t: "Schemes.euler")
+        """))
+        expect = "euler" if obj == "euler" else "Schemes.euler"
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.syspath_prepend(str(tmp_path))
     rec = next(r for r in small_report if r.check == "convergence_order")
     script = _python_of(reproduction(rec, {"target": target, "command": "check"}))
-    compile(script, "<repro>", "exec")
-    assert repr(target) in script or f"from {target.partition(':')[0]} import" in script
+    binding = "\n".join(line for line in script.splitlines()
+                        if ("stepper" in line or "load_target" in line) and "check_" not in line)
+    scope: dict = {}
+    exec(compile(binding, "<repro>", "exec"), scope)
+    assert scope["stepper"](None, None) == expect
 
 
 def _section(html: str, name: str) -> str:

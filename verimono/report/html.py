@@ -190,7 +190,8 @@ def _import_stepper(target: str) -> str:
     """Python binding ``stepper`` to ``MODULE:OBJECT``: a plain import for a dotted module and a single
     name, else :func:`verimono.cli.load_target` (``.py`` paths, dotted objects), as ``verimono check`` does."""
     module, _, obj = target.partition(":")
-    if all(p.isidentifier() and not keyword.iskeyword(p) for p in [*module.split("."), obj]):
+    if not module.endswith(".py") and all(p.isidentifier() and not keyword.iskeyword(p)
+                                          for p in [*module.split("."), obj]):
         return f"from {module} import {obj} as stepper"
     return f"from verimono.cli import load_target\nstepper = load_target({target!r})"
 
