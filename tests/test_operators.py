@@ -13,7 +13,7 @@ import pytest
 from scipy.optimize import brentq, minimize
 
 import verimono as vm
-from verimono.sets import Ball, Box, HalfSpace, Polyhedron
+from verimono.sets import Ball, Box, HalfSpace, Polyhedron, Translated
 from verimono.tolerances import tolerance
 
 RNG = np.random.default_rng(20261122)
@@ -226,3 +226,29 @@ def test_membership_at_a_kink_reached_through_rounding():
     l1 = vm.Shifted(vm.L1Subdifferential(1.0, dim=2), [0.3, 0.1])
     J, Y = l1.resolvent(np.array([-0.1, 2.0]), 1.0), l1.yosida(np.array([-0.1, 2.0]), 1.0)
     assert l1.contains(J, Y) and not l1.contains(J, Y + np.array([0.0, 0.5]))
+
+
+def test_resolvent_rows_batches_only_what_declares_it():
+    """resolvent_rows: one vectorized call for a catalog operator (the same bits as row by row), one call per
+    row for a user's operator — whose resolvent may treat a (B, n) array as one point — and for a catalog
+    subclass that overrides the resolvent."""
+    from verimono.operators import resolvent_rows
+
+    X = RNG.normal(size=(5, 2))
+    calls = []
+
+    class Counting(vm.NormSubdifferential):
+        def resolvent(self, x, lam, t=0.0):
+            calls.append(np.shape(x))
+            return super().resolvent(x, lam, t)
+
+    for op in (vm.NormSubdifferential(0.7, dim=2), vm.Shifted(vm.L1Subdifferential(0.3, dim=2), [0.1, -0.2]),
+               vm.NormalCone(Translated(Ball(np.zeros(2), 1.0), lambda t: np.array([t, 0.0])))):
+        assert op._accepts_batches()
+        np.testing.assert_array_equal(resolvent_rows(op, X, 0.4, 0.5), np.stack([op.resolvent(x, 0.4, 0.5) for x in X]))
+    whole = vm.operator_from_resolvent(lambda x, lam, t: x * max(1 - lam / np.linalg.norm(x), 0.0), 2)
+    assert not whole._accepts_batches()
+    np.testing.assert_allclose(resolvent_rows(whole, X, 0.4), resolvent_rows(vm.NormSubdifferential(1.0, dim=2), X, 0.4),
+                               rtol=1e-14)
+    sub = Counting(0.7, dim=2)
+    assert not sub._accepts_batches() and resolvent_rows(sub, X, 0.4).shape == X.shape and calls == [(2,)] * 5

@@ -81,6 +81,11 @@ class Operator:
         return bool(np.max(np.abs(p - x), initial=0.0) <= tol)
 
     # -- performance hook (private) ----------------------------------------------------------------
+    def _accepts_batches(self) -> bool:
+        """Whether :meth:`resolvent` maps a batch ``(B, n)`` row by row, bit-identically to ``B`` separate
+        calls (the catalog's own resolvents do; a user's, or a subclass override, is not assumed to)."""
+        return False
+
     def _kernel(self, x0: np.ndarray) -> Callable | None:
         """A fast ``step(x, lam, t) = J_λ x`` for float arrays shaped like ``x0``, or ``None``.
 
@@ -102,6 +107,15 @@ def resolvent_kernel(op: "Operator", x0: np.ndarray) -> Callable:
     kern = getattr(op, "_kernel", None)
     step = kern(np.asarray(x0, dtype=float)) if kern is not None else None
     return op.resolvent if step is None else step
+
+
+def resolvent_rows(op: "Operator", X: np.ndarray, lam: float, t: float = 0.0) -> np.ndarray:
+    """``J_λ`` of every row of ``X`` ``(B, n)``: one vectorized call when the operator's resolvent maps
+    batches row by row (the catalog's), else one call per row — the same values either way."""
+    X = np.asarray(X, dtype=float)
+    if op._accepts_batches():
+        return np.asarray(op.resolvent(X, lam, t), dtype=float)
+    return np.array([np.asarray(op.resolvent(x, lam, t), dtype=float) for x in X]).reshape(X.shape)
 
 
 def _own(obj: Any, cls: type, member: str = "resolvent") -> bool:
@@ -232,6 +246,9 @@ class Linear(Operator):
         # (one BLAS call per row); a plain (B, n) @ (n, n) product would sum in another order
         return (x[..., None, :] @ W)[..., 0, :]
 
+    def _accepts_batches(self):
+        return _own(self, Linear)
+
     def _kernel(self, x0):
         if not _own(self, Linear) or not self.static or x0.ndim != 1:
             return None
@@ -298,6 +315,9 @@ class NormSubdifferential(Operator):
         nrm = _norm(x)
         return x * (_mx(nrm - lam * self._col(t, x), 0.0) / _mx(nrm, _TINY))
 
+    def _accepts_batches(self):
+        return _own(self, NormSubdifferential)
+
     def _kernel(self, x0):
         if not _own(self, NormSubdifferential) or x0.ndim != 1 or self._c(0.0).ndim:
             return None
@@ -347,6 +367,9 @@ class L1Subdifferential(Operator):
         x = np.asarray(x, dtype=float)
         return np.sign(x) * _mx(np.abs(x) - lam * self._c(t), 0.0)
 
+    def _accepts_batches(self):
+        return _own(self, L1Subdifferential)
+
     def _kernel(self, x0):
         if not _own(self, L1Subdifferential):
             return None
@@ -393,6 +416,9 @@ class NormalCone(Operator):
 
     def resolvent(self, x, lam, t=0.0):
         return self.S.project(x, t)
+
+    def _accepts_batches(self):
+        return _own(self, NormalCone) and getattr(self.S, "_accepts_batches", lambda: False)()
 
     def _kernel(self, x0):
         if not _own(self, NormalCone):
@@ -443,6 +469,9 @@ class Shifted(Operator):
     def resolvent(self, x, lam, t=0.0):
         p = self._Phi(t)
         return self.F.resolvent(np.asarray(x, dtype=float) + p, lam, t) - p
+
+    def _accepts_batches(self):
+        return _own(self, Shifted) and self.F._accepts_batches()
 
     def _kernel(self, x0):
         if not _own(self, Shifted):
@@ -500,6 +529,9 @@ class LogBarrier(Operator):
         # for x < 0, r - x >= -x > 0: the max only silences the discarded x >= 0 entries (no errstate)
         r = np.sqrt(x * x + 4.0 * lam * c)
         return np.where(x >= 0.0, 0.5 * (x + r), 2.0 * lam * c / _mx(r - x, _TINY))
+
+    def _accepts_batches(self):
+        return _own(self, LogBarrier)
 
     def _kernel(self, x0):
         if not _own(self, LogBarrier):

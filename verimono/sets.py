@@ -46,6 +46,11 @@ class ConvexSet:
         tol = tolerance(x) if tol is None else tol
         return bool(np.max(np.abs(self.project(x, t) - x), initial=0.0) <= tol)
 
+    def _accepts_batches(self) -> bool:
+        """Whether :meth:`project` maps a batch ``(B, n)`` row by row, bit-identically (the catalog sets'
+        own projections do; a user's set or override is not assumed to)."""
+        return False
+
     def _kernel(self, x0: np.ndarray) -> Callable | None:
         """A fast ``step(x, lam, t) = proj_{S(t)} x`` (``lam`` ignored) for float arrays shaped like
         ``x0``, returning exactly what :meth:`project` returns; ``None`` means use :meth:`project`."""
@@ -93,6 +98,9 @@ class Ball(ConvexSet):
     def radius(self, t: float = 0.0) -> float:
         r = self._r(t)
         return float(r) if r.ndim == 0 else r
+
+    def _accepts_batches(self):
+        return _own(self, Ball)
 
     def project(self, x, t=0.0):
         # points inside are returned unchanged (not as c + (x - c), which may differ in the last bit)
@@ -155,6 +163,9 @@ class Box(ConvexSet):
     def upper(self, t: float = 0.0) -> np.ndarray:
         return self._hi(t)
 
+    def _accepts_batches(self):
+        return _own(self, Box)
+
     def project(self, x, t=0.0):
         return _mn(_mx(np.asarray(x, dtype=float), self._lo(t)), self._hi(t))
 
@@ -205,6 +216,9 @@ class HalfSpace(ConvexSet):
 
     def offset(self, t: float = 0.0) -> float:
         return float(self._b(t))
+
+    def _accepts_batches(self):
+        return _own(self, HalfSpace)
 
     def project(self, x, t=0.0):
         # inner products row by row (dot_rows, not x @ a): the same summation for a point and a batch row
@@ -277,6 +291,9 @@ class Polyhedron(ConvexSet):
             ok &= np.all(dot_rows(x[..., None, :], A) == b, axis=-1)
         return ok
 
+    def _accepts_batches(self):
+        return _own(self, Polyhedron)
+
     def project(self, x, t=0.0):
         """Points inside are returned as they are; the others by a KKT-verified QP each.
 
@@ -312,6 +329,9 @@ class Translated(ConvexSet):
 
     def shift(self, t: float = 0.0) -> np.ndarray:
         return self._c(t)
+
+    def _accepts_batches(self):
+        return _own(self, Translated) and self.S._accepts_batches()
 
     def project(self, x, t=0.0):
         c = self._c(t)

@@ -208,6 +208,9 @@ class LCSOperator(Operator):
             sm = self._mats[lam] = self.system.step_matrices(lam, 1.0, None)
         return sm
 
+    def _accepts_batches(self):
+        return type(self).resolvent is LCSOperator.resolvent
+
     def resolvent(self, x, lam, t=0.0):
         x = np.asarray(x, dtype=float)
         if x.ndim == 2:
