@@ -17,10 +17,32 @@ def python_blocks(section: str) -> list[str]:
     return re.findall(r"```python\n(.*?)```", match.group(1), re.S)
 
 
+#: ``print(...)  # what it prints`` on a line of its own: the comment is a claim about the output
+PRINTED = re.compile(r"^print\((?P<args>.*)\)\s+#\s*(?P<claim>.+?)\s*$")
+
+
+def with_claims_checked(block: str) -> str:
+    """The block with every ``print(...)  # claim`` line turned into a call that prints and asserts that the
+    printed line is the claim (the README's quoted output stays what the code prints)."""
+    out = []
+    for line in block.splitlines():
+        m = PRINTED.match(line)
+        out.append(f"_printed_as_claimed(({m['args']},), {m['claim']!r})" if m else line)
+    return "\n".join(out)
+
+
+def _printed_as_claimed(args: tuple, claim: str) -> None:
+    text = " ".join(map(str, args))
+    print(text)
+    assert text == claim, f"README claims {claim!r}, the code prints {text!r}"
+
+
 @pytest.mark.parametrize("section", ["Verify your own solver", "The solver core"])
 def test_readme_examples_run(section):
     blocks = python_blocks(section)
     assert blocks
-    namespace: dict = {}
+    namespace: dict = {"_printed_as_claimed": _printed_as_claimed}
+    claims = sum(bool(PRINTED.match(line)) for block in blocks for line in block.splitlines())
     for block in blocks:
-        exec(compile(block, f"README.md ({section})", "exec"), namespace)
+        exec(compile(with_claims_checked(block), f"README.md ({section})", "exec"), namespace)
+    assert section != "Verify your own solver" or claims >= 3
