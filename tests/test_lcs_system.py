@@ -131,3 +131,15 @@ def test_least_norm_growth_on_random_passive_systems():
     (r,) = check_hypotheses(LinearRelationSystem([[-1.0]], [[1.0]], [[1.0]], [[1.0]], Relay()), 1.0
                             ).by_check("lcs.least_norm_growth")
     assert r.status == "passed" and "exact" in r.message
+
+
+def test_membership_with_a_negligible_entry_in_D():
+    """ẋ₂ = z₁, w = (x₂ + z₁/2 + 1, 1.4e-37 z₂ + 1): at x = 0, η = (1, 1) > 0 gives z = 0, so 0 ∈ H(0) and
+    H^0(0) = 0.  The 1.4e-37 entry once made the multiplier selection return z = (-0.67, 0) and contains
+    answer False (found by the Section 7 operator property of properties/laws_operators.py)."""
+    D = np.array([[0.5, 0.0], [0.0, 1.4411277378133533e-37]])
+    S = LinearRelationSystem(np.zeros((2, 2)), [[0.0, 0.0], [1.0, 0.0]], [[0.0, 1.0], [0.0, 0.0]], D,
+                             Complementarity(), v=[1.0, 1.0])
+    H = S.operator()
+    assert H.contains(np.zeros(2), np.zeros(2)) and np.allclose(H.min_norm(np.zeros(2)), 0.0, atol=1e-14)
+    assert not H.contains(np.zeros(2), np.array([0.0, 0.5]))

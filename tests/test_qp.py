@@ -81,6 +81,10 @@ def test_zero_rows_are_dropped_or_prove_infeasibility():
     np.testing.assert_allclose(solve_qp(np.eye(2), [1.0, -1.0], G, [0.0, 0.0]), [0.0, 1.0], atol=1e-12)
     with pytest.raises(InfeasibleStep, match="zero constraint row"):
         solve_qp(np.eye(2), [1.0, -1.0], G, [-1.0, 0.0])
+    # -5e-17 against data of size 1 (the caller's scale) is rounding: the row holds; as exact data it fails
+    np.testing.assert_allclose(solve_qp(np.eye(2), [1.0, -1.0], G, [-5e-17, 0.0], scale=1.0), [0.0, 1.0], atol=1e-12)
+    with pytest.raises(InfeasibleStep, match="zero constraint row"):
+        solve_qp(np.zeros((1, 1)), [0.0], np.zeros((1, 1)), [-5e-17])
     with pytest.raises(InfeasibleStep, match="zero constraint row"):
         solve_qp(np.eye(2), [1.0, -1.0], None, None, np.zeros((1, 2)), [1.0])
 
@@ -109,3 +113,14 @@ def test_a_point_near_a_bound_that_its_multipliers_treat_as_active_is_rejected()
     assert rep.primal <= 1e-12 and rep.dual <= 1e-12 and rep.comp > 1e-8 and not rep.ok
     z = solve_qp(P, q, G, h)
     assert z[0] == pytest.approx(0.464, rel=1e-12) and abs(z[1]) <= 1e-12
+
+
+def test_a_half_space_far_beyond_the_data_does_not_set_the_units():
+    """z ≥ 0, z1 + z2 = 0 and 1.4e-37·z2 ≥ -1 (the LCP row of a matrix with a 1.4e-37 entry): the last is a
+    half-space 7e36 from the origin.  Taken as the unit of the solve it made every other constraint
+    unresolvable and a verified answer of -0.67 for z1 (the minimiser is 0)."""
+    G = np.array([[-1.0, 0.0], [0.0, -1.0], [0.0, -1.4411277378133533e-37]])
+    z = solve_qp(np.diag([1.0, 0.0]), [0.0, 0.0], G, [0.0, 0.0, 1.0], np.array([[1.0, 1.0]]), [0.0])
+    np.testing.assert_allclose(z, [0.0, 0.0], atol=1e-12)
+    z = solve_qp(np.eye(2), [-1.0, -2.0], G, [0.0, 0.0, 1.0])       # the far row never binds
+    np.testing.assert_allclose(z, [1.0, 2.0], rtol=1e-12)

@@ -115,22 +115,36 @@ class ScaledQP:
     scale: float
 
 
-def _unit_rows(E, e, kind):
+def _unit_rows(E, e, kind, ref):
     """Rows of ``E`` scaled to unit length (with ``e``); zero rows dropped after checking ``0 ≤ e``
-    (inequalities) or ``0 = e`` (equalities) — a zero row with the wrong sign is an empty feasible set."""
+    (inequalities) or ``0 = e`` (equalities) up to ``QP_RTOL·ref`` (``ref`` the size of the data) — a zero
+    row whose right-hand side has the wrong sign beyond rounding is an empty feasible set."""
     if E is None:
         return None, None
     norms = np.linalg.norm(E, axis=1)
     zero = norms == 0.0
     if np.any(zero):
-        bad = e[zero] < 0 if kind == "<=" else e[zero] != 0
+        slack = QP_RTOL * ref
+        bad = e[zero] < -slack if kind == "<=" else np.abs(e[zero]) > slack
         if np.any(bad):
             raise InfeasibleStep(f"the QP has a zero constraint row with right-hand side "
                                  f"{e[zero][bad][0]:.3g} ({'0 <= h' if kind == '<=' else '0 = b'} fails)")
         E, e, norms = E[~zero], e[~zero], norms[~zero]
+    E, e = E / norms[:, None], e / norms
+    if kind == "<=":   # a half-space farther than FAR·ref from the origin binds no point of the data's scale
+        near = e <= FAR * ref
+        E, e = E[near], e[near]
     if E.shape[0] == 0:
         return None, None
-    return E / norms[:, None], e / norms
+    return E, e
+
+
+#: an inequality whose unit-normal form ``⟨g, z⟩ ≤ d`` has ``d > FAR·ref`` (``ref`` the size of the data) is
+#: dropped: a half-space at ``1/ε`` times the data's size from the origin contains every point the solve can
+#: represent at that size.  Kept, it sets the units (``s = d``) and every other constraint falls below their
+#: resolution: the row ``1.4e-37 z₂ ≥ -1`` of an LCP whose matrix has a 1.4e-37 entry made ``s = 7e36`` and
+#: turned a verified ``y = -1e-37`` into a multiplier ``z = -0.67`` (found by the Section 7 operator property)
+FAR = 1.0 / float(np.finfo(float).eps)
 
 
 def equilibrate(P, q, G, h, A, b, scale: float | None = None) -> ScaledQP:
@@ -143,9 +157,12 @@ def equilibrate(P, q, G, h, A, b, scale: float | None = None) -> ScaledQP:
 
         min ½ yᵀ(P/p)y + (q/(p s))ᵀy   s.t.  (G/‖G_i‖)y ≤ h/(‖G_i‖ s),  (A/‖A_i‖)y = b/(‖A_i‖ s).
     """
-    G, h = _unit_rows(G, h, "<=")
-    A, b = _unit_rows(A, b, "=")
     p = float(np.abs(P).max(initial=0.0)) or 1.0
+    ref = max(float(np.abs(h).max(initial=0.0)) if h is not None else 0.0,
+              float(np.abs(b).max(initial=0.0)) if b is not None else 0.0,
+              float(np.abs(q).max(initial=0.0)) / p, 0.0 if scale is None else float(scale))
+    G, h = _unit_rows(G, h, "<=", ref)
+    A, b = _unit_rows(A, b, "=", ref)
     s = max(float(np.abs(h).max(initial=0.0)) if h is not None else 0.0,
             float(np.abs(b).max(initial=0.0)) if b is not None else 0.0,
             float(np.abs(q).max(initial=0.0)) / p, 0.0 if scale is None else float(scale))
