@@ -20,6 +20,7 @@ Bounds (so that conditioning stays moderate and the tolerances of :mod:`verimono
   ``sup_{z ∈ S(s)} dist(z, S(t)) ≤ φ(t) - φ(s)``;
 * passive systems: KYP data with entries in ``[-2, 2]``, storage ``K = U diag(k) Uᵀ`` with
   ``k ∈ {0} ∪ [1/4, 4]``;
+* matrix entries are 0 or at least ``ENTRY_FLOOR = 1e-3`` in magnitude (no rounding-sized entries);
 * grids: ``1 ≤ K ≤ 64`` cells, nonuniform ones with step ratios ``≤ 100``.
 
 Drawn objects have readable reprs (numbers rounded to 4 digits) so counterexamples can be read.
@@ -66,8 +67,19 @@ def _vec(n: int, lo: float, hi: float) -> st.SearchStrategy[np.ndarray]:
     return st.lists(floats(lo, hi), min_size=n, max_size=n).map(lambda v: np.array(v, dtype=float))
 
 
+#: matrix entries are 0 or at least this in magnitude (entries are drawn in ranges of size ~1): an entry at
+#: the size of rounding is no test of an operator, only of float64 — a drawn 1.2e-19 in G made
+#: D = -GGᵀ/2 carry 1.4e-37, an operator of slope 3e37 whose resolvent rounds onto the far side of its graph
+ENTRY_FLOOR = 1e-3
+
+
+def _entry(v: float) -> float:
+    return 0.0 if abs(v) < ENTRY_FLOOR else v
+
+
 def _mat(r: int, c: int, lo: float, hi: float) -> st.SearchStrategy[np.ndarray]:
-    return st.lists(floats(lo, hi), min_size=r * c, max_size=r * c).map(
+    """Matrices with entries in ``[lo, hi]`` that are 0 or at least ``ENTRY_FLOOR`` in magnitude."""
+    return st.lists(floats(lo, hi).map(_entry), min_size=r * c, max_size=r * c).map(
         lambda v: np.array(v, dtype=float).reshape(r, c))
 
 
@@ -198,18 +210,29 @@ def psd_matrices(n: int | None = None, rank: int | None = None,
 def monotone_linear_operators(n: int | None = None, time_dependent: bool | None = None
                               ) -> st.SearchStrategy[Linear]:
     """``Linear(M(t))`` with ``M(t) = M0 + g(t) M1``, ``M0, M1`` from :func:`psd_matrices` and
-    ``g ∈ {0, t, t², 1 + sin ωt} ≥ 0`` on ``t ≥ 0``, so ``M(t) + M(t)ᵀ ⪰ 0`` for every ``t ≥ 0``."""
+    ``g ∈ {0, t, t², 1 + sin ωt} ≥ 0`` on ``t ≥ 0``, so ``M(t) + M(t)ᵀ ⪰ 0`` for every ``t ≥ 0``
+    (the operators of :func:`stated_linear_operators`)."""
+    return stated_linear_operators(n, time_dependent).map(_operator_of)
+
+
+def stated_linear_operators(n: int | None = None, time_dependent: bool | None = None
+                            ) -> st.SearchStrategy["Stated"]:
+    """:func:`monotone_linear_operators` with their assumptions: ``dom F = R^n`` so (A3) with ``φ ≡ 0``;
+    (LG) with ``σ(t) = ‖M(t)‖₂`` (``|F^0(t,x)| = |M(t)x| ≤ ‖M(t)‖₂|x|``); (YB) with ``θ ≡ 0`` for a constant
+    ``M`` (Prop. ``prop:maxmon-resolvent-Yosida`` vi), not stated for a moving one (its Yosida values move by
+    ``O(λ|x|)``, not uniformly in ``x``)."""
     @st.composite
     def _draw(draw):
         k = draw(_dim(n), label="n")
         M0 = draw(psd_matrices(k), label="M0")
         td = draw(st.booleans(), label="time_dependent") if time_dependent is None else time_dependent
         if not td:
-            return Linear(M0, name=f"Linear[M={_fmt(M0)}]")
+            return Stated(Linear(M0, name=f"Linear[M={_fmt(M0)}]"), phi=_ZERO,
+                          sigma=_Const(float(np.linalg.norm(M0, 2))), theta=_ZERO)
         M1 = draw(psd_matrices(k), label="M1")
         g = draw(st.sampled_from(["t", "t^2", "1+sin(t)"]), label="g")
         fn = _MatrixPath(M0, M1, g)
-        return Linear(fn, name=f"Linear[M(t)={fn!r}]")
+        return Stated(Linear(fn, name=f"Linear[M(t)={fn!r}]"), phi=_ZERO, sigma=_NormOf(fn))
     return _draw()
 
 
@@ -231,6 +254,123 @@ class _MatrixPath:
 
     def __repr__(self) -> str:
         return f"{_fmt(self.M0)} + {self.g}·{_fmt(self.M1)}"
+
+
+# -- the functions of the paper's assumptions -----------------------------------------------------
+
+@dataclasses.dataclass(frozen=True)
+class _Const:
+    """``t ↦ value``."""
+
+    value: float
+
+    def __call__(self, t: float) -> float:
+        return self.value
+
+    def __repr__(self) -> str:
+        return f"{self.value:.4g}"
+
+
+@dataclasses.dataclass(frozen=True)
+class _Rate:
+    """``t ↦ rate·t`` (nondecreasing for ``rate ≥ 0``; ``0`` is the constant function 0)."""
+
+    rate: float
+
+    def __call__(self, t: float) -> float:
+        return self.rate * float(t)
+
+    def __repr__(self) -> str:
+        return "0" if self.rate == 0 else f"{self.rate:.4g}·t"
+
+
+_ZERO = _Rate(0.0)
+
+
+@dataclasses.dataclass(frozen=True)
+class _NormOf:
+    """``t ↦ scale·|p(t)|`` (the spectral norm for a matrix-valued ``p``)."""
+
+    p: Any
+    scale: float = 1.0
+
+    def __call__(self, t: float) -> float:
+        v = np.asarray(self.p(t), dtype=float)
+        return self.scale * float(np.linalg.norm(v, 2) if v.ndim == 2 else np.linalg.norm(v))
+
+    def __repr__(self) -> str:
+        return ("" if self.scale == 1.0 else f"{self.scale:.4g}·") + f"|{self.p!r}|"
+
+
+@dataclasses.dataclass(frozen=True)
+class _PlusRate:
+    """``t ↦ f(t) + rate·t``."""
+
+    f: Any
+    rate: float
+
+    def __call__(self, t: float) -> float:
+        return float(self.f(t)) + self.rate * float(t)
+
+    def __repr__(self) -> str:
+        return f"{self.f!r} + {self.rate:.4g}·t"
+
+
+@dataclasses.dataclass(frozen=True)
+class _Grown:
+    """``t ↦ σ(t)(1 + rate·t)``."""
+
+    sigma: Any
+    rate: float
+
+    def __call__(self, t: float) -> float:
+        return float(self.sigma(t)) * (1.0 + self.rate * float(t))
+
+    def __repr__(self) -> str:
+        return f"({self.sigma!r})(1 + {self.rate:.4g}·t)"
+
+
+def _operator_of(stated: "Stated") -> Operator:
+    return stated.operator
+
+
+@dataclasses.dataclass(frozen=True)
+class Stated:
+    """An operator with the functions of the paper's assumptions that hold for it by construction on
+    ``t ≥ 0``: ``phi`` of (A3), ``sigma`` of (LG), ``theta`` of (YB) (nondecreasing, as the assumptions
+    require).  ``None``: not stated — the assumption fails (``(LG)`` for the log-barrier, ``(YB)`` for a
+    moving set) or its constant is not explicit; the laws needing it then skip with that reason.
+    ``system``: the :class:`verimono.lcs.LinearRelationSystem` of a Section 7 operator ``H``.
+    """
+
+    operator: Operator
+    phi: Any = None
+    sigma: Any = None
+    theta: Any = None
+    system: Any = None
+
+    @property
+    def dim(self) -> int:
+        return self.operator.dim
+
+    def assumptions(self) -> dict[str, Any]:
+        """``phi``/``sigma``/``theta`` as keyword arguments of :class:`verimono.Problem`."""
+        return {"phi": self.phi, "sigma": self.sigma, "theta": self.theta}
+
+    def shifted(self, u: "ACInput") -> "Stated":
+        """``G(t, ξ) = F(t, ξ + Φ(t))``, ``Φ = ∫_0^t u`` (lemma ``l:extinput``), with ``M = sup|u|`` so that
+        ``|Φ(t) - Φ(s)| ≤ M(t - s)`` and ``|Φ(t)| ≤ Mt``: (A3) with ``φ + Mt`` (``dom G(t) = dom F(t) - Φ(t)``);
+        (LG) with ``σ(t)(1 + Mt)`` (``|G^0(t,ξ)| ≤ σ(t)(1 + |ξ| + |Φ(t)|)``).  (YB) is not stated: it fails
+        in general — ``Y^G_λ(s+λ, ξ) = Y^F_λ(s+λ, ξ + Φ(s+λ))`` moves by up to ``|Φ(s+λ) - Φ(s)|/λ ≈ |u|``,
+        an amount that does not vanish with ``λ`` (``F = ∂|·|``, ``u = 1``: ``|Y^G_λ(λ, 0)| = 1`` while
+        ``G^0(0, 0) = 0``, for every ``λ ≤ 1``)."""
+        M = u.bound
+        G = Shifted(self.operator, u.integral, name=f"Shifted[{self.operator.name}, Φ=∫{u!r}]")
+        return Stated(G, phi=None if self.phi is None else _PlusRate(self.phi, M),
+                      sigma=None if self.sigma is None else _Grown(self.sigma, M))
+
+    def __repr__(self) -> str:
+        return f"Stated({self.operator.name}, φ={self.phi!r}, σ={self.sigma!r}, θ={self.theta!r})"
 
 
 # -- convex sets ------------------------------------------------------------------------------------
@@ -361,7 +501,33 @@ def subdifferential_operators(n: int | None = None, time_dependent: bool | None 
                               ) -> st.SearchStrategy[Operator]:
     """Subdifferentials of convex functions: ``∂(c‖·‖₂)``, ``∂(Σ cᵢ|xᵢ|)``, ``∂(-c Σ ln xᵢ)``,
     ``N_S = ∂ι_S`` (static sets) and ``∇(½xᵀPx)`` with ``P = Pᵀ ⪰ 0``.  Weights ``c(t) ≥ 0``
-    (``> 0`` for the barrier) are constant, increasing affine or sinusoidal."""
+    (``> 0`` for the barrier) are constant, increasing affine or sinusoidal (the operators of
+    :func:`stated_subdifferential_operators`)."""
+    return stated_subdifferential_operators(n, time_dependent).map(_operator_of)
+
+
+#: the Yosida values of the log-barrier ``-c/x`` move with ``c`` by at most ``LOGBARRIER_YB · L^{3/2}/c_min · λ``
+#: per component (``L = Lip(c)``): ``max_r (Lλ/r - λc²/r³) = 2(Lλ)^{3/2}/(3√3 √λ c)`` — see
+#: :func:`stated_subdifferential_operators`
+LOGBARRIER_YB = 2.0 / (3.0 * np.sqrt(3.0))
+
+
+def stated_subdifferential_operators(n: int | None = None, time_dependent: bool | None = None
+                                     ) -> st.SearchStrategy[Stated]:
+    """:func:`subdifferential_operators` with their assumptions (all domains are static: φ ≡ 0).
+
+    * ``∂(c(t)|·|)``: ``|F^0| ≤ c`` so σ = c; (YB) with ``θ = Lip(c)·t``: ``|Y_λ(s+λ,x)| = min(|x|/λ,
+      c(s+λ)) ≤ c(s+λ) - c(s) + |F^0(s,x)|`` for ``x ≠ 0`` (0 at 0) — the paper's example ``g = t|x|``,
+      ``θ(s) = s``; a sinusoidal ``c`` is not monotone, ``θ`` is then its Lipschitz majorant.
+    * ``∂(Σ c(t)|x_i|)``: σ = ``|c(t) 1|``; ``Y_λ`` is componentwise ``min(|x_i|/λ, c) sgn x_i``, so (YB) with
+      ``θ = √n Lip(c) t``.
+    * ``∂(-c(t) Σ ln x_i)``: (LG) fails (``|F^0| = c/x`` is unbounded near the boundary).  (YB): per
+      component ``|Y_λ| = f(c) = (√(x² + 4λc) - x)/(2λ)`` is concave in ``c`` with ``f' = 1/r``,
+      ``r = √(x² + 4λc)``, and ``c/x - f(c) = 4λc²/(x(r + x)²) ≥ λc²/r³``; with ``c(s+λ) - c(s) ≤ Lλ``,
+      ``|Y_λ(s+λ,x)_i| - |F^0(s,x)_i| ≤ Lλ/r - λc²/r³ ≤ LOGBARRIER_YB·L^{3/2}λ/c_min``, so
+      ``θ = √n·LOGBARRIER_YB·L^{3/2}/c_min·t``.
+    * ``N_S`` (static), ``∇(½xᵀPx)``: static, ``θ ≡ 0``; σ = 0 and ``‖P‖₂``.
+    """
     @st.composite
     def _draw(draw):
         k = draw(_dim(n), label="n")
@@ -369,21 +535,60 @@ def subdifferential_operators(n: int | None = None, time_dependent: bool | None 
         td = draw(st.booleans(), label="time_dependent") if time_dependent is None else time_dependent
         if kind == "norm":
             c = draw(_nonneg_time_functions(0.0, 5.0) if td else floats(0.0, 5.0).map(lambda v: TimeFunction(v, 0.0)))
-            return NormSubdifferential(c if td else c.a, k, name=f"NormSubdifferential[c={c!r}, n={k}]")
+            op = NormSubdifferential(c if td else c.a, k, name=f"NormSubdifferential[c={c!r}, n={k}]")
+            return Stated(op, phi=_ZERO, sigma=_NormOf(c), theta=_Rate(c.lipschitz))
         if kind == "l1":
             if td:
                 c = draw(_nonneg_time_functions(0.0, 5.0))
-                return L1Subdifferential(c, k, name=f"L1Subdifferential[c={c!r}, n={k}]")
+                op = L1Subdifferential(c, k, name=f"L1Subdifferential[c={c!r}, n={k}]")
+                root = float(np.sqrt(k))
+                return Stated(op, phi=_ZERO, sigma=_NormOf(c, root), theta=_Rate(root * c.lipschitz))
             c = draw(_vec(k, 0.0, 5.0))
-            return L1Subdifferential(c, k, name=f"L1Subdifferential[c={_fmt(c)}]")
+            return Stated(L1Subdifferential(c, k, name=f"L1Subdifferential[c={_fmt(c)}]"), phi=_ZERO,
+                          sigma=_Const(float(np.linalg.norm(c))), theta=_ZERO)
         if kind == "logbarrier":
             c = draw(_nonneg_time_functions(0.1, 5.0) if td else floats(0.1, 5.0).map(lambda v: TimeFunction(v, 0.0)))
-            return LogBarrier(c if td else c.a, k, name=f"LogBarrier[c={c!r}, n={k}]")
+            op = LogBarrier(c if td else c.a, k, name=f"LogBarrier[c={c!r}, n={k}]")
+            cmin = float(c.a) - (abs(float(c.b)) if c.kind == "sin" else 0.0)
+            rate = np.sqrt(k) * LOGBARRIER_YB * c.lipschitz ** 1.5 / cmin
+            return Stated(op, phi=_ZERO, theta=_Rate(float(rate)))
         if kind == "quadratic":
             P = draw(psd_matrices(k, symmetric=True))
-            return Linear(P, name=f"Gradient[P={_fmt(P)}]")
+            return Stated(Linear(P, name=f"Gradient[P={_fmt(P)}]"), phi=_ZERO,
+                          sigma=_Const(float(np.linalg.norm(P, 2))), theta=_ZERO)
         S = draw(convex_sets(k))
-        return NormalCone(S, name=f"NormalCone[{S.name}]")
+        return Stated(NormalCone(S, name=f"NormalCone[{S.name}]"), phi=_ZERO, sigma=_ZERO, theta=_ZERO)
+    return _draw()
+
+
+def stated_moving_set_normal_cones(n: int | None = None, T: float = 1.0) -> st.SearchStrategy[Stated]:
+    """``N_{S(t)}`` for :func:`moving_sets`: (A3) with their ``φ = rate·t``; ``F^0 = 0`` on ``S(t)`` so (LG)
+    with ``σ ≡ 0``; (YB) only for a set that does not move (``θ ≡ 0``) — for ``rate > 0``,
+    ``|Y_λ(s+λ, x)| = dist(x, S(s+λ))/λ`` is of order ``rate`` at ``F^0 = 0``, which no ``θ`` increment
+    ``θ(s+λ) - θ(s) → 0`` bounds: (YB) fails and is not stated."""
+    def build(ms: MovingSet) -> Stated:
+        op = NormalCone(ms.set, name=f"NormalCone[{ms.set.name}]")
+        return Stated(op, phi=_Rate(ms.rate), sigma=_ZERO, theta=_ZERO if ms.rate == 0 else None)
+    return moving_sets(n, T).map(build)
+
+
+def stated_operators(n: int | None = None, T: float = 1.0,
+                     families: tuple[str, ...] = ("linear", "subdifferential", "moving_set"),
+                     shifted: bool | None = None) -> st.SearchStrategy[Stated]:
+    """An operator of one of ``families`` with its assumptions (:class:`Stated`), optionally shifted by
+    ``Φ = ∫_0^t u`` for an absolutely continuous ``u`` of :func:`ac_inputs` (:meth:`Stated.shifted`;
+    ``shifted=None`` draws it)."""
+    makers = {"linear": lambda k: stated_linear_operators(k),
+              "subdifferential": lambda k: stated_subdifferential_operators(k),
+              "moving_set": lambda k: stated_moving_set_normal_cones(k, T)}
+
+    @st.composite
+    def _draw(draw):
+        k = draw(_dim(n), label="n")
+        base = draw(st.one_of(*(makers[f](k) for f in families)), label="F")
+        if draw(st.booleans(), label="shifted") if shifted is None else shifted:
+            return base.shifted(draw(ac_inputs(k, T), label="u"))
+        return base
     return _draw()
 
 
@@ -391,18 +596,8 @@ def maximal_monotone_operators(n: int | None = None, T: float = 1.0) -> st.Searc
     """Every family: monotone linear maps (also time-dependent), subdifferentials (also with moving
     weights), normal cones of moving sets (the sweeping process, with (A3) from :func:`moving_sets`) and
     ``Shifted(F, Φ)`` (the input shift of Section 6) of any of these with ``Φ(t) = ∫_0^t u`` for an
-    absolutely continuous ``u`` from :func:`ac_inputs`."""
-    @st.composite
-    def _draw(draw):
-        k = draw(_dim(n), label="n")
-        base = draw(st.one_of(monotone_linear_operators(k), subdifferential_operators(k),
-                                   moving_sets(k, T).map(lambda m: NormalCone(m.set, name=f"NormalCone[{m.set.name}]"))),
-                         label="F")
-        if draw(st.booleans(), label="shifted"):
-            u = draw(ac_inputs(k, T), label="u")
-            return Shifted(base, u.integral, name=f"Shifted[{base.name}, Φ=∫{u!r}]")
-        return base
-    return _draw()
+    absolutely continuous ``u`` from :func:`ac_inputs` (the operators of :func:`stated_operators`)."""
+    return stated_operators(n, T).map(_operator_of)
 
 
 def catalog(n: int = 2) -> list[Operator]:
@@ -535,6 +730,57 @@ def passive_systems(n: int | None = None, m: int | None = None, storage: str | N
     return _draw()
 
 
+#: smallest ``μ = λ_min((D + Dᵀ)/2)`` for which :func:`lcs_operators` states σ of (LG) through ``|z| ≤ |q|/μ``:
+#: eigvalsh is accurate to ~1e-15‖D‖ (‖D‖ ≤ 8 here), so a smaller computed μ cannot be told from a singular
+#: ``D + Dᵀ`` (where the constant of Theorem ``thm: linear case`` vi is not explicit), and σ ~ 1/μ would
+#: exceed 10^6 — a bound that says nothing
+LCS_MU_FLOOR = 1e-6
+
+
+def lcs_operators(n: int | None = None, m: int | None = None, moving_v: bool | None = False
+                  ) -> st.SearchStrategy[Stated]:
+    """``H(t,·)`` of a linear complementarity system (Section 7): ``Σ(A, B, C, D)`` from
+    :func:`passive_systems` with storage ``K = I`` (Theorem ``thm: linear case`` i), the complementarity
+    relation (ii, a normal cone of ``R^m_+``) and ``v(t) ≥ v_0 > 0`` entrywise (``v_0 ∈ [1/4, 2]^m``;
+    constant, or ``v_0 + |b| + b sin ωt`` with ``moving_v``): ``x = 0`` gives ``Cx + v(t) ∈ int R^m_+ ⊂
+    int im(𝓟 + D)``, so ``im C ∩ ri(im(𝓟 + D) − v(t)) ≠ ∅`` (iii) holds by design and ``0 ∈ dom H(t,·)``;
+    ``v`` is bounded and absolutely continuous (iv).  Dimensions ``n ≤ 3``, ``m ≤ 2`` unless given.
+
+    Stated: for constant ``v``, ``H`` is static: (A3) with ``φ ≡ 0``, (YB) with ``θ ≡ 0``.  (LG) when
+    ``μ = λ_min((D + Dᵀ)/2) > LCS_MU_FLOOR``: the multiplier of ``0 ≤ z ⊥ Dz + q ≥ 0`` has
+    ``μ|z|² ≤ zᵀDz = −zᵀq``, so ``|H^0(t,x)| ≤ ‖A‖|x| + ‖B‖(‖C‖|x| + |v|)/μ ≤ σ(1 + |x|)`` with
+    ``σ = ‖A‖ + ‖B‖(‖C‖ + sup|v|)/μ``.  A moving ``v`` moves ``dom H`` by a Hoffman-constant multiple of
+    ``|v'|``: φ and θ are then not stated.
+    """
+    from .lcs import Complementarity, LinearRelationSystem
+
+    @st.composite
+    def _draw(draw):
+        k_n = draw(st.integers(1, 3), label="n") if n is None else int(n)
+        k_m = draw(st.integers(1, 2), label="m") if m is None else int(m)
+        ps = draw(passive_systems(k_n, k_m, storage="identity"), label="Σ")
+        v0 = draw(_vec(k_m, 0.25, 2.0), label="v0")
+        mv = draw(st.booleans(), label="moving v") if moving_v is None else moving_v
+        if mv:
+            b = draw(_vec(k_m, -1.0, 1.0), label="v1")
+            w = draw(floats(0.5, 2 * np.pi), label="ω")
+            v = TimeFunction(v0 + np.abs(b), b, "sin", w)
+            vmax = float(np.linalg.norm(v0 + np.abs(b)) + np.linalg.norm(b))
+        else:
+            v, vmax = v0, float(np.linalg.norm(v0))
+        vtext = repr(v) if mv else _fmt(v)
+        name = f"LCS[A={_fmt(ps.A)}, B={_fmt(ps.B)}, C={_fmt(ps.C)}, D={_fmt(ps.D)}, v={vtext}]"
+        system = LinearRelationSystem(ps.A, ps.B, ps.C, ps.D, Complementarity(), v=v, name=name)
+        mu = float(np.linalg.eigvalsh(0.5 * (ps.D + ps.D.T))[0])
+        sigma = None
+        if mu > LCS_MU_FLOOR:
+            nA, nB, nC = (float(np.linalg.norm(X, 2)) for X in (ps.A, ps.B, ps.C))
+            sigma = _Const(nA + nB * (nC + vmax) / mu)
+        static = None if mv else _ZERO
+        return Stated(system.operator(), phi=static, sigma=sigma, theta=static, system=system)
+    return _draw()
+
+
 # -- inputs and grids -------------------------------------------------------------------------------
 
 @dataclasses.dataclass(frozen=True)
@@ -611,6 +857,18 @@ class ACInput:
         """Bound on the total variation ``∫_0^T |u'|``."""
         return self.lipschitz * self.T
 
+    @property
+    def bound(self) -> float:
+        """``M ≥ sup_{[0, T]} |u|``: exact at the ends for an affine ``u`` and at the knots for a piecewise
+        linear one (``|u|`` is convex on each piece), ``|a| + |b|`` for a sinusoid."""
+        if self.kind == "const":
+            return float(np.linalg.norm(self.a))
+        if self.kind == "affine":
+            return max(float(np.linalg.norm(self.a)), float(np.linalg.norm(self.a + self.T * self.b)))
+        if self.kind == "sin":
+            return float(np.linalg.norm(self.a)) + float(np.linalg.norm(self.b))
+        return float(np.max(np.linalg.norm(self.values, axis=1)))
+
     def __repr__(self) -> str:
         if self.kind == "const":
             return f"u={_fmt(self.a)}"
@@ -669,5 +927,6 @@ __all__ = [
     "MAX_DIM", "POINT_SCALE", "SET_SCALE", "floats", "points", "step_sizes", "times", "TimeFunction",
     "time_functions", "psd_matrices", "monotone_linear_operators", "convex_sets", "MovingSet", "moving_sets",
     "subdifferential_operators", "maximal_monotone_operators", "catalog", "catalog_operators", "PassiveSystem", "passive_systems",
-    "ACInput", "ac_inputs", "grids",
+    "Stated", "stated_linear_operators", "stated_subdifferential_operators", "stated_moving_set_normal_cones",
+    "stated_operators", "lcs_operators", "LCS_MU_FLOOR", "LOGBARRIER_YB", "ACInput", "ac_inputs", "grids",
 ]
