@@ -106,3 +106,32 @@ def test_my_operator(subject, check): check(subject)
 def test_check_id():
     assert check_id("selections[t|x| (n=1)]") == "selections-t_x_n=1"
     assert check_id("monotone") == "monotone"
+
+
+def test_dropping_a_law_from_the_registry_is_a_shrunk_battery(monkeypatch):
+    """Without min_checks the battery must still be the full registry: len(subjects) × the law table for
+    operators, the references × (order + laws) plus the generated problems × laws for steppers."""
+    import pytest
+
+    from verimono import Linear
+    from verimono.checks import operator_laws, trajectory_laws
+    from verimono.testing import parametrize_with_checks
+    from zoo_steppers import amplifier
+
+    ops = [Linear([[1.0]], name="a"), Linear([[2.0]], name="b")]
+    parametrize_with_checks(ops)                                        # the full battery: fine
+    reduced = {k: v for k, v in operator_laws.OPERATOR_CHECKS.items() if k != "monotone"}
+    monkeypatch.setattr(operator_laws, "OPERATOR_CHECKS", reduced)
+    with pytest.raises(ValueError, match="checks were lost"):
+        parametrize_with_checks(ops)
+    monkeypatch.undo()
+
+    problems = [get("t|x| (n=1)")]
+    parametrize_with_checks([amplifier], problems=problems)
+    full = trajectory_laws.stepper_checks
+
+    def one_less(*args, **kw):
+        return list(full(*args, **kw))[:-1]
+    monkeypatch.setattr(trajectory_laws, "stepper_checks", one_less)
+    with pytest.raises(ValueError, match="checks were lost"):
+        parametrize_with_checks([amplifier], problems=problems)

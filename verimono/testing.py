@@ -28,7 +28,9 @@ reason when every record was skipped — pytest counts the skip and ``-rs`` list
 ``expected_failed_checks`` maps a check name (``"selections"``, the full ``"selections[t|x| (n=1)]"``, or a
 case id) to the reason, and turns those cases into **strict** xfails: a check that starts passing fails the
 run as ``XPASS(strict)``.  A name that matches no check is an error, and so is a subject yielding no
-checks or a battery smaller than ``min_checks``: a battery must not shrink silently.
+checks or a battery smaller than the full registry for its subjects (:func:`registry_size`; ``min_checks``
+may raise that floor): a battery must not shrink silently.  Without ``examples`` the operator laws search
+with the active profile's effort (``dev``/``ci``/``thorough``: :func:`verimono.profiles.get_profile`).
 
 **Counting.**  With this module loaded as a pytest plugin (``-p verimono.testing``, or
 ``from verimono.testing import pytest_configure`` in a ``conftest.py`` as ``properties/conftest.py`` does) the
@@ -109,6 +111,24 @@ def checks_for(subject: Any, *, seed: int | None = None, examples: int | None = 
                     "(a callable stepper(problem, t_grid))")
 
 
+def registry_size(subject: Any, *, problems: Iterable | None = None, generated: int = 4) -> int:
+    """How many checks the full registry gives ``subject`` — counted from the law tables, not from the
+    generator, so that a generator or registry that lost a law shows as a shrunk battery:
+    ``len(operator_laws.LAWS)`` for an operator; for a stepper ``(1 + len(trajectory_laws.CHECKS))`` per
+    reference (``problems``, or the reference catalog) plus ``len(CHECKS)`` per generated problem."""
+    if is_operator(subject):
+        from .checks.operator_laws import LAWS
+
+        return len(LAWS)
+    from .checks.trajectory_laws import CHECKS
+
+    if problems is not None:
+        return len(list(problems)) * (1 + len(CHECKS))
+    from verimono.reference import catalog
+
+    return len(catalog()) * (1 + len(CHECKS)) + int(generated) * len(CHECKS)
+
+
 def _records(out: Any) -> list[CheckResult]:
     if isinstance(out, CheckResult):
         return [out]
@@ -177,11 +197,16 @@ def parametrize_with_checks(subjects: Iterable[Any], expected_failed_checks: Map
     a law (``"selections"``), a full check name (``"selections[t|x| (n=1)]"``) or a case id
     (``"my_stepper-selections-t_x_n=1"``).  Matching cases become strict xfails (``raises=AssertionError``,
     so an exception other than a failed check still fails).  Raises ``ValueError`` at collection when a
-    name matches no check, when a subject has no checks, or when fewer than ``min_checks`` cases result.
+    name matches no check, when a subject has no checks, or when fewer cases result than the full registry
+    gives the subjects (:func:`registry_size`, summed over the subjects) — a battery that silently shrinks
+    is a failure; ``min_checks`` can only raise that floor.
     ``seed``/``examples`` are passed to the operator laws (``seed=None``: a fresh recorded seed per check,
-    ``0`` under a derandomized profile); ``problems``/``generated`` to the stepper battery.
+    ``0`` under a derandomized profile; ``examples=None``: the active profile's effort);
+    ``problems``/``generated`` to the stepper battery.
     """
     subjects = list(subjects)
+    if problems is not None:
+        problems = list(problems)
     if seed is None:
         from .profiles import active_profile
 
@@ -209,9 +234,12 @@ def parametrize_with_checks(subjects: Iterable[Any], expected_failed_checks: Map
     unknown = sorted(all_keys - used)
     if unknown:
         raise ValueError(f"expected_failed_checks names checks that do not exist: {unknown}")
-    if min_checks is not None and len(cases) < min_checks:
-        raise ValueError(f"the battery has {len(cases)} checks, fewer than the {min_checks} declared "
-                         "(min_checks): checks were lost")
+    full = sum(registry_size(s, problems=problems, generated=generated) for s in subjects)
+    floor = full if min_checks is None else max(full, int(min_checks))
+    if len(cases) < floor:
+        why = (f"the full registry for these subjects ({full})" if floor == full
+               else f"the {floor} declared (min_checks)")
+        raise ValueError(f"the battery has {len(cases)} checks, fewer than {why}: checks were lost")
     _BATTERIES.append({"subjects": [subject_name(s) for s in subjects], "cases": len(cases),
                        "xfail": len(used)})
 
@@ -294,5 +322,5 @@ def battery_counts(config: Any) -> dict[str, int] | None:
 
 
 __all__ = ["parametrize_with_checks", "checks_for", "BoundCheck", "describe", "check_id", "is_operator",
-           "subject_name", "register_hypothesis_profiles", "load_hypothesis_profile", "battery_counts",
+           "subject_name", "registry_size", "register_hypothesis_profiles", "load_hypothesis_profile", "battery_counts",
            "BatteryCounter", "pytest_configure"]

@@ -35,12 +35,15 @@ import hypothesis.errors
 from hypothesis import HealthCheck, Phase, Verbosity, given, settings
 from hypothesis import strategies as st
 
+from ..errors import OutsideDomain, VerimonoError
 from ..operators import Operator
 from ..results import FAILED, PASSED, SKIPPED, CheckResult, Report
 from ..strategies import points, step_sizes, times
 from ..tolerances import EPS, LIMIT_FLOOR, STALL_RATIO, STALL_WINDOW, tolerance
 
-#: hypothesis examples per law when ``examples`` is not given
+#: hypothesis examples per law when ``examples`` is not given and the active profile is not one of
+#: verimono's (a user's own hypothesis profile); otherwise the profile's ``law_examples`` governs
+#: (:func:`default_examples`)
 DEFAULT_EXAMPLES = 50
 #: every law's ratio ``lhs / (rhs + slack)`` must not exceed this
 BOUND = 1.0
@@ -109,6 +112,8 @@ class _Eval:
     slack: float
     what: str
     info: dict[str, Any] = dataclasses.field(default_factory=dict)
+    #: the sample cannot decide the law (it neither holds nor fails there): counted, never a pass
+    inconclusive: bool = False
 
     @property
     def ratio(self) -> float:
@@ -293,20 +298,52 @@ def _yosida_limit(op, s):
             return _Eval(gap, 0.0, slack, "|Y_λx| → |F^0(t, x)| as λ → 0 (gap within tolerance)", info)
         if y <= 2 * tx / lam and _only_within_rounding(op, x, np.zeros_like(x), s.t, 2 * tx):
             return _Eval(0.0, 0.0, slack, "|Y_λx| → 0: x is within rounding, not exactly at, a zero of F(t,·) "
-                         "(F^0 is ill-conditioned there; sample inconclusive)", info)
+                         "(F^0 is ill-conditioned there; sample inconclusive)", info, inconclusive=True)
         if lam / 2 < floor:
             break
         lam /= 2
     w = min(STALL_WINDOW, len(gaps) - 1)
-    if w == 0:
-        return _Eval(gaps[-1], gaps[-1], slack, "|Y_λx| → |F^0(t, x)| (no room to halve λ)", info)
+    if w == 0:   # one λ above the rounding floor: the gap can be neither closed nor seen shrinking
+        return _Eval(gaps[-1], gaps[-1], slack, "|Y_λx| → |F^0(t, x)| (no room to halve λ; sample inconclusive)",
+                     info, inconclusive=True)
+    if _kink_within(op, x, s.t, KINK_PROBE * lams[-1] * (1.0 + f0)):
+        return _Eval(0.0, 0.0, slack, f"|Y_λx| → |F^0(t, x)|: F^0 jumps within {KINK_PROBE * lams[-1] * (1.0 + f0):.2g} "
+                     "of x, where the gap closes only below the sweep's rounding floor λ = "
+                     f"{lams[-1]:.3g} (sample inconclusive)", info, inconclusive=True)
     if _closing_below_floor(gaps, 8 * EPS * (1.0 + float(np.max(np.abs(x)))) / lams[-1]):
         return _Eval(0.0, 0.0, slack, "|Y_λx| → |F^0(t, x)|: the gap is still closing, ever faster, at the rounding "
-                     "floor (a kink of F closer to x than λ|F^0| resolves; sample inconclusive)", info)
+                     "floor (a kink of F closer to x than λ|F^0| resolves; sample inconclusive)", info,
+                     inconclusive=True)
     # the gap exceeds the rounding floor: it must at least still be shrinking
     return _Eval(gaps[-1], STALL_RATIO * gaps[-1 - w], _tol(gaps[-1], gaps[-1 - w]),
                  f"|Y_λx| → |F^0(t, x)|: gap ||F^0| - |Y_λx|| above tolerance {slack:.3g} must still shrink over "
                  f"the last {w} halvings down to λ = {lams[-1]:.3g}", info)
+
+
+#: a stalled Yosida gap is inconclusive when F^0 jumps within KINK_PROBE·λ_floor·(1 + |F^0|) of x: at distance
+#: d from a kink of F the gap closes once λ|F^0| ≲ d (soft thresholding: λc < d), so a kink nearer than
+#: that is resolved only below the floor (a 2^-23 offset from a kink of a shifted ∂‖·‖₁, found by a
+#: thorough run); the factor 4 covers the constant of that estimate
+KINK_PROBE = 4.0
+
+
+def _kink_within(op, x: np.ndarray, t: float, delta: float) -> bool:
+    """Whether ``F^0(t, ·)`` jumps (changes by more than half its size) or leaves its domain within ``delta``
+    of ``x``, probed along the coordinate axes and the direction of ``F^0(t, x)``."""
+    f0 = _F0(op, x, t)
+    n0 = _nrm(f0)
+    dirs = list(np.eye(x.size))
+    if n0 > 0:
+        dirs.append(f0 / n0)
+    for d in dirs:
+        for sgn in (1.0, -1.0):
+            try:
+                g = _F0(op, x + sgn * delta * d, t)
+            except (OutsideDomain, VerimonoError, ArithmeticError, ValueError):
+                return True
+            if _nrm(g - f0) > 0.5 * max(n0, _nrm(g)):
+                return True
+    return False
 
 
 def _closing_below_floor(gaps: list[float], noise: float) -> bool:
@@ -349,13 +386,14 @@ def _min_norm_least(op, s):
     info = {"x": x.tolist(), "y": y0.tolist(), "F0": f0.tolist()}
     try:   # y0 must be certified in F(t, x) where that can be tested (else yosida_in_graph fails)
         if not op.contains(x.copy(), y0.copy(), s.t, _tol(x, y0) * (2.0 + 2.0 / s.nu)):
-            return _Eval(0.0, 0.0, 1.0, "uncertified y0 ∉ F(t, x): comparison skipped", info)
+            return _Eval(0.0, 0.0, 1.0, "uncertified y0 ∉ F(t, x) (contains rejects it): sample inconclusive", info,
+                         inconclusive=True)
     except NotImplementedError:
         pass
     slack = 4 * tau / s.nu + _tol(f0)
     if _nrm(f0) > _nrm(y0) + slack and _only_within_rounding(op, x, y0, s.t, _tol(x, y0) * (2.0 + 2.0 / s.nu)):
         return _Eval(0.0, 0.0, 1.0, "y0 ∈ F(t, x') only for x' within rounding of x, near a jump of F^0: "
-                     "comparison inconclusive", info)
+                     "sample inconclusive", info, inconclusive=True)
     return _Eval(_nrm(f0), _nrm(y0), slack, "|F^0(t, x)| ≤ |y| for x = J_νx1 and y = Y_νx1 ∈ F(t, x)", info)
 
 
@@ -413,6 +451,8 @@ class _State:
     fail_sample: Sample | None = None
     fail_eval: _Eval | None = None
     unsupported: str | None = None
+    inconclusive: int = 0
+    inconclusive_what: str = ""
 
 
 def _evaluate(law: Law, op: Operator, s: Sample) -> _Eval:
@@ -433,14 +473,33 @@ def _subject(op: Operator) -> str:
     return getattr(op, "name", None) or repr(op)
 
 
+def default_examples() -> tuple[int, str]:
+    """``(examples per law, profile)`` when ``examples`` is not given: the active profile's ``law_examples``
+    (``dev``/``ci``/``thorough``, :func:`verimono.profiles.active_profile`), else ``DEFAULT_EXAMPLES``."""
+    from ..profiles import UnknownProfile, active_profile, get_profile
+
+    name = active_profile()
+    try:
+        return get_profile(name).law_examples, name
+    except UnknownProfile:
+        return DEFAULT_EXAMPLES, name
+
+
 def run_law(law: Law | str, op: Operator, *, seed: int | None = None, examples: int | None = None,
             horizon: float = 1.0, sample: Sample | dict | None = None) -> CheckResult:
-    """Check one law on ``op`` by hypothesis search (or on one given ``sample``)."""
+    """Check one law on ``op`` by hypothesis search (or on one given ``sample``).
+
+    ``examples=None``: the active profile's effort (:func:`default_examples`).  Inconclusive samples (the
+    law can neither hold nor fail there) are counted in ``details["inconclusive"]``; a record whose every
+    evaluated sample was inconclusive is skipped with the reason, never passed."""
     law = LAWS[law] if isinstance(law, str) else law
     start = time.perf_counter()
     if sample is None:  # the search is seeded (a fresh recorded seed when none is given)
         seed = fresh_seed() if seed is None else int(seed)
-    examples = DEFAULT_EXAMPLES if examples is None else int(examples)
+    profile = None
+    if examples is None:
+        examples, profile = default_examples()
+    examples = int(examples)
     state = _State()
 
     def body(s: Sample, search: bool = True) -> None:
@@ -450,6 +509,10 @@ def run_law(law: Law | str, op: Operator, *, seed: int | None = None, examples: 
             state.unsupported = str(exc) or type(exc).__name__
             return
         state.runs += 1
+        if ev.inconclusive:
+            state.inconclusive += 1
+            state.inconclusive_what = ev.what
+            return
         r = ev.ratio
         if state.worst_eval is None or not r <= state.worst:
             state.worst, state.worst_sample, state.worst_eval = r, s, ev
@@ -484,7 +547,10 @@ def run_law(law: Law | str, op: Operator, *, seed: int | None = None, examples: 
     duration = time.perf_counter() - start
     subject = _subject(op)
     base = dict(check=law.name, subject=subject, seed=seed, duration=duration)
-    details = {"item": law.item, "examples": examples, "evaluations": state.runs, "horizon": horizon}
+    details = {"item": law.item, "examples": examples, "evaluations": state.runs, "horizon": horizon,
+               "inconclusive": state.inconclusive}
+    if profile is not None:
+        details["profile"] = profile
 
     if state.fail_eval is None and state.unsupported is not None:
         return CheckResult(status=SKIPPED, message=f"needs a member the operator lacks: {state.unsupported} "
@@ -498,90 +564,105 @@ def run_law(law: Law | str, op: Operator, *, seed: int | None = None, examples: 
                f"at {s!r}{flaky}")
         return CheckResult(status=FAILED, worst=max(state.worst, ev.ratio), bound=BOUND, counterexample=cex,
                            message=msg, details=details, **base)
+    if state.runs and state.inconclusive == state.runs:
+        return CheckResult(status=SKIPPED, message=f"all {state.runs} samples inconclusive (e.g. "
+                                                   f"{state.inconclusive_what})", details=details, **base)
     if state.worst_sample is not None:
         details["worst_sample"] = state.worst_sample.to_dict()
         details["worst_info"] = {"what": state.worst_eval.what, "lhs": state.worst_eval.lhs,
                                  "rhs": state.worst_eval.rhs, "slack": state.worst_eval.slack}
-    worst = state.worst if state.runs else None
+    worst = state.worst if state.worst_eval is not None else None
+    counted = f"{state.runs} samples" + (f" ({state.inconclusive} inconclusive)" if state.inconclusive else "")
     return CheckResult(status=PASSED, worst=worst, bound=BOUND,
-                       message=f"{state.runs} samples" + (f"; {flaky}" if flaky else ""), details=details, **base)
+                       message=counted + (f"; {flaky}" if flaky else ""), details=details, **base)
 
 
 def check_resolvent_single_valued(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
-    """Items i–ii: ``J_λ`` is defined on all of ``R^n`` and single-valued — two calls on the same ``x``
+    """Proposition prop:maxmon-resolvent-Yosida i–ii:
+    ``J_λ`` is defined on all of ``R^n`` and single-valued — two calls on the same ``x``
     return the same finite point of shape ``(n,)`` and leave ``x`` unchanged (ratio: |difference|/tol)."""
     return run_law("resolvent_single_valued", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
 
 
 def check_resolvent_nonexpansive(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
-    """Item ii: ``|J_λx1 - J_λx2| ≤ |x1 - x2|`` (ratio ``|ΔJ| / (|Δx| + slack)``)."""
+    """Proposition prop:maxmon-resolvent-Yosida ii:
+    ``|J_λx1 - J_λx2| ≤ |x1 - x2|`` (ratio ``|ΔJ| / (|Δx| + slack)``)."""
     return run_law("resolvent_nonexpansive", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
 
 
 def check_resolvent_firmly_nonexpansive(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
-    """Item ii sharpened (equivalent to monotonicity of ``F``, (A1)):
+    """Proposition prop:maxmon-resolvent-Yosida ii (A1):
+    item ii sharpened, equivalent to monotonicity of ``F``:
     ``|J_λx1 - J_λx2|² ≤ ⟨J_λx1 - J_λx2, x1 - x2⟩`` (ratio ``|ΔJ|² / (⟨ΔJ, Δx⟩ + slack)``)."""
     return run_law("resolvent_firmly_nonexpansive", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
 
 
 def check_resolvent_in_domain(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
-    """``J_λx ∈ dom F(t,·)`` (``x = J_λx + λy`` with ``y ∈ F(t, J_λx)``): the projection onto
+    """range J_λ = dom F:
+    ``J_λx ∈ dom F(t,·)`` (``x = J_λx + λy`` with ``y ∈ F(t, J_λx)``): the projection onto
     ``cl dom F(t,·)`` leaves ``J_λx`` in place (needs ``project_domain``; ratio: distance/tol)."""
     return run_law("resolvent_in_domain", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
 
 
 def check_resolvent_identity(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
-    """Resolvent identity ``J_λx = J_μ((μ/λ)x + (1 - μ/λ)J_λx)`` for all ``λ, μ > 0`` (it holds because
+    """The resolvent identity ``J_λx = J_μ((μ/λ)x + (1 - μ/λ)J_λx)`` for all ``λ, μ > 0`` (it holds because
     ``x - J_λx ∈ λF(J_λx)``); catches resolvents with a wrong or stale step size (ratio: |difference|/tol)."""
     return run_law("resolvent_identity", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
 
 
 def check_resolvent_limit(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
-    """Item iii, quantitatively: for ``x ∈ dom F`` and ``y ∈ F(x)``, ``|J_λx - x| ≤ λ|y|`` (nonexpansiveness
+    """Proposition prop:maxmon-resolvent-Yosida iii, quantitatively:
+    for ``x ∈ dom F`` and ``y ∈ F(x)``, ``|J_λx - x| ≤ λ|y|`` (nonexpansiveness
     at ``J_λ(x + λy) = x``), hence ``J_λx → x`` as ``λ → 0``.  Tested at ``x = J_νx1``, ``y = Y_νx1`` over
     ``λ, λ/4, …, λ/4^5`` (ratio ``|J_λx - x| / (λ|y| + slack)``)."""
     return run_law("resolvent_limit", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
 
 
 def check_monotone(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
-    """(A1): the graph of ``F(t,·)`` is monotone, ``⟨x_a - x_b, y_a - y_b⟩ ≥ 0``, sampled through the
+    """Assumption (A1): the graph of ``F(t,·)`` is monotone, ``⟨x_a - x_b, y_a - y_b⟩ ≥ 0``, sampled through the
     resolvent: ``(J_λx1, Y_λx1)`` and ``(J_μx2, Y_μx2)`` are graph elements (item v) for different step
     sizes (ratio ``-⟨Δx, Δy⟩ / slack``)."""
     return run_law("monotone", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
 
 
 def check_yosida_lipschitz(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
-    """Item iv: ``Y_λ`` is ``1/λ``-Lipschitz, ``λ|Y_λx1 - Y_λx2| ≤ |x1 - x2|``
+    """Proposition prop:maxmon-resolvent-Yosida iv:
+    ``Y_λ`` is ``1/λ``-Lipschitz, ``λ|Y_λx1 - Y_λx2| ≤ |x1 - x2|``
     (ratio ``λ|ΔY| / (|Δx| + slack)``)."""
     return run_law("yosida_lipschitz", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
 
 
 def check_yosida_monotone(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
-    """Item iv: ``Y_λ`` is (maximal) monotone, ``⟨Y_λx1 - Y_λx2, x1 - x2⟩ ≥ 0``
+    """Proposition prop:maxmon-resolvent-Yosida iv:
+    ``Y_λ`` is (maximal) monotone, ``⟨Y_λx1 - Y_λx2, x1 - x2⟩ ≥ 0``
     (ratio ``-⟨ΔY, Δx⟩ / slack``)."""
     return run_law("yosida_monotone", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
 
 
 def check_yosida_in_graph(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
-    """Item v: ``Y_λx ∈ F(t, J_λx)`` through ``contains`` (ratio: the smallest power-of-100 multiple of the
+    """Proposition prop:maxmon-resolvent-Yosida v:
+    ``Y_λx ∈ F(t, J_λx)`` through ``contains`` (ratio: the smallest power-of-100 multiple of the
     tolerance at which membership is accepted; 1 when it is accepted at the tolerance)."""
     return run_law("yosida_in_graph", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
 
 
 def check_yosida_nonincreasing(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
-    """Item vi: ``λ ↦ |Y_λx|`` is nonincreasing, ``|Y_μx| ≤ |Y_λx|`` for ``λ ≤ μ`` (stated in the paper for
+    """Proposition prop:maxmon-resolvent-Yosida vi:
+    ``λ ↦ |Y_λx|`` is nonincreasing, ``|Y_μx| ≤ |Y_λx|`` for ``λ ≤ μ`` (stated in the paper for
     ``x ∈ dom F``; it holds for every ``x`` since ``Y_μ = (Y_λ)_{μ-λ}``) (ratio ``|Y_μx| / (|Y_λx| + slack)``)."""
     return run_law("yosida_nonincreasing", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
 
 
 def check_yosida_bounded_by_min_norm(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
-    """Item vi: ``|Y_λx| ≤ |F^0(x)|`` for ``x ∈ dom F`` (at ``x = J_νx1``; needs ``min_norm``)
+    """Proposition prop:maxmon-resolvent-Yosida vi:
+    ``|Y_λx| ≤ |F^0(x)|`` for ``x ∈ dom F`` (at ``x = J_νx1``; needs ``min_norm``)
     (ratio ``|Y_λx| / (|F^0(x)| + slack)``)."""
     return run_law("yosida_bounded_by_min_norm", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
 
 
 def check_yosida_limit(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
-    """Item vi: ``|Y_λx| → |F^0(x)|`` as ``λ → 0`` for ``x ∈ dom F`` (needs ``min_norm``).  ``λ`` is halved
+    """Proposition prop:maxmon-resolvent-Yosida vi:
+    ``|Y_λx| → |F^0(x)|`` as ``λ → 0`` for ``x ∈ dom F`` (needs ``min_norm``).  ``λ`` is halved
     until the gap ``||F^0(x)| - |Y_λx||`` is within tolerance, or down to the rounding floor where the gap must
     still be shrinking (``tolerances.STALL_RATIO`` over ``STALL_WINDOW`` halvings); a stalled positive gap
     means ``min_norm`` is not the least-norm element or ``J_λ`` has the wrong ``λ``."""
@@ -589,13 +670,15 @@ def check_yosida_limit(op, *, seed=None, examples=None, horizon=1.0, sample=None
 
 
 def check_min_norm_in_graph(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
-    """The minimal section lies in the graph: ``F^0(t, x) ∈ F(t, x)`` for ``x = J_νx1 ∈ dom F`` (needs
+    """The minimal section F^0 = proj(0, F(x)) lies in the graph:
+    ``F^0(t, x) ∈ F(t, x)`` for ``x = J_νx1 ∈ dom F`` (needs
     ``min_norm`` and ``contains``; ratio as for :func:`check_yosida_in_graph`)."""
     return run_law("min_norm_in_graph", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
 
 
 def check_min_norm_least(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
-    """The minimal section has least norm, ``|F^0(t, x)| ≤ |y|`` for every ``y ∈ F(t, x)``: compared with
+    """The minimal section F^0 = proj(0, F(x)) has least norm,
+    ``|F^0(t, x)| ≤ |y|`` for every ``y ∈ F(t, x)``: compared with
     ``y = Y_νx1`` at ``x = J_νx1`` (item v; certified by ``contains`` when available)
     (ratio ``|F^0(x)| / (|y| + slack)``)."""
     return run_law("min_norm_least", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
@@ -624,16 +707,20 @@ def check_operator(op: Operator, *, seed: int | None = None, examples: int | Non
     """Run every operator law on ``op`` and return the :class:`verimono.Report` of their records.
 
     ``seed`` makes the search reproducible (one fresh seed is drawn and recorded when ``None``);
-    ``examples`` is the number of hypothesis examples per law (default ``DEFAULT_EXAMPLES``); times are
-    sampled in ``[0, horizon]``.
+    ``examples`` is the number of hypothesis examples per law (default: the active profile's
+    ``law_examples``, :func:`default_examples`); times are sampled in ``[0, horizon]``.
     """
     seed = fresh_seed() if seed is None else int(seed)
-    report = Report(meta={"subject": _subject(op), "seed": seed,
-                          "examples": DEFAULT_EXAMPLES if examples is None else examples, "horizon": horizon})
+    if examples is None:
+        examples, profile = default_examples()
+    else:
+        profile = None
+    report = Report(meta={"subject": _subject(op), "seed": seed, "examples": examples, "horizon": horizon,
+                          **({"profile": profile} if profile else {})})
     for _, check in operator_checks(op, seed=seed, examples=examples, horizon=horizon):
         report.add(check(op))
     return report
 
 
 __all__ = ["Sample", "law_samples", "Law", "LAWS", "run_law", "fresh_seed", "OPERATOR_CHECKS", "operator_checks",
-           "check_operator", "DEFAULT_EXAMPLES", "BOUND"] + [f"check_{name}" for name in LAWS]
+           "check_operator", "DEFAULT_EXAMPLES", "default_examples", "BOUND"] + [f"check_{name}" for name in LAWS]
