@@ -61,6 +61,13 @@ def _static_domain(t):
     return 0.0
 
 
+def _unit_rate(t):
+    """(YB) with ``θ(s) = s``: for ``x ∈ dom H(s,·) = [0, ∞)`` and ``c = max(−v1, 0)`` (1-Lipschitz for both
+    references), ``J_{λH(s+λ,·)}(x) = x + λc(s+λ)``, so ``|Y_λ(s+λ, x)| = c(s+λ) ≤ c(s) + λ = |H^0(s, x)| +
+    θ(s+λ) − θ(s)`` — ``H^0(s, x) = −c(s)`` on the whole domain, the boundary point included."""
+    return float(t)
+
+
 def ramp_problem(x0: float = 0.5, T: float = 2.0) -> Problem:
     """``v = (−t, 0)``: ``x = x0 + t²/2``, proximal-scheme error exactly ``hT/2``."""
     if x0 < 0:
@@ -70,7 +77,7 @@ def ramp_problem(x0: float = 0.5, T: float = 2.0) -> Problem:
                        order=Order(1.0, "Example ex, v = (−t, 0): x_k = x0 + t_k²/2 + h t_k/2 (derived in "
                                    "reference/lcs_example.py)", constant=T / 2.0),
                        steps=[T / 8, T / 16, T / 32, T / 64], name="Example ex, v = (−t, 0)",
-                       phi=_static_domain, sigma=lambda t: t)
+                       phi=_static_domain, sigma=lambda t: t, theta=_unit_rate)
 
 
 def _sine_exact(x0):
@@ -90,7 +97,7 @@ def sine_problem(x0: float = 0.0, T: float = 3 * np.pi) -> Problem:
                        order=Order(1.0, "Example ex, v = (sin t, 0): right Riemann sum of the Lipschitz "
                                    "max(−sin t, 0)", constant=0.5),
                        steps=[T / 64, T / 128, T / 256, T / 512], name="Example ex, v = (sin t, 0)",
-                       phi=_static_domain, sigma=lambda t: max(-np.sin(t), 0.0))
+                       phi=_static_domain, sigma=lambda t: max(-np.sin(t), 0.0), theta=_unit_rate)
 
 
 def pseudo_distance_demo(rhos=(0.0, 1.0, 10.0, 100.0, 1000.0), lams=(0.5, 1.0, 2.0)):
