@@ -124,3 +124,28 @@ def test_a_half_space_far_beyond_the_data_does_not_set_the_units():
     np.testing.assert_allclose(z, [0.0, 0.0], atol=1e-12)
     z = solve_qp(np.eye(2), [-1.0, -2.0], G, [0.0, 0.0, 1.0])       # the far row never binds
     np.testing.assert_allclose(z, [1.0, 2.0], rtol=1e-12)
+
+
+def test_rows_scaled_down_together_are_not_far():
+    """z₁ = 5 and z₁ ≤ 1 written with rows of norm 1e-20 (and right-hand sides to match): in unit-normal form
+    both offsets are of size 1 — neither is far from the other, whatever the raw numbers — so the
+    contradiction is found, and z₁ ≤ 10 instead binds nothing."""
+    A, G = np.array([[1e-20, 0.0]]), np.array([[1e-20, 0.0]])
+    with pytest.raises(InfeasibleStep):
+        solve_qp(np.eye(2), np.zeros(2), G, [1e-20], A, [5e-20])
+    np.testing.assert_allclose(solve_qp(np.eye(2), np.zeros(2), G, [1e-19], A, [5e-20]), [5.0, 0.0], rtol=1e-12)
+
+
+def test_a_far_half_space_is_never_dropped_from_the_answer():
+    """min -z₂ + ½z₁² s.t. 1e-37·z₂ ≤ 1: the only bound on z₂ is 1e37 away (far).  Set aside, the problem is
+    unbounded and no back-end's point verifies; the solve is retried with the row in its units, and the
+    answer satisfies it.  (The linear term is then 1e-37 of the data's size, below double precision: any
+    feasible z with z₁ = 0 is a minimiser to that precision, which is all a relative check can decide.)"""
+    from verimono.qp import equilibrate
+
+    P, q, G, h = np.diag([1.0, 0.0]), np.array([0.0, -1.0]), np.array([[0.0, 1e-37]]), np.array([1.0])
+    S = equilibrate(P, q, G, h, None, None)
+    assert S.G is None and S.G_far is not None and S.scale == 1.0       # set aside: the units stay those of q
+    assert S.far_violation(np.array([0.0, 2e37])) > 0.9 and S.far_violation(np.array([0.0, 1.0])) == 0.0
+    z = solve_qp(P, q, G, h)
+    assert G @ z <= h * (1 + 1e-12) and abs(z[0]) <= 1e-12

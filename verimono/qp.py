@@ -105,7 +105,9 @@ def _polish(P, q, G, h, A, b, z):
 
 @dataclasses.dataclass
 class ScaledQP:
-    """``min ½yᵀPy + qᵀy  s.t. Gy ≤ h, Ay = b`` with ``z = scale·y`` the original problem's variable."""
+    """``min ½yᵀPy + qᵀy  s.t. Gy ≤ h, Ay = b`` with ``z = scale·y`` the original problem's variable.
+
+    ``G_far y ≤ h_far``: the far half-spaces (:data:`FAR`), left out of the solve and checked on its answer."""
     P: np.ndarray
     q: np.ndarray
     G: np.ndarray | None
@@ -113,6 +115,14 @@ class ScaledQP:
     A: np.ndarray | None
     b: np.ndarray | None
     scale: float
+    G_far: np.ndarray | None = None
+    h_far: np.ndarray | None = None
+
+    def far_violation(self, y: np.ndarray) -> float:
+        """How far ``y`` violates a far half-space, relative to its offset (0 when it satisfies all)."""
+        if self.G_far is None:
+            return 0.0
+        return float(np.max((self.G_far @ y - self.h_far) / self.h_far, initial=0.0))
 
 
 def _unit_rows(E, e, kind, ref):
@@ -130,45 +140,102 @@ def _unit_rows(E, e, kind, ref):
             raise InfeasibleStep(f"the QP has a zero constraint row with right-hand side "
                                  f"{e[zero][bad][0]:.3g} ({'0 <= h' if kind == '<=' else '0 = b'} fails)")
         E, e, norms = E[~zero], e[~zero], norms[~zero]
-    E, e = E / norms[:, None], e / norms
-    if kind == "<=":   # a half-space farther than FAR·ref from the origin binds no point of the data's scale
-        near = e <= FAR * ref
-        E, e = E[near], e[near]
     if E.shape[0] == 0:
         return None, None
-    return E, e
+    return E / norms[:, None], e / norms
 
 
-#: an inequality whose unit-normal form ``⟨g, z⟩ ≤ d`` has ``d > FAR·ref`` (``ref`` the size of the data) is
-#: dropped: a half-space at ``1/ε`` times the data's size from the origin contains every point the solve can
-#: represent at that size.  Kept, it sets the units (``s = d``) and every other constraint falls below their
+#: a half-space ``⟨g, z⟩ ≤ d`` (``|g| = 1``) is *far* when ``d`` exceeds ``FAR`` times the size of all the data
+#: nearer to the origin: at that distance it contains every point the solve can represent in the data's units.
+#: Kept in the solve it would set the units (``s = d``) and every other constraint would fall below their
 #: resolution: the row ``1.4e-37 z₂ ≥ -1`` of an LCP whose matrix has a 1.4e-37 entry made ``s = 7e36`` and
-#: turned a verified ``y = -1e-37`` into a multiplier ``z = -0.67`` (found by the Section 7 operator property)
+#: turned a verified ``y = -1e-37`` into a multiplier ``z = -0.67`` (found by the Section 7 operator property).
+#: Far rows are solved without and checked on the answer: a minimiser that satisfies them is the minimiser
+#: with them (its feasible set only shrank around it); one that violates them is a ``SolverFailure``.
 FAR = 1.0 / float(np.finfo(float).eps)
 
 
-def equilibrate(P, q, G, h, A, b, scale: float | None = None) -> ScaledQP:
+def _far(h: np.ndarray, core: float) -> np.ndarray:
+    """Mask of the far rows among unit-normal offsets ``h``: taken in increasing order, a row is far once its
+    offset exceeds ``FAR`` times the largest of ``core`` and the offsets before it (so a far row never
+    hides a nearer one, and rows at every scale below the data's stay)."""
+    far = np.zeros(h.shape, dtype=bool)
+    size = core
+    order = np.argsort(h)
+    for pos, i in enumerate(order):
+        if h[i] > FAR * size:
+            far[order[pos:]] = True
+            break
+        size = max(size, abs(float(h[i])))
+    return far
+
+
+def equilibrate(P, q, G, h, A, b, scale: float | None = None, set_aside_far: bool = True) -> ScaledQP:
     """The same QP in units where its data are of size 1 (same minimiser, up to ``z = s·y``).
 
-    ``s = max(|h|∞, |b|∞, |q|∞/p, scale)`` after the rows are normalised, with ``p = max |P|``: the size of
-    the constraints' offsets and of the unconstrained minimiser.  ``scale`` is a floor for ``s``: the size
-    of the numbers the data were computed from, when their rounding errors are larger than the data (see
-    :func:`verimono.lcs.solve_lcp`).  Substituting ``z = s·y`` and dividing the objective by ``p·s²``::
+    ``s = max(|h|∞, |b|∞, |q|∞/p, scale)`` after the rows are normalised and the far half-spaces (:data:`FAR`)
+    set aside (unless ``set_aside_far=False``), with ``p = max |P|``: the size of the constraints' offsets and of the unconstrained minimiser.
+    ``scale`` is a floor for ``s``: the size of the numbers the data were computed from, when their rounding
+    errors are larger than the data (see :func:`verimono.lcs.solve_lcp`).  Substituting ``z = s·y`` and
+    dividing the objective by ``p·s²``::
 
         min ½ yᵀ(P/p)y + (q/(p s))ᵀy   s.t.  (G/‖G_i‖)y ≤ h/(‖G_i‖ s),  (A/‖A_i‖)y = b/(‖A_i‖ s).
     """
     p = float(np.abs(P).max(initial=0.0)) or 1.0
+    floor = 0.0 if scale is None else float(scale)
     ref = max(float(np.abs(h).max(initial=0.0)) if h is not None else 0.0,
               float(np.abs(b).max(initial=0.0)) if b is not None else 0.0,
-              float(np.abs(q).max(initial=0.0)) / p, 0.0 if scale is None else float(scale))
+              float(np.abs(q).max(initial=0.0)) / p, floor)
     G, h = _unit_rows(G, h, "<=", ref)
     A, b = _unit_rows(A, b, "=", ref)
-    s = max(float(np.abs(h).max(initial=0.0)) if h is not None else 0.0,
-            float(np.abs(b).max(initial=0.0)) if b is not None else 0.0,
-            float(np.abs(q).max(initial=0.0)) / p, 0.0 if scale is None else float(scale))
+    core = max(float(np.abs(b).max(initial=0.0)) if b is not None else 0.0,
+               float(np.abs(q).max(initial=0.0)) / p, floor)
+    G_far = h_far = None
+    if G is not None and set_aside_far:
+        far = _far(h, core)
+        if np.any(far):
+            G_far, h_far = G[far], h[far]
+            G, h = (G[~far], h[~far]) if not np.all(far) else (None, None)
+    s = max(core, float(np.abs(h).max(initial=0.0)) if h is not None else 0.0)
     if not (np.isfinite(s) and s > 0.0):
         s = 1.0
-    return ScaledQP(P / p, q / (p * s), G, None if h is None else h / s, A, None if b is None else b / s, s)
+    return ScaledQP(P / p, q / (p * s), G, None if h is None else h / s, A, None if b is None else b / s, s,
+                    G_far, None if h_far is None else h_far / s)
+
+
+def _badness(rep: KKTReport, S: ScaledQP, y: np.ndarray) -> float:
+    """How far a candidate is from verified: its largest KKT residual, or its far-row violation."""
+    return max(rep.primal, rep.dual, rep.comp, S.far_violation(y))
+
+
+def _attempt(name: str, S: ScaledQP) -> tuple[np.ndarray | None, str, bool]:
+    """One back-end on the equilibrated ``S``: ``(verified minimiser or None, reason, whether it returned a
+    point)``."""
+    import qpsolvers
+
+    if name not in qpsolvers.available_solvers:
+        return None, f"{name}: not installed", False
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            y = qpsolvers.solve_qp(S.P, S.q, S.G, S.h, S.A, S.b, solver=name, **BACKENDS.get(name, {}))
+    except Exception as exc:  # a back-end's own failure is one reason among others
+        return None, f"{name}: raised {type(exc).__name__}: {exc}", False
+    if y is None or not np.all(np.isfinite(y)):
+        return None, f"{name}: returned no solution", False
+    best = None
+    for cand in (_polish(S.P, S.q, S.G, S.h, S.A, S.b, y), y):
+        rep = kkt_residual(S.P, S.q, S.G, S.h, S.A, S.b, cand)
+        if rep.ok and S.far_violation(cand) <= QP_RTOL:
+            return S.scale * cand, "", True
+        if best is None or _badness(rep, S, cand) < _badness(best[0], S, best[1]):
+            best = (rep, cand)
+    rep, cand = best
+    if rep.ok:
+        return None, (f"{name}: its minimiser without the far half-spaces violates one by "
+                      f"{S.far_violation(cand):.2e} of its offset"), True
+    return None, (f"{name}: KKT check failed (primal {rep.primal:.2e}, dual {rep.dual:.2e}, "
+                  f"complementarity {rep.comp:.2e})"), True
 
 
 def solve_qp(P, q, G=None, h=None, A=None, b=None, *, backends=None, scale: float | None = None) -> np.ndarray:
@@ -181,8 +248,6 @@ def solve_qp(P, q, G=None, h=None, A=None, b=None, *, backends=None, scale: floa
     infeasibility and none returns a point), :class:`SolverFailure` when candidates exist but none
     verifies.
     """
-    import qpsolvers
-
     # writable copies: back-ends such as DAQP reject read-only buffers (constant parameters are read-only)
     P = np.array(P, float); q = np.array(q, float)
     G = None if G is None or len(G) == 0 else np.atleast_2d(np.array(G, float))
@@ -190,33 +255,18 @@ def solve_qp(P, q, G=None, h=None, A=None, b=None, *, backends=None, scale: floa
     A = None if A is None or len(A) == 0 else np.atleast_2d(np.array(A, float))
     b = None if A is None else np.atleast_1d(np.array(b, float))
     S = equilibrate(P, q, G, h, A, b, scale)
+    attempts = [("", S)]
+    if S.G_far is not None:   # far rows set aside first; with them in the solve (their units) if that fails
+        attempts.append(("with the far half-spaces: ", equilibrate(P, q, G, h, A, b, scale, set_aside_far=False)))
     reasons = []
     got_point = False
-    for name in backends or BACKENDS:
-        if name not in qpsolvers.available_solvers:
-            reasons.append(f"{name}: not installed")
-            continue
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                y = qpsolvers.solve_qp(S.P, S.q, S.G, S.h, S.A, S.b, solver=name, **BACKENDS.get(name, {}))
-        except Exception as exc:  # a back-end's own failure is one reason among others
-            reasons.append(f"{name}: raised {type(exc).__name__}: {exc}")
-            continue
-        if y is None or not np.all(np.isfinite(y)):
-            reasons.append(f"{name}: returned no solution")
-            continue
-        got_point = True
-        best_rep = None
-        for cand in (_polish(S.P, S.q, S.G, S.h, S.A, S.b, y), y):
-            rep = kkt_residual(S.P, S.q, S.G, S.h, S.A, S.b, cand)
-            if rep.ok:
-                return S.scale * cand
-            if best_rep is None or max(rep.primal, rep.dual, rep.comp) < max(best_rep.primal, best_rep.dual,
-                                                                                best_rep.comp):
-                best_rep = rep
-        reasons.append(f"{name}: KKT check failed (primal {best_rep.primal:.2e}, dual {best_rep.dual:.2e}, "
-                       f"complementarity {best_rep.comp:.2e})")
+    for label, S in attempts:
+        for name in backends or BACKENDS:
+            z, reason, point = _attempt(name, S)
+            got_point = got_point or point
+            if z is not None:
+                return z
+            reasons.append(label + reason)
     if not got_point:
         raise InfeasibleStep("no back-end found a feasible point: " + "; ".join(reasons))
     raise SolverFailure("no QP back-end produced a verified solution: " + "; ".join(reasons))
