@@ -143,3 +143,23 @@ def test_membership_with_a_negligible_entry_in_D():
     H = S.operator()
     assert H.contains(np.zeros(2), np.zeros(2)) and np.allclose(H.min_norm(np.zeros(2)), 0.0, atol=1e-14)
     assert not H.contains(np.zeros(2), np.array([0.0, 0.5]))
+
+
+def test_membership_within_rounding_of_the_edge_of_dom_H():
+    """The Example's H(0,·) = N_[0,∞): J_λ(-1.25) rounds to 2.2e-16 (not 0) and Y_λ = -0.28 ∈ H(0, 0) =
+    (-∞, 0] but ∉ H(0, 2.2e-16) = {0}.  The pair is 2.2e-16 from the graph point (0, -0.28), so contains must
+    accept it (its contract: a graph point within tol in each coordinate) — a 20-seed sweep of the operator
+    laws found yosida_in_graph failing here — while pairs far from the graph are still rejected."""
+    from verimono.checks.operator_laws import Sample, check_yosida_in_graph
+    from verimono.reference.lcs_example import ramp_problem
+
+    H = ramp_problem().operator
+    lam = 4.4646433849248
+    J = H.resolvent(np.array([-1.25]), lam, 0.0)
+    assert 0.0 < J[0] <= 1e-15                                               # the rounding is real
+    assert H.contains(J, (np.array([-1.25]) - J) / lam, 0.0)
+    assert not H.contains(np.array([1.0]), np.array([-0.28]), 0.0)          # H(0, 1) = {0}
+    assert not H.contains(np.array([-1e-3]), np.array([-0.28]), 0.0)        # outside dom H(0,·) = [0, ∞)
+    assert not H.contains(np.array([2.2e-16]), np.array([0.28]), 0.0)       # H(0, 0) = (-∞, 0]
+    s = Sample(np.array([-1.25]), np.zeros(1), lam, 1.0, 1.0, 0.0)
+    assert check_yosida_in_graph(H, sample=s).status == "passed"

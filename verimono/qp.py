@@ -10,7 +10,8 @@ squares residual), both to ``QP_RTOL`` relative to the data.  When no candidate 
 
 The problem is equilibrated first (:func:`equilibrate`): constraint rows scaled to unit length, the
 objective to ``max |P| = 1``, and the variable to ``z = s·y`` with ``s`` the size of the data
-(``max(|h|∞, |b|∞, |q|∞/max|P|)``).  None of this changes the minimiser, but it makes "relative to the
+(``max(|h|∞, |b|∞, |q|∞/max|P|)``; a half-space more than ``1/ε`` beyond all nearer data is set aside,
+:data:`FAR`, and checked on the answer).  None of this changes the minimiser, but it makes "relative to the
 data" mean the same at every scale: the back-ends' absolute stopping floors and the KKT check's would
 otherwise lose constraints of size 1e-9 (the one-step problems of a complementarity system near
 ``t = 0``), and ProxQP 0.8 does not return at all on a linear term 1e100 times its constraints (seen

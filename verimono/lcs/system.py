@@ -272,15 +272,22 @@ class LCSOperator(Operator):
         return -Ax - s.B @ lam
 
     def contains(self, x, y, t=0.0, tol=None):
+        """Whether some ``(x', y') ∈ graph H(t,·)`` lies within ``tol`` of ``(x, y)`` in each coordinate (the
+        :meth:`verimono.Operator.contains` contract): first at ``x' = x`` (the multiplier nearest to explaining
+        ``y``), else through the graph point ``(p, x + y − p)``, ``p = J_1(x + y)``, which is ``|x − p|`` from
+        ``(x, y)`` in both coordinates — a point within rounding of a kink of ``H`` (``x = 2e-16`` for the
+        edge ``0`` of the Example's ``dom H``, where ``H(x) = {0}`` but ``H(0) = (−∞, 0]``) is a member there."""
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
         s = self.system
+        tol = tolerance(s.A @ x, y) if tol is None else tol
         try:
             lam = self._select(x, t, s.B.T @ s.B, s.B.T @ (s.A @ x + y))
+            if np.max(np.abs(-s.A @ x - s.B @ lam - y)) <= tol:
+                return True
         except OutsideDomain:
-            return False
-        r = -s.A @ x - s.B @ lam - y
-        tol = tolerance(s.A @ x, y) if tol is None else tol
-        return bool(np.max(np.abs(r)) <= tol)
+            pass
+        p = self.resolvent(x + y, 1.0, t)
+        return bool(np.max(np.abs(p - x)) <= tol)
 
     def project_domain(self, x, t=0.0):
         x = np.asarray(x, dtype=float)
