@@ -311,3 +311,14 @@ def test_shift_constants_are_needed():
     z = n.operator.project_domain(np.array([1.0]), 0.0)                                  # 1 ∈ dom G(0)
     d = float(np.linalg.norm(z - n.operator.project_domain(z, 0.25)))
     assert d == pytest.approx(0.5) and d <= n.phi(0.25) - n.phi(0.0) + 1e-12
+
+
+@FAST
+@given(vs.convex_sets(6, kinds=("polyhedron", "halfspace")))
+def test_constraint_normals_have_no_rounding_sized_components(S):
+    """Rows of G and A (and half-space normals) have components 0 or ≥ ENTRY_FLOOR: near-parallel rows 1e-7
+    apart in angle make projections no double-precision QP verifies (see _nonzero_vectors)."""
+    for param in (getattr(S, "_G", None), getattr(S, "_A", None), getattr(S, "_a", None)):
+        if param is not None:
+            M = np.abs(np.asarray(param(0.0)))
+            assert np.all((M == 0) | (M >= vs.ENTRY_FLOOR)), M
