@@ -204,10 +204,6 @@ def _stated_functions_hold(stated, w, lam, s, t, nu):
     s, t = min(s, t), max(s, t)
     s = min(s, 1.0 - lam)
     x = np.asarray(op.resolvent(w, nu, s), dtype=float)
-    if stated.system is not None:
-        # H's minimal section fails at points of ∂dom H reached through rounding (test_operator_laws::
-        # test_lcs_min_norm_on_the_boundary_of_dom_H); 0 ∈ int dom H by design, so (1 - ε)x is interior
-        x = (1.0 - 1e-3) * x
     f0 = float(np.linalg.norm(op.min_norm(x, s)))
     slack = quotient_tolerance(nu, w, x) * 10
     if stated.sigma is not None:
