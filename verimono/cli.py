@@ -1,7 +1,7 @@
 """Command line of verimono.
 
     verimono run [--profile dev|ci|thorough] [--out DIR] [--stage NAME ...] [--seed N] [--data DIR]
-                 [--baseline FILE]
+                 [--baseline FILE] [--executor serial|process:N|tcp://host:port] [--unit-timeout S]
         The whole verification (every registered stage, see ``verimono.stages``); writes DIR/results.json
         and DIR/report.html (DIR defaults to reports/).  Exit 0 when every check holds, 1 when one fails.
     verimono check MODULE:OBJECT [--profile P] [--out DIR] [--seed N]
@@ -42,26 +42,39 @@ class BadTarget(VerimonoError, ValueError):
 
 
 class Progress:
-    """A one-line progress bar on a terminal; one plain line per finished stage otherwise."""
+    """Progress of a run: on a terminal, one redrawn line (stage, units done / total within it, the
+    current subject); otherwise — output not a terminal, or ``$CI`` set — quiet and line-oriented: one
+    plain line per finished stage, and within a long stage at most one line every ``interval`` seconds."""
 
-    def __init__(self, stream: TextIO | None = None, enabled: bool | None = None) -> None:
+    def __init__(self, stream: TextIO | None = None, enabled: bool | None = None, interval: float = 60.0) -> None:
         self.stream = stream or sys.stderr
-        self.tty = self.stream.isatty() if enabled is None else enabled
+        if enabled is None:
+            enabled = self.stream.isatty() and not _ci()
+        self.tty = enabled
         self.stage, self.index, self.total = "", 0, 1
         self.width = min(shutil.get_terminal_size((100, 20)).columns, 120)
+        self.interval = interval
+        self._last_line = time.monotonic()
 
     def start(self, stage: Any, index: int, total: int) -> None:
         self.stage, self.index, self.total = stage.name, index, total
+        self._last_line = time.monotonic()
         self.within(0, 1, "")
 
     def within(self, done: int, total: int, label: str) -> None:
         if not self.tty:
+            now = time.monotonic()
+            if total and 0 < done < total and now - self._last_line >= self.interval:
+                self._last_line = now
+                self.stream.write(f"[{self.index + 1}/{self.total}] {self.stage}: {done}/{total} units done"
+                                  + (f", at {label}" if label else "") + "\n")
+                self.stream.flush()
             return
         frac = (self.index + (done / total if total else 1.0)) / self.total
         bar_w = 24
         fill = int(round(frac * bar_w))
         text = (f"\r[{'#' * fill}{'-' * (bar_w - fill)}] {frac * 100:3.0f}%  stage {self.index + 1}/{self.total} "
-                f"{self.stage}  {done}/{total} {label}")
+                f"{self.stage}  {done}/{total} units  {label}")
         self.stream.write(text[: self.width - 1].ljust(self.width - 1))
         self.stream.flush()
 
@@ -75,12 +88,22 @@ class Progress:
         self.stream.flush()
 
 
+def _ci() -> bool:
+    """``$CI`` set (non-empty, not ``0``/``false``/``no``), as CI services do."""
+    ci = os.environ.get("CI", "").strip().lower()
+    return bool(ci) and ci not in ("0", "false", "no")
+
+
 # -- running -----------------------------------------------------------------------------------------
 
 
 def execute(*, command: str, profile_name: str, stages: list[str] | None, context: Any, target: str | None = None,
-            progress: Progress | None = None) -> Report:
-    """Run ``stages`` with ``context`` under a profile and return the merged, fully annotated report."""
+            progress: Progress | None = None, executor: Any = None, unit_timeout: float | None = None) -> Report:
+    """Run ``stages`` with ``context`` under a profile and return the merged, fully annotated report.
+
+    ``executor`` (``"process:N"``, a dask scheduler address or ``Client``; ``None``: serial) is where the
+    stages' independent units run (:mod:`verimono.executors`); ``unit_timeout`` bounds each unit there."""
+    from .executors import make_runner
     from .report.schema import environment
     from .stages import calibrate, run_stages
 
@@ -88,9 +111,16 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
     load_hypothesis_profile(profile_name)
     progress = progress or Progress(enabled=False)
     context.progress = progress.within
+    runner = make_runner(executor, timeout=unit_timeout)
+    if executor is not None and context.executor is None:
+        print(f"verimono: units run on {runner.spec}", file=sys.stderr)
+    context.executor = context.executor if context.executor is not None else runner
     cal = calibrate()
     start = time.perf_counter()
-    report = run_stages(stages, profile, context, on_start=progress.start, on_done=progress.done)
+    try:
+        report = run_stages(stages, profile, context, on_start=progress.start, on_done=progress.done)
+    finally:
+        runner.close()
     selection = {"stages": stages, "references": None if context.problems is None else
                  [p.name for p in context.problems]}
     report.meta.update({"command": command, "target": target, "profile": profile_name, "seed": context.seed,
@@ -117,6 +147,11 @@ def _context(args: argparse.Namespace, **kw: Any) -> Any:
         except KeyError as exc:
             raise BadTarget(str(exc.args[0])) from None
     return RunContext(seed=getattr(args, "seed", None), data_dir=data, problems=problems, **kw)
+
+
+def _executor_options(args: argparse.Namespace) -> dict[str, Any]:
+    spec = getattr(args, "executor", None)
+    return {"executor": None if spec in (None, "serial") else spec, "unit_timeout": getattr(args, "unit_timeout", None)}
 
 
 def _baseline_for(args: argparse.Namespace) -> Report | None:
@@ -186,7 +221,7 @@ def _finish(report: Report, out: Path, baseline: Report | None) -> int:
 def _cmd_run(args: argparse.Namespace) -> int:
     baseline = _baseline_for(args)
     report = execute(command="run", profile_name=args.profile, stages=args.stage, context=_context(args),
-                     progress=Progress())
+                     progress=Progress(), **_executor_options(args))
     return _finish(report, Path(args.out), baseline)
 
 
@@ -250,7 +285,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
                         "callable(problem, t_grid)")
     print(f"verimono: checking {args.target} as a {kind}", file=sys.stderr)
     report = execute(command="check", profile_name=args.profile, stages=stages, context=ctx,
-                     target=args.target, progress=Progress())
+                     target=args.target, progress=Progress(), **_executor_options(args))
     if report.results and all(r.status == SKIPPED for r in report.results):
         _finish(report, Path(args.out), None)
         print(f"verimono: no {kind} battery could run here: " +
@@ -266,7 +301,7 @@ def _cmd_baseline(args: argparse.Namespace) -> int:
         report = load(args.from_results)
     else:
         report = execute(command="run", profile_name=args.profile, stages=args.stage, context=_context(args),
-                         progress=Progress())
+                         progress=Progress(), **_executor_options(args))
     report.trajectories = []  # plot samples only: the gate never reads them, and they are half the size
     path = report.save(args.out)
     print(f"verimono: baseline of {report.summary()} (profile {report.meta.get('profile')}) written to {path}")
@@ -318,6 +353,11 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--data", default=None, help="shared data folder (Siconos references); default ../shared")
         p.add_argument("--reference", action="append", metavar="NAME",
                        help="use only this analytic reference (repeatable; default: the whole catalog)")
+        p.add_argument("--executor", default=None, metavar="SPEC",
+                       help="where the stages' independent units run: serial (default), process:N (N worker "
+                            "processes), or a dask.distributed scheduler address such as tcp://host:8786")
+        p.add_argument("--unit-timeout", type=float, default=None, metavar="SECONDS",
+                       help="with --executor: a unit still running after this long becomes a failed record")
 
     run = sub.add_parser("run", help="run the whole verification and write the report")
     run_options(run)

@@ -14,11 +14,19 @@
   garbled or empty one (no executed record) before any test runs, with the reason on stderr; one from
   another kind of run (e.g. ``verimono run`` rather than pytest, another profile) at the end of the
   session, which then exits 4 — even if tests failed — with the reason in the terminal summary.
+* Under pytest-xdist (``-n N``) each worker attaches the records of a test to that test's call report
+  (the attribute ``verimono_records``, a JSON string that xdist carries to the controller with the report);
+  the controller collects them and writes the report and gates, in collection order, so ``pytest -n N``
+  gives the same records, statuses and summary as ``pytest``.  A call report that arrives without that
+  attribute comes from a process whose records cannot reach this report (a parallel runner verimono does
+  not know): the session says how many tests that was and fails (exit status 1) instead of writing a
+  report that is silently short.
 """
 
 from __future__ import annotations
 
 import functools
+import json
 import time
 from pathlib import Path
 from typing import Any
@@ -71,7 +79,9 @@ def pytest_configure(config: pytest.Config) -> None:
             check_baseline(baseline)
         except SchemaError as exc:
             raise pytest.UsageError(f"verimono baseline unusable: {exc}") from None
-    collector = _Collector(Path(out) if out else None, baseline, profile)
+    worker = hasattr(config, "workerinput")  # a pytest-xdist worker: ships its records, writes nothing
+    collector = _Collector(None if worker else (Path(out) if out else None), None if worker else baseline,
+                           profile, worker=worker)
     config.stash[_KEY] = collector
     config.pluginmanager.register(collector, "verimono-collector")
 
@@ -79,8 +89,14 @@ def pytest_configure(config: pytest.Config) -> None:
 class _Collector:
     """Session-wide sink of result records (registered only with ``--verimono-report/-baseline``)."""
 
-    def __init__(self, out: Path | None, baseline: Report | None, profile: str | None) -> None:
-        self.out, self.baseline, self.profile = out, baseline, profile
+    #: the attribute of a call report that carries its test's records from an xdist worker
+    ATTR = "verimono_records"
+
+    def __init__(self, out: Path | None, baseline: Report | None, profile: str | None, worker: bool = False) -> None:
+        self.out, self.baseline, self.profile, self.worker = out, baseline, profile, worker
+        self.extras: dict[str, dict[str, list]] = {}   # nodeid -> studies and trajectories of added Reports
+        self.order: dict[str, int] = {}                # nodeid -> position in the collection
+        self.hidden: list[str] = []                    # call reports whose records could not reach us
         self.report = Report(meta={"command": "pytest", "target": None, "profile": profile, "seed": None})
         self.nodeid: str | None = None
         self.seen: set[int] = set()
@@ -91,6 +107,7 @@ class _Collector:
 
     def add(self, item: Any) -> None:
         records = item.results if isinstance(item, Report) else [item]
+        studies, trajectories = [], []
         for r in records:
             if not isinstance(r, CheckResult) or id(r) in self.seen:
                 continue
@@ -102,11 +119,17 @@ class _Collector:
             if isinstance(r.details.get("study"), dict) and not isinstance(item, Report):
                 from .convergence import ConvergenceStudy
 
-                self.report.studies.append(ConvergenceStudy.from_dict(r.details["study"]))
+                studies.append(ConvergenceStudy.from_dict(r.details["study"]))
         if isinstance(item, Report):
             known = {id(s) for s in self.report.studies}
-            self.report.studies.extend(s for s in item.studies if id(s) not in known)
-            self.report.trajectories.extend(item.trajectories)
+            studies += [s for s in item.studies if id(s) not in known]
+            trajectories = list(item.trajectories)
+        self.report.studies.extend(studies)
+        self.report.trajectories.extend(trajectories)
+        if self.nodeid and (studies or trajectories):
+            extra = self.extras.setdefault(self.nodeid, {"studies": [], "trajectories": []})
+            extra["studies"].extend(studies)
+            extra["trajectories"].extend(trajectories)
 
     @pytest.hookimpl(hookwrapper=True)
     def pytest_runtest_call(self, item: pytest.Item):
@@ -115,8 +138,59 @@ class _Collector:
             yield
         self.nodeid = None
 
+    @pytest.hookimpl(hookwrapper=True)
+    def pytest_runtest_makereport(self, item: pytest.Item, call: Any):
+        """Mark the call report as seen by verimono; on an xdist worker, attach the test's records."""
+        outcome = yield
+        report = outcome.get_result()
+        if call.when != "call":
+            return
+        if not self.worker:
+            setattr(report, self.ATTR, "")   # recorded here: nothing to carry
+            return
+        records = self.by_node.pop(item.nodeid, [])
+        extra = self.extras.pop(item.nodeid, {"studies": [], "trajectories": []})
+        self.report.results.clear()          # a worker keeps nothing once shipped
+        self.report.studies.clear()
+        self.report.trajectories.clear()
+        self.seen.clear()
+        setattr(report, self.ATTR, json.dumps({
+            "results": [r.to_dict() for r in records],
+            "studies": [s.to_dict() if hasattr(s, "to_dict") else s for s in extra["studies"]],
+            "trajectories": extra["trajectories"]}, default=str))
+
+    def pytest_collection_finish(self, session: pytest.Session) -> None:
+        self.order = {it.nodeid: i for i, it in enumerate(session.items)}
+
+    @pytest.hookimpl(optionalhook=True)
+    def pytest_xdist_node_collection_finished(self, node: Any, ids: list[str]) -> None:
+        if not self.order:
+            self.order = {nodeid: i for i, nodeid in enumerate(ids)}
+
+    def _receive(self, report: pytest.TestReport) -> None:
+        """Records of a test that ran elsewhere (an xdist worker), carried by its call report."""
+        from .report.schema import _record_from_dict, _study_from_dict
+        from .results import to_jsonable
+
+        data = json.loads(getattr(report, self.ATTR))
+        self.nodeid = report.nodeid
+        try:
+            self.add(Report([_record_from_dict(d, i) for i, d in enumerate(data["results"])],
+                            [_study_from_dict(s, i) for i, s in enumerate(data["studies"])],
+                            trajectories=to_jsonable(data["trajectories"])))
+        finally:
+            self.nodeid = None
+
     def pytest_runtest_logreport(self, report: pytest.TestReport) -> None:
-        """A test marked xfail that failed as declared: its failed records are expected failures."""
+        """Records from a worker; then: a test marked xfail that failed as declared has its failed records
+        as expected failures."""
+        if self.worker:
+            return
+        if report.when == "call":
+            if not hasattr(report, self.ATTR):
+                self.hidden.append(report.nodeid)
+            elif getattr(report, self.ATTR):
+                self._receive(report)
         wasxfail = getattr(report, "wasxfail", None)
         if report.when == "call" and report.skipped and wasxfail is not None:
             for r in self.by_node.get(report.nodeid, []):
@@ -131,9 +205,27 @@ class _Collector:
             if _is_verimono_check(value):
                 pyfuncitem.funcargs[name] = _recording(value, self.add)
 
+    def _in_collection_order(self) -> None:
+        """Records, studies and trajectories of parallel workers arrive as tests finish: put them in
+        collection order (stably), so the report does not depend on how tests were spread over workers."""
+        if not self.order:
+            return
+        last = len(self.order)
+        rank = {id(r): self.order.get(r.details.get("pytest_nodeid"), last) for r in self.report.results}
+        self.report.results.sort(key=lambda r: rank[id(r)])
+        for kind in ("studies", "trajectories"):
+            where = {id(x): self.order.get(nodeid, last) for nodeid, extra in self.extras.items()
+                     for x in extra[kind]}
+            getattr(self.report, kind).sort(key=lambda x: where.get(id(x), last))
+
     def pytest_sessionfinish(self, session: pytest.Session, exitstatus: int) -> None:
+        if self.worker:
+            return
         from .report.schema import environment
 
+        self._in_collection_order()
+        if self.hidden and session.exitstatus == pytest.ExitCode.OK:
+            session.exitstatus = pytest.ExitCode.TESTS_FAILED
         self.report.meta.update({"duration": time.perf_counter() - self.start, "environment": environment()})
         if self.baseline is not None:
             from .gate import check_runs_compatible, compare
@@ -154,10 +246,17 @@ class _Collector:
             self.paths = write(self.report, self.out, changes=self.comparison)
 
     def pytest_terminal_summary(self, terminalreporter: Any) -> None:
+        if self.worker:
+            return
         tr = terminalreporter
         tr.section("verimono")
         tr.write_line(f"{len(self.report)} verimono records: {self.report.summary()} "
                       f"(hypothesis profile {self.profile})")
+        if self.hidden:
+            tr.write_line(f"verimono: {len(self.hidden)} tests ran where their verimono records cannot reach this "
+                          f"report (a parallel runner verimono does not know?), e.g. {self.hidden[0]}: the "
+                          "report is incomplete and the session fails (exit status 1); run without that "
+                          "runner, or with pytest-xdist (-n N)", red=True)
         if self.out is not None:
             tr.write_line(f"report: {self.out / 'report.html'}  records: {self.out / 'results.json'}")
         if self.gate_error:

@@ -61,6 +61,7 @@ class RunContext:
     seed: int | None = None
     data_dir: Path | None = None
     progress: Callable[[int, int, str], None] = lambda done, total, label: None
+    executor: Any = None
 
     _catalog: list[Any] | None = dataclasses.field(default=None, repr=False)
 
@@ -73,6 +74,15 @@ class RunContext:
 
             self._catalog = catalog()
         return self._catalog
+
+    def run_units(self, profile: Profile, units: list[Any]) -> list[Report]:
+        """The reports of ``units`` (:class:`verimono.executors.Unit`), in their order, run on
+        ``executor`` (serially here when it is ``None``); a unit that raises, whose worker dies or that
+        times out gives one failed record ``unit[<stage>: <label>]`` and the other units' records stay."""
+        from .executors import SerialRunner
+
+        runner = self.executor if self.executor is not None else SerialRunner()
+        return runner.map(units, profile.name, self.progress)
 
     def seed_for(self, profile: Profile) -> int | None:
         """The seed a randomized battery uses: ``seed`` if given, else 0 under a derandomized profile
@@ -217,28 +227,40 @@ def sample_trajectory(stepper: Callable, problem: Any, h: float | None = None) -
                         "exact": first(exact) if exact is not None else None})
 
 
-@register_stage("convergence", "every analytic reference's convergence study against its expected order")
-def convergence_stage(profile: Profile, context: RunContext) -> Report:
-    """Every analytic reference's convergence study, plus a trajectory sample for the report's plots."""
+def _convergence_unit(stepper: Callable, problem: Any) -> Report:
+    """One reference: its convergence-order record and study, and a trajectory sample for the plots."""
     from .checks.orders import check_convergence_order
     from .convergence import ConvergenceStudy
+
+    report = Report()
+    rec = report.add(check_convergence_order(stepper, problem))
+    if "study" in rec.details:
+        report.studies.append(ConvergenceStudy.from_dict(rec.details["study"]))
+    try:
+        report.trajectories.append(sample_trajectory(stepper, problem))
+    except (VerimonoError, ArithmeticError, ValueError) as exc:
+        rec.details["trajectory_error"] = f"{type(exc).__name__}: {exc}"
+    return report
+
+
+def _merged(reports: Iterable[Report]) -> Report:
+    out = Report()
+    for rep in reports:
+        out.extend(rep)
+    return out
+
+
+@register_stage("convergence", "every analytic reference's convergence study against its expected order")
+def convergence_stage(profile: Profile, context: RunContext) -> Report:
+    """Every analytic reference's convergence study, plus a trajectory sample for the report's plots;
+    one unit per reference."""
+    from .executors import Unit
 
     stepper = context.stepper
     if stepper is None:
         from .stepping import solve as stepper
-    problems = context.catalog()
-    report = Report()
-    for i, p in enumerate(problems):
-        context.progress(i, len(problems), p.name)
-        rec = report.add(check_convergence_order(stepper, p))
-        if "study" in rec.details:
-            report.studies.append(ConvergenceStudy.from_dict(rec.details["study"]))
-        try:
-            report.trajectories.append(sample_trajectory(stepper, p))
-        except (VerimonoError, ArithmeticError, ValueError) as exc:
-            rec.details["trajectory_error"] = f"{type(exc).__name__}: {exc}"
-    context.progress(len(problems), len(problems), "")
-    return report
+    units = [Unit("convergence", p.name, _convergence_unit, (stepper, p)) for p in context.catalog()]
+    return _merged(context.run_units(profile, units))
 
 
 def _catalog_operators(context: RunContext) -> list[tuple[str, Any]]:
@@ -299,15 +321,21 @@ def operator_laws_stage(profile: Profile, context: RunContext) -> Report:
             subjects += _generated_operators(profile, context.seed_for(profile))
         except StageUnavailable as exc:
             report.add(CheckResult("stage", "operator_laws: generated families", SKIPPED, message=str(exc)))
-    for i, (label, op) in enumerate(subjects):
-        context.progress(i, len(subjects), label)
-        rep = laws.check_operator(op, seed=context.seed_for(profile), examples=profile.law_examples)
-        for r in rep.results:
-            r.details.setdefault("operator", r.subject)
-            r.subject = label
-        report.extend(rep)
-    context.progress(len(subjects), len(subjects), "")
-    return report
+    from .executors import Unit
+
+    units = [Unit("operator_laws", label, _operator_unit,
+                  (laws.check_operator, label, op, context.seed_for(profile), profile.law_examples))
+             for label, op in subjects]
+    return report.extend(_merged(context.run_units(profile, units)))
+
+
+def _operator_unit(check_operator: Callable, label: str, op: Any, seed: int | None, examples: Any) -> Report:
+    """One operator's law battery, its records renamed ``subject = label`` (the operator's problem or draw)."""
+    rep = check_operator(op, seed=seed, examples=examples)
+    for r in rep.results:
+        r.details.setdefault("operator", r.subject)
+        r.subject = label
+    return rep
 
 
 @register_stage("trajectory_laws", "contraction, uniqueness of the limit, domain, a-priori bounds, selections")
@@ -321,10 +349,36 @@ def trajectory_laws_stage(profile: Profile, context: RunContext) -> Report:
     seed = context.seed_for(profile)
     checks = list(mod.stepper_checks(stepper, context.problems, seed=0 if seed is None else seed,
                                      generated=profile.generated_subjects, orders=False))
-    report = Report()
-    for i, (name, check) in enumerate(checks):
-        context.progress(i, len(checks), name)
-        report.add(check(stepper))
+    from .executors import Unit
+
+    # one unit per subject problem (the battery of checks ``law[problem]`` on it), in first-seen order;
+    # the records are then put back in the order of ``checks``, as a serial loop over them gives
+    groups: dict[str, list[int]] = {}
+    for k, (name, _) in enumerate(checks):
+        groups.setdefault(name.partition("[")[2].rstrip("]") or name, []).append(k)
+    units = [Unit("trajectory_laws", subject, _checks_unit, ([checks[k] for k in ks], stepper))
+             for subject, ks in groups.items()]
+    slots: list[list[CheckResult]] = [[] for _ in checks]
+    for ks, rep in zip(groups.values(), context.run_units(profile, units)):
+        sizes = rep.meta.get("records_per_check")
+        if sizes is None or len(sizes) != len(ks):  # a unit that did not finish: its one failed record
+            slots[ks[0]].extend(rep.results)
+            continue
+        it = iter(rep.results)
+        for k, n in zip(ks, sizes):
+            slots[k].extend(next(it) for _ in range(n))
+    return Report([r for slot in slots for r in slot])
+
+
+def _checks_unit(checks: list[tuple[str, Callable]], subject: Any) -> Report:
+    """Every ``check(subject)`` of one battery, in order (``meta["records_per_check"]``: how many each gave)."""
+    report, sizes = Report(), []
+    for _, check in checks:
+        out = check(subject)
+        before = len(report)
+        report.extend(out) if isinstance(out, Report) else report.add(out)
+        sizes.append(len(report) - before)
+    report.meta["records_per_check"] = sizes
     return report
 
 
@@ -337,24 +391,31 @@ def assumptions_stage(profile: Profile, context: RunContext) -> Report:
     which alternative holds), and one record ``assumptions_thm_main`` per problem states whether the
     theorem's hypotheses as a whole have evidence for them."""
     mod = optional_module("verimono.checks.assumptions")
+    from .executors import Unit
+
     seed = context.seed_for(profile)
+    units = [Unit("assumptions", p.name, _assumptions_unit, (mod.check_assumptions, p, seed))
+             for p in context.catalog()]
+    return _merged(context.run_units(profile, units))
+
+
+def _assumptions_unit(check_assumptions: Callable, p: Any, seed: int | None) -> Report:
+    """One reference's assumption records, the (LG)/(YB) alternative as xfail, and its
+    ``assumptions_thm_main`` record (see :func:`assumptions_stage`)."""
     report = Report()
-    problems = context.catalog()
-    for i, p in enumerate(problems):
-        context.progress(i, len(problems), p.name)
-        rep = mod.check_assumptions(p, seed=0 if seed is None else seed)
-        by = {r.check: r for r in rep.results}
-        lg, yb = by.get("assumption_LG"), by.get("assumption_YB")
-        for this, other, name in ((lg, yb, "(YB)"), (yb, lg, "(LG)")):
-            if this is not None and other is not None and this.status == FAILED and other.status == PASSED:
-                this.status = XFAIL
-                this.message = f"the alternative hypothesis {name} has evidence for it; {this.message}"
-        bad = [r.check for r in rep.results if r.status == FAILED]
-        report.extend(rep)
-        report.add(CheckResult(
-            "assumptions_thm_main", p.name, FAILED if bad else PASSED, seed=seed,
-            message=("evidence against " + ", ".join(bad)) if bad else
-            "no sample contradicts (A1)–(A3) and (LG) or (YB) — evidence, not proof"))
+    rep = check_assumptions(p, seed=0 if seed is None else seed)
+    by = {r.check: r for r in rep.results}
+    lg, yb = by.get("assumption_LG"), by.get("assumption_YB")
+    for this, other, name in ((lg, yb, "(YB)"), (yb, lg, "(LG)")):
+        if this is not None and other is not None and this.status == FAILED and other.status == PASSED:
+            this.status = XFAIL
+            this.message = f"the alternative hypothesis {name} has evidence for it; {this.message}"
+    bad = [r.check for r in rep.results if r.status == FAILED]
+    report.extend(rep)
+    report.add(CheckResult(
+        "assumptions_thm_main", p.name, FAILED if bad else PASSED, seed=seed,
+        message=("evidence against " + ", ".join(bad)) if bad else
+        "no sample contradicts (A1)–(A3) and (LG) or (YB) — evidence, not proof"))
     return report
 
 

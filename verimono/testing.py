@@ -265,33 +265,45 @@ class BatteryCounter:
     def __init__(self) -> None:
         self.collected: set[str] = set()
         self.outcome: dict[str, str] = {}
-        self.reasons: Counter = Counter()
+        self.reason_of: dict[str, str] = {}
 
     def pytest_collection_modifyitems(self, session: Any, config: Any, items: list) -> None:
         self.collected = {it.nodeid for it in items if _is_battery_item(it)}
+        if hasattr(config, "workeroutput"):  # a pytest-xdist worker: tell the controller what it collected
+            config.workeroutput["verimono_battery"] = sorted(self.collected)
+
+    @pytest.hookimpl(optionalhook=True)
+    def pytest_testnodedown(self, node: Any, error: Any) -> None:
+        """pytest-xdist controller: the battery cases a worker collected (every worker collects all)."""
+        self.collected |= set((getattr(node, "workeroutput", None) or {}).get("verimono_battery", ()))
 
     def pytest_runtest_logreport(self, report: Any) -> None:
-        if report.nodeid not in self.collected:
-            return
+        # every test's outcome is noted, and only battery cases are counted: under pytest-xdist the
+        # controller learns which tests are battery cases only when the workers finish
         if not (report.when == "call" or (report.when == "setup" and (report.skipped or report.failed))):
             return
         if hasattr(report, "wasxfail"):
             outcome = "xfailed" if report.skipped else "xpassed"
         elif report.skipped:
             outcome = "skipped"
-            reason = report.longrepr[2] if isinstance(report.longrepr, tuple) else str(report.longrepr)
+            reason = report.longrepr[2] if isinstance(report.longrepr, (tuple, list)) else str(report.longrepr)
             reason = reason.removeprefix("Skipped: ")
             # "law[problem]: why" -> group by why (the per-case list is in pytest's -rs section)
-            self.reasons[reason.split("]: ", 1)[-1] if "]: " in reason else reason] += 1
+            self.reason_of[report.nodeid] = reason.split("]: ", 1)[-1] if "]: " in reason else reason
         elif report.failed and "XPASS(strict)" in str(report.longrepr):
             outcome = "xpassed"
         else:
             outcome = report.outcome
         self.outcome[report.nodeid] = outcome
 
+    @property
+    def reasons(self) -> Counter:
+        """Skip reasons of the battery cases, with how many cases gave each."""
+        return Counter(r for nodeid, r in self.reason_of.items() if nodeid in self.collected)
+
     def counts(self) -> dict[str, int]:
-        c = Counter(self.outcome.values())
-        return {"collected": len(self.collected), "ran": len(self.outcome), "passed": c["passed"],
+        c = Counter(o for nodeid, o in self.outcome.items() if nodeid in self.collected)
+        return {"collected": len(self.collected), "ran": sum(c.values()), "passed": c["passed"],
                 "failed": c["failed"], "skipped": c["skipped"], "xfailed": c["xfailed"], "xpassed": c["xpassed"]}
 
     def pytest_terminal_summary(self, terminalreporter: Any, exitstatus: int, config: Any) -> None:
@@ -303,7 +315,7 @@ class BatteryCounter:
         tr.write_line(f"{c['collected']} collected, {c['ran']} ran: {c['passed']} passed, {c['failed']} failed, "
                       f"{c['skipped']} skipped, {c['xfailed']} xfailed (expected), {c['xpassed']} xpassed "
                       "(strict: reported as failures)")
-        for reason, n in self.reasons.most_common():
+        for reason, n in sorted(self.reasons.items(), key=lambda kv: (-kv[1], kv[0])):  # not arrival order
             tr.write_line(f"  skipped x{n}: {reason}")
         if c["ran"] < c["collected"]:
             tr.write_line(f"  {c['collected'] - c['ran']} collected checks did not run (deselected or interrupted)")

@@ -1,0 +1,126 @@
+"""pytest-xdist: the README's ``parametrize_with_checks`` suite under ``pytest -n 2`` gives the same
+records, statuses, studies and battery summary as under plain ``pytest``, and gates the same; records that a
+parallel runner hides make the session fail instead of writing an empty, green report."""
+
+from __future__ import annotations
+
+import ast
+import json
+import re
+import textwrap
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("xdist")  # the test extra installs it; without it there is nothing to verify here
+
+pytest_plugins = ["pytester"]
+
+README = (Path(__file__).resolve().parent.parent / "README.md").read_text()
+
+
+def _blocks(heading: str) -> list[str]:
+    match = re.search(rf"^#{{2,4}} {re.escape(heading)}\n(.*?)(?=^#{{2,4}} |\Z)", README, re.S | re.M)
+    assert match, f"README has no section {heading!r}"
+    return re.findall(r"```python\n(.*?)```", match.group(1), re.S)
+
+
+def mysolver_source() -> str:
+    """``mysolver.py`` as the README's walk-through builds it: its imports, ``disc_projection``,
+    ``moving_disc`` and the last (corrected) ``my_stepper``, taken from the README's own code."""
+    keep: dict[str, str] = {}
+    imports: list[str] = []
+    for block in _blocks("Verify your own solver"):
+        for node in ast.parse(block).body:
+            src = ast.get_source_segment(block, node)
+            if isinstance(node, (ast.Import, ast.ImportFrom)):
+                imports.append(src)
+            elif isinstance(node, ast.FunctionDef):
+                keep[node.name] = src
+            elif isinstance(node, ast.Assign) and [getattr(t, "id", None) for t in node.targets] == ["moving_disc"]:
+                keep["moving_disc"] = src
+    assert {"disc_projection", "moving_disc", "my_stepper"} <= keep.keys()
+    return "\n".join(dict.fromkeys(imports)) + "\n\n" + "\n\n".join(keep.values()) + "\n"
+
+
+def suite_source() -> str:
+    """The README's pytest suite (section "2. pytest"), verbatim."""
+    (block,) = _blocks("2. pytest")
+    assert "parametrize_with_checks([moving_disc, my_stepper])" in block
+    return block
+
+
+def _summary(result: pytest.RunResult) -> list[str]:
+    """The ``verimono checks`` section and the ``verimono records`` line of a run's terminal output."""
+    lines = result.stdout.lines
+    start = next(i for i, line in enumerate(lines) if "verimono checks" in line)
+    out = []
+    for line in lines[start + 1:]:
+        if line.startswith(("=", "-")):
+            break
+        out.append(line)
+    out += [line for line in lines if "verimono records:" in line]
+    return out
+
+
+def _records(path: Path) -> tuple[list, list, list]:
+    doc = json.loads(path.read_text())
+    records = [(r["check"], r["subject"], r["status"], r["details"].get("pytest_nodeid")) for r in doc["results"]]
+    studies = [(s["problem"], s["stepper"], s["steps"]) for s in doc["studies"]]
+    return records, studies, [t["problem"] for t in doc["trajectories"]]
+
+
+@pytest.fixture
+def readme_project(pytester: pytest.Pytester, monkeypatch: pytest.MonkeyPatch) -> pytest.Pytester:
+    pytester.makepyfile(mysolver=mysolver_source(), test_mysolver=suite_source())
+    monkeypatch.setenv("CI", "1")                    # the ci profile, as the README's quoted output
+    monkeypatch.delenv("HYPOTHESIS_PROFILE", raising=False)
+    monkeypatch.delenv("PYTEST_XDIST_AUTO_NUM_WORKERS", raising=False)
+    return pytester
+
+
+def test_xdist_gives_the_serial_records_summary_and_gate(readme_project):
+    serial = readme_project.runpytest_subprocess("-p", "no:cacheprovider", "--verimono-report", "serial")
+    assert serial.ret == 0, serial.stdout.str()[-3000:]
+    parallel = readme_project.runpytest_subprocess("-p", "no:cacheprovider", "-n", "2", "--verimono-report", "par",
+                                                   "--verimono-baseline", "serial/results.json")
+    assert parallel.ret == 0, parallel.stdout.str()[-3000:]
+    assert "2 workers" in parallel.stdout.str()                      # it really ran on xdist workers
+
+    s_summary, p_summary = _summary(serial), _summary(parallel)
+    assert s_summary == p_summary
+    collected = int(s_summary[0].split()[0])
+    assert collected >= 150 and s_summary[0].startswith(f"{collected} collected, {collected} ran: ")
+
+    s_rec, s_studies, s_traj = _records(readme_project.path / "serial" / "results.json")
+    p_rec, p_studies, p_traj = _records(readme_project.path / "par" / "results.json")
+    assert len(s_rec) >= collected                                    # every case gave its record(s)
+    assert p_rec == s_rec                                             # same keys, statuses, order
+    assert p_studies == s_studies and len(s_studies) >= 1
+    assert p_traj == s_traj
+    parallel.stdout.fnmatch_lines(["verimono gate: no regressions*"])
+
+
+def test_records_hidden_by_a_parallel_runner_fail_the_session(readme_project):
+    # a runner that carries test outcomes but not verimono's records (simulated: the controller loses them)
+    readme_project.makeconftest(textwrap.dedent('''
+        import pytest
+
+        @pytest.hookimpl(tryfirst=True)
+        def pytest_runtest_logreport(report):
+            if report.when == "call" and hasattr(report, "verimono_records"):
+                del report.verimono_records
+    '''))
+    readme_project.makepyfile(test_mysolver=textwrap.dedent('''
+        from verimono.testing import parametrize_with_checks
+        from mysolver import moving_disc
+
+        @parametrize_with_checks([moving_disc])
+        def test_my_operator(subject, check):
+            check(subject)
+    '''))
+    result = readme_project.runpytest_subprocess("-p", "no:cacheprovider", "-n", "2", "--verimono-report", "out")
+    outcomes = result.parseoutcomes()
+    assert outcomes.get("passed", 0) > 0 and outcomes.get("failed", 0) == 0   # every test itself passed
+    assert result.ret == pytest.ExitCode.TESTS_FAILED                         # ... and the session fails
+    result.stdout.fnmatch_lines(["*verimono: * tests ran where their verimono records cannot reach this report*"])

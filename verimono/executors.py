@@ -1,0 +1,395 @@
+"""Fan-out of a verification run: independent *units* (a stage's per-subject batteries, per-reference
+studies) mapped over an executor, their results merged in the units' own order.
+
+``verimono run --executor SPEC`` (and ``verimono check``) chooses where units run:
+
+* ``serial`` (the default): in this process, one after the other;
+* ``process:N``: ``N`` worker processes of this machine (started with ``spawn``);
+* ``tcp://host:port`` (any ``scheme://address``): the workers of a running ``dask.distributed`` scheduler
+  (``pip install "verimono[dask]"``; verimono must be importable on the workers).
+
+A unit is ``fn(*args) -> Report``, shipped with ``cloudpickle`` (closures, lambdas and a ``verimono check``
+target loaded from a file travel by value).  Each worker loads the run's hypothesis profile and pins BLAS
+to one thread, as ``verimono run`` does, so a unit's records do not depend on where it ran: under a
+derandomized profile the merged report equals the serial run's apart from timings.
+
+A unit never takes the run down with it: a unit that raises, whose worker dies, or that runs longer than
+``timeout`` seconds becomes one *failed* record ``unit[<stage>: <label>]`` naming it (:func:`unit_failure`);
+the records of every other unit are kept.  With ``process:N`` the unit a dying worker was running is known
+exactly (each worker runs one unit at a time) and a fresh worker replaces it; on dask a unit that kills
+workers is reported once the scheduler gives up on it (``KilledWorker``, after its ``allowed-failures``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import multiprocessing
+import os
+import time
+import traceback
+from collections import deque
+from multiprocessing.connection import wait as _wait
+from typing import Any, Callable, Sequence
+
+from .errors import VerimonoError
+from .results import FAILED, CheckResult, Report
+
+#: the check name of the record that stands for a unit that crashed, died or timed out
+UNIT_CHECK = "unit"
+
+
+class BadExecutor(VerimonoError, ValueError):
+    """An ``--executor`` specification verimono cannot use (unknown form, or dask not installed)."""
+
+
+@dataclasses.dataclass
+class Unit:
+    """One independent piece of a stage: ``fn(*args) -> Report``; ``label`` names it in progress and in
+    the failed record that stands for it if it cannot finish."""
+
+    stage: str
+    label: str
+    fn: Callable[..., Report]
+    args: tuple = ()
+
+
+def unit_failure(unit: Unit, message: str, *, traceback_text: str | None = None,
+                 duration: float | None = None) -> Report:
+    """The report of a unit that did not finish: one failed record ``unit[<stage>: <label>]``."""
+    rec = CheckResult(UNIT_CHECK, f"{unit.stage}: {unit.label}", FAILED, message=message, duration=duration)
+    if traceback_text:
+        rec.details["traceback"] = traceback_text
+    return Report([rec])
+
+
+# -- what runs on a worker ----------------------------------------------------------------------------
+
+def _prepare_worker(profile: str | None) -> None:
+    """The run's hypothesis profile and one BLAS thread, as in the ``verimono run`` process."""
+    if profile:
+        from .profiles import load_hypothesis_profile
+
+        load_hypothesis_profile(profile)
+    try:
+        from threadpoolctl import threadpool_limits
+
+        threadpool_limits(limits=1, user_api="blas")
+    except ImportError:  # pragma: no cover - threadpoolctl is a dependency
+        pass
+
+
+def run_payload(payload: bytes) -> bytes:
+    """Run one shipped unit: ``payload`` is ``cloudpickle.dumps((profile, fn, args))``; the answer is
+    ``cloudpickle.dumps(("ok", report))`` or ``("error", message, traceback)`` — never an exception, so a
+    unit's own error is told apart from the worker's death."""
+    import cloudpickle
+
+    start = time.perf_counter()
+    try:
+        profile, fn, args = cloudpickle.loads(payload)
+        _prepare_worker(profile)
+        out = fn(*args)
+        if not isinstance(out, Report):
+            raise TypeError(f"a unit returned {type(out).__name__}, expected a verimono.Report")
+        return cloudpickle.dumps(("ok", out))
+    except Exception as exc:
+        return cloudpickle.dumps(("error", f"{type(exc).__name__}: {exc}", traceback.format_exc(limit=8),
+                                  time.perf_counter() - start))
+
+
+def _decode(unit: Unit, answer: bytes) -> Report:
+    import cloudpickle
+
+    try:
+        out = cloudpickle.loads(answer)
+    except Exception as exc:
+        return unit_failure(unit, f"its result could not be read back ({type(exc).__name__}: {exc})")
+    if out[0] == "ok":
+        return out[1]
+    return unit_failure(unit, f"raised {out[1]}", traceback_text=out[2], duration=out[3])
+
+
+def _process_worker(conn: Any) -> None:
+    """Loop of a ``process:N`` worker: receive a payload, answer, until an empty message."""
+    while True:
+        try:
+            payload = conn.recv_bytes()
+        except (EOFError, OSError):
+            return
+        if not payload:
+            return
+        conn.send_bytes(run_payload(payload))
+
+
+def _ship(unit: Unit, profile: str | None) -> bytes:
+    import cloudpickle
+
+    _register_targets_by_value()
+    return cloudpickle.dumps((profile, unit.fn, unit.args))
+
+
+def _register_targets_by_value() -> None:
+    """A ``verimono check`` target loaded from a ``.py`` file lives in a module no worker can import:
+    ship that module's functions by value."""
+    import sys
+
+    import cloudpickle
+
+    for name, module in list(sys.modules.items()):
+        if name.startswith("verimono_target_") and module is not None:
+            try:
+                cloudpickle.register_pickle_by_value(module)
+            except ValueError:  # pragma: no cover - already registered
+                pass
+
+
+# -- runners --------------------------------------------------------------------------------------------
+
+Progress = Callable[[int, int, str], None]
+
+
+class SerialRunner:
+    """Units in this process, in order (what ``verimono run`` does without ``--executor``)."""
+
+    spec = "serial"
+
+    def map(self, units: Sequence[Unit], profile: str | None, progress: Progress) -> list[Report]:
+        out = []
+        for i, u in enumerate(units):
+            progress(i, len(units), u.label)
+            start = time.perf_counter()
+            try:
+                rep = u.fn(*u.args)
+                if not isinstance(rep, Report):
+                    raise TypeError(f"a unit returned {type(rep).__name__}, expected a verimono.Report")
+            except Exception as exc:
+                rep = unit_failure(u, f"raised {type(exc).__name__}: {exc}",
+                                   traceback_text=traceback.format_exc(limit=8),
+                                   duration=time.perf_counter() - start)
+            out.append(rep)
+        progress(len(units), len(units), "")
+        return out
+
+    def close(self) -> None:
+        pass
+
+
+class ProcessRunner:
+    """``N`` spawned worker processes, each running one unit at a time; a worker that dies or overruns
+    ``timeout`` is replaced and its unit becomes a failed record (see the module docstring)."""
+
+    def __init__(self, workers: int, timeout: float | None = None) -> None:
+        if workers < 1:
+            raise BadExecutor(f"process:N needs N >= 1, got {workers}")
+        self.workers, self.timeout = int(workers), timeout
+        self.spec = f"process:{self.workers}"
+        self._ctx = multiprocessing.get_context("spawn")
+        self._pool: list[tuple[Any, Any]] = []  # (process, connection)
+
+    def _start(self) -> tuple[Any, Any]:
+        parent, child = self._ctx.Pipe(duplex=True)
+        # not a daemon: a unit may itself start a process pool (a large convergence study)
+        proc = self._ctx.Process(target=_process_worker, args=(child,), name="verimono-unit-worker")
+        proc.start()
+        child.close()
+        return proc, parent
+
+    @staticmethod
+    def _stop(worker: tuple[Any, Any], kill: bool = False) -> None:
+        proc, conn = worker
+        if kill:
+            proc.kill()
+        else:
+            try:
+                conn.send_bytes(b"")
+            except OSError:
+                pass
+        proc.join(timeout=5)
+        if proc.is_alive():
+            proc.kill()
+            proc.join()
+        conn.close()
+
+    def map(self, units: Sequence[Unit], profile: str | None, progress: Progress) -> list[Report]:
+        results: list[Report | None] = [None] * len(units)
+        pending = deque(range(len(units)))
+        busy: dict[Any, tuple[tuple[Any, Any], int, float]] = {}   # conn -> (worker, unit index, start)
+        while len(self._pool) < min(self.workers, len(units)):
+            self._pool.append(self._start())
+        idle = list(self._pool)
+        done = 0
+        progress(0, len(units), "")
+
+        def assign(worker):
+            i = pending.popleft()
+            worker[1].send_bytes(_ship(units[i], profile))
+            busy[worker[1]] = (worker, i, time.monotonic())
+            progress(done, len(units), units[i].label)
+
+        def replace(worker):
+            self._pool.remove(worker)
+            new = self._start()
+            self._pool.append(new)
+            return new
+
+        try:
+            while pending or busy:
+                while pending and idle:
+                    assign(idle.pop())
+                wait_for = None
+                if self.timeout is not None:
+                    now = time.monotonic()
+                    wait_for = max(0.0, min(start + self.timeout - now for _, _, start in busy.values()))
+                for conn in _wait(list(busy), timeout=wait_for):
+                    worker, i, start = busy.pop(conn)
+                    try:
+                        answer = conn.recv_bytes()
+                    except (EOFError, OSError):
+                        worker[0].join(timeout=5)
+                        code = worker[0].exitcode
+                        how = (f"signal {-code}" if code is not None and code < 0 else f"exit status {code}")
+                        results[i] = unit_failure(units[i], f"its worker process died ({how}) while running it",
+                                                  duration=time.monotonic() - start)
+                        self._stop(worker, kill=True)
+                        worker = replace(worker)
+                    else:
+                        results[i] = _decode(units[i], answer)
+                    done += 1
+                    idle.append(worker)
+                    progress(done, len(units), units[i].label)
+                if self.timeout is not None:
+                    now = time.monotonic()
+                    for conn, (worker, i, start) in list(busy.items()):
+                        if now - start > self.timeout:
+                            busy.pop(conn)
+                            self._stop(worker, kill=True)
+                            results[i] = unit_failure(units[i], f"timed out after {self.timeout:g} s (worker "
+                                                      "stopped)", duration=now - start)
+                            done += 1
+                            idle.append(replace(worker))
+        except BaseException:
+            self.close(kill=True)
+            raise
+        progress(len(units), len(units), "")
+        return [r for r in results]  # type: ignore[misc]
+
+    def close(self, kill: bool = False) -> None:
+        for w in self._pool:
+            self._stop(w, kill=kill)
+        self._pool = []
+
+
+class DaskRunner:
+    """The workers of a ``dask.distributed`` scheduler at ``address`` (or an existing ``Client``).
+
+    At most as many units are in flight as the cluster has worker threads, so a unit's ``timeout`` counts
+    from when it could start; a unit still unfinished then is cancelled and reported."""
+
+    def __init__(self, address: Any, timeout: float | None = None) -> None:
+        try:
+            from distributed import Client
+        except ImportError:
+            raise BadExecutor(f"--executor {address}: dask.distributed is not installed "
+                              '(pip install "verimono[dask]")') from None
+        self.timeout = timeout
+        if isinstance(address, Client):
+            self.client, self._own = address, False
+            self.spec = str(address.scheduler.address if address.scheduler else address)
+        else:
+            try:
+                self.client, self._own = Client(address, timeout="30s"), True
+            except (OSError, TimeoutError) as exc:
+                raise BadExecutor(f"--executor {address}: no dask scheduler answers there ({exc})") from None
+            self.spec = str(address)
+
+    def _slots(self) -> int:
+        try:
+            return max(1, sum(self.client.nthreads().values()))
+        except Exception:  # pragma: no cover
+            return 1
+
+    def map(self, units: Sequence[Unit], profile: str | None, progress: Progress) -> list[Report]:
+        from distributed import wait as dwait
+
+        results: list[Report | None] = [None] * len(units)
+        pending = deque(range(len(units)))
+        flying: dict[Any, tuple[int, float]] = {}
+        done = 0
+        progress(0, len(units), "")
+        try:
+            while pending or flying:
+                slots = self._slots()
+                while pending and len(flying) < slots:
+                    i = pending.popleft()
+                    fut = self.client.submit(run_payload, _ship(units[i], profile), pure=False,
+                                             key=f"verimono-unit-{i}-{os.urandom(4).hex()}")
+                    flying[fut] = (i, time.monotonic())
+                    progress(done, len(units), units[i].label)
+                wait_for = 5.0
+                if self.timeout is not None:
+                    now = time.monotonic()
+                    wait_for = max(0.05, min(start + self.timeout - now for _, start in flying.values()))
+                try:
+                    finished, _ = dwait(list(flying), timeout=wait_for, return_when="FIRST_COMPLETED")
+                except TimeoutError:
+                    finished = set()
+                for fut in finished:
+                    i, start = flying.pop(fut)
+                    if fut.status == "finished":
+                        results[i] = _decode(units[i], fut.result())
+                    else:
+                        exc = fut.exception()
+                        name = type(exc).__name__
+                        what = ("its worker died while running it (the scheduler gave up: "
+                                f"{name}: {exc})" if name == "KilledWorker" else f"failed on dask: {name}: {exc}")
+                        results[i] = unit_failure(units[i], what, duration=time.monotonic() - start)
+                    done += 1
+                    progress(done, len(units), units[i].label)
+                if self.timeout is not None:
+                    now = time.monotonic()
+                    for fut, (i, start) in list(flying.items()):
+                        if now - start > self.timeout:
+                            flying.pop(fut)
+                            fut.cancel()
+                            results[i] = unit_failure(units[i], f"timed out after {self.timeout:g} s (cancelled)",
+                                                      duration=now - start)
+                            done += 1
+        except BaseException:
+            for fut in flying:
+                fut.cancel()
+            raise
+        progress(len(units), len(units), "")
+        return [r for r in results]  # type: ignore[misc]
+
+    def close(self) -> None:
+        if self._own:
+            self.client.close()
+
+
+def make_runner(spec: Any = None, *, timeout: float | None = None) -> Any:
+    """A runner for ``spec``: ``None``/``"serial"``, ``"process:N"``, a ``scheme://address`` of a dask
+    scheduler, or a ``distributed.Client``; :class:`BadExecutor` for anything else."""
+    if spec is None or spec == "serial":
+        return SerialRunner()
+    if isinstance(spec, str):
+        if spec.startswith("process:"):
+            try:
+                n = int(spec.partition(":")[2])
+            except ValueError:
+                raise BadExecutor(f"--executor {spec}: expected process:N with an integer N") from None
+            return ProcessRunner(n, timeout)
+        if spec == "process":
+            return ProcessRunner(os.cpu_count() or 1, timeout)
+        if "://" in spec:
+            return DaskRunner(spec, timeout)
+        raise BadExecutor(f"--executor {spec!r}: expected serial, process:N or the address of a dask "
+                          "scheduler (tcp://host:8786)")
+    if type(spec).__name__ == "Client" and type(spec).__module__.startswith("distributed"):
+        return DaskRunner(spec, timeout)
+    if hasattr(spec, "map") and hasattr(spec, "close"):
+        return spec
+    raise BadExecutor(f"executor must be serial, process:N, a dask scheduler address or Client, got {spec!r}")
+
+
+__all__ = ["Unit", "UNIT_CHECK", "BadExecutor", "SerialRunner", "ProcessRunner", "DaskRunner", "make_runner",
+           "unit_failure", "run_payload"]
