@@ -109,8 +109,16 @@ def _decode(unit: Unit, answer: bytes) -> Report:
     return unit_failure(unit, f"raised {out[1]}", traceback_text=out[2], duration=out[3])
 
 
+#: seconds a new worker process may take to import verimono and say it is ready
+WORKER_START_TIMEOUT = 300.0
+
+
 def _process_worker(conn: Any) -> None:
-    """Loop of a ``process:N`` worker: receive a payload, answer, until an empty message."""
+    """Loop of a ``process:N`` worker: say ``ready`` once verimono is imported (so a unit's timeout does
+    not count the worker's start), then receive a payload and answer, until an empty message."""
+    import verimono.stages  # noqa: F401  (numpy, scipy and the stages: what every unit needs)
+
+    conn.send_bytes(b"ready")
     while True:
         try:
             payload = conn.recv_bytes()
@@ -186,13 +194,27 @@ class ProcessRunner:
         self._ctx = multiprocessing.get_context("spawn")
         self._pool: list[tuple[Any, Any]] = []  # (process, connection)
 
-    def _start(self) -> tuple[Any, Any]:
-        parent, child = self._ctx.Pipe(duplex=True)
-        # not a daemon: a unit may itself start a process pool (a large convergence study)
-        proc = self._ctx.Process(target=_process_worker, args=(child,), name="verimono-unit-worker")
-        proc.start()
-        child.close()
-        return proc, parent
+    def _start(self, count: int = 1) -> list[tuple[Any, Any]]:
+        """``count`` new workers, returned once each has said it is ready."""
+        started = []
+        for _ in range(count):
+            parent, child = self._ctx.Pipe(duplex=True)
+            # not a daemon: a unit may itself start a process pool (a large convergence study)
+            proc = self._ctx.Process(target=_process_worker, args=(child,), name="verimono-unit-worker")
+            proc.start()
+            child.close()
+            started.append((proc, parent))
+        for w in started:
+            try:
+                ready = w[1].poll(WORKER_START_TIMEOUT) and w[1].recv_bytes() == b"ready"
+            except (EOFError, OSError):
+                ready = False
+            if not ready:
+                for x in started:
+                    self._stop(x, kill=True)
+                raise BadExecutor(f"a worker process of {self.spec} did not start within "
+                                  f"{WORKER_START_TIMEOUT:g} s (exit status {w[0].exitcode})")
+        return started
 
     @staticmethod
     def _stop(worker: tuple[Any, Any], kill: bool = False) -> None:
@@ -214,8 +236,7 @@ class ProcessRunner:
         results: list[Report | None] = [None] * len(units)
         pending = deque(range(len(units)))
         busy: dict[Any, tuple[tuple[Any, Any], int, float]] = {}   # conn -> (worker, unit index, start)
-        while len(self._pool) < min(self.workers, len(units)):
-            self._pool.append(self._start())
+        self._pool += self._start(min(self.workers, len(units)) - len(self._pool))
         idle = list(self._pool)
         done = 0
         progress(0, len(units), "")
@@ -228,7 +249,7 @@ class ProcessRunner:
 
         def replace(worker):
             self._pool.remove(worker)
-            new = self._start()
+            (new,) = self._start()
             self._pool.append(new)
             return new
 
@@ -377,12 +398,14 @@ def make_runner(spec: Any = None, *, timeout: float | None = None) -> Any:
                 n = int(spec.partition(":")[2])
             except ValueError:
                 raise BadExecutor(f"--executor {spec}: expected process:N with an integer N") from None
+            if n < 1:
+                raise BadExecutor(f"--executor {spec}: process:N needs N >= 1 worker processes")
             return ProcessRunner(n, timeout)
         if spec == "process":
             return ProcessRunner(os.cpu_count() or 1, timeout)
         if "://" in spec:
             return DaskRunner(spec, timeout)
-        raise BadExecutor(f"--executor {spec!r}: expected serial, process:N or the address of a dask "
+        raise BadExecutor(f"--executor {spec}: expected serial, process:N or the address of a dask "
                           "scheduler (tcp://host:8786)")
     if type(spec).__name__ == "Client" and type(spec).__module__.startswith("distributed"):
         return DaskRunner(spec, timeout)

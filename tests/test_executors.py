@@ -1,0 +1,159 @@
+"""A distributed verification run (``--executor``): the stages' units on worker processes or a dask cluster
+give the serial run's JSON apart from timings; a worker that dies, or a unit that overruns its timeout,
+becomes one failed record naming the unit while every other unit's records stay as in the serial run."""
+
+from __future__ import annotations
+
+import json
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from verimono.cli import main
+from verimono.executors import BadExecutor, SerialRunner, Unit, make_runner
+from verimono.results import CheckResult, Report
+
+REF = ["--reference", "moving box", "--reference", "t|x| (n=1)"]
+RUN = ["run", "--profile", "ci", "--stage", "convergence", "--stage", "assumptions", *REF]
+#: keys whose values are timings (seconds, or when the document was written): all that may differ
+TIMING_KEYS = {"duration", "timings", "calibration", "created"}
+
+STEPPERS = '''
+import multiprocessing, os, signal, time
+from verimono.stepping import solve as _solve
+
+
+def killer(problem, t_grid):
+    """verimono's own solve, except that it kills its worker process on the moving box."""
+    if problem.name == "moving box" and multiprocessing.parent_process() is not None:
+        os.kill(os.getpid(), signal.SIGKILL)
+    return _solve(problem, t_grid)
+
+
+def sleeper(problem, t_grid):
+    """verimono's own solve, except that it hangs on the moving box when run by a worker."""
+    if problem.name == "moving box" and multiprocessing.parent_process() is not None:
+        time.sleep(600)
+    return _solve(problem, t_grid)
+'''
+
+
+def without_timings(value):
+    if isinstance(value, dict):
+        return {k: without_timings(v) for k, v in value.items() if k not in TIMING_KEYS}
+    if isinstance(value, list):
+        return [without_timings(v) for v in value]
+    return value
+
+
+def document(out: Path) -> dict:
+    return without_timings(json.loads((out / "results.json").read_text()))
+
+
+@pytest.fixture(scope="module")
+def serial_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("serial")
+    assert main([*RUN, "--out", str(out)]) == 0
+    doc = document(out)
+    assert len(doc["results"]) == 2 + 2 * 6 and len(doc["studies"]) == 2   # what the selection gives
+    return doc
+
+
+@pytest.fixture(scope="module")
+def steppers(tmp_path_factory):
+    d = tmp_path_factory.mktemp("steppers")
+    (d / "steppers.py").write_text(textwrap.dedent(STEPPERS))
+    return d / "steppers.py"
+
+
+@pytest.fixture(scope="module")
+def serial_check(steppers, tmp_path_factory):
+    """``verimono check`` of the killer stepper, serially (here it never kills: it is not in a worker)."""
+    out = tmp_path_factory.mktemp("check")
+    assert main(["check", f"{steppers}:killer", "--profile", "ci", *REF, "--out", str(out)]) == 0
+    return document(out)
+
+
+def killed_unit_intact(serial: dict, parallel: dict, how: str) -> None:
+    """The moving box's units are failed ``unit`` records saying ``how``; every other record is the serial one."""
+    failed = [r for r in parallel["results"] if r["check"] == "unit"]
+    assert [(r["subject"], r["status"]) for r in failed] == [("convergence: moving box", "failed"),
+                                                            ("trajectory_laws: moving box", "failed")]
+    assert all(how in r["message"] for r in failed), [r["message"] for r in failed]
+    kept = [r for r in serial["results"] if "moving box" not in r["subject"]]
+    assert len(kept) >= 6
+    assert [r for r in parallel["results"] if r["check"] != "unit"] == kept
+    assert [s for s in parallel["studies"]] == [s for s in serial["studies"] if s["problem"] != "moving box"]
+
+
+def test_process_executor_gives_the_serial_json(serial_run, tmp_path, capsys):
+    assert main([*RUN, "--out", str(tmp_path), "--executor", "process:2"]) == 0
+    assert "units run on process:2" in capsys.readouterr().err
+    assert document(tmp_path) == serial_run
+
+
+def test_a_killed_worker_process_fails_its_unit_only(steppers, serial_check, tmp_path):
+    code = main(["check", f"{steppers}:killer", "--profile", "ci", *REF, "--out", str(tmp_path),
+                 "--executor", "process:2"])
+    assert code == 1
+    killed_unit_intact(serial_check, document(tmp_path), "worker process died (signal 9)")
+
+
+def test_a_unit_over_its_timeout_fails_and_the_run_goes_on(steppers, serial_check, tmp_path):
+    code = main(["check", f"{steppers}:sleeper", "--profile", "ci", *REF, "--out", str(tmp_path),
+                 "--executor", "process:2", "--unit-timeout", "15"])
+    assert code == 1
+    doc = document(tmp_path)
+    serial = json.loads(json.dumps(serial_check).replace('"killer', '"sleeper').replace("killer on", "sleeper on"))
+    killed_unit_intact(serial, doc, "timed out after 15 s")
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    distributed = pytest.importorskip("distributed")
+    import dask
+
+    # a unit that kills its worker is reported at once rather than retried on the other workers
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+        with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                      dashboard_address=None, silence_logs=50) as c:
+            yield c
+
+
+def test_dask_local_cluster_gives_the_serial_json(cluster, serial_run, tmp_path):
+    assert main([*RUN, "--out", str(tmp_path), "--executor", cluster.scheduler_address]) == 0
+    assert document(tmp_path) == serial_run
+
+
+def test_a_killed_dask_worker_fails_its_unit_only(cluster, steppers, serial_check, tmp_path):
+    code = main(["check", f"{steppers}:killer", "--profile", "ci", *REF, "--out", str(tmp_path),
+                 "--executor", cluster.scheduler_address])
+    assert code == 1
+    killed_unit_intact(serial_check, document(tmp_path), "KilledWorker")
+
+
+def _ok(name):
+    return Report([CheckResult("law", name, "passed", worst=0.5, bound=1.0)])
+
+
+def _boom(name):
+    raise ZeroDivisionError(f"{name} divided by zero")
+
+
+def test_a_unit_that_raises_is_one_failed_record_in_place():
+    units = [Unit("s", "a", _ok, ("a",)), Unit("s", "b", _boom, ("b",)), Unit("s", "c", _ok, ("c",))]
+    seen = []
+    reports = SerialRunner().map(units, None, lambda done, total, label: seen.append((done, total, label)))
+    assert [r.key for rep in reports for r in rep] == ["law[a]", "unit[s: b]", "law[c]"]
+    assert reports[1][0].status == "failed" and "ZeroDivisionError: b divided by zero" in reports[1][0].message
+    assert "traceback" in reports[1][0].details
+    assert seen[0] == (0, 3, "a") and seen[-1] == (3, 3, "")
+
+
+@pytest.mark.parametrize("spec", ["process:two", "threads", "process:0"])
+def test_a_bad_executor_is_a_usage_error(spec, tmp_path, capsys):
+    with pytest.raises(BadExecutor):
+        make_runner(spec)
+    assert main([*RUN, "--out", str(tmp_path), "--executor", spec]) == 2
+    assert f"--executor {spec}" in capsys.readouterr().err
