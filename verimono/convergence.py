@@ -146,6 +146,25 @@ class ConvergenceStudy:
             msg += " (pre-asymptotic: local slopes " + ", ".join(f"{s:.2f}" for s in fit.local_slopes) + ")"
         return ok, msg
 
+    def __repr__(self) -> str:
+        """The errors per grid, the fitted orders and the verdict, as a small table."""
+        from .report.notebook import study_text
+
+        return study_text(self)
+
+    def _repr_html_(self) -> str:
+        """Jupyter: the report's log-log plot of this study next to its table of errors and orders."""
+        from .report.notebook import study_html
+
+        return study_html(self)
+
+    def plot(self, ax: Any = None) -> Any:
+        """The report's log-log plot (errors per norm, fitted slope with its 95% interval, expected slope,
+        round-off floor) as a matplotlib ``Figure`` on the Agg canvas, or drawn on ``ax``."""
+        from .report.plots import convergence_figure
+
+        return convergence_figure(self, ax)
+
     def to_dict(self) -> dict[str, Any]:
         from .results import to_jsonable
 

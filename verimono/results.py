@@ -96,6 +96,18 @@ class CheckResult:
         msg = f" — {self.message}" if self.message else ""
         return f"{self.status.upper():7s} {self.key}{ratio}{msg}"
 
+    def __repr__(self) -> str:
+        """One readable line: status, key, worst against bound, seed, message (details left out)."""
+        from .report.notebook import record_text
+
+        return record_text(self)
+
+    def _repr_html_(self) -> str:
+        """Jupyter: the record as the HTML report shows it (counterexample, reproduction, study plot)."""
+        from .report.notebook import record_html
+
+        return record_html(self)
+
 
 class Report:
     """An ordered collection of :class:`CheckResult` records, plus convergence studies.
@@ -155,7 +167,16 @@ class Report:
         return ", ".join(f"{c[s]} {s}" for s in STATUSES)
 
     def __repr__(self) -> str:
-        return f"Report({self.summary()})"
+        """``Report(N passed, N failed, N skipped, N xfail)``, then the counts and the failures."""
+        from .report.notebook import report_text
+
+        return report_text(self)
+
+    def _repr_html_(self) -> str:
+        """Jupyter: the HTML report's own sections and plots, its stylesheet scoped to the output."""
+        from .report.notebook import report_html
+
+        return report_html(self)
 
     # -- serialization (schema: verimono.report.schema) ------------------------------------------------
     def to_dict(self) -> dict[str, Any]:

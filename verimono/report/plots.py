@@ -38,9 +38,12 @@ def _svg(fig: Any) -> str:
 
 
 def _figure(width: float = 4.4, height: float = 3.1) -> Any:
+    """A figure on the Agg canvas, outside pyplot (no global state, no GUI backend)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(width, height), dpi=96)
+    FigureCanvasAgg(fig)
     fig.set_layout_engine("constrained")
     return fig
 
@@ -50,12 +53,20 @@ def _num(v: Any) -> float:
 
 
 def convergence_plot(study: Any) -> str:
+    """:func:`convergence_figure` as an inline ``<svg>``."""
+    return _svg(convergence_figure(study))
+
+
+def convergence_figure(study: Any, ax: Any = None) -> Any:
     """Log-log errors against ``|Δ|`` for each norm, the fitted sup-norm slope with its 95% interval as a
-    shaded wedge, the expected slope dashed, and the round-off floor dotted."""
+    shaded wedge, the expected slope dashed, and the round-off floor dotted; drawn on ``ax`` (default: a
+    new Agg figure).  Returns the matplotlib ``Figure``."""
     from matplotlib.ticker import NullLocator
 
-    fig = _figure()
-    ax = fig.add_subplot()
+    if ax is None:
+        fig = _figure()
+        ax = fig.add_subplot()
+    fig = ax.figure
     h = np.asarray(study.mesh, float)
     floor = float(study.floor)
     positive = []
@@ -110,7 +121,7 @@ def convergence_plot(study: Any) -> str:
     ax.set_title(study.problem, fontsize=10)
     ax.grid(True, which="major", alpha=0.3)
     ax.legend(fontsize=6.5, loc="lower right", framealpha=0.85)
-    return _svg(fig)
+    return fig
 
 
 def trajectory_plot(sample: dict[str, Any]) -> str:
@@ -138,4 +149,4 @@ def trajectory_plot(sample: dict[str, Any]) -> str:
     return _svg(fig)
 
 
-__all__ = ["convergence_plot", "trajectory_plot"]
+__all__ = ["convergence_plot", "convergence_figure", "trajectory_plot"]

@@ -1,0 +1,189 @@
+"""Notebook rendering: what ``Report``, ``CheckResult`` and ``ConvergenceStudy`` show in Jupyter.
+
+``_repr_html_`` gives a fragment of the HTML report — the same sections, tables and plots
+(:mod:`.html`, :mod:`.plots`) — inside ``<div class="vm-nb">`` with the report's stylesheet scoped to that
+``div``, so a notebook's own style is left alone.  The ``*_text`` functions are the readable ``repr``.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from typing import Any
+
+from ..results import FAILED, PASSED, CheckResult, Report
+
+SCOPE = "vm-nb"
+#: rules the notebook needs on top of the report's (no sticky header rows inside a notebook cell)
+_EXTRA_CSS = (".vm-nb { font: 13px/1.45 system-ui, sans-serif; color:#1d2330; }"
+              " .vm-nb th { position:static; } .vm-nb section { margin:10px 0; }"
+              " .vm-nb .grid { grid-template-columns:repeat(auto-fill, minmax(360px, 1fr)); }")
+
+
+def scoped_css(css: str, scope: str = SCOPE) -> str:
+    """``css`` with every selector confined to ``.scope`` (``:root`` and ``body`` become ``.scope``)."""
+    out = []
+    for selectors, body in re.findall(r"([^{}]+)\{([^{}]*)\}", css):
+        scoped = []
+        for sel in selectors.split(","):
+            sel = sel.strip()
+            if sel in (":root", "body"):
+                scoped.append(f".{scope}")
+            elif sel:
+                scoped.append(f".{scope} {sel}")
+        out.append(", ".join(scoped) + " {" + body + "}")
+    return "\n".join(out)
+
+
+def _wrap(body: str) -> str:
+    from .html import CSS
+
+    return f'<div class="{SCOPE}"><style>{scoped_css(CSS)}\n{_EXTRA_CSS}</style>{body}</div>'
+
+
+def _section(title: str, body: str) -> str:
+    return f"<section><h2>{title}</h2>{body}</section>"
+
+
+def report_html(report: Report) -> str:
+    """The report as a notebook fragment: summary, convergence plots, trajectories, failures, laws and
+    performance — the HTML report's own sections (those with something to show)."""
+    from . import html
+
+    parts = [_section("verimono report", html._summary(report, None))]
+    if any(hasattr(s, "fits") for s in report.studies):
+        parts.append(_section("Convergence orders", html._convergence(report)))
+    if report.trajectories:
+        parts.append(_section("Trajectories against exact solutions", html._trajectories(report)))
+    if report.failures:
+        parts.append(_section("Failures and how to reproduce them", html._failures(report)))
+    if report.results:
+        parts.append(_section("Laws and checks", html._laws(report)))
+    if any(r.check.startswith("performance_") for r in report.results):
+        parts.append(_section("Performance", html._performance(report)))
+    return _wrap("".join(parts))
+
+
+def record_html(rec: CheckResult) -> str:
+    """One record: status, key, worst observed ratio against its bound, message, counterexample and, for
+    a failure, the command that reproduces it."""
+    from . import html
+    from ..results import to_jsonable
+
+    rows = [["status", html._badge(rec.status)], ["check", html._e(rec.check)], ["subject", html._e(rec.subject)]]
+    if rec.worst is not None or rec.bound is not None:
+        rows.append(["worst / bound", f"{html._num(rec.worst)} / {html._num(rec.bound)} {html._bar(html._ratio(rec))}"])
+    if rec.seed is not None:
+        rows.append(["seed", html._num(rec.seed, "d")])
+    if rec.duration is not None:
+        rows.append(["seconds", html._num(rec.duration, ".3f")])
+    if rec.message:
+        rows.append(["message", html._e(rec.message)])
+    body = '<table class="kv">' + "".join(f"<tr><td>{k}</td><td>{v}</td></tr>" for k, v in rows) + "</table>"
+    if rec.counterexample:
+        body += f"<b>Counterexample</b><pre>{html._e(html._compact(to_jsonable(rec.counterexample)))}</pre>"
+    if rec.status == FAILED:
+        body += f"<b>Reproduce</b><pre>{html._e(html.reproduction(rec, {}))}</pre>"
+    study = rec.details.get("study") if isinstance(rec.details, dict) else None
+    if isinstance(study, dict):
+        from ..convergence import ConvergenceStudy
+
+        try:
+            body += study_figure_html(ConvergenceStudy.from_dict(study))
+        except (KeyError, TypeError, ValueError):
+            pass
+    cls = "failure" if rec.status == FAILED else ""
+    return _wrap(f'<div class="{cls}" style="padding:6px 10px"><h3 style="margin:2px 0 6px">{html._e(rec.key)}</h3>'
+                 f"{body}</div>")
+
+
+def study_figure_html(study: Any) -> str:
+    from . import html
+    from .plots import convergence_plot
+
+    ok, msg = study.verdict()
+    status = PASSED if ok else FAILED
+    return (f'<figure style="max-width:560px">{convergence_plot(study)}<figcaption><b class="{status}">'
+            f"{status.upper()}</b> {html._e(study.stepper)} — {html._e(msg)}. Reference: "
+            f"{html._e(study.reference)}.</figcaption></figure>")
+
+
+def study_html(study: Any) -> str:
+    """A study: its log-log plot (the report's), errors per grid and the fitted order in each norm."""
+    from . import html
+
+    norms = list(study.errors)
+    rows = [[html._num(h, ".4g"), html._num(k, "d")] + [html._num(study.errors[n][i], ".3e") for n in norms]
+            for i, (h, k) in enumerate(zip(study.mesh, study.steps))]
+    rows.append(["order [95%]", ""] + [html._e(study.fits[n]) for n in norms])
+    table = html._table(["mesh |Δ|", "steps"] + [f"{n} error" for n in norms], rows,
+                        tuple(range(len(norms) + 2)))
+    exp = "none stated" if study.expected is None else html._e(study.expected)
+    head = (f"<h3 style='margin:2px 0 6px'>Convergence of {html._e(study.stepper)} on {html._e(study.problem)}"
+            f"</h3><p class='note'>expected order: {exp}; reference: {html._e(study.reference)}</p>")
+    return _wrap(head + '<div style="display:flex;gap:14px;flex-wrap:wrap;align-items:flex-start">'
+                 + study_figure_html(study) + f'<div style="flex:1;min-width:320px">{table}</div></div>')
+
+
+# -- readable repr ---------------------------------------------------------------------------------
+
+
+def _short(text: str, limit: int = 160) -> str:
+    text = " ".join(str(text).split())
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+def _g(x: Any) -> str:
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        return str(x)
+    return f"{v:.4g}" if math.isfinite(v) else str(v)
+
+
+def record_text(rec: CheckResult) -> str:
+    """``CheckResult(passed convergence_order[solve on box], worst 0.9524 ≤ bound 1: measured …)``."""
+    parts = [f"{rec.status} {rec.key}"]
+    if rec.worst is not None:
+        rel = "≤" if rec.bound is None or not (float(rec.worst) > float(rec.bound)) else ">"
+        parts.append(f"worst {_g(rec.worst)}" + (f" {rel} bound {_g(rec.bound)}" if rec.bound is not None else ""))
+    if rec.seed is not None:
+        parts.append(f"seed {rec.seed}")
+    text = ", ".join(parts)
+    if rec.message:
+        text += f": {_short(rec.message)}"
+    if rec.counterexample:
+        text += f" (counterexample: {', '.join(map(str, rec.counterexample))})"
+    return f"CheckResult({text})"
+
+
+def report_text(report: Report, limit: int = 10) -> str:
+    """First line ``Report(10 passed, 0 failed, 5 skipped, 0 xfail)``, then the failures (at most ``limit``)
+    and how many records, checks and studies there are."""
+    lines = [f"Report({report.summary()})"]
+    checks = len({r.check for r in report.results})
+    lines.append(f"  {len(report)} records of {checks} checks, {len(report.studies)} convergence studies")
+    for r in report.failures[:limit]:
+        lines.append(f"  {r}")
+    if len(report.failures) > limit:
+        lines.append(f"  … and {len(report.failures) - limit} more failures")
+    return "\n".join(lines)
+
+
+def study_text(study: Any) -> str:
+    """The study as a small table: mesh, steps, each norm's error per grid, the fitted orders, the verdict."""
+    norms = list(study.errors)
+    head = f"ConvergenceStudy({study.stepper} on {study.problem}; expected order " + \
+        ("none stated" if study.expected is None else str(study.expected)) + f"; reference: {study.reference})"
+    cols = ["mesh |Δ|", "steps"] + [f"{n} error" for n in norms]
+    rows = [[f"{h:.4g}", str(k)] + [f"{float(study.errors[n][i]):.3e}" for n in norms]
+            for i, (h, k) in enumerate(zip(study.mesh, study.steps))]
+    rows.append(["order", ""] + [str(study.fits[n]) for n in norms])
+    widths = [max(len(r[j]) for r in rows + [cols]) for j in range(len(cols))]
+    fmt = "  " + "  ".join(f"{{:>{w}}}" for w in widths)
+    ok, msg = study.verdict()
+    return "\n".join([head, fmt.format(*cols)] + [fmt.format(*r) for r in rows]
+                     + [f"  verdict: {'reaches the expected order' if ok else 'MISSES the expected order'} — {msg}"])
+
+
+__all__ = ["report_html", "record_html", "study_html", "scoped_css", "record_text", "report_text", "study_text"]
