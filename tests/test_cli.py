@@ -180,3 +180,68 @@ def test_a_py_target_is_the_file_itself_not_a_module_of_the_same_name(tmp_path):
         assert load_target(f"{d}/lagged.py:solve")(None, None) == i
     with pytest.raises(BadTarget, match="does not exist"):
         load_target(f"{tmp_path}/missing.py:solve")
+
+
+# -- progress ---------------------------------------------------------------------------------------
+
+
+class _Stream:
+    """A text stream that says whether it is a terminal."""
+
+    def __init__(self, tty: bool) -> None:
+        self.tty, self.parts = tty, []
+
+    def isatty(self) -> bool:
+        return self.tty
+
+    def write(self, text: str) -> None:
+        self.parts.append(text)
+
+    def flush(self) -> None:
+        pass
+
+    @property
+    def text(self) -> str:
+        return "".join(self.parts)
+
+
+def test_progress_on_a_terminal_shows_units_and_the_current_subject(monkeypatch):
+    from verimono.cli import Progress, execute
+    from verimono.reference import get
+    from verimono.stages import RunContext
+
+    monkeypatch.delenv("CI", raising=False)
+    stream = _Stream(tty=True)
+    progress = Progress(stream)
+    assert progress.tty
+    problems = [get("moving box"), get("t|x| (n=1)")]
+    execute(command="run", profile_name="ci", stages=["convergence", "assumptions"],
+            context=RunContext(problems=problems), progress=progress)
+    frames = [p for p in stream.parts if p.startswith("\r[")]
+    # every unit of each stage was announced with its subject, and each stage reached all its units
+    for stage in ("convergence", "assumptions"):
+        assert any(f"{stage}  0/2 units  moving box" in f for f in frames)
+        assert any(f"{stage}  1/2 units  t|x| (n=1)" in f for f in frames)
+        assert any(f"{stage}  2/2 units" in f for f in frames)
+    assert "stage 2/2" in stream.text and "[2/2] assumptions: passed" in stream.text
+
+
+def test_progress_is_quiet_and_line_oriented_off_a_terminal_or_under_ci(monkeypatch):
+    from verimono.cli import Progress
+
+    class Stage:
+        name = "operator_laws"
+
+    monkeypatch.setenv("CI", "true")
+    assert not Progress(_Stream(tty=True)).tty            # CI: no redrawn bar even on a terminal
+    monkeypatch.delenv("CI")
+    for stream, interval, lines in ((_Stream(tty=False), 60.0, 0), (_Stream(tty=False), 0.0, 2)):
+        progress = Progress(stream, interval=interval)
+        progress.start(Stage(), 1, 7)
+        for done, label in ((0, "a"), (1, "b"), (2, "c"), (3, "")):
+            progress.within(done, 3, label)
+        assert "\r" not in stream.text
+        within = [line for line in stream.text.splitlines() if "units done" in line]
+        assert len(within) == lines                         # at most one line per interval, none at 0 or total
+        assert all(line.startswith("[2/7] operator_laws: ") for line in within)
+    assert within == ["[2/7] operator_laws: 1/3 units done, at b", "[2/7] operator_laws: 2/3 units done, at c"]

@@ -283,6 +283,10 @@ def _cmd_check(args: argparse.Namespace) -> int:
     else:
         raise BadTarget(f"{args.target} is neither an operator (with .dim and .resolvent) nor a stepper "
                         "callable(problem, t_grid)")
+    if getattr(args, "executor", None) not in (None, "serial"):
+        from .executors import ship_by_value
+
+        ship_by_value(obj)  # its module need not be importable on the workers
     print(f"verimono: checking {args.target} as a {kind}", file=sys.stderr)
     report = execute(command="check", profile_name=args.profile, stages=stages, context=ctx,
                      target=args.target, progress=Progress(), **_executor_options(args))

@@ -151,6 +151,23 @@ def _register_targets_by_value() -> None:
                 pass
 
 
+def ship_by_value(obj: Any) -> None:
+    """Let workers that cannot import ``obj``'s module still run it: a module of the user's (not verimono's,
+    not an installed distribution's) is shipped by value with every unit (``cloudpickle``)."""
+    import sys
+
+    import cloudpickle
+
+    module = sys.modules.get(getattr(obj, "__module__", None) or "")
+    path = getattr(module, "__file__", None) or ""
+    if module is None or module.__name__.split(".")[0] in ("verimono", "__main__") or "-packages" in path:
+        return
+    try:
+        cloudpickle.register_pickle_by_value(module)
+    except ValueError:  # pragma: no cover - a module cloudpickle refuses: it ships by reference
+        pass
+
+
 # -- runners --------------------------------------------------------------------------------------------
 
 Progress = Callable[[int, int, str], None]
@@ -414,5 +431,5 @@ def make_runner(spec: Any = None, *, timeout: float | None = None) -> Any:
     raise BadExecutor(f"executor must be serial, process:N, a dask scheduler address or Client, got {spec!r}")
 
 
-__all__ = ["Unit", "UNIT_CHECK", "BadExecutor", "SerialRunner", "ProcessRunner", "DaskRunner", "make_runner",
+__all__ = ["Unit", "UNIT_CHECK", "ship_by_value", "BadExecutor", "SerialRunner", "ProcessRunner", "DaskRunner", "make_runner",
            "unit_failure", "run_payload"]
