@@ -351,6 +351,7 @@ def thm_main(problem: Problem, records: dict[str, CheckResult]) -> CheckResult:
             this.message = f"the alternative hypothesis {name} has evidence for it; {this.message}"
     bad = [r.check for r in records.values() if r.status == FAILED]
     return CheckResult("assumptions_thm_main", _subject(problem), FAILED if bad else PASSED,
+                       details={"evidence": EVIDENCE, "from": sorted(records)},
                        message=("evidence against " + ", ".join(bad)) if bad else
                        "no sample contradicts (A1)–(A3) and (LG) or (YB) — evidence, not proof")
 
@@ -376,5 +377,23 @@ def check_assumptions(problem: Problem, *, seed: int = 0, points: int = 12, time
     return report
 
 
-__all__ = ["check_assumptions", "thm_main", "ASSUMPTION_LAWS", "EVIDENCE", "LAMBDAS", "A2_LEVELS", "A2_RATIO", "A2_SETTLED",
+def problem_checks(problem: Problem | None = None, *, seed: int = 0, points: int = 12, times: int = 7):
+    """The battery of a problem, as ``(name, check)`` pairs with ``check(problem) -> CheckResult`` — one
+    source for :func:`check_assumptions`'s records in :func:`verimono.testing.parametrize_with_checks`.
+
+    The five assumption laws share their samples and the composite :func:`thm_main` reads their records,
+    so the first check run evaluates the whole battery once (per problem) and every check returns its own
+    record of it."""
+    done: dict[int, dict[str, CheckResult]] = {}
+
+    def records(p: Problem) -> dict[str, CheckResult]:
+        if id(p) not in done:
+            done[id(p)] = {r.check: r for r in check_assumptions(p, seed=seed, points=points, times=times)}
+        return done[id(p)]
+
+    for name in (*ASSUMPTION_LAWS, "assumptions_thm_main"):
+        yield name, (lambda p, _name=name: records(p)[_name])
+
+
+__all__ = ["check_assumptions", "problem_checks", "thm_main", "ASSUMPTION_LAWS", "EVIDENCE", "LAMBDAS", "A2_LEVELS", "A2_RATIO", "A2_SETTLED",
            "A2_TAIL_SAFETY", "A2_LAMBDAS"]

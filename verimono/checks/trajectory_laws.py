@@ -27,6 +27,11 @@ Laws (labels of the paper, Camlibel–Iannelli–Tanwani):
 * ``selections`` — ``eq:iteration``: ``y_{k+1} = (x_k + h f(x_k) + ∫u - x_{k+1})/h_{k+1} ∈
   F(t_{k+1}, x_{k+1})``, tested with ``operator.contains`` and with the resolvent characterisation
   ``J_μ(x + μy) = x`` at ``μ = h/2`` (a different step than the scheme's).
+
+Each law declares what it needs (:mod:`verimono.checks.core`), the stepper's claim among it
+(:mod:`verimono.claims`): ``bounds_lg``, ``bounds_yb``, ``psi_interpolation`` and ``selections`` bind only
+the proximal scheme; ``contraction`` binds steppers claiming it; ``unique_limit`` binds every convergent
+scheme, and ``in_domain`` too, as a distance vanishing at the claimed order for ``scheme="any"``.
 """
 
 from __future__ import annotations
@@ -283,6 +288,9 @@ def check_contraction(stepper: Callable, problem: Problem, *, grids: Any = None,
     (``x_{k+1} = J(x_k + h f(x_k))``: ``1 + hL ≤ e^{hL}``), or ``1/(1 - L h_k)`` when larger (``hL < 1``: a
     stepper treating ``f`` implicitly, ``x_{k+1} = J(x_k + h f(x_{k+1}))``); both give ``e^{L t_k}`` as
     ``h → 0``.
+
+    Claim: ``contracts`` — the proximal scheme contracts (its resolvents are nonexpansive); a scheme
+    claiming only convergence need not contract step by step, so it must say so (``contracts=True``).
     """
     grids = _as_grids(grids, problem, seed)
 
@@ -344,6 +352,8 @@ def check_unique_limit(stepper: Callable, problem: Problem, *, levels: Sequence[
     dies out at ``t = 1/64``, and partitions of mesh 0.1 and 0.025 all give 0 there, so the distance is
     0, 0, then ``c h`` at mesh 1/160).  A stepper with no unique limit keeps an O(1) distance, which never
     falls to ``LIMIT_SHRINK`` times its largest value.
+
+    Claim: any — every convergent scheme has a unique limit (Section 5.4: it is the unique solution).
     """
     subject = f"{_name(stepper)} on {problem.name}"
     start = time.perf_counter()
@@ -683,6 +693,8 @@ def check_bounds_lg(stepper: Callable, problem: Problem, *, grids: Any = None, s
     ``β = α + φ(T) - φ(0) + (1 + α)∫_0^T σ``, ``ψ(t) = t + 2φ(t) + (1 + γ)∫_0^t σ``, ``α = |x0| + φ(T) -
     φ(0)``, ``γ = β + φ(T) - φ(0)``.  For non-constant σ the lemma holds on fine enough partitions (the
     proof's piecewise-constant approximation); the default partitions have 40 cells.
+
+    Claim: ``proximal`` — the lemma bounds the iterates of the paper's scheme on the given partition.
     """
     return _drive("bounds_lg", stepper, problem, _as_grids(grids, problem, seed),
                   _bounds_evaluate(stepper, _lg_setup, "lem:bndSeq"),
@@ -692,7 +704,9 @@ def check_bounds_lg(stepper: Callable, problem: Problem, *, grids: Any = None, s
 @stepper_law("bounds_yb", "lem:bndSeqYB", PROXIMAL_CLAIM, _holds(_yb_requirements))
 def check_bounds_yb(stepper: Callable, problem: Problem, *, grids: Any = None, seed: int = 0) -> CheckResult:
     """Lemma ``lem:bndSeqYB`` (under (YB), ``|Δ| < Λ``): ``|x_k| ≤ |x0| + αT`` and
-    ``|x_k - x_{k-1}| ≤ α h_k`` with ``α = 2(θ(T) - θ(0)) + |F^0(0, x0)|``."""
+    ``|x_k - x_{k-1}| ≤ α h_k`` with ``α = 2(θ(T) - θ(0)) + |F^0(0, x0)|``.
+
+    Claim: ``proximal`` — the lemma bounds the iterates of the paper's scheme on the given partition."""
     return _drive("bounds_yb", stepper, problem, _as_grids(grids, problem, seed),
                   _bounds_evaluate(stepper, _yb_setup, "lem:bndSeqYB"),
                   message_ok="|x_k| <= |x0| + alpha T and |x_k - x_(k-1)| <= alpha h_k (lem:bndSeqYB)")
@@ -708,6 +722,8 @@ def check_psi_interpolation(stepper: Callable, problem: Problem, *, grids: Any =
     ``ψ`` from lem:bndSeq and/or lem:bndSeqYB (whichever applies); ``x_Δ`` from
     :meth:`verimono.Trajectory.interpolate` with ``kind="psi"``; all pairs among the nodes, cell
     midpoints and ``samples`` random times.
+
+    Claim: ``proximal`` — ``x_Δ`` interpolates the proximal iterates with the ψ of their lemmas.
     """
     grids = _as_grids(grids, problem, seed)
 
@@ -761,6 +777,9 @@ def check_selections(stepper: Callable, problem: Problem, *, grids: Any = None, 
 
     Tolerance: :func:`verimono.tolerances.quotient_tolerance` (a difference quotient divides the
     round-off of the states by ``h``).
+
+    Claim: ``proximal`` — the discrete velocities of the paper's scheme are selections; another scheme's
+    (the midpoint rule, the exact solution sampled) are not, and need not be.
     """
     grids = _as_grids(grids, problem, seed)
     has_contains = type(problem.operator).contains is not Operator.contains
