@@ -104,6 +104,9 @@ def test_record_html_shows_the_failure_and_its_study(bad):
     html = bad[0]._repr_html_()
     p = fragment(html)
     assert p.tags.count("svg") == 1 and "Reproduce" in html and "badge failed" in html
+    # the reproduction calls the notebook's own stepper, not verimono's solve
+    assert "check_convergence_order(drops_input, get(&#x27;Lipschitz field and input&#x27;))" in html
+    assert "import solve" not in html
 
 
 def test_study_repr_tabulates_errors_and_orders(good):

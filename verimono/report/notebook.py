@@ -14,8 +14,10 @@ from typing import Any
 from ..results import FAILED, PASSED, CheckResult, Report
 
 SCOPE = "vm-nb"
-#: rules the notebook needs on top of the report's (no sticky header rows inside a notebook cell)
+#: rules the notebook needs on top of the report's: no sticky header rows inside a cell, and headings in
+#: the report's ink whatever colour the notebook gives its own (measured: a notebook ``h2`` colour leaked)
 _EXTRA_CSS = (".vm-nb { font: 13px/1.45 system-ui, sans-serif; color:#1d2330; }"
+              " .vm-nb h2, .vm-nb h3 { color:#1d2330; font-family:inherit; }"
               " .vm-nb th { position:static; } .vm-nb section { margin:10px 0; }"
               " .vm-nb .grid { grid-template-columns:repeat(auto-fill, minmax(360px, 1fr)); }")
 
@@ -82,9 +84,9 @@ def record_html(rec: CheckResult) -> str:
     body = '<table class="kv">' + "".join(f"<tr><td>{k}</td><td>{v}</td></tr>" for k, v in rows) + "</table>"
     if rec.counterexample:
         body += f"<b>Counterexample</b><pre>{html._e(html._compact(to_jsonable(rec.counterexample)))}</pre>"
-    if rec.status == FAILED:
-        body += f"<b>Reproduce</b><pre>{html._e(html.reproduction(rec, {}))}</pre>"
     study = rec.details.get("study") if isinstance(rec.details, dict) else None
+    if rec.status == FAILED:
+        body += f"<b>Reproduce</b><pre>{html._e(_reproduction(rec, study))}</pre>"
     if isinstance(study, dict):
         from ..convergence import ConvergenceStudy
 
@@ -95,6 +97,20 @@ def record_html(rec: CheckResult) -> str:
     cls = "failure" if rec.status == FAILED else ""
     return _wrap(f'<div class="{cls}" style="padding:6px 10px"><h3 style="margin:2px 0 6px">{html._e(rec.key)}</h3>'
                  f"{body}</div>")
+
+
+def _reproduction(rec: CheckResult, study: Any) -> str:
+    """The report's reproduction, except for the order of a stepper of the notebook's own (no
+    ``MODULE:OBJECT`` names it): then the call to run in the notebook itself."""
+    from . import html
+
+    stepper = study.get("stepper") if isinstance(study, dict) else None
+    if rec.check == "convergence_order" and stepper and stepper != "solve" and not rec.details.get("reproduce"):
+        return ("from verimono.reference import get\n"
+                "from verimono.checks.orders import check_convergence_order\n"
+                f"check_convergence_order({stepper}, get({study['problem']!r}))   # {stepper}: the stepper "
+                "defined in this notebook")
+    return html.reproduction(rec, {})
 
 
 def study_figure_html(study: Any) -> str:
