@@ -124,3 +124,53 @@ def test_records_hidden_by_a_parallel_runner_fail_the_session(readme_project):
     assert outcomes.get("passed", 0) > 0 and outcomes.get("failed", 0) == 0   # every test itself passed
     assert result.ret == pytest.ExitCode.TESTS_FAILED                         # ... and the session fails
     result.stdout.fnmatch_lines(["*verimono: * tests ran where their verimono records cannot reach this report*"])
+
+
+def test_records_kept_by_a_forked_test_process_fail_the_session(readme_project):
+    # a runner that runs each test in a child process and sends back only the report (as pytest-forked
+    # does): the child's records never reach the report, and the session must say so
+    readme_project.makeconftest(textwrap.dedent('''
+        import os
+        import pytest
+        from _pytest.runner import runtestprotocol
+
+        @pytest.hookimpl(tryfirst=True)
+        def pytest_runtest_protocol(item, nextitem):
+            ihook = item.ihook
+            ihook.pytest_runtest_logstart(nodeid=item.nodeid, location=item.location)
+            r, w = os.pipe()
+            pid = os.fork()
+            if pid == 0:
+                os.close(r)
+                reports = runtestprotocol(item, log=False)
+                data = [item.config.hook.pytest_report_to_serializable(config=item.config, report=rep)
+                        for rep in reports]
+                os.write(w, repr(data).encode())
+                os._exit(0)
+            os.close(w)
+            chunks = []
+            while chunk := os.read(r, 1 << 16):
+                chunks.append(chunk)
+            os.waitpid(pid, 0)
+            for d in eval(b"".join(chunks).decode()):
+                rep = item.config.hook.pytest_report_from_serializable(config=item.config, data=d)
+                ihook.pytest_runtest_logreport(report=rep)
+            ihook.pytest_runtest_logfinish(nodeid=item.nodeid, location=item.location)
+            return True
+    '''))
+    readme_project.makepyfile(test_mysolver=textwrap.dedent('''
+        from verimono.results import CheckResult, emit
+
+        def test_law():
+            emit(CheckResult("my_law", "my operator", "passed", worst=0.5, bound=1.0))
+    '''))
+    result = readme_project.runpytest_subprocess("-p", "no:cacheprovider", "--verimono-report", "out")
+    result.assert_outcomes(passed=1)
+    assert result.ret == pytest.ExitCode.TESTS_FAILED
+    result.stdout.fnmatch_lines(["*verimono: 1 tests ran where their verimono records cannot reach this report*"])
+    # without the forking runner the same test's record is in the report and the session passes
+    (readme_project.path / "conftest.py").unlink()
+    plain = readme_project.runpytest_subprocess("-p", "no:cacheprovider", "--verimono-report", "out")
+    assert plain.ret == 0
+    assert [r["check"] for r in json.loads((readme_project.path / "out" / "results.json").read_text())["results"]] \
+        == ["my_law"]

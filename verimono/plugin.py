@@ -18,15 +18,16 @@
   (the attribute ``verimono_records``, a JSON string that xdist carries to the controller with the report);
   the controller collects them and writes the report and gates, in collection order, so ``pytest -n N``
   gives the same records, statuses and summary as ``pytest``.  A call report that arrives without that
-  attribute comes from a process whose records cannot reach this report (a parallel runner verimono does
-  not know): the session says how many tests that was and fails (exit status 1) instead of writing a
-  report that is silently short.
+  attribute, or made by another process that kept its records (``pid:N``: a forked test), comes from a
+  process whose records cannot reach this report (a parallel runner verimono does not know): the session
+  says how many tests that was and fails (exit status 1) instead of writing a report that is silently short.
 """
 
 from __future__ import annotations
 
 import functools
 import json
+import os
 import time
 from pathlib import Path
 from typing import Any
@@ -145,8 +146,8 @@ class _Collector:
         report = outcome.get_result()
         if call.when != "call":
             return
-        if not self.worker:
-            setattr(report, self.ATTR, "")   # recorded here: nothing to carry
+        if not self.worker:  # recorded in this process: only say which one (a forked test's records stay
+            setattr(report, self.ATTR, f"pid:{os.getpid()}")   # in its child, and the report must say so)
             return
         records = self.by_node.pop(item.nodeid, [])
         extra = self.extras.pop(item.nodeid, {"studies": [], "trajectories": []})
@@ -187,9 +188,10 @@ class _Collector:
         if self.worker:
             return
         if report.when == "call":
-            if not hasattr(report, self.ATTR):
-                self.hidden.append(report.nodeid)
-            elif getattr(report, self.ATTR):
+            carried = getattr(report, self.ATTR, None)
+            if carried is None or (carried.startswith("pid:") and carried != f"pid:{os.getpid()}"):
+                self.hidden.append(report.nodeid)   # records held by a process that does not send them here
+            elif not carried.startswith("pid:"):
                 self._receive(report)
         wasxfail = getattr(report, "wasxfail", None)
         if report.when == "call" and report.skipped and wasxfail is not None:
