@@ -37,7 +37,9 @@ with the active profile's effort (``dev``/``ci``/``thorough``: :func:`verimono.p
 **Counting.**  With this module loaded as a pytest plugin (``-p verimono.testing``, or
 ``from verimono.testing import pytest_configure`` in a ``conftest.py`` as ``properties/conftest.py`` does) the
 terminal summary gets a ``verimono checks`` section: how many checks were collected, ran, passed, failed,
-were skipped (grouped by reason), xfailed and xpassed.
+were skipped (grouped by reason), xfailed and xpassed.  Under pytest-xdist (``-n N``) each worker tells
+the controller which battery cases it collected (``workeroutput["verimono_battery"]``) and the outcomes
+arrive with the workers' reports, so the section is the one a serial run prints.
 """
 
 from __future__ import annotations
