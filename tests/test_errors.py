@@ -113,3 +113,26 @@ def test_resolvent_of_wrong_shape_is_reported():
     op = vm.operator_from_resolvent(lambda x, lam, t: np.zeros(3), 2)
     with pytest.raises(vm.SolverFailure, match="returned shape"):
         vm.solve(vm.Problem(op, [1.0, 0.0], 1.0), vm.uniform_grid(1.0, 0.5))
+
+
+def test_every_public_exception_class_lives_in_errors():
+    """Every public exception class of the package is defined in verimono/errors.py and still importable
+    from where it was before (``verimono.stages.StageUnavailable``, ``verimono.report.schema.SchemaError``, ...)."""
+    import importlib
+    import pkgutil
+
+    from verimono import errors
+
+    modules = [importlib.import_module(m.name) for m in pkgutil.walk_packages(vm.__path__, "verimono.")
+               if m.name.split(".")[1] not in ("reference", "properties")]
+    defined = {(obj.__module__, name) for mod in modules for name, obj in vars(mod).items()
+               if isinstance(obj, type) and issubclass(obj, BaseException) and not name.startswith("_")
+               and obj.__module__.startswith("verimono")}
+    assert {m for m, _ in defined} == {"verimono.errors"}, sorted(defined)
+    old_homes = {"verimono.stages": ("StageUnavailable", "UnknownStage"), "verimono.cli": ("BadTarget",),
+                 "verimono.profiles": ("UnknownProfile",), "verimono.report.schema": ("SchemaError",),
+                 "verimono.gate": ("IncompatibleBaseline",), "verimono.lcs.passivity": ("MissingOptionalDependency",)}
+    for module, names in old_homes.items():
+        for name in names:
+            assert getattr(importlib.import_module(module), name) is getattr(errors, name)
+            assert issubclass(getattr(errors, name), vm.VerimonoError)

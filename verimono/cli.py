@@ -27,15 +27,11 @@ import time
 from pathlib import Path
 from typing import Any, Callable, TextIO
 
-from .errors import VerimonoError
+from .errors import BadTarget, VerimonoError
 from .profiles import PROFILES, active_profile, get_profile, load_hypothesis_profile
 from .results import SKIPPED, Report
 
 EXIT_OK, EXIT_FAILED, EXIT_UNDECIDED = 0, 1, 2
-
-
-class BadTarget(VerimonoError, ValueError):
-    """``MODULE:OBJECT`` does not name an importable operator or stepper."""
 
 
 # -- progress ----------------------------------------------------------------------------------------

@@ -29,20 +29,12 @@ from typing import Any, Callable, Iterable
 
 import numpy as np
 
-from .errors import VerimonoError
+from .errors import StageUnavailable, UnknownStage, VerimonoError
 from .profiles import Profile
 from .results import FAILED, PASSED, SKIPPED, XFAIL, CheckResult, Report
 
 #: how many points of a trajectory the report keeps for its plot (enough for a smooth curve)
 TRAJECTORY_SAMPLES = 400
-
-
-class StageUnavailable(VerimonoError):
-    """A stage cannot run here (its module is not installed yet, or its data are absent)."""
-
-
-class UnknownStage(VerimonoError, ValueError):
-    """A stage name that is not registered."""
 
 
 @dataclasses.dataclass

@@ -52,7 +52,7 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any
 
-from ..errors import VerimonoError
+from ..errors import SchemaError
 from ..results import CheckResult, Report, to_jsonable
 
 SCHEMA_NAME = "verimono.results"
@@ -63,10 +63,6 @@ VERSIONED = ("verimono", "numpy", "scipy", "hypothesis", "qpsolvers", "proxsuite
              "pytest")
 #: optional solvers whose versions are recorded, or ``"not installed"``
 OPTIONAL = ("cvxpy", "clarabel")
-
-
-class SchemaError(VerimonoError, ValueError):
-    """A results/baseline document is missing, not JSON, not verimono's, or of an incompatible version."""
 
 
 def _version(dist: str) -> str | None:
