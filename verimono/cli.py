@@ -147,11 +147,8 @@ def _changes(baseline: Report | None, report: Report) -> Any:
 def order_table(report: Report) -> list[str]:
     """One line per convergence study: reference, expected order, measured sup-norm order with its 95%
     interval, verdict (``missed`` when the stepper does not reach the expected order)."""
-    from .convergence import ConvergenceStudy
-
     rows = []
     for s in report.studies:
-        s = ConvergenceStudy.from_dict(s) if isinstance(s, dict) else s
         exp = "-" if s.expected is None else ("exact" if s.expected.exact else f"{s.expected.value:g}")
         rows.append((s.problem, exp, str(s.order), "ok" if s.verdict()[0] else "MISSED"))
     if not rows:

@@ -34,8 +34,7 @@ from typing import Any
 
 from .convergence import ORDER_SLACK
 from .errors import IncompatibleBaseline, SchemaError
-from .report.schema import load
-from .results import FAILED, PASSED, SKIPPED, XFAIL, Report
+from .results import FAILED, PASSED, SKIPPED, XFAIL, Report, load
 
 #: smallest drop of a fitted slope that counts as a regression when both intervals are narrower: slopes
 #: are refitted on the same grids, so they reproduce to round-off on one machine and to ~1e-3 across

@@ -213,7 +213,6 @@ def sample_trajectory(stepper: Callable, problem: Any, h: float | None = None) -
 def convergence_stage(profile: Profile, context: RunContext) -> Report:
     """Every analytic reference's convergence study, plus a trajectory sample for the report's plots."""
     from .checks.orders import check_convergence_order
-    from .convergence import ConvergenceStudy
 
     stepper = context.stepper
     if stepper is None:
@@ -223,8 +222,8 @@ def convergence_stage(profile: Profile, context: RunContext) -> Report:
     for i, p in enumerate(problems):
         context.progress(i, len(problems), p.name)
         rec = report.add(check_convergence_order(stepper, p))
-        if "study" in rec.details:
-            report.studies.append(ConvergenceStudy.from_dict(rec.details["study"]))
+        if rec.study is not None:
+            report.studies.append(rec.study)
         try:
             report.trajectories.append(sample_trajectory(stepper, p))
         except (VerimonoError, ArithmeticError, ValueError) as exc:
@@ -358,7 +357,6 @@ def section7_stage(profile: Profile, context: RunContext) -> Report:
     example = optional_module("verimono.reference.lcs_example")
     lcs = optional_module("verimono.lcs")
     from .checks.orders import check_convergence_order
-    from .convergence import ConvergenceStudy
 
     stepper = context.stepper
     if stepper is None:
@@ -369,8 +367,8 @@ def section7_stage(profile: Profile, context: RunContext) -> Report:
     for i, p in enumerate(problems):
         context.progress(i, len(problems) + 1, p.name)
         rec = report.add(check_convergence_order(stepper, p))
-        if "study" in rec.details:
-            report.studies.append(ConvergenceStudy.from_dict(rec.details["study"]))
+        if rec.study is not None:
+            report.studies.append(rec.study)
         report.trajectories.append(sample_trajectory(stepper, p))
     seed = context.seed_for(profile)
     report.add(example.check_closed_form_resolvent(seed=0 if seed is None else seed))

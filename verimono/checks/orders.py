@@ -38,8 +38,11 @@ def check_convergence_order(stepper: Callable, problem: Problem, steps=None, exe
     else:
         worst = exp.value / (fit.high + ORDER_SLACK) if fit.high == fit.high else float("inf")
     counter = None if ok else {"steps": study.mesh, "errors": study.errors["sup"]}
+    script = ("from verimono.reference import get\n"
+              "from verimono.checks.orders import check_convergence_order\n"
+              f"print(check_convergence_order(stepper, get({problem.name!r})))")
     return CheckResult("convergence_order", subject, PASSED if ok else FAILED, worst=worst, bound=1.0,
-                       counterexample=counter, message=msg, details={"study": study.to_dict()},
+                       counterexample=counter, message=msg, details={"study": study, "reproduce_python": script},
                        duration=time.perf_counter() - start)
 
 
@@ -63,8 +66,6 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
                                         orders=orders, executor=executor):
         rec = check(stepper)
         report.add(rec)
-        if "study" in rec.details:
-            from ..convergence import ConvergenceStudy
-
-            report.studies.append(ConvergenceStudy.from_dict(rec.details["study"]))
+        if rec.study is not None:
+            report.studies.append(rec.study)
     return report

@@ -18,7 +18,7 @@ from collections import Counter, defaultdict
 from html import escape
 from typing import Any
 
-from ..results import FAILED, PASSED, SKIPPED, STATUSES, XFAIL, CheckResult, Report, to_jsonable
+from ..results import FAILED, PASSED, SKIPPED, STATUSES, XFAIL, CheckResult, Report, environment, to_jsonable
 
 SECTIONS = ("summary", "changes", "convergence", "trajectories", "laws", "failures", "performance", "timings",
             "environment")
@@ -166,23 +166,22 @@ def _table(head: list[str], rows: list[list[str]], num_cols: tuple[int, ...] = (
 
 
 def reproduction(rec: CheckResult, meta: dict[str, Any]) -> str:
-    """A copy-paste reproduction of one record: the check's own ``details["reproduce"]`` if it gave one,
-    a hypothesis ``@example`` from ``details["example"]``, a script for a convergence order, or the
-    command with the record's seed and stage."""
+    """A copy-paste reproduction of one record, from what the check handed over: its own
+    ``details["reproduce"]`` (used as is), a hypothesis ``@example`` from ``details["example"]``, or a Python
+    script ``details["reproduce_python"]`` using the free name ``stepper`` (bound here, after the script's
+    imports, to the run's target); else the command with the record's seed and stage."""
     if rec.details.get("reproduce"):
         return str(rec.details["reproduce"])
     target = meta.get("target") or "verimono.stepping:solve"
     if rec.details.get("example"):
         return f"@example({rec.details['example']})  # add above the failing @given test, or:\n" + \
             _command(rec, meta)
-    study = rec.details.get("study")
-    if rec.check == "convergence_order" and isinstance(study, dict):
-        return ("python - <<'EOF'\n"
-                "from verimono.reference import get\n"
-                "from verimono.checks.orders import check_convergence_order\n"
-                f"{_import_stepper(str(target))}\n"
-                f"print(check_convergence_order(stepper, get({study['problem']!r})))\n"
-                "EOF")
+    script = rec.details.get("reproduce_python")
+    if script:
+        lines = str(script).splitlines()
+        k = next((i for i, line in enumerate(lines) if not line.startswith(("from ", "import "))), len(lines))
+        body = "\n".join([*lines[:k], _import_stepper(str(target)), *lines[k:]])
+        return f"python - <<'EOF'\n{body}\nEOF"
     return _command(rec, meta)
 
 
@@ -467,8 +466,6 @@ def _environment(report: Report) -> str:
 def render(report: Report, *, changes: Any = None, title: str = "verimono report") -> str:
     """The complete HTML document for ``report`` (``changes``: a :class:`verimono.gate.Comparison`)."""
     if "environment" not in report.meta:
-        from .schema import environment
-
         report.meta["environment"] = environment()
     bodies = {
         "summary": _summary(report, changes), "changes": _changes(changes),
