@@ -1,4 +1,5 @@
-"""Convergence-order checks of a stepper against the analytic references.
+"""Convergence-order checks of a stepper against the analytic references (one record per reference; the
+whole battery of a stepper, orders and laws, is :func:`verimono.checks.trajectory_laws.check_stepper`).
 
 ``check_convergence_order(stepper, problem)`` runs a :func:`verimono.convergence.convergence_study` and
 turns its verdict into a result record: ``worst = expected / (upper end of the interval + slack)`` and
@@ -9,12 +10,12 @@ on which the scheme is exact at the nodes, ``worst = max error / round-off floor
 from __future__ import annotations
 
 import time
-from typing import Callable, Iterable
+from typing import Callable
 
 from ..convergence import ORDER_SLACK, convergence_study, _name
 from ..errors import VerimonoError
 from ..problem import Problem
-from ..results import FAILED, PASSED, SKIPPED, CheckResult, Report
+from ..results import FAILED, PASSED, SKIPPED, CheckResult
 
 
 def check_convergence_order(stepper: Callable, problem: Problem, steps=None, executor=None) -> CheckResult:
@@ -44,28 +45,3 @@ def check_convergence_order(stepper: Callable, problem: Problem, steps=None, exe
     return CheckResult("convergence_order", subject, PASSED if ok else FAILED, worst=worst, bound=1.0,
                        counterexample=counter, message=msg, details={"study": study, "reproduce_python": script},
                        duration=time.perf_counter() - start)
-
-
-def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, *, executor=None,
-                  laws: bool | Iterable[str] = True, seed: int = 0, generated: int = 4,
-                  orders: bool = True) -> Report:
-    """Result records for ``stepper``: convergence orders on the references, then the trajectory laws.
-
-    ``problems=None`` means the whole catalog of :mod:`verimono.reference` (orders and laws) plus
-    ``generated`` seeded sample problems (laws only).  The records come first per problem for the
-    convergence orders (in the order of ``problems``), then one record per (problem, law) of
-    :mod:`verimono.checks.trajectory_laws`; ``laws=False`` keeps the orders only, a list of law names
-    selects laws, ``orders=False`` keeps the laws only.  The records are those of :func:`verimono.checks.trajectory_laws.stepper_checks`,
-    the same generator :func:`verimono.testing.parametrize_with_checks` turns into pytest cases.
-    """
-    from .trajectory_laws import LAWS, stepper_checks
-
-    selected = () if laws is False else (LAWS if laws is True else tuple(laws))
-    report = Report()
-    for _name_, check in stepper_checks(stepper, problems, seed=seed, generated=generated, laws=selected,
-                                        orders=orders, executor=executor):
-        rec = check(stepper)
-        report.add(rec)
-        if rec.study is not None:
-            report.studies.append(rec.study)
-    return report

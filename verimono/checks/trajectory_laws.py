@@ -41,9 +41,10 @@ from ..errors import OutsideDomain, VerimonoError
 from ..grids import graded_grid, random_grid, uniform_grid, validate_grid
 from ..operators import L1Subdifferential, Linear, NormSubdifferential, Operator
 from ..problem import Problem
-from ..results import FAILED, PASSED, SKIPPED, CheckResult
+from ..results import FAILED, PASSED, SKIPPED, CheckResult, Report
 from ..stepping import Trajectory
 from ..tolerances import LIMIT_EXTRA_LEVELS, LIMIT_SHRINK, quotient_tolerance, tolerance
+from .orders import check_convergence_order
 
 #: cells of the default partitions (fine enough for the lemmas' bounds, fast enough for a battery)
 DEFAULT_CELLS = 40
@@ -747,8 +748,6 @@ def stepper_checks(stepper: Callable | None = None, problems: Iterable[Problem] 
     problems (:func:`verimono.checks.sample_problems.sample_problems`, laws only).  ``stepper`` is unused
     (the battery does not depend on it); it is accepted for the protocol ``stepper_checks(stepper)``.
     """
-    from .orders import check_convergence_order
-
     if problems is None:
         from verimono.reference import catalog
 
@@ -765,7 +764,30 @@ def stepper_checks(stepper: Callable | None = None, problems: Iterable[Problem] 
     yield from law_checks(list(refs) + list(extra), laws, seed)
 
 
+def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, *, executor=None,
+                  laws: bool | Iterable[str] = True, seed: int = 0, generated: int = 4,
+                  orders: bool = True) -> Report:
+    """Result records for ``stepper``: convergence orders on the references, then the trajectory laws.
+
+    ``problems=None`` means the whole catalog of :mod:`verimono.reference` (orders and laws) plus
+    ``generated`` seeded sample problems (laws only).  The records come first per problem for the
+    convergence orders (in the order of ``problems``), then one record per (problem, law) of
+    :mod:`verimono.checks.trajectory_laws`; ``laws=False`` keeps the orders only, a list of law names
+    selects laws, ``orders=False`` keeps the laws only.  The records are those of :func:`stepper_checks`, the
+    same generator :func:`verimono.testing.parametrize_with_checks` turns into pytest cases.
+    """
+    selected = () if laws is False else (LAWS if laws is True else tuple(laws))
+    report = Report()
+    for _name_, check in stepper_checks(stepper, problems, seed=seed, generated=generated, laws=selected,
+                                        orders=orders, executor=executor):
+        rec = check(stepper)
+        report.add(rec)
+        if rec.study is not None:
+            report.studies.append(rec.study)
+    return report
+
+
 __all__ = ["LAWS", "CHECKS", "check_contraction", "check_unique_limit", "check_in_domain", "check_bounds_lg",
-           "check_bounds_yb", "check_psi_interpolation", "check_selections", "stepper_checks", "law_checks",
-           "reproduce", "run_stepper", "with_changes", "perturbed_starts", "default_grids", "limit_grids",
+           "check_bounds_yb", "check_psi_interpolation", "check_selections", "stepper_checks", "check_stepper",
+           "law_checks", "reproduce", "run_stepper", "with_changes", "perturbed_starts", "default_grids", "limit_grids",
            "LGBounds", "YBBounds"]
