@@ -19,7 +19,8 @@ import math
 
 import numpy as np
 
-from verimono import LogBarrier, NormSubdifferential, Order, Problem
+from verimono.operators import LogBarrier, NormSubdifferential
+from verimono.problem import Order, Problem
 
 
 def _tnorm_c(t):
