@@ -136,3 +136,25 @@ def test_every_public_exception_class_lives_in_errors():
         for name in names:
             assert getattr(importlib.import_module(module), name) is getattr(errors, name)
             assert issubclass(getattr(errors, name), vm.VerimonoError)
+
+
+def test_problem_is_frozen_and_replace_revalidates():
+    import dataclasses
+    import warnings
+
+    from verimono.checks.trajectory_laws import with_changes
+
+    p = ok_problem(name="p", order=1)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        p.T = 2.0
+    q = p.replace(T=2.0, x0=[0.5, 0.5])
+    assert (q.T, q.name, q.order, q.operator) == (2.0, "p", p.order, p.operator) and p.T == 1.0
+    assert np.array_equal(q.x0, [0.5, 0.5]) and dataclasses.replace(p, T=3.0).T == 3.0
+    with pytest.raises(vm.InvalidProblem, match="T must"):
+        p.replace(T=-1.0)
+    with pytest.raises(vm.InvalidProblem, match="no field"):
+        p.replace(horizon=2.0)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        r = with_changes(p, T=4.0)
+    assert r.T == 4.0 and any(issubclass(w.category, DeprecationWarning) for w in caught)

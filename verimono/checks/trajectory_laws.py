@@ -32,6 +32,7 @@ Laws (labels of the paper, Camlibel–Iannelli–Tanwani):
 from __future__ import annotations
 
 import time
+import warnings
 from typing import Any, Callable, Iterable, Iterator, Sequence
 
 import numpy as np
@@ -68,20 +69,15 @@ def _name(obj: Any) -> str:
 
 
 def with_changes(problem: Problem, **changes: Any) -> Problem:
-    """A copy of ``problem`` with some constructor arguments replaced (``x0``, ``T``, ``name``, ...)."""
-    kw = dict(f=problem.f, u=problem.u, exact=problem.exact, order=problem.order, name=problem.name,
-              U=problem.U, lipschitz=problem.lipschitz, phi=problem.phi, sigma=problem.sigma,
-              theta=problem.theta, steps=problem.steps, initial_jump=problem.initial_jump,
-              notes=problem.notes)
-    args = dict(operator=problem.operator, x0=problem.x0, T=problem.T)
-    for k, v in changes.items():
-        (args if k in args else kw)[k] = v
-    return Problem(args["operator"], args["x0"], args["T"], **kw)
+    """Deprecated: ``problem.replace(**changes)`` (:meth:`verimono.Problem.replace`)."""
+    warnings.warn("with_changes(problem, ...) is deprecated; use problem.replace(...)", DeprecationWarning,
+                  stacklevel=2)
+    return problem.replace(**changes)
 
 
 def _single(problem: Problem) -> Problem:
     """The laws are stated per initial point: a batch is checked through its first row."""
-    return with_changes(problem, x0=problem.x0[0]) if problem.batched else problem
+    return problem.replace(x0=problem.x0[0]) if problem.batched else problem
 
 
 def run_stepper(stepper: Callable, problem: Problem, grid: np.ndarray) -> np.ndarray:
@@ -169,7 +165,7 @@ def _drive(law: str, stepper: Callable, problem: Problem, grids: dict[str, np.nd
     if shrink and out.k is not None and 1 <= out.k < len(grid) - 1:
         t_k = float(grid[out.k])
         try:
-            small = with_changes(problem, T=t_k)
+            small = problem.replace(T=t_k)
             prefix = grid[:out.k + 1].copy()
             again = evaluate(small, prefix)
         except (_Skip, NotImplementedError, VerimonoError, ArithmeticError, ValueError):
@@ -235,13 +231,13 @@ def run_starts(stepper: Callable, problem: Problem, starts: Sequence[np.ndarray]
     """
     if getattr(stepper, "batched", False) and starts:
         try:
-            xs = np.asarray(stepper(with_changes(problem, x0=np.stack([problem.x0, *starts])), grid), dtype=float)
+            xs = np.asarray(stepper(problem.replace(x0=np.stack([problem.x0, *starts])), grid), dtype=float)
         except (VerimonoError, ArithmeticError, ValueError, TypeError, IndexError):
             xs = None
         if (xs is not None and xs.shape == (len(grid), len(starts) + 1) + problem.x0.shape
                 and np.array_equal(xs[:, 0], x) and np.all(np.isfinite(xs))):
             return [xs[:, i + 1] for i in range(len(starts))]
-    return [run_stepper(stepper, with_changes(problem, x0=z), grid) for z in starts]
+    return [run_stepper(stepper, problem.replace(x0=z), grid) for z in starts]
 
 
 def check_contraction(stepper: Callable, problem: Problem, *, grids: Any = None, x0_primes: Any = None,
@@ -722,7 +718,7 @@ def reproduce(stepper: Callable, problem: Problem, record: CheckResult) -> Check
     law = CHECKS[record.check]
     if record.check == "unique_limit":
         return law(stepper, problem, levels=cx["levels"], seed=cx["seed"])
-    p = with_changes(_single(problem), T=float(cx["T"]))
+    p = _single(problem).replace(T=float(cx["T"]))
     kw: dict[str, Any] = {"grids": [np.asarray(cx["grid"], dtype=float)]}
     if "x0_prime" in cx:
         kw["x0_primes"] = [np.asarray(cx["x0_prime"], dtype=float)]
@@ -789,5 +785,5 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
 
 __all__ = ["LAWS", "CHECKS", "check_contraction", "check_unique_limit", "check_in_domain", "check_bounds_lg",
            "check_bounds_yb", "check_psi_interpolation", "check_selections", "stepper_checks", "check_stepper",
-           "law_checks", "reproduce", "run_stepper", "with_changes", "perturbed_starts", "default_grids", "limit_grids",
-           "LGBounds", "YBBounds"]
+           "law_checks", "reproduce", "run_stepper", "with_changes", "perturbed_starts", "default_grids",
+           "limit_grids", "LGBounds", "YBBounds"]
