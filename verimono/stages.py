@@ -20,6 +20,7 @@ To add a battery::
 from __future__ import annotations
 
 import dataclasses
+import functools
 import importlib
 import os
 import time
@@ -140,11 +141,22 @@ def run_stages(names: Iterable[str] | None, profile: Profile, context: RunContex
         info = {"name": n, "status": status, "records": len(rep), "duration": duration, "message": message}
         for r in rep.results:
             r.details.setdefault("stage", n)
+            cx = r.counterexample if isinstance(r.counterexample, dict) else {}
+            if isinstance(cx.get("problem"), str) and cx["problem"] in _reference_names():
+                r.details.setdefault("reference", cx["problem"])  # `--reference NAME` reproduces it
         total.extend(rep)
         total.meta["stages"].append(info)
         if on_done:
             on_done(stage, rep, info)
     return total
+
+
+@functools.lru_cache(maxsize=1)
+def _reference_names() -> frozenset[str]:
+    """Names ``verimono run --reference NAME`` accepts (the reference catalog's)."""
+    from verimono.reference import catalog
+
+    return frozenset(p.name for p in catalog())
 
 
 def calibrate(repeats: int = 3) -> float:

@@ -4,11 +4,15 @@ Sections, in order (each a ``<section id=...>``): ``summary`` (counts and stages
 the baseline), ``convergence`` (log-log plots per reference), ``trajectories`` (scheme against exact
 solution), ``laws`` (every check with its worst ratio and bound), ``failures`` (counterexample and a
 copy-paste reproduction each), ``timings`` and ``environment``.
+
+The renderer knows no producers: it reads records and ``meta`` only (it imports :mod:`verimono.results`
+and its own plots).  Reproductions are what the producers handed over in ``details``: ``reproduce`` (a
+complete text), ``example`` (a hypothesis ``@example``), ``reproduce_python`` (a script using ``stepper``,
+bound here to the run's target), ``stage`` and ``reference`` (the options of the command that reruns it).
 """
 
 from __future__ import annotations
 
-import functools
 import json
 import keyword
 import math
@@ -195,16 +199,6 @@ def _import_stepper(target: str) -> str:
     return f"from verimono.cli import load_target\nstepper = load_target({target!r})"
 
 
-@functools.lru_cache(maxsize=1)
-def _catalog_names() -> frozenset[str]:
-    try:
-        from verimono.reference import catalog
-
-        return frozenset(p.name for p in catalog())
-    except Exception:  # the report renders without the catalog too
-        return frozenset()
-
-
 def _command(rec: CheckResult, meta: dict[str, Any]) -> str:
     cmd = ["verimono", meta.get("command") or "run"]
     if meta.get("command") == "check" and meta.get("target"):
@@ -216,9 +210,8 @@ def _command(rec: CheckResult, meta: dict[str, Any]) -> str:
     if rec.details.get("stage") and meta.get("command", "run") == "run":
         cmd += ["--stage", str(rec.details["stage"])]
     refs = (meta.get("selection") or {}).get("references")
-    cx = rec.counterexample if isinstance(rec.counterexample, dict) else {}
-    if isinstance(cx.get("problem"), str) and cx["problem"] in _catalog_names():
-        refs = [cx["problem"]]  # the one reference the counterexample needs
+    if isinstance(rec.details.get("reference"), str):
+        refs = [rec.details["reference"]]  # the one reference the counterexample needs (the run says which)
     for name in refs or []:
         cmd += ["--reference", shlex.quote(str(name))]
     return " ".join(cmd)
