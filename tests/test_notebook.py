@@ -12,7 +12,6 @@ import pytest
 
 import verimono as vm
 from verimono.checks.orders import check_convergence_order
-from verimono.convergence import ConvergenceStudy
 from verimono.reference import get
 from verimono.report.notebook import SCOPE, scoped_css
 
@@ -22,7 +21,7 @@ from zoo_steppers import drops_input
 @pytest.fixture(scope="module")
 def good():
     rec = check_convergence_order(vm.solve, get("t|x| (n=1)"))
-    return rec, ConvergenceStudy.from_dict(rec.details["study"])
+    return rec, rec.study
 
 
 @pytest.fixture(scope="module")
@@ -30,7 +29,7 @@ def bad():
     """The stepper that forgets the input u(t): order 0 on the reference with an input (a failure)."""
     rec = check_convergence_order(drops_input, get("Lipschitz field and input"))
     assert rec.status == "failed"
-    return rec, ConvergenceStudy.from_dict(rec.details["study"])
+    return rec, rec.study
 
 
 class _Tags(HTMLParser):

@@ -40,6 +40,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 from scipy import stats
 
+from ._jsonable import to_jsonable
 from .errors import InvalidProblem
 from .grids import uniform_grid, validate_grid
 from .problem import Order, Problem
@@ -148,26 +149,24 @@ class ConvergenceStudy:
 
     def __repr__(self) -> str:
         """The errors per grid, the fitted orders and the verdict, as a small table."""
-        from .report.notebook import study_text
-
         return study_text(self)
 
-    def _repr_html_(self) -> str:
+    def _repr_html_(self) -> str | None:
         """Jupyter: the report's log-log plot of this study next to its table of errors and orders."""
-        from .report.notebook import study_html
+        from .display import render
 
-        return study_html(self)
+        return render("study_html", self)
 
     def plot(self, ax: Any = None) -> Any:
         """The report's log-log plot (errors per norm, fitted slope with its 95% interval, expected slope,
         round-off floor) as a matplotlib ``Figure`` on the Agg canvas, or drawn on ``ax``."""
-        from .report.plots import convergence_figure
+        from .display import RENDERERS
 
-        return convergence_figure(self, ax)
+        if "study_figure" not in RENDERERS:  # pragma: no cover - registered by ``import verimono``
+            raise RuntimeError("no plot renderer: import verimono (it registers verimono.report's)")
+        return RENDERERS["study_figure"](self, ax)
 
     def to_dict(self) -> dict[str, Any]:
-        from .results import to_jsonable
-
         d = dataclasses.asdict(self)
         d["expected"] = None if self.expected is None else dataclasses.asdict(self.expected)
         d["verdict"] = self.verdict()[0]
@@ -189,6 +188,22 @@ class ConvergenceStudy:
         return cls(d["problem"], d["stepper"], [num(m) for m in d["mesh"]], list(d["steps"]),
                    {k: [num(x) for x in v] for k, v in d["errors"].items()}, fits, exp, d["reference"],
                    num(d["floor"]), [num(x) for x in d["timings"]])
+
+
+def study_text(study: Any) -> str:
+    """The study as a small table: mesh, steps, each norm's error per grid, the fitted orders, the verdict."""
+    norms = list(study.errors)
+    head = f"ConvergenceStudy({study.stepper} on {study.problem}; expected order " + \
+        ("none stated" if study.expected is None else str(study.expected)) + f"; reference: {study.reference})"
+    cols = ["mesh |Δ|", "steps"] + [f"{n} error" for n in norms]
+    rows = [[f"{h:.4g}", str(k)] + [f"{float(study.errors[n][i]):.3e}" for n in norms]
+            for i, (h, k) in enumerate(zip(study.mesh, study.steps))]
+    rows.append(["order", ""] + [str(study.fits[n]) for n in norms])
+    widths = [max(len(r[j]) for r in rows + [cols]) for j in range(len(cols))]
+    fmt = "  " + "  ".join(f"{{:>{w}}}" for w in widths)
+    ok, msg = study.verdict()
+    return "\n".join([head, fmt.format(*cols)] + [fmt.format(*r) for r in rows]
+                     + [f"  verdict: {'reaches the expected order' if ok else 'MISSES the expected order'} — {msg}"])
 
 
 def exact_on(problem: Problem, t: np.ndarray) -> np.ndarray:

@@ -2,7 +2,8 @@
 
 ``_repr_html_`` gives a fragment of the HTML report — the same sections, tables and plots
 (:mod:`.html`, :mod:`.plots`) — inside ``<div class="vm-nb">`` with the report's stylesheet scoped to that
-``div``, so a notebook's own style is left alone.  The ``*_text`` functions are the readable ``repr``.
+``div``, so a notebook's own style is left alone.  The renderers are registered in
+:mod:`verimono.display`, through which the records and studies reach them (imports stay one-way).
 """
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ import math
 import re
 from typing import Any
 
+from ..display import register
 from ..results import FAILED, PASSED, CheckResult, Report
 
 SCOPE = "vm-nb"
@@ -47,6 +49,7 @@ def _section(title: str, body: str) -> str:
     return f"<section><h2>{title}</h2>{body}</section>"
 
 
+@register("report_html")
 def report_html(report: Report) -> str:
     """The report as a notebook fragment: summary, convergence plots, trajectories, failures, laws and
     performance — the HTML report's own sections (those with something to show)."""
@@ -66,6 +69,7 @@ def report_html(report: Report) -> str:
     return _wrap("".join(parts))
 
 
+@register("record_html")
 def record_html(rec: CheckResult) -> str:
     """One record: status, key, worst observed ratio against its bound, message, counterexample and, for
     a failure, the command that reproduces it."""
@@ -84,19 +88,22 @@ def record_html(rec: CheckResult) -> str:
     body = '<table class="kv">' + "".join(f"<tr><td>{k}</td><td>{v}</td></tr>" for k, v in rows) + "</table>"
     if rec.counterexample:
         body += f"<b>Counterexample</b><pre>{html._e(html._compact(to_jsonable(rec.counterexample)))}</pre>"
-    study = rec.details.get("study") if isinstance(rec.details, dict) else None
+    study = rec.study
     if rec.status == FAILED:
         body += f"<b>Reproduce</b><pre>{html._e(_reproduction(rec, study))}</pre>"
-    if isinstance(study, dict):
-        from ..convergence import ConvergenceStudy
-
-        try:
-            body += study_figure_html(ConvergenceStudy.from_dict(study))
-        except (KeyError, TypeError, ValueError):
-            pass
+    if study is not None:
+        body += study_figure_html(study)
     cls = "failure" if rec.status == FAILED else ""
     return _wrap(f'<div class="{cls}" style="padding:6px 10px"><h3 style="margin:2px 0 6px">{html._e(rec.key)}</h3>'
                  f"{body}</div>")
+
+
+@register("study_figure")
+def study_figure(study: Any, ax: Any = None) -> Any:
+    """The report's log-log plot of ``study`` as a matplotlib ``Figure`` (Agg canvas), or drawn on ``ax``."""
+    from .plots import convergence_figure
+
+    return convergence_figure(study, ax)
 
 
 def _reproduction(rec: CheckResult, study: Any) -> str:
@@ -104,11 +111,11 @@ def _reproduction(rec: CheckResult, study: Any) -> str:
     ``MODULE:OBJECT`` names it): then the call to run in the notebook itself."""
     from . import html
 
-    stepper = study.get("stepper") if isinstance(study, dict) else None
+    stepper = getattr(study, "stepper", None)
     if rec.check == "convergence_order" and stepper and stepper != "solve" and not rec.details.get("reproduce"):
         return ("from verimono.reference import get\n"
                 "from verimono.checks.orders import check_convergence_order\n"
-                f"check_convergence_order({stepper}, get({study['problem']!r}))   # {stepper}: the stepper "
+                f"check_convergence_order({stepper}, get({study.problem!r}))   # {stepper}: the stepper "
                 "defined in this notebook")
     return html.reproduction(rec, {})
 
@@ -124,6 +131,7 @@ def study_figure_html(study: Any) -> str:
             f"{html._e(study.reference)}.</figcaption></figure>")
 
 
+@register("study_html")
 def study_html(study: Any) -> str:
     """A study: its log-log plot (the report's), errors per grid and the fitted order in each norm."""
     from . import html
@@ -141,65 +149,4 @@ def study_html(study: Any) -> str:
                  + study_figure_html(study) + f'<div style="flex:1;min-width:320px">{table}</div></div>')
 
 
-# -- readable repr ---------------------------------------------------------------------------------
-
-
-def _short(text: str, limit: int = 160) -> str:
-    text = " ".join(str(text).split())
-    return text if len(text) <= limit else text[: limit - 1] + "…"
-
-
-def _g(x: Any) -> str:
-    try:
-        v = float(x)
-    except (TypeError, ValueError):
-        return str(x)
-    return f"{v:.4g}" if math.isfinite(v) else str(v)
-
-
-def record_text(rec: CheckResult) -> str:
-    """``CheckResult(passed convergence_order[solve on box], worst 0.9524 ≤ bound 1: measured …)``."""
-    parts = [f"{rec.status} {rec.key}"]
-    if rec.worst is not None:
-        rel = "≤" if rec.bound is None or not (float(rec.worst) > float(rec.bound)) else ">"
-        parts.append(f"worst {_g(rec.worst)}" + (f" {rel} bound {_g(rec.bound)}" if rec.bound is not None else ""))
-    if rec.seed is not None:
-        parts.append(f"seed {rec.seed}")
-    text = ", ".join(parts)
-    if rec.message:
-        text += f": {_short(rec.message)}"
-    if rec.counterexample:
-        text += f" (counterexample: {', '.join(map(str, rec.counterexample))})"
-    return f"CheckResult({text})"
-
-
-def report_text(report: Report, limit: int = 10) -> str:
-    """First line ``Report(10 passed, 0 failed, 5 skipped, 0 xfail)``, then the failures (at most ``limit``)
-    and how many records, checks and studies there are."""
-    lines = [f"Report({report.summary()})"]
-    checks = len({r.check for r in report.results})
-    lines.append(f"  {len(report)} records of {checks} checks, {len(report.studies)} convergence studies")
-    for r in report.failures[:limit]:
-        lines.append(f"  {r}")
-    if len(report.failures) > limit:
-        lines.append(f"  … and {len(report.failures) - limit} more failures")
-    return "\n".join(lines)
-
-
-def study_text(study: Any) -> str:
-    """The study as a small table: mesh, steps, each norm's error per grid, the fitted orders, the verdict."""
-    norms = list(study.errors)
-    head = f"ConvergenceStudy({study.stepper} on {study.problem}; expected order " + \
-        ("none stated" if study.expected is None else str(study.expected)) + f"; reference: {study.reference})"
-    cols = ["mesh |Δ|", "steps"] + [f"{n} error" for n in norms]
-    rows = [[f"{h:.4g}", str(k)] + [f"{float(study.errors[n][i]):.3e}" for n in norms]
-            for i, (h, k) in enumerate(zip(study.mesh, study.steps))]
-    rows.append(["order", ""] + [str(study.fits[n]) for n in norms])
-    widths = [max(len(r[j]) for r in rows + [cols]) for j in range(len(cols))]
-    fmt = "  " + "  ".join(f"{{:>{w}}}" for w in widths)
-    ok, msg = study.verdict()
-    return "\n".join([head, fmt.format(*cols)] + [fmt.format(*r) for r in rows]
-                     + [f"  verdict: {'reaches the expected order' if ok else 'MISSES the expected order'} — {msg}"])
-
-
-__all__ = ["report_html", "record_html", "study_html", "scoped_css", "record_text", "report_text", "study_text"]
+__all__ = ["report_html", "record_html", "study_html", "study_figure", "scoped_css"]

@@ -1,0 +1,33 @@
+"""How a notebook shows verimono's objects: hooks filled by the report layer.
+
+``CheckResult``, ``Report`` (:mod:`verimono.results`) and ``ConvergenceStudy`` (:mod:`verimono.convergence`)
+have ``_repr_html_`` (and a study ``.plot()``), but the HTML and the plots are the report's
+(:mod:`verimono.report`), a layer above them.  So the lower layers ask this registry, which imports nothing,
+and :mod:`verimono.report.notebook` fills it when ``verimono`` is imported — the imports stay one-way.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable
+
+#: kind (``"record_html"``, ``"report_html"``, ``"study_html"``, ``"study_figure"``) -> renderer
+RENDERERS: dict[str, Callable[..., Any]] = {}
+
+
+def register(kind: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """Decorator: ``fn`` renders ``kind``."""
+    def deco(fn: Callable[..., Any]) -> Callable[..., Any]:
+        RENDERERS[kind] = fn
+        return fn
+
+    return deco
+
+
+def render(kind: str, *args: Any, **kwargs: Any) -> Any:
+    """``RENDERERS[kind](*args, **kwargs)``; ``None`` when no renderer is registered (Jupyter then shows
+    the ``repr``)."""
+    fn = RENDERERS.get(kind)
+    return None if fn is None else fn(*args, **kwargs)
+
+
+__all__ = ["RENDERERS", "register", "render"]
