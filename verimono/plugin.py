@@ -168,8 +168,7 @@ class _Collector:
 
     def _receive(self, report: pytest.TestReport) -> None:
         """Records of a test that ran elsewhere (an xdist worker), carried by its call report."""
-        from .report.schema import _record_from_dict, _study_from_dict
-        from .results import to_jsonable
+        from .results import _record_from_dict, _study_from_dict, to_jsonable
 
         data = json.loads(getattr(report, self.ATTR))
         self.nodeid = report.nodeid

@@ -20,7 +20,7 @@ SCOPE = "vm-nb"
 #: the report's ink whatever colour the notebook gives its own (measured: a notebook ``h2`` colour leaked)
 _EXTRA_CSS = (".vm-nb { font: 13px/1.45 system-ui, sans-serif; color:#1d2330; }"
               " .vm-nb h2, .vm-nb h3 { color:#1d2330; font-family:inherit; }"
-              " .vm-nb th { position:static; } .vm-nb section { margin:10px 0; }"
+              " .vm-nb th { position:static; } .vm-nb section { margin:10px 0; overflow-x:auto; }"
               " .vm-nb .grid { grid-template-columns:repeat(auto-fill, minmax(360px, 1fr)); }")
 
 
