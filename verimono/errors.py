@@ -63,6 +63,11 @@ class BadTarget(VerimonoError, ValueError):
     """``MODULE:OBJECT`` does not name an importable operator or stepper."""
 
 
+class BadExecutor(VerimonoError, ValueError):
+    """An ``--executor`` that verimono cannot use: an unknown form, no dask installed, no scheduler
+    answering, or worker processes that do not start."""
+
+
 class SchemaError(VerimonoError, ValueError):
     """A results/baseline document is missing, not JSON, not verimono's, or of an incompatible version."""
 
@@ -90,6 +95,7 @@ __all__ = [
     "UnknownStage",
     "StageUnavailable",
     "BadTarget",
+    "BadExecutor",
     "SchemaError",
     "IncompatibleBaseline",
     "MissingOptionalDependency",

@@ -31,15 +31,11 @@ from collections import deque
 from multiprocessing.connection import wait as _wait
 from typing import Any, Callable, Sequence
 
-from .errors import VerimonoError
+from .errors import BadExecutor
 from .results import FAILED, CheckResult, Report
 
 #: the check name of the record that stands for a unit that crashed, died or timed out
 UNIT_CHECK = "unit"
-
-
-class BadExecutor(VerimonoError, ValueError):
-    """An ``--executor`` specification verimono cannot use (unknown form, or dask not installed)."""
 
 
 @dataclasses.dataclass
