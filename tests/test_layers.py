@@ -213,3 +213,24 @@ if __name__ == "__main__":  # pragma: no cover - a listing for whoever is untang
     for g in (import_graph(), layers(import_graph())):
         for c in cycles(g):
             print(" → ".join(cycle_path(g, c)), f"  ({len(c)} modules: {', '.join(c)})")
+
+
+#: modules `import verimono` must not load: the heavy ones (SciPy's statistics and optimizers, hypothesis,
+#: matplotlib, the QP back-ends: together about 1 s of the 1.2-1.5 s the import took) and the layers that
+#: pull them in; each is imported where it is used (the first order fit, the first check, ...)
+NOT_AT_IMPORT = ("scipy.stats", "scipy.optimize", "hypothesis", "matplotlib", "qpsolvers", "proxsuite",
+                 "verimono.checks", "verimono.strategies", "verimono.lcs", "verimono.qp", "verimono.report")
+
+
+def test_import_verimono_loads_only_the_core():
+    import subprocess
+    import sys
+
+    code = ("import sys, verimono; "
+            f"print(' '.join(m for m in {NOT_AT_IMPORT!r} if m in sys.modules)); "
+            "from verimono import check_stepper, check_assumptions, lcs, strategies; "  # still importable
+            "print(check_stepper.__module__, lcs.__name__, strategies.grids.__module__)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    loaded, names = out.splitlines()
+    assert loaded == "", f"`import verimono` loads {loaded}"
+    assert names == "verimono.checks.trajectory_laws verimono.lcs verimono.strategies.partitions"

@@ -60,7 +60,6 @@ import platform
 import sys
 from collections import Counter
 from contextlib import contextmanager
-from importlib import metadata
 from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator
 
@@ -237,6 +236,8 @@ OPTIONAL = ("cvxpy", "clarabel")
 
 
 def _version(dist: str) -> str | None:
+    from importlib import metadata  # stdlib, but slow to import: only when a document is written
+
     try:
         return metadata.version(dist)
     except metadata.PackageNotFoundError:
