@@ -41,6 +41,7 @@ from ._jsonable import to_jsonable
 from .errors import InvalidProblem
 from .grids import uniform_grid, validate_grid
 from .problem import Order, Problem
+from .stepping import solve, stream
 from .tolerances import EPS
 
 NORMS = ("sup", "l2", "final")
@@ -333,9 +334,7 @@ def _job(stepper, problem, grid, want, ref=None):
     """
     stepper, problem = _unwrap(stepper), _unwrap(problem)
     sink = ErrorAccumulator(problem, ref) if want == "errors" else Sampler(ref)
-    if stepper is _solve():
-        from .stepping import stream
-
+    if stepper is solve:
         spent = 0.0
         it = stream(problem, grid)
         while True:
@@ -352,11 +351,6 @@ def _job(stepper, problem, grid, want, ref=None):
     if want == "errors":
         return sink.errors(), sink.scale, spent
     return sink.values, None, spent
-
-
-def _solve():
-    from .stepping import solve
-    return solve
 
 
 def _cells_finer_than(grids, T: float) -> int:
