@@ -37,6 +37,10 @@ class SolverFailure(VerimonoError, ArithmeticError):
     """Every numerical back-end failed to produce a solution that passes verification."""
 
 
+class InvalidClaim(VerimonoError, ValueError):
+    """A stepper claim that cannot be stated (unknown scheme, nonpositive order, not callable)."""
+
+
 class UnknownProfile(VerimonoError, ValueError):
     """A profile name other than ``dev``, ``ci`` or ``thorough``."""
 
@@ -74,6 +78,7 @@ __all__ = [
     "NotMonotone",
     "InfeasibleStep",
     "SolverFailure",
+    "InvalidClaim",
     "UnknownProfile",
     "UnknownStage",
     "StageUnavailable",
