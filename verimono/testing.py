@@ -50,6 +50,7 @@ import pytest
 
 from .profiles import active_profile
 from .profiles import load_hypothesis_profile as _load
+from .problem import Problem
 from .profiles import register_hypothesis_profiles as _register
 from .results import FAILED, SKIPPED, CheckResult, Report, to_jsonable
 
@@ -83,8 +84,6 @@ def is_operator(subject: Any) -> bool:
 
 def is_problem(subject: Any) -> bool:
     """Problems (:class:`verimono.Problem`) get the battery of assumption evidence."""
-    from .problem import Problem
-
     return isinstance(subject, Problem)
 
 
