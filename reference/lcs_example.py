@@ -32,6 +32,8 @@ import numpy as np
 from verimono.lcs import Complementarity, LinearRelationSystem
 from verimono.problem import Order, Problem
 from verimono.pseudo_distance import pseudo_distance_lower_bound
+from verimono.results import FAILED, PASSED, CheckResult
+from verimono.tolerances import tolerance
 
 A = np.zeros((1, 1))
 B = np.array([[0.0, 1.0]])
@@ -122,9 +124,6 @@ def pseudo_distance_demo(rhos=(0.0, 1.0, 10.0, 100.0, 1000.0), lams=(0.5, 1.0, 2
 
 def check_closed_form_resolvent(samples: int = 200, seed: int = 0):
     """Record: the system's one-step solve equals ``max(x + h max(−v1, 0), −v2)`` at random (x, h, v)."""
-    from verimono.results import FAILED, PASSED, CheckResult
-    from verimono.tolerances import tolerance
-
     rng = np.random.default_rng(seed)
     worst, counter = 0.0, None
     for _ in range(samples):
@@ -143,8 +142,6 @@ def check_closed_form_resolvent(samples: int = 200, seed: int = 0):
 def check_pseudo_distance_unbounded(rhos=(0.0, 1.0, 10.0, 100.0, 1000.0)):
     """Record: sampled lower bounds of ``dis(H(t1,·), H(t2,·))`` reach ``(ρ+1)/2`` for every ``ρ`` — the
     pseudo-distance is unbounded, so Vladimirov's absolute continuity (``d:vlad``) fails for the Example."""
-    from verimono.results import FAILED, PASSED, CheckResult
-
     pairs = [(rho, float(bound)) for rho, bound in pseudo_distance_demo(rhos)]
     worst = max((rho + 1.0) / 2.0 / bound for rho, bound in pairs)
     ok = worst <= 1.0 + 1e-12

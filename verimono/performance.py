@@ -23,7 +23,13 @@ from typing import Any, Callable
 
 import numpy as np
 
+from .convergence import convergence_study
+from .grids import uniform_grid
+from .operators import NormalCone, NormSubdifferential
+from .problem import Problem
 from .results import FAILED, PASSED, CheckResult, Report
+from .sets import Ball, Box
+from .stepping import solve
 
 #: issue 6, target 1: ``solve`` within 1.5x a bare NumPy loop doing the same arithmetic
 PER_STEP_TARGET = 1.5
@@ -112,20 +118,17 @@ def bare_ball(x0, t, c, r):
 
 def per_step_case(kind: str, n: int):
     """``(problem, bare)`` for ``kind`` in :data:`PER_STEP_KINDS`: ``bare(t)`` runs the same arithmetic."""
-    import verimono as vm
-    from .sets import Ball, Box
-
     x0 = np.linspace(0.5, 1.0, n)
     x0 /= np.linalg.norm(x0)
     if kind == "t|x|":
-        return vm.Problem(vm.NormSubdifferential(lambda s: s, dim=n), x0, 2.0), lambda t: bare_t_norm(x0, t)
+        return Problem(NormSubdifferential(lambda s: s, dim=n), x0, 2.0), lambda t: bare_t_norm(x0, t)
     if kind == "box":
         lo, hi = -0.3 * np.ones(n), 0.4 * np.ones(n)
-        return (vm.Problem(vm.NormalCone(Box(lo, hi)), x0, 2.0, initial_jump=True),
+        return (Problem(NormalCone(Box(lo, hi)), x0, 2.0, initial_jump=True),
                 lambda t: bare_box(x0, t, lo, hi))
     if kind == "ball":
         c = np.zeros(n)
-        return (vm.Problem(vm.NormalCone(Ball(c, 0.5)), x0, 2.0, initial_jump=True),
+        return (Problem(NormalCone(Ball(c, 0.5)), x0, 2.0, initial_jump=True),
                 lambda t: bare_ball(x0, t, c, 0.5))
     raise ValueError(f"unknown kind {kind!r}; expected one of {PER_STEP_KINDS}")
 
@@ -202,17 +205,13 @@ def ratio_record(check: str, subject: str, subj_t: list[float], base_t: list[flo
 
 
 def _default_stepper(stepper):
-    if stepper is None:
-        from .stepping import solve as stepper
-    return stepper
+    return solve if stepper is None else stepper
 
 
 def check_per_step(kind: str, n: int, *, steps: int, rounds: int, stepper: Callable | None = None,
                    runner: Runner | None = None) -> CheckResult:
     """Target 1: ``stepper`` (default ``verimono.solve``) on ``kind`` in dimension ``n`` against the bare
     loop; a result that differs from the bare loop's bits fails the record (not the same arithmetic)."""
-    from .grids import uniform_grid
-
     stepper = _default_stepper(stepper)
     problem, bare = per_step_case(kind, n)
     t = uniform_grid(problem.T, steps=steps)
@@ -233,14 +232,12 @@ def check_ensemble(op, label: str, *, batch: int, steps: int, rounds: int, probl
                    seed: int = 6, stepper: Callable | None = None, runner: Runner | None = None) -> CheckResult:
     """Target 2: one solve of ``batch`` initial conditions against ``batch`` separate solves of ``op``
     (problems built outside the timing); the two must agree bit for bit, else the record fails."""
-    import verimono as vm
-
     stepper = _default_stepper(stepper)
     kw = dict(problem_kw or {})
     X0 = np.random.default_rng(seed).normal(size=(batch, op.dim))
-    t = vm.uniform_grid(1.0, steps=steps)
-    whole = vm.Problem(op, X0, 1.0, **kw)
-    singles = [vm.Problem(op, x, 1.0, **kw) for x in X0]
+    t = uniform_grid(1.0, steps=steps)
+    whole = Problem(op, X0, 1.0, **kw)
+    singles = [Problem(op, x, 1.0, **kw) for x in X0]
     subj_t, base_t, last = interleave(lambda: stepper(whole, t), lambda: [stepper(p, t) for p in singles],
                                       rounds, runner)
     xb = np.asarray(last["subject"])
@@ -285,8 +282,7 @@ def peak_memory(fn: Callable[[], Any]) -> tuple[int, float, Any]:
 def check_memory(*, steps: int, n: int = 10, stepper: Callable | None = None) -> CheckResult:
     """Target 6: peak traced memory of a serial convergence study on t|x| (grids of ``steps/4``,
     ``steps/2`` and ``steps`` steps, streamed errors) against allocating one trajectory of ``steps``."""
-    from .convergence import convergence_study
-    from .reference import subdifferential
+    from .reference import subdifferential  # the catalog package loads the LCS tools (SciPy's optimizers)
 
     stepper = _default_stepper(stepper)
     x0 = np.linspace(0.1, 1.0, n)

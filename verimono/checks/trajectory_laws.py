@@ -46,7 +46,7 @@ from scipy import integrate
 
 from ..errors import OutsideDomain, VerimonoError
 from ..grids import graded_grid, random_grid, uniform_grid, validate_grid
-from ..operators import L1Subdifferential, Linear, NormSubdifferential, Operator
+from ..operators import L1Subdifferential, Linear, NormalCone, NormSubdifferential, Operator
 from ..problem import Problem
 from ..claims import claim_of, with_claim
 from ..results import FAILED, PASSED, SKIPPED, CheckResult, Report
@@ -507,8 +507,6 @@ def _phi_of(problem: Problem) -> tuple[Callable[[float], float], str]:
 def _sigma_of(problem: Problem) -> tuple[Callable[[float], float], str]:
     """σ of (LG): the problem's, or derived from the catalog operator — ``N_S``: ``F^0 = 0``, ``σ ≡ 0``;
     ``Linear``: ``|M(t)x| ≤ ‖M(t)‖₂|x|``; ``∂(c|·|)``, ``∂(Σc_i|x_i|)``: ``|F^0(t,x)| ≤ |F^0(t, 1)|``."""
-    from ..operators import NormalCone
-
     if problem.sigma is not None:
         return problem.sigma, "stated"
     op = problem.operator
