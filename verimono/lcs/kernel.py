@@ -16,7 +16,8 @@ must hold with the margin ``τ = RTOL·S_k``, ``S_k`` the size of the terms the 
 (``‖T_P‖ |ξ_k|``), and every output must be finite.  A candidate that passes is *strictly* complementary
 with ``M_II`` nonsingular, hence (``M`` PSD) the **unique** solution of the step — so it is the least-norm
 solution of Proposition ``p:lcp2`` (the solution set is convex; a second solution would give a segment of
-solutions near the candidate keeping its pattern, where ``z_I`` is fixed by ``M_II``).  Otherwise the kernel
+solutions near the candidate keeping its pattern, where ``z_I`` is fixed by ``M_II``).  The pattern whose
+``z`` is 0 needs only ``w ≥ 0``, not strictly: no solution has a smaller norm (``solve_lcp``'s ``q ≥ 0``).  Otherwise the kernel
 tries the pattern the violated signs point to, then (for ``≤ ENUM_PATTERNS`` patterns) every pattern, and
 only then the verified least-norm solver (``Relation.solve``, i.e. :func:`verimono.lcs.solve_lcp` /
 ``solve_box``) with today's arithmetic; its solution's pattern is the next step's guess.
@@ -217,6 +218,11 @@ class StepKernel:
         p.re = RTOL * float(np.abs(cols[P, n:]).sum(axis=1).max(initial=0.0)) if self.ne else 0.0
         p.rb = RTOL * float(np.abs(const[P]).max())
         p.pcomp, p.pnew = np.array(pcomp), np.array(pnew)
+        if not I.size and not np.any(fixed):
+            # z = 0: no solution has a smaller norm, so w ≥ 0 (not strict, as in solve_lcp's q ≥ 0) suffices;
+            # ``min > −5e-324`` is ``min ≥ 0`` in doubles
+            p.ra = p.re = 0.0
+            p.rb = -5e-324
         return p
 
     # -- one row ---------------------------------------------------------------------------------------
