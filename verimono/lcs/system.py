@@ -214,24 +214,27 @@ class LinearRelationSystem:
         if dU is not None:
             flat = dU.reshape(-1, self.n)
             parts.append(sla.lu_solve(sm.lu, flat.T, check_finite=False).T.reshape(dU.shape))
-        vrow = vc is not None and vc.ndim == 2
+        # a nonzero constant v enters as a column of the exogenous terms, like a per-row or varying v: a row of
+        # a batch and its single run then do the same multiply-adds (a zero v is folded away: it adds nothing)
+        vrow = vc is not None and bool(np.any(vc != 0.0))
         if V is not None:
             parts.append(V)
         elif vrow:
-            parts.append(np.broadcast_to(vc, (K, B, self.m)))
+            parts.append(np.broadcast_to(vc, (K, B, self.m)) if vc.ndim == 2 else np.broadcast_to(vc, (K, self.m)))
         E = None
-        if parts:
-            if len(parts) == 1:
-                E = parts[0]
-            else:
-                E = np.concatenate([np.broadcast_to(p, (K, B, p.shape[-1])) if p.ndim == 2 and any(q.ndim == 3 for q in parts)
-                                    else p for p in parts], axis=-1)
+        if len(parts) == 1:
+            E = parts[0]
+        elif parts:   # W^{-1}∫u then v; shared (K, ·) parts repeated for every row when another part is per row
+            if any(p.ndim == 3 for p in parts):
+                parts = [np.broadcast_to(p[:, None, :], (K, B, p.shape[-1])) if p.ndim == 2 else p for p in parts]
+            E = np.concatenate(parts, axis=-1)
         kern = StepKernel(self, sm, exo_u=dU is not None, exo_v=V is not None or vrow,
-                          v_const=None if (V is not None or vrow) else vc)
-        if not batched and (E is None or E.ndim == 2):
-            x, z, w = kern.run(X0[0], E, t)
-            return x[:, None], z[:, None], w[:, None], []
-        return kern.run_batch(X0, E, t)
+                          v_const=None)
+        with np.errstate(over="ignore", invalid="ignore"):   # overflow becomes a typed error naming the step
+            if not batched and (E is None or E.ndim == 2):
+                x, z, w = kern.run(X0[0], E, t)
+                return x[:, None], z[:, None], w[:, None], []
+            return kern.run_batch(X0, E, t)
 
     def _simulate_general(self, X0, t, theta, gamma, dU, V, vc, uniform):
         """Every step solved by the relation's verified solver (non-box relations, non-uniform grids)."""
@@ -248,7 +251,7 @@ class LinearRelationSystem:
                 if len(cache) > 64:
                     cache.clear()
                 sm = cache[h] = self.step_matrices(h, theta, gamma)
-            return sm
+            return h, sm
 
         g = 1.0 if gamma is None else float(gamma)
         X = np.full((K + 1, B, self.n), np.nan)
@@ -257,15 +260,17 @@ class LinearRelationSystem:
         X[0] = X0
         C, D = self.C, self.D
         failures = []
-        steppers: dict[int, Callable] = {}
+        steppers: dict[float, Callable] = {}   # by step size: each row starts from fresh warm starts
         for i in range(B):
             k = 0
             try:
                 for k in range(K):
-                    sm = mats(k)
-                    step = steppers.get(id(sm))
+                    h, sm = mats(k)
+                    step = steppers.get(h)
                     if step is None:
-                        step = steppers[id(sm)] = sm.relation_step()
+                        if len(steppers) > 64:
+                            steppers.clear()
+                        step = steppers[h] = sm.relation_step()
                     xk = X[k, i]
                     xfree = sm.E @ xk
                     if dU is not None:
