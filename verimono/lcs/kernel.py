@@ -309,13 +309,15 @@ class StepKernel:
         xs = [x]
         pids = []
         explicit = {}
-        try_row, by_id = self.try_row, self.by_id
+        by_id, fn, ne, isfinite = self.by_id, self.fn, self.ne, math.isfinite
         for k in range(K):
             e = El[k] if El is not None else empty
             em = emax[k] if emax is not None else 0.0
-            if pid >= 0:
-                y, ok = try_row(by_id[pid], x, e, em)
-                if ok:
+            if pid >= 0:   # try_row, inlined: the step rows of the guess and their checks
+                p = by_id[pid]
+                y = fn(p.rows, *x, *e)
+                tau = p.ra * max(map(abs, x)) + p.re * em + p.rb if ne else p.ra * max(map(abs, x)) + p.rb
+                if min(y[n:]) > tau and all(map(isfinite, y)):
                     x = y[:n]
                     xs.append(x)
                     pids.append(pid)
