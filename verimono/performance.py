@@ -67,10 +67,13 @@ class Sizes:
 
 
 #: ``thorough``: the issue's sizes (about 90 s); ``ci`` and ``dev``: about 8 s on 2 cores, with fewer steps
-#: (the ratios move by less than their round-to-round spread), but B = 1000 and a 10^5-step memory study
+#: (the ratios move by less than their round-to-round spread), but B = 1000 and a 10^5-step memory study;
+#: DiodeBridge keeps the issue's 5000 steps (its one-off cost, building the maps of the patterns met, ~2 ms,
+#: would be most of a 1000-step run) and its batch runs 200 steps
 #: (the study's fixed ~3.6 MiB of per-block buffers exceed one trajectory below ~75 000 steps at n = 10)
 _QUICK = Sizes(per_step_steps=10_000, per_step_rounds=5, ensemble_batch=1000, ensemble_steps=20,
-               ensemble_rounds=5, lcs_steps=1000, lcs_rounds=5, memory_steps=100_000)
+               ensemble_rounds=5, lcs_steps=5000, lcs_rounds=5, memory_steps=100_000,
+               lcs_batch=1000, lcs_batch_steps=200, lcs_batch_rounds=3)
 SIZES = {
     "dev": _QUICK,
     "ci": _QUICK,

@@ -247,8 +247,9 @@ class StepKernel:
             yield np.array(states, dtype=np.int8)
 
     def slow_row(self, pid: int, x: list, e: list, emax: float):
-        """A step whose guess ``pid`` failed (``pid < 0``: no guess): the flipped pattern, every pattern when
-        there are few, then the verified least-norm solver.
+        """A step whose guess ``pid`` failed (``pid < 0``: no guess, start from ``z = 0``): the patterns the
+        violated signs point to (at most ``m`` in turn), every pattern when there are few, then the verified
+        least-norm solver.
 
         Returns ``(x_{k+1}, pattern of this step, guess for the next, (z, w) or None)``: ``(z, w)`` only when
         the solver, not a pattern's map, made the step (the pattern is then −1)."""
@@ -258,11 +259,14 @@ class StepKernel:
             s = self.flipped(p, y)
         else:
             s = np.zeros(self.m, dtype=np.int8)
-        q2 = self.pattern(s)
-        if q2 is not None:
+        for _ in range(self.m):   # follow the violated signs (principal pivoting), at most m times
+            q2 = self.pattern(s)
+            if q2 is None:
+                break
             y, ok = self.try_row(q2, x, e, emax)
             if ok:
                 return y[:self.F], q2.key, q2.key, None
+            s = self.flipped(q2, y)
         if self.enum:
             for s in self.all_patterns():
                 p = self.pattern(s)
@@ -424,9 +428,12 @@ class StepKernel:
                 return E[k], emax[k]
             return (E[k].T, emax[k]) if rows is None else (E[k, rows].T, emax[k, rows])
 
+        stepped = np.zeros(B, dtype=bool)   # rows a pattern's map has made this step (after a failed guess)
+
         def accept(k, rows, Y, ok, newp):
             r = rows[ok]
             if r.size:
+                stepped[r] = True
                 XA[k + 1][:, r] = Y[:n, ok]
                 ZW[k][:, r] = Y[L:, ok]
                 newp = newp[ok] if np.ndim(newp) else np.full(r.size, newp)
@@ -446,17 +453,30 @@ class StepKernel:
             rows = np.flatnonzero(~ok & alive)
             if not rows.size:
                 continue
+            stepped[rows] = False
             old = pid[rows].copy()
             XTr = XT_old[:, rows]
             Er, em = exo(k, rows)
             guess = self._flip_rows(old, Y[n:L][:, rows])
-            Y2, ok2 = self._eval_rows(guess, XTr, Er, em)
-            keep = accept(k, rows, Y2, ok2, guess)
-            rows, old, XTr = rows[keep], old[keep], XTr[:, keep]
+            cur, Xc = rows, XTr                  # the rows still following their violated signs
+            for _ in range(m):
+                live = guess >= 0
+                cur, guess, Xc = cur[live], guess[live], Xc[:, live]
+                if not cur.size:
+                    break
+                Er, em = exo(k, cur)
+                Y2, ok2 = self._eval_rows(guess, Xc, Er, em)
+                keep = accept(k, cur, Y2, ok2, guess)
+                cur, Xc = cur[keep], Xc[:, keep]
+                guess = self._flip_rows(guess[keep], Y2[n:L][:, keep])
+            left = ~stepped[rows]
+            rows, old, XTr = rows[left], old[left], XTr[:, left]
             if self.enum and rows.size:
                 for s in self.all_patterns():
+                    if not rows.size:
+                        break
                     p = self.pattern(s)
-                    if p is None or not rows.size:
+                    if p is None:
                         continue
                     Er, em = exo(k, rows)
                     Y3, ok3 = self._eval_rows(np.full(rows.size, p.key), XTr, Er, em)
