@@ -11,6 +11,7 @@ from .grids import graded_grid, random_grid, refine, uniform_grid, validate_grid
 from .operators import (L1Subdifferential, Linear, LogBarrier, NormalCone, NormSubdifferential, Operator,
                         Shifted, operator_from_resolvent)
 from .problem import Order, Problem
+from .claims import Claim, Stepper
 from .results import CheckResult, Report
 from .stepping import Trajectory, solve, stream
 from .pseudo_distance import pseudo_distance_lower_bound
@@ -26,7 +27,7 @@ __all__ = [
     "SolverFailure",
     "Operator", "operator_from_resolvent", "Linear", "NormSubdifferential", "L1Subdifferential",
     "NormalCone", "Shifted", "LogBarrier", "sets",
-    "Problem", "Order", "Trajectory", "solve", "stream", "ErrorAccumulator",
+    "Problem", "Order", "Stepper", "Claim", "Trajectory", "solve", "stream", "ErrorAccumulator",
     "uniform_grid", "graded_grid", "random_grid", "refine", "validate_grid",
     "CheckResult", "Report", "pseudo_distance_lower_bound", "lcs", "strategies",
     "convergence_study", "ConvergenceStudy", "check_stepper", "check_operator", "operator_checks",

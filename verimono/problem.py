@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 from typing import Any, Callable, Sequence
 
 import numpy as np
@@ -24,10 +25,25 @@ class Order:
     source: str
     exact: bool = False
     constant: float | None = None
+    #: the highest order the solution's regularity allows *any* convergent scheme (``inf``: smooth), with
+    #: its source — what a stepper claiming only ``scheme="any"`` is held to (:mod:`verimono.claims`)
+    regularity: float | None = None
+    regularity_source: str = ""
 
     @classmethod
-    def exact_at_nodes(cls, source: str) -> "Order":
-        return cls(None, source, exact=True)
+    def exact_at_nodes(cls, source: str, regularity: float | None = None, regularity_source: str = "") -> "Order":
+        return cls(None, source, exact=True, regularity=regularity, regularity_source=regularity_source)
+
+    def for_claim(self, claimed: float) -> "Order":
+        """The order a scheme claiming convergence with order ``claimed`` must reach here:
+        ``min(claimed, regularity)`` (the claim alone where the regularity is not stated)."""
+        reg = math.inf if self.regularity is None else float(self.regularity)
+        if claimed <= reg:
+            why = (f"the claimed order {claimed:g}" + ("" if self.regularity is None else
+                   f" (within the order {reg:g} the solution's regularity allows: {self.regularity_source})"))
+            return Order(float(claimed), why)
+        return Order(reg, f"the claimed order {claimed:g}, capped at {reg:g} by the solution's regularity: "
+                          f"{self.regularity_source}")
 
     def __str__(self) -> str:
         return "exact" if self.exact else f"{self.value:g}"
