@@ -237,3 +237,29 @@ def test_non_uniform_grids_and_operator_relations_batch_row_by_row():
     for i in range(2):
         np.testing.assert_allclose(b.x[:, i], sysO.simulate(X0[i], t, theta=0.5).x, rtol=0, atol=1e-8)
     np.testing.assert_allclose(sysO.simulate(X0, t, theta=0.5).x, sysR.simulate(X0, t, theta=0.5).x, atol=1e-8)
+
+
+def test_a_degenerate_candidate_is_accepted_only_when_it_is_least_norm(monkeypatch):
+    """M = [[0,0,1],[0,1,0],[−1,0,0]] (M + Mᵀ ⪰ 0), q = (0, −1, 1): SOL = {(t, 1, 0) : 0 ≤ t ≤ 1}, least-norm
+    (0, 1, 0).  Both ends are degenerate (z_i = w_i = 0 in one component); the far end, pattern {1, 2, 3}
+    with M nonsingular, must be rejected by the tangent-cone certificate (−e1 keeps w3 ≥ 0 and shortens
+    it), the near end, pattern {2}, accepted — and simulate returns the least-norm multiplier."""
+    M = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])
+    q = np.array([0.0, -1.0, 1.0])
+    sys = LinearRelationSystem([[0.0]], np.zeros((1, 3)), np.zeros((3, 1)), M, Complementarity(), v=q)
+    t = np.linspace(0.0, 1.0, 6)
+    tr = sys.simulate([0.0], t)
+    assert np.array_equal(tr.extras["z"], np.tile([0.0, 1.0, 0.0], (5, 1)))
+    kern = K.StepKernel(sys, sys.step_matrices(0.2, 1.0), exo_u=False, exo_v=True, v_const=None)
+    far, near = kern.pattern(np.array([1, 1, 1])), kern.pattern(np.array([0, 1, 0]))
+    y_far, ok_far = kern.try_row(far, [0.0], q.tolist(), 1.0)
+    y_near, ok_near = kern.try_row(near, [0.0], q.tolist(), 1.0)
+    assert not ok_far and not ok_near                         # neither is strictly complementary
+    assert y_far[1:4] == [1.0, 1.0, 0.0] and y_near[1:4] == [0.0, 1.0, 1.0]   # (z1, z2, w3) / (w1, z2, w3)
+    assert not kern._least_norm_degenerate(far, y_far, [0.0], 1.0)
+    assert kern._least_norm_degenerate(near, y_near, [0.0], 1.0)
+    # seen failing: without the tangent-cone directions the far end would pass
+    monkeypatch.setattr(K.StepKernel, "_degenerate_certificate", lambda self, s, deg: [])
+    kern2 = K.StepKernel(sys, sys.step_matrices(0.2, 1.0), exo_u=False, exo_v=True, v_const=None)
+    far2 = kern2.pattern(np.array([1, 1, 1]))
+    assert kern2._least_norm_degenerate(far2, kern2.try_row(far2, [0.0], q.tolist(), 1.0)[0], [0.0], 1.0)

@@ -17,7 +17,11 @@ must hold with the margin ``τ = RTOL·S_k``, ``S_k`` the size of the terms the 
 with ``M_II`` nonsingular, hence (``M`` PSD) the **unique** solution of the step — so it is the least-norm
 solution of Proposition ``p:lcp2`` (the solution set is convex; a second solution would give a segment of
 solutions near the candidate keeping its pattern, where ``z_I`` is fixed by ``M_II``).  The pattern whose
-``z`` is 0 needs only ``w ≥ 0``, not strictly: no solution has a smaller norm (``solve_lcp``'s ``q ≥ 0``).  Otherwise the kernel
+``z`` is 0 needs only ``w ≥ 0``, not strictly: no solution has a smaller norm (``solve_lcp``'s ``q ≥ 0``).
+When no candidate is strictly complementary, a *degenerate* one (``z_i ≈ 0 ≈ w_i`` in some components, e.g.
+a diode with zero current and voltage) is accepted for a complementarity relation only with a certificate
+that it is the least-norm solution (:meth:`StepKernel._least_norm_degenerate`: ``z_cᵀd ≥ 0`` on the tangent
+cone of every piece of ``SOL`` through it) — the DiodeBridgeCapFilter's non-unique steps.  Otherwise the kernel
 tries the pattern the violated signs point to, then (for ``≤ ENUM_PATTERNS`` patterns) every pattern, and
 only then the verified least-norm solver (``Relation.solve``, i.e. :func:`verimono.lcs.solve_lcp` /
 ``solve_box``) with today's arithmetic; its solution's pattern is the next step's guess.
@@ -146,6 +150,8 @@ class StepKernel:
         self.cache: dict[bytes, _Pattern | None] = {}
         self.by_id: list[_Pattern] = []
         self.enum = int(np.prod(self.nstates.astype(float))) <= ENUM_PATTERNS
+        self.is_lcp = bool(rel.is_lcp)
+        self._deg: dict = {}
 
     # -- patterns --------------------------------------------------------------------------------------
     def pattern(self, s: np.ndarray) -> _Pattern | None:
@@ -274,7 +280,75 @@ class StepKernel:
                     y, ok = self.try_row(p, x, e, emax)
                     if ok:
                         return y[:self.F], p.key, p.key, None
+        # no strictly complementary candidate: a degenerate one that is provably the least-norm solution
+        for p in ([self.pattern(s) for s in self.all_patterns()] if self.enum else
+                  [self.by_id[pid]] if pid >= 0 else []):
+            if p is not None:
+                y, _ = self.try_row(p, x, e, emax)
+                if self._least_norm_degenerate(p, y, x, emax):
+                    return y[:self.F], p.key, p.key, None
         return self.solve_row(x, e)
+
+    def _least_norm_degenerate(self, p: _Pattern, y: list, x: list, emax: float) -> bool:
+        """Whether ``p``'s candidate, a solution whose sign rows are ``≥ −(QP_RTOL/RTOL)τ`` but some ``≤ τ`` (the
+        *degenerate* components ``Dg``: ``z_i ≈ 0 ≈ w_i``), is the least-norm solution (complementarity only).
+
+        ``SOL(q, M)`` is convex and, near the candidate ``z_c``, the union of the pieces
+        ``P_γ = {z_γ̄ = 0, z_γ ≥ 0, w_γ = 0, w_γ̄ ≥ 0}`` with ``Z ⊆ γ ⊆ Z ∪ Dg`` (``Z``: ``z_i > τ``), so ``z_c`` is
+        least-norm iff ``z_cᵀd ≥ 0`` on each piece's tangent cone: ``{0}`` when ``M_γγ`` is nonsingular; for a
+        one-dimensional ``ker M_γγ = span(ν)`` the directions ``±ν`` that keep ``d_i ≥ 0`` (``i ∈ γ ∩ Dg``) and
+        ``(Md)_i ≥ 0`` (``i ∈ Dg`` outside ``γ``).  Larger kernels are left to the solver."""
+        if not self.is_lcp or not all(map(math.isfinite, y)):
+            return False
+        n, m = self.n, self.m
+        tau = (p.ra * max(map(abs, x)) + p.re * emax + p.rb) if self.ne else (p.ra * max(map(abs, x)) + p.rb)
+        tol = (QP_RTOL / RTOL) * tau
+        P = np.array(y[n:n + m])
+        if tau <= 0.0 or P.min() <= -tol:
+            return False
+        deg = P <= tau
+        if not deg.any():
+            return False
+        key = (p.key, deg.tobytes())
+        cert = self._deg.get(key, False)
+        if cert is False:
+            cert = self._deg[key] = self._degenerate_certificate(p.s, deg)
+        if cert is None:
+            return False
+        z = np.where(p.s == 1, P, 0.0)
+        return all(sg * float(nu @ z) >= -tol * float(np.abs(nu).sum()) for sg, nu in cert)
+
+    def _degenerate_certificate(self, s: np.ndarray, deg: np.ndarray):
+        """The directions ``(σ, ν)`` of :meth:`_least_norm_degenerate` for pattern ``s`` and degenerate set
+        ``deg``, or None when some piece's ``M_γγ`` has a kernel of dimension ≥ 2 or an undecided rank."""
+        M = self.M
+        Zs = np.flatnonzero((s == 1) & ~deg)
+        Dg = np.flatnonzero(deg)
+        out = []
+        big = float(np.abs(M).max()) or 1.0
+        for r in range(Dg.size + 1):
+            for S in itertools.combinations(Dg.tolist(), r):
+                g = np.sort(np.concatenate([Zs, np.array(S, dtype=int)])).astype(int)
+                if not g.size:
+                    continue
+                U, sv, Vt = np.linalg.svd(M[np.ix_(g, g)])
+                zero = sv <= RTOL * big
+                if np.any(~zero & (sv < sv[0] / ACTIVE_SET_COND)):
+                    return None   # an undecided rank
+                if zero.sum() == 0:
+                    continue
+                if zero.sum() > 1:
+                    return None
+                nu = np.zeros(self.m)
+                nu[g] = Vt[-1] / np.abs(Vt[-1]).max()
+                Mnu = M @ nu
+                inside = [i for i in Dg.tolist() if i in set(g.tolist())]
+                outside = [i for i in Dg.tolist() if i not in set(g.tolist())]
+                small = RTOL * (1.0 + float(np.abs(Mnu).max()))
+                for sg in (1.0, -1.0):
+                    if all(sg * nu[i] >= -small for i in inside) and all(sg * Mnu[i] >= -small for i in outside):
+                        out.append((sg, nu))
+        return out
 
     def solve_row(self, x: list, e: list):
         """Today's arithmetic: ``x_free``, ``q``, the relation's verified least-norm solve, the update."""
