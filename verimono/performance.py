@@ -291,8 +291,8 @@ def check_lcs_step(*, steps: int, rounds: int, runner: Runner | None = None) -> 
                                       lambda: floor_loop(A, x0, steps), rounds, runner)
     tr = last["subject"]
     X, Z, W = minimal_lcs(system, system.step_matrices(h, theta), x0, steps)
-    diff = max(float(np.abs(tr.x - X).max() / np.abs(X).max()), float(np.abs(tr.extras["z"] - Z).max() / np.abs(Z).max()),
-               float(np.abs(tr.extras["w"] - W).max() / np.abs(W).max()))
+    diff = max(float(np.abs(got - ref).max() / np.abs(ref).max())
+               for got, ref in ((tr.x, X), (tr.extras["z"], Z), (tr.extras["w"], W)))
     ok = diff <= LCS_AGREEMENT
     return ratio_record("performance_lcs_step", f"DiodeBridge {steps} steps vs floor loop", subj_t, base_t,
                         target=LCS_TARGET,

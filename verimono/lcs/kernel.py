@@ -46,7 +46,7 @@ import math
 import numpy as np
 import scipy.linalg as sla
 
-from ..errors import InfeasibleStep, InvalidProblem, SolverFailure, VerimonoError
+from ..errors import BatchStepError, InfeasibleStep, InvalidProblem, SolverFailure, VerimonoError
 from ..tolerances import ACTIVE_SET_COND, QP_RTOL, RTOL
 from .lcp import lcp_scale
 from .relations import BoxRelation
@@ -81,25 +81,6 @@ class RowFailure:
 
     def __str__(self) -> str:
         return f"row {self.row}, step {self.step} (t = {self.t:.6g}): {type(self.error).__name__}: {self.error}"
-
-
-class BatchStepError(VerimonoError, ArithmeticError):
-    """Some rows of a batched :meth:`simulate` failed; the others ran to the end.
-
-    ``failures``: the :class:`RowFailure` of each failed row; ``trajectory``: every row's results
-    (``x (K+1, B, n)``, ``extras["z"], extras["w"] (K, B, m)``) with NaN after a row's failure;
-    ``valid`` ``(K+1, B)``: which states were computed."""
-
-    def __init__(self, failures: list[RowFailure], trajectory, valid: np.ndarray) -> None:
-        self.failures, self.trajectory, self.valid = failures, trajectory, valid
-        shown = "; ".join(str(f) for f in failures[:5])
-        more = f"; and {len(failures) - 5} more" if len(failures) > 5 else ""
-        super().__init__(f"{len(failures)} of {valid.shape[1]} rows failed (the others ran to the end; "
-                         f"results in .trajectory, .valid): {shown}{more}")
-
-    @property
-    def rows(self) -> list[int]:
-        return [f.row for f in self.failures]
 
 
 class _Pattern:
