@@ -5,7 +5,7 @@ proximal scheme of Camlibel, Iannelli and Tanwani and checked against the laws a
 Data flow one way: Problem → stepper → Trajectory → checks → results → report / gate.
 """
 
-from .errors import (BadTarget, IncompatibleBaseline, InfeasibleStep, InvalidClaim, InvalidGrid, InvalidProblem,
+from .errors import (BadTarget, BatchStepError, IncompatibleBaseline, InfeasibleStep, InvalidClaim, InvalidGrid, InvalidProblem,
                      MissingOptionalDependency, NotMonotone, OutsideDomain, SchemaError, SolverFailure,
                      StageUnavailable, UnknownProfile, UnknownStage, VerimonoError)
 from .grids import graded_grid, random_grid, refine, uniform_grid, validate_grid
@@ -50,7 +50,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "VerimonoError", "InvalidProblem", "InvalidGrid", "OutsideDomain", "NotMonotone", "InfeasibleStep",
-    "SolverFailure", "UnknownProfile", "UnknownStage", "StageUnavailable", "BadTarget", "SchemaError",
+    "BatchStepError", "SolverFailure", "UnknownProfile", "UnknownStage", "StageUnavailable", "BadTarget", "SchemaError",
     "IncompatibleBaseline", "MissingOptionalDependency", "InvalidClaim",
     "Operator", "operator_from_resolvent", "Linear", "NormSubdifferential", "L1Subdifferential",
     "NormalCone", "Shifted", "LogBarrier", "sets",

@@ -363,6 +363,8 @@ def section7_stage(profile: Profile, context: RunContext) -> Report:
         report.trajectories.append(sample_trajectory(stepper, p))
     seed = context.seed_for(profile)
     report.add(example.check_closed_form_resolvent(seed=0 if seed is None else seed))
+    if hasattr(example, "check_batched_scheme"):   # a batch of trajectories in one simulate (issue 15)
+        report.add(example.check_batched_scheme(seed=0 if seed is None else seed))
     report.add(example.check_pseudo_distance_unbounded())
     for label, v in (("v = (−t, 0)", lambda t: np.array([-t, 0.0])),
                      ("v = (sin t, 0)", lambda t: np.array([np.sin(t), 0.0]))):
