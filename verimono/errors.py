@@ -76,12 +76,6 @@ class MissingOptionalDependency(VerimonoError, ImportError):
     """An optional extra (e.g. cvxpy/clarabel for the KYP SDP) is not installed."""
 
 
-class NotApplicable(Exception):
-    """Raised by a law's evaluator when a requirement shows only while evaluating (e.g. ``x0 ∉ dom F(0,·)``
-    where ``|F^0(0, x0)|`` is needed): the driver makes the record a skip with this reason (a signal
-    between a law and its driver, not an error: not a :class:`VerimonoError`)."""
-
-
 __all__ = [
     "VerimonoError",
     "InvalidProblem",
@@ -99,5 +93,4 @@ __all__ = [
     "SchemaError",
     "IncompatibleBaseline",
     "MissingOptionalDependency",
-    "NotApplicable",
 ]
