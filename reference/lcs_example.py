@@ -143,9 +143,6 @@ def check_batched_scheme(batch: int = 64, steps: int = 400, T: float = 4.0, seed
     """Record: ``batch`` initial points and inputs ``v_b(t) = (a_b sin t − c_b, d_b)`` stepped at once by
     ``LinearRelationSystem.simulate`` (θ = 1, ``x0`` of shape ``(B, 1)``, ``v`` returning ``(B, 2)``) equal, on
     every row and step, the closed-form scheme ``x_{k+1} = max(x_k + h max(−v1(t_{k+1}), 0), −v2(t_{k+1}))``."""
-    from verimono.results import FAILED, PASSED, CheckResult
-    from verimono.tolerances import tolerance
-
     rng = np.random.default_rng(seed)
     a, c, d = rng.uniform(0, 2, batch), rng.uniform(-1, 1, batch), rng.uniform(-1, 1, batch)
     x0 = rng.uniform(-2, 3, batch)

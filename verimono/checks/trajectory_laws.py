@@ -593,6 +593,9 @@ class YBBounds:
             f0 = float(np.linalg.norm(op.min_norm(x0, 0.0)))
         except OutsideDomain:
             raise _Skip("x0 is not in dom F(0,·) (lem:bndSeqYB needs |F^0(0, x0)|)") from None
+        if not np.isfinite(f0):   # x0 within rounding of the boundary: F^0 overflows (c/x at x = 7e-304)
+            raise _Skip(f"|F^0(0, x0)| = {f0} is not finite: x0 is at the edge of dom F(0,·), where "
+                        "lem:bndSeqYB's α is infinite and its bounds say nothing")
         self.alpha = 2.0 * (float(theta(T)) - float(theta(0.0))) + f0
         self.beta = float(np.linalg.norm(x0)) + self.alpha * T
         self.f0 = f0
