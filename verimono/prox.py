@@ -1,0 +1,203 @@
+"""Proximal operators as operators: ``F = ∂g`` known through ``prox_{λg}`` and, optionally, ``g`` itself.
+
+``prox_{λg}(x) = argmin_z λ g(z) + |z - x|²/2`` is the resolvent ``J_λ`` of ``F = ∂g`` for a proper,
+closed, convex ``g``, so every resolvent law applies.  A resolvent law cannot tell *which* ``g``: the exact
+prox of a wrong function (a wrong weight, a formula valid for another norm) passes all of them.  Given
+``value = g``, the value laws of :mod:`verimono.checks.prox_laws` can, and ``g`` also gives a membership
+test (:meth:`ProxOperator.contains`), so ``yosida_in_graph`` runs instead of being skipped.
+
+Arrays of any shape: with ``shape=(m, n)`` the operator acts on ``R^{m×n}`` with the Frobenius inner
+product ``⟨X, Y⟩ = Σ X_ij Y_ij``.  It is presented to the laws as an operator on ``R^{mn}`` through a
+flattening adapter (row-major ``reshape``, an isometry of the Frobenius norm onto the Euclidean norm), so
+every law and tolerance is the one of ``R^{mn}``; the user's ``prox`` and ``value`` always receive arrays
+of ``shape``.  A ``prox`` returning a tuple (``(p, info)``) is rejected with :class:`ProxOutputError`
+unless ``unwrap=`` says which element is the point — never unwrapped silently.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Callable
+
+import numpy as np
+
+from .errors import InvalidProblem, VerimonoError
+from .operators import Operator, _accepts
+from .tolerances import tolerance
+
+#: sampled points ``z`` of the subgradient inequality in :meth:`ProxOperator.contains`
+CONTAINS_POINTS = 24
+
+
+class ProxOutputError(VerimonoError, TypeError):
+    """A prox returned something that is not one array of the operator's shape (a tuple, a list of
+    arrays, a scalar): verimono does not guess which part is the point."""
+
+
+def checked_value(op: Operator, v: Any) -> float:
+    """``v`` as a float ``g(x) ∈ R ∪ {+inf}``; anything else is a :class:`ProxOutputError`."""
+    try:
+        a = np.asarray(v, dtype=float)
+    except (TypeError, ValueError):
+        raise ProxOutputError(f"{op.name}: value returned {type(v).__name__}, expected a number") from None
+    if a.shape != ():
+        raise ProxOutputError(f"{op.name}: value returned shape {a.shape}, expected a scalar")
+    f = float(a)
+    if math.isnan(f) or f == -math.inf:
+        raise ProxOutputError(f"{op.name}: value returned {f}; g must be real or +inf")
+    return f
+
+
+def _arity(fn: Callable, with_t: int) -> bool:
+    """Whether ``fn`` takes the time argument (``with_t`` positional arguments)."""
+    return _accepts(fn, with_t)
+
+
+class ProxOperator(Operator):
+    """``F(t, ·) = ∂g(t, ·)`` given by ``prox(X, lam[, t])`` (and ``value(X[, t]) = g(t, X)``) on arrays of
+    ``shape``; presented to the laws as an operator on ``R^{prod(shape)}`` (row-major flattening)."""
+
+    def __init__(self, prox: Callable, *, value: Callable | None = None, shape: Any = None,
+                 dim: int | None = None, name: str | None = None, unwrap: int | Callable | None = None) -> None:
+        if not callable(prox):
+            raise InvalidProblem("prox must be callable as prox(x, lam) or prox(x, lam, t)")
+        if value is not None and not callable(value):
+            raise InvalidProblem("value must be callable as value(x) or value(x, t)")
+        if shape is None and dim is None:
+            raise InvalidProblem("give the shape of the points (shape=(n,) or shape=(m, n)) or dim")
+        if shape is None:
+            shape = (int(dim),)
+        shape = (int(shape),) if np.ndim(shape) == 0 else tuple(int(s) for s in shape)
+        if not shape or any(s < 1 for s in shape):
+            raise InvalidProblem(f"shape must be a tuple of positive integers, got {shape!r}")
+        if dim is not None and int(dim) != math.prod(shape):
+            raise InvalidProblem(f"dim={dim} does not match shape={shape}")
+        super().__init__(math.prod(shape), name or getattr(prox, "__name__", "prox"))
+        self.shape = shape
+        self._prox, self._value, self._unwrap = prox, value, unwrap
+        self._prox_t = _arity(prox, 3)
+        self._value_t = value is not None and _arity(value, 2)
+
+    # -- the adapter ------------------------------------------------------------------------------
+    def _shaped(self, x: np.ndarray) -> np.ndarray:
+        x = np.asarray(x, dtype=float)
+        if x.shape != (self.dim,):
+            raise InvalidProblem(f"{self.name} acts on R^{self.dim} (arrays of shape {self.shape}, flattened); "
+                                 f"got a point of shape {x.shape}")
+        return x.reshape(self.shape).copy()
+
+    def _point(self, out: Any) -> np.ndarray:
+        if self._unwrap is not None:
+            out = self._unwrap(out) if callable(self._unwrap) else out[self._unwrap]
+        elif isinstance(out, tuple) and not all(np.ndim(o) == 0 for o in out):
+            raise ProxOutputError(f"{self.name}: prox returned a tuple of {len(out)} items, not an array of shape "
+                                  f"{self.shape}; pass unwrap=0 (or the index or function that picks the point) "
+                                  "to operator_from_prox")
+        try:
+            p = np.asarray(out, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise ProxOutputError(f"{self.name}: prox returned {type(out).__name__}, not an array of shape "
+                                  f"{self.shape} ({exc})") from None
+        if p.shape != self.shape:
+            raise ProxOutputError(f"{self.name}: prox returned shape {p.shape} for a point of shape {self.shape}")
+        return p.reshape(self.dim)
+
+    # -- the contract ------------------------------------------------------------------------------
+    def resolvent(self, x, lam, t=0.0):
+        x = np.asarray(x, dtype=float)
+        if x.ndim == 2:   # a batch of flattened points, one call per row
+            return np.array([self.resolvent(r, lam, t) for r in x]).reshape(x.shape)
+        X = self._shaped(x)
+        out = self._prox(X, lam, t) if self._prox_t else self._prox(X, lam)
+        return self._point(out)
+
+    def value(self, x, t=0.0) -> float:
+        """``g(t, x)`` (``+inf`` outside ``dom g``) of a flattened point."""
+        if self._value is None:
+            return super().value(x, t)
+        X = self._shaped(x)
+        return checked_value(self, self._value(X, t) if self._value_t else self._value(X))
+
+    def contains(self, x, y, t=0.0, tol=None):
+        """Evidence for ``y ∈ ∂g(t, x)`` from ``value`` (:func:`subgradient_contains`)."""
+        if self._value is None:
+            return super().contains(x, y, t, tol)
+        return subgradient_contains(self, x, y, t, tol)
+
+    def provides(self, member):
+        if member in ("value", "contains"):
+            return self._value is not None
+        return Operator.provides(self, member)
+
+    def __repr__(self) -> str:
+        return f"{self.name}(shape={self.shape})"
+
+
+def subgradient_contains(op: Operator, x, y, t: float = 0.0, tol: float | None = None) -> bool:
+    """Evidence for ``y ∈ ∂g(t, x)`` from ``op.value`` and ``op.resolvent`` — not a proof:
+
+    * the resolvent characterisation ``J_1(x + y) = x`` (exact for a maximal monotone ``F``, but it trusts
+      the resolvent, so alone it would make ``yosida_in_graph`` circular), and
+    * the subgradient inequality ``g(x) + ⟨y, z - x⟩ ≤ g(z) + tol·(1 + |z - x|)(1 + |y|)`` at the
+      ``CONTAINS_POINTS`` points ``z`` of :func:`contains_points` (``0``, and ``x ± s·d`` along coordinates,
+      ``y`` and seeded random directions ``d`` at scales ``s`` from ``10^-6`` to ``10`` times
+      ``1 + |x|_∞``; the same ``(x, y)`` always gets the same ``z``), which is what ties the pair to ``g``.
+
+    ``g(x) = +inf`` (``x ∉ dom g``) is never contained; points ``z`` with ``g(z) = +inf`` are skipped."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    tol = tolerance(x, y) if tol is None else float(tol)
+    ny = float(np.linalg.norm(y))
+    p = np.asarray(op.resolvent(x + y, 1.0, t), dtype=float)
+    if np.max(np.abs(p - x), initial=0.0) > tol * (1.0 + ny):
+        return False
+    gx = op.value(x, t)
+    if not math.isfinite(gx):
+        return False
+    for z in contains_points(x, y):
+        gz = op.value(z, t)
+        if gz == math.inf:
+            continue
+        d = float(np.linalg.norm(z - x))
+        if gx + float(y @ (z - x)) > gz + tol * (1.0 + d) * (1.0 + ny) + tolerance(gx, gz):
+            return False
+    return True
+
+
+def contains_points(x: np.ndarray, y: np.ndarray, count: int = CONTAINS_POINTS) -> list[np.ndarray]:
+    """The deterministic test points ``z`` of :meth:`ProxOperator.contains` (see there)."""
+    n = x.size
+    rng = np.random.default_rng(n)
+    s0 = 1.0 + float(np.max(np.abs(x), initial=0.0))
+    dirs = [np.eye(n)[i % n] for i in range(min(n, 4))]
+    ny = float(np.linalg.norm(y))
+    if ny > 0:
+        dirs.append(y / ny)
+    while len(dirs) < max(8, count // 3):
+        v = rng.standard_normal(n)
+        dirs.append(v / np.linalg.norm(v))
+    pts = [np.zeros(n)]
+    scales = (1e-6, 1e-3, 1e-1, 1.0, 10.0)
+    k = 0
+    while len(pts) < count:
+        d, s = dirs[k % len(dirs)], scales[(k // len(dirs)) % len(scales)]
+        sign = 1.0 if k % 2 == 0 else -1.0
+        pts.append(x + sign * s * s0 * d)
+        k += 1
+    return pts
+
+
+def operator_from_prox(prox: Callable, *, value: Callable | None = None, shape: Any = None,
+                       name: str | None = None, unwrap: int | Callable | None = None) -> ProxOperator:
+    """``F = ∂g`` from ``prox(x, lam) = argmin_z lam·g(z) + |z - x|²/2`` (or ``prox(x, lam, t)`` for a
+    time-dependent ``g``), on arrays of ``shape`` (an int ``n`` or a tuple; the Frobenius inner product).
+
+    ``value(x)`` or ``value(x, t)`` is ``g`` (``+inf`` outside its domain): it enables the value laws
+    (prox inequality, optimality, Moreau envelope) and the membership test of ``yosida_in_graph``.
+    ``unwrap`` picks the point from a prox returning a tuple (an index or a function); without it a tuple
+    is a :class:`ProxOutputError`.  The arity of ``prox``/``value`` decides whether ``t`` is passed."""
+    if shape is None:
+        raise InvalidProblem("operator_from_prox needs shape= (an int n for R^n, or a tuple such as (m, n))")
+    return ProxOperator(prox, value=value, shape=shape, name=name, unwrap=unwrap)
+
+
+__all__ = ["ProxOperator", "ProxOutputError", "operator_from_prox", "subgradient_contains", "contains_points", "CONTAINS_POINTS"]
