@@ -23,7 +23,7 @@ import numpy as np
 
 from .errors import InvalidProblem, VerimonoError
 from .operators import Operator, _accepts
-from .tolerances import tolerance
+from .tolerances import RTOL, tolerance
 
 #: sampled points ``z`` of the subgradient inequality in :meth:`ProxOperator.contains`
 CONTAINS_POINTS = 24
@@ -158,7 +158,7 @@ def subgradient_contains(op: Operator, x, y, t: float = 0.0, tol: float | None =
         if gz == math.inf:
             continue
         d = float(np.linalg.norm(z - x))
-        if gx + float(y @ (z - x)) > gz + tol * (1.0 + d) * (1.0 + ny) + tolerance(gx, gz):
+        if gx + float(y @ (z - x)) > gz + tol * (1.0 + d) * (1.0 + ny) + RTOL * (1.0 + max(abs(gx), abs(gz))):
             return False
     return True
 

@@ -26,7 +26,7 @@ import zlib
 import numpy as np
 
 from .core import Outcome
-from ..tolerances import tolerance
+from ..tolerances import RTOL, tolerance
 
 #: the independent minimiser (scipy.optimize, derivative-free Powell) runs only on R^n with n ≤ this
 MINIMISER_MAX_DIM = 4
@@ -39,6 +39,11 @@ def _J(op, x, lam, t):
     if y.shape != x.shape or not np.all(np.isfinite(y)):
         raise ValueError(f"resolvent returned {y!r} for a point of shape {x.shape}")
     return y
+
+
+def _tolf(*values: float) -> float:
+    """:func:`verimono.tolerances.tolerance` of scalars, in Python floats (called per perturbation)."""
+    return RTOL * (1.0 + max(abs(v) for v in values))
 
 
 def _g(op, z, t) -> float:
@@ -110,8 +115,8 @@ def _prox_optimal(op, s):
         return _outside(p, gp, "optimality")
     fp = lam * gp + 0.5 * float((p - x) @ (p - x))
     s0 = 1.0 + float(np.max(np.abs(p), initial=0.0))
-    tau = tolerance(x, p)
-    worst = None
+    tau, dxp = tolerance(x, p), _nrm(x - p)
+    worst, at = -math.inf, None
     for d in _directions(x, p, x.size, x):
         for h in PERTURBATIONS:
             for sgn in (1.0, -1.0):
@@ -120,13 +125,18 @@ def _prox_optimal(op, s):
                 if fz == math.inf:
                     continue
                 dz = h * s0
-                slack = 4 * tolerance(fp, fz, lam * gp) + 4 * tau * (_nrm(x - p) + dz + tau)
-                ev = Outcome.compare(fp + 0.5 * dz * dz - fz, 0.0, slack,
-                                     "Φ(p) + |z - p|²/2 ≤ Φ(z), Φ(z) = λg(z) + |z - x|²/2, at z = p + δ (perturbation)",
-                                     {"p": p.tolist(), "z": z.tolist(), "Phi(p)": fp, "Phi(z)": fz})
-                if worst is None or not ev.ratio <= worst.ratio:
-                    worst = ev
-    return worst
+                slack = 4 * _tolf(fp, fz, lam * gp) + 4 * tau * (dxp + dz + tau)
+                r = (fp + 0.5 * dz * dz - fz) / slack
+                if not r <= worst:
+                    worst, at = r, (z, fz, slack)
+    if at is None:
+        return Outcome.compare(0.0, 0.0, 1.0, "optimality: every perturbation left dom g (sample inconclusive)", {},
+                               inconclusive=True)
+    z, fz, slack = at
+    dz2 = float((z - p) @ (z - p))
+    return Outcome.compare(fp + 0.5 * dz2 - fz, 0.0, slack,
+                           "Φ(p) + |z - p|²/2 ≤ Φ(z), Φ(z) = λg(z) + |z - x|²/2, at z = p + δ (perturbation)",
+                           {"p": p.tolist(), "z": z.tolist(), "Phi(p)": fp, "Phi(z)": fz})
 
 
 def _prox_minimiser(op, s):
