@@ -24,7 +24,7 @@ from typing import Callable
 import numpy as np
 
 #: magnitudes of the swept points: tiny (below the rounding scale of a unit problem), unit, huge
-SCALES = (1e-9, 1e-7, 5e-7, 1e-5, 1e-3, 1e-1, 1.0, 3.0, 10.0, 1e3, 1e6)
+SCALES = (1e-9, 1e-7, 5e-7, 1e-5, 1e-3, 1e-1, 1.0, 3.0, 10.0, 1e2, 1e3)
 #: sweep samples per law and profile (``None``: a profile not of verimono's, e.g. a user's own)
 SWEEP_BY_PROFILE = {"dev": 33, "ci": 33, "thorough": 132, None: 33}
 #: laws whose one evaluation is expensive (an independent minimiser) see this many sweep samples at most
