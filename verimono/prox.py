@@ -49,8 +49,20 @@ def checked_value(op: Operator, v: Any) -> float:
 
 
 def _arity(fn: Callable, with_t: int) -> bool:
-    """Whether ``fn`` takes the time argument (``with_t`` positional arguments)."""
-    return _accepts(fn, with_t)
+    """Whether ``fn`` takes the time argument as its ``with_t``-th positional argument: that many positional
+    parameters, the last without a default or named ``t``/``time`` (a parameter with another default, such
+    as ``lambda x, lam, f=f: ...``, is not the time; nor is ``*args``, as in decorated library methods)."""
+    import inspect
+
+    try:
+        params = list(inspect.signature(fn).parameters.values())
+    except (TypeError, ValueError):
+        return False
+    pos = [p for p in params if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
+    if len(pos) < with_t:
+        return False
+    third = pos[with_t - 1]
+    return third.default is inspect.Parameter.empty or third.name in ("t", "time")
 
 
 class ProxOperator(Operator):
