@@ -26,7 +26,8 @@ import math
 
 import numpy as np
 
-from verimono import NormalCone, Order, Problem
+from verimono.operators import NormalCone
+from verimono.problem import Order, Problem
 from verimono.sets import Ball, Box, HalfSpace
 
 TWO_PI = 2.0 * math.pi

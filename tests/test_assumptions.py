@@ -10,7 +10,6 @@ import pytest
 from verimono import Linear, Problem, operator_from_resolvent
 from verimono.checks.assumptions import EVIDENCE, check_assumptions
 from verimono.checks.sample_problems import sample_problem
-from verimono.checks.trajectory_laws import with_changes
 from verimono.reference import get
 from verimono.results import FAILED, PASSED
 
@@ -67,10 +66,10 @@ def test_right_continuous_jump_satisfies_A2():
 
 def test_understated_phi_sigma_theta_are_contradicted():
     ball = get("translating ball")                          # moves at |v| = sqrt(1.25)
-    rec = _by(check_assumptions(with_changes(ball, phi=lambda t: 0.5 * t)))["assumption_A3"]
+    rec = _by(check_assumptions(ball.replace(phi=lambda t: 0.5 * t)))["assumption_A3"]
     assert rec.status == FAILED and rec.counterexample["dist"] > 0
     tn = get("t|x| (n=1)")                                  # |F^0(t,x)| = t, |Y_λ(s+λ)| - |Y_λ(s)| ≤ λ
-    rep = _by(check_assumptions(with_changes(tn, sigma=lambda t: 0.3 * t, theta=lambda t: 0.5 * t)))
+    rep = _by(check_assumptions(tn.replace(sigma=lambda t: 0.3 * t, theta=lambda t: 0.5 * t)))
     assert rep["assumption_LG"].status == FAILED and rep["assumption_YB"].status == FAILED
 
 

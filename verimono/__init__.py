@@ -5,8 +5,9 @@ proximal scheme of Camlibel, Iannelli and Tanwani and checked against the laws a
 Data flow one way: Problem → stepper → Trajectory → checks → results → report / gate.
 """
 
-from .errors import (InfeasibleStep, InvalidGrid, InvalidProblem, NotMonotone, OutsideDomain,
-                     SolverFailure, VerimonoError)
+from .errors import (BadTarget, IncompatibleBaseline, InfeasibleStep, InvalidClaim, InvalidGrid, InvalidProblem,
+                     MissingOptionalDependency, NotMonotone, OutsideDomain, SchemaError, SolverFailure,
+                     StageUnavailable, UnknownProfile, UnknownStage, VerimonoError)
 from .grids import graded_grid, random_grid, refine, uniform_grid, validate_grid
 from .operators import (L1Subdifferential, Linear, LogBarrier, NormalCone, NormSubdifferential, Operator,
                         Shifted, operator_from_resolvent)
@@ -25,8 +26,10 @@ __version__ = "0.1.0"
 
 __all__ = [
     "VerimonoError", "InvalidProblem", "InvalidGrid", "OutsideDomain", "NotMonotone", "InfeasibleStep",
-    "SolverFailure",
-    "Operator", "operator_from_resolvent", "operator_from_prox", "ProxOperator", "ProxOutputError", "Linear", "NormSubdifferential", "L1Subdifferential",
+    "SolverFailure", "UnknownProfile", "UnknownStage", "StageUnavailable", "BadTarget", "SchemaError",
+    "IncompatibleBaseline", "MissingOptionalDependency", "InvalidClaim",
+    "Operator", "operator_from_resolvent", "operator_from_prox", "ProxOperator", "ProxOutputError", "Linear",
+    "NormSubdifferential", "L1Subdifferential",
     "NormalCone", "Shifted", "LogBarrier", "sets",
     "Problem", "Order", "Stepper", "Claim", "Trajectory", "solve", "stream", "ErrorAccumulator",
     "uniform_grid", "graded_grid", "random_grid", "refine", "validate_grid",

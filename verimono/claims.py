@@ -30,14 +30,10 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .errors import VerimonoError
+from .errors import InvalidClaim
 
 PROXIMAL, ANY = "proximal", "any"
 SCHEMES = (PROXIMAL, ANY)
-
-
-class InvalidClaim(VerimonoError, ValueError):
-    """A stepper claim that cannot be stated (unknown scheme, nonpositive order, not callable)."""
 
 
 @dataclasses.dataclass(frozen=True)

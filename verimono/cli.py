@@ -29,15 +29,11 @@ from pathlib import Path
 from typing import Any, Callable, TextIO
 
 from .claims import SCHEMES, claim_of, with_claim
-from .errors import VerimonoError
+from .errors import BadTarget, VerimonoError
 from .profiles import PROFILES, active_profile, get_profile, load_hypothesis_profile
 from .results import SKIPPED, Report
 
 EXIT_OK, EXIT_FAILED, EXIT_UNDECIDED = 0, 1, 2
-
-
-class BadTarget(VerimonoError, ValueError):
-    """``MODULE:OBJECT`` does not name an importable operator or stepper."""
 
 
 # -- progress ----------------------------------------------------------------------------------------
@@ -153,11 +149,8 @@ def _changes(baseline: Report | None, report: Report) -> Any:
 def order_table(report: Report) -> list[str]:
     """One line per convergence study: reference, expected order, measured sup-norm order with its 95%
     interval, verdict (``missed`` when the stepper does not reach the expected order)."""
-    from .convergence import ConvergenceStudy
-
     rows = []
     for s in report.studies:
-        s = ConvergenceStudy.from_dict(s) if isinstance(s, dict) else s
         exp = "-" if s.expected is None else ("exact" if s.expected.exact else f"{s.expected.value:g}")
         rows.append((s.problem, exp, str(s.order), "ok" if s.verdict()[0] else "MISSED"))
     if not rows:

@@ -70,6 +70,7 @@ def _finite_array(value: Any, what: str) -> np.ndarray:
     return arr
 
 
+@dataclasses.dataclass(frozen=True, init=False, repr=False, eq=False)
 class Problem:
     """``x' ∈ -F(t, x) + f(x) + u(t)`` on ``[0, T]`` with ``x(0) = x0``.
 
@@ -96,7 +97,28 @@ class Problem:
     (the functions of assumptions (A3), (LG), (YB) when known), ``steps`` (step sizes for which the
     expected order is asymptotic), ``initial_jump`` (allow ``x0 ∉ cl dom F(0)``: the catching-up
     scheme then jumps to the projection in its first step), ``notes``.
+
+    A frozen dataclass: fields cannot be reassigned; :meth:`replace` (or :func:`dataclasses.replace`)
+    builds a changed copy through the same validation.  Equality is identity (the fields hold arrays and
+    functions).
     """
+
+    operator: Any
+    x0: np.ndarray
+    T: float
+    f: Callable | None = None
+    u: Callable | None = None
+    exact: Callable | None = None
+    order: Order | None = None
+    name: str = ""
+    U: Callable | None = None
+    lipschitz: float | None = None
+    phi: Callable | None = None
+    sigma: Callable | None = None
+    theta: Callable | None = None
+    steps: list[float] | None = None
+    initial_jump: bool = False
+    notes: str = ""
 
     def __init__(self, operator: Any, x0: Any, T: float, *, f: Callable | None = None,
                  u: Callable | None = None, exact: Callable | None = None, order: Any = None,
@@ -118,14 +140,12 @@ class Problem:
         for what, fn in (("f", f), ("u", u), ("exact", exact), ("U", U)):
             if fn is not None and not callable(fn):
                 raise InvalidProblem(f"{what} must be callable, got {fn!r}")
-        self.operator, self.x0, self.T = operator, x0, T
-        self.f, self.u, self.U, self.exact = f, u, U, exact
-        self.order = _as_order(order)
-        self.name = name or f"{getattr(operator, 'name', 'F')} problem"
-        self.lipschitz, self.phi, self.sigma, self.theta = lipschitz, phi, sigma, theta
-        self.steps = None if steps is None else [float(h) for h in steps]
-        self.initial_jump = bool(initial_jump)
-        self.notes = notes
+        fields = dict(operator=operator, x0=x0, T=T, f=f, u=u, exact=exact, order=_as_order(order),
+                      name=name or f"{getattr(operator, 'name', 'F')} problem", U=U, lipschitz=lipschitz,
+                      phi=phi, sigma=sigma, theta=theta, steps=None if steps is None else [float(h) for h in steps],
+                      initial_jump=bool(initial_jump), notes=notes)
+        for key, value in fields.items():
+            object.__setattr__(self, key, value)  # frozen: the one place the fields are set
         if f is not None:
             fx = _finite_array(f(x0), "f(x0)")
             if fx.shape != x0.shape:
@@ -137,6 +157,16 @@ class Problem:
                     raise InvalidProblem(f"{what} must have shape ({n},), got {val.shape}")
         if not initial_jump:
             self._check_initial_point()
+
+    def replace(self, **changes: Any) -> "Problem":
+        """A copy with some constructor arguments replaced (``x0``, ``T``, ``name``, ``phi``, ...), validated
+        as a new problem; an unknown name is an :class:`InvalidProblem`."""
+        kw = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        unknown = sorted(set(changes) - kw.keys())
+        if unknown:
+            raise InvalidProblem(f"Problem has no field {', '.join(unknown)}; fields: {', '.join(kw)}")
+        kw.update(changes)
+        return Problem(kw.pop("operator"), kw.pop("x0"), kw.pop("T"), **kw)
 
     @property
     def dim(self) -> int:

@@ -1,4 +1,5 @@
-"""Convergence-order checks of a stepper against the analytic references.
+"""Convergence-order checks of a stepper against the analytic references (one record per reference; the
+whole battery of a stepper, orders and laws, is :func:`verimono.checks.trajectory_laws.check_stepper`).
 
 ``check_convergence_order(stepper, problem)`` runs a :func:`verimono.convergence.convergence_study` and
 turns its verdict into a result record: ``worst = expected / (upper end of the interval + slack)`` and
@@ -8,12 +9,12 @@ on which the scheme is exact at the nodes, ``worst = max error / round-off floor
 
 from __future__ import annotations
 
-from typing import Callable, Iterable
+from typing import Callable
 
-from ..claims import claim_of, with_claim
+from ..claims import claim_of
 from ..convergence import ORDER_SLACK, convergence_study, _name
 from ..problem import Order, Problem
-from ..results import FAILED, PASSED, CheckResult, Report
+from ..results import FAILED, PASSED, CheckResult
 from .core import Holds, law as _declare, run as _run
 
 
@@ -34,7 +35,7 @@ def _expected(stepper: Callable, problem: Problem) -> Order | None:
 def _convergence_order(stepper: Callable, problem: Problem, steps=None, executor=None) -> CheckResult:
     subject = f"{_name(stepper)} on {problem.name}"
     exp = _expected(stepper, problem)
-    study = convergence_study(stepper, problem if exp is problem.order else with_order(problem, exp), steps,
+    study = convergence_study(stepper, problem if exp is problem.order else problem.replace(order=exp), steps,
                               executor=executor)
     ok, msg = study.verdict()
     fit = study.order
@@ -45,7 +46,10 @@ def _convergence_order(stepper: Callable, problem: Problem, steps=None, executor
     else:
         worst = exp.value / (fit.high + ORDER_SLACK) if fit.high == fit.high else float("inf")
     counter = None if ok else {"steps": study.mesh, "errors": study.errors["sup"]}
-    details = {"study": study.to_dict()}
+    script = ("from verimono.reference import get\n"
+              "from verimono.checks.orders import check_convergence_order\n"
+              f"print(check_convergence_order(stepper, get({problem.name!r})))")
+    details = {"study": study, "reproduce_python": script}
     if not claim_of(stepper).proximal:
         details["expected"] = {"order": exp.value, "source": exp.source}
     return CheckResult("convergence_order", subject, PASSED if ok else FAILED, worst=worst, bound=1.0,
@@ -58,50 +62,5 @@ def check_convergence_order(stepper: Callable, problem: Problem, steps=None, exe
     claiming only ``scheme="any"`` with order ``p``, ``min(p, problem.order.regularity)``."""
     if steps is not None:   # explicit step sizes stand in for the problem's own
         return _run(_convergence_order.law, stepper, problem, steps, executor, stepper=stepper,
-                    problem=with_steps(problem, steps))
+                    problem=problem.replace(steps=list(steps)))
     return _run(_convergence_order.law, stepper, problem, steps, executor, stepper=stepper, problem=problem)
-
-
-def with_order(problem: Problem, order: Order) -> Problem:
-    from .trajectory_laws import with_changes
-
-    return with_changes(problem, order=order)
-
-
-def with_steps(problem: Problem, steps) -> Problem:
-    from .trajectory_laws import with_changes
-
-    return with_changes(problem, steps=list(steps))
-
-
-def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, *, scheme: str | None = None,
-                  order: float | None = None, seed: int | None = None, executor=None,
-                  laws: bool | Iterable[str] = True, generated: int = 4, orders: bool = True) -> Report:
-    """Result records for ``stepper``: convergence orders on the references, then the trajectory laws.
-
-    ``scheme``/``order`` state what the stepper claims (:class:`verimono.Stepper`; a bare callable
-    claims ``scheme="proximal"``, the paper's scheme): a law that needs more than the claim is skipped
-    with that reason, and ``convergence_order``/``in_domain`` hold an ``"any"`` scheme to its order.
-
-    ``problems=None`` means the whole catalog of :mod:`verimono.reference` (orders and laws) plus
-    ``generated`` seeded sample problems (laws only).  The records come first per problem for the
-    convergence orders (in the order of ``problems``), then one record per (problem, law) of
-    :mod:`verimono.checks.trajectory_laws`; ``laws=False`` keeps the orders only, a list of law names
-    selects laws, ``orders=False`` keeps the laws only.  The records are those of :func:`verimono.checks.trajectory_laws.stepper_checks`,
-    the same generator :func:`verimono.testing.parametrize_with_checks` turns into pytest cases.
-    """
-    from .trajectory_laws import LAWS, stepper_checks
-
-    stepper = with_claim(stepper, scheme, order)
-    seed = 0 if seed is None else int(seed)
-    selected = () if laws is False else (LAWS if laws is True else tuple(laws))
-    report = Report()
-    for _name_, check in stepper_checks(stepper, problems, seed=seed, generated=generated, laws=selected,
-                                        orders=orders, executor=executor):
-        rec = check(stepper)
-        report.add(rec)
-        if "study" in rec.details:
-            from ..convergence import ConvergenceStudy
-
-            report.studies.append(ConvergenceStudy.from_dict(rec.details["study"]))
-    return report

@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import functools
 import time
+import warnings
 from typing import Any, Callable, Iterable, Iterator, Sequence
 
 import numpy as np
@@ -47,12 +48,13 @@ from ..errors import OutsideDomain, VerimonoError
 from ..grids import graded_grid, random_grid, uniform_grid, validate_grid
 from ..operators import L1Subdifferential, Linear, NormSubdifferential, Operator
 from ..problem import Problem
-from ..results import FAILED, PASSED, SKIPPED, CheckResult
-from .core import (CONTRACTION_CLAIM, PROXIMAL_CLAIM, Holds, Member, NotApplicable, Outcome, law as _declare,
-                   record, run as _run)
-from ..claims import claim_of
+from ..claims import claim_of, with_claim
+from ..results import FAILED, PASSED, SKIPPED, CheckResult, Report
 from ..stepping import Trajectory
 from ..tolerances import DOMAIN_ORDER_SLACK, LIMIT_EXTRA_LEVELS, LIMIT_SHRINK, quotient_tolerance, tolerance
+from .core import (CONTRACTION_CLAIM, PROXIMAL_CLAIM, Holds, Member, NotApplicable, Outcome, law as _declare,
+                   record, run as _run)
+from .orders import check_convergence_order
 
 #: cells of the default partitions (fine enough for the lemmas' bounds, fast enough for a battery)
 DEFAULT_CELLS = 40
@@ -76,20 +78,15 @@ def _name(obj: Any) -> str:
 
 
 def with_changes(problem: Problem, **changes: Any) -> Problem:
-    """A copy of ``problem`` with some constructor arguments replaced (``x0``, ``T``, ``name``, ...)."""
-    kw = dict(f=problem.f, u=problem.u, exact=problem.exact, order=problem.order, name=problem.name,
-              U=problem.U, lipschitz=problem.lipschitz, phi=problem.phi, sigma=problem.sigma,
-              theta=problem.theta, steps=problem.steps, initial_jump=problem.initial_jump,
-              notes=problem.notes)
-    args = dict(operator=problem.operator, x0=problem.x0, T=problem.T)
-    for k, v in changes.items():
-        (args if k in args else kw)[k] = v
-    return Problem(args["operator"], args["x0"], args["T"], **kw)
+    """Deprecated: ``problem.replace(**changes)`` (:meth:`verimono.Problem.replace`)."""
+    warnings.warn("with_changes(problem, ...) is deprecated; use problem.replace(...)", DeprecationWarning,
+                  stacklevel=2)
+    return problem.replace(**changes)
 
 
 def _single(problem: Problem) -> Problem:
     """The laws are stated per initial point: a batch is checked through its first row."""
-    return with_changes(problem, x0=problem.x0[0]) if problem.batched else problem
+    return problem.replace(x0=problem.x0[0]) if problem.batched else problem
 
 
 def run_stepper(stepper: Callable, problem: Problem, grid: np.ndarray) -> np.ndarray:
@@ -202,7 +199,7 @@ def _drive(law: str, stepper: Callable, problem: Problem, grids: dict[str, np.nd
     if shrink and out.k is not None and 1 <= out.k < len(grid) - 1:
         t_k = float(grid[out.k])
         try:
-            small = with_changes(problem, T=t_k)
+            small = problem.replace(T=t_k)
             prefix = grid[:out.k + 1].copy()
             again = evaluate(small, prefix)
         except (_Skip, NotImplementedError, VerimonoError, ArithmeticError, ValueError):
@@ -268,13 +265,13 @@ def run_starts(stepper: Callable, problem: Problem, starts: Sequence[np.ndarray]
     """
     if getattr(stepper, "batched", False) and starts:
         try:
-            xs = np.asarray(stepper(with_changes(problem, x0=np.stack([problem.x0, *starts])), grid), dtype=float)
+            xs = np.asarray(stepper(problem.replace(x0=np.stack([problem.x0, *starts])), grid), dtype=float)
         except (VerimonoError, ArithmeticError, ValueError, TypeError, IndexError):
             xs = None
         if (xs is not None and xs.shape == (len(grid), len(starts) + 1) + problem.x0.shape
                 and np.array_equal(xs[:, 0], x) and np.all(np.isfinite(xs))):
             return [xs[:, i + 1] for i in range(len(starts))]
-    return [run_stepper(stepper, with_changes(problem, x0=z), grid) for z in starts]
+    return [run_stepper(stepper, problem.replace(x0=z), grid) for z in starts]
 
 
 @stepper_law("contraction", "uniqueness argument and the Lipschitz theorem (Section 6)", CONTRACTION_CLAIM,
@@ -832,7 +829,7 @@ def reproduce(stepper: Callable, problem: Problem, record: CheckResult) -> Check
     law = CHECKS[record.check]
     if record.check == "unique_limit":
         return law(stepper, problem, levels=cx["levels"], seed=cx["seed"])
-    p = with_changes(_single(problem), T=float(cx["T"]))
+    p = _single(problem).replace(T=float(cx["T"]))
     kw: dict[str, Any] = {"grids": [np.asarray(cx["grid"], dtype=float)]}
     if "x0_prime" in cx:
         kw["x0_primes"] = [np.asarray(cx["x0_prime"], dtype=float)]
@@ -858,8 +855,6 @@ def stepper_checks(stepper: Callable | None = None, problems: Iterable[Problem] 
     problems (:func:`verimono.checks.sample_problems.sample_problems`, laws only).  ``stepper`` is unused
     (the battery does not depend on it); it is accepted for the protocol ``stepper_checks(stepper)``.
     """
-    from .orders import check_convergence_order
-
     if problems is None:
         from verimono.reference import catalog
 
@@ -876,8 +871,36 @@ def stepper_checks(stepper: Callable | None = None, problems: Iterable[Problem] 
     yield from law_checks(list(refs) + list(extra), laws, seed)
 
 
+def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, *, scheme: str | None = None,
+                  order: float | None = None, seed: int | None = None, executor=None,
+                  laws: bool | Iterable[str] = True, generated: int = 4, orders: bool = True) -> Report:
+    """Result records for ``stepper``: convergence orders on the references, then the trajectory laws.
+
+    ``scheme``/``order`` state what the stepper claims (:class:`verimono.Stepper`; a bare callable
+    claims ``scheme="proximal"``, the paper's scheme): a law that needs more than the claim is skipped
+    with that reason, and ``convergence_order``/``in_domain`` hold an ``"any"`` scheme to its order.
+
+    ``problems=None`` means the whole catalog of :mod:`verimono.reference` (orders and laws) plus
+    ``generated`` seeded sample problems (laws only).  The records come first per problem for the
+    convergence orders (in the order of ``problems``), then one record per (problem, law) of
+    :mod:`verimono.checks.trajectory_laws`; ``laws=False`` keeps the orders only, a list of law names
+    selects laws, ``orders=False`` keeps the laws only.  The records are those of :func:`stepper_checks`, the
+    same generator :func:`verimono.testing.parametrize_with_checks` turns into pytest cases.
+    """
+    stepper = with_claim(stepper, scheme, order)
+    seed = 0 if seed is None else int(seed)
+    selected = () if laws is False else (LAWS if laws is True else tuple(laws))
+    report = Report()
+    for _name_, check in stepper_checks(stepper, problems, seed=seed, generated=generated, laws=selected,
+                                        orders=orders, executor=executor):
+        rec = check(stepper)
+        report.add(rec)
+        if rec.study is not None:
+            report.studies.append(rec.study)
+    return report
+
+
 __all__ = ["LAWS", "CHECKS", "check_contraction", "check_unique_limit", "check_in_domain", "check_domain_vanishing",
-           "stepper_law", "check_bounds_lg",
-           "check_bounds_yb", "check_psi_interpolation", "check_selections", "stepper_checks", "law_checks",
-           "reproduce", "run_stepper", "with_changes", "perturbed_starts", "default_grids", "limit_grids",
-           "LGBounds", "YBBounds"]
+           "stepper_law", "check_bounds_lg", "check_bounds_yb", "check_psi_interpolation", "check_selections",
+           "stepper_checks", "check_stepper", "law_checks", "reproduce", "run_stepper", "with_changes",
+           "perturbed_starts", "default_grids", "limit_grids", "LGBounds", "YBBounds"]
