@@ -10,16 +10,11 @@ from typing import Any
 
 import numpy as np
 
-from .errors import VerimonoError
+from .errors import ProxOutputError
 from .tolerances import RTOL, tolerance
 
 #: sampled points ``z`` of the subgradient inequality in :meth:`ProxOperator.contains`
 CONTAINS_POINTS = 24
-
-
-class ProxOutputError(VerimonoError, TypeError):
-    """A prox returned something that is not one array of the operator's shape (a tuple, a list of
-    arrays, a scalar): verimono does not guess which part is the point."""
 
 
 def checked_value(op: Any, v: Any) -> float:

@@ -70,7 +70,13 @@ class MissingOptionalDependency(VerimonoError, ImportError):
     """An optional extra (e.g. cvxpy/clarabel for the KYP SDP) is not installed."""
 
 
+class ProxOutputError(VerimonoError, TypeError):
+    """A prox (or its ``value``) returned something that is not one array of the operator's shape (a tuple,
+    a list of arrays, a non-scalar value): verimono does not guess which part is the point."""
+
+
 __all__ = [
+    "ProxOutputError",
     "VerimonoError",
     "InvalidProblem",
     "InvalidGrid",
