@@ -745,25 +745,29 @@ def check_min_norm_least(op, *, seed=None, examples=None, horizon=1.0, sample=No
 
 
 def check_prox_inequality(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
-    """The prox inequality ``⟨x - p, z - p⟩ ≤ λ(g(z) - g(p))`` for ``p = J_λx`` and ``z`` among ``x2``,
+    """The prox inequality:
+    ``⟨x - p, z - p⟩ ≤ λ(g(z) - g(p))`` for ``p = J_λx`` and ``z`` among ``x2``,
     ``x1``, ``0`` and other resolvent values (needs ``value``; :mod:`verimono.checks.prox_laws`)."""
     return run_law("prox_inequality", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
 
 
 def check_prox_optimal(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
-    """``p = J_λx`` minimises ``Φ(z) = λg(z) + |z - x|²/2``, 1-strongly: ``Φ(p) + |δ|²/2 ≤ Φ(p + δ)`` for
+    """The prox optimality (perturbations):
+    ``p = J_λx`` minimises ``Φ(z) = λg(z) + |z - x|²/2``, 1-strongly: ``Φ(p) + |δ|²/2 ≤ Φ(p + δ)`` for
     perturbations ``δ`` along coordinates, ``x - p``, ``p`` and seeded directions (needs ``value``)."""
     return run_law("prox_optimal", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
 
 
 def check_prox_minimiser(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
-    """``Φ(p) ≤ Φ(z*)`` for ``z*`` an independent minimiser of ``Φ`` (scipy's Powell from ``p``, ``x``, ``0``;
+    """The prox optimality (independent minimiser):
+    ``Φ(p) ≤ Φ(z*)`` for ``z*`` an independent minimiser of ``Φ`` (scipy's Powell from ``p``, ``x``, ``0``;
     ``n ≤ 4`` only, larger samples are inconclusive; needs ``value``)."""
     return run_law("prox_minimiser", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
 
 
 def check_moreau_envelope(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
-    """The Moreau envelope ``e_λ(x) = g(J_λx) + |x - J_λx|²/(2λ)`` is convex with the ``1/λ``-Lipschitz
+    """The Moreau envelope:
+    ``e_λ(x) = g(J_λx) + |x - J_λx|²/(2λ)`` is convex with the ``1/λ``-Lipschitz
     gradient ``Y_λ``: ``e(x1) + ⟨Y_λx1, x2 - x1⟩ ≤ e(x2) ≤ e(x1) + ⟨Y_λx1, x2 - x1⟩ + |x2 - x1|²/(2λ)``
     (needs ``value``)."""
     return run_law("moreau_envelope", op, seed=seed, examples=examples, horizon=horizon, sample=sample)

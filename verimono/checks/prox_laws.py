@@ -201,10 +201,10 @@ def _moreau_envelope(op, s):
 
 #: (law name, evaluator, label) of the value laws, in the order they run
 VALUE_LAWS = [
-    ("prox_inequality", _prox_inequality, "prox inequality ⟨x − p, z − p⟩ ≤ λ(g(z) − g(p))"),
-    ("prox_optimal", _prox_optimal, "p minimises λg(z) + |z − x|²/2 (perturbations)"),
-    ("prox_minimiser", _prox_minimiser, "p minimises λg(z) + |z − x|²/2 (independent minimiser)"),
-    ("moreau_envelope", _moreau_envelope, "Moreau envelope: convex, ∇e_λ = Y_λ, 1/λ-Lipschitz"),
+    ("prox_inequality", _prox_inequality, "prox inequality"),
+    ("prox_optimal", _prox_optimal, "prox optimality (perturbations)"),
+    ("prox_minimiser", _prox_minimiser, "prox optimality (independent minimiser)"),
+    ("moreau_envelope", _moreau_envelope, "Moreau envelope"),
 ]
 
 __all__ = ["VALUE_LAWS", "MINIMISER_MAX_DIM", "PERTURBATIONS"]
