@@ -41,6 +41,12 @@ class InvalidClaim(VerimonoError, ValueError):
     """A stepper claim that cannot be stated (unknown scheme, nonpositive order, not callable)."""
 
 
+class NotApplicable(Exception):
+    """Raised by a law's evaluator when a requirement shows only while evaluating (e.g. ``x0 ∉ dom F(0,·)``
+    where ``|F^0(0, x0)|`` is needed): the check driver (:mod:`verimono.checks.core`) makes the record a
+    skip with this reason.  Not an error of the caller's input, so not a :class:`VerimonoError`."""
+
+
 class UnknownProfile(VerimonoError, ValueError):
     """A profile name other than ``dev``, ``ci`` or ``thorough``."""
 
@@ -85,6 +91,7 @@ __all__ = [
     "InfeasibleStep",
     "SolverFailure",
     "InvalidClaim",
+    "NotApplicable",
     "UnknownProfile",
     "UnknownStage",
     "StageUnavailable",
