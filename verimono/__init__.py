@@ -11,6 +11,7 @@ from .errors import (BadTarget, BatchStepError, IncompatibleBaseline, Infeasible
 from .grids import graded_grid, random_grid, refine, uniform_grid, validate_grid
 from .operators import (L1Subdifferential, Linear, LogBarrier, NormalCone, NormSubdifferential, Operator,
                         Shifted, operator_from_resolvent)
+from .prox import ProxOperator, ProxOutputError, operator_from_prox
 from .problem import Order, Problem
 from .claims import Claim, Stepper
 from .results import CheckResult, Report
@@ -52,7 +53,8 @@ __all__ = [
     "VerimonoError", "InvalidProblem", "InvalidGrid", "OutsideDomain", "NotMonotone", "InfeasibleStep",
     "BatchStepError", "SolverFailure", "UnknownProfile", "UnknownStage", "StageUnavailable", "BadTarget", "SchemaError",
     "IncompatibleBaseline", "MissingOptionalDependency", "InvalidClaim",
-    "Operator", "operator_from_resolvent", "Linear", "NormSubdifferential", "L1Subdifferential",
+    "Operator", "operator_from_resolvent", "operator_from_prox", "ProxOperator", "ProxOutputError", "Linear",
+    "NormSubdifferential", "L1Subdifferential",
     "NormalCone", "Shifted", "LogBarrier", "sets",
     "Problem", "Order", "Stepper", "Claim", "Trajectory", "solve", "stream", "ErrorAccumulator",
     "uniform_grid", "graded_grid", "random_grid", "refine", "validate_grid",

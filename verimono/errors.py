@@ -95,7 +95,13 @@ class BatchStepError(VerimonoError, ArithmeticError):
         return [f.row for f in self.failures]
 
 
+class ProxOutputError(VerimonoError, TypeError):
+    """A prox (or its ``value``) returned something that is not one array of the operator's shape (a tuple,
+    a list of arrays, a non-scalar value): verimono does not guess which part is the point."""
+
+
 __all__ = [
+    "ProxOutputError",
     "VerimonoError",
     "BatchStepError",
     "InvalidProblem",
