@@ -29,6 +29,7 @@ import numpy as np
 
 from ._kernels import _TINY, _mx, _norm, _sqrt, batch_column, dot_rows
 from ._params import as_param
+from ._values import checked_value, subgradient_contains
 from .errors import InvalidProblem, NotMonotone, OutsideDomain
 from .tolerances import tolerance
 
@@ -184,7 +185,6 @@ class _FromResolvent(Operator):
     def value(self, x, t=0.0):
         if self._value is None:
             return super().value(x, t)
-        from ._values import checked_value
         return checked_value(self, self._value(x, t) if self._value_t else self._value(x))
 
     def min_norm(self, x, t=0.0):
@@ -199,7 +199,6 @@ class _FromResolvent(Operator):
 
     def contains(self, x, y, t=0.0, tol=None):
         if self._contains is None and self._value is not None:
-            from ._values import subgradient_contains
             return subgradient_contains(self, x, y, t, tol)
         if self._contains is None:
             return super().contains(x, y, t, tol)

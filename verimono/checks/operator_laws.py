@@ -480,8 +480,6 @@ def default_examples() -> tuple[int, str]:
 def _sweep(law: Law, op: Operator, seed: int, horizon: float, state: "_State", body: Callable) -> int:
     """Evaluate ``law`` on the scale sweep (:mod:`verimono.checks.sweep`) after a search found nothing; a
     violation is shrunk greedily and recorded in ``state``.  Returns the number of sweep samples."""
-    from ..profiles import active_profile
-
     samples = sweep_samples(op, seed, horizon, sweep_count(active_profile(), law.name), Sample)
     for s in samples:
         try:
