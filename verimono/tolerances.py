@@ -86,3 +86,10 @@ STALL_WINDOW = 8
 #: solvers stop at about 1e-8 relative duality gap; the LMI is then re-checked by an eigenvalue computation
 #: against this looser tolerance, scaled to the size of the KYP matrix.
 SDP_RTOL = 1e-6
+
+#: ``pseudo_distance_hausdorff``: a sampled lower bound of ``dis(N_C1, N_C2) = d_H(C1, C2)`` must come within
+#: this factor of ``d_H`` on the catalog pairs (:mod:`verimono.checks.pseudo_distance`).  With the boundary
+#: points of both sets and projected-ascent steps towards their farthest points among the samples, the
+#: bound misses ``d_H`` only by the ascent's last step and by ``1/(1 + |y|)`` with ``|y| ≈ 1e6``: measured
+#: 0.99927 … 0.9999998 of ``d_H`` (seeds 0–19, 32 directions); an estimator half as large fails by 2
+PSEUDO_DISTANCE_FACTOR = 1.01
