@@ -35,3 +35,9 @@ def half_as_large(F1, F2, samples, *, lams=(1.0,), t1=0.0, t2=0.0):
 ESTIMATORS = {"twice_too_large": (twice_too_large, "above d_H: not a lower bound"),
               "sign_error": (sign_error, None),
               "half_as_large": (half_as_large, "below")}
+
+
+def understated_lipschitz(problem, factor: float = 0.5):
+    """The problem's Lipschitz constant of ``f`` understated by ``factor`` (a constant copied from a
+    component, or from the wrong norm)."""
+    return factor * problem.lipschitz
