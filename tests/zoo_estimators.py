@@ -41,3 +41,9 @@ def understated_lipschitz(problem, factor: float = 0.5):
     """The problem's Lipschitz constant of ``f`` understated by ``factor`` (a constant copied from a
     component, or from the wrong norm)."""
     return factor * problem.lipschitz
+
+
+def alpha_min_max_slip(M):
+    """``1/λ_max`` of the symmetric part instead of ``1/λ_min`` for the constant of Proposition p:lcp2 v."""
+    lam = np.linalg.eigvalsh(0.5 * (np.asarray(M) + np.asarray(M).T))
+    return 1.0 / float(lam[-1]) if lam[0] > 0 else None
