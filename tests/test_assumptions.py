@@ -180,3 +180,23 @@ def test_lemma_A3_implies_A2_is_false_as_stated():
     ok = Problem(NormSubdifferential(lambda t: 1.0 if t < 0.5 else 2.0, dim=1), [1.0], 1.0, phi=lambda t: 0.0)
     rep = _by(check_assumptions(ok))
     assert rep["assumption_A3"].status == PASSED and rep["assumption_A2"].status == PASSED
+
+
+def test_t_non_auto_YB_claim_is_false_for_a_shifted_operator():
+    """t:non-auto claims G(t, ξ) = F(t, ξ + Φ(t)) satisfies (YB) with θ̄ = M_u + θ when F does.  But θ̄ has the
+    increments of θ.  F = ∂|x| (static: (YB) with θ ≡ 0), u = 1 (Φ(t) = t): at ξ = −s, G^0(s, ξ) = 0 while
+    |Y^G_λ(s+λ, ξ)| = |Y^F_λ(λ)| = 1 for every λ — (YB) fails for every θ; the evidence grows like 1/λ.
+    bounds_yb therefore skips problems with an input, and says why."""
+    import verimono as vm
+    from verimono.checks.trajectory_laws import check_bounds_yb
+    from verimono.operators import Shifted
+
+    F = vm.NormSubdifferential(1.0, dim=1)
+    assert _by(check_assumptions(Problem(F, [0.0], 1.0)))["assumption_YB"].status == PASSED
+    G = Shifted(F, lambda t: np.array([t]))
+    s, lam = 0.3, 1e-4
+    assert G.min_norm(np.array([-s]), s)[0] == 0.0 and G.yosida(np.array([-s]), lam, s + lam)[0] == pytest.approx(1.0)
+    rec = _by(check_assumptions(Problem(G, [0.0], 1.0)))["assumption_YB"]
+    assert rec.status == FAILED and rec.details["growth"] >= 100, str(rec)
+    skip = check_bounds_yb(vm.solve, Problem(F, [0.5], 1.0, u=lambda t: np.array([1.0]), theta=lambda t: 0.0))
+    assert skip.status == "skipped" and "θ̄ = M_u + θ has the increments of θ" in skip.message, str(skip)

@@ -603,7 +603,10 @@ def _yb_setup(p: Problem, t: np.ndarray):
     if p.f is not None:
         raise _Skip("lem:bndSeqYB covers f = 0 (the Lipschitz theorem's constants are not explicit)")
     if p.u is not None or p.U is not None:
-        raise _Skip("with an input, (YB) for G holds with θ + M_u where M_u is not explicit (l:extinput)")
+        raise _Skip("with an input, lem:bndSeqYB would apply to G(t, ξ) = F(t, ξ + Φ(t)) (l:extinput), but (YB) "
+                    "does not pass from F to G: t:non-auto's θ̄ = M_u + θ has the increments of θ (the constant "
+                    "cancels) while the defect |Φ(s+λ) − Φ(s)|/λ ≈ |u(s)| stays as λ → 0 (F = ∂|x|, u = 1: G "
+                    "fails (YB) for every θ)")
     theta, src = _theta_of(p)
     return YBBounds(p.x0, theta, p.operator, p.T), np.zeros((len(t), p.dim)), {"theta": src}
 
