@@ -403,8 +403,8 @@ def check_unique_limit(stepper: Callable, problem: Problem, *, levels: Sequence[
     not_cauchy = [k for k, r in ratios.items() if r >= 1.0]
     details = {"levels": levels, "distances": distances, "mesh": [p.T / K for K in levels],
                "differences": diffs, "ratios": ratios, "tails": tails, "criterion": "Cauchy with own-trend tail"}
-    finite = [t for t in tails.values() if np.isfinite(t)]
-    worst = D / (max(sum(finite), 0.0) + tol) if not not_cauchy else max(ratios.values())
+    pair = info["pair"] if info else list(tails)[:2]
+    worst = D / (tails[pair[0]] + tails[pair[1]] + tol) if not not_cauchy else max(ratios.values())
     if gap <= tol and not not_cauchy:
         return CheckResult("unique_limit", subject, PASSED, worst=worst if gap > 0 else min(worst, 1.0),
                            bound=1.0, details=details, duration=time.perf_counter() - start,
