@@ -17,7 +17,7 @@ from __future__ import annotations
 import dataclasses
 import os
 
-from .errors import VerimonoError
+from .errors import UnknownProfile
 
 PROFILES = ("dev", "ci", "thorough")
 
@@ -45,10 +45,6 @@ _EFFORT = {
     "thorough": Profile("thorough", max_examples=500, law_examples=200, generated_subjects=30,
                         derandomize=False),
 }
-
-
-class UnknownProfile(VerimonoError, ValueError):
-    """A profile name other than ``dev``, ``ci`` or ``thorough``."""
 
 
 def get_profile(name: str) -> Profile:

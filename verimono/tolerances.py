@@ -96,6 +96,12 @@ STALL_WINDOW = 8
 #: against this looser tolerance, scaled to the size of the KYP matrix.
 SDP_RTOL = 1e-6
 
+#: a scheme claiming order p (``scheme="any"``) passes ``in_domain`` when the largest distance of its
+#: iterates to ``cl dom F(t_k)`` at the finest level is at most this factor times the prediction
+#: ``max_j D(K_j) (K_j/K_m)^p`` from the coarser levels: the constant of ``C h^p`` is unknown and drifts
+#: by O(h) between levels; a distance that does not vanish (a constant offset) exceeds any fixed factor
+DOMAIN_ORDER_SLACK = 2.0
+
 #: ``pseudo_distance_hausdorff``: a sampled lower bound of ``dis(N_C1, N_C2) = d_H(C1, C2)`` must come within
 #: this factor of ``d_H`` on the catalog pairs (:mod:`verimono.checks.pseudo_distance`).  With the boundary
 #: points of both sets and projected-ascent steps towards their farthest points among the samples, the

@@ -10,21 +10,18 @@ from pathlib import Path
 from typing import Any
 
 
-def write(report: Any, out_dir: str | Path, *, baseline: Any = None, changes: Any = None) -> dict[str, Path]:
+def write(report: Any, out_dir: str | Path, *, changes: Any = None) -> dict[str, Path]:
     """Write ``out_dir/results.json`` and ``out_dir/report.html``; returns their paths.
 
-    ``baseline`` (a :class:`verimono.Report`) or precomputed ``changes`` (a
-    :class:`verimono.gate.Comparison`) fill the report's "changes against the baseline" section.
+    ``changes`` (a :class:`verimono.gate.Comparison`, computed by the caller with
+    :func:`verimono.gate.compare`: the report knows nothing of the gate) fill the report's "changes against
+    the baseline" section.
     """
     from .html import render
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     json_path = report.save(out / "results.json")
-    if changes is None and baseline is not None:
-        from ..gate import compare
-
-        changes = compare(baseline, report)
     html_path = out / "report.html"
     html_path.write_text(render(report, changes=changes), encoding="utf-8")
     return {"json": json_path, "html": html_path}
