@@ -90,6 +90,8 @@ def test_unique_limit_assumes_no_rate():
     bad = check_unique_limit(BREAKS["unique_limit"][0], get(BREAKS["unique_limit"][1]))
     assert bad.status == FAILED and "different limits" in bad.message, str(bad)
     assert bad.counterexample["tails"] and bad.counterexample["pair"]
+    # two levels give one difference per kind: a third is added (the tail needs a ratio)
+    assert check_unique_limit(solve, get("t|x| (n=1)"), levels=(10, 40)).details["levels"] == [10, 40, 160]
 
 
 def test_contraction_runs_its_starts_in_one_batch_and_falls_back_when_a_batch_is_wrong():

@@ -366,6 +366,8 @@ def check_unique_limit(stepper: Callable, problem: Problem, *, levels: Sequence[
     subject = f"{_name(stepper)} on {problem.name}"
     start = time.perf_counter()
     levels = list(levels)
+    while len(levels) < 3:               # two differences per kind: the least the own-trend tail needs
+        levels.append(4 * levels[-1])
     try:
         p = _single(problem)
         scale = [float(np.max(np.abs(p.x0)))]
