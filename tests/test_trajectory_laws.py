@@ -239,3 +239,17 @@ def test_contraction_admits_an_implicit_lipschitz_term():
     assert check_contraction(implicit_f, p).status == PASSED
     assert check_contraction(solve, p).status == PASSED
     assert check_contraction(amplifier, p).status == FAILED
+
+
+def test_yb_bounds_skip_where_f0_overflows_at_the_edge_of_the_domain():
+    """x0 = 7e-304 for x' = c/x: |F^0(0, x0)| = c/x0 overflows, so lem:bndSeqYB's α is infinite — the
+    bounds say nothing there and the laws are skipped with the reason (found by a dev-profile search,
+    which saw bounds_yb fail with ψ = nan and psi_interpolation raise)."""
+    import verimono as vm
+    from verimono.checks.trajectory_laws import check_bounds_yb, check_psi_interpolation
+
+    p = vm.Problem(vm.LogBarrier(1.0), [7e-304], 1.0, theta=lambda s: 0.0, name="c/x at the edge")
+    for check in (check_bounds_yb, check_psi_interpolation):
+        rec = check(vm.solve, p)
+        assert rec.status == "skipped", rec
+    assert "not finite" in check_bounds_yb(vm.solve, p).message

@@ -41,6 +41,12 @@ class InvalidClaim(VerimonoError, ValueError):
     """A stepper claim that cannot be stated (unknown scheme, nonpositive order, not callable)."""
 
 
+class NotApplicable(Exception):
+    """Raised by a law's evaluator when a requirement shows only while evaluating (e.g. ``x0 ∉ dom F(0,·)``
+    where ``|F^0(0, x0)|`` is needed): the check driver (:mod:`verimono.checks.core`) makes the record a
+    skip with this reason.  Not an error of the caller's input, so not a :class:`VerimonoError`."""
+
+
 class UnknownProfile(VerimonoError, ValueError):
     """A profile name other than ``dev``, ``ci`` or ``thorough``."""
 
@@ -70,8 +76,28 @@ class MissingOptionalDependency(VerimonoError, ImportError):
     """An optional extra (e.g. cvxpy/clarabel for the KYP SDP) is not installed."""
 
 
+class BatchStepError(VerimonoError, ArithmeticError):
+    """Some rows of a batched ``LinearRelationSystem.simulate`` failed; the others ran to the end.
+
+    ``failures``: the ``verimono.lcs.RowFailure`` (row, step, t, error) of each failed row;
+    ``trajectory``: every row's results (``x (K+1, B, n)``, ``extras["z"], extras["w"] (K, B, m)``) with NaN
+    after a row's failure; ``valid`` ``(K+1, B)``: which states were computed."""
+
+    def __init__(self, failures: list, trajectory, valid) -> None:
+        self.failures, self.trajectory, self.valid = failures, trajectory, valid
+        shown = "; ".join(str(f) for f in failures[:5])
+        more = f"; and {len(failures) - 5} more" if len(failures) > 5 else ""
+        super().__init__(f"{len(failures)} of {valid.shape[1]} rows failed (the others ran to the end; "
+                         f"results in .trajectory, .valid): {shown}{more}")
+
+    @property
+    def rows(self) -> list[int]:
+        return [f.row for f in self.failures]
+
+
 __all__ = [
     "VerimonoError",
+    "BatchStepError",
     "InvalidProblem",
     "InvalidGrid",
     "OutsideDomain",
@@ -79,6 +105,7 @@ __all__ = [
     "InfeasibleStep",
     "SolverFailure",
     "InvalidClaim",
+    "NotApplicable",
     "UnknownProfile",
     "UnknownStage",
     "StageUnavailable",

@@ -39,6 +39,13 @@ def tolerance(*scales: float, rtol: float = RTOL) -> float:
 #: rescued by it and is rejected by the residual check instead.
 POLISH_RTOL = 1e-6
 
+#: largest condition number of a principal submatrix ``M_II`` whose factorisation the LCS stepping kernel
+#: (:mod:`verimono.lcs.kernel`) caches as an affine map of the state: the map's entries then carry a relative
+#: error ``≤ cond·EPS = RTOL/1000``, a thousandth of the margin ``RTOL`` its sign checks demand, so a candidate that
+#: passes them is strictly complementary in exact arithmetic too (worse-conditioned patterns are solved
+#: step by step by the verified solver instead)
+ACTIVE_SET_COND = 1e-3 * RTOL / EPS
+
 # -- trajectory laws and assumption evidence (verimono.checks.trajectory_laws / .assumptions) ----------
 
 

@@ -32,7 +32,7 @@ import time
 from typing import Any, Callable, Iterable
 
 from ..claims import Claim, claim_of
-from ..errors import VerimonoError
+from ..errors import NotApplicable, VerimonoError
 from ..results import FAILED, PASSED, SKIPPED, CheckResult
 
 SUBJECTS = ("operator", "stepper", "problem")
@@ -142,11 +142,6 @@ def provides(op: Any, member: str) -> bool:
     where it says, else whether it has the member at all (a duck-typed operator)."""
     says = getattr(op, "provides", None)
     return bool(says(member)) if callable(says) else callable(getattr(op, member, None))
-
-
-class NotApplicable(Exception):
-    """Raised by a law's evaluator when a requirement shows only while evaluating (e.g. ``x0 ∉ dom F(0,·)``
-    where ``|F^0(0, x0)|`` is needed): the driver makes the record a skip with this reason."""
 
 
 @dataclasses.dataclass

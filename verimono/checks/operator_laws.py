@@ -37,6 +37,7 @@ from hypothesis import strategies as st
 
 from ..errors import VerimonoError
 from ..operators import Operator
+from ..profiles import UnknownProfile, active_profile, get_profile
 from ..results import FAILED, PASSED, SKIPPED, CheckResult, Report
 from .core import Law, Member, Outcome, law as _declare, laws_of, run as _run_law
 from ..strategies import points, step_sizes, times
@@ -454,8 +455,6 @@ def _subject(op: Operator) -> str:
 def default_examples() -> tuple[int, str]:
     """``(examples per law, profile)`` when ``examples`` is not given: the active profile's ``law_examples``
     (``dev``/``ci``/``thorough``, :func:`verimono.profiles.active_profile`), else ``DEFAULT_EXAMPLES``."""
-    from ..profiles import UnknownProfile, active_profile, get_profile
-
     name = active_profile()
     try:
         return get_profile(name).law_examples, name

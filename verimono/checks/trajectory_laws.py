@@ -47,7 +47,7 @@ from scipy import integrate
 
 from ..errors import OutsideDomain, VerimonoError
 from ..grids import graded_grid, random_grid, uniform_grid, validate_grid
-from ..operators import L1Subdifferential, Linear, NormSubdifferential, Operator
+from ..operators import L1Subdifferential, Linear, NormalCone, NormSubdifferential, Operator
 from ..problem import Problem
 from ..claims import claim_of, with_claim
 from ..results import FAILED, PASSED, SKIPPED, CheckResult, Report
@@ -575,8 +575,6 @@ def _phi_of(problem: Problem) -> tuple[Callable[[float], float], str]:
 def _sigma_of(problem: Problem) -> tuple[Callable[[float], float], str]:
     """σ of (LG): the problem's, or derived from the catalog operator — ``N_S``: ``F^0 = 0``, ``σ ≡ 0``;
     ``Linear``: ``|M(t)x| ≤ ‖M(t)‖₂|x|``; ``∂(c|·|)``, ``∂(Σc_i|x_i|)``: ``|F^0(t,x)| ≤ |F^0(t, 1)|``."""
-    from ..operators import NormalCone
-
     if problem.sigma is not None:
         return problem.sigma, "stated"
     op = problem.operator
@@ -663,6 +661,9 @@ class YBBounds:
             f0 = float(np.linalg.norm(op.min_norm(x0, 0.0)))
         except OutsideDomain:
             raise _Skip("x0 is not in dom F(0,·) (lem:bndSeqYB needs |F^0(0, x0)|)") from None
+        if not np.isfinite(f0):   # x0 within rounding of the boundary: F^0 overflows (c/x at x = 7e-304)
+            raise _Skip(f"|F^0(0, x0)| = {f0} is not finite: x0 is at the edge of dom F(0,·), where "
+                        "lem:bndSeqYB's α is infinite and its bounds say nothing")
         self.alpha = 2.0 * (float(theta(T)) - float(theta(0.0))) + f0
         self.beta = float(np.linalg.norm(x0)) + self.alpha * T
         self.f0 = f0
