@@ -30,7 +30,9 @@ import numpy as np
 from ..grids import uniform_grid, validate_grid
 from ..problem import Problem
 from ..results import FAILED, PASSED, SKIPPED, CheckResult
+from ..stepping import solve
 from ..tolerances import tolerance
+from .trajectory_laws import _name, _single, run_stepper
 
 #: Picard iterates built (the bound is checked for ℓ = 1, ..., PICARD_ITERATIONS − 1)
 PICARD_ITERATIONS = 8
@@ -48,9 +50,6 @@ def _primitive(t: np.ndarray, values: np.ndarray) -> Callable[[float], np.ndarra
 def check_picard(stepper: Callable | None, problem: Problem, *, L: float | None = None,
                  iterations: int = PICARD_ITERATIONS, grid: np.ndarray | None = None) -> CheckResult:
     """``picard_step``: ``e: bound x l plus one to x l`` on the Picard iterates (module docstring)."""
-    from ..stepping import solve
-    from .trajectory_laws import _name, _single, run_stepper
-
     stepper = solve if stepper is None else stepper
     p = _single(problem)
     L = p.lipschitz if L is None else float(L)
