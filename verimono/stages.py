@@ -366,6 +366,13 @@ def section7_stage(profile: Profile, context: RunContext) -> Report:
     if hasattr(example, "check_batched_scheme"):   # a batch of trajectories in one simulate (issue 15)
         report.add(example.check_batched_scheme(seed=0 if seed is None else seed))
     report.add(example.check_pseudo_distance_unbounded())
+    # def:dis against the exact d_H of catalog sets, and the Picard step of Section 6 (issue 13)
+    from .checks.picard import check_picard
+    from .checks.pseudo_distance import check_pseudo_distance
+    report.add(check_pseudo_distance(seed=0 if seed is None else seed))
+    for p in context.catalog():
+        if p.f is not None and p.lipschitz is not None:
+            report.add(check_picard(stepper, p))
     for label, v in (("v = (−t, 0)", lambda t: np.array([-t, 0.0])),
                      ("v = (sin t, 0)", lambda t: np.array([np.sin(t), 0.0]))):
         rep = lcs.check_hypotheses(example.example_system(v), 2.0, seed=0 if seed is None else seed)
