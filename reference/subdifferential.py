@@ -66,3 +66,28 @@ def log_barrier(c: float = 1.0, T: float = 1.0) -> Problem:
                                       "D(phi)): O(h^1/2), Crandall-Liggett 1971, Rulla 1996"),
         name="x' = c/x from 0 (order 1/2)", steps=[T / k for k in (100, 200, 400, 800, 1600)],
         notes="(LG) fails: |F^0(x)| = c/x is unbounded near the boundary of the domain")
+
+
+def _slow_c(t):
+    return 0.1 * t ** -0.9 if t > 0 else 0.0
+
+
+def slow_rate(T: float = 1.0) -> Problem:
+    """``x' ∈ -∂(c(t)|x|)`` with ``c(t) = 0.1 t^{-0.9}`` from ``x0 = 2``: ``x = 2 - t^{0.1}`` while positive
+    (until ``t = 2^{10}``).  ``σ = c`` is in L¹ but unbounded, so (LG) holds and the paper gives no rate.
+    On a uniform grid the scheme subtracts ``h c(t_{k+1})`` per cell, ``h c(h) = 0.1 h^{0.1}`` on the first
+    against ``∫_0^h c = h^{0.1}``, and ``h^{0.1}(j^{0.1} − (j−1)^{0.1} − 0.1 j^{−0.9})`` on cell ``j``: the error
+    at ``t_k`` sums to ``h^{0.1} Σ_{j≤k}(...) → 0.943 h^{0.1}`` (the series, summed to 10^7 terms) — order 0.1
+    (measured: 1.0477·0.9 h^{0.1} at K = 40 … 2560), and the uniform and graded
+    (``h_1 = T/K²``) solutions drift *apart* like ``0.9(K^{-0.1} − K^{-0.2})`` until ``K = 2^{10}``.
+    ``c(0) = 0`` is a convention (the scheme never evaluates ``F`` at ``t = 0``).  Not in the run's catalog:
+    the test problem of ``unique_limit`` without an assumed rate (``tests/test_trajectory_laws.py``)."""
+    def exact(t):
+        return np.array([2.0 - t ** 0.1])
+
+    return Problem(NormSubdifferential(_slow_c, dim=1), [2.0], T, exact=exact,
+                   order=Order(0.1, "derived in verimono.reference.subdifferential.slow_rate: the cell errors sum to "
+                                    "0.943 h^0.1; none is ever recovered", constant=0.943),
+                   name="c = 0.1 t^-0.9 (order 0.1)", steps=[T / k for k in (40, 160, 640, 2560, 10240)],
+                   sigma=_slow_c, phi=lambda t: 0.0,
+                   notes="sigma in L1 but unbounded near 0: no rate from the paper")

@@ -109,3 +109,94 @@ def test_a_stated_theta_is_judged_on_YB_not_on_the_stronger_YB_prime():
     bad = vm.Problem(vm.Linear(lambda t: np.array([[1.0 + 5.0 * t]])), [1.0], 1.0, theta=lambda s: 0.0,
                      name="(1+5t)x")
     assert check_assumptions(bad, composite=False).by_check("assumption_YB")[0].status == FAILED
+
+
+def _jumping_ball(t_jump=0.45, size=3.0, right_continuous=True):
+    import verimono as vm
+
+    def centre(t):
+        after = t >= t_jump if right_continuous else t > t_jump
+        return np.array([size if after else 0.0, 0.0])
+    return Problem(vm.NormalCone(vm.sets.Ball(centre, 1.0)), [0.0, 0.0], 1.0, name=f"ball jumping at {t_jump}")
+
+
+def test_A3_without_a_stated_phi_fails_on_a_jumping_domain():
+    """Issue 13 item 1: with no φ given, a ball whose centre jumps by 3 at t = 0.45 passed (φ̂(T) − φ̂(0) =
+    2.998 was reported).  The jump search brackets the jump by adjacent floats, and the excess of dom F(a)
+    over dom F(b) stays 3 − (rounding of the sampled points) across it: no absolutely continuous φ."""
+    rec = _by(check_assumptions(_jumping_ball()))["assumption_A3"]
+    assert rec.status == FAILED, str(rec)
+    c = rec.counterexample
+    assert c["t"] == 0.45 and c["bracket"][0] < 0.45 <= c["bracket"][1] and c["bracket"][1] - c["bracket"][0] < 1e-15
+    # the sampled z ∈ dom F(a) farthest from dom F(b) = B((3, 0), 1): at most the true excess 3 (z = (-1, 0))
+    assert 2.9 < c["excess"] <= 3.0 + 1e-12 and c["excess_earlier"] <= c["excess"] / 0.99
+    assert "jumps at t ≈ 0.45" in rec.message
+
+
+@pytest.mark.parametrize("speed", ["lipschitz", "sqrt"])
+def test_A3_absolutely_continuous_motion_still_passes(speed):
+    """φ̂ absolutely continuous (Lipschitz, or √t: AC but with unbounded rate) — no jump is reported, and
+    the bisected increments of the projections shrink (by 2 or √2 per halving)."""
+    import verimono as vm
+
+    move = (lambda t: np.array([2.0 * t, 0.0])) if speed == "lipschitz" else (lambda t: np.array([np.sqrt(t), 0.0]))
+    rec = _by(check_assumptions(Problem(vm.NormalCone(vm.sets.Ball(move, 1.0)), [0.0, 0.0], 1.0)))["assumption_A3"]
+    assert rec.status == PASSED and rec.details["jump_search"]["bisected"] > 0, str(rec)
+
+
+@pytest.mark.parametrize("t_jump", [0.45, 0.1234, 0.9, 0.03, 1 / 3, 0.5, 0.7071])
+def test_A2_jumps_between_sample_times_are_found(t_jump):
+    """Issue 13 item 2: c(t) = 1 for t ≤ t_jump, 2 after (F = c(t)x) passed when t_jump was no sample time.
+    The jump search finds every such jump, wherever it lies, and the right-limit test at the jump time
+    fails; the right-continuous variant (c(t_jump) = 2) is found too, and passes."""
+    left = _by(check_assumptions(_scaled_identity(lambda t: 1.0 if t <= t_jump else 2.0)))["assumption_A2"]
+    assert left.status == FAILED, str(left)
+    c = left.counterexample
+    assert c["t"] == t_jump, str(left)
+    on_sample = bool(np.any(np.linspace(0.0, 1.0, 7) == t_jump))       # 1/3 and 1/2 are sample times
+    assert on_sample or c["found_by"] == "jump search"
+    assert [(j["t"], j["side"]) for j in left.details["jumps"]] == [(t_jump, "left value at t (jump right after t)")]
+    np.testing.assert_allclose(c["limit"], c["p"] / (1 + 2 * c["lam"]), rtol=1e-9)          # the right value
+    np.testing.assert_allclose(c["resolvent_at_t"], c["p"] / (1 + c["lam"]), rtol=1e-12)     # the left value
+    right = _by(check_assumptions(_scaled_identity(lambda t: 1.0 if t < t_jump else 2.0)))["assumption_A2"]
+    assert right.status == PASSED, str(right)
+    assert [j["t"] for j in right.details["jumps"]] == [t_jump] and right.details["jumps"][0]["side"] == "right-continuous"
+
+
+def test_lemma_A3_implies_A2_is_false_as_stated():
+    """lem:A3ImpliesA2 claims (A3) ⇒ (A2) for subdifferentials.  g(t, x) = c(t)|x| with c = 1 on [0, ½] and
+    2 after: dom ∂g(t,·) = R for every t, so (A3) holds with φ ≡ 0; but (0, 2) ∈ graph ∂g(t_ℓ) for t_ℓ ↓ ½
+    while ∂g(½, 0) = [−1, 1]: (A2) fails at ½.  The proof's last step needs g(t_ℓ, ·) → g(t, ·), i.e. g
+    right-continuous in t.  With c(½) = 2 (right-continuous) both hold."""
+    from verimono import NormSubdifferential
+
+    bad = Problem(NormSubdifferential(lambda t: 1.0 if t <= 0.5 else 2.0, dim=1), [1.0], 1.0, phi=lambda t: 0.0)
+    rep = _by(check_assumptions(bad))
+    assert rep["assumption_A3"].status == PASSED and rep["assumption_A3"].details["stated"]
+    assert rep["assumption_A2"].status == FAILED and rep["assumption_A2"].counterexample["t"] == 0.5
+    c = rep["assumption_A2"].counterexample      # soft thresholding: J_λ p = p − λ c sign(p) for |p| > λc
+    assert abs(c["resolvent_at_t"][0] - (c["p"][0] - c["lam"] * np.sign(c["p"][0]))) < 1e-12
+    assert abs(c["limit"][0] - (c["p"][0] - 2 * c["lam"] * np.sign(c["p"][0]))) < 1e-9
+    ok = Problem(NormSubdifferential(lambda t: 1.0 if t < 0.5 else 2.0, dim=1), [1.0], 1.0, phi=lambda t: 0.0)
+    rep = _by(check_assumptions(ok))
+    assert rep["assumption_A3"].status == PASSED and rep["assumption_A2"].status == PASSED
+
+
+def test_t_non_auto_YB_claim_is_false_for_a_shifted_operator():
+    """t:non-auto claims G(t, ξ) = F(t, ξ + Φ(t)) satisfies (YB) with θ̄ = M_u + θ when F does.  But θ̄ has the
+    increments of θ.  F = ∂|x| (static: (YB) with θ ≡ 0), u = 1 (Φ(t) = t): at ξ = −s, G^0(s, ξ) = 0 while
+    |Y^G_λ(s+λ, ξ)| = |Y^F_λ(λ)| = 1 for every λ — (YB) fails for every θ; the evidence grows like 1/λ.
+    bounds_yb therefore skips problems with an input, and says why."""
+    import verimono as vm
+    from verimono.checks.trajectory_laws import check_bounds_yb
+    from verimono.operators import Shifted
+
+    F = vm.NormSubdifferential(1.0, dim=1)
+    assert _by(check_assumptions(Problem(F, [0.0], 1.0)))["assumption_YB"].status == PASSED
+    G = Shifted(F, lambda t: np.array([t]))
+    s, lam = 0.3, 1e-4
+    assert G.min_norm(np.array([-s]), s)[0] == 0.0 and G.yosida(np.array([-s]), lam, s + lam)[0] == pytest.approx(1.0)
+    rec = _by(check_assumptions(Problem(G, [0.0], 1.0), composite=False))["assumption_YB"]
+    assert rec.status == FAILED and rec.details["growth"] >= 100, str(rec)
+    skip = check_bounds_yb(vm.solve, Problem(F, [0.5], 1.0, u=lambda t: np.array([1.0]), theta=lambda t: 0.0))
+    assert skip.status == "skipped" and "θ̄ = M_u + θ has the increments of θ" in skip.message, str(skip)

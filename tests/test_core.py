@@ -21,7 +21,7 @@ from verimono.results import CheckResult
 
 def test_every_law_is_declared_once_with_its_label_and_subject_kind():
     reg = core.REGISTRY
-    assert set(OPERATOR_LAWS) == set(reg["operator"]) and len(OPERATOR_LAWS) == 15
+    assert set(OPERATOR_LAWS) == set(reg["operator"]) and len(OPERATOR_LAWS) == 19   # 15 + 4 value laws
     assert set(STEPPER_LAWS) | {"convergence_order"} == set(reg["stepper"])
     assert set(ASSUMPTION_LAWS) | {"assumptions_thm_main"} == set(reg["problem"])
     for kind, laws in reg.items():
@@ -55,7 +55,8 @@ def test_operator_members_are_requirements_judged_from_the_declaration():
     rep = vm.check_operator(op, seed=0, examples=5)
     skipped = {r.check: r.message for r in rep if r.status == "skipped"}
     assert set(skipped) == {"resolvent_in_domain", "yosida_in_graph", "yosida_bounded_by_min_norm", "yosida_limit",
-                            "min_norm_in_graph", "min_norm_least"}
+                            "min_norm_in_graph", "min_norm_least", "prox_inequality", "prox_optimal",
+                            "prox_minimiser", "moreau_envelope"}
     assert all("does not provide" in m for m in skipped.values())
     assert all(r.details["evaluations"] == 0 for r in rep if r.status == "skipped")
 
@@ -69,7 +70,7 @@ def test_an_operator_whose_resolvent_raises_gives_one_root_cause_record():
     root = rep.failures[0]
     assert "RuntimeError: factorization not initialised" in root.message and "root cause" in root.message
     others = [r for r in rep if r.check != ROOT_LAW]
-    assert len(others) == 14 and all(r.status == "skipped" for r in others)
+    assert len(others) == 18 and all(r.status == "skipped" for r in others)
     assert all("root cause is recorded once" in r.message or "does not provide" in r.message for r in others)
 
 

@@ -12,6 +12,8 @@ re-export, and counting them would make every re-exporting ``__init__`` a cycle.
 from __future__ import annotations
 
 import ast
+import dataclasses
+import sys
 import tomllib
 from pathlib import Path
 
@@ -61,22 +63,43 @@ def _known(name: str, known: set[str]) -> str | None:
     return None
 
 
+@dataclasses.dataclass(frozen=True)
+class Import:
+    """One imported name: ``target`` (a module of the package, else ``None``), ``name`` (as written, made
+    absolute), the line, and whether the statement sits inside a function (``local``)."""
+
+    target: str | None
+    name: str
+    line: int
+    local: bool
+
+
+def import_statements(module: str, source: str, known: set[str], *, is_package: bool) -> list[Import]:
+    """Every import in ``source``, module-level and function-local (``from __future__`` excepted)."""
+    found: list[Import] = []
+
+    def visit(node: ast.AST, local: bool) -> None:
+        for child in ast.iter_child_nodes(node):
+            inner = local or isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda))
+            if isinstance(child, ast.Import):
+                names = [alias.name for alias in child.names]
+            elif isinstance(child, ast.ImportFrom) and child.module != "__future__":
+                base = _resolve(module, is_package, child.level, child.module)
+                names = [f"{base}.{a.name}" if f"{base}.{a.name}" in known else base for a in child.names]
+            else:
+                names = []
+            for name in names:
+                found.append(Import(_known(name, known), name, child.lineno, local))
+            visit(child, inner)
+
+    visit(ast.parse(source), False)
+    return found
+
+
 def imports_of(module: str, source: str, known: set[str], *, is_package: bool) -> set[str]:
     """The package's modules that ``module`` imports anywhere in ``source`` (function-local imports included)."""
-    edges: set[str] = set()
-    for node in ast.walk(ast.parse(source)):
-        if isinstance(node, ast.Import):
-            targets = [alias.name for alias in node.names]
-        elif isinstance(node, ast.ImportFrom):
-            base = _resolve(module, is_package, node.level, node.module)
-            targets = [f"{base}.{alias.name}" if f"{base}.{alias.name}" in known else base for alias in node.names]
-        else:
-            continue
-        for target in targets:
-            hit = _known(target, known)
-            if hit is not None and hit != module:
-                edges.add(hit)
-    return edges
+    return {i.target for i in import_statements(module, source, known, is_package=is_package)
+            if i.target is not None and i.target != module}
 
 
 def import_graph(repo: Path = REPO) -> dict[str, set[str]]:
@@ -213,3 +236,100 @@ if __name__ == "__main__":  # pragma: no cover - a listing for whoever is untang
     for g in (import_graph(), layers(import_graph())):
         for c in cycles(g):
             print(" → ".join(cycle_path(g, c)), f"  ({len(c)} modules: {', '.join(c)})")
+
+
+#: modules `import verimono` must not load: the heavy ones (SciPy's statistics and optimizers, hypothesis,
+#: matplotlib, the QP back-ends: together about 1 s of the 1.2-1.5 s the import took) and the layers that
+#: pull them in; each is imported where it is used (the first order fit, the first check, ...)
+NOT_AT_IMPORT = ("scipy.stats", "scipy.optimize", "hypothesis", "matplotlib", "qpsolvers", "proxsuite",
+                 "verimono.checks", "verimono.strategies", "verimono.lcs", "verimono.qp", "verimono.report")
+
+
+def test_import_verimono_loads_only_the_core():
+    import subprocess
+    import sys
+
+    code = ("import sys, verimono; "
+            f"print(' '.join(m for m in {NOT_AT_IMPORT!r} if m in sys.modules)); "
+            "from verimono import check_stepper, check_assumptions, lcs, strategies; "  # still importable
+            "print(check_stepper.__module__, lcs.__name__, strategies.grids.__module__)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    loaded, names = out.splitlines()
+    assert loaded == "", f"`import verimono` loads {loaded}"
+    assert names == "verimono.checks.trajectory_laws verimono.lcs verimono.strategies.partitions"
+
+
+# -- function-local imports: only for what is optional or heavy ---------------------------------------------
+
+#: modules that must stay cheap to import and load the rest where it is used: the facade, the command line
+#: and the pytest plugin (which every pytest session loads)
+ENTRY_POINTS = frozenset({"verimono", "verimono.cli", "verimono.plugin"})
+
+
+def heavy_modules(repo: Path = REPO) -> dict[str, list[str]]:
+    """``{module: third-party modules besides NumPy that importing it loads}`` (module-level imports, its own
+    and transitively those of the package's modules it imports, parent packages included: importing
+    ``verimono.checks.orders`` runs ``verimono/checks/__init__.py``).  Empty: a light module."""
+    files = module_files(package_roots(repo))
+    known = set(files)
+    stmts = {m: import_statements(m, p.read_text(encoding="utf-8"), known, is_package=p.name == "__init__.py")
+             for m, p in files.items()}
+    light = set(sys.stdlib_module_names) | {"numpy"}
+
+    def closure(module: str, seen: set[str]) -> set[str]:
+        if module in seen:
+            return set()
+        seen.add(module)
+        parts = module.split(".")
+        out: set[str] = set()
+        for k in range(1, len(parts)):
+            if ".".join(parts[:k]) in stmts:
+                out |= closure(".".join(parts[:k]), seen)
+        for i in stmts[module]:
+            if i.local:
+                continue
+            if i.target is None:
+                out.add(i.name)
+            elif i.target != module:
+                out |= closure(i.target, seen)
+        return out
+
+    return {m: sorted(e for e in closure(m, set()) if e.split(".")[0] not in light) for m in files}
+
+
+def misplaced_local_imports(repo: Path = REPO) -> list[str]:
+    """Function-local imports of a light module of the package outside the entry points (``where → target``):
+    with the import graph acyclic such an import only hides an edge."""
+    files = module_files(package_roots(repo))
+    known = set(files)
+    heavy = heavy_modules(repo)
+    out = []
+    for module, path in files.items():
+        if module in ENTRY_POINTS:
+            continue
+        for i in import_statements(module, path.read_text(encoding="utf-8"), known,
+                                   is_package=path.name == "__init__.py"):
+            if i.local and i.target is not None and not heavy[i.target]:
+                out.append(f"{module}:{i.line} → {i.target}")
+    return sorted(set(out))
+
+
+def test_the_local_import_rule_is_seen_failing(tmp_path):
+    (tmp_path / "pyproject.toml").write_text('[tool.setuptools.package-dir]\n"verimono" = "pkg"\n')
+    (tmp_path / "pkg").mkdir()
+    (tmp_path / "pkg" / "__init__.py").write_text("")
+    (tmp_path / "pkg" / "light.py").write_text("import math\nimport numpy\n")
+    (tmp_path / "pkg" / "heavy.py").write_text("from .light import math\nimport hypothesis\n")
+    (tmp_path / "pkg" / "user.py").write_text("def f():\n    from . import heavy\n    from .light import numpy\n"
+                                               "    import cvxpy\n")
+    assert heavy_modules(tmp_path)["verimono.heavy"] == ["hypothesis"]
+    assert heavy_modules(tmp_path)["verimono.light"] == []
+    assert misplaced_local_imports(tmp_path) == ["verimono.user:3 → verimono.light"]
+
+
+def test_function_local_imports_are_for_optional_or_heavy_modules():
+    """A function-local import names a third-party module (optional: cvxpy, dask, matplotlib...; or heavy:
+    hypothesis, SciPy's optimizers) or a module of the package that loads one; a light module of the
+    package is imported at the top (the entry points excepted: they load everything where it is used)."""
+    found = misplaced_local_imports()
+    assert not found, "function-local imports of light modules (import them at the top):\n" + "\n".join(found)

@@ -241,3 +241,21 @@ def test_example_records_for_the_run_stage(monkeypatch):
                         lambda x, h, v1, v2: np.maximum(np.asarray(x, float) + h * max(v1, 0.0), -v2))
     bad = lcs_example.check_closed_form_resolvent(samples=50)
     assert bad.status == "failed" and {"x", "h", "v"} <= set(bad.counterexample)
+
+
+def test_batched_scheme_record_passes_and_fails_on_an_unchecked_kernel(monkeypatch):
+    """The Section 7 stage's batched record: 64 trajectories in one simulate equal the closed-form scheme; a
+    batch kernel that accepts every guess unchecked (seen failing) breaks it."""
+    rec = E.check_batched_scheme()
+    assert rec.status == "passed" and rec.worst <= 1.0
+    from verimono.lcs import kernel as K
+
+    orig = K.StepKernel._eval_T
+
+    def unchecked(self, *args):
+        Y, ok = orig(self, *args)
+        return Y, np.isfinite(Y).all(axis=0)
+
+    monkeypatch.setattr(K.StepKernel, "_eval_T", unchecked)
+    bad = E.check_batched_scheme()
+    assert bad.status == "failed" and bad.worst > 1e3 and {"row", "step"} <= set(bad.counterexample)

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import zoo
+import zoo_prox
 from verimono import Report, operator_from_resolvent
 from verimono.checks import LAWS, OPERATOR_CHECKS, check_operator, operator_checks, run_law
 from verimono.strategies import catalog
@@ -14,9 +15,14 @@ from verimono.strategies import catalog
 ZOO_CASES = [(member, law) for member, laws in zoo.BREAKS.items() for law in laws]
 
 
+#: the value laws are seen failing on the zoo of lawful prox bugs (tests/zoo_prox.py, tests/test_prox.py)
+VALUE_LAWS = {"prox_inequality", "prox_optimal", "prox_minimiser", "moreau_envelope"}
+
+
 def test_every_law_is_broken_by_some_zoo_member():
-    broken = {law for _, law in ZOO_CASES}
+    broken = {law for _, law in ZOO_CASES} | VALUE_LAWS
     assert broken == set(LAWS), set(LAWS) - broken
+    assert zoo_prox.LAWFUL
 
 
 @pytest.mark.parametrize("member,law", ZOO_CASES, ids=[f"{m}-{lw}" for m, lw in ZOO_CASES])
@@ -48,7 +54,8 @@ def test_no_law_fails_on_catalog_operator(op):
         report = check_operator(op, seed=seed, examples=6)
         assert isinstance(report, Report) and len(report) == len(LAWS)
         assert report.ok, "\n".join(str(r) for r in report.failures)
-        assert report.counts["skipped"] == 0, [str(r) for r in report if r.status == "skipped"]
+        skipped = {r.check for r in report if r.status == "skipped"}
+        assert skipped == VALUE_LAWS, skipped   # catalog operators do not provide value
 
 
 def test_unsupported_members_are_skipped_not_passed():
@@ -56,7 +63,7 @@ def test_unsupported_members_are_skipped_not_passed():
     report = check_operator(op, seed=0, examples=5)
     skipped = {r.check for r in report if r.status == "skipped"}
     assert skipped == {"resolvent_in_domain", "yosida_in_graph", "yosida_bounded_by_min_norm", "yosida_limit",
-                       "min_norm_in_graph", "min_norm_least"}
+                       "min_norm_in_graph", "min_norm_least"} | VALUE_LAWS
     assert all(r.message for r in report if r.status == "skipped")
     assert report.counts["passed"] == len(LAWS) - len(skipped)
 

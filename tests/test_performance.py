@@ -18,7 +18,8 @@ from verimono.stepping import solve
 #: per-block buffers exceed one trajectory, so the record would fail by construction)
 SMALL = performance.Sizes(per_step_steps=3000, per_step_rounds=3, ensemble_batch=300, ensemble_steps=10,
                           ensemble_rounds=2, lcs_steps=300, lcs_rounds=3,
-                          memory_steps=performance.SIZES["ci"].memory_steps)
+                          memory_steps=performance.SIZES["ci"].memory_steps, lcs_batch=100, lcs_batch_steps=50,
+                          lcs_batch_rounds=2)
 
 
 def slow_solve(problem, t):
@@ -35,7 +36,7 @@ def test_stage_records_names_and_statuses(monkeypatch):
     assert isinstance(rep, Report)
     names = [r.check for r in rep]
     assert names == ["performance_per_step"] * 9 + ["performance_ensemble"] * 3 + \
-        ["performance_lcs_step", "performance_memory"]
+        ["performance_lcs_step", "performance_lcs_batch", "performance_memory"]
     assert [r.subject for r in rep.by_check("performance_per_step")] == \
         [f"{k} n={n}" for k in ("t|x|", "box", "ball") for n in (1, 3, 10)]
     assert len({r.key for r in rep}) == len(rep)

@@ -66,6 +66,34 @@ def test_unique_limit_refines_past_meshes_coarser_than_the_problem():
     assert check_unique_limit(BREAKS["unique_limit"][0], p).status == FAILED
 
 
+def test_unique_limit_assumes_no_rate():
+    """x' ∈ −∂(c(t)|x|), c = 0.1 t^(−0.9) (σ ∈ L¹ unbounded; exact 2 − t^0.1): the scheme converges like
+    0.943 h^0.1, and the uniform and graded partitions drift apart until K ≈ 1000.  The old law (distance
+    must halve per 16-fold refinement, an assumed rate 1/4) failed here; the Cauchy criterion with each
+    sequence's own tail passes, while the error against the exact solution falls."""
+    from verimono.reference.subdifferential import slow_rate
+    from verimono.checks.trajectory_laws import check_unique_limit
+    from verimono import uniform_grid as ug
+
+    p = slow_rate()
+    rec = check_unique_limit(solve, p)
+    assert rec.status == PASSED, str(rec)
+    D = rec.details["distances"]
+    assert D[0] < D[1] < D[2], D                                    # the partitions do drift apart
+    assert D[-1] > 0.5 * max(D[:-1])                                # what the assumed rate rejected
+    r = rec.details["ratios"]
+    assert 4 ** -0.25 < r["uniform"] < 1.0, r                       # 4^-0.1 = 0.87: a rate near 0.1
+    errs = [float(np.max(np.abs(solve(p, ug(1.0, steps=K)).x[:, 0] - (2.0 - ug(1.0, steps=K) ** 0.1))))
+            for K in (10, 40, 160)]
+    assert errs[0] > errs[1] > errs[2] and abs(errs[2] / (0.943 * (1 / 160) ** 0.1) - 1) < 0.05, errs
+    # the zoo's member with different limits per partition kind is still caught, on this problem too
+    bad = check_unique_limit(BREAKS["unique_limit"][0], get(BREAKS["unique_limit"][1]))
+    assert bad.status == FAILED and "different limits" in bad.message, str(bad)
+    assert bad.counterexample["tails"] and bad.counterexample["pair"]
+    # two levels give one difference per kind: a third is added (the tail needs a ratio)
+    assert check_unique_limit(solve, get("t|x| (n=1)"), levels=(10, 40)).details["levels"] == [10, 40, 160]
+
+
 def test_contraction_runs_its_starts_in_one_batch_and_falls_back_when_a_batch_is_wrong():
     """solve declares batches: x0 and the perturbed starts run as one (B, n) solve.  A user's resolvent that
     takes the norm of the whole batch instead of each row changes the batch's first row, so the check
@@ -211,3 +239,17 @@ def test_contraction_admits_an_implicit_lipschitz_term():
     assert check_contraction(implicit_f, p).status == PASSED
     assert check_contraction(solve, p).status == PASSED
     assert check_contraction(amplifier, p).status == FAILED
+
+
+def test_yb_bounds_skip_where_f0_overflows_at_the_edge_of_the_domain():
+    """x0 = 7e-304 for x' = c/x: |F^0(0, x0)| = c/x0 overflows, so lem:bndSeqYB's α is infinite — the
+    bounds say nothing there and the laws are skipped with the reason (found by a dev-profile search,
+    which saw bounds_yb fail with ψ = nan and psi_interpolation raise)."""
+    import verimono as vm
+    from verimono.checks.trajectory_laws import check_bounds_yb, check_psi_interpolation
+
+    p = vm.Problem(vm.LogBarrier(1.0), [7e-304], 1.0, theta=lambda s: 0.0, name="c/x at the edge")
+    for check in (check_bounds_yb, check_psi_interpolation):
+        rec = check(vm.solve, p)
+        assert rec.status == "skipped", rec
+    assert "not finite" in check_bounds_yb(vm.solve, p).message

@@ -5,30 +5,57 @@ proximal scheme of Camlibel, Iannelli and Tanwani and checked against the laws a
 Data flow one way: Problem → stepper → Trajectory → checks → results → report / gate.
 """
 
-from .errors import (BadTarget, IncompatibleBaseline, InfeasibleStep, InvalidClaim, InvalidGrid, InvalidProblem,
+from .errors import (BadTarget, BatchStepError, IncompatibleBaseline, InfeasibleStep, InvalidClaim, InvalidGrid, InvalidProblem,
                      MissingOptionalDependency, NotMonotone, OutsideDomain, SchemaError, SolverFailure,
                      StageUnavailable, UnknownProfile, UnknownStage, VerimonoError)
 from .grids import graded_grid, random_grid, refine, uniform_grid, validate_grid
 from .operators import (L1Subdifferential, Linear, LogBarrier, NormalCone, NormSubdifferential, Operator,
                         Shifted, operator_from_resolvent)
+from .prox import ProxOperator, ProxOutputError, operator_from_prox
 from .problem import Order, Problem
 from .claims import Claim, Stepper
 from .results import CheckResult, Report
 from .stepping import Trajectory, solve, stream
 from .pseudo_distance import pseudo_distance_lower_bound
-from .checks import check_operator, check_stepper, operator_checks
-from .checks.assumptions import check_assumptions
 from .convergence import ConvergenceStudy, ErrorAccumulator, convergence_study
-from . import lcs, sets, strategies
+from . import sets
 from .report import notebook as _notebook  # noqa: F401  (registers the notebook renderers: verimono.display)
+
+
+def __getattr__(name: str):
+    """Names loaded on first use (``from verimono import check_stepper`` works as before): the checks and
+    strategies import hypothesis, the LCS tools SciPy's optimizers, so ``import verimono`` does not."""
+    if name in ("check_operator", "check_stepper", "operator_checks"):
+        from .checks import check_operator, check_stepper, operator_checks
+
+        value = {"check_operator": check_operator, "check_stepper": check_stepper,
+                 "operator_checks": operator_checks}[name]
+    elif name == "check_assumptions":
+        from .checks.assumptions import check_assumptions as value
+    elif name == "checks":  # `import a.b as c` imports the submodule before reading it: no recursion here
+        import verimono.checks as value
+    elif name == "lcs":
+        import verimono.lcs as value
+    elif name == "strategies":
+        import verimono.strategies as value
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
+
 
 __version__ = "0.1.0"
 
 __all__ = [
     "VerimonoError", "InvalidProblem", "InvalidGrid", "OutsideDomain", "NotMonotone", "InfeasibleStep",
-    "SolverFailure", "UnknownProfile", "UnknownStage", "StageUnavailable", "BadTarget", "SchemaError",
+    "BatchStepError", "SolverFailure", "UnknownProfile", "UnknownStage", "StageUnavailable", "BadTarget", "SchemaError",
     "IncompatibleBaseline", "MissingOptionalDependency", "InvalidClaim",
-    "Operator", "operator_from_resolvent", "Linear", "NormSubdifferential", "L1Subdifferential",
+    "Operator", "operator_from_resolvent", "operator_from_prox", "ProxOperator", "ProxOutputError", "Linear",
+    "NormSubdifferential", "L1Subdifferential",
     "NormalCone", "Shifted", "LogBarrier", "sets",
     "Problem", "Order", "Stepper", "Claim", "Trajectory", "solve", "stream", "ErrorAccumulator",
     "uniform_grid", "graded_grid", "random_grid", "refine", "validate_grid",

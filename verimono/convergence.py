@@ -29,21 +29,19 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-import multiprocessing
 import os
 import pickle
 import sys
 import time
-from concurrent.futures import ProcessPoolExecutor
 from typing import Any, Callable, Sequence
 
 import numpy as np
-from scipy import stats
 
 from ._jsonable import to_jsonable
 from .errors import InvalidProblem
 from .grids import uniform_grid, validate_grid
 from .problem import Order, Problem
+from .stepping import solve, stream
 from .tolerances import EPS
 
 NORMS = ("sup", "l2", "final")
@@ -97,6 +95,8 @@ def fit_order(h: Sequence[float], e: Sequence[float], floor: float = 0.0) -> Ord
     local = (np.diff(le) / np.diff(lh)).tolist() if len(lh) > 1 else []
     if len(lh) < 2:
         return OrderFit(math.nan, math.nan, math.nan, used, dropped, local, True)
+    from scipy import stats  # heavy (≈ 0.9 s here): loaded by the first fit, not by `import verimono`
+
     res = stats.linregress(lh, le)
     if len(lh) > 2:
         half = stats.t.ppf(0.975, len(lh) - 2) * res.stderr
@@ -369,9 +369,7 @@ def _job(stepper, problem, grid, want, ref=None):
     """
     stepper, problem = _unwrap(stepper), _unwrap(problem)
     sink = ErrorAccumulator(problem, ref) if want == "errors" else Sampler(ref)
-    if stepper is _solve():
-        from .stepping import stream
-
+    if stepper is solve:
         spent = 0.0
         it = stream(problem, grid)
         while True:
@@ -388,11 +386,6 @@ def _job(stepper, problem, grid, want, ref=None):
     if want == "errors":
         return sink.errors(), sink.scale, spent
     return sink.values, None, spent
-
-
-def _solve():
-    from .stepping import solve
-    return solve
 
 
 def _cells_finer_than(grids, T: float) -> int:
@@ -417,6 +410,9 @@ def _run_jobs(stepper, problem, jobs, executor):
         return [_job(stepper, problem, *job) for job in jobs]
     order = sorted(range(len(jobs)), key=lambda i: -len(jobs[i][0]))
     if executor == "process":
+        import multiprocessing  # with the process pool: only for a parallel study, not `import verimono`
+        from concurrent.futures import ProcessPoolExecutor
+
         workers = max(1, min(len(jobs), os.cpu_count() or 1))
         if "fork" in multiprocessing.get_all_start_methods() and sys.platform.startswith("linux"):
             # forked workers inherit the registry: closures and lambdas need no pickling

@@ -81,8 +81,34 @@ class MissingOptionalDependency(VerimonoError, ImportError):
     """An optional extra (e.g. cvxpy/clarabel for the KYP SDP) is not installed."""
 
 
+class BatchStepError(VerimonoError, ArithmeticError):
+    """Some rows of a batched ``LinearRelationSystem.simulate`` failed; the others ran to the end.
+
+    ``failures``: the ``verimono.lcs.RowFailure`` (row, step, t, error) of each failed row;
+    ``trajectory``: every row's results (``x (K+1, B, n)``, ``extras["z"], extras["w"] (K, B, m)``) with NaN
+    after a row's failure; ``valid`` ``(K+1, B)``: which states were computed."""
+
+    def __init__(self, failures: list, trajectory, valid) -> None:
+        self.failures, self.trajectory, self.valid = failures, trajectory, valid
+        shown = "; ".join(str(f) for f in failures[:5])
+        more = f"; and {len(failures) - 5} more" if len(failures) > 5 else ""
+        super().__init__(f"{len(failures)} of {valid.shape[1]} rows failed (the others ran to the end; "
+                         f"results in .trajectory, .valid): {shown}{more}")
+
+    @property
+    def rows(self) -> list[int]:
+        return [f.row for f in self.failures]
+
+
+class ProxOutputError(VerimonoError, TypeError):
+    """A prox (or its ``value``) returned something that is not one array of the operator's shape (a tuple,
+    a list of arrays, a non-scalar value): verimono does not guess which part is the point."""
+
+
 __all__ = [
+    "ProxOutputError",
     "VerimonoError",
+    "BatchStepError",
     "InvalidProblem",
     "InvalidGrid",
     "OutsideDomain",

@@ -29,6 +29,7 @@ import numpy as np
 
 from ._kernels import _TINY, _mx, _norm, _sqrt, batch_column, dot_rows
 from ._params import as_param
+from ._values import checked_value, subgradient_contains
 from .errors import InvalidProblem, NotMonotone, OutsideDomain
 from .tolerances import tolerance
 
@@ -72,8 +73,13 @@ class Operator:
         ``(x', y') ∈ graph F(t,·)`` lies within ``tol`` of ``(x, y)`` in each coordinate."""
         raise NotImplementedError(f"{self.name} does not provide a membership test")
 
+    def value(self, x: np.ndarray, t: float = 0.0) -> float:
+        """``g(t, x)`` when ``F(t,·) = ∂g(t,·)`` is a subdifferential and ``g`` is known (``+inf`` outside
+        ``dom g``); enables the value laws of :mod:`verimono.checks.prox_laws`."""
+        raise NotImplementedError(f"{self.name} does not provide the function value g")
+
     def provides(self, member: str) -> bool:
-        """Whether this operator provides ``member`` (``"min_norm"``, ``"project_domain"``, ``"contains"``):
+        """Whether this operator provides ``member`` (``"min_norm"``, ``"project_domain"``, ``"contains"``, ``"value"``):
         the laws that need a member it lacks are skipped before they run, with that reason."""
         own = getattr(type(self), member, None)
         return own is not None and own is not getattr(Operator, member, None)
@@ -158,9 +164,11 @@ def _provides(op: Any, member: str) -> bool:
 
 
 class _FromResolvent(Operator):
-    def __init__(self, resolvent, dim, min_norm, project_domain, contains, name):
+    def __init__(self, resolvent, dim, min_norm, project_domain, contains, name, value=None):
         super().__init__(dim, name or getattr(resolvent, "__name__", "user operator"))
         self._resolvent = resolvent
+        self._value = value
+        self._value_t = value is not None and _accepts(value, 2)
         self._min_norm = min_norm
         self._project_domain = project_domain
         self._contains = contains
@@ -170,7 +178,14 @@ class _FromResolvent(Operator):
         return np.asarray(self._resolvent(x, lam, t), dtype=float)
 
     def provides(self, member):
+        if member == "contains" and self._value is not None:
+            return True   # the value-based membership evidence (verimono.prox.subgradient_contains)
         return getattr(self, f"_{member}", None) is not None
+
+    def value(self, x, t=0.0):
+        if self._value is None:
+            return super().value(x, t)
+        return checked_value(self, self._value(x, t) if self._value_t else self._value(x))
 
     def min_norm(self, x, t=0.0):
         if self._min_norm is None:
@@ -183,6 +198,8 @@ class _FromResolvent(Operator):
         return np.asarray(self._project_domain(x, t), dtype=float)
 
     def contains(self, x, y, t=0.0, tol=None):
+        if self._contains is None and self._value is not None:
+            return subgradient_contains(self, x, y, t, tol)
         if self._contains is None:
             return super().contains(x, y, t, tol)
         if self._contains_takes_tol:
@@ -202,15 +219,20 @@ def _accepts(fn: Callable, n: int) -> bool:
 
 def operator_from_resolvent(resolvent: Callable[[np.ndarray, float, float], Any], dim: int, *,
                             min_norm: Callable | None = None, project_domain: Callable | None = None,
-                            contains: Callable | None = None, name: str | None = None) -> Operator:
+                            contains: Callable | None = None, name: str | None = None,
+                            value: Callable | None = None) -> Operator:
     """Wrap a user's ``resolvent(x, lam, t)`` as an :class:`Operator`.
 
-    Optional callables: ``min_norm(x, t)``, ``project_domain(x, t)``, ``contains(x, y, t[, tol])``.
+    Optional callables: ``min_norm(x, t)``, ``project_domain(x, t)``, ``contains(x, y, t[, tol])``,
+    ``value(x[, t])`` — the function ``g`` when ``F = ∂g`` (enables the value laws, and, without
+    ``contains``, the membership evidence of :func:`verimono.prox.subgradient_contains`).
     Members not given raise :class:`NotImplementedError`, so checks needing them are skipped.
     """
     if not callable(resolvent):
         raise InvalidProblem("resolvent must be callable as resolvent(x, lam, t)")
-    return _FromResolvent(resolvent, dim, min_norm, project_domain, contains, name)
+    if value is not None and not callable(value):
+        raise InvalidProblem("value must be callable as value(x) or value(x, t)")
+    return _FromResolvent(resolvent, dim, min_norm, project_domain, contains, name, value)
 
 
 class Linear(Operator):

@@ -35,6 +35,11 @@ Layout (schema ``verimono.results``, version ``SCHEMA_VERSION`` = ``MAJOR.MINOR`
       "trajectories": [{"problem", "stepper", "h", "t", "x", "exact"}, ...]   # samples for plots
     }
 
+A record's ``details`` are free-form; keys that producers hand to consumers: ``study`` (a convergence-order
+record's study, read back as a :class:`ConvergenceStudy`: ``CheckResult.study``), ``stage`` and ``reference``
+(set by the run), ``reproduce``, ``reproduce_python``, ``example`` (what the report's reproduction shows),
+``error`` and ``timing_ratio`` (compared by the gate).
+
 ``environment`` holds ``versions`` (Python and the distributions in ``VERSIONED``, ``null`` when absent;
 the optional solvers in ``OPTIONAL`` as ``"not installed"``), ``blas`` (the BLAS libraries NumPy and SciPy
 loaded, from ``threadpoolctl``) and ``machine``.  A pytest session (``--verimono-report``) writes
@@ -60,7 +65,6 @@ import platform
 import sys
 from collections import Counter
 from contextlib import contextmanager
-from importlib import metadata
 from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator
 
@@ -254,6 +258,8 @@ OPTIONAL = ("cvxpy", "clarabel")
 
 
 def _version(dist: str) -> str | None:
+    from importlib import metadata  # stdlib, but slow to import: only when a document is written
+
     try:
         return metadata.version(dist)
     except metadata.PackageNotFoundError:

@@ -32,7 +32,9 @@ import numpy as np
 
 from .errors import StageUnavailable, UnknownStage, VerimonoError
 from .profiles import Profile
-from .results import FAILED, PASSED, SKIPPED, XFAIL, CheckResult, Report
+from .grids import uniform_grid
+from .results import FAILED, PASSED, SKIPPED, XFAIL, CheckResult, Report, to_jsonable
+from .stepping import solve
 
 #: how many points of a trajectory the report keeps for its plot (enough for a smooth curve)
 TRAJECTORY_SAMPLES = 400
@@ -212,8 +214,6 @@ def _name(obj: Any) -> str:
 def sample_trajectory(stepper: Callable, problem: Any, h: float | None = None) -> dict[str, Any]:
     """A plot sample: ``stepper`` on a uniform grid of step ``h`` (default: the problem's coarsest
     recommended step) next to the exact solution, thinned to :data:`TRAJECTORY_SAMPLES` points."""
-    from .grids import uniform_grid
-
     h = h or (max(problem.steps) if problem.steps else problem.T / 50)
     t = uniform_grid(problem.T, h)
     x = np.asarray(stepper(problem, t), dtype=float)
@@ -223,8 +223,6 @@ def sample_trajectory(stepper: Callable, problem: Any, h: float | None = None) -
     if problem.exact is not None:
         exact = np.array([np.asarray(problem.exact(s), dtype=float) for s in fine])
     first = (lambda a: a[:, 0] if a.ndim == 3 else a)  # a batch: plot its first member
-    from .results import to_jsonable
-
     return to_jsonable({"problem": problem.name, "stepper": _name(stepper), "h": float(h),
                         "t": t[keep], "x": first(x)[keep],
                         "t_exact": fine if exact is not None else None,
@@ -259,9 +257,7 @@ def convergence_stage(profile: Profile, context: RunContext) -> Report:
     one unit per reference."""
     from .executors import Unit
 
-    stepper = context.stepper
-    if stepper is None:
-        from .stepping import solve as stepper
+    stepper = solve if context.stepper is None else context.stepper
     units = [Unit("convergence", p.name, _convergence_unit, (stepper, p)) for p in context.catalog()]
     return _merged(context.run_units(profile, units))
 
@@ -346,9 +342,7 @@ def trajectory_laws_stage(profile: Profile, context: RunContext) -> Report:
     """The trajectory laws of the stepper under test on every reference (and, without a user-given
     problem list, on ``profile.generated_subjects`` sampled problems)."""
     mod = optional_module("verimono.checks.trajectory_laws")
-    stepper = context.stepper
-    if stepper is None:
-        from .stepping import solve as stepper
+    stepper = solve if context.stepper is None else context.stepper
     seed = context.seed_for(profile)
     checks = list(mod.stepper_checks(stepper, context.problems, seed=0 if seed is None else seed,
                                      generated=profile.generated_subjects, orders=False))
@@ -417,9 +411,7 @@ def section7_stage(profile: Profile, context: RunContext) -> Report:
     lcs = optional_module("verimono.lcs")
     from .checks.orders import check_convergence_order
 
-    stepper = context.stepper
-    if stepper is None:
-        from .stepping import solve as stepper
+    stepper = solve if context.stepper is None else context.stepper
     report = Report()
     in_catalog = {p.name for p in context.catalog()}  # already studied by the convergence stage
     problems = [p for p in (example.ramp_problem(), example.sine_problem()) if p.name not in in_catalog]
@@ -431,7 +423,16 @@ def section7_stage(profile: Profile, context: RunContext) -> Report:
         report.trajectories.append(sample_trajectory(stepper, p))
     seed = context.seed_for(profile)
     report.add(example.check_closed_form_resolvent(seed=0 if seed is None else seed))
+    if hasattr(example, "check_batched_scheme"):   # a batch of trajectories in one simulate (issue 15)
+        report.add(example.check_batched_scheme(seed=0 if seed is None else seed))
     report.add(example.check_pseudo_distance_unbounded())
+    # def:dis against the exact d_H of catalog sets, and the Picard step of Section 6 (issue 13)
+    from .checks.picard import check_picard
+    from .checks.pseudo_distance import check_pseudo_distance
+    report.add(check_pseudo_distance(seed=0 if seed is None else seed))
+    for p in context.catalog():
+        if p.f is not None and p.lipschitz is not None:
+            report.add(check_picard(stepper, p))
     for label, v in (("v = (−t, 0)", lambda t: np.array([-t, 0.0])),
                      ("v = (sin t, 0)", lambda t: np.array([np.sin(t), 0.0]))):
         rep = lcs.check_hypotheses(example.example_system(v), 2.0, seed=0 if seed is None else seed)

@@ -50,7 +50,11 @@ from typing import Any, Callable, Iterable, Mapping
 
 import pytest
 
-from .results import FAILED, SKIPPED, CheckResult, Report
+from .profiles import active_profile
+from .profiles import load_hypothesis_profile as _load
+from .problem import Problem
+from .profiles import register_hypothesis_profiles as _register
+from .results import FAILED, SKIPPED, CheckResult, Report, to_jsonable
 
 try:  # the listener hook of the results module (present when a report plugin is installed)
     from .results import emit as _emit
@@ -64,16 +68,12 @@ except ImportError:  # pragma: no cover - older results module
 def register_hypothesis_profiles() -> None:
     """Register the hypothesis profiles ``dev``, ``ci`` (derandomized, no deadline, no database) and
     ``thorough`` — one definition, in :mod:`verimono.profiles`, shared with ``verimono run``."""
-    from .profiles import register_hypothesis_profiles as _register
-
     _register()
 
 
 def load_hypothesis_profile(name: str | None = None) -> str:
     """Register the profiles and load ``name`` (default: ``$HYPOTHESIS_PROFILE``, else ``ci`` when ``$CI``
     is set, else ``dev``); returns the name loaded."""
-    from .profiles import load_hypothesis_profile as _load
-
     return _load(name)
 
 
@@ -86,8 +86,6 @@ def is_operator(subject: Any) -> bool:
 
 def is_problem(subject: Any) -> bool:
     """Problems (:class:`verimono.Problem`) get the battery of assumption evidence."""
-    from .problem import Problem
-
     return isinstance(subject, Problem)
 
 
@@ -160,8 +158,6 @@ def describe(record: CheckResult) -> str:
     """The record's line plus its counterexample and seed: what a failing test prints."""
     lines = [str(record)]
     if record.counterexample:
-        from .results import to_jsonable
-
         cx = to_jsonable(record.counterexample)
         lines.append("counterexample: " + ", ".join(f"{k}={_short(v)}" for k, v in cx.items()))
     if record.seed is not None:
@@ -227,8 +223,6 @@ def parametrize_with_checks(subjects: Iterable[Any], expected_failed_checks: Map
     if problems is not None:
         problems = list(problems)
     if seed is None:
-        from .profiles import active_profile
-
         seed = 0 if active_profile() == "ci" else None
     cases, used, seen_ids = [], set(), Counter()
     all_keys: set[str] = set()

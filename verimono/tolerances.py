@@ -39,6 +39,13 @@ def tolerance(*scales: float, rtol: float = RTOL) -> float:
 #: rescued by it and is rejected by the residual check instead.
 POLISH_RTOL = 1e-6
 
+#: largest condition number of a principal submatrix ``M_II`` whose factorisation the LCS stepping kernel
+#: (:mod:`verimono.lcs.kernel`) caches as an affine map of the state: the map's entries then carry a relative
+#: error ``≤ cond·EPS = RTOL/1000``, a thousandth of the margin ``RTOL`` its sign checks demand, so a candidate that
+#: passes them is strictly complementary in exact arithmetic too (worse-conditioned patterns are solved
+#: step by step by the verified solver instead)
+ACTIVE_SET_COND = 1e-3 * RTOL / EPS
+
 # -- trajectory laws and assumption evidence (verimono.checks.trajectory_laws / .assumptions) ----------
 
 
@@ -52,13 +59,24 @@ def quotient_tolerance(h: float, *scales: float, rtol: float = RTOL) -> float:
     return tolerance(*scales, rtol=rtol) / float(h)
 
 
-#: the distance between discrete solutions on two partitions of mesh ``|Δ|`` must shrink at least by
-#: this factor when ``|Δ|`` shrinks 16-fold (i.e. observed order ≥ 1/4, half the worst known rate 1/2 of
-#: the proximal scheme for ``x0 ∈ cl dom F``; a scheme converging to *different* limits on different
-#: partitions keeps an O(1) distance and fails by a factor ~2)
-LIMIT_SHRINK = 0.5
+#: ``unique_limit`` assumes no rate (the paper gives none; ``c = 0.1 t^{-0.9}`` converges like ``h^{0.1}``):
+#: the distance of a refinement sequence to its limit is estimated from its own last differences as a
+#: geometric tail ``c r/(1 - r)`` (exact for errors ``C h^p`` on 4-fold refinements), times this factor
+#: because the error constant still varies from level to level where the solution has a kink (the nodes
+#: fall differently around it): the tail was 2.26 times too small at the extinction time of x' ∈ −∂(2|x|)
+#: from 1/32 (random partition, K = 2560), and 1.3–2.4 times on the moving half-space at t = π/2 (seeds
+#: 1–6).  A stepper whose partitions converge to different limits keeps an O(1) distance while its tails
+#: shrink at its own rate: mean_step stays caught by a factor 2.15 (x' = c/x) to 2.6 (t|x|, n = 3)
+LIMIT_TAIL_SAFETY = 4.0
+#: the ratio of successive differences used in that tail is at least this (order 1 on 4-fold refinements):
+#: the implicit Euler scheme is first order, and a faster fall between the coarse default levels (K = 10, 40:
+#: meshes 0.63 on the moving half-space, ratios 0.02–0.08) is pre-asymptotic — extrapolating it
+#: underestimated the tails 4-fold there (a false alarm on random-partition seeds 1 and 2).  A rate floor,
+#: not a rate assumption: slower sequences keep their own, larger ratio
+LIMIT_RATIO_FLOOR = 0.25
 #: further 4-fold refinements (up to 64 times the finest of the default levels) granted to a problem whose
-#: own time scale is finer than the default meshes before the unique-limit law is judged: a generated
+#: own time scale is finer than the default meshes (while some kind's differences still grow, or a distance
+#: lies before the tails' first cells) before the unique-limit law is judged: a generated
 #: sweeping process in a ball of radius 0.002 driven by a unit input is pre-asymptotic until |Δ| < 0.002
 LIMIT_EXTRA_LEVELS = 3
 #: a sampled ratio (``|F^0(t,x)|/(1+|x|)``, a Yosida increment per unit time) that grows by more than
@@ -90,3 +108,10 @@ SDP_RTOL = 1e-6
 #: ``max_j D(K_j) (K_j/K_m)^p`` from the coarser levels: the constant of ``C h^p`` is unknown and drifts
 #: by O(h) between levels; a distance that does not vanish (a constant offset) exceeds any fixed factor
 DOMAIN_ORDER_SLACK = 2.0
+
+#: ``pseudo_distance_hausdorff``: a sampled lower bound of ``dis(N_C1, N_C2) = d_H(C1, C2)`` must come within
+#: this factor of ``d_H`` on the catalog pairs (:mod:`verimono.checks.pseudo_distance`).  With the boundary
+#: points of both sets and projected-ascent steps towards their farthest points among the samples, the
+#: bound misses ``d_H`` only by the ascent's last step and by ``1/(1 + |y|)`` with ``|y| ≈ 1e6``: measured
+#: 0.99927 … 0.9999998 of ``d_H`` (seeds 0–19, 32 directions); an estimator half as large fails by 2
+PSEUDO_DISTANCE_FACTOR = 1.01

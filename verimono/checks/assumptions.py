@@ -14,10 +14,19 @@ points without knowing the domain.  One record per assumption:
   differences (geometric tail), and a limit whose distance from ``J_λ(t) p`` stays above tolerance after
   subtracting the tail disproves (A2).  (The Minty residual of the graph point ``(J_λ(t+δ)p, Y_λ(t+δ)p)``
   with respect to ``graph F(t)`` is exactly ``√2 |J_λ(t+δ)p - J_λ(t)p|``.)  A sequence that has not
-  settled is no evidence either way and is counted.
+  settled is no evidence either way and is counted.  Between the sample times, the jumps of
+  ``t ↦ J_λ(t) p`` are searched adaptively (:mod:`verimono.checks.jumps`, the bisection of ``lcs.v_ac``)
+  down to adjacent floats ``a < b``; the jump time is the one with the shorter decimal (``t <= 0.45``
+  switches right after ``0.45``), and the right-limit test runs there: a jump whose time carries the left
+  value fails (A2), a right-continuous one passes.  (A2) is *not* implied by (A3) for subdifferentials,
+  whatever Lemma ``lem:A3ImpliesA2`` says: ``c(t)|x|`` with ``c = 1`` on ``[0, ½]``, 2 after, has a fixed
+  domain and fails (A2) at ½ (the proof needs ``g`` right-continuous in ``t``).
 * ``assumption_A3`` — ``D(s,t) = max_z dist(z, dom F(t))`` over sampled ``z ∈ dom F(s)`` (``project_domain``);
   the least nondecreasing ``φ̂`` with ``φ̂(t) - φ̂(s) ≥ D(s,t)`` on the sampled times is reported.  A stated
-  ``problem.phi`` below a sample disproves it.
+  ``problem.phi`` below a sample disproves it.  With or without a stated φ, a jump of φ̂ disproves (A3)
+  (φ must be absolutely continuous): the jumps of the projections ``t ↦ proj_{dom F(t)} p`` are searched
+  adaptively as for (A2), and one across which ``D(a, b)`` stays above tolerance (stalled) fails, with
+  its time and size.
 * ``assumption_LG`` — ``σ̂(t) = max |F^0(t,z)|/(1 + |z|)``; a stated ``problem.sigma`` below a sample is
   disproved; without one, growth of the ratio by more than ``GROWTH_FLAG`` as ``λ`` (and with it ``z``'s
   distance to the boundary of the domain) shrinks 1000-fold is reported as evidence that (LG) fails.
@@ -42,7 +51,8 @@ from ..operators import resolvent_rows
 from ..problem import Problem
 from ..results import FAILED, PASSED, SKIPPED, XFAIL, CheckResult, Report
 from .core import law as _declare, laws_of, run as _run
-from ..tolerances import GROWTH_FLAG, RTOL, quotient_tolerance, tolerance
+from ..tolerances import GROWTH_FLAG, RTOL, STALL_RATIO, STALL_WINDOW, quotient_tolerance, tolerance
+from .jumps import find_jumps, jump_time
 
 EVIDENCE = "evidence from samples, not a proof"
 #: (A2): right limits t + δ_k, δ_k = (T - t) A2_RATIO^k for k = 0, ..., A2_LEVELS (down to 1.5e-5 (T - t))
@@ -149,34 +159,70 @@ def _limit_gap(q: np.ndarray, target: np.ndarray) -> tuple[float, float]:
     return float(np.linalg.norm(q[-1] - target)), tail
 
 
+def _right_limit(S: _Samples, t: float, lam: float, P: np.ndarray | None = None):
+    """``(worst ratio, counterexample, sequences, unsettled)`` of the right-limit test at ``t``: the
+    sequences ``J_λ(t + δ_k) p`` against ``J_λ(t) p`` (module docstring)."""
+    P = S.points if P is None else P
+    deltas = (S.T - t) * A2_RATIO ** np.arange(A2_LEVELS + 1)
+    Q = np.stack([resolvent_rows(S.op, P, lam, t + d) for d in deltas], axis=1)   # (P, D, n)
+    AT = resolvent_rows(S.op, P, lam, t)
+    worst, counter, sequences, unsettled = 0.0, None, 0, 0
+    for p, q, at_t in zip(P, Q, AT):
+        gap, tail = _limit_gap(q, at_t)
+        sequences += 1
+        if not np.isfinite(tail):
+            unsettled += 1
+            continue
+        ratio = max(gap - tail, 0.0) / tolerance(p, q[-1], at_t)
+        if ratio > worst:
+            worst, counter = ratio, {"t": t, "lam": lam, "p": p, "delta": deltas[-1], "limit": q[-1],
+                                     "resolvent_at_t": at_t, "gap": gap, "tail": tail}
+    return worst, counter, sequences, unsettled
+
+
 def _a2(S: _Samples) -> CheckResult:
-    op, T = S.op, S.T
+    """Right limits at the sampled times, then at every jump of ``t ↦ J_λ(t) p`` found between them
+    (:func:`verimono.checks.jumps.find_jumps`): a jump bracketed by adjacent floats ``a < b`` happens at
+    :func:`~verimono.checks.jumps.jump_time`; if that is ``a`` (``J_λ(a) p`` is the left value, the right
+    limit the other one) the right-limit test there fails, if ``b`` the jump is right-continuous and (A2)
+    holds there; neither (no shorter decimal) is counted as undecided."""
+    T = S.T
     worst, counter, sequences, unsettled = 0.0, None, 0, 0
     for t in S.times[:-1]:
-        t = float(t)
-        deltas = (T - t) * A2_RATIO ** np.arange(A2_LEVELS + 1)
         for lam in (rel * T for rel in A2_LAMBDAS):
-            Q = np.stack([resolvent_rows(op, S.points, lam, t + d) for d in deltas], axis=1)   # (P, D, n)
-            AT = resolvent_rows(op, S.points, lam, t)
-            for p, q, at_t in zip(S.points, Q, AT):
-                gap, tail = _limit_gap(q, at_t)
-                sequences += 1
-                if not np.isfinite(tail):
-                    unsettled += 1
-                    continue
-                tol = tolerance(p, q[-1], at_t)
-                ratio = max(gap - tail, 0.0) / tol
-                if ratio > worst:
-                    worst, counter = ratio, {"t": t, "lam": lam, "p": p, "delta": deltas[-1], "limit": q[-1],
-                                             "resolvent_at_t": at_t, "gap": gap, "tail": tail}
+            w, c, n, u = _right_limit(S, float(t), lam)
+            sequences, unsettled = sequences + n, unsettled + u
+            if w > worst:
+                worst, counter = w, c
+    lam = A2_LAMBDAS[0] * T
+    jumps, searched = find_jumps(lambda t: resolvent_rows(S.op, S.points, lam, t), T)
+    found = []
+    for j in jumps:
+        tj = jump_time(j)
+        entry = {"bracket": [j.a, j.b], "size": j.size, "t": tj}
+        if tj is None:
+            entry["side"] = "undecided (no shorter decimal at either end of the bracket)"
+        elif tj >= T:
+            entry["side"] = "at T (no right limit)"
+        else:
+            entry["side"] = "left value at t (jump right after t)" if tj == j.a else "right-continuous"
+            w, c, _, _ = _right_limit(S, tj, lam)
+            if w > worst:
+                worst, counter = w, dict(c, found_by="jump search", jump=j.size, bracket=[j.a, j.b])
+        found.append(entry)
     return _verdict(
-        "assumption_A2", S, worst, counter, {"evidence": EVIDENCE, "sequences": sequences, "unsettled": unsettled},
+        "assumption_A2", S, worst, counter,
+        {"evidence": EVIDENCE, "sequences": sequences, "unsettled": unsettled, "jumps": found,
+         "jump_search": searched},
         lambda c: (f"J_λ(t+δ) p → {np.array2string(c['limit'], precision=4)} as δ ↓ 0 but J_λ(t) p = "
                    f"{np.array2string(c['resolvent_at_t'], precision=4)} (gap {c['gap']:.3g}, tail ≤ "
-                   f"{c['tail']:.3g}; t = {c['t']:.4g}, λ = {c['lam']:.3g}): t ↦ graph F(t,·) is not outer "
-                   "semicontinuous from the right"),
+                   f"{c['tail']:.3g}; t = {c['t']!r}, λ = {c['lam']:.3g}"
+                   + (f"; a jump found between sample times, bracket [{c['bracket'][0]!r}, {c['bracket'][1]!r}]"
+                      if c.get("found_by") else "")
+                   + "): t ↦ graph F(t,·) is not outer semicontinuous from the right"),
         f"every settled right limit lim J_λ(t+δ) p equals J_λ(t) p ({sequences - unsettled} of {sequences} "
-        f"sequences settled; {EVIDENCE})")
+        f"sequences settled at the sample times; {len(found)} jump(s) of J_λ found between them, none with the "
+        f"left value at its time; {EVIDENCE})")
 
 
 def _a3(S: _Samples) -> CheckResult:
@@ -197,6 +243,14 @@ def _a3(S: _Samples) -> CheckResult:
     rate = max((D[a, b] / (ts[b] - ts[a]) for a in range(n) for b in range(a + 1, n)), default=0.0)
     details = {"evidence": EVIDENCE, "times": ts, "phi_hat": phi_hat, "max_rate": rate,
                "stated": S.problem.phi is not None}
+    jump = _a3_jump(S, details)
+    if jump is not None:
+        return CheckResult("assumption_A3", _subject(S.problem), FAILED, worst=jump["worst"], bound=1.0,
+                           details=details, counterexample=jump,
+                           message=f"dom F jumps at t ≈ {jump['t']!r}: sup_z dist(z, dom F(b)) over z ∈ dom F(a) "
+                                   f"stays {jump['excess']:.4g} on brackets [a, b] around it down to width "
+                                   f"{jump['bracket'][1] - jump['bracket'][0]:.2g} — no absolutely continuous φ "
+                                   f"bounds it ({EVIDENCE})")
     if S.problem.phi is None:
         return CheckResult("assumption_A3", _subject(S.problem), PASSED, details=details,
                            message=f"estimated least φ: φ̂(T) - φ̂(0) = {phi_hat[-1]:.4g}, max rate {rate:.4g} "
@@ -217,6 +271,37 @@ def _a3(S: _Samples) -> CheckResult:
                     lambda c: f"dist(z, dom F(t)) = {c['dist']:.4g} > φ(t) - φ(s) = {c['phi_t'] - c['phi_s']:.4g} "
                               f"for z in dom F(s), s = {c['s']:.4g}, t = {c['t']:.4g}: the stated φ is contradicted",
                     f"stated φ bounds every sampled domain motion ({EVIDENCE})")
+
+
+def _excess(S: _Samples, a: float, b: float) -> tuple[float, np.ndarray]:
+    """``max_z dist(z, dom F(b))`` over the sampled ``z = proj_{dom F(a)} p``, and the maximiser."""
+    Z = np.array([S.op.project_domain(p, a) for p in S.points])
+    Q = np.array([S.op.project_domain(z, b) for z in Z])
+    d = np.linalg.norm(Z - Q, axis=1)
+    m = int(np.argmax(d))
+    return float(d[m]), Z[m]
+
+
+def _a3_jump(S: _Samples, details: dict) -> dict | None:
+    """A jump of ``φ̂``: :func:`verimono.checks.jumps.find_jumps` on the projections ``t ↦ proj_{dom F(t)} p``
+    (continuous when ``dom F`` moves continuously in the Hausdorff distance), then the excess of
+    ``dom F(a)`` over ``dom F(b)`` on the final bracket: still above tolerance and stalled (≥ ``STALL_RATIO``
+    times its value ``STALL_WINDOW`` bisections earlier) means ``φ(b) − φ(a) ≥ excess`` on ever shorter
+    ``[a, b]``: no absolutely continuous φ (a domain that only grows jumps without violating (A3))."""
+    jumps, searched = find_jumps(lambda t: np.array([S.op.project_domain(p, t) for p in S.points]), S.T)
+    details["jump_search"] = searched
+    details["domain_jumps"] = []
+    for j in jumps:
+        e, z = _excess(S, j.a, j.b)
+        a0, b0 = j.brackets[max(len(j.brackets) - 1 - STALL_WINDOW, 0)]
+        e0, _ = _excess(S, a0, b0)
+        tol = tolerance(z, e)
+        details["domain_jumps"].append({"t": j.time, "bracket": [j.a, j.b], "projection_jump": j.size, "excess": e})
+        if e > tol and e >= STALL_RATIO * e0:
+            tj = jump_time(j)
+            return {"t": j.time if tj is None else tj, "bracket": [j.a, j.b], "excess": e, "excess_earlier": e0,
+                    "earlier_bracket": [a0, b0], "z": z, "worst": e / tol, "projection_increments": j.increments}
+    return None
 
 
 def _f0_norm(op, z, t, mu):

@@ -37,9 +37,13 @@ from hypothesis import strategies as st
 
 from ..errors import VerimonoError
 from ..operators import Operator
+from ..profiles import UnknownProfile, active_profile, get_profile
 from ..results import FAILED, PASSED, SKIPPED, CheckResult, Report
 from .core import Law, Member, Outcome, law as _declare, laws_of, run as _run_law
 from ..strategies import points, step_sizes, times
+from .._reproducible import no_local_constants
+from .prox_laws import VALUE_LAWS
+from .sweep import shrink as _shrink, sweep_count, sweep_samples
 from ..tolerances import EPS, LIMIT_FLOOR, STALL_RATIO, STALL_WINDOW, tolerance
 
 #: hypothesis examples per law when ``examples`` is not given and the active profile is not one of
@@ -85,16 +89,24 @@ class Sample:
 def law_samples(n: int, horizon: float = 1.0) -> st.SearchStrategy[Sample]:
     """Samples for the laws on ``R^n``: ``x1`` from :func:`verimono.strategies.points`, ``x2`` either
     independent or within ``10^-2`` of ``x1`` (local violations), ``λ, μ, ν ∈ [10^-3, 10]`` and
-    ``t ∈ [0, horizon]``; everything shrinks toward 0, 1 and ``t = 0``."""
+    ``t ∈ [0, horizon]``; everything shrinks toward 0, 1 and ``t = 0``.  The strategy is built once per
+    ``(n, horizon)`` (building strategies inside every draw cost more than evaluating the law)."""
+    return _law_samples(int(n), float(horizon))
+
+
+@functools.lru_cache(maxsize=128)
+def _law_samples(n: int, horizon: float) -> st.SearchStrategy[Sample]:
+    pts, near, steps, when, coin = points(n), points(n, 1e-2), step_sizes(), times(horizon), st.booleans()
+
     @st.composite
     def _draw(draw):
-        x1 = draw(points(n), label="x1")
-        if draw(st.booleans(), label="x2 near x1"):
-            x2 = x1 + draw(points(n, 1e-2), label="x2 - x1")
+        x1 = draw(pts, label="x1")
+        if draw(coin, label="x2 near x1"):
+            x2 = x1 + draw(near, label="x2 - x1")
         else:
-            x2 = draw(points(n), label="x2")
-        lam, mu, nu = (draw(step_sizes(), label=k) for k in ("lam", "mu", "nu"))
-        return Sample(x1, x2, lam, mu, nu, draw(times(horizon), label="t"))
+            x2 = draw(pts, label="x2")
+        lam, mu, nu = (draw(steps, label=k) for k in ("lam", "mu", "nu"))
+        return Sample(x1, x2, lam, mu, nu, draw(when, label="t"))
     return _draw()
 
 
@@ -407,6 +419,9 @@ _TABLE = [
     ("min_norm_in_graph", _min_norm_in_graph, "minimal section F^0 = proj(0, F(x))", (_MIN_NORM, _CONTAINS)),
     ("min_norm_least", _min_norm_least, "minimal section F^0 = proj(0, F(x))", (_MIN_NORM,)),
 ]
+_VALUE = Member("value")
+#: the value laws (verimono.checks.prox_laws): they need g, given as ``value`` (operator_from_prox)
+_TABLE += [(name, fn, label, (_VALUE,)) for name, fn, label in VALUE_LAWS]
 for _name_, _fn, _item, _needs in _TABLE:
     _declare(_name_, _item, subject="operator", requires=_needs)(_fn)
 
@@ -429,6 +444,7 @@ class _State:
     fail_sample: Sample | None = None
     fail_eval: Outcome | None = None
     unsupported: str | None = None
+    found_by: str = ""
     inconclusive: int = 0
     inconclusive_what: str = ""
 
@@ -454,13 +470,30 @@ def _subject(op: Operator) -> str:
 def default_examples() -> tuple[int, str]:
     """``(examples per law, profile)`` when ``examples`` is not given: the active profile's ``law_examples``
     (``dev``/``ci``/``thorough``, :func:`verimono.profiles.active_profile`), else ``DEFAULT_EXAMPLES``."""
-    from ..profiles import UnknownProfile, active_profile, get_profile
-
     name = active_profile()
     try:
         return get_profile(name).law_examples, name
     except UnknownProfile:
         return DEFAULT_EXAMPLES, name
+
+
+def _sweep(law: Law, op: Operator, seed: int, horizon: float, state: "_State", body: Callable) -> int:
+    """Evaluate ``law`` on the scale sweep (:mod:`verimono.checks.sweep`) after a search found nothing; a
+    violation is shrunk greedily and recorded in ``state``.  Returns the number of sweep samples."""
+    samples = sweep_samples(op, seed, horizon, sweep_count(active_profile(), law.name), Sample)
+    for s in samples:
+        try:
+            body(s, search=False)
+        except _Violation:
+            def fails(c: Sample) -> bool:
+                return not _evaluate(law, op, c).ratio <= BOUND
+            small, _ = _shrink(s, fails, dataclasses.replace)
+            state.fail_sample, state.fail_eval = small, _evaluate(law, op, small)
+            state.found_by = "sweep (shrunk greedily)"
+            break
+        if state.unsupported is not None:
+            break
+    return len(samples)
 
 
 def run_law(law: Law | str, op: Operator, *, seed: int | None = None, examples: int | None = None,
@@ -543,7 +576,7 @@ def _search(law: Law, op: Operator, seed: int | None, examples: int | None, hori
     def searched(s: Sample) -> None:
         body(s, True)
 
-    flaky = ""
+    flaky, swept = "", 0
     if sample is not None:
         s = Sample.from_dict(sample) if isinstance(sample, dict) else sample
         try:
@@ -557,16 +590,20 @@ def _search(law: Law, op: Operator, seed: int | None, examples: int | None, hori
             given(law_samples(op.dim, horizon))(searched))
         test = hypothesis.seed(seed)(test)
         try:
-            test()
+            with no_local_constants():   # the same seed draws the same samples whatever was imported
+                test()
         except _Violation:
             pass
         except hypothesis.errors.Flaky as exc:  # a failure that did not reproduce on replay
             flaky = f" (not reproducible on replay: {type(exc).__name__}; the operator is not deterministic)"
+        if state.fail_eval is None and state.unsupported is None:
+            swept = _sweep(law, op, seed, horizon, state, body)
+    duration = time.perf_counter() - start
     duration = time.perf_counter() - start
     subject = _subject(op)
     base = dict(check=law.name, subject=subject, seed=seed, duration=duration)
     details = {"item": law.label, "examples": examples, "evaluations": state.runs, "horizon": horizon,
-               "inconclusive": state.inconclusive}
+               "inconclusive": state.inconclusive, "sweep": swept}
     if profile is not None:
         details["profile"] = profile
 
@@ -578,6 +615,8 @@ def _search(law: Law, op: Operator, seed: int | None, examples: int | None, hori
         ev, s = state.fail_eval, state.fail_sample
         cex = {**s.to_dict(), "seed": seed, "examples": examples, "horizon": horizon, "operator": repr(op),
                "ratio": ev.ratio, "lhs": ev.lhs, "rhs": ev.rhs, "slack": ev.slack, **ev.info}
+        if state.found_by:
+            cex["found_by"] = state.found_by
         msg = (f"{ev.what}: lhs {ev.lhs:.6g} > rhs {ev.rhs:.6g} + slack {ev.slack:.3g} "
                f"at {s!r}{flaky}")
         return CheckResult(status=FAILED, worst=max(state.worst, ev.ratio), bound=BOUND, counterexample=cex,
@@ -700,6 +739,35 @@ def check_min_norm_least(op, *, seed=None, examples=None, horizon=1.0, sample=No
     ``y = Y_νx1`` at ``x = J_νx1`` (item v; certified by ``contains`` when available)
     (ratio ``|F^0(x)| / (|y| + slack)``)."""
     return run_law("min_norm_least", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
+
+
+def check_prox_inequality(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
+    """The prox inequality:
+    ``⟨x - p, z - p⟩ ≤ λ(g(z) - g(p))`` for ``p = J_λx`` and ``z`` among ``x2``,
+    ``x1``, ``0`` and other resolvent values (needs ``value``; :mod:`verimono.checks.prox_laws`)."""
+    return run_law("prox_inequality", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
+
+
+def check_prox_optimal(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
+    """The prox optimality (perturbations):
+    ``p = J_λx`` minimises ``Φ(z) = λg(z) + |z - x|²/2``, 1-strongly: ``Φ(p) + |δ|²/2 ≤ Φ(p + δ)`` for
+    perturbations ``δ`` along coordinates, ``x - p``, ``p`` and seeded directions (needs ``value``)."""
+    return run_law("prox_optimal", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
+
+
+def check_prox_minimiser(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
+    """The prox optimality (independent minimiser):
+    ``Φ(p) ≤ Φ(z*)`` for ``z*`` an independent minimiser of ``Φ`` (scipy's Powell from ``p``, ``x``, ``0``;
+    ``n ≤ 4`` only, larger samples are inconclusive; needs ``value``)."""
+    return run_law("prox_minimiser", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
+
+
+def check_moreau_envelope(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
+    """The Moreau envelope:
+    ``e_λ(x) = g(J_λx) + |x - J_λx|²/(2λ)`` is convex with the ``1/λ``-Lipschitz
+    gradient ``Y_λ``: ``e(x1) + ⟨Y_λx1, x2 - x1⟩ ≤ e(x2) ≤ e(x1) + ⟨Y_λx1, x2 - x1⟩ + |x2 - x1|²/(2λ)``
+    (needs ``value``)."""
+    return run_law("moreau_envelope", op, seed=seed, examples=examples, horizon=horizon, sample=sample)
 
 
 #: the registry: stable law name → check function, in the order they run

@@ -13,8 +13,9 @@ Laws (labels of the paper, Camlibel–Iannelli–Tanwani):
   theorem of Section 6: ``|x_k - x'_k| ≤ e^{L h_k} |x_{k-1} - x'_{k-1}|``, hence
   ``|x_k - x'_k| ≤ e^{L t_k}|x_0 - x'_0|`` (``L = 0`` without ``f``; the scheme's explicit ``f`` gives
   the factor ``1 + hL ≤ e^{hL}``; the input ``u`` cancels).
-* ``unique_limit`` — solutions on different (uniform, random, graded) partitions approach each other
-  as ``|Δ| → 0`` (the limit of ``x_Δ`` in Section 5.4 is the unique solution).
+* ``unique_limit`` — solutions on different (uniform, random, graded) partitions approach one limit as
+  ``|Δ| → 0`` (the limit of ``x_Δ`` in Section 5.4 is the unique solution); no rate assumed: a Cauchy
+  criterion with each refinement sequence's own geometric tail.
 * ``in_domain`` — ``x_k ∈ cl dom F(t_k, ·)`` (``e:x k+1 props.1``).
 * ``bounds_lg`` — lemma ``lem:bndSeq`` under (A3) and (LG): ``|x_k| ≤ β`` and
   ``|x_k - x_{k-1}| ≤ ψ(t_k) - ψ(t_{k-1})`` with ``β, ψ`` of ``e:only beta``, ``eq:defPsi``; with an
@@ -46,12 +47,13 @@ from scipy import integrate
 
 from ..errors import OutsideDomain, VerimonoError
 from ..grids import graded_grid, random_grid, uniform_grid, validate_grid
-from ..operators import L1Subdifferential, Linear, NormSubdifferential, Operator
+from ..operators import L1Subdifferential, Linear, NormalCone, NormSubdifferential, Operator
 from ..problem import Problem
 from ..claims import claim_of, with_claim
 from ..results import FAILED, PASSED, SKIPPED, CheckResult, Report
 from ..stepping import Trajectory
-from ..tolerances import DOMAIN_ORDER_SLACK, LIMIT_EXTRA_LEVELS, LIMIT_SHRINK, quotient_tolerance, tolerance
+from ..tolerances import (DOMAIN_ORDER_SLACK, LIMIT_EXTRA_LEVELS, LIMIT_RATIO_FLOOR, LIMIT_TAIL_SAFETY,
+                          quotient_tolerance, tolerance)
 from .core import (CONTRACTION_CLAIM, PROXIMAL_CLAIM, Holds, Member, NotApplicable, Outcome, law as _declare,
                    record, run as _run)
 from .orders import check_convergence_order
@@ -336,62 +338,113 @@ def limit_grids(T: float, K: int, seed: int = 0) -> dict[str, np.ndarray]:
 @stepper_law("unique_limit", "the limit of x_Δ is the unique solution (Section 5.4)")
 def check_unique_limit(stepper: Callable, problem: Problem, *, levels: Sequence[int] = LIMIT_LEVELS,
                        seed: int = 0) -> CheckResult:
-    """Solutions on different partitions approach each other as ``|Δ| → 0`` (unique limit, Section 5.4).
+    """Solutions on different partitions approach one limit as ``|Δ| → 0`` (unique limit, Section 5.4).
 
-    ``D(K) = max`` over pairs of partitions (uniform, random, graded, ``K`` cells each) of the sup over
-    their nodes, from the end of both first cells on, of the distance between the piecewise-linear
-    interpolants (the first cell holds the catching-up jump, or a transient faster than the mesh, which no
-    interpolant resolves there; it shrinks with the mesh, so the limit is still the uniform one).
-    Law: ``D(K_m) ≤ LIMIT_SHRINK · max(D(K_0), ..., D(K_{m-1})) + tol`` at the last of ``levels`` — or,
-    for a problem whose time scale is finer than those meshes (the limit is only asymptotic), at one of up
-    to ``LIMIT_EXTRA_LEVELS`` further 4-fold refinements, granted while the distance keeps shrinking or is
-    still growing (the largest distance is at the finest level: ``x' ∈ −∂(2|x|)`` from ``x0 = 1/32``
-    dies out at ``t = 1/64``, and partitions of mesh 0.1 and 0.025 all give 0 there, so the distance is
-    0, 0, then ``c h`` at mesh 1/160).  A stepper with no unique limit keeps an O(1) distance, which never
-    falls to ``LIMIT_SHRINK`` times its largest value.
+    No rate is assumed (the paper gives none: ``x' ∈ −∂(c(t)|x|)`` with ``c = 0.1 t^{-0.9}``, σ in L¹ but
+    unbounded, converges like ``h^{0.1}``, and its uniform and graded partitions even move *apart* until
+    ``K ≈ 1000``).  For each kind ``k`` of partition (uniform, random, graded) the solutions ``x^k_m`` on
+    ``K_m`` cells form a sequence; ``c_{k,m}`` is the sup distance between the piecewise-linear interpolants
+    of ``x^k_m`` and ``x^k_{m+1}`` (from the end of both first cells on: the first cell holds the
+    catching-up jump, or a transient faster than the mesh, that no interpolant resolves there).
+
+    Criterion — Cauchy, against each sequence's own trend: when the last ratio ``r = c_{k,M-1}/c_{k,M-2}``
+    is below 1, ``|x^k_M − x^k_∞| ≤ c_{k,M-1} r/(1 − r)`` (the a-posteriori bound of a geometrically
+    convergent sequence — Banach's fixed-point estimate; Aitken's Δ² model; any rate ``h^p``, ``p > 0``,
+    is geometric in ``m`` on 4-fold refinements, with ``r = 4^{-p}``), times ``LIMIT_TAIL_SAFETY`` = 4, with
+    ``r`` raised to ``LIMIT_RATIO_FLOOR = 1/4`` (a fall faster than order 1 between the coarse levels is
+    pre-asymptotic and does not extrapolate: the scheme is first order).
+    The law fails when two kinds' limits are provably apart, ``D(K_M) > tail_a + tail_b + tol`` with
+    ``D(K_M)`` the sup distance between their finest solutions (different limits, e.g. a stepper using
+    the mean step), or when a kind's differences do not shrink (``r ≥ 1``: not a Cauchy sequence) after up
+    to ``LIMIT_EXTRA_LEVELS`` further 4-fold refinements.  Those are granted while some kind's differences
+    still grow (``x' ∈ −∂(2|x|)`` from ``x0 = 1/32`` dies out at ``t = 1/64``: meshes 0.1 and 0.025 all
+    give 0 there, the differences are 0, then ``c h``).  Evidence, not proof: a sequence converging at
+    rate ``p`` gives ``tail ≈ 4/(4^p − 1)`` times its last difference, so a slow one is judged leniently.
 
     Claim: any — every convergent scheme has a unique limit (Section 5.4: it is the unique solution).
     """
     subject = f"{_name(stepper)} on {problem.name}"
     start = time.perf_counter()
     levels = list(levels)
+    while len(levels) < 3:               # two differences per kind: the least the own-trend tail needs
+        levels.append(4 * levels[-1])
     try:
         p = _single(problem)
         scale = [float(np.max(np.abs(p.x0)))]
 
-        def distance(K: int) -> tuple[float, dict | None]:
+        def sup_dist(ga, xa, gb, xb, since=0.0):
+            tau = np.union1d(ga, gb)
+            tau = tau[tau >= max(ga[1], gb[1], since)]
+            if tau.size == 0:
+                return 0.0, float(ga[-1]), xa[-1], xb[-1]
+            dist = _norms(_interp(ga, xa, tau) - _interp(gb, xb, tau))
+            m = int(np.argmax(dist))
+            return float(dist[m]), float(tau[m]), _interp(ga, xa, tau[m:m + 1])[0], _interp(gb, xb, tau[m:m + 1])[0]
+
+        runs: list[tuple[dict, dict]] = []     # (grids, solutions) per level
+
+        def add_level(K: int) -> None:
             gs = limit_grids(p.T, K, seed)
+            K0 = levels[0]
+            if K % K0 == 0:
+                # the random kind as a refinement sequence: the first level's random partition with every
+                # cell split in K/K0 equal parts (independent random partitions per level have errors C_m h_m
+                # with a random C_m, which no own-trend tail can extrapolate)
+                base = limit_grids(p.T, K0, seed)["random"]
+                sub = np.linspace(0.0, 1.0, K // K0 + 1)[:-1]
+                gs["random"] = np.append((base[:-1, None] + np.diff(base)[:, None] * sub[None, :]).ravel(), p.T)
             sols = {g: run_stepper(stepper, p, t) for g, t in gs.items()}
             scale[0] = max(scale[0], max(float(np.max(np.abs(x))) for x in sols.values()))
-            names = list(gs)
-            best, info = 0.0, None
+            runs.append((gs, sols))
+
+        def cross(m: int, since: dict | None = None) -> tuple[float, dict | None]:
+            gs, sols = runs[m]
+            names, best, info = list(gs), 0.0, None
             for i in range(len(names)):
                 for j in range(i + 1, len(names)):
                     a, b = names[i], names[j]
-                    tau = np.union1d(gs[a], gs[b])
-                    # from the end of both first cells on: a jump, or a transient faster than the mesh
-                    # (a set thinner than |u|·h), is resolved by no interpolant on its first cell
-                    tau = tau[tau >= max(gs[a][1], gs[b][1])]
-                    dist = _norms(_interp(gs[a], sols[a], tau) - _interp(gs[b], sols[b], tau))
-                    m = int(np.argmax(dist))
-                    if dist[m] >= best:
-                        best, info = float(dist[m]), {"pair": [a, b], "tau": tau[m],
-                                                      "x_a": _interp(gs[a], sols[a], tau[m:m + 1])[0],
-                                                      "x_b": _interp(gs[b], sols[b], tau[m:m + 1])[0]}
+                    s0 = 0.0 if since is None else max(since[a], since[b])
+                    d, tau, xa, xb = sup_dist(gs[a], sols[a], gs[b], sols[b], s0)
+                    if d >= best:
+                        best, info = d, {"pair": [a, b], "tau": tau, "x_a": xa, "x_b": xb}
             return best, info
 
-        D, where = zip(*(distance(K) for K in levels))
-        D, where = list(D), list(where)
+        def judge():
+            """Tails of each kind and the cross distance, both from the end of the first cells of the
+            coarsest level the tails use on (where the differences are measured)."""
+            tol = tolerance(scale[0])
+            kinds, M = list(runs[0][0]), len(runs) - 1
+            since = {k: float(runs[M - 2][0][k][1]) for k in kinds}
+            diffs = {k: [sup_dist(runs[m][0][k], runs[m][1][k], runs[m + 1][0][k], runs[m + 1][1][k], since[k])[0]
+                         for m in (M - 2, M - 1)] for k in kinds}
+            tails, ratios = {}, {}
+            for k, c in diffs.items():
+                if c[-1] <= tol:
+                    tails[k], ratios[k] = c[-1], 0.0
+                    continue
+                r = c[-1] / c[-2] if c[-2] > 0 else np.inf
+                ratios[k] = r
+                re = max(r, LIMIT_RATIO_FLOOR)      # a faster fall than order 1 is pre-asymptotic
+                tails[k] = LIMIT_TAIL_SAFETY * c[-1] * re / (1.0 - re) if r < 1.0 else np.inf
+            D, info = cross(M, since)
+            a, b = info["pair"] if info else (kinds[0], kinds[1])
+            gap = D - tails[a] - tails[b]
+            # a distance before the tails' region (first cells of the coarser levels) is not judged, but
+            # asks for a finer level; so do differences that do not shrink yet
+            D_all, _ = cross(M)
+            unresolved = any(r >= 1.0 for r in ratios.values()) or (
+                D_all > D and D_all > min(tails[x] + tails[y] for x in kinds for y in kinds if x < y) + tol)
+            return D, info, diffs, tails, ratios, gap, tol, unresolved
+
+        for K in levels:
+            add_level(K)
+        D, info, diffs, tails, ratios, gap, tol, unresolved = judge()
         for _ in range(LIMIT_EXTRA_LEVELS):
-            holds = D[-1] <= LIMIT_SHRINK * max(D[:-1]) + tolerance(scale[0])
-            growing = D[-1] > max(D[:-1])     # the meshes do not resolve the problem's time scale yet
-            if holds or not (growing or D[-1] < D[-2]):
-                break  # the law holds, or the distance stopped shrinking: refining cannot help
+            if not unresolved or (gap > tol and all(r < 1.0 for r in ratios.values())):
+                break        # judged: no doubt left, or two settled kinds are provably apart
             levels.append(4 * levels[-1])
-            d, info = distance(levels[-1])
-            D.append(d)
-            where.append(info)
-        rhs = LIMIT_SHRINK * max(D[:-1])
+            add_level(levels[-1])
+            D, info, diffs, tails, ratios, gap, tol, unresolved = judge()
     except NotImplementedError as exc:
         return CheckResult("unique_limit", subject, SKIPPED, message=f"not available: {exc}",
                            duration=time.perf_counter() - start)
@@ -399,19 +452,34 @@ def check_unique_limit(stepper: Callable, problem: Problem, *, levels: Sequence[
         return CheckResult("unique_limit", subject, FAILED, message=f"{type(exc).__name__}: {exc}",
                            counterexample={"problem": problem.name, "levels": levels, "seed": seed},
                            duration=time.perf_counter() - start)
-    worst = D[-1] / (rhs + tolerance(scale[0]))
-    details = {"levels": levels, "distances": D, "mesh": [p.T / K for K in levels]}
-    if worst <= 1.0:
-        return CheckResult("unique_limit", subject, PASSED, worst=worst, bound=1.0, details=details,
-                           message=f"distance between partitions {D[0]:.3g} -> {D[-1]:.3g}",
-                           duration=time.perf_counter() - start)
+    distances = [cross(m)[0] for m in range(len(runs))]
+    not_cauchy = [k for k, r in ratios.items() if r >= 1.0]
+    details = {"levels": levels, "distances": distances, "mesh": [p.T / K for K in levels],
+               "differences": diffs, "ratios": ratios, "tails": tails, "criterion": "Cauchy with own-trend tail"}
+    pair = info["pair"] if info else list(tails)[:2]
+    worst = D / (tails[pair[0]] + tails[pair[1]] + tol) if not not_cauchy else max(ratios.values())
+    if gap <= tol and not not_cauchy:
+        return CheckResult("unique_limit", subject, PASSED, worst=worst if gap > 0 else min(worst, 1.0),
+                           bound=1.0, details=details, duration=time.perf_counter() - start,
+                           message=f"distance between partitions {distances[0]:.3g} -> {D:.3g}, within the "
+                                   f"estimated distances to their limits {tails[info['pair'][0]]:.3g} + "
+                                   f"{tails[info['pair'][1]]:.3g} (last ratios "
+                                   f"{', '.join(f'{k} {r:.3g}' for k, r in ratios.items())}; no rate assumed)"
+                           if info else f"distance between partitions {D:.3g}")
     counter = {"problem": problem.name, "T": p.T, "x0": p.x0, "levels": levels, "seed": seed,
-               "distances": D, "grid_kinds": list(limit_grids(p.T, levels[0], seed)), **where[-1]}
-    return CheckResult("unique_limit", subject, FAILED, worst=worst, bound=1.0, counterexample=counter,
-                       details=details, duration=time.perf_counter() - start,
-                       message=f"solutions on different partitions do not approach each other: distances "
-                               f"{', '.join(f'{d:.3g}' for d in D)} for K = {levels} (worst pair "
-                               f"{where[-1]['pair']} at t = {where[-1]['tau']:.4g})")
+               "distances": distances, "grid_kinds": list(runs[0][0]), "tails": tails, **(info or {})}
+    if not_cauchy:
+        msg = (f"no limit: on {', '.join(not_cauchy)} partitions the differences between successive refinements "
+               f"do not shrink ({'; '.join(f'{k}: ' + ', '.join(f'{c:.3g}' for c in diffs[k]) for k in not_cauchy)}"
+               f" for K = {levels})")
+    else:
+        msg = (f"solutions on different partitions converge to different limits: {info['pair'][0]} and "
+               f"{info['pair'][1]} are {D:.3g} apart at K = {levels[-1]} (t = {info['tau']:.4g}) while each is "
+               f"within {tails[info['pair'][0]]:.3g} and {tails[info['pair'][1]]:.3g} of its own limit "
+               f"(distances {', '.join(f'{d:.3g}' for d in distances)} for K = {levels})")
+    return CheckResult("unique_limit", subject, FAILED, worst=max(worst, 1.0 + 1e-12) if np.isfinite(worst) else worst,
+                       bound=1.0, counterexample=counter, details=details, duration=time.perf_counter() - start,
+                       message=msg)
 
 
 # -- domain -----------------------------------------------------------------------------------------
@@ -507,8 +575,6 @@ def _phi_of(problem: Problem) -> tuple[Callable[[float], float], str]:
 def _sigma_of(problem: Problem) -> tuple[Callable[[float], float], str]:
     """σ of (LG): the problem's, or derived from the catalog operator — ``N_S``: ``F^0 = 0``, ``σ ≡ 0``;
     ``Linear``: ``|M(t)x| ≤ ‖M(t)‖₂|x|``; ``∂(c|·|)``, ``∂(Σc_i|x_i|)``: ``|F^0(t,x)| ≤ |F^0(t, 1)|``."""
-    from ..operators import NormalCone
-
     if problem.sigma is not None:
         return problem.sigma, "stated"
     op = problem.operator
@@ -595,6 +661,9 @@ class YBBounds:
             f0 = float(np.linalg.norm(op.min_norm(x0, 0.0)))
         except OutsideDomain:
             raise _Skip("x0 is not in dom F(0,·) (lem:bndSeqYB needs |F^0(0, x0)|)") from None
+        if not np.isfinite(f0):   # x0 within rounding of the boundary: F^0 overflows (c/x at x = 7e-304)
+            raise _Skip(f"|F^0(0, x0)| = {f0} is not finite: x0 is at the edge of dom F(0,·), where "
+                        "lem:bndSeqYB's α is infinite and its bounds say nothing")
         self.alpha = 2.0 * (float(theta(T)) - float(theta(0.0))) + f0
         self.beta = float(np.linalg.norm(x0)) + self.alpha * T
         self.f0 = f0
@@ -628,7 +697,10 @@ def _yb_requirements(p: Problem) -> None:
     if p.f is not None:
         raise _Skip("lem:bndSeqYB covers f = 0 (the Lipschitz theorem's constants are not explicit)")
     if p.u is not None or p.U is not None:
-        raise _Skip("with an input, (YB) for G holds with θ + M_u where M_u is not explicit (l:extinput)")
+        raise _Skip("with an input, lem:bndSeqYB would apply to G(t, ξ) = F(t, ξ + Φ(t)) (l:extinput), but (YB) "
+                    "does not pass from F to G: t:non-auto's θ̄ = M_u + θ has the increments of θ (the constant "
+                    "cancels) while the defect |Φ(s+λ) − Φ(s)|/λ ≈ |u(s)| stays as λ → 0 (F = ∂|x|, u = 1: G "
+                    "fails (YB) for every θ)")
     _theta_of(p)
 
 

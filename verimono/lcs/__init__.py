@@ -7,6 +7,7 @@ Proposition ``p:pass``) and evidence for the hypotheses of Theorems ``thm: linea
 """
 
 from .hypotheses import check_hypotheses
+from .kernel import BatchStepError, RowFailure
 from .lcp import LCPResult, box_residual, lcp_residual, lemke, solve_box, solve_lcp
 from .passivity import PassivityResult, is_passive
 from .relations import Complementarity, OperatorRelation, Relation, Relay
@@ -18,4 +19,5 @@ __all__ = [
     "LinearRelationSystem", "LCSOperator", "Relation", "Complementarity", "Relay", "OperatorRelation",
     "solve_lcp", "solve_box", "LCPResult", "lcp_residual", "box_residual", "lemke",
     "is_passive", "PassivityResult", "check_hypotheses", "read_ref", "read_lcp", "check_siconos",
+    "BatchStepError", "RowFailure",
 ]

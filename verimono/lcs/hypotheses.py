@@ -18,8 +18,10 @@ argument:
   ``v ∈ AC``): no jump — the largest increments of ``v`` must vanish when bisected (:func:`_v_ac_record`) —
   and a settled total variation; a jump fails with its location;
 * ``lcs.least_norm_growth`` (item vi, from Proposition ``p:lcp2`` iv–v for PSD ``D``): the least-norm
-  multiplier ``z*`` of sampled unit ``q ∈ Q_D^+`` is homogeneous (``z*(sq) = s z*(q)``) and least-norm,
-  giving ``|z*(q)| ≤ α|q|`` with ``α`` estimated (:func:`_least_norm_record`);
+  multiplier ``z*`` of sampled unit ``q ∈ Q_D^+`` is homogeneous (``z*(sq) = s z*(q)``) and least-norm;
+  ``|z*(q)| ≤ α|q|`` is checked against the explicit ``α = 1/λ_min((D + Dᵀ)/2)`` when that is positive
+  (:func:`verimono.lcs.lcp.lcp_alpha`), and otherwise ``α`` is only estimated from below by the samples
+  (said so in the record) (:func:`_least_norm_record`);
 * ``lcs.A1``, ``lcs.A2``, ``lcs.A3``, ``lcs.LG``: the main theorem's assumptions, passed when the items the
   Section 7 theorem derives them from passed, skipped (not established, with the items that did not pass
   and their status) otherwise — those items are sufficient conditions, so their failure refutes nothing.
@@ -33,8 +35,8 @@ from scipy.optimize import linprog
 
 from ..errors import VerimonoError
 from ..results import FAILED, PASSED, SKIPPED, CheckResult, Report
-from ..tolerances import EPS, STALL_RATIO, STALL_WINDOW, tolerance
-from .lcp import is_psd, lcp_residual, sol_polyhedron, solve_lcp
+from ..tolerances import EPS, RTOL, STALL_RATIO, STALL_WINDOW, tolerance
+from .lcp import is_psd, lcp_alpha, lcp_residual, sol_polyhedron, solve_lcp
 from .passivity import is_passive
 from .relations import BoxRelation, OperatorRelation
 
@@ -227,7 +229,8 @@ def _least_norm_record(system, rng, samples: int) -> CheckResult:
     if not (isinstance(rel, BoxRelation) and rel.is_lcp and is_psd(D)):
         return _rec("lcs.least_norm_growth", subj, SKIPPED, "needs a bounded box, or complementarity with "
                     "D + Dᵀ ⪰ 0 (Proposition p:lcp2)")
-    alpha, worst, bad, shorter_checked = 0.0, 0.0, None, 0
+    alpha, worst, bad, shorter_checked, q_alpha = 0.0, 0.0, None, 0, None
+    explicit = lcp_alpha(D)
     for _ in range(samples):
         q = _sample_q(D, rng)
         try:
@@ -252,7 +255,8 @@ def _least_norm_record(system, rng, samples: int) -> CheckResult:
                            "ratio |z(q)|/|q|": float(np.linalg.norm(z))}
         if bad is not None:
             break
-        alpha = max(alpha, float(np.linalg.norm(z)))
+        if float(np.linalg.norm(z)) > alpha:
+            alpha, q_alpha = float(np.linalg.norm(z)), (q, z)
         p = _shorter_solution(D, q, z)
         shorter_checked += 1
         if p is not None:
@@ -260,12 +264,24 @@ def _least_norm_record(system, rng, samples: int) -> CheckResult:
             bad = {"q": q, "z": z, "shorter solution": p}
             break
     bn = float(np.linalg.norm(B, 2))
+    if bad is None and explicit is not None and alpha > explicit * (1.0 + RTOL) + tolerance(alpha):
+        worst = alpha / (explicit * (1.0 + RTOL) + tolerance(alpha))
+        bad = {"q": q_alpha[0], "z": q_alpha[1], "|z|/|q|": alpha, "alpha": explicit}
+    a_used = explicit if explicit is not None else alpha
+    a_kind = ("explicit 1/λ_min((D + Dᵀ)/2)" if explicit is not None else
+              "sampled sup |z*(q)|/|q|, a lower estimate: D + Dᵀ is singular, p:lcp2 v gives no α")
     if bad is None:
         msg = (f"Proposition p:lcp2 iv–v on {samples} unit q ∈ Q_D^+: z*(sq) = s z*(q) for s ∈ {list(LN_SCALES)} "
                f"(worst defect {worst:.2g}·tolerance), no shorter solution (linear programming); "
-               f"α ≈ max |z*(q)|/|q| = {alpha:.4g}, so |B z*(η)| ≤ {bn * alpha:.4g}|η| ({EVIDENCE})")
+               + (f"|z*(q)| ≤ α|q| with the explicit α = 1/λ_min((D + Dᵀ)/2) = {explicit:.4g} (sampled sup "
+                  f"{alpha:.4g}), so |B z*(η)| ≤ {bn * explicit:.4g}|η|" if explicit is not None else
+                  f"α ≥ {alpha:.4g} (sampled sup of |z*(q)|/|q|; D + Dᵀ is singular, so p:lcp2 v gives no explicit "
+                  f"α and this is an estimate from below)") + f" ({EVIDENCE})")
     elif "error" in bad:
         msg = f"Proposition p:lcp2: q ∈ Q_D^+ (feasible by construction) but no least-norm solution: {bad['error']}"
+    elif "alpha" in bad:
+        msg = (f"Proposition p:lcp2 v: |z*(q)|/|q| = {bad['|z|/|q|']:.6g} exceeds α = 1/λ_min((D + Dᵀ)/2) = "
+               f"{bad['alpha']:.6g} at q = {np.array2string(np.asarray(bad['q']), precision=4)}")
     elif "shorter solution" in bad:
         msg = (f"Proposition p:lcp2 iv: solve_lcp's z (|z| = {np.linalg.norm(bad['z']):.6g}) is not the least-norm "
                f"solution: a solution of norm {np.linalg.norm(bad['shorter solution']):.6g} exists")
@@ -274,7 +290,8 @@ def _least_norm_record(system, rng, samples: int) -> CheckResult:
                f"{bad['ratio |z(sq)|/|sq|']:.4g} at s = {bad['s']:g} but |z*(q)|/|q| = {bad['ratio |z(q)|/|q|']:.4g}: "
                "no α with |z*(q)| ≤ α|q| for this selection")
     return _rec("lcs.least_norm_growth", subj, bad is None, msg, worst=worst, bound=1.0, counterexample=bad,
-                details={"evidence": True, "alpha": alpha, "B_alpha": bn * alpha, "samples": samples,
+                details={"evidence": True, "alpha": a_used, "alpha_kind": a_kind, "alpha_sampled": alpha,
+                         "B_alpha": bn * a_used, "samples": samples,
                          "least_norm_checked": shorter_checked, "scales": list(LN_SCALES)})
 
 

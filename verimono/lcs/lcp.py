@@ -476,5 +476,18 @@ def solve_box(M, q, lower, upper, *, least_norm: bool = True, info: bool = False
     return out if info else lam
 
 
-__all__ = ["solve_lcp", "solve_box", "LCPResult", "lcp_residual", "box_residual", "lemke", "is_psd",
+def lcp_alpha(M: np.ndarray) -> float | None:
+    """The constant of Proposition ``p:lcp2`` v, ``|z*(q)| ≤ α|q|``, where it is explicit: ``α = 1/λ_min(S)``
+    for a positive definite symmetric part ``S = (M + Mᵀ)/2`` — for *every* solution ``z`` of
+    ``LCP(q, M)``, ``λ_min(S)|z|² ≤ zᵀMz = −zᵀq ≤ |z||q|`` (``zᵀ(Mz + q) = 0``).  ``None`` when ``S`` is
+    singular (``λ_min(S) ≤ RTOL·(1 + max|M|)``): the proposition (Cottle–Pang–Stone Cor. 3.8.10) then
+    asserts that some α exists without giving one."""
+    M = np.asarray(M, dtype=float)
+    if M.size == 0:
+        return 0.0
+    lam = float(np.linalg.eigvalsh(0.5 * (M + M.T))[0])
+    return 1.0 / lam if lam > RTOL * (1.0 + float(np.abs(M).max())) else None
+
+
+__all__ = ["solve_lcp", "solve_box", "LCPResult", "lcp_residual", "box_residual", "lemke", "is_psd", "lcp_alpha",
            "BACKENDS", "ENUM_MAX", "select_over_sol", "sol_polyhedron", "principal_solve"]

@@ -17,14 +17,13 @@ with ``γ = 1`` unless the θ-γ variant is asked for.  ``θ = 1`` is the paper'
 
 from __future__ import annotations
 
-import types
 from typing import Any, Callable
 
 import numpy as np
 import scipy.linalg as sla
 
 from .._params import as_param
-from ..errors import InfeasibleStep, InvalidProblem, OutsideDomain
+from ..errors import InfeasibleStep, InvalidProblem, OutsideDomain, SolverFailure
 from ..grids import validate_grid
 from ..operators import Operator
 from ..problem import Problem
@@ -32,6 +31,7 @@ from ..qp import solve_qp
 from ..stepping import Trajectory
 from ..tolerances import tolerance
 from .lcp import _box_lcp, _feasible, is_psd, select_over_sol, solve_lcp
+from .kernel import BatchStepError
 from .relations import BoxRelation, as_relation
 
 
@@ -66,6 +66,11 @@ class StepMatrices:
         self.G = h * WiB
         self.M = sys.D + h * gamma * sys.C @ WiB
         self.step = sys.relation.stepper(self.M)
+        self._relation = sys.relation
+
+    def relation_step(self):
+        """A fresh warm-started one-step solver ``(q, scale) ↦ (z, w)`` for ``M`` (:meth:`Relation.stepper`)."""
+        return self._relation.stepper(self.M)
 
 
 class LinearRelationSystem:
@@ -126,21 +131,117 @@ class LinearRelationSystem:
         kw.setdefault("name", self.name)
         return Problem(self.operator(), x0, T, u=self.u, **kw)
 
-    def simulate(self, x0, t_grid, *, theta: float = 1.0, gamma: float | None = None) -> Trajectory:
+    def simulate(self, x0, t_grid, *, theta: float = 1.0, gamma: float | None = None, u: Callable | None = None,
+                 v: Any = None) -> Trajectory:
         """Run ``EulerMoreauOSI(θ)`` (θ-γ variant when ``gamma`` is given) on ``t_grid``.
 
-        Returns a :class:`verimono.Trajectory` with ``x`` of shape ``(K+1, n)`` and ``extras["z"]``,
-        ``extras["w"]`` of shape ``(K, m)``: the multiplier and output of step ``k → k+1``.
+        ``x0`` of shape ``(n,)``: a :class:`verimono.Trajectory` with ``x`` of shape ``(K+1, n)`` and
+        ``extras["z"]``, ``extras["w"]`` of shape ``(K, m)``, the multiplier and output of step ``k → k+1``.
+        ``x0`` of shape ``(B, n)``: ``B`` trajectories at once, ``x (K+1, B, n)``, ``z``, ``w`` ``(K, B, m)``,
+        bit-identical to ``B`` separate runs (:mod:`verimono.lcs.kernel`).
+
+        ``u`` / ``v`` replace the system's inputs for this run: ``u`` a callable of ``t`` returning ``(n,)``
+        (every row) or ``(B, n)`` (one input per row); ``v`` a constant or a callable of ``t``, of shape
+        ``(m,)`` or ``(B, m)``.
+
+        Box relations on a uniform grid step through the cached active-set kernel (every step verified,
+        least-norm kept); other relations and grids solve each step with the relation's verified solver.
+        Raises :class:`InvalidProblem` on a malformed ``x0``/input (naming the rows), the step's error
+        (e.g. :class:`InfeasibleStep`, naming the step) for a single run, and
+        :class:`verimono.lcs.kernel.BatchStepError` (every row's results, the failed rows and steps) when
+        rows of a batch fail.
         """
-        x0 = np.array(x0, dtype=float).reshape(-1) if np.ndim(x0) <= 1 else None
-        if x0 is None or x0.shape != (self.n,) or not np.all(np.isfinite(x0)):
-            raise InvalidProblem(f"x0 must be a finite vector of shape ({self.n},)")
+        X0, batched = self._initial(x0)
         if not (0.0 <= theta <= 1.0) or (gamma is not None and not 0.0 < gamma <= 1.0):
             raise InvalidProblem(f"need 0 ≤ θ ≤ 1 and 0 < γ ≤ 1, got θ = {theta}, γ = {gamma}")
         t = validate_grid(t_grid)
+        B = X0.shape[0]
         hs = np.diff(t)
         K = hs.size
         uniform = np.ptp(hs) <= 1e-9 * hs.mean()
+        u_fn = self.u if u is None else u
+        vpar = self._v if v is None else as_param(v, "v")
+        dU = _increments(u_fn, t, self.n, B if batched else None)
+        V = None if vpar.constant else _values(vpar, t[1:], self.m, B if batched else None)
+        vc = None
+        if vpar.constant:
+            vc = np.array(vpar(0.0), dtype=float)
+            if vc.shape not in ((self.m,), (B, self.m)) or (vc.ndim == 2 and not batched):
+                raise InvalidProblem(f"v must have shape ({self.m},)" + (f" or ({B}, {self.m})" if batched else "")
+                                     + f", got {vc.shape}")
+            if not np.all(np.isfinite(vc)):
+                raise InvalidProblem(f"v is not finite (rows {_bad_rows(vc)})")
+        if uniform and isinstance(self.relation, BoxRelation):
+            x, z, w, failures = self._simulate_kernel(X0, t, theta, gamma, dU, V, vc, batched)
+        else:
+            x, z, w, failures = self._simulate_general(X0, t, theta, gamma, dU, V, vc, uniform)
+        if not batched:
+            if failures:
+                raise failures[0].error
+            return Trajectory(t, x[:, 0], None, extras={"z": z[:, 0], "w": w[:, 0]})
+        tr = Trajectory(t, x, None, extras={"z": z, "w": w})
+        if failures:
+            valid = np.ones((K + 1, B), dtype=bool)
+            for f in failures:
+                valid[f.step + 1:, f.row] = False
+            raise BatchStepError(failures, tr, valid)
+        return tr
+
+    def _initial(self, x0):
+        try:
+            X0 = np.array(x0, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise InvalidProblem(f"x0 must be numeric: {exc}") from None
+        batched = X0.ndim == 2
+        if X0.ndim == 0 and self.n == 1:
+            X0 = X0.reshape(1)
+        if X0.ndim == 1 and X0.shape == (self.n,):
+            X0 = X0[None]
+        elif not (batched and X0.shape[1] == self.n and X0.shape[0] >= 1):
+            raise InvalidProblem(f"x0 must be a finite vector of shape ({self.n},) or a batch of shape (B, {self.n}), "
+                                 f"got shape {X0.shape}")
+        if not np.all(np.isfinite(X0)):
+            where = f" (rows {_bad_rows(X0)})" if batched else ""
+            raise InvalidProblem(f"x0 must be a finite vector of shape ({self.n},): not finite{where}")
+        return X0, batched
+
+    def _simulate_kernel(self, X0, t, theta, gamma, dU, V, vc, batched):
+        from .kernel import StepKernel
+
+        K, B = t.size - 1, X0.shape[0]
+        sm = self.step_matrices(t[-1] / K, theta, gamma)
+        parts = []
+        if dU is not None:
+            flat = dU.reshape(-1, self.n)
+            parts.append(sla.lu_solve(sm.lu, flat.T, check_finite=False).T.reshape(dU.shape))
+        # a nonzero constant v enters as a column of the exogenous terms, like a per-row or varying v: a row of
+        # a batch and its single run then do the same multiply-adds (a zero v is folded away: it adds nothing)
+        vrow = vc is not None and bool(np.any(vc != 0.0))
+        if V is not None:
+            parts.append(V)
+        elif vrow:
+            parts.append(np.broadcast_to(vc, (K, B, self.m)) if vc.ndim == 2 else np.broadcast_to(vc, (K, self.m)))
+        E = None
+        if len(parts) == 1:
+            E = parts[0]
+        elif parts:   # W^{-1}∫u then v; shared (K, ·) parts repeated for every row when another part is per row
+            if any(p.ndim == 3 for p in parts):
+                parts = [np.broadcast_to(p[:, None, :], (K, B, p.shape[-1])) if p.ndim == 2 else p for p in parts]
+            E = np.concatenate(parts, axis=-1)
+        kern = StepKernel(self, sm, exo_u=dU is not None, exo_v=V is not None or vrow,
+                          v_const=None)
+        with np.errstate(over="ignore", invalid="ignore"):   # overflow becomes a typed error naming the step
+            if not batched and (E is None or E.ndim == 2):
+                x, z, w = kern.run(X0[0], E, t)
+                return x[:, None], z[:, None], w[:, None], []
+            return kern.run_batch(X0, E, t)
+
+    def _simulate_general(self, X0, t, theta, gamma, dU, V, vc, uniform):
+        """Every step solved by the relation's verified solver (non-box relations, non-uniform grids)."""
+        from .kernel import RowFailure
+
+        K, B = t.size - 1, X0.shape[0]
+        hs = np.diff(t)
         cache: dict[float, StepMatrices] = {}
 
         def mats(k):
@@ -150,37 +251,98 @@ class LinearRelationSystem:
                 if len(cache) > 64:
                     cache.clear()
                 sm = cache[h] = self.step_matrices(h, theta, gamma)
-            return sm
+            return h, sm
 
-        dU = None
-        if self.u is not None:
-            shim = types.SimpleNamespace(U=None, u=self.u, dim=self.n)
-            dU = Problem.input_increments(shim, t)
         g = 1.0 if gamma is None else float(gamma)
-        vconst = self.v(0.0) if self.v_constant else None
-        X = np.empty((K + 1, self.n))
-        Z = np.empty((K, self.m))
-        Wout = np.empty((K, self.m))
-        X[0] = x0
+        X = np.full((K + 1, B, self.n), np.nan)
+        Z = np.full((K, B, self.m), np.nan)
+        Wout = np.full((K, B, self.m), np.nan)
+        X[0] = X0
         C, D = self.C, self.D
-        sm = mats(0)
-        for k in range(K):
-            if not uniform:
-                sm = mats(k)
-            xk = X[k]
-            xfree = sm.E @ xk
-            if dU is not None:
-                xfree = xfree + sla.lu_solve(sm.lu, dU[k])
-            v = vconst if vconst is not None else self.v(t[k + 1])
-            xq = xfree if g == 1.0 else g * xfree + (1.0 - g) * xk
-            z, _ = sm.step(C @ xq + v, self.q_scale(xq, v))
-            X[k + 1] = xfree + sm.G @ z
-            Z[k] = z
-            Wout[k] = C @ X[k + 1] + D @ z + v
-        return Trajectory(t, X, None, extras={"z": Z, "w": Wout})
+        failures = []
+        steppers: dict[float, Callable] = {}   # by step size: each row starts from fresh warm starts
+        for i in range(B):
+            k = 0
+            try:
+                for k in range(K):
+                    h, sm = mats(k)
+                    step = steppers.get(h)
+                    if step is None:
+                        if len(steppers) > 64:
+                            steppers.clear()
+                        step = steppers[h] = sm.relation_step()
+                    xk = X[k, i]
+                    xfree = sm.E @ xk
+                    if dU is not None:
+                        xfree = xfree + sla.lu_solve(sm.lu, dU[k] if dU.ndim == 2 else dU[k, i])
+                    if V is not None:
+                        v = V[k] if V.ndim == 2 else V[k, i]
+                    else:
+                        v = vc if vc.ndim == 1 else vc[i]
+                    xq = xfree if g == 1.0 else g * xfree + (1.0 - g) * xk
+                    z, _ = step(C @ xq + v, self.q_scale(xq, v))
+                    X[k + 1, i] = xn = xfree + sm.G @ z
+                    Z[k, i] = z
+                    Wout[k, i] = wo = C @ xn + D @ z + v
+                    if not (np.all(np.isfinite(xn)) and np.all(np.isfinite(wo))):
+                        raise SolverFailure("the step produced non-finite values (overflow)")
+            except (InfeasibleStep, SolverFailure, InvalidProblem) as exc:
+                X[k + 1:, i] = np.nan
+                Z[k:, i] = Wout[k:, i] = np.nan
+                err = type(exc)(f"step {k} (t = {t[k]:.6g} → {t[k + 1]:.6g}): {exc}")
+                err.__cause__ = exc
+                failures.append(RowFailure(i, k, float(t[k]), err))
+            steppers.clear()
+        return X, Z, Wout, failures
 
     def __repr__(self) -> str:
         return self.name
+
+
+def _bad_rows(a: np.ndarray) -> list[int]:
+    bad = ~np.isfinite(a)
+    return np.flatnonzero(bad.reshape(bad.shape[0], -1).any(axis=1) if a.ndim > 1 else bad).tolist()[:10]
+
+
+def _values(vpar, ts: np.ndarray, m: int, B: int | None) -> np.ndarray:
+    """``v(t)`` at every ``t`` of ``ts``: ``(K, m)``, or ``(K, B, m)`` when ``v`` returns a batch."""
+    vals = [np.asarray(vpar(s), dtype=float) for s in ts.tolist()]
+    shape = vals[0].shape
+    ok = ((m,),) + (((B, m),) if B is not None else ())
+    if shape not in ok or any(a.shape != shape for a in vals):
+        raise InvalidProblem(f"v(t) must return shape {' or '.join(map(str, ok))}, got {shape}")
+    V = np.array(vals)
+    if not np.all(np.isfinite(V)):
+        raise InvalidProblem("v(t) returned non-finite values on the grid" +
+                             (f" (rows {_bad_rows(V.transpose(1, 0, 2))})" if V.ndim == 3 else ""))
+    return V
+
+
+def _increments(u, t: np.ndarray, n: int, B: int | None) -> np.ndarray | None:
+    """``∫_{t_k}^{t_{k+1}} u`` per cell by 3-point Gauss–Legendre (as :meth:`Problem.input_increments`):
+    ``(K, n)``, or ``(K, B, n)`` when ``u`` returns a batch."""
+    if u is None:
+        return None
+    if not callable(u):
+        raise InvalidProblem("u must be a callable of t returning an (n,) or (B, n) array")
+    nodes, weights = np.polynomial.legendre.leggauss(3)
+    h = np.diff(t)
+    mid = 0.5 * (t[:-1] + t[1:])
+    shape = np.shape(u(0.0))
+    ok = ((n,),) + (((B, n),) if B is not None else ())
+    if shape not in ok:
+        raise InvalidProblem(f"u(t) must return shape {' or '.join(map(str, ok))}, got {shape}")
+    total = np.zeros((h.size,) + shape)
+    hb = h.reshape((-1,) + (1,) * len(shape))
+    for xi, w in zip(nodes, weights):
+        vals = np.array([np.asarray(u(s), dtype=float) for s in (mid + 0.5 * h * xi).tolist()])
+        if vals.shape != total.shape:
+            raise InvalidProblem(f"u(t) must return shape {shape} at every t, got {vals.shape[1:]}")
+        total += (0.5 * w) * hb * vals
+    if not np.all(np.isfinite(total)):
+        raise InvalidProblem("u(t) returned non-finite values on the grid" +
+                             (f" (rows {_bad_rows(total.transpose(1, 0, 2))})" if total.ndim == 3 else ""))
+    return total
 
 
 class LCSOperator(Operator):
@@ -311,4 +473,4 @@ class LCSOperator(Operator):
         return solve_qp(P, np.concatenate([-x, np.zeros(m)]), G, h)[:n]
 
 
-__all__ = ["LinearRelationSystem", "LCSOperator", "StepMatrices"]
+__all__ = ["LinearRelationSystem", "LCSOperator", "StepMatrices", "BatchStepError"]

@@ -9,6 +9,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from .html import render
+
 
 def write(report: Any, out_dir: str | Path, *, changes: Any = None) -> dict[str, Path]:
     """Write ``out_dir/results.json`` and ``out_dir/report.html``; returns their paths.
@@ -17,8 +19,6 @@ def write(report: Any, out_dir: str | Path, *, changes: Any = None) -> dict[str,
     :func:`verimono.gate.compare`: the report knows nothing of the gate) fill the report's "changes against
     the baseline" section.
     """
-    from .html import render
-
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     json_path = report.save(out / "results.json")

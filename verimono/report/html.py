@@ -23,6 +23,7 @@ from html import escape
 from typing import Any
 
 from ..results import FAILED, PASSED, SKIPPED, STATUSES, XFAIL, CheckResult, Report, environment, to_jsonable
+from .plots import convergence_plot, trajectory_plot
 
 SECTIONS = ("summary", "changes", "convergence", "trajectories", "laws", "failures", "performance", "timings",
             "environment")
@@ -286,8 +287,6 @@ def _changes(changes: Any) -> str:
 
 
 def _convergence(report: Report) -> str:
-    from .plots import convergence_plot
-
     studies = [s for s in report.studies if hasattr(s, "fits")]
     if not studies:
         return '<p class="note">No convergence studies in this run.</p>'
@@ -308,8 +307,6 @@ def _convergence(report: Report) -> str:
 
 
 def _trajectories(report: Report) -> str:
-    from .plots import trajectory_plot
-
     if not report.trajectories:
         return '<p class="note">No trajectory samples in this run.</p>'
     figs = [f"<figure>{trajectory_plot(s)}<figcaption>{_e(s.get('stepper'))} on the coarsest grid of the "

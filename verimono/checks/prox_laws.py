@@ -1,0 +1,210 @@
+"""Value laws: what ``prox_{λg}`` must satisfy *for the given* ``g`` (operators providing ``value``).
+
+For a proper closed convex ``g``, ``p = J_λx = prox_{λg}(x)`` is the unique minimiser of the 1-strongly
+convex ``Φ(z) = λg(z) + |z - x|²/2``, characterised by the prox inequality
+
+    ⟨x - p, z - p⟩ ≤ λ (g(z) - g(p))   for every z          (⟺ Φ(p) + |z - p|²/2 ≤ Φ(z)),
+
+equivalently ``(x - p)/λ ∈ ∂g(p)`` (the subgradient inequality, tested by the value-based ``contains`` of
+:func:`verimono.prox.subgradient_contains`, through ``yosida_in_graph``).  The resolvent laws hold for the
+prox of *any* convex function; these laws tie it to the stated ``g`` and catch the exact prox of a wrong
+one (a wrong weight, another norm's formula, a degenerate functional).  The Moreau envelope
+``e_λ(x) = g(p) + |x - p|²/(2λ)`` is convex and differentiable with the ``1/λ``-Lipschitz gradient
+``Y_λx = (x - p)/λ``, hence two-sided bounds between any two points.
+
+Each evaluator takes ``(op, s)`` with ``s`` a :class:`verimono.checks.operator_laws.Sample` and returns an
+:class:`Outcome` whose ratio is the violation in units of its slack (``(lhs - rhs)/slack``), so a
+negative or small ratio holds.  Slacks: ``τ = tolerance(x, p, z)`` per point (the resolvent's accuracy,
+:mod:`verimono.tolerances`), propagated through each side, plus ``tolerance`` of the function values.
+"""
+
+from __future__ import annotations
+
+import math
+import zlib
+
+import numpy as np
+
+from .core import Outcome
+from ..tolerances import RTOL, tolerance
+
+#: the independent minimiser (scipy.optimize, derivative-free Powell) runs only on R^n with n ≤ this
+MINIMISER_MAX_DIM = 4
+#: relative perturbation sizes of the optimality law, times 1 + |p|_∞
+PERTURBATIONS = (1e-4, 1e-2, 1.0)
+
+
+def _J(op, x, lam, t):
+    y = np.asarray(op.resolvent(x.copy(), lam, t), dtype=float)
+    if y.shape != x.shape or not np.all(np.isfinite(y)):
+        raise ValueError(f"resolvent returned {y!r} for a point of shape {x.shape}")
+    return y
+
+
+def _tolf(*values: float) -> float:
+    """:func:`verimono.tolerances.tolerance` of scalars, in Python floats (called per perturbation)."""
+    return RTOL * (1.0 + max(abs(v) for v in values))
+
+
+def _g(op, z, t) -> float:
+    return float(op.value(np.array(z, dtype=float), t))
+
+
+def _nrm(v) -> float:
+    v = np.asarray(v, dtype=float)
+    m = float(np.max(np.abs(v), initial=0.0))
+    return 0.0 if m == 0.0 or not np.isfinite(m) else m * float(np.linalg.norm(v / m))
+
+
+def _outside(p, gp, what) -> Outcome:
+    return Outcome.compare(math.inf, 0.0, 1.0, f"{what}: g(p) = {gp} at p = J_λx, so p ∉ dom g",
+                           {"p": p.tolist(), "g(p)": gp})
+
+
+def _directions(x, p, n, seed_like) -> list[np.ndarray]:
+    """Unit directions: the coordinates, ``x - p``, ``p`` and seeded random ones (deterministic in the sample)."""
+    dirs = [np.eye(n)[i] for i in range(min(n, 3))]
+    for v in (x - p, p):
+        nv = _nrm(v)
+        if nv > 0:
+            dirs.append(v / nv)
+    rng = np.random.default_rng(zlib.crc32(np.asarray(seed_like, dtype=float).tobytes()))
+    for _ in range(2):
+        v = rng.standard_normal(n)
+        dirs.append(v / _nrm(v))
+    return dirs
+
+
+def _prox_inequality(op, s):
+    x, lam, t = s.x1, s.lam, s.t
+    p = _J(op, x, lam, t)
+    gp = _g(op, p, t)
+    if not math.isfinite(gp):
+        return _outside(p, gp, "prox inequality")
+    cands = [("x2", s.x2), ("x1", x), ("0", np.zeros_like(x))]
+    for k, (lab, v) in enumerate((("J_μ x2", s.x2), ("J_μ x1", x), ("J_ν x2", s.x2))):
+        try:
+            cands.append((lab, _J(op, v, s.mu if k < 2 else s.nu, t)))
+        except Exception:   # noqa: BLE001 - other resolvent values are only extra test points
+            pass
+    worst = None
+    for lab, z in cands:
+        gz = _g(op, z, t)
+        if gz == math.inf:
+            continue
+        tau = tolerance(x, p, z)
+        lhs = float((x - p) @ (z - p))
+        rhs = lam * (gz - gp)
+        slack = 4 * tau * (_nrm(x - p) + _nrm(z - p) + tau) + 4 * lam * tolerance(gp, gz)
+        ev = Outcome.compare(lhs - rhs, 0.0, slack, "⟨x - p, z - p⟩ ≤ λ(g(z) - g(p)) for p = prox_{λg}(x), z = " + lab,
+                             {"p": p.tolist(), "z": z.tolist(), "z_is": lab, "g(p)": gp, "g(z)": gz})
+        if worst is None or not ev.ratio <= worst.ratio:
+            worst = ev
+    return worst
+
+
+def _phi(op, z, x, lam, t):
+    return lam * _g(op, z, t) + 0.5 * float((z - x) @ (z - x))
+
+
+def _prox_optimal(op, s):
+    x, lam, t = s.x1, s.lam, s.t
+    p = _J(op, x, lam, t)
+    gp = _g(op, p, t)
+    if not math.isfinite(gp):
+        return _outside(p, gp, "optimality")
+    fp = lam * gp + 0.5 * float((p - x) @ (p - x))
+    s0 = 1.0 + float(np.max(np.abs(p), initial=0.0))
+    tau, dxp = tolerance(x, p), _nrm(x - p)
+    worst, at = -math.inf, None
+    for d in _directions(x, p, x.size, x):
+        for h in PERTURBATIONS:
+            for sgn in (1.0, -1.0):
+                z = p + sgn * h * s0 * d
+                fz = _phi(op, z, x, lam, t)
+                if fz == math.inf:
+                    continue
+                dz = h * s0
+                slack = 4 * _tolf(fp, fz, lam * gp) + 4 * tau * (dxp + dz + tau)
+                r = (fp + 0.5 * dz * dz - fz) / slack
+                if not r <= worst:
+                    worst, at = r, (z, fz, slack)
+    if at is None:
+        return Outcome.compare(0.0, 0.0, 1.0, "optimality: every perturbation left dom g (sample inconclusive)", {},
+                               inconclusive=True)
+    z, fz, slack = at
+    dz2 = float((z - p) @ (z - p))
+    return Outcome.compare(fp + 0.5 * dz2 - fz, 0.0, slack,
+                           "Φ(p) + |z - p|²/2 ≤ Φ(z), Φ(z) = λg(z) + |z - x|²/2, at z = p + δ (perturbation)",
+                           {"p": p.tolist(), "z": z.tolist(), "Phi(p)": fp, "Phi(z)": fz})
+
+
+def _prox_minimiser(op, s):
+    x, lam, t = s.x1, s.lam, s.t
+    n = x.size
+    if n > MINIMISER_MAX_DIM:
+        return Outcome.compare(0.0, 0.0, 1.0, f"independent minimiser runs only for n ≤ {MINIMISER_MAX_DIM} "
+                               "(sample inconclusive)", {}, inconclusive=True)
+    from scipy.optimize import minimize
+
+    p = _J(op, x, lam, t)
+    gp = _g(op, p, t)
+    if not math.isfinite(gp):
+        return _outside(p, gp, "independent minimiser")
+    fp = lam * gp + 0.5 * float((p - x) @ (p - x))
+    big = 1e300
+
+    def phi(z):
+        v = _phi(op, np.asarray(z, dtype=float), x, lam, t)
+        return v if v < big else big
+    best, zbest = math.inf, None
+    scale = 1.0 + float(np.max(np.abs(x), initial=0.0))
+    for z0 in (p, x):
+        if phi(z0) >= big:
+            continue
+        res = minimize(phi, z0, method="Powell", options={"xtol": 1e-10 * scale, "ftol": 1e-14, "maxfev": 200 * n})
+        if res.fun < best:
+            best, zbest = float(res.fun), np.asarray(res.x, dtype=float)
+    if zbest is None:
+        return Outcome.compare(0.0, 0.0, 1.0, "independent minimiser: no start point in dom g (sample inconclusive)",
+                               {}, inconclusive=True)
+    tau = tolerance(x, p)
+    slack = 4 * tolerance(fp, best, lam * gp) + 4 * tau * (_nrm(x - p) + tau)
+    return Outcome.compare(fp - best, 0.0, slack,
+                           "Φ(p) ≤ Φ(z*) for z* an independent minimiser (Powell) of Φ(z) = λg(z) + |z - x|²/2",
+                           {"p": p.tolist(), "z_star": zbest.tolist(), "Phi(p)": fp, "Phi(z_star)": best})
+
+
+def _moreau_envelope(op, s):
+    lam, t = s.lam, s.t
+    x1, x2 = s.x1, s.x2
+    p1, p2 = _J(op, x1, lam, t), _J(op, x2, lam, t)
+    g1, g2 = _g(op, p1, t), _g(op, p2, t)
+    for p, gv in ((p1, g1), (p2, g2)):
+        if not math.isfinite(gv):
+            return _outside(p, gv, "Moreau envelope")
+    e1 = g1 + float((x1 - p1) @ (x1 - p1)) / (2 * lam)
+    e2 = g2 + float((x2 - p2) @ (x2 - p2)) / (2 * lam)
+    y1 = (x1 - p1) / lam
+    dx = x2 - x1
+    lin = e1 + float(y1 @ dx)
+    quad = float(dx @ dx) / (2 * lam)
+    tau = tolerance(x1, x2, p1, p2)
+    slack = 4 * tolerance(e1, e2, lin, g1, g2) + 4 * tau * (_nrm(y1) + _nrm(dx) / lam + tau / lam) * (1.0 + _nrm(dx))
+    info = {"p1": p1.tolist(), "p2": p2.tolist(), "e1": e1, "e2": e2, "grad1": y1.tolist()}
+    low = Outcome.compare(lin - e2, 0.0, slack, "e_λ(x1) + ⟨Y_λx1, x2 - x1⟩ ≤ e_λ(x2) (the envelope "
+                          "e_λ(x) = g(J_λx) + |x - J_λx|²/(2λ) is convex with gradient Y_λx)", info)
+    high = Outcome.compare(e2 - lin - quad, 0.0, slack, "e_λ(x2) ≤ e_λ(x1) + ⟨Y_λx1, x2 - x1⟩ + |x2 - x1|²/(2λ) "
+                           "(the gradient Y_λ of the envelope is 1/λ-Lipschitz)", info)
+    return low if not low.ratio <= high.ratio else high
+
+
+#: (law name, evaluator, label) of the value laws, in the order they run
+VALUE_LAWS = [
+    ("prox_inequality", _prox_inequality, "prox inequality"),
+    ("prox_optimal", _prox_optimal, "prox optimality (perturbations)"),
+    ("prox_minimiser", _prox_minimiser, "prox optimality (independent minimiser)"),
+    ("moreau_envelope", _moreau_envelope, "Moreau envelope"),
+]
+
+__all__ = ["VALUE_LAWS", "MINIMISER_MAX_DIM", "PERTURBATIONS"]

@@ -1,0 +1,121 @@
+"""The scale sweep: seeded samples at every scale, evaluated after the hypothesis search of each law.
+
+Hypothesis draws points of moderate size and climbs toward large ratios; a bug confined to a thin region
+(a prox that crashes or takes a wrong branch only for ``|x| < 10^-6``, or only on the boundary of its
+domain) is then found at some seeds only.  The sweep evaluates every law, after its search, on
+``count`` samples drawn from ``numpy.random.default_rng(seed)`` (the record's seed, so the same seed gives
+the same samples): ``x1`` at each scale of :data:`SCALES` in turn (from ``10^-9`` to ``10^6``; every
+third one with a single nonzero coordinate, the boundary of orthants, boxes and ℓ1 balls), ``x2`` near
+``x1`` or at another scale, and every fourth sample replaced by ``J_ν x`` and ``J_ν(J_ν x)`` — points in
+the range of the resolvent, i.e. on the boundary of ``dom F`` for a normal cone.  Step sizes are
+log-uniform in ``[10^-3, 10]`` (``λ = 1`` every fifth sample), times uniform in ``[0, horizon]`` with both
+ends included.
+
+A sweep sample that breaks the law is shrunk greedily (:func:`shrink`: ``t → 0``, step sizes → 1,
+coordinates → 0, then each coordinate rounded to fewer digits, kept while the law still fails) and
+reported like a hypothesis counterexample (``counterexample["found_by"] = "sweep"``); it is replayed by
+``sample=``.
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+
+#: magnitudes of the swept points: tiny (below the rounding scale of a unit problem), unit, huge
+SCALES = (1e-9, 1e-7, 5e-7, 1e-5, 1e-3, 1e-1, 1.0, 3.0, 10.0, 1e2, 1e3)
+#: sweep samples per law and profile (``None``: a profile not of verimono's, e.g. a user's own)
+SWEEP_BY_PROFILE = {"dev": 33, "ci": 33, "thorough": 132, None: 33}
+#: laws whose one evaluation is expensive (an independent minimiser) see this many sweep samples at most
+SWEEP_CAP = {"prox_minimiser": 4}
+
+
+def sweep_count(profile: str | None, law: str) -> int:
+    n = SWEEP_BY_PROFILE.get(profile, SWEEP_BY_PROFILE[None])
+    return min(n, SWEEP_CAP.get(law, n))
+
+
+def sweep_samples(op, seed: int, horizon: float, count: int, make: Callable) -> list:
+    """``count`` samples (built by ``make(x1, x2, lam, mu, nu, t)``) for ``op`` on ``R^n``, seeded by ``seed``."""
+    n = int(op.dim)
+    rng = np.random.default_rng([int(seed) % (2 ** 63), n, count])
+    out = []
+    for i in range(count):
+        s1 = SCALES[i % len(SCALES)]
+        u = rng.uniform(-1.0, 1.0, n)
+        if i % 3 == 2:
+            u = np.zeros(n)
+            u[rng.integers(n)] = rng.choice((-1.0, 1.0))
+        x1 = s1 * u
+        if i % 2 == 0:
+            x2 = x1 + 1e-2 * s1 * rng.uniform(-1.0, 1.0, n)
+        else:
+            x2 = SCALES[rng.integers(len(SCALES))] * rng.uniform(-1.0, 1.0, n)
+        lam, mu, nu = (float(10.0 ** rng.uniform(-3.0, 1.0)) for _ in range(3))
+        if i % 5 == 0:
+            lam = 1.0
+        t = float((0.0, float(horizon))[i % 2]) if i % 7 < 2 else float(rng.uniform(0.0, horizon))
+        if i % 4 == 3:   # points in the range of J: J_ν x and J_ν(J_ν x)
+            try:
+                a = np.asarray(op.resolvent(x1.copy(), nu, t), dtype=float)
+                b = np.asarray(op.resolvent(a.copy(), nu, t), dtype=float)
+                if a.shape == x1.shape and b.shape == x1.shape and np.all(np.isfinite(a)) and np.all(np.isfinite(b)):
+                    x1, x2 = a, b
+            except Exception:   # noqa: BLE001 - the law itself evaluates (and fails) the raw point
+                pass
+        out.append(make(x1, x2, lam, mu, nu, t))
+    return out
+
+
+def _simpler_floats(v: float) -> list[float]:
+    if v == 0.0:
+        return []
+    out = []
+    for digits in (1, 2, 4):
+        r = float(f"{v:.{digits - 1}e}")
+        if r != v:
+            out.append(r)
+    return out
+
+
+def shrink(sample, fails: Callable[[object], bool], replace: Callable, budget: int = 300):
+    """Greedy shrinking of a failing ``sample``: simpler candidates (``t = 0``, step sizes 1, coordinates 0,
+    coordinates rounded to 1, 2, 4 significant digits) are kept while ``fails(candidate)``; at most
+    ``budget`` evaluations.  ``replace(sample, **fields)`` builds a modified sample."""
+    calls = 0
+
+    def attempt(cand) -> bool:
+        nonlocal calls, sample
+        if calls >= budget:
+            return False
+        calls += 1
+        try:
+            ok = fails(cand)
+        except Exception:   # noqa: BLE001 - a candidate the law cannot evaluate is not simpler
+            ok = False
+        if ok:
+            sample = cand
+        return ok
+
+    changed = True
+    while changed and calls < budget:
+        changed = False
+        for field, simple in (("t", 0.0), ("lam", 1.0), ("mu", 1.0), ("nu", 1.0)):
+            if getattr(sample, field) != simple:
+                changed |= attempt(replace(sample, **{field: simple}))
+        for field in ("x1", "x2"):
+            for i in range(getattr(sample, field).size):
+                v = getattr(sample, field)
+                if v[i] == 0.0:
+                    continue
+                for r in [0.0] + _simpler_floats(float(v[i])):
+                    w = v.copy()
+                    w[i] = r
+                    if attempt(replace(sample, **{field: w})):
+                        changed = True
+                        break
+    return sample, calls
+
+
+__all__ = ["SCALES", "SWEEP_BY_PROFILE", "SWEEP_CAP", "sweep_count", "sweep_samples", "shrink"]

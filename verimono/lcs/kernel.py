@@ -1,0 +1,611 @@
+"""The small-LCP kernel of :meth:`LinearRelationSystem.simulate` on a uniform grid (issue 15).
+
+With the constant step matrices of a uniform grid (:class:`StepMatrices`), one ``EulerMoreauOSI(θ, γ)`` step
+is, for a fixed *pattern* ``s ∈ {0, 1, 2}^m`` of the box relation ``−w ∈ N_[l,u](z)`` (``s_i = 0``: ``z_i = l_i``,
+``w_i ≥ 0``; ``1``: ``l_i < z_i < u_i``, ``w_i = 0``; ``2``: ``z_i = u_i``, ``w_i ≤ 0``), an **affine map** of
+``ξ = (x_k, e_k, 1)`` with ``e_k = (W^{-1}∫u, v(t_{k+1}))`` the exogenous terms (only those that vary):
+
+    z_I = −M_II^{-1}(q_I + (M z_fix)_I),  q = C(γ x_free + (1−γ)x_k) + v,  x_free = E x_k + W^{-1}∫u,
+    x_{k+1} = x_free + G z,  w = Mz + q,  w_out = C x_{k+1} + D z + v.
+
+The map of a pattern is built once (one LU of ``M_II``, accepted only when ``cond M_II ≤ ACTIVE_SET_COND``, and
+its identity ``w_I ≡ 0`` verified to ``QP_RTOL`` coefficient by coefficient), cached by pattern, and a step
+evaluates one map: a handful of multiply-adds.  Each step's candidate is **verified**: every sign condition
+of its pattern (``w_i > τ`` at ``l``, ``−w_i > τ`` at ``u``, ``z_i − l_i > τ`` and ``u_i − z_i > τ`` inside)
+must hold with the margin ``τ = RTOL·S_k``, ``S_k`` the size of the terms the checked entries are summed from
+(``‖T_P‖ |ξ_k|``), and every output must be finite.  A candidate that passes is *strictly* complementary
+with ``M_II`` nonsingular, hence (``M`` PSD) the **unique** solution of the step — so it is the least-norm
+solution of Proposition ``p:lcp2`` (the solution set is convex; a second solution would give a segment of
+solutions near the candidate keeping its pattern, where ``z_I`` is fixed by ``M_II``).  The pattern whose
+``z`` is 0 needs only ``w ≥ 0``, not strictly: no solution has a smaller norm (``solve_lcp``'s ``q ≥ 0``).
+When no candidate is strictly complementary, a *degenerate* one (``z_i ≈ 0 ≈ w_i`` in some components, e.g.
+a diode with zero current and voltage) is accepted for a complementarity relation only with a certificate
+that it is the least-norm solution (:meth:`StepKernel._least_norm_degenerate`: ``z_cᵀd ≥ 0`` on the tangent
+cone of every piece of ``SOL`` through it) — the DiodeBridgeCapFilter's non-unique steps.  Otherwise the kernel
+tries the pattern the violated signs point to, then (for ``≤ ENUM_PATTERNS`` patterns) every pattern, and
+only then the verified least-norm solver (``Relation.solve``, i.e. :func:`verimono.lcs.solve_lcp` /
+``solve_box``) with today's arithmetic; its solution's pattern is the next step's guess.
+
+**Batches.** ``x0`` of shape ``(B, n)``: every row carries its own pattern; rows with the same pattern are
+stepped together with the same elementwise operations, in the same order, as a single run (a single run
+evaluates the map in Python floats, a batch in NumPy columns: IEEE multiply-add by multiply-add, so the
+results are **bit-identical** to ``B`` separate runs).  A row whose step is infeasible or fails stops there;
+the others run to the end, then :class:`BatchStepError` carries every row's results (``valid`` masks the
+steps after a row's failure, which hold NaN) and names each failed row and step.
+
+Pure Python/NumPy: a compiled kernel (numba) would cost seconds of import and JIT per process, more than a
+whole Section 7 run takes with this one.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import math
+
+import numpy as np
+import scipy.linalg as sla
+
+from ..errors import BatchStepError, InfeasibleStep, InvalidProblem, SolverFailure, VerimonoError
+from ..tolerances import ACTIVE_SET_COND, QP_RTOL, RTOL
+from .lcp import lcp_scale
+from .relations import BoxRelation
+
+#: largest number of patterns (``∏ states``) that a failed guess is followed by trying all of
+ENUM_PATTERNS = 64
+
+_ROW_FNS: dict[int, object] = {}
+
+
+def _row_fn(ncols: int):
+    """``f(rows, v_0, …, v_{c−1}) = [r_0 + r_1 v_0 + … + r_c v_{c−1} for r in rows]`` (left to right)."""
+    fn = _ROW_FNS.get(ncols)
+    if fn is None:
+        names = [f"v{j}" for j in range(ncols)]
+        coefs = [f"a{j}" for j in range(ncols)]
+        expr = " + ".join(["c"] + [f"{a}*{v}" for a, v in zip(coefs, names)])
+        src = f"lambda rows, {', '.join(names)}: [{expr} for c, {', '.join(coefs)} in rows]" if ncols else \
+            "lambda rows: [c for (c,) in rows]"
+        fn = _ROW_FNS[ncols] = eval(src)  # noqa: S307  (generated from integers only)
+    return fn
+
+
+@dataclasses.dataclass
+class RowFailure:
+    """Why row ``row`` of a batch stopped: at step ``step`` (``t_step → t_{step+1}``) with ``error``."""
+
+    row: int
+    step: int
+    t: float
+    error: VerimonoError
+
+    def __str__(self) -> str:
+        return f"row {self.row}, step {self.step} (t = {self.t:.6g}): {type(self.error).__name__}: {self.error}"
+
+
+class _Pattern:
+    __slots__ = ("key", "s", "rows", "const", "cols", "oconst", "ocols", "coef", "ra", "re", "rb", "pcomp", "pnew")
+
+
+#: steps post-processed at a time when the outputs ``z``, ``w`` are evaluated after the loop (bounds memory)
+_OUT_BLOCK = 256
+
+
+class StepKernel:
+    """The per-pattern affine maps of one step for ``sm`` (see the module docstring).
+
+    A pattern's map has *step rows* ``(x_{k+1}, sign rows)`` — evaluated every step, in the loop — and
+    *output rows* ``(z_k, w_k)``, evaluated after the loop for all steps at once (the same multiply-adds).
+    ``exo_u``/``exo_v``: whether ``W^{-1}∫u`` / ``v`` vary (columns of ``e_k``); otherwise ``v_const`` is
+    folded into the constant column."""
+
+    def __init__(self, system, sm, *, exo_u: bool, exo_v: bool, v_const: np.ndarray | None) -> None:
+        rel = system.relation
+        if not isinstance(rel, BoxRelation):
+            raise TypeError("StepKernel needs a box relation (Complementarity, Relay)")
+        n, m = system.n, system.m
+        self.sys, self.sm, self.n, self.m = system, sm, n, m
+        self.M = sm.M
+        self.lo, self.hi = rel.bounds(m)
+        self.nstates = np.where(np.isfinite(self.hi), 3, 2)
+        self.exo_u, self.exo_v = exo_u, exo_v
+        self.v_const = v_const
+        self.F = n
+        self.L = n + int(self.nstates.sum() - m)   # x_{k+1} and the most sign rows a pattern has
+        g = sm.gamma
+        self.g = g
+        N = 2 * n + m + 1
+        I = np.eye(n)
+        X = np.zeros((n, N)); X[:, :n] = I
+        R = np.zeros((n, N)); R[:, n:2 * n] = I
+        V = np.zeros((m, N)); V[:, 2 * n:2 * n + m] = np.eye(m)
+        self._xfree = sm.E @ X + R
+        xq = self._xfree if g == 1.0 else g * self._xfree + (1.0 - g) * X
+        self._q = system.C @ xq + V
+        self._V = V
+        keep = list(range(n)) + (list(range(n, 2 * n)) if exo_u else []) + \
+            (list(range(2 * n, 2 * n + m)) if exo_v else [])
+        self._keep = keep
+        self.ne = len(keep) - n
+        self.fn = _row_fn(len(keep))
+        self.cache: dict[bytes, _Pattern | None] = {}
+        self.by_id: list[_Pattern] = []
+        self.enum = int(np.prod(self.nstates.astype(float))) <= ENUM_PATTERNS
+        self.is_lcp = bool(rel.is_lcp)
+        self._deg: dict = {}
+
+    # -- patterns --------------------------------------------------------------------------------------
+    def pattern(self, s: np.ndarray) -> _Pattern | None:
+        """The map of pattern ``s`` (cached), or None when ``M_II`` is too ill-conditioned or the map's
+        identity ``w_I ≡ 0`` fails its check."""
+        key = np.asarray(s).astype(np.int8).tobytes()
+        if key in self.cache:
+            return self.cache[key]
+        p = self.cache[key] = self._build(np.frombuffer(key, dtype=np.int8))
+        if p is not None:
+            p.key = len(self.by_id)
+            self.by_id.append(p)
+        return p
+
+    def _build(self, s: np.ndarray) -> _Pattern | None:
+        n, m, M, lo, hi = self.n, self.m, self.M, self.lo, self.hi
+        q = self._q
+        N = q.shape[1]
+        I = np.flatnonzero(s == 1)
+        fixed = np.where(s == 2, hi, lo)
+        fixed[I] = 0.0
+        Mfixed = M @ fixed
+        z = np.zeros((m, N))
+        z[:, -1] = fixed
+        if I.size:
+            MII = M[np.ix_(I, I)]
+            cond = np.linalg.cond(MII)
+            if not cond <= ACTIVE_SET_COND:
+                return None
+            rhs = q[I].copy()
+            rhs[:, -1] += Mfixed[I]
+            z[I] = -sla.lu_solve(sla.lu_factor(MII, check_finite=False), rhs, check_finite=False)
+        xn = self._xfree + self.sm.G @ z
+        wl = M @ z + q
+        wo = self.sys.C @ xn + self.sys.D @ z + self._V
+        if I.size:   # the identity w_I ≡ 0, coefficient by coefficient, against the terms it sums
+            size = np.abs(M[I]) @ np.abs(z) + np.abs(q[I])
+            if np.any(np.abs(wl[I]) > QP_RTOL * size):
+                return None
+        prow, pcomp, pnew = [], [], []
+        one = np.zeros(N); one[-1] = 1.0
+        for i in range(m):
+            if s[i] == 0:
+                prow.append(wl[i]); pcomp.append(i); pnew.append(1)
+            elif s[i] == 2:
+                prow.append(-wl[i]); pcomp.append(i); pnew.append(1)
+            else:
+                prow.append(z[i] - lo[i] * one); pcomp.append(i); pnew.append(0)
+                if np.isfinite(hi[i]):
+                    prow.append(hi[i] * one - z[i]); pcomp.append(i); pnew.append(2)
+        while len(prow) < self.L - n:   # pad with a repeated sign row: one row length for every pattern
+            prow.append(prow[0]); pcomp.append(pcomp[0]); pnew.append(pnew[0])
+        T = np.vstack([xn, np.array(prow), z, wo])
+        const = T[:, -1].copy()
+        if not self.exo_v and self.v_const is not None:
+            const = const + T[:, 2 * n:2 * n + m] @ self.v_const
+        cols = T[:, self._keep]
+        if not (np.all(np.isfinite(cols)) and np.all(np.isfinite(const))):
+            return None
+        L = self.L
+        P = slice(n, L)
+        p = _Pattern()
+        p.s = s.copy()
+        p.const, p.oconst = const[:L].copy(), const[L:].copy()
+        p.cols = [cols[:L, j].copy() for j in range(cols.shape[1])]
+        p.ocols = [cols[L:, j].copy() for j in range(cols.shape[1])]
+        p.rows = np.column_stack([const[:L], cols[:L]]).tolist()
+        p.coef = np.vstack([const[None], cols.T])          # (1 + ncols, L + 2m): every row, for batches
+        p.ra = RTOL * float(np.abs(cols[P, :n]).sum(axis=1).max())
+        p.re = RTOL * float(np.abs(cols[P, n:]).sum(axis=1).max(initial=0.0)) if self.ne else 0.0
+        p.rb = RTOL * float(np.abs(const[P]).max())
+        p.pcomp, p.pnew = np.array(pcomp), np.array(pnew)
+        if not I.size and not np.any(fixed):
+            # z = 0: no solution has a smaller norm, so w ≥ 0 (not strict, as in solve_lcp's q ≥ 0) suffices;
+            # ``min > −5e-324`` is ``min ≥ 0`` in doubles
+            p.ra = p.re = 0.0
+            p.rb = -5e-324
+        return p
+
+    # -- one row ---------------------------------------------------------------------------------------
+    def try_row(self, p: _Pattern, x: list, e: list, emax: float):
+        """The step rows of pattern ``p`` at ``(x, e)`` and whether its sign checks pass: ``(y, accepted)``."""
+        y = self.fn(p.rows, *x, *e)
+        if self.ne:
+            tau = p.ra * max(map(abs, x)) + p.re * emax + p.rb
+        else:
+            tau = p.ra * max(map(abs, x)) + p.rb
+        return y, min(y[self.F:]) > tau and all(map(math.isfinite, y))
+
+    def flipped(self, p: _Pattern, y) -> np.ndarray:
+        """The pattern the violated signs of ``p``'s candidate ``y`` point to."""
+        s = p.s.copy()
+        viol = np.asarray(y[self.F:]) <= 0.0
+        s[p.pcomp[viol]] = p.pnew[viol]
+        return s
+
+    def all_patterns(self):
+        for states in itertools.product(*[range(k) for k in self.nstates]):
+            yield np.array(states, dtype=np.int8)
+
+    def slow_row(self, pid: int, x: list, e: list, emax: float):
+        """A step whose guess ``pid`` failed (``pid < 0``: no guess, start from ``z = 0``): the patterns the
+        violated signs point to (at most ``m`` in turn), every pattern when there are few, then the verified
+        least-norm solver.
+
+        Returns ``(x_{k+1}, pattern of this step, guess for the next, (z, w) or None)``: ``(z, w)`` only when
+        the solver, not a pattern's map, made the step (the pattern is then −1)."""
+        if pid >= 0:
+            p = self.by_id[pid]
+            y, ok = self.try_row(p, x, e, emax)
+            s = self.flipped(p, y)
+        else:
+            s = np.zeros(self.m, dtype=np.int8)
+        for _ in range(self.m):   # follow the violated signs (principal pivoting), at most m times
+            q2 = self.pattern(s)
+            if q2 is None:
+                break
+            y, ok = self.try_row(q2, x, e, emax)
+            if ok:
+                return y[:self.F], q2.key, q2.key, None
+            s = self.flipped(q2, y)
+        if self.enum:
+            for s in self.all_patterns():
+                p = self.pattern(s)
+                if p is not None:
+                    y, ok = self.try_row(p, x, e, emax)
+                    if ok:
+                        return y[:self.F], p.key, p.key, None
+        # no strictly complementary candidate: a degenerate one that is provably the least-norm solution
+        for p in ([self.pattern(s) for s in self.all_patterns()] if self.enum else
+                  [self.by_id[pid]] if pid >= 0 else []):
+            if p is not None:
+                y, _ = self.try_row(p, x, e, emax)
+                if self._least_norm_degenerate(p, y, x, emax):
+                    return y[:self.F], p.key, p.key, None
+        return self.solve_row(x, e)
+
+    def _least_norm_degenerate(self, p: _Pattern, y: list, x: list, emax: float) -> bool:
+        """Whether ``p``'s candidate, a solution whose sign rows are ``≥ −(QP_RTOL/RTOL)τ`` but some ``≤ τ`` (the
+        *degenerate* components ``Dg``: ``z_i ≈ 0 ≈ w_i``), is the least-norm solution (complementarity only).
+
+        ``SOL(q, M)`` is convex and, near the candidate ``z_c``, the union of the pieces
+        ``P_γ = {z_γ̄ = 0, z_γ ≥ 0, w_γ = 0, w_γ̄ ≥ 0}`` with ``Z ⊆ γ ⊆ Z ∪ Dg`` (``Z``: ``z_i > τ``), so ``z_c`` is
+        least-norm iff ``z_cᵀd ≥ 0`` on each piece's tangent cone: ``{0}`` when ``M_γγ`` is nonsingular; for a
+        one-dimensional ``ker M_γγ = span(ν)`` the directions ``±ν`` that keep ``d_i ≥ 0`` (``i ∈ γ ∩ Dg``) and
+        ``(Md)_i ≥ 0`` (``i ∈ Dg`` outside ``γ``).  Larger kernels are left to the solver."""
+        if not self.is_lcp or not all(map(math.isfinite, y)):
+            return False
+        n, m = self.n, self.m
+        tau = (p.ra * max(map(abs, x)) + p.re * emax + p.rb) if self.ne else (p.ra * max(map(abs, x)) + p.rb)
+        tol = (QP_RTOL / RTOL) * tau
+        P = np.array(y[n:n + m])
+        if tau <= 0.0 or P.min() <= -tol:
+            return False
+        deg = P <= tau
+        if not deg.any():
+            return False
+        key = (p.key, deg.tobytes())
+        cert = self._deg.get(key, False)
+        if cert is False:
+            cert = self._deg[key] = self._degenerate_certificate(p.s, deg)
+        if cert is None:
+            return False
+        z = np.where(p.s == 1, P, 0.0)
+        return all(sg * float(nu @ z) >= -tol * float(np.abs(nu).sum()) for sg, nu in cert)
+
+    def _degenerate_certificate(self, s: np.ndarray, deg: np.ndarray):
+        """The directions ``(σ, ν)`` of :meth:`_least_norm_degenerate` for pattern ``s`` and degenerate set
+        ``deg``, or None when some piece's ``M_γγ`` has a kernel of dimension ≥ 2 or an undecided rank."""
+        M = self.M
+        Zs = np.flatnonzero((s == 1) & ~deg)
+        Dg = np.flatnonzero(deg)
+        out = []
+        big = float(np.abs(M).max()) or 1.0
+        for r in range(Dg.size + 1):
+            for S in itertools.combinations(Dg.tolist(), r):
+                g = np.sort(np.concatenate([Zs, np.array(S, dtype=int)])).astype(int)
+                if not g.size:
+                    continue
+                U, sv, Vt = np.linalg.svd(M[np.ix_(g, g)])
+                zero = sv <= RTOL * big
+                if np.any(~zero & (sv < sv[0] / ACTIVE_SET_COND)):
+                    return None   # an undecided rank
+                if zero.sum() == 0:
+                    continue
+                if zero.sum() > 1:
+                    return None
+                nu = np.zeros(self.m)
+                nu[g] = Vt[-1] / np.abs(Vt[-1]).max()
+                Mnu = M @ nu
+                inside = [i for i in Dg.tolist() if i in set(g.tolist())]
+                outside = [i for i in Dg.tolist() if i not in set(g.tolist())]
+                small = RTOL * (1.0 + float(np.abs(Mnu).max()))
+                for sg in (1.0, -1.0):
+                    if all(sg * nu[i] >= -small for i in inside) and all(sg * Mnu[i] >= -small for i in outside):
+                        out.append((sg, nu))
+        return out
+
+    def solve_row(self, x: list, e: list):
+        """Today's arithmetic: ``x_free``, ``q``, the relation's verified least-norm solve, the update."""
+        n, m, sm, sysm = self.n, self.m, self.sm, self.sys
+        xk = np.array(x)
+        ev = np.array(e)
+        xfree = sm.E @ xk
+        if self.exo_u:
+            xfree = xfree + ev[:n]
+        v = ev[self.ne - m:] if self.exo_v else (self.v_const if self.v_const is not None else np.zeros(m))
+        xq = xfree if self.g == 1.0 else self.g * xfree + (1.0 - self.g) * xk
+        q = sysm.C @ xq + v
+        if not (np.all(np.isfinite(xk)) and np.all(np.isfinite(q))):
+            raise SolverFailure("the state or the one-step data are not finite (overflow)")
+        r = sysm.relation.solve(self.M, q, sysm.q_scale(xq, v))
+        z = r.z
+        xn = xfree + sm.G @ z
+        wo = sysm.C @ xn + sysm.D @ z + v
+        if not (np.all(np.isfinite(xn)) and np.all(np.isfinite(z)) and np.all(np.isfinite(wo))):
+            raise SolverFailure("the step produced non-finite values (overflow)")
+        tau = RTOL * lcp_scale(self.M, q, z)
+        s = np.where(z - self.lo <= tau, 0, np.where(self.hi - z <= tau, 2, 1)).astype(np.int8)
+        p = self.pattern(s)
+        return xn.tolist(), -1, (p.key if p is not None else -1), (z, wo)
+
+    # -- runs ------------------------------------------------------------------------------------------
+    def run(self, x0: np.ndarray, E: np.ndarray | None, t: np.ndarray):
+        """One trajectory: ``x (K+1, n)``, ``z``, ``w`` ``(K, m)``; errors name the step."""
+        K = t.size - 1
+        n = self.n
+        x = x0.tolist()
+        El = E.tolist() if E is not None else None
+        emax = np.abs(E).max(axis=1).tolist() if E is not None and self.ne else None
+        empty: list = []
+        pid = -1
+        xs = [x]
+        pids = []
+        explicit = {}
+        by_id, fn, ne, isfinite = self.by_id, self.fn, self.ne, math.isfinite
+        for k in range(K):
+            e = El[k] if El is not None else empty
+            em = emax[k] if emax is not None else 0.0
+            if pid >= 0:   # try_row, inlined: the step rows of the guess and their checks
+                p = by_id[pid]
+                y = fn(p.rows, *x, *e)
+                tau = p.ra * max(map(abs, x)) + p.re * em + p.rb if ne else p.ra * max(map(abs, x)) + p.rb
+                if min(y[n:]) > tau and all(map(isfinite, y)):
+                    x = y[:n]
+                    xs.append(x)
+                    pids.append(pid)
+                    continue
+            try:
+                x, this, pid, zw = self.slow_row(pid, x, e, em)
+            except (InfeasibleStep, SolverFailure, InvalidProblem) as exc:
+                raise type(exc)(f"step {k} (t = {t[k]:.6g} → {t[k + 1]:.6g}): {exc}") from exc
+            if zw is not None:
+                explicit[k] = zw
+            xs.append(x)
+            pids.append(this)
+        X = np.array(xs)
+        Z, W = self.outputs(X, np.array(pids, dtype=np.int64), E, explicit)
+        return X, Z, W
+
+    # -- batches ---------------------------------------------------------------------------------------
+    def _stacked(self):
+        """Every pattern's coefficients ``(npat + 1, 1 + ncols, L + 2m)`` and margins ``(npat + 1, 3)``; the
+        last entry (index −1, "no pattern") is NaN, so its candidates never pass."""
+        if getattr(self, "_stack_n", -1) != len(self.by_id):
+            nc, Lf = len(self._keep) + 1, self.L + 2 * self.m
+            st = np.full((len(self.by_id) + 1, nc, Lf), np.nan)
+            mg = np.full((len(self.by_id) + 1, 3), np.nan)
+            for p in self.by_id:
+                st[p.key] = p.coef
+                mg[p.key] = (p.ra, p.re, p.rb)
+            self._stack, self._margins, self._stack_n = st, mg, len(self.by_id)
+        return self._stack, self._margins
+
+    def _eval_rows(self, pids: np.ndarray, XT: np.ndarray, ET, em):
+        """Candidates ``(L + 2m, b)`` of the patterns ``pids`` at the states ``XT (n, b)`` (exogenous ``ET``:
+        ``(ne,)`` shared or ``(ne, b)``) and whether their step rows pass: the multiply-adds of
+        :meth:`try_row`, in the same order, elementwise."""
+        st, mg = self._stacked()
+        return self._eval_T(np.ascontiguousarray(st[pids].transpose(1, 2, 0)), mg[pids].T, XT, ET, em)
+
+    def _eval_T(self, CT, MG, XT, ET, em):
+        n, L = self.n, self.L
+        Y = CT[0] + CT[1] * XT[0]
+        for j in range(1, n):
+            Y = Y + CT[1 + j] * XT[j]
+        for j in range(self.ne):
+            Y = Y + CT[1 + n + j] * ET[j]
+        ax = np.abs(XT[0])
+        for j in range(1, n):
+            ax = np.maximum(ax, np.abs(XT[j]))
+        tau = MG[0] * ax + MG[1] * em + MG[2] if self.ne else MG[0] * ax + MG[2]
+        ok = (Y[n:L].min(axis=0) > tau) & np.isfinite(Y[:L]).all(axis=0)
+        return Y, ok
+
+    def _flip_rows(self, pid: np.ndarray, YP: np.ndarray) -> np.ndarray:
+        """:meth:`flipped` for many rows (``YP``: their sign rows, ``(P, b)``): the pattern ids the violated
+        signs point to (−1 where that pattern is unusable; the zero pattern for rows without a guess)."""
+        out = np.full(pid.size, -1, dtype=np.int64)
+        for p_id in set(pid.tolist()):
+            sel = np.flatnonzero(pid == p_id)
+            if p_id < 0:
+                z = self.pattern(np.zeros(self.m, dtype=np.int8))
+                out[sel] = -1 if z is None else z.key
+                continue
+            p = self.by_id[p_id]
+            S = np.broadcast_to(p.s, (sel.size, self.m)).copy()
+            viol = YP[:, sel] <= 0.0
+            for r in range(viol.shape[0]):
+                S[viol[r], p.pcomp[r]] = p.pnew[r]
+            for j, srow in zip(sel.tolist(), S):
+                q = self.pattern(srow)
+                out[j] = -1 if q is None else q.key
+        return out
+
+    def run_batch(self, X0: np.ndarray, E: np.ndarray | None, t: np.ndarray):
+        """``B`` trajectories: ``(x (K+1, B, n), z, w (K, B, m), failures)``, the arrays transposed views of
+        row-major buffers (``x[k]`` is ``XT[k].T``); ``E`` is ``(K, ne)`` shared or ``(K, B, ne)``.  A failed row
+        is NaN from its failure on; ``failures`` is the :class:`RowFailure` list.
+
+        Every row keeps its pattern's coefficients in columns of ``CT (1 + ncols, L + 2m, B)``, so a step is a
+        few elementwise operations on rows of length ``B``.  A failed guess is followed, for all failed rows at
+        once, by the patterns :meth:`slow_row` tries (the flipped one, then every pattern when there are few),
+        then by :meth:`slow_row` row by row: a candidate that passes is the unique solution, so the rows get
+        the same bits as single runs."""
+        K = t.size - 1
+        B = X0.shape[0]
+        n, m, L, ne = self.n, self.m, self.L, self.ne
+        XA = np.empty((K + 1, n, B))
+        ZW = np.empty((K, 2 * m, B))
+        X = XA.transpose(0, 2, 1)
+        Z, W = ZW[:, :m].transpose(0, 2, 1), ZW[:, m:].transpose(0, 2, 1)
+        X[0] = X0
+        XT = XA[0]
+        pid = np.full(B, -1, dtype=np.int64)
+        st, mg = self._stacked()
+        CT = np.ascontiguousarray(st[pid].transpose(1, 2, 0))
+        MG = np.ascontiguousarray(mg[pid].T)
+        alive = np.ones(B, dtype=bool)
+        failures: list[RowFailure] = []
+        shared = E is not None and E.ndim == 2
+        emax = np.abs(E).max(axis=-1) if E is not None and ne else None   # (K,) or (K, B)
+
+        def exo(k, rows):
+            if not ne:
+                return None, None
+            if shared:
+                return E[k], emax[k]
+            return (E[k].T, emax[k]) if rows is None else (E[k, rows].T, emax[k, rows])
+
+        stepped = np.zeros(B, dtype=bool)   # rows a pattern's map has made this step (after a failed guess)
+
+        def accept(k, rows, Y, ok, newp):
+            r = rows[ok]
+            if r.size:
+                stepped[r] = True
+                XA[k + 1][:, r] = Y[:n, ok]
+                ZW[k][:, r] = Y[L:, ok]
+                newp = newp[ok] if np.ndim(newp) else np.full(r.size, newp)
+                pid[r] = newp
+                st, mg = self._stacked()
+                CT[:, :, r] = st[newp].transpose(1, 2, 0)
+                MG[:, r] = mg[newp].T
+            return ~ok
+
+        for k in range(K):
+            Y, ok = self._eval_T(CT, MG, XT, *exo(k, None))
+            XA[k + 1] = Y[:n]
+            ZW[k] = Y[L:]
+            XT_old, XT = XT, XA[k + 1]
+            if ok.all():
+                continue
+            rows = np.flatnonzero(~ok & alive)
+            if not rows.size:
+                continue
+            stepped[rows] = False
+            old = pid[rows].copy()
+            XTr = XT_old[:, rows]
+            Er, em = exo(k, rows)
+            guess = self._flip_rows(old, Y[n:L][:, rows])
+            cur, Xc = rows, XTr                  # the rows still following their violated signs
+            for _ in range(m):
+                live = guess >= 0
+                cur, guess, Xc = cur[live], guess[live], Xc[:, live]
+                if not cur.size:
+                    break
+                Er, em = exo(k, cur)
+                Y2, ok2 = self._eval_rows(guess, Xc, Er, em)
+                keep = accept(k, cur, Y2, ok2, guess)
+                cur, Xc = cur[keep], Xc[:, keep]
+                guess = self._flip_rows(guess[keep], Y2[n:L][:, keep])
+            left = ~stepped[rows]
+            rows, old, XTr = rows[left], old[left], XTr[:, left]
+            if self.enum and rows.size:
+                for s in self.all_patterns():
+                    if not rows.size:
+                        break
+                    p = self.pattern(s)
+                    if p is None:
+                        continue
+                    Er, em = exo(k, rows)
+                    Y3, ok3 = self._eval_rows(np.full(rows.size, p.key), XTr, Er, em)
+                    keep = accept(k, rows, Y3, ok3, p.key)
+                    rows, old, XTr = rows[keep], old[keep], XTr[:, keep]
+            for i, o in zip(rows.tolist(), old.tolist()):
+                x = XT_old[:, i].tolist()
+                if ne:
+                    e = (E[k] if shared else E[k, i]).tolist()
+                    emi = float(emax[k] if shared else emax[k, i])
+                else:
+                    e, emi = [], 0.0
+                try:
+                    xn, this, nxt, zw = self.slow_row(o, x, e, emi)
+                except (InfeasibleStep, SolverFailure, InvalidProblem) as exc:
+                    err = type(exc)(f"step {k} (t = {t[k]:.6g} → {t[k + 1]:.6g}): {exc}")
+                    err.__cause__ = exc
+                    failures.append(RowFailure(i, k, float(t[k]), err))
+                    alive[i] = False
+                    nxt = -1
+                    XA[k + 1:, :, i] = np.nan
+                    ZW[k:, :, i] = np.nan
+                else:
+                    XA[k + 1, :, i] = xn
+                    if zw is None:   # a pattern's map made the step: its output rows, as a single run has them
+                        Er, em = exo(k, np.array([i]))
+                        Y4, _ = self._eval_rows(np.array([this]), XT_old[:, i:i + 1], Er, em)
+                        ZW[k, :, i] = Y4[L:, 0]
+                    else:
+                        ZW[k, :m, i], ZW[k, m:, i] = zw
+                pid[i] = nxt
+                st, mg = self._stacked()
+                CT[:, :, i] = st[nxt]
+                MG[:, i] = mg[nxt]
+            if not alive.any():
+                break
+        # a finite state with a non-finite multiplier or output (overflow in the output rows only)
+        bad = ~np.isfinite(ZW).all(axis=1)
+        bad[:, ~alive] = False
+        for i in np.flatnonzero(bad.any(axis=0)).tolist():
+            k = int(np.flatnonzero(bad[:, i])[0])
+            failures.append(RowFailure(i, k, float(t[k]), SolverFailure(
+                f"step {k} (t = {t[k]:.6g} → {t[k + 1]:.6g}): the multiplier or output is not finite (overflow)")))
+            XA[k + 1:, :, i] = np.nan
+            ZW[k:, :, i] = np.nan
+        failures.sort(key=lambda f: f.row)
+        return X, Z, W, failures
+
+    def outputs(self, X: np.ndarray, PID: np.ndarray, E: np.ndarray | None, explicit: dict):
+        """``z``, ``w`` ``(K, m)`` of a single run: each run of steps with one pattern through its output rows
+        (the multiply-adds of the batch, elementwise), the solver's where it made the step."""
+        K = PID.size
+        m, n, ne = self.m, self.n, self.ne
+        Z = np.empty((K, m))
+        W = np.empty((K, m))
+        cuts = np.concatenate([[0], np.flatnonzero(PID[1:] != PID[:-1]) + 1, [K]]).tolist()
+        for a, b in zip(cuts[:-1], cuts[1:]):
+            p_id = int(PID[a])
+            if p_id < 0:
+                continue
+            p = self.by_id[p_id]
+            Xk = X[a:b]
+            Y = p.oconst + p.ocols[0] * Xk[:, 0:1]
+            for j in range(1, n):
+                Y = Y + p.ocols[j] * Xk[:, j:j + 1]
+            for j in range(ne):
+                Y = Y + p.ocols[n + j] * E[a:b, j:j + 1]
+            Z[a:b], W[a:b] = Y[:, :m], Y[:, m:]
+        for k, (z, w) in explicit.items():
+            Z[k], W[k] = z, w
+        if not (np.all(np.isfinite(Z)) and np.all(np.isfinite(W))):
+            k = int(np.flatnonzero(~(np.isfinite(Z).all(axis=1) & np.isfinite(W).all(axis=1)))[0])
+            raise SolverFailure(f"step {k}: the multiplier or output is not finite (overflow)")
+        return Z, W
+
+
+__all__ = ["StepKernel", "BatchStepError", "RowFailure", "ENUM_PATTERNS"]
