@@ -19,7 +19,6 @@ from .stepping import Trajectory, solve, stream
 from .pseudo_distance import pseudo_distance_lower_bound
 from .convergence import ConvergenceStudy, ErrorAccumulator, convergence_study
 from . import sets
-from .report import notebook as _notebook  # noqa: F401  (registers the notebook renderers: verimono.display)
 
 
 def __getattr__(name: str):

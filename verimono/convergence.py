@@ -38,6 +38,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from ._jsonable import to_jsonable
+from .display import render
 from .errors import InvalidProblem
 from .grids import uniform_grid, validate_grid
 from .problem import Order, Problem
@@ -153,18 +154,12 @@ class ConvergenceStudy:
 
     def _repr_html_(self) -> str | None:
         """Jupyter: the report's log-log plot of this study next to its table of errors and orders."""
-        from .display import render
-
         return render("study_html", self)
 
     def plot(self, ax: Any = None) -> Any:
         """The report's log-log plot (errors per norm, fitted slope with its 95% interval, expected slope,
         round-off floor) as a matplotlib ``Figure`` on the Agg canvas, or drawn on ``ax``."""
-        from .display import RENDERERS
-
-        if "study_figure" not in RENDERERS:  # pragma: no cover - registered by ``import verimono``
-            raise RuntimeError("no plot renderer: import verimono (it registers verimono.report's)")
-        return RENDERERS["study_figure"](self, ax)
+        return render("study_figure", self, ax)
 
     def to_dict(self) -> dict[str, Any]:
         d = dataclasses.asdict(self)

@@ -3,7 +3,8 @@
 ``CheckResult``, ``Report`` (:mod:`verimono.results`) and ``ConvergenceStudy`` (:mod:`verimono.convergence`)
 have ``_repr_html_`` (and a study ``.plot()``), but the HTML and the plots are the report's
 (:mod:`verimono.report`), a layer above them.  So the lower layers ask this registry, which imports nothing,
-and :mod:`verimono.report.notebook` fills it when ``verimono`` is imported — the imports stay one-way.
+and :mod:`verimono.report.notebook` (:data:`PROVIDER`, loaded by name the first time something is rendered)
+fills it — the import statements stay one-way.
 """
 
 from __future__ import annotations
@@ -12,6 +13,8 @@ from typing import Any, Callable
 
 #: kind (``"record_html"``, ``"report_html"``, ``"study_html"``, ``"study_figure"``) -> renderer
 RENDERERS: dict[str, Callable[..., Any]] = {}
+#: the module that registers the renderers, loaded by name on first use (``import verimono`` stays light)
+PROVIDER = "verimono.report.notebook"
 
 
 def register(kind: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
@@ -26,6 +29,10 @@ def register(kind: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
 def render(kind: str, *args: Any, **kwargs: Any) -> Any:
     """``RENDERERS[kind](*args, **kwargs)``; ``None`` when no renderer is registered (Jupyter then shows
     the ``repr``)."""
+    if kind not in RENDERERS:
+        import importlib
+
+        importlib.import_module(PROVIDER)  # a plugin looked up by name: the report layer fills RENDERERS
     fn = RENDERERS.get(kind)
     return None if fn is None else fn(*args, **kwargs)
 

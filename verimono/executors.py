@@ -32,6 +32,7 @@ from multiprocessing.connection import wait as _wait
 from typing import Any, Callable, Sequence
 
 from .errors import BadExecutor
+from .profiles import load_hypothesis_profile
 from .results import FAILED, CheckResult, Report
 
 #: the check name of the record that stands for a unit that crashed, died or timed out
@@ -63,8 +64,6 @@ def unit_failure(unit: Unit, message: str, *, traceback_text: str | None = None,
 def _prepare_worker(profile: str | None) -> None:
     """The run's hypothesis profile and one BLAS thread, as in the ``verimono run`` process."""
     if profile:
-        from .profiles import load_hypothesis_profile
-
         load_hypothesis_profile(profile)
     try:
         from threadpoolctl import threadpool_limits

@@ -69,6 +69,7 @@ from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator
 
 from ._jsonable import to_jsonable
+from .display import render
 from .convergence import NORMS, ConvergenceStudy
 from .errors import SchemaError
 
@@ -144,8 +145,6 @@ class CheckResult:
 
     def _repr_html_(self) -> str | None:
         """Jupyter: the record as the HTML report shows it (counterexample, reproduction, study plot)."""
-        from .display import render
-
         return render("record_html", self)
 
 
@@ -212,8 +211,6 @@ class Report:
 
     def _repr_html_(self) -> str | None:
         """Jupyter: the HTML report's own sections and plots, its stylesheet scoped to the output."""
-        from .display import render
-
         return render("report_html", self)
 
     # -- saving and loading (the schema: this module's docstring) --------------------------------------

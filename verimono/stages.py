@@ -34,6 +34,7 @@ from .errors import StageUnavailable, UnknownStage, VerimonoError
 from .profiles import Profile
 from .grids import uniform_grid
 from .results import FAILED, PASSED, SKIPPED, XFAIL, CheckResult, Report, to_jsonable
+from .executors import SerialRunner, Unit
 from .stepping import solve
 
 #: how many points of a trajectory the report keeps for its plot (enough for a smooth curve)
@@ -74,8 +75,6 @@ class RunContext:
         """The reports of ``units`` (:class:`verimono.executors.Unit`), in their order, run on
         ``executor`` (serially here when it is ``None``); a unit that raises, whose worker dies or that
         times out gives one failed record ``unit[<stage>: <label>]`` and the other units' records stay."""
-        from .executors import SerialRunner
-
         runner = self.executor if self.executor is not None else SerialRunner()
         return runner.map(units, profile.name, self.progress)
 
@@ -255,8 +254,6 @@ def _merged(reports: Iterable[Report]) -> Report:
 def convergence_stage(profile: Profile, context: RunContext) -> Report:
     """Every analytic reference's convergence study, plus a trajectory sample for the report's plots;
     one unit per reference."""
-    from .executors import Unit
-
     stepper = solve if context.stepper is None else context.stepper
     units = [Unit("convergence", p.name, _convergence_unit, (stepper, p)) for p in context.catalog()]
     return _merged(context.run_units(profile, units))
@@ -320,8 +317,6 @@ def operator_laws_stage(profile: Profile, context: RunContext) -> Report:
             subjects += _generated_operators(profile, context.seed_for(profile))
         except StageUnavailable as exc:
             report.add(CheckResult("stage", "operator_laws: generated families", SKIPPED, message=str(exc)))
-    from .executors import Unit
-
     units = [Unit("operator_laws", label, _operator_unit,
                   (laws.check_operator, label, op, context.seed_for(profile), profile.law_examples))
              for label, op in subjects]
@@ -346,8 +341,6 @@ def trajectory_laws_stage(profile: Profile, context: RunContext) -> Report:
     seed = context.seed_for(profile)
     checks = list(mod.stepper_checks(stepper, context.problems, seed=0 if seed is None else seed,
                                      generated=profile.generated_subjects, orders=False))
-    from .executors import Unit
-
     # one unit per subject problem (the battery of checks ``law[problem]`` on it), in first-seen order;
     # the records are then put back in the order of ``checks``, as a serial loop over them gives
     groups: dict[str, list[int]] = {}
@@ -387,8 +380,6 @@ def assumptions_stage(profile: Profile, context: RunContext) -> Report:
     :func:`verimono.checks.assumptions.thm_main` states it (an ``xfail`` for the alternative that fails
     while the other holds, one ``assumptions_thm_main`` record per problem)."""
     mod = optional_module("verimono.checks.assumptions")
-    from .executors import Unit
-
     seed = context.seed_for(profile)
     units = [Unit("assumptions", p.name, _assumptions_unit, (mod.check_assumptions, p, seed))
              for p in context.catalog()]

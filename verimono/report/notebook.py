@@ -13,7 +13,9 @@ import re
 from typing import Any
 
 from ..display import register
-from ..results import FAILED, PASSED, CheckResult, Report
+from ..results import FAILED, PASSED, CheckResult, Report, to_jsonable
+from . import html
+from .plots import convergence_figure, convergence_plot
 
 SCOPE = "vm-nb"
 #: rules the notebook needs on top of the report's: no sticky header rows inside a cell, and headings in
@@ -40,9 +42,7 @@ def scoped_css(css: str, scope: str = SCOPE) -> str:
 
 
 def _wrap(body: str) -> str:
-    from .html import CSS
-
-    return f'<div class="{SCOPE}"><style>{scoped_css(CSS)}\n{_EXTRA_CSS}</style>{body}</div>'
+    return f'<div class="{SCOPE}"><style>{scoped_css(html.CSS)}\n{_EXTRA_CSS}</style>{body}</div>'
 
 
 def _section(title: str, body: str) -> str:
@@ -53,8 +53,6 @@ def _section(title: str, body: str) -> str:
 def report_html(report: Report) -> str:
     """The report as a notebook fragment: summary, convergence plots, trajectories, failures, laws and
     performance — the HTML report's own sections (those with something to show)."""
-    from . import html
-
     parts = [_section("verimono report", html._summary(report, None))]
     if any(hasattr(s, "fits") for s in report.studies):
         parts.append(_section("Convergence orders", html._convergence(report)))
@@ -73,9 +71,6 @@ def report_html(report: Report) -> str:
 def record_html(rec: CheckResult) -> str:
     """One record: status, key, worst observed ratio against its bound, message, counterexample and, for
     a failure, the command that reproduces it."""
-    from . import html
-    from ..results import to_jsonable
-
     rows = [["status", html._badge(rec.status)], ["check", html._e(rec.check)], ["subject", html._e(rec.subject)]]
     if rec.worst is not None or rec.bound is not None:
         rows.append(["worst / bound", f"{html._num(rec.worst)} / {html._num(rec.bound)} {html._bar(html._ratio(rec))}"])
@@ -101,16 +96,12 @@ def record_html(rec: CheckResult) -> str:
 @register("study_figure")
 def study_figure(study: Any, ax: Any = None) -> Any:
     """The report's log-log plot of ``study`` as a matplotlib ``Figure`` (Agg canvas), or drawn on ``ax``."""
-    from .plots import convergence_figure
-
     return convergence_figure(study, ax)
 
 
 def _reproduction(rec: CheckResult, study: Any) -> str:
     """The report's reproduction, except for the order of a stepper of the notebook's own (no
     ``MODULE:OBJECT`` names it): then the call to run in the notebook itself."""
-    from . import html
-
     stepper = getattr(study, "stepper", None)
     if rec.check == "convergence_order" and stepper and stepper != "solve" and not rec.details.get("reproduce"):
         return ("from verimono.reference import get\n"
@@ -121,9 +112,6 @@ def _reproduction(rec: CheckResult, study: Any) -> str:
 
 
 def study_figure_html(study: Any) -> str:
-    from . import html
-    from .plots import convergence_plot
-
     ok, msg = study.verdict()
     status = PASSED if ok else FAILED
     return (f'<figure style="max-width:560px">{convergence_plot(study)}<figcaption><b class="{status}">'
@@ -134,8 +122,6 @@ def study_figure_html(study: Any) -> str:
 @register("study_html")
 def study_html(study: Any) -> str:
     """A study: its log-log plot (the report's), errors per grid and the fitted order in each norm."""
-    from . import html
-
     norms = list(study.errors)
     rows = [[html._num(h, ".4g"), html._num(k, "d")] + [html._num(study.errors[n][i], ".3e") for n in norms]
             for i, (h, k) in enumerate(zip(study.mesh, study.steps))]
