@@ -5,8 +5,8 @@ proximal scheme of Camlibel, Iannelli and Tanwani and checked against the laws a
 Data flow one way: Problem → stepper → Trajectory → checks → results → report / gate.
 """
 
-from .errors import (InfeasibleStep, InvalidGrid, InvalidProblem, NotMonotone, OutsideDomain,
-                     SolverFailure, VerimonoError)
+from .errors import (InfeasibleStep, InvalidCheckArgument, InvalidGrid, InvalidProblem, NotMonotone,
+                     OutsideDomain, SolverFailure, UnitTimeout, VerimonoError)
 from .grids import graded_grid, random_grid, refine, uniform_grid, validate_grid
 from .operators import (L1Subdifferential, Linear, LogBarrier, NormalCone, NormSubdifferential, Operator,
                         Shifted, operator_from_resolvent)
@@ -24,6 +24,8 @@ __version__ = "0.1.0"
 __all__ = [
     "VerimonoError", "InvalidProblem", "InvalidGrid", "OutsideDomain", "NotMonotone", "InfeasibleStep",
     "SolverFailure",
+    "InvalidCheckArgument",
+    "UnitTimeout",
     "Operator", "operator_from_resolvent", "Linear", "NormSubdifferential", "L1Subdifferential",
     "NormalCone", "Shifted", "LogBarrier", "sets",
     "Problem", "Order", "Trajectory", "solve", "stream", "ErrorAccumulator",

@@ -35,6 +35,15 @@ class SolverFailure(VerimonoError, ArithmeticError):
     """Every numerical back-end failed to produce a solution that passes verification."""
 
 
+class InvalidCheckArgument(VerimonoError, ValueError):
+    """A check was asked to verify nothing: ``examples <= 0``, an empty list of problems, ``T <= 0``, a
+    non-positive time budget.  A check that evaluates nothing must not be able to pass."""
+
+
+class UnitTimeout(VerimonoError, TimeoutError):
+    """A unit of work (one law on one operator, one check of one stepper) exceeded its time budget."""
+
+
 __all__ = [
     "VerimonoError",
     "InvalidProblem",
@@ -43,4 +52,6 @@ __all__ = [
     "NotMonotone",
     "InfeasibleStep",
     "SolverFailure",
+    "InvalidCheckArgument",
+    "UnitTimeout",
 ]

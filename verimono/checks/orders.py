@@ -12,7 +12,7 @@ import time
 from typing import Callable, Iterable
 
 from ..convergence import ORDER_SLACK, convergence_study, _name
-from ..errors import VerimonoError
+from ..errors import InvalidCheckArgument, VerimonoError
 from ..problem import Problem
 from ..results import FAILED, PASSED, SKIPPED, CheckResult, Report
 
@@ -57,6 +57,11 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
     """
     from .trajectory_laws import LAWS, stepper_checks
 
+    if problems is not None:
+        problems = list(problems)
+        if not problems:
+            raise InvalidCheckArgument("check_stepper was given an empty list of problems: it would verify "
+                                       "nothing (pass problems=None for the whole catalog)")
     selected = () if laws is False else (LAWS if laws is True else tuple(laws))
     report = Report()
     for _name_, check in stepper_checks(stepper, problems, seed=seed, generated=generated, laws=selected,
@@ -67,4 +72,6 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
             from ..convergence import ConvergenceStudy
 
             report.studies.append(ConvergenceStudy.from_dict(rec.details["study"]))
+    if not len(report):
+        raise InvalidCheckArgument("check_stepper selected no check (no law, no order): it would verify nothing")
     return report

@@ -305,7 +305,14 @@ def loads(text: str, source: str = "<string>") -> Report:
         data = json.loads(text)
     except json.JSONDecodeError as exc:
         raise SchemaError(f"{source} is not valid JSON ({exc})") from None
-    return report_from_dict(data)
+    except RecursionError:      # pathologically nested arrays/objects: unreadable, not a crash
+        raise SchemaError(f"{source} is nested too deeply to be a verimono document") from None
+    except (ValueError, MemoryError) as exc:
+        raise SchemaError(f"{source} cannot be parsed ({type(exc).__name__}: {exc})") from None
+    try:
+        return report_from_dict(data)
+    except RecursionError:
+        raise SchemaError(f"{source} is nested too deeply to be a verimono document") from None
 
 
 def load(path: str | Path) -> Report:
