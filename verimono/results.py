@@ -208,11 +208,10 @@ class Report:
         return loads(text)
 
     def save(self, path: str | Path) -> Path:
-        """Write :meth:`to_json` to ``path`` (parents created); returns the path."""
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(self.to_json(), encoding="utf-8")
-        return path
+        """Write :meth:`to_json` to ``path`` atomically (parents created); returns the path."""
+        from .atomic import write_text
+
+        return write_text(path, self.to_json())   # temporary file + rename: never a truncated document
 
     @classmethod
     def load(cls, path: str | Path) -> "Report":

@@ -32,6 +32,7 @@ import numpy as np
 from .errors import VerimonoError
 from .profiles import Profile
 from .results import FAILED, PASSED, SKIPPED, XFAIL, CheckResult, Report
+from .timeouts import run_unit
 
 #: how many points of a trajectory the report keeps for its plot (enough for a smooth curve)
 TRAJECTORY_SAMPLES = 400
@@ -230,7 +231,8 @@ def convergence_stage(profile: Profile, context: RunContext) -> Report:
     report = Report()
     for i, p in enumerate(problems):
         context.progress(i, len(problems), p.name)
-        rec = report.add(check_convergence_order(stepper, p))
+        rec = report.add(run_unit(lambda: check_convergence_order(stepper, p), check="convergence_order",
+                                  subject=f"{_name(stepper)} on {p.name}"))
         if "study" in rec.details:
             report.studies.append(ConvergenceStudy.from_dict(rec.details["study"]))
         try:
@@ -324,7 +326,8 @@ def trajectory_laws_stage(profile: Profile, context: RunContext) -> Report:
     report = Report()
     for i, (name, check) in enumerate(checks):
         context.progress(i, len(checks), name)
-        report.add(check(stepper))
+        law, _, problem_name = name.partition("[")
+        report.add(run_unit(lambda: check(stepper), check=law, subject=f"{_name(stepper)} on {problem_name[:-1]}"))
     return report
 
 
@@ -376,7 +379,8 @@ def section7_stage(profile: Profile, context: RunContext) -> Report:
     problems = [p for p in (example.ramp_problem(), example.sine_problem()) if p.name not in in_catalog]
     for i, p in enumerate(problems):
         context.progress(i, len(problems) + 1, p.name)
-        rec = report.add(check_convergence_order(stepper, p))
+        rec = report.add(run_unit(lambda: check_convergence_order(stepper, p), check="convergence_order",
+                                  subject=f"{_name(stepper)} on {p.name}"))
         if "study" in rec.details:
             report.studies.append(ConvergenceStudy.from_dict(rec.details["study"]))
         report.trajectories.append(sample_trajectory(stepper, p))

@@ -35,7 +35,8 @@ import hypothesis.errors
 from hypothesis import HealthCheck, Phase, Verbosity, given, settings
 from hypothesis import strategies as st
 
-from ..errors import InvalidCheckArgument, VerimonoError
+from ..errors import InvalidCheckArgument, UnitTimeout, VerimonoError
+from ..timeouts import current_budget, time_limit
 from ..operators import Operator
 from ..results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult, Report
 from ..strategies import points, step_sizes, times
@@ -593,12 +594,18 @@ def run_law(law: Law | str, op: Operator, *, seed: int | None = None, examples: 
         body(s, True)
 
     flaky = ""
+    timed_out = ""
+    limit = current_budget()
+    unit = f"{law.name} on {_subject(op)}"
     if sample is not None:
         s = Sample.from_dict(sample) if isinstance(sample, dict) else sample
         try:
-            body(s, search=False)
+            with time_limit(limit, unit):
+                body(s, search=False)
         except _Violation:
             pass
+        except UnitTimeout as exc:
+            timed_out = str(exc)
     else:
         test = settings(database=None, max_examples=max(1, examples), deadline=None, derandomize=False,
                         verbosity=Verbosity.quiet, print_blob=False, suppress_health_check=list(HealthCheck),
@@ -606,9 +613,12 @@ def run_law(law: Law | str, op: Operator, *, seed: int | None = None, examples: 
             given(law_samples(op.dim, horizon))(searched))
         test = hypothesis.seed(seed)(test)
         try:
-            test()
+            with time_limit(limit, unit):
+                test()
         except _Violation:
             pass
+        except UnitTimeout as exc:   # a resolvent that does not return: a failure of the operator, named
+            timed_out = str(exc)
         except hypothesis.errors.Flaky as exc:  # a failure that did not reproduce on replay
             flaky = f" (not reproducible on replay: {type(exc).__name__}; the operator is not deterministic)"
         except (hypothesis.errors.HypothesisException, MemoryError, RecursionError) as exc:
@@ -623,6 +633,10 @@ def run_law(law: Law | str, op: Operator, *, seed: int | None = None, examples: 
     if profile is not None:
         details["profile"] = profile
 
+    if timed_out and state.fail_eval is None:
+        details["timeout"], details["elapsed"] = limit, duration
+        return CheckResult(status=FAILED, message=f"timed out: {timed_out} ({state.runs} samples evaluated "
+                                                  "before)", details=details, **base)
     if state.fail_eval is None and harness:
         return CheckResult(status=UNDECIDED, message=f"the harness could not search this operator "
                                                      f"({harness}; {state.runs} samples evaluated before); "

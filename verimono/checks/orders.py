@@ -15,6 +15,7 @@ from ..convergence import ORDER_SLACK, convergence_study, _name
 from ..errors import InvalidCheckArgument, VerimonoError
 from ..problem import Problem
 from ..results import FAILED, PASSED, SKIPPED, CheckResult, Report
+from ..timeouts import run_unit
 
 
 def check_convergence_order(stepper: Callable, problem: Problem, steps=None, executor=None) -> CheckResult:
@@ -66,7 +67,8 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
     report = Report()
     for _name_, check in stepper_checks(stepper, problems, seed=seed, generated=generated, laws=selected,
                                         orders=orders, executor=executor):
-        rec = check(stepper)
+        law, _, problem_name = _name_.partition("[")
+        rec = run_unit(lambda: check(stepper), check=law, subject=f"{_name(stepper)} on {problem_name[:-1]}")
         report.add(rec)
         if "study" in rec.details:
             from ..convergence import ConvergenceStudy
