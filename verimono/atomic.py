@@ -75,10 +75,29 @@ def replace_all(files: Mapping[str | os.PathLike, str]) -> list[Path]:
         for t in temps:
             _unlink(t)
         raise
-    with _signals_held():
+    with _signals_held(), _folder_lock(targets[0].parent if len(targets) > 1 else None):
         for tmp, path in zip(temps, targets):
             os.replace(tmp, path)
     return targets
+
+
+@contextmanager
+def _folder_lock(folder: Path | None) -> Iterator[None]:
+    """An exclusive ``flock`` on ``folder/.verimono.lock`` while a pair is renamed: two runs writing into
+    one folder rename their pairs one after the other, never interleaved (a no-op without ``fcntl``)."""
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - not POSIX
+        fcntl = None
+    if folder is None or fcntl is None:
+        yield
+        return
+    with open(folder / ".verimono.lock", "a+") as fh:
+        fcntl.flock(fh.fileno(), fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(fh.fileno(), fcntl.LOCK_UN)
 
 
 def write_text(path: str | os.PathLike, text: str) -> Path:

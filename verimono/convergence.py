@@ -483,7 +483,9 @@ def _unwrap(obj):
 
 def _timed_run(stepper, problem, grid):
     start = time.perf_counter()
-    x = np.asarray(stepper(problem, grid), dtype=float)
+    from ._kernels import real_array
+
+    x = real_array(stepper(problem, grid), f"the values of stepper {_name(stepper)}")   # complex: an error
     if x.shape != (len(grid),) + problem.x0.shape:
         raise InvalidProblem(f"stepper {_name(stepper)} returned shape {x.shape}, expected "
                              f"{(len(grid),) + problem.x0.shape}")

@@ -71,6 +71,13 @@ def pytest_configure(config: pytest.Config) -> None:
             check_baseline(baseline)
         except SchemaError as exc:
             raise pytest.UsageError(f"verimono baseline unusable: {exc}") from None
+    if out:   # checked before the session's work, not after it
+        from .atomic import OutputNotWritable, ensure_writable_dir
+
+        try:
+            ensure_writable_dir(out)
+        except OutputNotWritable as exc:
+            raise pytest.UsageError(f"--verimono-report: {exc}") from None
     collector = _Collector(Path(out) if out else None, baseline, profile)
     config.stash[_KEY] = collector
     config.pluginmanager.register(collector, "verimono-collector")

@@ -345,7 +345,11 @@ def assumptions_stage(profile: Profile, context: RunContext) -> Report:
     problems = context.catalog()
     for i, p in enumerate(problems):
         context.progress(i, len(problems), p.name)
-        rep = mod.check_assumptions(p, seed=0 if seed is None else seed)
+        rep = run_unit(lambda: mod.check_assumptions(p, seed=0 if seed is None else seed), check="assumptions",
+                       subject=p.name)
+        if isinstance(rep, CheckResult):    # the unit ran out of its time budget: a failed record, go on
+            report.add(rep)
+            continue
         by = {r.check: r for r in rep.results}
         lg, yb = by.get("assumption_LG"), by.get("assumption_YB")
         for this, other, name in ((lg, yb, "(YB)"), (yb, lg, "(LG)")):

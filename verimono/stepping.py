@@ -40,8 +40,8 @@ class Trajectory:
 
     def __init__(self, t: np.ndarray, x: np.ndarray, problem: Problem | None = None,
                  extras: dict[str, np.ndarray] | None = None) -> None:
-        self.t = np.asarray(t, dtype=float)
-        self.x = np.asarray(x, dtype=float)
+        self.t = real_array(t, "trajectory times")
+        self.x = real_array(x, "trajectory states")
         if self.x.shape[0] != self.t.shape[0]:
             raise InvalidProblem(f"trajectory has {self.x.shape[0]} states for {self.t.shape[0]} times")
         self.problem = problem
