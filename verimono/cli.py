@@ -414,7 +414,14 @@ def _cmd_baseline(args: argparse.Namespace) -> int:
 def _cmd_gate(args: argparse.Namespace) -> int:
     from .gate import gate
 
-    comparison = gate(args.baseline, args.results)
+    try:
+        comparison = gate(args.baseline, args.results)
+    except VerimonoError:
+        raise
+    except Exception as exc:   # the gate fails closed: a document it cannot compare is never a regression
+        print(f"verimono gate: cannot compare {args.baseline} with {args.results} ({type(exc).__name__}: "
+              f"{exc})", file=sys.stderr)
+        return EXIT_UNDECIDED
     for c in comparison.regressions:
         print(f"  {c}")
     if args.verbose:

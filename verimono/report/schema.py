@@ -313,6 +313,9 @@ def loads(text: str, source: str = "<string>") -> Report:
         return report_from_dict(data)
     except RecursionError:
         raise SchemaError(f"{source} is nested too deeply to be a verimono document") from None
+    except (TypeError, AttributeError, KeyError, IndexError, ValueError, OverflowError) as exc:
+        # a field of an unexpected type that the type checks above did not anticipate: unreadable
+        raise SchemaError(f"{source} is malformed ({type(exc).__name__}: {exc})") from None
 
 
 def load(path: str | Path) -> Report:
