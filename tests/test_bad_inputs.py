@@ -157,6 +157,13 @@ CASES = [
      vm.InvalidProblem, "real"),
     ("complex Ball centre", lambda: sets.Ball(np.array([1j, 0.0]), 1.0), vm.InvalidProblem, "real"),
     ("complex Box bound", lambda: sets.Box(np.array([0j]), [1.0]), vm.InvalidProblem, "real"),
+    ("complex x0 array", lambda: vm.Problem(NSUB, x0=np.array([1 + 1j, 0.0]), T=1.0), vm.InvalidProblem, "real"),
+    ("complex time grid", lambda: vm.solve(vm.Problem(NSUB, x0=[1.0, 0.0], T=1.0), np.linspace(0, 1, 5) + 0j),
+     vm.InvalidGrid, "real"),
+    ("complex stepper values", lambda: vm.convergence_study(
+        lambda p, t: np.zeros((len(t), 2), dtype=complex) + 1j, vm.Problem(NSUB, x0=[1.0, 0.0], T=1.0,
+                                                                           exact=lambda t: [1.0, 0.0]),
+        [0.1, 0.05]), vm.InvalidProblem, "real"),
     ("complex c(t) in solve", lambda: _solve(vm.NormSubdifferential(lambda t: np.complex128(1 + 1j * t), dim=2),
                                              [1.0, 0.0]), vm.InvalidProblem, "real"),
 ]

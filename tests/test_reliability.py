@@ -299,3 +299,23 @@ def test_a_harness_limitation_is_undecided_not_failed(monkeypatch):
     assert rec.status == "undecided" and "limitation of verimono" in rec.message
     assert not Report([rec]).ok and "1 undecided" in Report([rec]).summary()
     assert hypothesis.errors  # the engine's own error is the reason, named in the message
+
+
+def test_verimono_check_on_a_hanging_resolvent_finishes_with_failed_records(tmp_path, capsys):
+    """``verimono check`` on a resolvent that loops forever used to hang with no output and no report."""
+    mod = tmp_path / "hang.py"
+    mod.write_text("import numpy as np\nimport verimono as vm\n"
+                   "def _res(x, lam, t):\n"
+                   "    x = np.asarray(x, dtype=float)\n"
+                   "    while np.abs(x).max() > 1.0:\n"
+                   "        pass\n"
+                   "    return x / (1.0 + lam)\n"
+                   "OP = vm.operator_from_resolvent(_res, 2, name='hangs')\n")
+    out = tmp_path / "out"
+    start = time.perf_counter()
+    code = main(["check", f"{mod}:OP", "--profile", "ci", "--timeout", "0.3", "--out", str(out)])
+    assert code == 1 and time.perf_counter() - start < 60.0
+    rep = load(out / "results.json")
+    timed = [r for r in rep if "time budget of 0.3 s" in r.message]
+    assert timed and all(r.status == "failed" and "on hangs" in r.message and "stopped after" in r.message
+                         for r in timed)
