@@ -144,7 +144,7 @@ def _weight_at(param, t: float, owner: str, what: str) -> np.ndarray:
     """A nonnegative weight ``param(t)`` of a convex function, checked at ``t`` when it moves (constants are
     checked once, at construction); :class:`NotMonotone` naming ``t`` otherwise (also for ``nan``)."""
     c = param(t)
-    if not param.constant and not np.all(c >= 0):
+    if not param.constant and not (float(c) >= 0.0 if c.ndim == 0 else (c >= 0).all()):
         raise bad_param(owner, what, c, t, "must be >= 0 (a negative weight makes the operator non-monotone)",
                         NotMonotone)
     return c

@@ -111,8 +111,11 @@ class Ball(ConvexSet):
         return r
 
     def project(self, x, t=0.0):
+        return self._project(finite_point(x, f"the point projected onto {self.name}"), t)
+
+    def _project(self, x, t):
+        """:meth:`project` of a finite float array (the solve loop checks finiteness per block instead)."""
         # points inside are returned unchanged (not as c + (x - c), which may differ in the last bit)
-        x = finite_point(x, f"the point projected onto {self.name}")
         c = self._c(t)
         d = x - c
         nrm = np.sqrt(dot_rows(d, d))[..., None]
@@ -124,9 +127,17 @@ class Ball(ConvexSet):
         return np.where(outside, c + d * (r / _mx(nrm, _mx(r, _TINY))), x)
 
     def _kernel(self, x0):
-        if not _own(self, Ball) or x0.ndim != 1 or self._r(0.0).ndim or self._c(0.0).ndim != 1:
+        if not _own(self, Ball):
             return None
         name = self.name
+        if x0.ndim != 1 or self._r(0.0).ndim or self._c(0.0).ndim != 1:
+            project = self._project
+
+            def batch_step(x, lam, t):
+                if not 0.0 < lam < _INF:
+                    raise bad_lam(lam, name)
+                return project(x, t)
+            return batch_step
         if self.static:
             c, r = self._c(0.0), float(self._r(0.0))
 
