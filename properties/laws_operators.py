@@ -108,11 +108,11 @@ def test_laws_on_generated_operators(family):
 
 def test_every_law_has_a_check_naming_its_paper_item():
     """Each law of the table has its own ``check_<law>`` in the registry, and that check's docstring names
-    the paper item the law states (``Law.item``) — a law renamed, re-pointed or left undocumented fails."""
+    the paper item the law states (``Law.label``) — a law renamed, re-pointed or left undocumented fails."""
     from verimono.checks import operator_laws
 
     for name, law in LAWS.items():
         fn = getattr(operator_laws, f"check_{name}", None)
         assert fn is not None and operator_laws.OPERATOR_CHECKS.get(name) is fn, name
         doc = " ".join((fn.__doc__ or "").split())
-        assert law.item in doc, f"check_{name} does not name its paper item {law.item!r}"
+        assert law.label in doc, f"check_{name} does not name its paper item {law.label!r}"

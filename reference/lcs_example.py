@@ -25,6 +25,8 @@ symmetric numerator of ``def:dis`` gives the same bound from the pair used here)
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from verimono.lcs import Complementarity, LinearRelationSystem
@@ -75,7 +77,8 @@ def ramp_problem(x0: float = 0.5, T: float = 2.0) -> Problem:
     sys = example_system(lambda t: np.array([-t, 0.0]))
     return sys.problem([x0], T, exact=lambda t: np.array([x0 + 0.5 * t * t]),
                        order=Order(1.0, "Example ex, v = (−t, 0): x_k = x0 + t_k²/2 + h t_k/2 (derived in "
-                                   "reference/lcs_example.py)", constant=T / 2.0),
+                                   "reference/lcs_example.py)", constant=T / 2.0, regularity=math.inf,
+                                   regularity_source="x = x0 + t^2/2 is a polynomial"),
                        steps=[T / 8, T / 16, T / 32, T / 64], name="Example ex, v = (−t, 0)",
                        phi=_static_domain, sigma=lambda t: t, theta=_unit_rate)
 
@@ -95,7 +98,10 @@ def sine_problem(x0: float = 0.0, T: float = 3 * np.pi) -> Problem:
     sys = example_system(lambda t: np.array([np.sin(t), 0.0]))
     return sys.problem([x0], T, exact=_sine_exact(x0),
                        order=Order(1.0, "Example ex, v = (sin t, 0): right Riemann sum of the Lipschitz "
-                                   "max(−sin t, 0)", constant=0.5),
+                                   "max(−sin t, 0)", constant=0.5, regularity=1.0,
+                                   regularity_source="x' = max(-sin t, 0) jumps in slope at t = k pi: x is "
+                                                     "C^1 with a Lipschitz, non-differentiable derivative; "
+                                                     "order 1 is what the scheme is bound to here"),
                        steps=[T / 64, T / 128, T / 256, T / 512], name="Example ex, v = (sin t, 0)",
                        phi=_static_domain, sigma=lambda t: max(-np.sin(t), 0.0), theta=_unit_rate)
 

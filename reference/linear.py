@@ -18,7 +18,8 @@ import math
 import numpy as np
 from scipy.linalg import expm
 
-from verimono import Linear, Order, Problem
+from verimono.operators import Linear
+from verimono.problem import Order, Problem
 
 M_DEFAULT = np.array([[1.0, 3.0], [-3.0, 0.5]])
 
@@ -34,7 +35,8 @@ def linear(M=M_DEFAULT, x0=(1.0, 0.0), T: float = 2.0) -> Problem:
     return Problem(Linear(M), x0, T, exact=exact,
                    order=Order(1.0, "implicit Euler on x' = -Mx: |x_k - x(t_k)| <= t_k h |M^2 x0|/2 "
                                     "(derived in verimono.reference.linear; literature notes)",
-                               constant=bound * T),
+                               constant=bound * T, regularity=math.inf,
+                               regularity_source="x = exp(-Mt) x0 is analytic"),
                    name="linear x' = -Mx", steps=[T / k for k in (200, 400, 800, 1600, 3200)])
 
 
@@ -52,5 +54,6 @@ def lipschitz_input(m: float = 1.0, a: float = 0.5, b: float = 0.2, omega: float
     return Problem(Linear([[m]]), [x0], T, f=lambda x: -a * x + b, u=lambda t: np.array([math.cos(omega * t)]),
                    exact=exact, lipschitz=a,
                    order=Order(1.0, "IMEX Euler (explicit f, implicit F): Bastien-Schatzman 2002; classical "
-                                    "first order for smooth data"),
+                                    "first order for smooth data", regularity=math.inf,
+                               regularity_source="smooth data: the solution is C^infinity"),
                    name="Lipschitz field and input", steps=[T / k for k in (100, 200, 400, 800, 1600)])

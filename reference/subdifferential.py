@@ -19,7 +19,12 @@ import math
 
 import numpy as np
 
-from verimono import LogBarrier, NormSubdifferential, Order, Problem
+from verimono.operators import LogBarrier, NormSubdifferential
+from verimono.problem import Order, Problem
+
+#: the regularity of t|x|: x is Lipschitz, with a jump of x' at the extinction time
+LIPSCHITZ_KINK = ("x is Lipschitz and x' jumps at the extinction time t* = sqrt(2|x0|) (x in W^{1,inf}, not "
+                  "C^1): first order, Rulla 1996 (x0 in D(dphi)); no uniform order above 1 for a generic scheme")
 
 
 def _tnorm_c(t):
@@ -39,7 +44,8 @@ def t_norm(x0=(1.0,), T: float = 2.0) -> Problem:
         NormSubdifferential(_tnorm_c, dim=n), x0, T, exact=exact,
         order=Order(1.0, "derived in verimono.reference.subdifferential: |x_k| = r - t_k^2/2 - h t_k/2 "
                          "before extinction, sup error h sqrt(r/2) + O(h^2); paper Section 4 example "
-                         "g(t,x)=t|x| satisfies (YB') with theta(s)=s", constant=math.sqrt(r / 2.0)),
+                         "g(t,x)=t|x| satisfies (YB') with theta(s)=s", constant=math.sqrt(r / 2.0),
+                    regularity=1.0, regularity_source=LIPSCHITZ_KINK),
         name=f"t|x| (n={n})", steps=[T / k for k in (40, 80, 160, 320, 640)],
         theta=lambda s: s, sigma=lambda s: s,
         notes="extinction at t* = sqrt(2|x0|) lies inside [0, T]")
@@ -55,6 +61,8 @@ def log_barrier(c: float = 1.0, T: float = 1.0) -> Problem:
         order=Order(0.5, "derived in verimono.reference.subdifferential: x_1 = sqrt(ch) vs sqrt(2ch), "
                          "sup error (sqrt 2 - 1) sqrt(c h), exactly; x0 = 0 is outside D(phi), beyond Rulla 1996's "
                          "O(h^1/2) for x0 in D(phi)",
-                    constant=(math.sqrt(2.0) - 1.0) * math.sqrt(c)),
+                    constant=(math.sqrt(2.0) - 1.0) * math.sqrt(c), regularity=0.5,
+                    regularity_source="x = sqrt(2ct) is only Hölder-1/2 at t = 0 (x0 on the boundary of "
+                                      "D(phi)): O(h^1/2), Crandall-Liggett 1971, Rulla 1996"),
         name="x' = c/x from 0 (order 1/2)", steps=[T / k for k in (100, 200, 400, 800, 1600)],
         notes="(LG) fails: |F^0(x)| = c/x is unbounded near the boundary of the domain")

@@ -26,10 +26,17 @@ import math
 
 import numpy as np
 
-from verimono import NormalCone, Order, Problem
+from verimono.operators import NormalCone
+from verimono.problem import Order, Problem
 from verimono.sets import Ball, Box, HalfSpace
 
 TWO_PI = 2.0 * math.pi
+#: regularity of a sweeping solution whose set moves smoothly: Lipschitz, its derivative jumps where the
+#: constraint engages or releases — order 1 for a generic convergent scheme (Moreau 1977; Kunze–Monteiro
+#: Marques 2000 give only 1/2 for Lipschitz motion in general)
+SWEEP_KINKS = "x is Lipschitz and x' jumps where the constraint engages or releases: order 1 at most"
+#: a solution constant on (0, T]
+CONSTANT = "x is constant on (0, T]"
 #: K = 2m+1 cells on [0, 2π]: π sits mid-cell and π/2, 3π/2 a quarter-cell from a node
 _ODD_STEPS = [TWO_PI / k for k in (41, 81, 161, 321, 641)]
 
@@ -38,7 +45,7 @@ def static_inside() -> Problem:
     S = Ball([0.0, 0.0], 1.0)
     x0 = np.array([0.3, -0.4])
     return Problem(NormalCone(S), x0, 1.0, exact=lambda t: x0,
-                   order=Order.exact_at_nodes("x0 in S: x stays; J = proj_S fixes it"),
+                   order=Order.exact_at_nodes("x0 in S: x stays; J = proj_S fixes it", math.inf, CONSTANT),
                    name="static ball, x0 inside", steps=[0.1, 0.05, 0.025])
 
 
@@ -47,7 +54,8 @@ def static_outside() -> Problem:
     x0 = np.array([2.0, 1.0])
     p = x0 / np.linalg.norm(x0)
     return Problem(NormalCone(S), x0, 1.0, exact=lambda t: x0 if t == 0.0 else p,
-                   order=Order.exact_at_nodes("catching-up jump: x_1 = proj_S(x0) = x(0+) (Moreau 1977)"),
+                   order=Order.exact_at_nodes("catching-up jump: x_1 = proj_S(x0) = x(0+) (Moreau 1977)", math.inf,
+                                             CONSTANT),
                    name="static ball, x0 outside (jump)", steps=[0.1, 0.05, 0.025], initial_jump=True)
 
 
@@ -69,7 +77,8 @@ def play_smooth(amplitude: float = 1.0, r: float = 0.25, x0: float = 0.1) -> Pro
     S = Box(lambda t: np.array([u(t) - r]), lambda t: np.array([u(t) + r]))
     return Problem(NormalCone(S), [x0], TWO_PI, exact=_play_exact(u, [math.pi / 2, 3 * math.pi / 2], r, x0),
                    order=Order(2.0, "scheme = play operator of the piecewise-linear interpolant of u; play "
-                                    "is 1-Lipschitz in sup norm, |u - u_PL| <= h^2 max|u''|/8"),
+                                    "is 1-Lipschitz in sup norm, |u - u_PL| <= h^2 max|u''|/8",
+                               regularity=1.0, regularity_source=SWEEP_KINKS),
                    name="play operator, u = sin t", steps=_ODD_STEPS, phi=lambda t: amplitude * t)
 
 
@@ -81,7 +90,8 @@ def play_piecewise_linear(r: float = 0.25, x0: float = 0.0) -> Problem:
     S = Box(lambda t: np.array([u(t) - r]), lambda t: np.array([u(t) + r]))
     return Problem(NormalCone(S), [x0], 4.0, exact=_play_exact(u, kinks[1:-1], r, x0),
                    order=Order.exact_at_nodes("the scheme is the play operator of the piecewise-linear "
-                                              "interpolant of u, which is u itself on these grids"),
+                                              "interpolant of u, which is u itself on these grids",
+                                              1.0, SWEEP_KINKS),
                    name="play operator, piecewise-linear u", steps=[0.5, 0.25, 0.125, 0.0625],
                    phi=lambda t: 1.6 * t)
 
@@ -103,7 +113,8 @@ def moving_half_space(a=(1.0, 2.0), x0=(-1.0, 0.5)) -> Problem:
     return Problem(NormalCone(S), x0, TWO_PI, exact=exact,
                    order=Order(2.0, "s = <a,x> follows the running minimum of cos; the nodes miss the "
                                     "minimum at pi (mid-cell) by 1 - cos(h/2) ~ h^2/8",
-                               constant=1.0 / (8.0 * float(np.linalg.norm(a)))),
+                               constant=1.0 / (8.0 * float(np.linalg.norm(a))), regularity=1.0,
+                               regularity_source=SWEEP_KINKS),
                    name="moving half-space", steps=_ODD_STEPS, phi=lambda t: t / float(np.linalg.norm(a)))
 
 
@@ -118,7 +129,8 @@ def moving_box(r=(0.3, 0.5), x0=(0.1, 0.6)) -> Problem:
     ex1 = _play_exact(lambda t: math.sin(t), [math.pi / 2, 3 * math.pi / 2], r[0], x0[0])
     ex2 = _play_exact(lambda t: 0.7 * math.cos(t), [math.pi], r[1], x0[1])
     return Problem(NormalCone(S), x0, TWO_PI, exact=lambda t: np.concatenate([ex1(t), ex2(t)]),
-                   order=Order(2.0, "componentwise play operators (see play_smooth)"),
+                   order=Order(2.0, "componentwise play operators (see play_smooth)", regularity=1.0,
+                               regularity_source=SWEEP_KINKS),
                    name="moving box", steps=_ODD_STEPS, phi=lambda t: math.hypot(1.0, 0.7) * t)
 
 
@@ -147,6 +159,7 @@ def translating_ball(v=(1.0, 0.5), R: float = 1.0, x0=(0.3, 0.6), T: float = 4.0
     S = Ball(lambda t: v * t, R)
     return Problem(NormalCone(S), x0, T, exact=exact,
                    order=Order(1.0, "y = x - vt is the gradient flow of <v,y> + I_B (implicit Euler, "
-                                    "order 1 for x0 in D(dphi): Rulla 1996; literature notes)"),
+                                    "order 1 for x0 in D(dphi): Rulla 1996; literature notes)",
+                               regularity=1.0, regularity_source=SWEEP_KINKS),
                    name="translating ball", steps=[T / k for k in (50, 100, 200, 400, 800)],
                    phi=lambda t: speed * t)

@@ -113,3 +113,48 @@ def test_resolvent_of_wrong_shape_is_reported():
     op = vm.operator_from_resolvent(lambda x, lam, t: np.zeros(3), 2)
     with pytest.raises(vm.SolverFailure, match="returned shape"):
         vm.solve(vm.Problem(op, [1.0, 0.0], 1.0), vm.uniform_grid(1.0, 0.5))
+
+
+def test_every_public_exception_class_lives_in_errors():
+    """Every public exception class of the package is defined in verimono/errors.py and still importable
+    from where it was before (``verimono.stages.StageUnavailable``, ``verimono.report.schema.SchemaError``, ...)."""
+    import importlib
+    import pkgutil
+
+    from verimono import errors
+
+    modules = [importlib.import_module(m.name) for m in pkgutil.walk_packages(vm.__path__, "verimono.")
+               if m.name.split(".")[1] not in ("reference", "properties")]
+    defined = {(obj.__module__, name) for mod in modules for name, obj in vars(mod).items()
+               if isinstance(obj, type) and issubclass(obj, BaseException) and not name.startswith("_")
+               and obj.__module__.startswith("verimono")}
+    assert {m for m, _ in defined} == {"verimono.errors"}, sorted(defined)
+    old_homes = {"verimono.stages": ("StageUnavailable", "UnknownStage"), "verimono.cli": ("BadTarget",),
+                 "verimono.profiles": ("UnknownProfile",), "verimono.report.schema": ("SchemaError",),
+                 "verimono.gate": ("IncompatibleBaseline",), "verimono.lcs.passivity": ("MissingOptionalDependency",)}
+    for module, names in old_homes.items():
+        for name in names:
+            assert getattr(importlib.import_module(module), name) is getattr(errors, name)
+            assert issubclass(getattr(errors, name), vm.VerimonoError)
+
+
+def test_problem_is_frozen_and_replace_revalidates():
+    import dataclasses
+    import warnings
+
+    from verimono.checks.trajectory_laws import with_changes
+
+    p = ok_problem(name="p", order=1)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        p.T = 2.0
+    q = p.replace(T=2.0, x0=[0.5, 0.5])
+    assert (q.T, q.name, q.order, q.operator) == (2.0, "p", p.order, p.operator) and p.T == 1.0
+    assert np.array_equal(q.x0, [0.5, 0.5]) and dataclasses.replace(p, T=3.0).T == 3.0
+    with pytest.raises(vm.InvalidProblem, match="T must"):
+        p.replace(T=-1.0)
+    with pytest.raises(vm.InvalidProblem, match="no field"):
+        p.replace(horizon=2.0)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        r = with_changes(p, T=4.0)
+    assert r.T == 4.0 and any(issubclass(w.category, DeprecationWarning) for w in caught)

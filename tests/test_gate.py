@@ -6,7 +6,7 @@ import copy
 
 import pytest
 
-from verimono.checks.orders import check_stepper
+from verimono.checks import check_stepper
 from verimono.gate import ERROR_GROWTH, TIMING_GROWTH, IncompatibleBaseline, compare, gate
 from verimono.report.schema import SchemaError
 from verimono.results import CheckResult, Report

@@ -134,7 +134,7 @@ def test_reproduction_of_a_convergence_record_is_a_runnable_script(small_report)
     rec = next(r for r in small_report if r.check == "convergence_order")
     script = reproduction(rec, {"target": "mypkg.steppers:euler"})
     assert "from mypkg.steppers import euler as stepper" in script
-    assert f"get({rec.details['study']['problem']!r})" in script
+    assert f"get({rec.study.problem!r})" in script
 
 
 def test_html_without_baseline_says_so():
@@ -143,10 +143,10 @@ def test_html_without_baseline_says_so():
 
 
 def test_schema_docstring_lists_every_meta_key_a_run_writes(small_report):
-    from verimono.report import schema
+    from verimono import results  # the one module that saves and loads, its docstring the schema
 
     for key in small_report.to_dict()["meta"]:
-        assert f'"{key}"' in schema.__doc__, key
+        assert f'"{key}"' in results.__doc__, key
 
 
 def test_environment_records_optional_solvers_and_blas():
@@ -270,3 +270,18 @@ def test_changes_are_grouped_per_subject():
     assert len(rows) == 2                                   # the broken study, and monotone[Ball]
     assert broken in rows[0] and "6 regressions" in rows[0]
     assert all(_e in html for _e in ("sup error at h=0.025 grew", "sup-norm order fell"))
+
+
+def test_a_failing_law_reproduces_with_the_reference_the_run_names():
+    """The run (not the renderer) says which catalog reference a counterexample needs: `--reference NAME`."""
+    from zoo_steppers import leaves_domain
+
+    from verimono.reference import get
+
+    ctx = RunContext(stepper=leaves_domain, problems=[get("moving box")])
+    rep = execute(command="run", profile_name="ci", stages=["trajectory_laws"], context=ctx)
+    failed = [r for r in rep if r.check == "in_domain" and r.status == "failed"]
+    assert failed and failed[0].details["reference"] == "moving box"
+    assert "--reference 'moving box'" in reproduction(failed[0], {"command": "run", "profile": "ci"})
+    own = CheckResult("in_domain", "mine", "failed", counterexample={"problem": "moving box"})
+    assert "--reference" not in reproduction(own, {"command": "run"})  # nothing said, nothing guessed

@@ -135,3 +135,36 @@ def test_dropping_a_law_from_the_registry_is_a_shrunk_battery(monkeypatch):
     monkeypatch.setattr(trajectory_laws, "stepper_checks", one_less)
     with pytest.raises(ValueError, match="checks were lost"):
         parametrize_with_checks([amplifier], problems=problems)
+
+
+CLAIMS_FILE = '''
+import sys
+sys.path.insert(0, {tests!r})
+import verimono as vm
+from verimono.reference import get
+from verimono.testing import parametrize_with_checks
+from zoo_steppers import midpoint_time
+
+PROBLEMS = [get("moving half-space")]
+
+@parametrize_with_checks([vm.Stepper(midpoint_time, scheme="any", order=1), get("x' = c/x from 0 (order 1/2)")],
+                         problems=PROBLEMS)
+def test_battery(subject, check):
+    check(subject)
+'''
+
+
+def test_claims_and_problems_are_subjects_of_the_pytest_battery(pytester):
+    """A declared scheme='any' stepper passes its battery with the proximal-only laws skipped (counted, with
+    the declaration's reason); a Problem gets the assumption evidence, thm_main included."""
+    import pathlib
+
+    pytester.makepyfile(test_battery=CLAIMS_FILE.format(tests=str(pathlib.Path(__file__).parent)))
+    res = pytester.runpytest_inprocess("-q", "-rs", "-p", "verimono.testing")
+    # stepper: orders, unique_limit, in_domain pass; contraction and the 4 proximal-only laws skip.
+    # problem: A1, A2, A3, YB, thm_main pass; LG is an expected failure (YB holds), a skip-free pass here
+    res.assert_outcomes(passed=3 + 6, skipped=5)
+    out = "\n".join(res.outlines)
+    assert "needs scheme='proximal'" in out and "contracts=True" in out
+    assert "selections[moving half-space]: needs scheme='proximal'" in out
+    assert "9 passed, 0 failed, 5 skipped" in out                  # the battery summary counts them

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from verimono import Problem, solve, uniform_grid
-from verimono.checks.orders import check_stepper
+from verimono.checks import check_stepper
 from verimono.checks.sample_problems import sample_problem
 from verimono.checks.trajectory_laws import (CHECKS, LAWS, LGBounds, YBBounds, check_bounds_lg, check_contraction,
                                              check_in_domain, reproduce, stepper_checks)

@@ -99,3 +99,41 @@ BREAKS = {
     "psi_interpolation": (double_step, "linear x' = -Mx", "uniform"),
     "selections": (wrong_time, "t|x| (n=1)", "uniform"),
 }
+
+
+# -- valid alternative schemes: correct, but not the paper's one-step scheme on the given grid -----------------
+# Each converges to the solution; declared ``scheme="any"`` (verimono.Stepper) they must pass every law
+# that binds a convergent scheme, on the whole reference catalog.
+
+def _drift(problem, x, h):
+    return x if problem.f is None else x + h * np.asarray(problem.f(x), dtype=float)
+
+
+def midpoint_time(problem, t_grid):
+    """The proximal step with the operator at the cell's midpoint, ``J_{h F((t_k + t_{k+1})/2)}``."""
+    return _scheme(problem, t_grid, time=lambda t, k: 0.5 * (t[k] + t[k + 1]))
+
+
+def random_substeps(problem, t_grid):
+    """The proximal scheme run on 2 or 3 substeps per cell, cut at random points (seeded by the grid)."""
+    t = validate_grid(t_grid, problem.T)
+    rng = np.random.default_rng(len(t))
+    fine = [t[:1]]
+    for a, b in zip(t[:-1], t[1:]):
+        cuts = np.sort(rng.uniform(a, b, rng.integers(1, 3)))
+        fine.append(np.concatenate([cuts, [b]]))
+    s = np.concatenate(fine)
+    x = _scheme(problem, s)
+    return x[np.searchsorted(s, t)]
+
+
+def exact_sampled(problem, t_grid):
+    """The exact solution itself, sampled on the grid (the references' ``problem.exact``)."""
+    t = validate_grid(t_grid, problem.T)
+    if problem.exact is None:
+        raise ValueError(f"{problem.name} has no exact solution to sample")
+    return np.array([np.asarray(problem.exact(float(s)), dtype=float) for s in t])
+
+
+#: correct schemes that are not the paper's scheme on the given grid
+VALID_ALTERNATIVES = [midpoint_time, random_substeps, exact_sampled]

@@ -5,12 +5,14 @@ proximal scheme of Camlibel, Iannelli and Tanwani and checked against the laws a
 Data flow one way: Problem → stepper → Trajectory → checks → results → report / gate.
 """
 
-from .errors import (InfeasibleStep, InvalidCheckArgument, InvalidGrid, InvalidProblem, NotMonotone,
-                     OutsideDomain, SolverFailure, UnitTimeout, VerimonoError)
+from .errors import (BadTarget, IncompatibleBaseline, InfeasibleStep, InvalidCheckArgument, InvalidClaim, InvalidGrid,
+                     InvalidProblem, MissingOptionalDependency, NotMonotone, OutsideDomain, SchemaError,
+                     SolverFailure, StageUnavailable, UnitTimeout, UnknownProfile, UnknownStage, VerimonoError)
 from .grids import graded_grid, random_grid, refine, uniform_grid, validate_grid
 from .operators import (L1Subdifferential, Linear, LogBarrier, NormalCone, NormSubdifferential, Operator,
                         Shifted, operator_from_resolvent)
 from .problem import Order, Problem
+from .claims import Claim, Stepper
 from .results import CheckResult, Report
 from .stepping import Trajectory, solve, stream
 from .pseudo_distance import pseudo_distance_lower_bound
@@ -23,12 +25,12 @@ __version__ = "0.1.0"
 
 __all__ = [
     "VerimonoError", "InvalidProblem", "InvalidGrid", "OutsideDomain", "NotMonotone", "InfeasibleStep",
-    "SolverFailure",
-    "InvalidCheckArgument",
-    "UnitTimeout",
+    "SolverFailure", "UnknownProfile", "UnknownStage", "StageUnavailable", "BadTarget", "SchemaError",
+    "IncompatibleBaseline", "MissingOptionalDependency", "InvalidClaim",
+    "InvalidCheckArgument", "UnitTimeout",
     "Operator", "operator_from_resolvent", "Linear", "NormSubdifferential", "L1Subdifferential",
     "NormalCone", "Shifted", "LogBarrier", "sets",
-    "Problem", "Order", "Trajectory", "solve", "stream", "ErrorAccumulator",
+    "Problem", "Order", "Stepper", "Claim", "Trajectory", "solve", "stream", "ErrorAccumulator",
     "uniform_grid", "graded_grid", "random_grid", "refine", "validate_grid",
     "CheckResult", "Report", "pseudo_distance_lower_bound", "lcs", "strategies",
     "convergence_study", "ConvergenceStudy", "check_stepper", "check_operator", "operator_checks",

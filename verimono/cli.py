@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import inspect
 import os
 import shutil
 import sys
@@ -33,15 +34,12 @@ import time
 from pathlib import Path
 from typing import Any, Callable, TextIO
 
-from .errors import VerimonoError
+from .claims import SCHEMES, claim_of, with_claim
+from .errors import BadTarget, VerimonoError
 from .profiles import PROFILES, active_profile, get_profile, load_hypothesis_profile
 from .results import SKIPPED, Report
 
 EXIT_OK, EXIT_FAILED, EXIT_UNDECIDED = 0, 1, 2
-
-
-class BadTarget(VerimonoError, ValueError):
-    """``MODULE:OBJECT`` does not name an importable operator or stepper."""
 
 
 # -- progress ----------------------------------------------------------------------------------------
@@ -162,11 +160,8 @@ def _changes(baseline: Report | None, report: Report) -> Any:
 def order_table(report: Report) -> list[str]:
     """One line per convergence study: reference, expected order, measured sup-norm order with its 95%
     interval, verdict (``missed`` when the stepper does not reach the expected order)."""
-    from .convergence import ConvergenceStudy
-
     rows = []
     for s in report.studies:
-        s = ConvergenceStudy.from_dict(s) if isinstance(s, dict) else s
         exp = "-" if s.expected is None else ("exact" if s.expected.exact else f"{s.expected.value:g}")
         rows.append((s.problem, exp, str(s.order), "ok" if s.verdict()[0] else "MISSED"))
     if not rows:
@@ -355,14 +350,42 @@ def load_target(spec: str) -> Any:
     return obj
 
 
+#: second-parameter names that mark a callable as a resolvent ``J(x, lam, t)``, not a stepper ``(problem, t_grid)``
+_STEP_NAMES = {"lam", "lamb", "lmbda", "lambda_", "lmb", "gamma", "tau", "step", "h", "mu", "alpha", "rho", "eta"}
+
+
+def _looks_like_resolvent(fn: Any) -> str | None:
+    """Why ``fn`` looks like a resolvent or prox ``f(x, lam[, t])`` rather than a stepper, or ``None``."""
+    try:
+        params = [p for p in inspect.signature(fn).parameters.values()
+                  if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
+    except (TypeError, ValueError):
+        return None
+    if len(params) >= 2 and params[1].name.lower() in _STEP_NAMES:
+        names = ", ".join(p.name for p in params)
+        return (f"looks like a resolvent or proximal operator ({names}), not a stepper(problem, t_grid): its "
+                f"second parameter {params[1].name!r} is a step size")
+    return None
+
+
+def attr_of(spec: str) -> str:
+    return spec.partition(":")[2] or spec
+
+
 def _cmd_check(args: argparse.Namespace) -> int:
     obj = load_target(args.target)
     if hasattr(obj, "resolvent") and hasattr(obj, "dim") and not isinstance(obj, type):
         stages, ctx = ["operator_laws"], _context(args, operators=[(args.target, obj)])
         kind = "operator"
     elif callable(obj) and not isinstance(obj, type):
+        hint = _looks_like_resolvent(obj)
+        if hint:
+            raise BadTarget(f"{args.target} {hint}: wrap it as an operator, e.g. in your module "
+                            f"`my_op = verimono.operator_from_resolvent({attr_of(args.target)}, dim=n)`, and check "
+                            f"MODULE:my_op")
+        obj = with_claim(obj, args.scheme, args.order)
         stages, ctx = ["convergence", "trajectory_laws"], _context(args, stepper=obj)
-        kind = "stepper"
+        kind = "stepper" + ("" if claim_of(obj).proximal else f" claiming {claim_of(obj).describe()}")
     else:
         raise BadTarget(f"{args.target} is neither an operator (with .dim and .resolvent) nor a stepper "
                         "callable(problem, t_grid)")
@@ -479,6 +502,11 @@ def build_parser() -> argparse.ArgumentParser:
     run_options(check)
     check.add_argument("--out", default="reports/check", help="output folder (default reports/check/)")
     check.add_argument("--baseline", default=None, help="show changes against this baseline")
+    check.add_argument("--scheme", choices=SCHEMES, default=None,
+                       help="what a stepper claims: 'proximal' (the paper's scheme: every law applies; the default "
+                            "for a bare callable) or 'any' (it only converges with --order)")
+    check.add_argument("--order", type=float, default=None,
+                       help="the convergence order a --scheme any stepper claims (default 1)")
     check.set_defaults(func=_cmd_check, stage=None)
 
     base = sub.add_parser("baseline", help="record the current results as the gate's baseline")

@@ -40,6 +40,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 from scipy import stats
 
+from ._jsonable import to_jsonable
 from .errors import InvalidProblem
 from .grids import uniform_grid, validate_grid
 from .problem import Order, Problem
@@ -161,8 +162,6 @@ class ConvergenceStudy:
         return ok, msg
 
     def to_dict(self) -> dict[str, Any]:
-        from .results import to_jsonable
-
         d = dataclasses.asdict(self)
         d["expected"] = None if self.expected is None else dataclasses.asdict(self.expected)
         d["verdict"] = self.verdict()[0]

@@ -1,7 +1,9 @@
 """Typed errors raised on bad input.
 
 Every error verimono raises because of what it was given derives from :class:`VerimonoError`, so a
-caller can catch one class.  Messages say what was wrong and what was expected.
+caller can catch one class.  Messages say what was wrong and what was expected.  Every public exception
+class of the package is defined here (the bottom layer, importing nothing), and re-exported where it is
+used (``verimono.stages.StageUnavailable``, ``verimono.report.schema.SchemaError``, ...).
 """
 
 from __future__ import annotations
@@ -35,6 +37,45 @@ class SolverFailure(VerimonoError, ArithmeticError):
     """Every numerical back-end failed to produce a solution that passes verification."""
 
 
+class InvalidClaim(VerimonoError, ValueError):
+    """A stepper claim that cannot be stated (unknown scheme, nonpositive order, not callable)."""
+
+
+class NotApplicable(Exception):
+    """Raised by a law's evaluator when a requirement shows only while evaluating (e.g. ``x0 ∉ dom F(0,·)``
+    where ``|F^0(0, x0)|`` is needed): the check driver (:mod:`verimono.checks.core`) makes the record a
+    skip with this reason.  Not an error of the caller's input, so not a :class:`VerimonoError`."""
+
+
+class UnknownProfile(VerimonoError, ValueError):
+    """A profile name other than ``dev``, ``ci`` or ``thorough``."""
+
+
+class UnknownStage(VerimonoError, ValueError):
+    """A stage name that is not registered."""
+
+
+class StageUnavailable(VerimonoError):
+    """A stage cannot run here (its module is not installed yet, or its data are absent)."""
+
+
+class BadTarget(VerimonoError, ValueError):
+    """``MODULE:OBJECT`` does not name an importable operator or stepper."""
+
+
+class SchemaError(VerimonoError, ValueError):
+    """A results/baseline document is missing, not JSON, not verimono's, or of an incompatible version."""
+
+
+class IncompatibleBaseline(SchemaError):
+    """The baseline records a different kind of run (command, target, profile, selection) than the
+    results, or no executed record at all."""
+
+
+class MissingOptionalDependency(VerimonoError, ImportError):
+    """An optional extra (e.g. cvxpy/clarabel for the KYP SDP) is not installed."""
+
+
 class InvalidCheckArgument(VerimonoError, ValueError):
     """A check was asked to verify nothing: ``examples <= 0``, an empty list of problems, ``T <= 0``, a
     non-positive time budget.  A check that evaluates nothing must not be able to pass."""
@@ -52,6 +93,15 @@ __all__ = [
     "NotMonotone",
     "InfeasibleStep",
     "SolverFailure",
+    "InvalidClaim",
+    "NotApplicable",
+    "UnknownProfile",
+    "UnknownStage",
+    "StageUnavailable",
+    "BadTarget",
+    "SchemaError",
+    "IncompatibleBaseline",
+    "MissingOptionalDependency",
     "InvalidCheckArgument",
     "UnitTimeout",
 ]

@@ -39,8 +39,8 @@ from pathlib import Path
 from typing import Any
 
 from .convergence import ORDER_SLACK
-from .report.schema import SchemaError, load
-from .results import FAILED, PASSED, SKIPPED, UNDECIDED, XFAIL, Report
+from .errors import IncompatibleBaseline, SchemaError
+from .results import FAILED, PASSED, SKIPPED, UNDECIDED, XFAIL, Report, load
 
 #: smallest drop of a fitted slope that counts as a regression when both intervals are narrower: slopes
 #: are refitted on the same grids, so they reproduce to round-off on one machine and to ~1e-3 across
@@ -64,11 +64,6 @@ GATED_NORMS = ("sup", "l2")
 #: run facts that must agree between a baseline and the results it gates (``selection``: the stages and
 #: references chosen with --stage / --reference; a battery that is selected but skipped still regresses)
 COMPATIBLE_KEYS = ("command", "target", "profile", "selection")
-
-
-class IncompatibleBaseline(SchemaError):
-    """The baseline records a different kind of run (command, target, profile, selection) than the
-    results, or no executed record at all."""
 
 
 class IncompatibleResults(SchemaError):

@@ -74,6 +74,12 @@ class Operator:
         ``(x', y') ∈ graph F(t,·)`` lies within ``tol`` of ``(x, y)`` in each coordinate."""
         raise NotImplementedError(f"{self.name} does not provide a membership test")
 
+    def provides(self, member: str) -> bool:
+        """Whether this operator provides ``member`` (``"min_norm"``, ``"project_domain"``, ``"contains"``):
+        the laws that need a member it lacks are skipped before they run, with that reason."""
+        own = getattr(type(self), member, None)
+        return own is not None and own is not getattr(Operator, member, None)
+
     # -- conveniences --------------------------------------------------------------------------
     def in_domain(self, x: np.ndarray, t: float = 0.0, tol: float | None = None) -> bool:
         """Whether ``x ∈ cl dom F(t,·)`` up to ``tol`` (through :meth:`project_domain`)."""
@@ -157,6 +163,12 @@ def _check_dim(op: Operator, x: np.ndarray) -> np.ndarray:
     return x
 
 
+def _provides(op: Any, member: str) -> bool:
+    """``op.provides(member)`` for operators that say, else whether ``op`` has the member at all."""
+    says = getattr(op, "provides", None)
+    return bool(says(member)) if callable(says) else callable(getattr(op, member, None))
+
+
 class _FromResolvent(Operator):
     def __init__(self, resolvent, dim, min_norm, project_domain, contains, name):
         super().__init__(dim, name or getattr(resolvent, "__name__", "user operator"))
@@ -169,6 +181,9 @@ class _FromResolvent(Operator):
     def resolvent(self, x, lam, t=0.0):
         lam = check_lam(lam, f"{self.name}.resolvent")
         return real_array(self._resolvent(real_array(x), lam, t), f"the resolvent of {self.name}")
+
+    def provides(self, member):
+        return getattr(self, f"_{member}", None) is not None
 
     def min_norm(self, x, t=0.0):
         if self._min_norm is None:
@@ -534,6 +549,9 @@ class Shifted(Operator):
                 p = Phi(t)
                 return inner(x + p, lam, t) - p
         return step
+
+    def provides(self, member):
+        return Operator.provides(self, member) and _provides(self.F, member)
 
     def min_norm(self, x, t=0.0):
         return self.F.min_norm(np.asarray(x, dtype=float) + self._Phi(t), t)

@@ -106,10 +106,8 @@ class _Collector:
                 r.details.setdefault("pytest_nodeid", self.nodeid)
                 self.by_node.setdefault(self.nodeid, []).append(r)
             self.report.add(r)
-            if isinstance(r.details.get("study"), dict) and not isinstance(item, Report):
-                from .convergence import ConvergenceStudy
-
-                self.report.studies.append(ConvergenceStudy.from_dict(r.details["study"]))
+            if r.study is not None and not isinstance(item, Report):
+                self.report.studies.append(r.study)
         if isinstance(item, Report):
             known = {id(s) for s in self.report.studies}
             self.report.studies.extend(s for s in item.studies if id(s) not in known)

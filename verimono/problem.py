@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 from typing import Any, Callable, Sequence
 
 import numpy as np
@@ -24,10 +25,25 @@ class Order:
     source: str
     exact: bool = False
     constant: float | None = None
+    #: the highest order the solution's regularity allows *any* convergent scheme (``inf``: smooth), with
+    #: its source — what a stepper claiming only ``scheme="any"`` is held to (:mod:`verimono.claims`)
+    regularity: float | None = None
+    regularity_source: str = ""
 
     @classmethod
-    def exact_at_nodes(cls, source: str) -> "Order":
-        return cls(None, source, exact=True)
+    def exact_at_nodes(cls, source: str, regularity: float | None = None, regularity_source: str = "") -> "Order":
+        return cls(None, source, exact=True, regularity=regularity, regularity_source=regularity_source)
+
+    def for_claim(self, claimed: float) -> "Order":
+        """The order a scheme claiming convergence with order ``claimed`` must reach here:
+        ``min(claimed, regularity)`` (the claim alone where the regularity is not stated)."""
+        reg = math.inf if self.regularity is None else float(self.regularity)
+        if claimed <= reg:
+            why = (f"the claimed order {claimed:g}" + ("" if self.regularity is None else
+                   f" (within the order {reg:g} the solution's regularity allows: {self.regularity_source})"))
+            return Order(float(claimed), why)
+        return Order(reg, f"the claimed order {claimed:g}, capped at {reg:g} by the solution's regularity: "
+                          f"{self.regularity_source}")
 
     def __str__(self) -> str:
         return "exact" if self.exact else f"{self.value:g}"
@@ -56,6 +72,7 @@ def _finite_array(value: Any, what: str) -> np.ndarray:
     return arr
 
 
+@dataclasses.dataclass(frozen=True, init=False, repr=False, eq=False)
 class Problem:
     """``x' ∈ -F(t, x) + f(x) + u(t)`` on ``[0, T]`` with ``x(0) = x0``.
 
@@ -82,7 +99,28 @@ class Problem:
     (the functions of assumptions (A3), (LG), (YB) when known), ``steps`` (step sizes for which the
     expected order is asymptotic), ``initial_jump`` (allow ``x0 ∉ cl dom F(0)``: the catching-up
     scheme then jumps to the projection in its first step), ``notes``.
+
+    A frozen dataclass: fields cannot be reassigned; :meth:`replace` (or :func:`dataclasses.replace`)
+    builds a changed copy through the same validation.  Equality is identity (the fields hold arrays and
+    functions).
     """
+
+    operator: Any
+    x0: np.ndarray
+    T: float
+    f: Callable | None = None
+    u: Callable | None = None
+    exact: Callable | None = None
+    order: Order | None = None
+    name: str = ""
+    U: Callable | None = None
+    lipschitz: float | None = None
+    phi: Callable | None = None
+    sigma: Callable | None = None
+    theta: Callable | None = None
+    steps: list[float] | None = None
+    initial_jump: bool = False
+    notes: str = ""
 
     def __init__(self, operator: Any, x0: Any, T: float, *, f: Callable | None = None,
                  u: Callable | None = None, exact: Callable | None = None, order: Any = None,
@@ -104,14 +142,12 @@ class Problem:
         for what, fn in (("f", f), ("u", u), ("exact", exact), ("U", U)):
             if fn is not None and not callable(fn):
                 raise InvalidProblem(f"{what} must be callable, got {fn!r}")
-        self.operator, self.x0, self.T = operator, x0, T
-        self.f, self.u, self.U, self.exact = f, u, U, exact
-        self.order = _as_order(order)
-        self.name = name or f"{getattr(operator, 'name', 'F')} problem"
-        self.lipschitz, self.phi, self.sigma, self.theta = lipschitz, phi, sigma, theta
-        self.steps = None if steps is None else [float(h) for h in steps]
-        self.initial_jump = bool(initial_jump)
-        self.notes = notes
+        fields = dict(operator=operator, x0=x0, T=T, f=f, u=u, exact=exact, order=_as_order(order),
+                      name=name or f"{getattr(operator, 'name', 'F')} problem", U=U, lipschitz=lipschitz,
+                      phi=phi, sigma=sigma, theta=theta, steps=None if steps is None else [float(h) for h in steps],
+                      initial_jump=bool(initial_jump), notes=notes)
+        for key, value in fields.items():
+            object.__setattr__(self, key, value)  # frozen: the one place the fields are set
         if f is not None:
             fx = _finite_array(f(x0), "f(x0)")
             if fx.shape != x0.shape:
@@ -123,6 +159,16 @@ class Problem:
                     raise InvalidProblem(f"{what} must have shape ({n},), got {val.shape}")
         if not initial_jump:
             self._check_initial_point()
+
+    def replace(self, **changes: Any) -> "Problem":
+        """A copy with some constructor arguments replaced (``x0``, ``T``, ``name``, ``phi``, ...), validated
+        as a new problem; an unknown name is an :class:`InvalidProblem`."""
+        kw = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        unknown = sorted(set(changes) - kw.keys())
+        if unknown:
+            raise InvalidProblem(f"Problem has no field {', '.join(unknown)}; fields: {', '.join(kw)}")
+        kw.update(changes)
+        return Problem(kw.pop("operator"), kw.pop("x0"), kw.pop("T"), **kw)
 
     @property
     def dim(self) -> int:

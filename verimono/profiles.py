@@ -17,7 +17,7 @@ from __future__ import annotations
 import dataclasses
 import os
 
-from .errors import VerimonoError
+from .errors import UnknownProfile
 
 PROFILES = ("dev", "ci", "thorough")
 
@@ -52,10 +52,6 @@ _EFFORT = {
     "thorough": Profile("thorough", max_examples=500, law_examples=200, generated_subjects=30,
                         derandomize=False, unit_timeout=600.0),
 }
-
-
-class UnknownProfile(VerimonoError, ValueError):
-    """A profile name other than ``dev``, ``ci`` or ``thorough``."""
 
 
 def get_profile(name: str) -> Profile:

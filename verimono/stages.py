@@ -20,6 +20,7 @@ To add a battery::
 from __future__ import annotations
 
 import dataclasses
+import functools
 import importlib
 import os
 import time
@@ -29,21 +30,13 @@ from typing import Any, Callable, Iterable
 
 import numpy as np
 
-from .errors import VerimonoError
+from .errors import StageUnavailable, UnknownStage, VerimonoError
 from .profiles import Profile
 from .results import FAILED, PASSED, SKIPPED, XFAIL, CheckResult, Report
 from .timeouts import run_unit
 
 #: how many points of a trajectory the report keeps for its plot (enough for a smooth curve)
 TRAJECTORY_SAMPLES = 400
-
-
-class StageUnavailable(VerimonoError):
-    """A stage cannot run here (its module is not installed yet, or its data are absent)."""
-
-
-class UnknownStage(VerimonoError, ValueError):
-    """A stage name that is not registered."""
 
 
 @dataclasses.dataclass
@@ -149,11 +142,22 @@ def run_stages(names: Iterable[str] | None, profile: Profile, context: RunContex
         info = {"name": n, "status": status, "records": len(rep), "duration": duration, "message": message}
         for r in rep.results:
             r.details.setdefault("stage", n)
+            cx = r.counterexample if isinstance(r.counterexample, dict) else {}
+            if isinstance(cx.get("problem"), str) and cx["problem"] in _reference_names():
+                r.details.setdefault("reference", cx["problem"])  # `--reference NAME` reproduces it
         total.extend(rep)
         total.meta["stages"].append(info)
         if on_done:
             on_done(stage, rep, info)
     return total
+
+
+@functools.lru_cache(maxsize=1)
+def _reference_names() -> frozenset[str]:
+    """Names ``verimono run --reference NAME`` accepts (the reference catalog's)."""
+    from verimono.reference import catalog
+
+    return frozenset(p.name for p in catalog())
 
 
 def calibrate(repeats: int = 3) -> float:
@@ -222,7 +226,6 @@ def sample_trajectory(stepper: Callable, problem: Any, h: float | None = None) -
 def convergence_stage(profile: Profile, context: RunContext) -> Report:
     """Every analytic reference's convergence study, plus a trajectory sample for the report's plots."""
     from .checks.orders import check_convergence_order
-    from .convergence import ConvergenceStudy
 
     stepper = context.stepper
     if stepper is None:
@@ -233,8 +236,8 @@ def convergence_stage(profile: Profile, context: RunContext) -> Report:
         context.progress(i, len(problems), p.name)
         rec = report.add(run_unit(lambda: check_convergence_order(stepper, p), check="convergence_order",
                                   subject=f"{_name(stepper)} on {p.name}"))
-        if "study" in rec.details:
-            report.studies.append(ConvergenceStudy.from_dict(rec.details["study"]))
+        if rec.study is not None:
+            report.studies.append(rec.study)
         try:
             report.trajectories.append(sample_trajectory(stepper, p))
         except (VerimonoError, ArithmeticError, ValueError) as exc:
@@ -335,10 +338,9 @@ def trajectory_laws_stage(profile: Profile, context: RunContext) -> Report:
 def assumptions_stage(profile: Profile, context: RunContext) -> Report:
     """``check_assumptions(problem)`` on every reference (evidence, never proof).
 
-    Theorem ``thm:main`` needs (A1)–(A3) and *one of* (LG) or (YB).  So when exactly one of the two
-    alternatives has evidence against it, that record becomes an expected failure (``xfail``, saying
-    which alternative holds), and one record ``assumptions_thm_main`` per problem states whether the
-    theorem's hypotheses as a whole have evidence for them."""
+    Theorem ``thm:main`` needs (A1)–(A3) and *one of* (LG) or (YB): the composite law
+    :func:`verimono.checks.assumptions.thm_main` states it (an ``xfail`` for the alternative that fails
+    while the other holds, one ``assumptions_thm_main`` record per problem)."""
     mod = optional_module("verimono.checks.assumptions")
     seed = context.seed_for(profile)
     report = Report()
@@ -350,18 +352,7 @@ def assumptions_stage(profile: Profile, context: RunContext) -> Report:
         if isinstance(rep, CheckResult):    # the unit ran out of its time budget: a failed record, go on
             report.add(rep)
             continue
-        by = {r.check: r for r in rep.results}
-        lg, yb = by.get("assumption_LG"), by.get("assumption_YB")
-        for this, other, name in ((lg, yb, "(YB)"), (yb, lg, "(LG)")):
-            if this is not None and other is not None and this.status == FAILED and other.status == PASSED:
-                this.status = XFAIL
-                this.message = f"the alternative hypothesis {name} has evidence for it; {this.message}"
-        bad = [r.check for r in rep.results if r.status == FAILED]
         report.extend(rep)
-        report.add(CheckResult(
-            "assumptions_thm_main", p.name, FAILED if bad else PASSED, seed=seed,
-            message=("evidence against " + ", ".join(bad)) if bad else
-            "no sample contradicts (A1)–(A3) and (LG) or (YB) — evidence, not proof"))
     return report
 
 
@@ -373,7 +364,6 @@ def section7_stage(profile: Profile, context: RunContext) -> Report:
     example = optional_module("verimono.reference.lcs_example")
     lcs = optional_module("verimono.lcs")
     from .checks.orders import check_convergence_order
-    from .convergence import ConvergenceStudy
 
     stepper = context.stepper
     if stepper is None:
@@ -385,8 +375,8 @@ def section7_stage(profile: Profile, context: RunContext) -> Report:
         context.progress(i, len(problems) + 1, p.name)
         rec = report.add(run_unit(lambda: check_convergence_order(stepper, p), check="convergence_order",
                                   subject=f"{_name(stepper)} on {p.name}"))
-        if "study" in rec.details:
-            report.studies.append(ConvergenceStudy.from_dict(rec.details["study"]))
+        if rec.study is not None:
+            report.studies.append(rec.study)
         report.trajectories.append(sample_trajectory(stepper, p))
     seed = context.seed_for(profile)
     report.add(example.check_closed_form_resolvent(seed=0 if seed is None else seed))

@@ -23,6 +23,7 @@ from typing import Any, Callable, Iterator
 import numpy as np
 
 from ._kernels import real_array
+from .claims import Claim
 from .errors import InvalidProblem, SolverFailure
 from .grids import validate_grid
 from .operators import resolvent_kernel
@@ -134,6 +135,8 @@ def solve(problem: Problem, t_grid: Any) -> Trajectory:
 
 #: solve accepts a batch ``x0`` of shape ``(B, n)`` (checks may run many initial points in one call)
 solve.batched = True
+#: verimono.solve is the paper's scheme (eq:iteration): every law applies to it (:mod:`verimono.claims`)
+solve.claim = Claim()
 
 #: rows per block of :func:`stream` (1 MiB of states for n = 16)
 STREAM_BLOCK = 8192

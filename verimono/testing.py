@@ -17,7 +17,9 @@ is a function of the subject yielding ``(name, check)`` pairs with ``check(subje
 
 * operators (anything with ``.resolvent`` and ``.dim``): ``verimono.checks.operator_laws.operator_checks(op)``,
   the generator of :func:`verimono.check_operator`;
-* steppers (any other callable ``stepper(problem, t_grid)``):
+* problems (:class:`verimono.Problem`): ``verimono.checks.assumptions.problem_checks(problem)``, the
+  records of :func:`verimono.check_assumptions` (evidence for (A1)–(A3), (LG), (YB) and ``thm:main``);
+* steppers (any other callable ``stepper(problem, t_grid)``; a :class:`verimono.Stepper` states its claim):
   ``verimono.checks.trajectory_laws.stepper_checks(stepper)``, the generator of
   :func:`verimono.check_stepper` (convergence orders on the references, trajectory laws on the references
   and on seeded sample problems).
@@ -80,8 +82,15 @@ def is_operator(subject: Any) -> bool:
     return hasattr(subject, "resolvent") and hasattr(subject, "dim")
 
 
+def is_problem(subject: Any) -> bool:
+    """Problems (:class:`verimono.Problem`) get the battery of assumption evidence."""
+    from .problem import Problem
+
+    return isinstance(subject, Problem)
+
+
 def subject_name(subject: Any) -> str:
-    return (getattr(subject, "name", None) if is_operator(subject) else None) or \
+    return (getattr(subject, "name", None) if is_operator(subject) or is_problem(subject) else None) or \
         getattr(subject, "__name__", None) or getattr(subject, "name", None) or type(subject).__name__
 
 
@@ -103,6 +112,10 @@ def checks_for(subject: Any, *, seed: int | None = None, examples: int | None = 
         from .checks.operator_laws import operator_checks
 
         return list(operator_checks(subject, seed=seed, examples=examples))
+    if is_problem(subject):
+        from .checks.assumptions import problem_checks
+
+        return list(problem_checks(subject, seed=0 if seed is None else seed))
     if callable(subject):
         from .checks.trajectory_laws import stepper_checks
 
@@ -120,6 +133,10 @@ def registry_size(subject: Any, *, problems: Iterable | None = None, generated: 
         from .checks.operator_laws import LAWS
 
         return len(LAWS)
+    if is_problem(subject):
+        from .checks.core import laws_of
+
+        return len(laws_of("problem"))
     from .checks.trajectory_laws import CHECKS
 
     if problems is not None:
@@ -326,5 +343,5 @@ def battery_counts(config: Any) -> dict[str, int] | None:
 
 
 __all__ = ["parametrize_with_checks", "checks_for", "BoundCheck", "describe", "check_id", "is_operator",
-           "subject_name", "registry_size", "register_hypothesis_profiles", "load_hypothesis_profile", "battery_counts",
+           "subject_name", "is_problem", "registry_size", "register_hypothesis_profiles", "load_hypothesis_profile", "battery_counts",
            "BatteryCounter", "pytest_configure"]

@@ -84,3 +84,9 @@ STALL_WINDOW = 8
 #: solvers stop at about 1e-8 relative duality gap; the LMI is then re-checked by an eigenvalue computation
 #: against this looser tolerance, scaled to the size of the KYP matrix.
 SDP_RTOL = 1e-6
+
+#: a scheme claiming order p (``scheme="any"``) passes ``in_domain`` when the largest distance of its
+#: iterates to ``cl dom F(t_k)`` at the finest level is at most this factor times the prediction
+#: ``max_j D(K_j) (K_j/K_m)^p`` from the coarser levels: the constant of ``C h^p`` is unknown and drifts
+#: by O(h) between levels; a distance that does not vanish (a constant offset) exceeds any fixed factor
+DOMAIN_ORDER_SLACK = 2.0

@@ -40,7 +40,8 @@ import numpy as np
 from ..errors import OutsideDomain, VerimonoError
 from ..operators import resolvent_rows
 from ..problem import Problem
-from ..results import FAILED, PASSED, SKIPPED, CheckResult, Report
+from ..results import FAILED, PASSED, SKIPPED, XFAIL, CheckResult, Report
+from .core import law as _declare, laws_of, run as _run
 from ..tolerances import GROWTH_FLAG, RTOL, quotient_tolerance, tolerance
 
 EVIDENCE = "evidence from samples, not a proof"
@@ -331,24 +332,68 @@ def _yb(S: _Samples) -> CheckResult:
                        message=f"estimated θ̂(t) = {rho:.4g} t ({key}; {EVIDENCE})")
 
 
-def check_assumptions(problem: Problem, *, seed: int = 0, points: int = 12, times: int = 7) -> Report:
-    """Sampled evidence for (A1), (A2), (A3), (LG) and (YB)/(YB') on ``problem`` (see the module docstring)."""
+for _law_name, _fn, _label in (("assumption_A1", _a1, "(A1)"), ("assumption_A2", _a2, "(A2)"),
+                                ("assumption_A3", _a3, "(A3)"), ("assumption_LG", _lg, "(LG)"),
+                                ("assumption_YB", _yb, "(YB)/(YB')")):
+    _declare(_law_name, _label, subject="problem")(_fn)
+
+
+@_declare("assumptions_thm_main", "thm:main: (A1)–(A3) and (LG) or (YB)", subject="problem")
+def thm_main(problem: Problem, records: dict[str, CheckResult]) -> CheckResult:
+    """Theorem ``thm:main`` needs (A1)–(A3) and *one of* (LG) or (YB): a composite law over the records of
+    the five assumptions.  When exactly one of (LG), (YB) has evidence against it and the other has
+    evidence for it, that record becomes an expected failure (``xfail``, saying which alternative holds);
+    this record fails when any remaining assumption record failed."""
+    lg, yb = records.get("assumption_LG"), records.get("assumption_YB")
+    for this, other, name in ((lg, yb, "(YB)"), (yb, lg, "(LG)")):
+        if this is not None and other is not None and this.status == FAILED and other.status == PASSED:
+            this.status = XFAIL
+            this.message = f"the alternative hypothesis {name} has evidence for it; {this.message}"
+    bad = [r.check for r in records.values() if r.status == FAILED]
+    return CheckResult("assumptions_thm_main", _subject(problem), FAILED if bad else PASSED,
+                       details={"evidence": EVIDENCE, "from": sorted(records)},
+                       message=("evidence against " + ", ".join(bad)) if bad else
+                       "no sample contradicts (A1)–(A3) and (LG) or (YB) — evidence, not proof")
+
+
+ASSUMPTION_LAWS = ("assumption_A1", "assumption_A2", "assumption_A3", "assumption_LG", "assumption_YB")
+
+
+def check_assumptions(problem: Problem, *, seed: int = 0, points: int = 12, times: int = 7,
+                      composite: bool = True) -> Report:
+    """Sampled evidence for (A1), (A2), (A3), (LG) and (YB)/(YB') on ``problem`` (see the module docstring),
+    then (``composite=True``) the composite law :func:`thm_main` of Theorem ``thm:main``."""
     S = _Samples(problem, seed, points, times)
     report = Report(meta={"subject": _subject(problem), "seed": seed, "evidence": EVIDENCE})
-    for name, fn in (("assumption_A1", _a1), ("assumption_A2", _a2), ("assumption_A3", _a3),
-                     ("assumption_LG", _lg), ("assumption_YB", _yb)):
-        start = time.perf_counter()
-        try:
-            rec = fn(S)
-        except NotImplementedError as exc:
-            rec = CheckResult(name, _subject(problem), SKIPPED, message=f"not available: {exc}")
-        except (VerimonoError, ArithmeticError, ValueError) as exc:
-            rec = CheckResult(name, _subject(problem), FAILED, message=f"{type(exc).__name__}: {exc}")
+    laws = laws_of("problem")
+    for name in ASSUMPTION_LAWS:
+        rec = _run(laws[name], S, problem=problem)
         rec.seed = seed
-        rec.duration = time.perf_counter() - start
+        report.add(rec)
+    if composite:
+        rec = _run(thm_main.law, problem, {r.check: r for r in report.results}, problem=problem)
+        rec.seed = seed
         report.add(rec)
     return report
 
 
-__all__ = ["check_assumptions", "EVIDENCE", "LAMBDAS", "A2_LEVELS", "A2_RATIO", "A2_SETTLED",
+def problem_checks(problem: Problem | None = None, *, seed: int = 0, points: int = 12, times: int = 7):
+    """The battery of a problem, as ``(name, check)`` pairs with ``check(problem) -> CheckResult`` — one
+    source for :func:`check_assumptions`'s records in :func:`verimono.testing.parametrize_with_checks`.
+
+    The five assumption laws share their samples and the composite :func:`thm_main` reads their records,
+    so the first check run evaluates the whole battery once (per problem) and every check returns its own
+    record of it."""
+    done: dict[int, dict[str, CheckResult]] = {}
+
+    def records(p: Problem) -> dict[str, CheckResult]:
+        if id(p) not in done:
+            done[id(p)] = {r.check: r for r in check_assumptions(p, seed=seed, points=points, times=times)}
+        return done[id(p)]
+
+    for name in (*ASSUMPTION_LAWS, "assumptions_thm_main"):
+        yield name, (lambda p, _name=name: records(p)[_name])
+
+
+__all__ = ["check_assumptions", "problem_checks", "thm_main", "ASSUMPTION_LAWS", "EVIDENCE", "LAMBDAS", "A2_LEVELS", "A2_RATIO", "A2_SETTLED",
            "A2_TAIL_SAFETY", "A2_LAMBDAS"]

@@ -35,10 +35,13 @@ import hypothesis.errors
 from hypothesis import HealthCheck, Phase, Verbosity, given, settings
 from hypothesis import strategies as st
 
-from ..errors import InvalidCheckArgument, UnitTimeout, VerimonoError
-from ..timeouts import current_budget, time_limit
+from ..errors import VerimonoError
 from ..operators import Operator
+from ..profiles import UnknownProfile, active_profile, get_profile
+from ..errors import InvalidCheckArgument, UnitTimeout
 from ..results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult, Report
+from ..timeouts import current_budget, time_limit
+from .core import Law, Member, Outcome, law as _declare, laws_of, run as _run_law
 from ..strategies import points, step_sizes, times
 from ..tolerances import EPS, LIMIT_FLOOR, STALL_RATIO, STALL_WINDOW, tolerance
 
@@ -162,28 +165,6 @@ class _BadOutput(Exception):
     """An operator member returned something that is not a finite point of the right shape."""
 
 
-@dataclasses.dataclass
-class _Eval:
-    """``lhs ≤ rhs + slack`` for one sample, with what was compared (for the message) and values."""
-
-    lhs: float
-    rhs: float
-    slack: float
-    what: str
-    info: dict[str, Any] = dataclasses.field(default_factory=dict)
-    #: the sample cannot decide the law (it neither holds nor fails there): counted, never a pass
-    inconclusive: bool = False
-
-    @property
-    def ratio(self) -> float:
-        den = self.rhs + self.slack
-        if not (math.isfinite(self.lhs) and math.isfinite(den)):
-            return math.inf
-        if den > 0.0:
-            return self.lhs / den
-        return 0.0 if self.lhs <= 0.0 else math.inf
-
-
 def _point(value: Any, like: np.ndarray, member: str) -> np.ndarray:
     y = np.asarray(value, dtype=float)
     if y.shape != like.shape:
@@ -242,7 +223,7 @@ def _resolvent_single_valued(op, s):
     moved = _nrm(x - s.x1)
     b = _J(op, s.x1, s.lam, s.t)
     tau = _tol(s.x1, a, b)
-    return _Eval(_nrm(a - b) + (math.inf if moved > 0 else 0.0), 0.0, tau,
+    return Outcome.compare(_nrm(a - b) + (math.inf if moved > 0 else 0.0), 0.0, tau,
                  "|J_λx - J_λx| over two calls" + (f" (the call modified its input by {moved:.3g})" if moved else ""),
                  {"J_first": _listed(a), "J_second": _listed(b), "input_modified_by": moved})
 
@@ -250,7 +231,7 @@ def _resolvent_single_valued(op, s):
 def _resolvent_nonexpansive(op, s):
     a, b = _J(op, s.x1, s.lam, s.t), _J(op, s.x2, s.lam, s.t)
     tau = _tol(s.x1, s.x2, a, b)
-    return _Eval(_nrm(a - b), _nrm(s.x1 - s.x2), 4 * tau, "|J_λx1 - J_λx2| ≤ |x1 - x2|",
+    return Outcome.compare(_nrm(a - b), _nrm(s.x1 - s.x2), 4 * tau, "|J_λx1 - J_λx2| ≤ |x1 - x2|",
                  {"J1": _listed(a), "J2": _listed(b)})
 
 
@@ -258,14 +239,14 @@ def _resolvent_firmly_nonexpansive(op, s):
     a, b = _J(op, s.x1, s.lam, s.t), _J(op, s.x2, s.lam, s.t)
     dJ, dx = a - b, s.x1 - s.x2
     tau = _tol(s.x1, s.x2, a, b)
-    return _Eval(float(dJ @ dJ), float(dJ @ dx), 4 * tau * (_nrm(dJ) + _nrm(dx) + tau),
+    return Outcome.compare(float(dJ @ dJ), float(dJ @ dx), 4 * tau * (_nrm(dJ) + _nrm(dx) + tau),
                  "|J_λx1 - J_λx2|² ≤ ⟨J_λx1 - J_λx2, x1 - x2⟩", {"J1": _listed(a), "J2": _listed(b)})
 
 
 def _resolvent_in_domain(op, s):
     a = _J(op, s.x1, s.lam, s.t)
     p = _point(op.project_domain(a.copy(), s.t), a, "project_domain")
-    return _Eval(_nrm(p - a), 0.0, 2 * _tol(s.x1, a), "dist(J_λx, cl dom F(t,·)) = 0",
+    return Outcome.compare(_nrm(p - a), 0.0, 2 * _tol(s.x1, a), "dist(J_λx, cl dom F(t,·)) = 0",
                  {"J": _listed(a), "proj_dom_J": _listed(p)})
 
 
@@ -275,7 +256,7 @@ def _resolvent_identity(op, s):
     z = r * s.x1 + (1.0 - r) * a
     b = _J(op, z, s.mu, s.t)
     tau = _tol(s.x1, a, z)
-    return _Eval(_nrm(a - b), 0.0, tau * (4.0 + abs(1.0 - r)),
+    return Outcome.compare(_nrm(a - b), 0.0, tau * (4.0 + abs(1.0 - r)),
                  "J_λx = J_μ((μ/λ)x + (1 - μ/λ)J_λx)", {"J_lam": _listed(a), "J_mu_of_z": _listed(b), "z": _listed(z)})
 
 
@@ -285,7 +266,7 @@ def _resolvent_limit(op, s):
     for k in range(6):
         lam = s.lam * 4.0 ** (-k)
         d = _nrm(_J(op, x, lam, s.t) - x)
-        ev = _Eval(d, lam * _nrm(y0), tau * (4.0 + lam / s.nu), "|J_λx - x| ≤ λ|y| for x = J_νx1, y = Y_νx1 ∈ F(x)",
+        ev = Outcome.compare(d, lam * _nrm(y0), tau * (4.0 + lam / s.nu), "|J_λx - x| ≤ λ|y| for x = J_νx1, y = Y_νx1 ∈ F(x)",
                    {"x": _listed(x), "y": _listed(y0), "lam_at_worst": lam})
         if worst is None or not ev.ratio <= worst.ratio:
             worst = ev
@@ -298,7 +279,7 @@ def _monotone(op, s):
     dx, dy = a - b, ya - yb
     ex = 2 * _tol(s.x1, s.x2, a, b)
     ey = ex * (1.0 / s.lam + 1.0 / s.mu)
-    return _Eval(-float(dx @ dy), 0.0, 2 * (ex * _nrm(dy) + ey * _nrm(dx) + ex * ey),
+    return Outcome.compare(-float(dx @ dy), 0.0, 2 * (ex * _nrm(dy) + ey * _nrm(dx) + ex * ey),
                  "⟨x_a - x_b, y_a - y_b⟩ ≥ 0 for (x_a, y_a) = (J_λx1, Y_λx1), (x_b, y_b) = (J_μx2, Y_μx2)",
                  {"xa": _listed(a), "ya": _listed(ya), "xb": _listed(b), "yb": _listed(yb)})
 
@@ -306,7 +287,7 @@ def _monotone(op, s):
 def _yosida_lipschitz(op, s):
     a, b = _J(op, s.x1, s.lam, s.t), _J(op, s.x2, s.lam, s.t)
     dY = ((s.x1 - a) - (s.x2 - b)) / s.lam
-    return _Eval(s.lam * _nrm(dY), _nrm(s.x1 - s.x2), 4 * _tol(s.x1, s.x2, a, b),
+    return Outcome.compare(s.lam * _nrm(dY), _nrm(s.x1 - s.x2), 4 * _tol(s.x1, s.x2, a, b),
                  "λ|Y_λx1 - Y_λx2| ≤ |x1 - x2|", {"J1": _listed(a), "J2": _listed(b)})
 
 
@@ -314,7 +295,7 @@ def _yosida_monotone(op, s):
     a, b = _J(op, s.x1, s.lam, s.t), _J(op, s.x2, s.lam, s.t)
     dx = s.x1 - s.x2
     dY = (dx - (a - b)) / s.lam
-    return _Eval(-float(dY @ dx), 0.0, 4 * _tol(s.x1, s.x2, a, b) * _nrm(dx) / s.lam,
+    return Outcome.compare(-float(dY @ dx), 0.0, 4 * _tol(s.x1, s.x2, a, b) * _nrm(dx) / s.lam,
                  "⟨Y_λx1 - Y_λx2, x1 - x2⟩ ≥ 0", {"J1": _listed(a), "J2": _listed(b)})
 
 
@@ -323,7 +304,7 @@ def _yosida_in_graph(op, s):
     y = (s.x1 - a) / s.lam
     tol = _tol(s.x1, a, s.lam * y) * (2.0 + 2.0 / s.lam)
     g = _graded_membership(op, a, y, s.t, tol)
-    return _Eval(g, 0.0, 1.0, "Y_λx ∈ F(t, J_λx) (ratio: tolerance multiple needed)",
+    return Outcome.compare(g, 0.0, 1.0, "Y_λx ∈ F(t, J_λx) (ratio: tolerance multiple needed)",
                  {"J": _listed(a), "Y": _listed(y), "tol": tol})
 
 
@@ -334,7 +315,7 @@ def _yosida_nonincreasing(op, s):
     a, b = _J(op, s.x1, lo, s.t), _J(op, s.x1, hi, s.t)
     ylo, yhi = (s.x1 - a) / lo, (s.x1 - b) / hi
     tau = _tol(s.x1, a, b)
-    return _Eval(_nrm(yhi), _nrm(ylo), 4 * tau * (1.0 / lo + 1.0 / hi),
+    return Outcome.compare(_nrm(yhi), _nrm(ylo), 4 * tau * (1.0 / lo + 1.0 / hi),
                  "|Y_μx| ≤ |Y_λx| for λ ≤ μ", {"lam": lo, "mu": hi, "Y_lam": _listed(ylo), "Y_mu": _listed(yhi)})
 
 
@@ -343,7 +324,7 @@ def _yosida_bounded_by_min_norm(op, s):
     f0 = _F0(op, x, s.t)
     a = _J(op, x, s.lam, s.t)
     y = (x - a) / s.lam
-    return _Eval(_nrm(y), _nrm(f0), 4 * _tol(x, a) / s.lam + 2 * tau / s.lam + _tol(f0),
+    return Outcome.compare(_nrm(y), _nrm(f0), 4 * _tol(x, a) / s.lam + 2 * tau / s.lam + _tol(f0),
                  "|Y_λx| ≤ |F^0(t, x)| for x = J_νx1 ∈ dom F", {"x": _listed(x), "Y": _listed(y), "F0": _listed(f0)})
 
 
@@ -362,27 +343,27 @@ def _yosida_limit(op, s):
         lams.append(lam)
         info = {"x": _listed(x), "|F0|": f0, "lams": lams, "gaps": gaps}
         if gap <= slack:
-            return _Eval(gap, 0.0, slack, "|Y_λx| → |F^0(t, x)| as λ → 0 (gap within tolerance)", info)
+            return Outcome.compare(gap, 0.0, slack, "|Y_λx| → |F^0(t, x)| as λ → 0 (gap within tolerance)", info)
         if y <= 2 * tx / lam and _only_within_rounding(op, x, np.zeros_like(x), s.t, 2 * tx):
-            return _Eval(0.0, 0.0, slack, "|Y_λx| → 0: x is within rounding, not exactly at, a zero of F(t,·) "
+            return Outcome.compare(0.0, 0.0, slack, "|Y_λx| → 0: x is within rounding, not exactly at, a zero of F(t,·) "
                          "(F^0 is ill-conditioned there; sample inconclusive)", info, inconclusive=True)
         if lam / 2 < floor:
             break
         lam /= 2
     w = min(STALL_WINDOW, len(gaps) - 1)
     if w == 0:   # one λ above the rounding floor: the gap can be neither closed nor seen shrinking
-        return _Eval(gaps[-1], gaps[-1], slack, "|Y_λx| → |F^0(t, x)| (no room to halve λ; sample inconclusive)",
+        return Outcome.compare(gaps[-1], gaps[-1], slack, "|Y_λx| → |F^0(t, x)| (no room to halve λ; sample inconclusive)",
                      info, inconclusive=True)
     if _kink_within(op, x, s.t, KINK_PROBE * lams[-1] * (1.0 + f0)):
-        return _Eval(0.0, 0.0, slack, f"|Y_λx| → |F^0(t, x)|: F^0 jumps within {KINK_PROBE * lams[-1] * (1.0 + f0):.2g} "
+        return Outcome.compare(0.0, 0.0, slack, f"|Y_λx| → |F^0(t, x)|: F^0 jumps within {KINK_PROBE * lams[-1] * (1.0 + f0):.2g} "
                      "of x, where the gap closes only below the sweep's rounding floor λ = "
                      f"{lams[-1]:.3g} (sample inconclusive)", info, inconclusive=True)
     if _closing_below_floor(gaps, 8 * EPS * (1.0 + float(np.max(np.abs(x)))) / lams[-1]):
-        return _Eval(0.0, 0.0, slack, "|Y_λx| → |F^0(t, x)|: the gap is still closing, ever faster, at the rounding "
+        return Outcome.compare(0.0, 0.0, slack, "|Y_λx| → |F^0(t, x)|: the gap is still closing, ever faster, at the rounding "
                      "floor (a kink of F closer to x than λ|F^0| resolves; sample inconclusive)", info,
                      inconclusive=True)
     # the gap exceeds the rounding floor: it must at least still be shrinking
-    return _Eval(gaps[-1], STALL_RATIO * gaps[-1 - w], _tol(gaps[-1], gaps[-1 - w]),
+    return Outcome.compare(gaps[-1], STALL_RATIO * gaps[-1 - w], _tol(gaps[-1], gaps[-1 - w]),
                  f"|Y_λx| → |F^0(t, x)|: gap ||F^0| - |Y_λx|| above tolerance {slack:.3g} must still shrink over "
                  f"the last {w} halvings down to λ = {lams[-1]:.3g}", info)
 
@@ -443,7 +424,7 @@ def _min_norm_in_graph(op, s):
     f0 = _F0(op, x, s.t)
     tol = 2 * _tol(x, f0)
     g = _graded_membership(op, x, f0, s.t, tol)
-    return _Eval(g, 0.0, 1.0, "F^0(t, x) ∈ F(t, x) (ratio: tolerance multiple needed)",
+    return Outcome.compare(g, 0.0, 1.0, "F^0(t, x) ∈ F(t, x) (ratio: tolerance multiple needed)",
                  {"x": _listed(x), "F0": _listed(f0), "tol": tol})
 
 
@@ -453,15 +434,15 @@ def _min_norm_least(op, s):
     info = {"x": _listed(x), "y": _listed(y0), "F0": _listed(f0)}
     try:   # y0 must be certified in F(t, x) where that can be tested (else yosida_in_graph fails)
         if not op.contains(x.copy(), y0.copy(), s.t, _tol(x, y0) * (2.0 + 2.0 / s.nu)):
-            return _Eval(0.0, 0.0, 1.0, "uncertified y0 ∉ F(t, x) (contains rejects it): sample inconclusive", info,
+            return Outcome.compare(0.0, 0.0, 1.0, "uncertified y0 ∉ F(t, x) (contains rejects it): sample inconclusive", info,
                          inconclusive=True)
     except NotImplementedError:
         pass
     slack = 4 * tau / s.nu + _tol(f0)
     if _nrm(f0) > _nrm(y0) + slack and _only_within_rounding(op, x, y0, s.t, _tol(x, y0) * (2.0 + 2.0 / s.nu)):
-        return _Eval(0.0, 0.0, 1.0, "y0 ∈ F(t, x') only for x' within rounding of x, near a jump of F^0: "
+        return Outcome.compare(0.0, 0.0, 1.0, "y0 ∈ F(t, x') only for x' within rounding of x, near a jump of F^0: "
                      "sample inconclusive", info, inconclusive=True)
-    return _Eval(_nrm(f0), _nrm(y0), slack, "|F^0(t, x)| ≤ |y| for x = J_νx1 and y = Y_νx1 ∈ F(t, x)", info)
+    return Outcome.compare(_nrm(f0), _nrm(y0), slack, "|F^0(t, x)| ≤ |y| for x = J_νx1 and y = Y_νx1 ∈ F(t, x)", info)
 
 
 def _only_within_rounding(op, x, y, t, tol) -> bool:
@@ -475,32 +456,31 @@ def _only_within_rounding(op, x, y, t, tol) -> bool:
         return False
 
 
-@dataclasses.dataclass(frozen=True)
-class Law:
-    """A law: stable ``name`` (the record's ``check``), its evaluator and the paper item it states."""
+_MIN_NORM, _CONTAINS, _PROJECT = Member("min_norm"), Member("contains"), Member("project_domain")
 
-    name: str
-    evaluate: Callable[[Operator, Sample], _Eval]
-    item: str
+#: law name -> (evaluator, the paper's item, required operator members), in the order they run
+_TABLE = [
+    ("resolvent_single_valued", _resolvent_single_valued, "prop:maxmon-resolvent-Yosida i–ii", ()),
+    ("resolvent_nonexpansive", _resolvent_nonexpansive, "prop:maxmon-resolvent-Yosida ii", ()),
+    ("resolvent_firmly_nonexpansive", _resolvent_firmly_nonexpansive, "prop:maxmon-resolvent-Yosida ii (A1)", ()),
+    ("resolvent_in_domain", _resolvent_in_domain, "range J_λ = dom F", (_PROJECT,)),
+    ("resolvent_identity", _resolvent_identity, "resolvent identity", ()),
+    ("resolvent_limit", _resolvent_limit, "prop:maxmon-resolvent-Yosida iii", ()),
+    ("monotone", _monotone, "(A1)", ()),
+    ("yosida_lipschitz", _yosida_lipschitz, "prop:maxmon-resolvent-Yosida iv", ()),
+    ("yosida_monotone", _yosida_monotone, "prop:maxmon-resolvent-Yosida iv", ()),
+    ("yosida_in_graph", _yosida_in_graph, "prop:maxmon-resolvent-Yosida v", (_CONTAINS,)),
+    ("yosida_nonincreasing", _yosida_nonincreasing, "prop:maxmon-resolvent-Yosida vi", ()),
+    ("yosida_bounded_by_min_norm", _yosida_bounded_by_min_norm, "prop:maxmon-resolvent-Yosida vi", (_MIN_NORM,)),
+    ("yosida_limit", _yosida_limit, "prop:maxmon-resolvent-Yosida vi", (_MIN_NORM,)),
+    ("min_norm_in_graph", _min_norm_in_graph, "minimal section F^0 = proj(0, F(x))", (_MIN_NORM, _CONTAINS)),
+    ("min_norm_least", _min_norm_least, "minimal section F^0 = proj(0, F(x))", (_MIN_NORM,)),
+]
+for _name_, _fn, _item, _needs in _TABLE:
+    _declare(_name_, _item, subject="operator", requires=_needs)(_fn)
 
-
-LAWS: dict[str, Law] = {law.name: law for law in [
-    Law("resolvent_single_valued", _resolvent_single_valued, "prop:maxmon-resolvent-Yosida i–ii"),
-    Law("resolvent_nonexpansive", _resolvent_nonexpansive, "prop:maxmon-resolvent-Yosida ii"),
-    Law("resolvent_firmly_nonexpansive", _resolvent_firmly_nonexpansive, "prop:maxmon-resolvent-Yosida ii (A1)"),
-    Law("resolvent_in_domain", _resolvent_in_domain, "range J_λ = dom F"),
-    Law("resolvent_identity", _resolvent_identity, "resolvent identity"),
-    Law("resolvent_limit", _resolvent_limit, "prop:maxmon-resolvent-Yosida iii"),
-    Law("monotone", _monotone, "(A1)"),
-    Law("yosida_lipschitz", _yosida_lipschitz, "prop:maxmon-resolvent-Yosida iv"),
-    Law("yosida_monotone", _yosida_monotone, "prop:maxmon-resolvent-Yosida iv"),
-    Law("yosida_in_graph", _yosida_in_graph, "prop:maxmon-resolvent-Yosida v"),
-    Law("yosida_nonincreasing", _yosida_nonincreasing, "prop:maxmon-resolvent-Yosida vi"),
-    Law("yosida_bounded_by_min_norm", _yosida_bounded_by_min_norm, "prop:maxmon-resolvent-Yosida vi"),
-    Law("yosida_limit", _yosida_limit, "prop:maxmon-resolvent-Yosida vi"),
-    Law("min_norm_in_graph", _min_norm_in_graph, "minimal section F^0 = proj(0, F(x))"),
-    Law("min_norm_least", _min_norm_least, "minimal section F^0 = proj(0, F(x))"),
-]}
+#: the operator laws (:class:`verimono.checks.core.Law`, evaluator: one :class:`Sample` -> :class:`Outcome`)
+LAWS: dict[str, Law] = laws_of("operator")
 
 
 # -- the driver -------------------------------------------------------------------------------------
@@ -514,21 +494,21 @@ class _State:
     runs: int = 0
     worst: float = -math.inf
     worst_sample: Sample | None = None
-    worst_eval: _Eval | None = None
+    worst_eval: Outcome | None = None
     fail_sample: Sample | None = None
-    fail_eval: _Eval | None = None
+    fail_eval: Outcome | None = None
     unsupported: str | None = None
     inconclusive: int = 0
     inconclusive_what: str = ""
 
 
-def _evaluate(law: Law, op: Operator, s: Sample) -> _Eval:
+def _evaluate(law: Law, op: Operator, s: Sample) -> Outcome:
     try:
         return law.evaluate(op, s)
     except NotImplementedError:
         raise
     except Exception as exc:  # an operator that raises on a valid input fails that input
-        return _Eval(math.inf, 0.0, 1.0, f"raised {type(exc).__name__}: {exc}")
+        return Outcome.compare(math.inf, 0.0, 1.0, f"raised {type(exc).__name__}: {exc}")
 
 
 def fresh_seed() -> int:
@@ -543,8 +523,6 @@ def _subject(op: Operator) -> str:
 def default_examples() -> tuple[int, str]:
     """``(examples per law, profile)`` when ``examples`` is not given: the active profile's ``law_examples``
     (``dev``/``ci``/``thorough``, :func:`verimono.profiles.active_profile`), else ``DEFAULT_EXAMPLES``."""
-    from ..profiles import UnknownProfile, active_profile, get_profile
-
     name = active_profile()
     try:
         return get_profile(name).law_examples, name
@@ -560,9 +538,51 @@ def run_law(law: Law | str, op: Operator, *, seed: int | None = None, examples: 
     law can neither hold nor fail there) are counted in ``details["inconclusive"]``; a record whose every
     evaluated sample was inconclusive is skipped with the reason, never passed."""
     law = LAWS[law] if isinstance(law, str) else law
-    start = time.perf_counter()
+    if examples is not None:
+        examples = _positive_examples(examples)
     if sample is None:  # the search is seeded (a fresh recorded seed when none is given)
         seed = fresh_seed() if seed is None else int(seed)
+    rec = _run_law(law, operator=op, call=lambda: _search(law, op, seed, examples, horizon, sample))
+    if rec.status == SKIPPED and "examples" not in rec.details:   # skipped from the declaration: the effort
+        n, profile = (examples, None) if examples is not None else default_examples()   # it would have had
+        rec.details.update({"item": law.label, "examples": int(n), "evaluations": 0, "horizon": horizon})
+        if profile is not None:
+            rec.details["profile"] = profile
+        rec.seed = seed
+    return rec
+
+
+#: the law that reports an operator whose resolvent raises on plain inputs (its statement: ``J_λ`` is
+#: defined on all of ``R^n``); every other law is then not evaluated, so the cause is reported once
+ROOT_LAW = "resolvent_single_valued"
+
+
+def root_cause(op: Operator, horizon: float = 1.0) -> str | None:
+    """Why ``op.resolvent`` cannot be evaluated at all — it raises (or returns no point of shape ``(n,)``)
+    at ``x = 0`` or ``x = (1, ..., 1)`` with ``λ = 1``, ``t ∈ {0, horizon}`` — or ``None``."""
+    for x in (np.zeros(op.dim), np.ones(op.dim)):
+        for t in (0.0, float(horizon)):
+            try:
+                y = np.asarray(op.resolvent(x.copy(), 1.0, t))
+            except Exception as exc:   # noqa: BLE001 - any exception is the root cause we report
+                return f"the resolvent raises {type(exc).__name__}: {exc} at x = {x[:3].tolist()}..., λ = 1, t = {t:g}"
+            if y.shape != x.shape:
+                return f"the resolvent returns shape {y.shape} for a point of shape {x.shape} (λ = 1, t = {t:g})"
+    return None
+
+
+def _search(law: Law, op: Operator, seed: int | None, examples: int | None, horizon: float,
+            sample: Sample | dict | None) -> CheckResult:
+    """The hypothesis search for a violation of ``law`` (or the evaluation of one given ``sample``)."""
+    start = time.perf_counter()
+    cause = root_cause(op, horizon) if sample is None else None
+    if cause is not None:
+        base = dict(check=law.name, subject=_subject(op), seed=seed, details={"item": law.label, "root_cause": cause})
+        if law.name == ROOT_LAW:
+            return CheckResult(status=FAILED, worst=math.inf, bound=BOUND, counterexample={"operator": repr(op)},
+                               message=f"root cause: {cause}; the other laws are not evaluated", **base)
+        return CheckResult(status=SKIPPED, message=f"not evaluated: {cause} (the root cause is recorded once, "
+                                                   f"as {ROOT_LAW})", **base)
     profile = None
     if examples is None:
         examples, profile = default_examples()
@@ -628,7 +648,7 @@ def run_law(law: Law | str, op: Operator, *, seed: int | None = None, examples: 
     duration = time.perf_counter() - start
     subject = _subject(op)
     base = dict(check=law.name, subject=subject, seed=seed, duration=duration)
-    details = {"item": law.item, "examples": examples, "evaluations": state.runs, "horizon": horizon,
+    details = {"item": law.label, "examples": examples, "evaluations": state.runs, "horizon": horizon,
                "inconclusive": state.inconclusive}
     if profile is not None:
         details["profile"] = profile

@@ -1,4 +1,5 @@
-"""Convergence-order checks of a stepper against the analytic references.
+"""Convergence-order checks of a stepper against the analytic references (one record per reference; the
+whole battery of a stepper, orders and laws, is :func:`verimono.checks.trajectory_laws.check_stepper`).
 
 ``check_convergence_order(stepper, problem)`` runs a :func:`verimono.convergence.convergence_study` and
 turns its verdict into a result record: ``worst = expected / (upper end of the interval + slack)`` and
@@ -8,30 +9,36 @@ on which the scheme is exact at the nodes, ``worst = max error / round-off floor
 
 from __future__ import annotations
 
-import time
-from typing import Callable, Iterable
+from typing import Callable
 
+from ..claims import claim_of
 from ..convergence import ORDER_SLACK, convergence_study, _name
-from ..errors import InvalidCheckArgument, VerimonoError
-from ..problem import Problem
-from ..results import FAILED, PASSED, SKIPPED, CheckResult, Report
-from ..timeouts import run_unit
+from ..problem import Order, Problem
+from ..results import FAILED, PASSED, CheckResult
+from .core import Holds, law as _declare, run as _run
 
 
-def check_convergence_order(stepper: Callable, problem: Problem, steps=None, executor=None) -> CheckResult:
-    """Whether ``stepper`` reaches ``problem.order`` on ``problem`` (one record, study in ``details``)."""
+def _expected(stepper: Callable, problem: Problem) -> Order | None:
+    """The order ``stepper`` must reach on ``problem``: the reference's order for the proximal scheme,
+    ``min(claimed, regularity)`` for a scheme claiming only ``scheme="any"`` (:meth:`Order.for_claim`)."""
+    claim = claim_of(stepper)
+    if claim.proximal:
+        return problem.order
+    if problem.order is None:
+        return Order(claim.order, "the claimed order (the problem states no regularity)")
+    return problem.order.for_claim(claim.order)
+
+
+@_declare("convergence_order", "thm:main (convergence) and each reference's stated order", subject="stepper",
+          requires=(Holds(lambda p: None if p.order is not None and p.steps else
+                          "the problem states no expected order or no step sizes"),))
+def _convergence_order(stepper: Callable, problem: Problem, steps=None, executor=None) -> CheckResult:
     subject = f"{_name(stepper)} on {problem.name}"
-    if problem.order is None or (steps is None and not problem.steps):
-        return CheckResult("convergence_order", subject, SKIPPED,
-                           message="the problem states no expected order or no step sizes")
-    start = time.perf_counter()
-    try:
-        study = convergence_study(stepper, problem, steps, executor=executor)
-    except (VerimonoError, ArithmeticError, ValueError) as exc:
-        return CheckResult("convergence_order", subject, FAILED, message=f"{type(exc).__name__}: {exc}",
-                           duration=time.perf_counter() - start)
+    exp = _expected(stepper, problem)
+    study = convergence_study(stepper, problem if exp is problem.order else problem.replace(order=exp), steps,
+                              executor=executor)
     ok, msg = study.verdict()
-    fit, exp = study.order, problem.order
+    fit = study.order
     if exp.exact:
         worst = max(study.errors["sup"]) / study.floor
     elif fit.exact:
@@ -39,41 +46,21 @@ def check_convergence_order(stepper: Callable, problem: Problem, steps=None, exe
     else:
         worst = exp.value / (fit.high + ORDER_SLACK) if fit.high == fit.high else float("inf")
     counter = None if ok else {"steps": study.mesh, "errors": study.errors["sup"]}
+    script = ("from verimono.reference import get\n"
+              "from verimono.checks.orders import check_convergence_order\n"
+              f"print(check_convergence_order(stepper, get({problem.name!r})))")
+    details = {"study": study, "reproduce_python": script}
+    if not claim_of(stepper).proximal:
+        details["expected"] = {"order": exp.value, "source": exp.source}
     return CheckResult("convergence_order", subject, PASSED if ok else FAILED, worst=worst, bound=1.0,
-                       counterexample=counter, message=msg, details={"study": study.to_dict()},
-                       duration=time.perf_counter() - start)
+                       counterexample=counter, message=msg, details=details)
 
 
-def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, *, executor=None,
-                  laws: bool | Iterable[str] = True, seed: int = 0, generated: int = 4,
-                  orders: bool = True) -> Report:
-    """Result records for ``stepper``: convergence orders on the references, then the trajectory laws.
-
-    ``problems=None`` means the whole catalog of :mod:`verimono.reference` (orders and laws) plus
-    ``generated`` seeded sample problems (laws only).  The records come first per problem for the
-    convergence orders (in the order of ``problems``), then one record per (problem, law) of
-    :mod:`verimono.checks.trajectory_laws`; ``laws=False`` keeps the orders only, a list of law names
-    selects laws, ``orders=False`` keeps the laws only.  The records are those of :func:`verimono.checks.trajectory_laws.stepper_checks`,
-    the same generator :func:`verimono.testing.parametrize_with_checks` turns into pytest cases.
-    """
-    from .trajectory_laws import LAWS, stepper_checks
-
-    if problems is not None:
-        problems = list(problems)
-        if not problems:
-            raise InvalidCheckArgument("check_stepper was given an empty list of problems: it would verify "
-                                       "nothing (pass problems=None for the whole catalog)")
-    selected = () if laws is False else (LAWS if laws is True else tuple(laws))
-    report = Report()
-    for _name_, check in stepper_checks(stepper, problems, seed=seed, generated=generated, laws=selected,
-                                        orders=orders, executor=executor):
-        law, _, problem_name = _name_.partition("[")
-        rec = run_unit(lambda: check(stepper), check=law, subject=f"{_name(stepper)} on {problem_name[:-1]}")
-        report.add(rec)
-        if "study" in rec.details:
-            from ..convergence import ConvergenceStudy
-
-            report.studies.append(ConvergenceStudy.from_dict(rec.details["study"]))
-    if not len(report):
-        raise InvalidCheckArgument("check_stepper selected no check (no law, no order): it would verify nothing")
-    return report
+def check_convergence_order(stepper: Callable, problem: Problem, steps=None, executor=None) -> CheckResult:
+    """Whether ``stepper`` reaches the order it must on ``problem`` (one record, study in ``details``): the
+    reference's stated order (exact at the nodes where it is) for the proximal scheme; for a scheme
+    claiming only ``scheme="any"`` with order ``p``, ``min(p, problem.order.regularity)``."""
+    if steps is not None:   # explicit step sizes stand in for the problem's own
+        return _run(_convergence_order.law, stepper, problem, steps, executor, stepper=stepper,
+                    problem=problem.replace(steps=list(steps)))
+    return _run(_convergence_order.law, stepper, problem, steps, executor, stepper=stepper, problem=problem)

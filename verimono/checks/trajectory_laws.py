@@ -27,11 +27,18 @@ Laws (labels of the paper, Camlibel–Iannelli–Tanwani):
 * ``selections`` — ``eq:iteration``: ``y_{k+1} = (x_k + h f(x_k) + ∫u - x_{k+1})/h_{k+1} ∈
   F(t_{k+1}, x_{k+1})``, tested with ``operator.contains`` and with the resolvent characterisation
   ``J_μ(x + μy) = x`` at ``μ = h/2`` (a different step than the scheme's).
+
+Each law declares what it needs (:mod:`verimono.checks.core`), the stepper's claim among it
+(:mod:`verimono.claims`): ``bounds_lg``, ``bounds_yb``, ``psi_interpolation`` and ``selections`` bind only
+the proximal scheme; ``contraction`` binds steppers claiming it; ``unique_limit`` binds every convergent
+scheme, and ``in_domain`` too, as a distance vanishing at the claimed order for ``scheme="any"``.
 """
 
 from __future__ import annotations
 
+import functools
 import time
+import warnings
 from typing import Any, Callable, Iterable, Iterator, Sequence
 
 import numpy as np
@@ -41,9 +48,13 @@ from ..errors import OutsideDomain, VerimonoError
 from ..grids import graded_grid, random_grid, uniform_grid, validate_grid
 from ..operators import L1Subdifferential, Linear, NormSubdifferential, Operator
 from ..problem import Problem
-from ..results import FAILED, PASSED, SKIPPED, CheckResult
+from ..claims import claim_of, with_claim
+from ..results import FAILED, PASSED, SKIPPED, CheckResult, Report
 from ..stepping import Trajectory
-from ..tolerances import LIMIT_EXTRA_LEVELS, LIMIT_SHRINK, quotient_tolerance, tolerance
+from ..tolerances import DOMAIN_ORDER_SLACK, LIMIT_EXTRA_LEVELS, LIMIT_SHRINK, quotient_tolerance, tolerance
+from .core import (CONTRACTION_CLAIM, PROXIMAL_CLAIM, Holds, Member, NotApplicable, Outcome, law as _declare,
+                   record, run as _run)
+from .orders import check_convergence_order
 
 #: cells of the default partitions (fine enough for the lemmas' bounds, fast enough for a battery)
 DEFAULT_CELLS = 40
@@ -52,12 +63,12 @@ RANDOM_SPREAD = 0.6
 #: cells of the three refinement levels of ``unique_limit`` (|Δ| shrinks 16-fold)
 LIMIT_LEVELS = (10, 40, 160)
 
-LAWS = ("contraction", "unique_limit", "in_domain", "bounds_lg", "bounds_yb", "psi_interpolation",
-        "selections")
+#: the trajectory laws, law name -> check function, in the order they run (filled by :func:`stepper_law`)
+CHECKS: dict[str, Callable[..., CheckResult]] = {}
 
 
-class _Skip(Exception):
-    """The law does not apply to this problem (the reason is the record's message)."""
+#: the law does not apply to this problem (the reason is the record's message)
+_Skip = NotApplicable
 
 
 # -- helpers ----------------------------------------------------------------------------------------
@@ -67,20 +78,15 @@ def _name(obj: Any) -> str:
 
 
 def with_changes(problem: Problem, **changes: Any) -> Problem:
-    """A copy of ``problem`` with some constructor arguments replaced (``x0``, ``T``, ``name``, ...)."""
-    kw = dict(f=problem.f, u=problem.u, exact=problem.exact, order=problem.order, name=problem.name,
-              U=problem.U, lipschitz=problem.lipschitz, phi=problem.phi, sigma=problem.sigma,
-              theta=problem.theta, steps=problem.steps, initial_jump=problem.initial_jump,
-              notes=problem.notes)
-    args = dict(operator=problem.operator, x0=problem.x0, T=problem.T)
-    for k, v in changes.items():
-        (args if k in args else kw)[k] = v
-    return Problem(args["operator"], args["x0"], args["T"], **kw)
+    """Deprecated: ``problem.replace(**changes)`` (:meth:`verimono.Problem.replace`)."""
+    warnings.warn("with_changes(problem, ...) is deprecated; use problem.replace(...)", DeprecationWarning,
+                  stacklevel=2)
+    return problem.replace(**changes)
 
 
 def _single(problem: Problem) -> Problem:
     """The laws are stated per initial point: a batch is checked through its first row."""
-    return with_changes(problem, x0=problem.x0[0]) if problem.batched else problem
+    return problem.replace(x0=problem.x0[0]) if problem.batched else problem
 
 
 def run_stepper(stepper: Callable, problem: Problem, grid: np.ndarray) -> np.ndarray:
@@ -125,20 +131,45 @@ def _cumulative(fn: Callable, t: np.ndarray) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(_cell_integrals(fn, t))])
 
 
-class _Outcome:
-    """What one evaluation of a law on one partition found."""
+def _holds(*tests: Callable[[Problem], Any]) -> Holds:
+    """A requirement met when every test passes on the (first row of the) problem; the reason is the
+    :class:`NotApplicable` message of the first that does not."""
+    def check(problem: Problem) -> str | None:
+        p = _single(problem)
+        for test in tests:
+            try:
+                test(p)
+            except NotApplicable as exc:
+                return str(exc)
+        return None
+    return Holds(check)
 
-    def __init__(self, worst: float, k: int | None = None, counter: dict | None = None,
-                 details: dict | None = None) -> None:
-        self.worst, self.k, self.counter, self.details = float(worst), k, counter or {}, details or {}
 
-    @property
-    def failed(self) -> bool:
-        return not self.worst <= 1.0
+def _either(*tests: Callable[[Problem], Any]) -> Holds:
+    """Met when at least one test passes (ψ of lem:bndSeq *or* of lem:bndSeqYB)."""
+    def check(problem: Problem) -> str | None:
+        reasons = [_holds(t).test(problem) for t in tests]
+        return None if any(r is None for r in reasons) else "no ψ available — " + "; ".join(reasons)
+    return Holds(check)
+
+
+def stepper_law(name: str, label: str, *requires: Any) -> Callable:
+    """Declare ``check_<name>(stepper, problem, **kw)`` as a trajectory law (:mod:`verimono.checks.core`):
+    its requirements are judged before the stepper runs, and it runs under the core's driver."""
+    def deco(fn: Callable) -> Callable:
+        decl = _declare(name, label, subject="stepper", requires=requires)(fn).law
+
+        @functools.wraps(fn)
+        def check(stepper: Callable, problem: Problem, **kw: Any) -> CheckResult:
+            return _run(decl, stepper, problem, stepper=stepper, problem=_single(problem), **kw)
+        check.law = decl
+        CHECKS[name] = check
+        return check
+    return deco
 
 
 def _drive(law: str, stepper: Callable, problem: Problem, grids: dict[str, np.ndarray],
-           evaluate: Callable[[Problem, np.ndarray], _Outcome], *, shrink: bool = True,
+           evaluate: Callable[[Problem, np.ndarray], Outcome], *, shrink: bool = True,
            message_ok: str = "", extra: dict | None = None) -> CheckResult:
     """Run ``evaluate`` on every partition, keep the worst, shrink a failure to its shortest prefix."""
     subject = f"{_name(stepper)} on {problem.name}"
@@ -168,7 +199,7 @@ def _drive(law: str, stepper: Callable, problem: Problem, grids: dict[str, np.nd
     if shrink and out.k is not None and 1 <= out.k < len(grid) - 1:
         t_k = float(grid[out.k])
         try:
-            small = with_changes(problem, T=t_k)
+            small = problem.replace(T=t_k)
             prefix = grid[:out.k + 1].copy()
             again = evaluate(small, prefix)
         except (_Skip, NotImplementedError, VerimonoError, ArithmeticError, ValueError):
@@ -234,15 +265,17 @@ def run_starts(stepper: Callable, problem: Problem, starts: Sequence[np.ndarray]
     """
     if getattr(stepper, "batched", False) and starts:
         try:
-            xs = np.asarray(stepper(with_changes(problem, x0=np.stack([problem.x0, *starts])), grid), dtype=float)
+            xs = np.asarray(stepper(problem.replace(x0=np.stack([problem.x0, *starts])), grid), dtype=float)
         except (VerimonoError, ArithmeticError, ValueError, TypeError, IndexError):
             xs = None
         if (xs is not None and xs.shape == (len(grid), len(starts) + 1) + problem.x0.shape
                 and np.array_equal(xs[:, 0], x) and np.all(np.isfinite(xs))):
             return [xs[:, i + 1] for i in range(len(starts))]
-    return [run_stepper(stepper, with_changes(problem, x0=z), grid) for z in starts]
+    return [run_stepper(stepper, problem.replace(x0=z), grid) for z in starts]
 
 
+@stepper_law("contraction", "uniqueness argument and the Lipschitz theorem (Section 6)", CONTRACTION_CLAIM,
+             _holds(lambda p: _lipschitz(p)))
 def check_contraction(stepper: Callable, problem: Problem, *, grids: Any = None, x0_primes: Any = None,
                       seed: int = 0) -> CheckResult:
     """Two discrete solutions never move apart faster than ``e^{L t}`` (uniqueness argument, Section 6).
@@ -252,10 +285,13 @@ def check_contraction(stepper: Callable, problem: Problem, *, grids: Any = None,
     (``x_{k+1} = J(x_k + h f(x_k))``: ``1 + hL ≤ e^{hL}``), or ``1/(1 - L h_k)`` when larger (``hL < 1``: a
     stepper treating ``f`` implicitly, ``x_{k+1} = J(x_k + h f(x_{k+1}))``); both give ``e^{L t_k}`` as
     ``h → 0``.
+
+    Claim: ``contracts`` — the proximal scheme contracts (its resolvents are nonexpansive); a scheme
+    claiming only convergence need not contract step by step, so it must say so (``contracts=True``).
     """
     grids = _as_grids(grids, problem, seed)
 
-    def evaluate(p: Problem, t: np.ndarray) -> _Outcome:
+    def evaluate(p: Problem, t: np.ndarray) -> Outcome:
         L = _lipschitz(p)
         starts = perturbed_starts(p, seed) if x0_primes is None else [np.asarray(z, float) for z in x0_primes]
         if not starts:
@@ -279,7 +315,7 @@ def check_contraction(stepper: Callable, problem: Problem, *, grids: Any = None,
                         "lhs": d[k], "rhs": growth[k - 1] * d[k - 1], "L": L,
                         "message": f"|x_k - x'_k| = {d[k]:.6g} > g_k |x_(k-1) - x'_(k-1)| = "
                                    f"{growth[k - 1] * d[k - 1]:.6g} at k = {k}, t_k = {t[k]:.6g}"}
-        return _Outcome(worst, best["k"], best, {"global_ratio": glob, "pairs": len(starts), "L": L})
+        return Outcome(worst, best["k"], best, {"global_ratio": glob, "pairs": len(starts), "L": L})
 
     return _drive("contraction", stepper, problem, grids, evaluate,
                   message_ok="|x_k - x'_k| <= g_k |x_{k-1} - x'_{k-1}| at every step (g_k = max(e^{L h}, 1/(1 - L h)))")
@@ -297,6 +333,7 @@ def limit_grids(T: float, K: int, seed: int = 0) -> dict[str, np.ndarray]:
             "graded": graded_grid(T, K, 2.0)}
 
 
+@stepper_law("unique_limit", "the limit of x_Δ is the unique solution (Section 5.4)")
 def check_unique_limit(stepper: Callable, problem: Problem, *, levels: Sequence[int] = LIMIT_LEVELS,
                        seed: int = 0) -> CheckResult:
     """Solutions on different partitions approach each other as ``|Δ| → 0`` (unique limit, Section 5.4).
@@ -312,6 +349,8 @@ def check_unique_limit(stepper: Callable, problem: Problem, *, levels: Sequence[
     dies out at ``t = 1/64``, and partitions of mesh 0.1 and 0.025 all give 0 there, so the distance is
     0, 0, then ``c h`` at mesh 1/160).  A stepper with no unique limit keeps an O(1) distance, which never
     falls to ``LIMIT_SHRINK`` times its largest value.
+
+    Claim: any — every convergent scheme has a unique limit (Section 5.4: it is the unique solution).
     """
     subject = f"{_name(stepper)} on {problem.name}"
     start = time.perf_counter()
@@ -377,11 +416,20 @@ def check_unique_limit(stepper: Callable, problem: Problem, *, levels: Sequence[
 
 # -- domain -----------------------------------------------------------------------------------------
 
+@stepper_law("in_domain", "e:x k+1 props.1", Member("project_domain"))
 def check_in_domain(stepper: Callable, problem: Problem, *, grids: Any = None, seed: int = 0) -> CheckResult:
-    """``x_k ∈ cl dom F(t_k,·)`` for every node (``e:x k+1 props.1``; from ``k = 1`` after a jump)."""
+    """``x_k ∈ cl dom F(t_k,·)`` for every node (``e:x k+1 props.1``; from ``k = 1`` after a jump).
+
+    That is a property of the proximal scheme's iterates (``x_k = J(...)`` lies in ``dom F(t_k)``).  A
+    stepper claiming only ``scheme="any"`` with order ``p`` is held to what every convergent scheme
+    obeys instead — ``dist(x_k, cl dom F(t_k)) ≤ |x_k - x(t_k)|`` vanishes at order ``p``
+    (:func:`check_domain_vanishing`)."""
+    claim = claim_of(stepper)
+    if not claim.proximal and grids is None:
+        return check_domain_vanishing(stepper, problem, claim.order, seed=seed)
     grids = _as_grids(grids, problem, seed)
 
-    def evaluate(p: Problem, t: np.ndarray) -> _Outcome:
+    def evaluate(p: Problem, t: np.ndarray) -> Outcome:
         x = run_stepper(stepper, p, t)
         first = 1 if p.initial_jump else 0
         ratios = np.zeros(len(t))
@@ -396,9 +444,49 @@ def check_in_domain(stepper: Callable, problem: Problem, *, grids: Any = None, s
                    "projection": p.operator.project_domain(x[k], float(t[k])),
                    "message": f"x_k = {np.array2string(x[k], precision=6)} is at distance {dists[k]:.3g} "
                               f"from cl dom F(t_k) at k = {k}, t_k = {t[k]:.6g}"}
-        return _Outcome(float(np.max(ratios)), k, counter, {"max_distance": float(np.max(dists))})
+        return Outcome(float(np.max(ratios)), k, counter, {"max_distance": float(np.max(dists))})
 
     return _drive("in_domain", stepper, problem, grids, evaluate, message_ok="x_k in cl dom F(t_k) at every node")
+
+
+def _domain_distances(stepper: Callable, p: Problem, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(x, dist(x_k, cl dom F(t_k)))`` along ``stepper``'s solution on ``t`` (0 at ``k = 0`` after a jump)."""
+    x = run_stepper(stepper, p, t)
+    d = np.zeros(len(t))
+    for k in range(1 if p.initial_jump else 0, len(t)):
+        d[k] = float(np.linalg.norm(np.asarray(p.operator.project_domain(x[k], float(t[k])), dtype=float) - x[k]))
+    return x, d
+
+
+def check_domain_vanishing(stepper: Callable, problem: Problem, order: float, *,
+                           levels: Sequence[int] = LIMIT_LEVELS, seed: int = 0) -> CheckResult:
+    """``D(K) = max_k dist(x_k, cl dom F(t_k))`` on uniform partitions with ``K`` cells vanishes at order
+    ``p = min(order, the order the problem's regularity allows)``: every convergent scheme has
+    ``dist(x_k, cl dom F(t_k)) ≤ |x_k - x(t_k)| = O(h^p)`` since ``x(t_k) ∈ cl dom F(t_k)``.
+
+    Law: ``D(K_m) ≤ DOMAIN_ORDER_SLACK · max_{j<m} D(K_j) (K_j/K_m)^p + tol`` at the finest level
+    (the constant of ``C h^p`` is not known; the slack absorbs its drift between levels).
+    """
+    p = _single(problem)
+    target = p.order.for_claim(order).value if p.order is not None else float(order)
+    D, where = [], []
+    for K in levels:
+        t = uniform_grid(p.T, steps=K)
+        x, d = _domain_distances(stepper, p, t)
+        k = int(np.argmax(d))
+        D.append(float(d[k]))
+        where.append({"K": K, "k": k, "t_k": t[k], "x_k": x[k]})
+    scale = max(1.0, float(np.max(np.abs(p.x0))))
+    rhs = DOMAIN_ORDER_SLACK * max(D[j] * (levels[j] / levels[-1]) ** target for j in range(len(levels) - 1))
+    out = Outcome(D[-1] / (rhs + tolerance(scale)),
+                  counter={"problem": p.name, "T": p.T, "x0": p.x0, "levels": list(levels), "distances": D,
+                           "order": target, **where[-1],
+                           "message": f"dist(x_k, cl dom F(t_k)) does not vanish at order {target:g}: "
+                                      f"{', '.join(f'{d:.3g}' for d in D)} for K = {list(levels)}"},
+                  details={"levels": list(levels), "distances": D, "order": target, "claim": "any"})
+    return record("in_domain", f"{_name(stepper)} on {problem.name}", out,
+                  passed=f"dist(x_k, cl dom F(t_k)) {D[0]:.3g} -> {D[-1]:.3g} as K = {levels[0]} -> {levels[-1]} "
+                         f"(order {target:g} claimed; scheme='any')")
 
 
 # -- a-priori bounds --------------------------------------------------------------------------------
@@ -521,13 +609,32 @@ class YBBounds:
         return {"alpha": self.alpha, "beta": self.beta, "F0_at_x0": self.f0}
 
 
-def _lg_setup(p: Problem, t: np.ndarray):
-    """Bounds of lem:bndSeq and the sequence they bound (``ξ_k = x_k - Φ(t_k)`` with an input)."""
+def _lg_requirements(p: Problem) -> None:
+    """What lem:bndSeq assumes of the problem (raises :class:`NotApplicable` with the reason)."""
     if p.initial_jump:
         raise _Skip("x0 is outside cl dom F(0,·) (catching-up jump): lem:bndSeq assumes x0 in the closure")
     if p.f is not None:
         raise _Skip("the bounds of the Lipschitz-perturbation theorem involve a constant C_1 that is not "
                     "explicit; lem:bndSeq covers f = 0")
+    _phi_of(p), _sigma_of(p)
+    if p.u is None and p.U is not None:
+        raise _Skip("an input given only by its primitive U: ∫|u| is not available")
+
+
+def _yb_requirements(p: Problem) -> None:
+    """What lem:bndSeqYB assumes of the problem (raises :class:`NotApplicable` with the reason)."""
+    if p.initial_jump:
+        raise _Skip("x0 is outside dom F(0,·) (catching-up jump): lem:bndSeqYB assumes x0 in dom F(0,·)")
+    if p.f is not None:
+        raise _Skip("lem:bndSeqYB covers f = 0 (the Lipschitz theorem's constants are not explicit)")
+    if p.u is not None or p.U is not None:
+        raise _Skip("with an input, (YB) for G holds with θ + M_u where M_u is not explicit (l:extinput)")
+    _theta_of(p)
+
+
+def _lg_setup(p: Problem, t: np.ndarray):
+    """Bounds of lem:bndSeq and the sequence they bound (``ξ_k = x_k - Φ(t_k)`` with an input)."""
+    _lg_requirements(p)
     (phi, phi_src), (sigma, sigma_src) = _phi_of(p), _sigma_of(p)
     shift = np.zeros((len(t), p.dim))
     extra = {"phi": phi_src, "sigma": sigma_src}
@@ -544,18 +651,13 @@ def _lg_setup(p: Problem, t: np.ndarray):
 
 
 def _yb_setup(p: Problem, t: np.ndarray):
-    if p.initial_jump:
-        raise _Skip("x0 is outside dom F(0,·) (catching-up jump): lem:bndSeqYB assumes x0 in dom F(0,·)")
-    if p.f is not None:
-        raise _Skip("lem:bndSeqYB covers f = 0 (the Lipschitz theorem's constants are not explicit)")
-    if p.u is not None or p.U is not None:
-        raise _Skip("with an input, (YB) for G holds with θ + M_u where M_u is not explicit (l:extinput)")
+    _yb_requirements(p)
     theta, src = _theta_of(p)
     return YBBounds(p.x0, theta, p.operator, p.T), np.zeros((len(t), p.dim)), {"theta": src}
 
 
 def _bounds_evaluate(stepper: Callable, setup: Callable, label: str):
-    def evaluate(p: Problem, t: np.ndarray) -> _Outcome:
+    def evaluate(p: Problem, t: np.ndarray) -> Outcome:
         bounds, shift, extra = setup(p, t)
         x = run_stepper(stepper, p, t)
         xi = x - shift
@@ -577,25 +679,31 @@ def _bounds_evaluate(stepper: Callable, setup: Callable, label: str):
                               f"psi increment = {dpsi[k - 1]:.6g}"}
         details = {**bounds.constants(), **extra, "max_ratio_beta": float(np.max(r_beta)),
                    "max_ratio_psi": float(np.max(r_step))}
-        return _Outcome(float(np.max(ratios)), k, counter, details)
+        return Outcome(float(np.max(ratios)), k, counter, details)
     return evaluate
 
 
+@stepper_law("bounds_lg", "lem:bndSeq", PROXIMAL_CLAIM, _holds(_lg_requirements))
 def check_bounds_lg(stepper: Callable, problem: Problem, *, grids: Any = None, seed: int = 0) -> CheckResult:
     """Lemma ``lem:bndSeq`` (under (A3), (LG)): ``|x_k| ≤ β``, ``|x_k - x_{k-1}| ≤ ψ(t_k) - ψ(t_{k-1})``.
 
     ``β = α + φ(T) - φ(0) + (1 + α)∫_0^T σ``, ``ψ(t) = t + 2φ(t) + (1 + γ)∫_0^t σ``, ``α = |x0| + φ(T) -
     φ(0)``, ``γ = β + φ(T) - φ(0)``.  For non-constant σ the lemma holds on fine enough partitions (the
     proof's piecewise-constant approximation); the default partitions have 40 cells.
+
+    Claim: ``proximal`` — the lemma bounds the iterates of the paper's scheme on the given partition.
     """
     return _drive("bounds_lg", stepper, problem, _as_grids(grids, problem, seed),
                   _bounds_evaluate(stepper, _lg_setup, "lem:bndSeq"),
                   message_ok="|x_k| <= beta and |x_k - x_(k-1)| <= psi(t_k) - psi(t_(k-1)) (lem:bndSeq)")
 
 
+@stepper_law("bounds_yb", "lem:bndSeqYB", PROXIMAL_CLAIM, _holds(_yb_requirements))
 def check_bounds_yb(stepper: Callable, problem: Problem, *, grids: Any = None, seed: int = 0) -> CheckResult:
     """Lemma ``lem:bndSeqYB`` (under (YB), ``|Δ| < Λ``): ``|x_k| ≤ |x0| + αT`` and
-    ``|x_k - x_{k-1}| ≤ α h_k`` with ``α = 2(θ(T) - θ(0)) + |F^0(0, x0)|``."""
+    ``|x_k - x_{k-1}| ≤ α h_k`` with ``α = 2(θ(T) - θ(0)) + |F^0(0, x0)|``.
+
+    Claim: ``proximal`` — the lemma bounds the iterates of the paper's scheme on the given partition."""
     return _drive("bounds_yb", stepper, problem, _as_grids(grids, problem, seed),
                   _bounds_evaluate(stepper, _yb_setup, "lem:bndSeqYB"),
                   message_ok="|x_k| <= |x0| + alpha T and |x_k - x_(k-1)| <= alpha h_k (lem:bndSeqYB)")
@@ -603,6 +711,7 @@ def check_bounds_yb(stepper: Callable, problem: Problem, *, grids: Any = None, s
 
 # -- ψ-interpolation --------------------------------------------------------------------------------
 
+@stepper_law("psi_interpolation", "lem:bndEquiCont", PROXIMAL_CLAIM, _either(_lg_requirements, _yb_requirements))
 def check_psi_interpolation(stepper: Callable, problem: Problem, *, grids: Any = None, seed: int = 0,
                             samples: int = 40) -> CheckResult:
     """Lemma ``lem:bndEquiCont``: ``|x_Δ(τ̄) - x_Δ(τ)| ≤ ψ(τ̄) - ψ(τ)`` for the ψ-interpolant ``e:x delta``.
@@ -610,10 +719,12 @@ def check_psi_interpolation(stepper: Callable, problem: Problem, *, grids: Any =
     ``ψ`` from lem:bndSeq and/or lem:bndSeqYB (whichever applies); ``x_Δ`` from
     :meth:`verimono.Trajectory.interpolate` with ``kind="psi"``; all pairs among the nodes, cell
     midpoints and ``samples`` random times.
+
+    Claim: ``proximal`` — ``x_Δ`` interpolates the proximal iterates with the ψ of their lemmas.
     """
     grids = _as_grids(grids, problem, seed)
 
-    def evaluate(p: Problem, t: np.ndarray) -> _Outcome:
+    def evaluate(p: Problem, t: np.ndarray) -> Outcome:
         setups = []
         reasons = []
         for label, setup in (("lem:bndSeq", _lg_setup), ("lem:bndSeqYB", _yb_setup)):
@@ -648,7 +759,7 @@ def check_psi_interpolation(stepper: Callable, problem: Problem, *, grids: Any =
                         "message": f"{label}/lem:bndEquiCont: |x_D(tau') - x_D(tau)| = {lhs[m]:.6g} > "
                                    f"psi(tau') - psi(tau) = {rhs[m]:.6g} for tau = {tau[i[m]]:.6g}, "
                                    f"tau' = {tau[j[m]]:.6g}"}
-        return _Outcome(worst, best["k"], best, {"worst_by_lemma": det, "pairs": len(tau) * (len(tau) - 1) // 2})
+        return Outcome(worst, best["k"], best, {"worst_by_lemma": det, "pairs": len(tau) * (len(tau) - 1) // 2})
 
     return _drive("psi_interpolation", stepper, problem, grids, evaluate,
                   message_ok="|x_D(tau') - x_D(tau)| <= psi(tau') - psi(tau) (lem:bndEquiCont)")
@@ -656,17 +767,21 @@ def check_psi_interpolation(stepper: Callable, problem: Problem, *, grids: Any =
 
 # -- selections -------------------------------------------------------------------------------------
 
+@stepper_law("selections", "eq:iteration", PROXIMAL_CLAIM)
 def check_selections(stepper: Callable, problem: Problem, *, grids: Any = None, seed: int = 0) -> CheckResult:
     """``y_{k+1} = (z_k - x_{k+1})/h_{k+1} ∈ F(t_{k+1}, x_{k+1})`` (``eq:iteration``), ``z_k = x_k + h f(x_k)
     + ∫u``: through ``operator.contains`` and through ``J_μ(x_{k+1} + μ y_{k+1}) = x_{k+1}`` at ``μ = h/2``.
 
     Tolerance: :func:`verimono.tolerances.quotient_tolerance` (a difference quotient divides the
     round-off of the states by ``h``).
+
+    Claim: ``proximal`` — the discrete velocities of the paper's scheme are selections; another scheme's
+    (the midpoint rule, the exact solution sampled) are not, and need not be.
     """
     grids = _as_grids(grids, problem, seed)
     has_contains = type(problem.operator).contains is not Operator.contains
 
-    def evaluate(p: Problem, t: np.ndarray) -> _Outcome:
+    def evaluate(p: Problem, t: np.ndarray) -> Outcome:
         x = run_stepper(stepper, p, t)
         y = Trajectory(t, x, p).selections
         h = np.diff(t)
@@ -694,7 +809,7 @@ def check_selections(stepper: Callable, problem: Problem, *, grids: Any = None, 
                    "message": f"y = (x_k - x_(k+1))/h = {np.array2string(y[k], precision=6)} is not in "
                               f"F(t_(k+1), x_(k+1)) at k+1 = {k + 1}, t = {t[k + 1]:.6g} "
                               f"(contains: {bool(member[k])}, |J(x + mu y) - x|/tol = {ratios[k]:.3g})"}
-        return _Outcome(worst, k + 1, counter, {"contains_used": contains_available,
+        return Outcome(worst, k + 1, counter, {"contains_used": contains_available,
                                                 "misses": int(np.sum(~member))})
 
     return _drive("selections", stepper, problem, grids, evaluate,
@@ -704,15 +819,8 @@ def check_selections(stepper: Callable, problem: Problem, *, grids: Any = None, 
 
 # -- registry ---------------------------------------------------------------------------------------
 
-CHECKS: dict[str, Callable[..., CheckResult]] = {
-    "contraction": check_contraction,
-    "unique_limit": check_unique_limit,
-    "in_domain": check_in_domain,
-    "bounds_lg": check_bounds_lg,
-    "bounds_yb": check_bounds_yb,
-    "psi_interpolation": check_psi_interpolation,
-    "selections": check_selections,
-}
+#: the trajectory laws' names, in the order they run
+LAWS = tuple(CHECKS)
 
 
 def reproduce(stepper: Callable, problem: Problem, record: CheckResult) -> CheckResult:
@@ -721,7 +829,7 @@ def reproduce(stepper: Callable, problem: Problem, record: CheckResult) -> Check
     law = CHECKS[record.check]
     if record.check == "unique_limit":
         return law(stepper, problem, levels=cx["levels"], seed=cx["seed"])
-    p = with_changes(_single(problem), T=float(cx["T"]))
+    p = _single(problem).replace(T=float(cx["T"]))
     kw: dict[str, Any] = {"grids": [np.asarray(cx["grid"], dtype=float)]}
     if "x0_prime" in cx:
         kw["x0_primes"] = [np.asarray(cx["x0_prime"], dtype=float)]
@@ -747,8 +855,6 @@ def stepper_checks(stepper: Callable | None = None, problems: Iterable[Problem] 
     problems (:func:`verimono.checks.sample_problems.sample_problems`, laws only).  ``stepper`` is unused
     (the battery does not depend on it); it is accepted for the protocol ``stepper_checks(stepper)``.
     """
-    from .orders import check_convergence_order
-
     if problems is None:
         from verimono.reference import catalog
 
@@ -765,7 +871,55 @@ def stepper_checks(stepper: Callable | None = None, problems: Iterable[Problem] 
     yield from law_checks(list(refs) + list(extra), laws, seed)
 
 
-__all__ = ["LAWS", "CHECKS", "check_contraction", "check_unique_limit", "check_in_domain", "check_bounds_lg",
-           "check_bounds_yb", "check_psi_interpolation", "check_selections", "stepper_checks", "law_checks",
-           "reproduce", "run_stepper", "with_changes", "perturbed_starts", "default_grids", "limit_grids",
-           "LGBounds", "YBBounds"]
+def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, *, scheme: str | None = None,
+                  order: float | None = None, seed: int | None = None, executor=None,
+                  laws: bool | Iterable[str] = True, generated: int = 4, orders: bool = True) -> Report:
+    """Result records for ``stepper``: convergence orders on the references, then the trajectory laws.
+
+    ``scheme``/``order`` state what the stepper claims (:class:`verimono.Stepper`; a bare callable
+    claims ``scheme="proximal"``, the paper's scheme): a law that needs more than the claim is skipped
+    with that reason, and ``convergence_order``/``in_domain`` hold an ``"any"`` scheme to its order.
+
+    ``problems=None`` means the whole catalog of :mod:`verimono.reference` (orders and laws) plus
+    ``generated`` seeded sample problems (laws only).  The records come first per problem for the
+    convergence orders (in the order of ``problems``), then one record per (problem, law) of
+    :mod:`verimono.checks.trajectory_laws`; ``laws=False`` keeps the orders only, a list of law names
+    selects laws, ``orders=False`` keeps the laws only.  The records are those of :func:`stepper_checks`, the
+    same generator :func:`verimono.testing.parametrize_with_checks` turns into pytest cases.
+    """
+    from ..errors import InvalidCheckArgument
+    from ..timeouts import run_unit
+
+    if problems is not None:
+        problems = list(problems)
+        if not problems:
+            raise InvalidCheckArgument("check_stepper was given an empty list of problems: it would verify "
+                                       "nothing (pass problems=None for the whole catalog)")
+    stepper = with_claim(stepper, scheme, order)
+    seed = 0 if seed is None else int(seed)
+    selected = () if laws is False else (LAWS if laws is True else tuple(laws))
+    report = Report()
+    for _name_, check in stepper_checks(stepper, problems, seed=seed, generated=generated, laws=selected,
+                                        orders=orders, executor=executor):
+        law, _, problem_name = _name_.partition("[")
+        # a stepper that never returns: a failed record naming the unit, and the battery goes on
+        rec = run_unit(lambda: check(stepper), check=law,
+                       subject=f"{_stepper_name(stepper)} on {problem_name[:-1]}")
+        report.add(rec)
+        if rec.study is not None:
+            report.studies.append(rec.study)
+    if not len(report):
+        raise InvalidCheckArgument("check_stepper selected no check (no law, no order): it would verify nothing")
+    return report
+
+
+def _stepper_name(stepper: Any) -> str:
+    from ..convergence import _name
+
+    return _name(stepper)
+
+
+__all__ = ["LAWS", "CHECKS", "check_contraction", "check_unique_limit", "check_in_domain", "check_domain_vanishing",
+           "stepper_law", "check_bounds_lg", "check_bounds_yb", "check_psi_interpolation", "check_selections",
+           "stepper_checks", "check_stepper", "law_checks", "reproduce", "run_stepper", "with_changes",
+           "perturbed_starts", "default_grids", "limit_grids", "LGBounds", "YBBounds"]

@@ -18,12 +18,8 @@ import dataclasses
 
 import numpy as np
 
-from ..errors import InvalidProblem, SolverFailure, VerimonoError
+from ..errors import InvalidProblem, MissingOptionalDependency, SolverFailure, VerimonoError
 from ..tolerances import RTOL, SDP_RTOL, tolerance
-
-
-class MissingOptionalDependency(VerimonoError, ImportError):
-    """An optional extra (here cvxpy/clarabel for the KYP SDP) is not installed."""
 
 
 @dataclasses.dataclass

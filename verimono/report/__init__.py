@@ -10,11 +10,12 @@ from pathlib import Path
 from typing import Any
 
 
-def write(report: Any, out_dir: str | Path, *, baseline: Any = None, changes: Any = None) -> dict[str, Path]:
+def write(report: Any, out_dir: str | Path, *, changes: Any = None) -> dict[str, Path]:
     """Write ``out_dir/results.json`` and ``out_dir/report.html``; returns their paths.
 
-    ``baseline`` (a :class:`verimono.Report`) or precomputed ``changes`` (a
-    :class:`verimono.gate.Comparison`) fill the report's "changes against the baseline" section.
+    ``changes`` (a :class:`verimono.gate.Comparison`, computed by the caller with
+    :func:`verimono.gate.compare`: the report knows nothing of the gate) fill the report's "changes against
+    the baseline" section.
     """
     from ..atomic import ensure_writable_dir, replace_all
     from .html import render
@@ -23,10 +24,6 @@ def write(report: Any, out_dir: str | Path, *, baseline: Any = None, changes: An
     # one run id in both files; both rendered in memory, written to temporaries, then renamed together
     # (verimono.atomic): a full disk or an interrupt leaves the previous pair or the new pair, never a mix
     report.meta["run_id"] = new_run_id()
-    if changes is None and baseline is not None:
-        from ..gate import compare
-
-        changes = compare(baseline, report)
     json_path, html_path = out / "results.json", out / "report.html"
     text = report.to_json()
     html = render(report, changes=changes)

@@ -4,11 +4,15 @@ Sections, in order (each a ``<section id=...>``): ``summary`` (counts and stages
 the baseline), ``convergence`` (log-log plots per reference), ``trajectories`` (scheme against exact
 solution), ``laws`` (every check with its worst ratio and bound), ``failures`` (counterexample and a
 copy-paste reproduction each), ``timings`` and ``environment``.
+
+The renderer knows no producers: it reads records and ``meta`` only (it imports :mod:`verimono.results`
+and its own plots).  Reproductions are what the producers handed over in ``details``: ``reproduce`` (a
+complete text), ``example`` (a hypothesis ``@example``), ``reproduce_python`` (a script using ``stepper``,
+bound here to the run's target), ``stage`` and ``reference`` (the options of the command that reruns it).
 """
 
 from __future__ import annotations
 
-import functools
 import json
 import keyword
 import math
@@ -18,7 +22,7 @@ from collections import Counter, defaultdict
 from html import escape
 from typing import Any
 
-from ..results import FAILED, PASSED, SKIPPED, STATUSES, UNDECIDED, XFAIL, CheckResult, Report, to_jsonable
+from ..results import FAILED, PASSED, SKIPPED, STATUSES, UNDECIDED, XFAIL, CheckResult, Report, environment, to_jsonable
 
 SECTIONS = ("summary", "changes", "convergence", "trajectories", "laws", "failures", "performance", "timings",
             "environment")
@@ -166,23 +170,22 @@ def _table(head: list[str], rows: list[list[str]], num_cols: tuple[int, ...] = (
 
 
 def reproduction(rec: CheckResult, meta: dict[str, Any]) -> str:
-    """A copy-paste reproduction of one record: the check's own ``details["reproduce"]`` if it gave one,
-    a hypothesis ``@example`` from ``details["example"]``, a script for a convergence order, or the
-    command with the record's seed and stage."""
+    """A copy-paste reproduction of one record, from what the check handed over: its own
+    ``details["reproduce"]`` (used as is), a hypothesis ``@example`` from ``details["example"]``, or a Python
+    script ``details["reproduce_python"]`` using the free name ``stepper`` (bound here, after the script's
+    imports, to the run's target); else the command with the record's seed and stage."""
     if rec.details.get("reproduce"):
         return str(rec.details["reproduce"])
     target = meta.get("target") or "verimono.stepping:solve"
     if rec.details.get("example"):
         return f"@example({rec.details['example']})  # add above the failing @given test, or:\n" + \
             _command(rec, meta)
-    study = rec.details.get("study")
-    if rec.check == "convergence_order" and isinstance(study, dict):
-        return ("python - <<'EOF'\n"
-                "from verimono.reference import get\n"
-                "from verimono.checks.orders import check_convergence_order\n"
-                f"{_import_stepper(str(target))}\n"
-                f"print(check_convergence_order(stepper, get({study['problem']!r})))\n"
-                "EOF")
+    script = rec.details.get("reproduce_python")
+    if script:
+        lines = str(script).splitlines()
+        k = next((i for i, line in enumerate(lines) if not line.startswith(("from ", "import "))), len(lines))
+        body = "\n".join([*lines[:k], _import_stepper(str(target)), *lines[k:]])
+        return f"python - <<'EOF'\n{body}\nEOF"
     return _command(rec, meta)
 
 
@@ -194,16 +197,6 @@ def _import_stepper(target: str) -> str:
                                           for p in [*module.split("."), obj]):
         return f"from {module} import {obj} as stepper"
     return f"from verimono.cli import load_target\nstepper = load_target({target!r})"
-
-
-@functools.lru_cache(maxsize=1)
-def _catalog_names() -> frozenset[str]:
-    try:
-        from verimono.reference import catalog
-
-        return frozenset(p.name for p in catalog())
-    except Exception:  # the report renders without the catalog too
-        return frozenset()
 
 
 def _command(rec: CheckResult, meta: dict[str, Any]) -> str:
@@ -219,9 +212,8 @@ def _command(rec: CheckResult, meta: dict[str, Any]) -> str:
     if rec.details.get("stage") and meta.get("command", "run") == "run":
         cmd += ["--stage", str(rec.details["stage"])]
     refs = (meta.get("selection") or {}).get("references")
-    cx = rec.counterexample if isinstance(rec.counterexample, dict) else {}
-    if isinstance(cx.get("problem"), str) and cx["problem"] in _catalog_names():
-        refs = [cx["problem"]]  # the one reference the counterexample needs
+    if isinstance(rec.details.get("reference"), str):
+        refs = [rec.details["reference"]]  # the one reference the counterexample needs (the run says which)
     for name in refs or []:
         cmd += ["--reference", str(name)]
     return " ".join(shlex.quote(w) for w in cmd)
@@ -473,8 +465,6 @@ def _environment(report: Report) -> str:
 def render(report: Report, *, changes: Any = None, title: str = "verimono report") -> str:
     """The complete HTML document for ``report`` (``changes``: a :class:`verimono.gate.Comparison`)."""
     if "environment" not in report.meta:
-        from .schema import environment
-
         report.meta["environment"] = environment()
     bodies = {
         "summary": _summary(report, changes), "changes": _changes(changes),
