@@ -18,11 +18,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterator, Mapping
 
-from .errors import VerimonoError
-
-
-class OutputNotWritable(VerimonoError, OSError):
-    """An output folder or file cannot be created or written (checked before any work is done)."""
+from .errors import OutputNotWritable
 
 
 def _temp_for(path: Path, text: str) -> Path:

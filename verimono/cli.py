@@ -35,7 +35,7 @@ from pathlib import Path
 from typing import Any, Callable, TextIO
 
 from .claims import SCHEMES, claim_of, with_claim
-from .errors import BadTarget, VerimonoError
+from .errors import BadTarget, NothingToResume, VerimonoError
 from .profiles import PROFILES, active_profile, get_profile, load_hypothesis_profile
 from .results import SKIPPED, Report
 
@@ -203,10 +203,6 @@ def _finish(report: Report, out: Path, baseline: Report | None) -> int:
 
 #: exit status of an interrupted run (the shell's convention for SIGINT)
 EXIT_INTERRUPTED = 130
-
-
-class NothingToResume(VerimonoError, ValueError):
-    """``--resume`` without an incomplete results file of the same kind of run in the output folder."""
 
 
 def _interruptible(run: Callable[[Callable], Report], out: Path, *, command: str, profile: str,

@@ -85,6 +85,19 @@ class UnitTimeout(VerimonoError, TimeoutError):
     """A unit of work (one law on one operator, one check of one stepper) exceeded its time budget."""
 
 
+class OutputNotWritable(VerimonoError, OSError):
+    """An output folder or file cannot be created or written (checked before any work is done)."""
+
+
+class NothingToResume(VerimonoError, ValueError):
+    """``--resume`` without an incomplete results file of the same kind of run in the output folder."""
+
+
+class IncompatibleResults(SchemaError):
+    """The results (or baseline) are marked incomplete: an interrupted run verifies only part of the
+    battery, so the gate cannot decide (exit status 2)."""
+
+
 __all__ = [
     "VerimonoError",
     "InvalidProblem",
@@ -104,4 +117,7 @@ __all__ = [
     "MissingOptionalDependency",
     "InvalidCheckArgument",
     "UnitTimeout",
+    "OutputNotWritable",
+    "NothingToResume",
+    "IncompatibleResults",
 ]

@@ -39,7 +39,7 @@ from pathlib import Path
 from typing import Any
 
 from .convergence import ORDER_SLACK
-from .errors import IncompatibleBaseline, SchemaError
+from .errors import IncompatibleBaseline, IncompatibleResults, SchemaError
 from .results import FAILED, PASSED, SKIPPED, UNDECIDED, XFAIL, Report, load
 
 #: smallest drop of a fitted slope that counts as a regression when both intervals are narrower: slopes
@@ -64,11 +64,6 @@ GATED_NORMS = ("sup", "l2")
 #: run facts that must agree between a baseline and the results it gates (``selection``: the stages and
 #: references chosen with --stage / --reference; a battery that is selected but skipped still regresses)
 COMPATIBLE_KEYS = ("command", "target", "profile", "selection")
-
-
-class IncompatibleResults(SchemaError):
-    """The results (or baseline) are marked incomplete: an interrupted run verifies only part of the
-    battery, so the gate cannot decide (exit status 2)."""
 
 
 @dataclasses.dataclass
