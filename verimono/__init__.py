@@ -5,9 +5,10 @@ proximal scheme of Camlibel, Iannelli and Tanwani and checked against the laws a
 Data flow one way: Problem → stepper → Trajectory → checks → results → report / gate.
 """
 
-from .errors import (BadTarget, BatchStepError, IncompatibleBaseline, InfeasibleStep, InvalidClaim, InvalidGrid, InvalidProblem,
-                     MissingOptionalDependency, NotMonotone, OutsideDomain, SchemaError, SolverFailure,
-                     StageUnavailable, UnknownProfile, UnknownStage, VerimonoError)
+from .errors import (BadTarget, BatchStepError, IncompatibleBaseline, InfeasibleStep, InvalidCheckArgument,
+                     InvalidClaim, InvalidGrid, InvalidProblem, MissingOptionalDependency, NotMonotone,
+                     OutsideDomain, SchemaError, SolverFailure, StageUnavailable, UnitTimeout, UnknownProfile,
+                     UnknownStage, VerimonoError)
 from .grids import graded_grid, random_grid, refine, uniform_grid, validate_grid
 from .operators import (L1Subdifferential, Linear, LogBarrier, NormalCone, NormSubdifferential, Operator,
                         Shifted, operator_from_resolvent)
@@ -53,6 +54,7 @@ __all__ = [
     "VerimonoError", "InvalidProblem", "InvalidGrid", "OutsideDomain", "NotMonotone", "InfeasibleStep",
     "BatchStepError", "SolverFailure", "UnknownProfile", "UnknownStage", "StageUnavailable", "BadTarget", "SchemaError",
     "IncompatibleBaseline", "MissingOptionalDependency", "InvalidClaim",
+    "InvalidCheckArgument", "UnitTimeout",
     "Operator", "operator_from_resolvent", "operator_from_prox", "ProxOperator", "ProxOutputError", "Linear",
     "NormSubdifferential", "L1Subdifferential",
     "NormalCone", "Shifted", "LogBarrier", "sets",

@@ -42,6 +42,57 @@ def _norm(x: np.ndarray) -> np.ndarray:
 
 
 
+_INF = math.inf
+
+
+def bad_lam(lam: object, who: str) -> InvalidProblem:
+    """The error for a step size ``λ`` that is not a finite positive number (``J_λ`` is defined for
+    ``λ > 0`` only: ``λ = 0`` is the identity, whose Yosida value ``0/0`` is NaN, and ``λ < 0`` inverts a
+    non-monotone ``I + λF``)."""
+    return InvalidProblem(f"{who}: the step size λ must be a finite number > 0, got {lam!r}")
+
+
+def check_lam(lam: object, who: str) -> float:
+    """``lam`` as a float after checking ``0 < λ < ∞`` (:func:`bad_lam` otherwise)."""
+    if isinstance(lam, complex) or isinstance(lam, np.complexfloating):
+        raise bad_lam(lam, who)
+    try:
+        v = float(lam)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise bad_lam(lam, who) from None
+    if not 0.0 < v < _INF:
+        raise bad_lam(lam, who)
+    return v
+
+
+def real_array(x: object, what: str = "point") -> np.ndarray:
+    """``x`` as a float64 array; :class:`InvalidProblem` for complex values (``np.asarray(z, float)`` would
+    silently drop the imaginary part) or non-numeric ones.  A float64 array is returned as it is."""
+    if type(x) is np.ndarray and x.dtype == np.float64:
+        return x
+    a = np.asarray(x)
+    if a.dtype.kind == "c":
+        raise InvalidProblem(f"{what} must be real, got complex values {x!r:.80}")
+    try:
+        return a.astype(float, copy=False)
+    except (TypeError, ValueError) as exc:
+        raise InvalidProblem(f"{what} must be numeric: {exc}") from None
+
+
+def finite_point(x: object, what: str) -> np.ndarray:
+    """:func:`real_array` and every entry finite (a projection of a NaN point has no meaning)."""
+    a = real_array(x, what)
+    if not np.isfinite(a).all():
+        raise InvalidProblem(f"{what} must be finite, got {np.array2string(a, threshold=8)}")
+    return a
+
+
+def bad_param(owner: str, what: str, value: object, t: float, need: str, cls: type = InvalidProblem) -> Exception:
+    """The error for a time-dependent parameter invalid at time ``t`` (the failing ``t`` in the message)."""
+    v = np.array2string(np.asarray(value), threshold=8) if not isinstance(value, float) else f"{value:g}"
+    return cls(f"{owner}: {what} = {v} at t = {t!r}: {need}")
+
+
 def batch_column(p: np.ndarray, x: np.ndarray, what: str) -> np.ndarray:
     """A per-operator scalar parameter ``p`` shaped to broadcast against the rows of ``x``.
 

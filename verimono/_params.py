@@ -6,6 +6,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ._kernels import real_array
 from .errors import InvalidProblem
 
 
@@ -25,7 +26,7 @@ class Param:
         elif callable(value):
             self._fn, self._value = value, None
         else:
-            arr = np.array(value, dtype=float)
+            arr = np.array(real_array(value, name), dtype=float)   # complex values raise, never truncate
             if not np.all(np.isfinite(arr)):
                 raise InvalidProblem(f"{name} must be finite, got {value!r}")
             arr.setflags(write=False)
@@ -39,7 +40,10 @@ class Param:
     def __call__(self, t: float) -> np.ndarray:
         if self._fn is None:
             return self._value
-        return np.asarray(self._fn(t), dtype=float)
+        v = self._fn(t)
+        if type(v) is float:
+            return np.asarray(v)
+        return real_array(v, f"{self.name}({t!r})")
 
     def describe(self) -> str:
         if self._fn is None:

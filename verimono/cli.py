@@ -1,9 +1,16 @@
 """Command line of verimono.
 
     verimono run [--profile dev|ci|thorough] [--out DIR] [--stage NAME ...] [--seed N] [--data DIR]
-                 [--baseline FILE] [--executor serial|process:N|tcp://host:port] [--unit-timeout S]
+                 [--baseline FILE] [--timeout S] [--resume] [--executor serial|process:N|tcp://host:port]
+                 [--unit-timeout S]
         The whole verification (every registered stage, see ``verimono.stages``); writes DIR/results.json
-        and DIR/report.html (DIR defaults to reports/).  Exit 0 when every check holds, 1 when one fails.
+        and DIR/report.html (DIR defaults to reports/).  Exit 0 when every check holds, 1 when one fails,
+        2 when nothing failed but a check was undecided (a limitation of the harness).
+        The output folder is checked writable before any work; both files are written atomically with one
+        run id.  An interrupt (Ctrl-C, SIGTERM) writes the finished stages to a results file marked
+        incomplete (the gate refuses it, exit 2) and exits 130; ``--resume`` runs the stages that file lacks
+        and completes it.  ``--timeout S``: seconds per unit of work (one law on one operator, one check of
+        one stepper; default: the profile's), beyond which the unit is stopped and recorded as failed.
     verimono check MODULE:OBJECT [--profile P] [--out DIR] [--seed N]
         The operator battery on an operator, or the stepper battery on a stepper ``f(problem, t_grid)``.
     verimono baseline [--out reports/baseline.json] [--from RESULTS] [run options]
@@ -29,7 +36,7 @@ from pathlib import Path
 from typing import Any, Callable, TextIO
 
 from .claims import SCHEMES, claim_of, with_claim
-from .errors import BadTarget, VerimonoError
+from .errors import BadTarget, NothingToResume, VerimonoError
 from .profiles import PROFILES, active_profile, get_profile, load_hypothesis_profile
 from .results import SKIPPED, Report
 
@@ -96,11 +103,13 @@ def _ci() -> bool:
 
 
 def execute(*, command: str, profile_name: str, stages: list[str] | None, context: Any, target: str | None = None,
-            progress: Progress | None = None, executor: Any = None, unit_timeout: float | None = None) -> Report:
+            progress: Progress | None = None, executor: Any = None, unit_timeout: float | None = None,
+            on_done: Callable | None = None) -> Report:
     """Run ``stages`` with ``context`` under a profile and return the merged, fully annotated report.
 
     ``executor`` (``"process:N"``, a dask scheduler address or ``Client``; ``None``: serial) is where the
-    stages' independent units run (:mod:`verimono.executors`); ``unit_timeout`` bounds each unit there."""
+    stages' independent units run (:mod:`verimono.executors`); ``unit_timeout`` bounds each unit there.
+    ``on_done(stage, report, info)`` is called after each stage (the interrupt handler keeps them)."""
     from .executors import make_runner
     from .report.schema import environment
     from .stages import calibrate, run_stages
@@ -115,8 +124,13 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
     context.executor = context.executor if context.executor is not None else runner
     cal = calibrate()
     start = time.perf_counter()
+    def done(stage, rep, info):
+        progress.done(stage, rep, info)
+        if on_done is not None:
+            on_done(stage, rep, info)
+
     try:
-        report = run_stages(stages, profile, context, on_start=progress.start, on_done=progress.done)
+        report = run_stages(stages, profile, context, on_start=progress.start, on_done=done)
     finally:
         runner.close()
     selection = {"stages": stages, "references": None if context.problems is None else
@@ -196,6 +210,16 @@ def order_table(report: Report) -> list[str]:
     return [fmt.format(*head)] + [fmt.format(*r) for r in rows]
 
 
+def _exit_status(report: Report) -> int:
+    """1 when a check failed; else 2 when one was undecided (nothing failed, but not everything was
+    verified: a limitation of the harness is never a pass); else 0."""
+    if report.failures:
+        return EXIT_FAILED
+    if report.undecided or report.meta.get("incomplete"):
+        return EXIT_UNDECIDED
+    return EXIT_OK
+
+
 def _finish(report: Report, out: Path, baseline: Report | None) -> int:
     from .report import write
 
@@ -210,14 +234,107 @@ def _finish(report: Report, out: Path, baseline: Report | None) -> int:
         line += f"; against the baseline: {changes.summary()}"
     print(line)
     print(f"verimono: wrote {paths['html']} and {paths['json']}")
-    return EXIT_OK if report.ok else EXIT_FAILED
+    for r in report.undecided:
+        print(f"  {r}")
+    return _exit_status(report)
+
+
+#: exit status of an interrupted run (the shell's convention for SIGINT)
+EXIT_INTERRUPTED = 130
+
+
+def _interruptible(run: Callable[[Callable], Report], out: Path, *, command: str, profile: str,
+                   stages: list[str] | None, previous: Report | None = None) -> Report | int:
+    """``run(on_done)`` with SIGTERM treated as an interrupt; on an interrupt write the stages finished so
+    far (with ``previous``'s, when resuming) to ``out`` marked ``incomplete`` and return the exit status."""
+    import signal
+
+    finished: list[tuple[Report, dict]] = []
+
+    def on_done(stage, rep, info):
+        finished.append((rep, info))
+
+    def term(signum, frame):
+        raise KeyboardInterrupt(f"signal {signum}")
+
+    old = signal.signal(signal.SIGTERM, term) if _main_thread() else None
+    try:
+        return run(on_done)
+    except KeyboardInterrupt:
+        partial = previous if previous is not None else Report(meta={"stages": []})
+        for rep, info in finished:
+            partial.extend(rep)
+            partial.meta.setdefault("stages", []).append(info)
+        done = [s["name"] for s in partial.meta.get("stages") or []]
+        partial.meta.update({"command": command, "profile": profile, "incomplete": True,
+                             "finished_stages": done,
+                             "selection": partial.meta.get("selection") or {"stages": stages, "references": None}})
+        from .report import write
+
+        paths = write(partial, out)
+        print(f"\nverimono: interrupted; the {len(done)} finished stage(s) ({', '.join(done) or 'none'}) are in "
+              f"{paths['json']}, marked incomplete; continue with `verimono {command} --resume`",
+              file=sys.stderr)
+        return EXIT_INTERRUPTED
+    finally:
+        if old is not None:
+            signal.signal(signal.SIGTERM, old)
+
+
+def _main_thread() -> bool:
+    import threading
+
+    return threading.current_thread() is threading.main_thread()
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
+    from .atomic import ensure_writable_dir
+    from .report.schema import load
+    from .timeouts import budget
+
+    out = ensure_writable_dir(args.out)           # before any work: a run must not be lost at the end
     baseline = _baseline_for(args)
-    report = execute(command="run", profile_name=args.profile, stages=args.stage, context=_context(args),
-                     progress=Progress(), **_executor_options(args))
-    return _finish(report, Path(args.out), baseline)
+    previous, stages = None, args.stage
+    if args.resume:
+        previous = load(out / "results.json") if (out / "results.json").is_file() else None
+        if previous is None or not previous.meta.get("incomplete"):
+            raise NothingToResume(f"nothing to resume: {out / 'results.json'} is "
+                                  f"{'absent' if previous is None else 'a complete run'}")
+        if previous.meta.get("profile") != args.profile:
+            raise NothingToResume(f"the interrupted run used profile {previous.meta.get('profile')!r}, not "
+                                  f"{args.profile!r}; resume it with the same options")
+        from .stages import STAGES
+
+        wanted = (previous.meta.get("selection") or {}).get("stages") or list(STAGES)
+        done = set(previous.meta.get("finished_stages") or [])
+        stages = [n for n in wanted if n not in done]
+        if args.seed is None and previous.meta.get("seed") is not None:
+            args.seed = previous.meta["seed"]
+
+    def run(on_done):
+        with budget(args.timeout):
+            return execute(command="run", profile_name=args.profile, stages=stages, context=_context(args),
+                           progress=Progress(), on_done=on_done, **_executor_options(args))
+
+    report = _interruptible(run, out, command="run", profile=args.profile, stages=args.stage, previous=previous)
+    if isinstance(report, int):
+        return report
+    if previous is not None:
+        report = _merge_resumed(previous, report)
+    return _finish(report, out, baseline)
+
+
+def _merge_resumed(previous: Report, rest: Report) -> Report:
+    """The interrupted run's finished stages followed by the resumed ones: one complete report."""
+    merged = Report(meta=dict(rest.meta))
+    merged.extend(previous)
+    merged.extend(rest)
+    merged.meta["stages"] = list(previous.meta.get("stages") or []) + list(rest.meta.get("stages") or [])
+    merged.meta["selection"] = previous.meta.get("selection")
+    merged.meta["resumed"] = True
+    for key in ("incomplete", "finished_stages"):
+        merged.meta.pop(key, None)
+    return merged
 
 
 def _load_file(path: Path) -> Any:
@@ -306,26 +423,43 @@ def _cmd_check(args: argparse.Namespace) -> int:
     else:
         raise BadTarget(f"{args.target} is neither an operator (with .dim and .resolvent) nor a stepper "
                         "callable(problem, t_grid)")
+    from .atomic import ensure_writable_dir
+    from .timeouts import budget
+
+    out = ensure_writable_dir(args.out)           # before any work
     if getattr(args, "executor", None) not in (None, "serial"):
         from .executors import ship_by_value
 
         ship_by_value(obj)  # its module need not be importable on the workers
     print(f"verimono: checking {args.target} as a {kind}", file=sys.stderr)
-    report = execute(command="check", profile_name=args.profile, stages=stages, context=ctx,
-                     target=args.target, progress=Progress(), **_executor_options(args))
+
+    def run(on_done):
+        with budget(args.timeout):
+            return execute(command="check", profile_name=args.profile, stages=stages, context=ctx,
+                           target=args.target, progress=Progress(), on_done=on_done, **_executor_options(args))
+
+    report = _interruptible(run, out, command="check", profile=args.profile, stages=stages)
+    if isinstance(report, int):
+        return report
+    report.meta.setdefault("target", args.target)
     if report.results and all(r.status == SKIPPED for r in report.results):
-        _finish(report, Path(args.out), None)
+        _finish(report, out, None)
         print(f"verimono: no {kind} battery could run here: " +
               "; ".join(r.message for r in report.results), file=sys.stderr)
         return EXIT_UNDECIDED
-    return _finish(report, Path(args.out), _baseline_for(args))
+    return _finish(report, out, _baseline_for(args))
 
 
 def _cmd_baseline(args: argparse.Namespace) -> int:
+    from .atomic import ensure_writable_file
     from .report.schema import load
 
+    ensure_writable_file(args.out)                # before any work
     if args.from_results:
         report = load(args.from_results)
+        if report.meta.get("incomplete"):
+            raise NothingToResume(f"{args.from_results} is an interrupted run (marked incomplete): finish it "
+                                  "with `verimono run --resume` before recording it as a baseline")
     else:
         report = execute(command="run", profile_name=args.profile, stages=args.stage, context=_context(args),
                          progress=Progress(), **_executor_options(args))
@@ -341,7 +475,14 @@ def _cmd_baseline(args: argparse.Namespace) -> int:
 def _cmd_gate(args: argparse.Namespace) -> int:
     from .gate import gate
 
-    comparison = gate(args.baseline, args.results)
+    try:
+        comparison = gate(args.baseline, args.results)
+    except VerimonoError:
+        raise
+    except Exception as exc:   # the gate fails closed: a document it cannot compare is never a regression
+        print(f"verimono gate: cannot compare {args.baseline} with {args.results} ({type(exc).__name__}: "
+              f"{exc})", file=sys.stderr)
+        return EXIT_UNDECIDED
     for c in comparison.regressions:
         print(f"  {c}")
     if args.verbose:
@@ -357,9 +498,10 @@ def _cmd_report(args: argparse.Namespace) -> int:
 
     report = load(args.results)
     changes = _changes(load(args.baseline), report) if args.baseline else None
-    out = Path(args.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(render(report, changes=changes), encoding="utf-8")
+    from .atomic import ensure_writable_file, write_text
+
+    out = ensure_writable_file(args.out)
+    write_text(out, render(report, changes=changes))
     print(f"verimono: wrote {out}")
     return EXIT_OK
 
@@ -380,17 +522,23 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--data", default=None, help="shared data folder (Siconos references); default ../shared")
         p.add_argument("--reference", action="append", metavar="NAME",
                        help="use only this analytic reference (repeatable; default: the whole catalog)")
+        p.add_argument("--timeout", type=float, default=None, metavar="S",
+                       help="seconds per unit of work (one law on one operator, one check of one stepper) "
+                            "before it is stopped and recorded as failed (default: the profile's)")
         p.add_argument("--executor", default=None, metavar="SPEC",
                        help="where the stages' independent units run: serial (default), process:N (N worker "
                             "processes), or a dask.distributed scheduler address such as tcp://host:8786")
         p.add_argument("--unit-timeout", type=float, default=None, metavar="SECONDS",
-                       help="with --executor: a unit still running after this long becomes a failed record")
+                       help="with --executor: a stage unit (a subject's battery) still running after this long "
+                            "becomes a failed record")
 
     run = sub.add_parser("run", help="run the whole verification and write the report")
     run_options(run)
     run.add_argument("--out", default="reports", help="output folder (default reports/)")
     run.add_argument("--baseline", default=None, help="show changes against this baseline (default "
                      "reports/baseline.json when present)")
+    run.add_argument("--resume", action="store_true", help="continue the interrupted run whose incomplete "
+                     "results.json is in --out: run only the stages it lacks")
     run.set_defaults(func=_cmd_run)
 
     check = sub.add_parser("check", help="run the operator or stepper battery on MODULE:OBJECT")

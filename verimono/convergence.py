@@ -68,6 +68,8 @@ class OrderFit:
     local_slopes: list[float]
     pre_asymptotic: bool
     exact: bool = False
+    #: indices of the grids whose error is not a finite number (a failed study, never "exact")
+    nonfinite: list[int] = dataclasses.field(default_factory=list)
 
     def contains(self, p: float, slack: float = ORDER_SLACK) -> bool:
         return self.low - slack <= p <= self.high + slack
@@ -76,6 +78,8 @@ class OrderFit:
         return self.high + slack >= p
 
     def __str__(self) -> str:
+        if self.nonfinite:
+            return "undefined (non-finite errors)"
         if self.exact:
             return "exact (round-off)"
         if math.isnan(self.low):
@@ -84,8 +88,15 @@ class OrderFit:
 
 
 def fit_order(h: Sequence[float], e: Sequence[float], floor: float = 0.0) -> OrderFit:
-    """Fit ``e ≈ C h^p`` on the points above ``floor`` (see the module docstring)."""
+    """Fit ``e ≈ C h^p`` on the points above ``floor`` (see the module docstring).
+
+    A non-finite error (``nan``/``inf``: a stepper that diverged or returned garbage) is never "below the
+    floor": the fit is then ``nan`` with ``nonfinite`` listing the offending grids, and the study fails.
+    """
     h, e = np.asarray(h, float), np.asarray(e, float)
+    bad = np.flatnonzero(~np.isfinite(e)).tolist()
+    if bad:
+        return OrderFit(math.nan, math.nan, math.nan, [], list(range(len(e))), [], False, nonfinite=bad)
     keep = e > floor
     used, dropped = np.flatnonzero(keep).tolist(), np.flatnonzero(~keep).tolist()
     if len(used) == 0:
@@ -131,6 +142,9 @@ class ConvergenceStudy:
     def verdict(self) -> tuple[bool, str]:
         """Whether the stepper reaches the expected order, with the reason."""
         fit, exp = self.order, self.expected
+        bad = _nonfinite_errors(self.errors, self.mesh)
+        if bad:
+            return False, f"non-finite error: {bad} (the stepper diverged or returned non-finite values)"
         if exp is None:
             return True, "no expected order stated"
         if exp.exact:
@@ -201,6 +215,13 @@ def study_text(study: Any) -> str:
                      + [f"  verdict: {'reaches the expected order' if ok else 'MISSES the expected order'} — {msg}"])
 
 
+def _nonfinite_errors(errors: dict[str, list[float]], mesh: list[float]) -> str:
+    """``"sup error nan at h=0.1, ..."`` for every error that is not a finite number ('' when none)."""
+    out = [f"{norm} error {e} at h={h:.3g}" for norm in NORMS for h, e in zip(mesh, errors.get(norm, []))
+           if not math.isfinite(float(e))]
+    return ", ".join(out[:4]) + (f" and {len(out) - 4} more" if len(out) > 4 else "")
+
+
 def exact_on(problem: Problem, t: np.ndarray) -> np.ndarray:
     """Exact solution at the times ``t``, shape ``(len(t),) + x0.shape``."""
     if problem.exact is None:
@@ -257,9 +278,9 @@ class ErrorAccumulator:
                 raise InvalidProblem(f"the reference has {self.reference.shape[0]} values, fewer than the grid")
         self._row += len(t)
         d = _pointwise(x, ref)
-        self.sup = max(self.sup, float(d.max()))
+        self.sup = _nanmax(self.sup, float(d.max()))      # d.max() is nan when any d is; keep it so
         self.final = float(d[-1])
-        self.scale = max(self.scale, float(np.max(np.abs(ref))))
+        self.scale = _nanmax(self.scale, float(np.max(np.abs(ref))))
         if self._t_last is None:
             h, dd = np.diff(t), d[1:]
         else:
@@ -272,6 +293,12 @@ class ErrorAccumulator:
 
     def errors(self) -> dict[str, float]:
         return {"sup": self.sup, "l2": math.sqrt(math.fsum(self._l2)), "final": self.final}
+
+
+def _nanmax(a: float, b: float) -> float:
+    """``max`` that propagates ``nan`` (Python's ``max(0.0, nan)`` is ``0.0``: a diverged stepper would
+    have looked exact)."""
+    return a if (a != a or a >= b) else b
 
 
 class Sampler:
@@ -343,7 +370,7 @@ def convergence_study(stepper: Callable, problem: Problem, steps: Sequence[Any] 
         results = _run_jobs(stepper, problem, jobs, executor)
         reference = f"fine-grid solution of the same stepper (h = {problem.T / (len(fine_t) - 1):.3g})"
     errors = {n: [errs[n] for errs, _, _ in results] for n in NORMS}
-    scale = max([1.0] + [sc for _, sc, _ in results])
+    scale = max([1.0] + [sc for _, sc, _ in results if math.isfinite(sc)])
     floor = ROUNDOFF_FACTOR * EPS * scale
     mesh = [float(np.max(np.diff(g))) for g in grids]
     fits = {n: fit_order(mesh, errors[n], floor) for n in NORMS}
@@ -481,7 +508,9 @@ def _unwrap(obj):
 
 def _timed_run(stepper, problem, grid):
     start = time.perf_counter()
-    x = np.asarray(stepper(problem, grid), dtype=float)
+    from ._kernels import real_array
+
+    x = real_array(stepper(problem, grid), f"the values of stepper {_name(stepper)}")   # complex: an error
     if x.shape != (len(grid),) + problem.x0.shape:
         raise InvalidProblem(f"stepper {_name(stepper)} returned shape {x.shape}, expected "
                              f"{(len(grid),) + problem.x0.shape}")

@@ -105,6 +105,28 @@ class ProxOutputError(VerimonoError, TypeError):
     a list of arrays, a non-scalar value): verimono does not guess which part is the point."""
 
 
+class InvalidCheckArgument(VerimonoError, ValueError):
+    """A check was asked to verify nothing: ``examples <= 0``, an empty list of problems, ``T <= 0``, a
+    non-positive time budget.  A check that evaluates nothing must not be able to pass."""
+
+
+class UnitTimeout(VerimonoError, TimeoutError):
+    """A unit of work (one law on one operator, one check of one stepper) exceeded its time budget."""
+
+
+class OutputNotWritable(VerimonoError, OSError):
+    """An output folder or file cannot be created or written (checked before any work is done)."""
+
+
+class NothingToResume(VerimonoError, ValueError):
+    """``--resume`` without an incomplete results file of the same kind of run in the output folder."""
+
+
+class IncompatibleResults(SchemaError):
+    """The results (or baseline) are marked incomplete: an interrupted run verifies only part of the
+    battery, so the gate cannot decide (exit status 2)."""
+
+
 __all__ = [
     "ProxOutputError",
     "VerimonoError",
@@ -125,4 +147,9 @@ __all__ = [
     "SchemaError",
     "IncompatibleBaseline",
     "MissingOptionalDependency",
+    "InvalidCheckArgument",
+    "UnitTimeout",
+    "OutputNotWritable",
+    "NothingToResume",
+    "IncompatibleResults",
 ]

@@ -14,6 +14,12 @@
   ``details["error"]``, e.g. Siconos agreement) grows by more than ``ERROR_GROWTH``;
 * **non-finite** — an error or order estimate is now ``nan``, ``inf`` or ``null`` where the baseline's
   was finite (reported as an error / order regression: NaN compares false against every threshold);
+* **non-finite figure** — a record that passes with a ``worst``, ``bound`` or ``details["error"]`` that is
+  ``nan`` or ``inf`` (a NaN ratio satisfies no bound: such a pass was never earned);
+* **undecided** — a record that passed and is now ``undecided`` (it verifies nothing);
+* **study** — a convergence study of the baseline that is absent now while its record remains (the
+  record's order claim is no longer backed by any errors);
+* **incomplete** — results marked ``meta.incomplete`` (an interrupted run) are refused: exit status 2;
 * **timing** — a stage's duration divided by the calibration workload measured in the same job (or a
   record's ``details["timing_ratio"]``, a same-job ratio) grows by more than ``TIMING_GROWTH``.
 
@@ -33,8 +39,8 @@ from pathlib import Path
 from typing import Any
 
 from .convergence import ORDER_SLACK
-from .errors import IncompatibleBaseline, SchemaError
-from .results import FAILED, PASSED, SKIPPED, XFAIL, Report, load
+from .errors import IncompatibleBaseline, IncompatibleResults, SchemaError
+from .results import FAILED, PASSED, SKIPPED, UNDECIDED, XFAIL, Report, load
 
 #: smallest drop of a fitted slope that counts as a regression when both intervals are narrower: slopes
 #: are refitted on the same grids, so they reproduce to round-off on one machine and to ~1e-3 across
@@ -151,6 +157,8 @@ def _compare_records(base: Report, cur: Report, out: list[Change]) -> None:
             out.append(Change("status", key, f"{b.status} → failed: {c.message or _why(c)}", True))
         elif b.status == PASSED and c.status == SKIPPED:
             out.append(Change("status", key, f"passed → skipped: {c.message}", True))
+        elif b.status in (PASSED, XFAIL) and c.status == UNDECIDED:
+            out.append(Change("status", key, f"{b.status} → undecided: {c.message}", True))
         elif b.status != c.status:
             out.append(Change("status", key, f"{b.status} → {c.status}", False))
         be, ce = b.details.get("error"), c.details.get("error")
@@ -168,6 +176,13 @@ def _compare_records(base: Report, cur: Report, out: list[Change]) -> None:
     for key, c in now.items():
         if key not in before:
             out.append(Change("new", key, f"new record ({c.status})", False))
+        if c.status == PASSED:
+            bad = [f"{name} = {v!r}" for name, v in (("worst", c.worst), ("bound", c.bound),
+                                                    ("error", c.details.get("error")))
+                   if v is not None and isinstance(v, (int, float)) and not math.isfinite(v)]
+            if bad:
+                out.append(Change("nonfinite", key, "passed with a non-finite figure (" + ", ".join(bad) +
+                                  "): a nan/inf satisfies no bound", True))
     executed = lambda rep: Counter(r.check for r in rep.results if r.status != SKIPPED)  # noqa: E731
     bc, cc = executed(base), executed(cur)
     for check, n in bc.items():
@@ -193,7 +208,13 @@ def _compare_studies(base: Report, cur: Report, out: list[Change]) -> None:
             continue
         s = now.get((b.problem, b.stepper))
         if s is None:
-            continue  # the record rules report the missing study
+            # a study that vanished while its record stayed: the order claim has lost its evidence
+            # (a vanished record is reported by the record rules)
+            if any(r.check == "convergence_order" and r.subject == f"{b.stepper} on {b.problem}"
+                   and r.status != SKIPPED for r in cur.results):
+                out.append(Change("study", f"{b.stepper} on {b.problem}", "the convergence study of the "
+                                  "baseline is absent from the results while its record remains", True))
+            continue
         key = f"{b.stepper} on {b.problem}"
         for norm in GATED_NORMS:
             bf, cf = b.fits.get(norm), s.fits.get(norm)
@@ -257,9 +278,14 @@ def gate(baseline: str | Path | Report, results: str | Path | Report) -> Compari
     """Load both documents (fail closed: :class:`SchemaError` / :class:`IncompatibleBaseline`) and compare."""
     base = baseline if isinstance(baseline, Report) else load(baseline)
     cur = results if isinstance(results, Report) else load(results)
+    for what, rep in (("baseline", base), ("results", cur)):
+        if rep.meta.get("incomplete"):
+            raise IncompatibleResults(f"the {what} come from an interrupted run (finished stages: "
+                                      f"{', '.join(rep.meta.get('finished_stages') or []) or 'none'}); finish it "
+                                      "with `verimono run --resume` before gating")
     check_runs_compatible(base, cur)
     return compare(base, cur)
 
 
 __all__ = ["Change", "Comparison", "compare", "gate", "check_baseline", "check_runs_compatible",
-           "IncompatibleBaseline", "ORDER_DROP_FLOOR", "ERROR_GROWTH", "TIMING_GROWTH", "TIMING_MIN_SECONDS"]
+           "IncompatibleBaseline", "IncompatibleResults", "ORDER_DROP_FLOOR", "ERROR_GROWTH", "TIMING_GROWTH", "TIMING_MIN_SECONDS"]

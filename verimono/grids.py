@@ -21,6 +21,8 @@ def validate_grid(t_grid, T: float | None = None) -> np.ndarray:
     Raises :class:`InvalidGrid` when it is not one-dimensional, has fewer than two points, contains
     non-finite values, does not start at 0, does not end at ``T`` or is not strictly increasing.
     """
+    if np.iscomplexobj(t_grid):   # np.asarray(z, dtype=float) would drop the imaginary part silently
+        raise InvalidGrid("time grid must be real, got complex values")
     try:
         t = np.asarray(t_grid, dtype=float)
     except (TypeError, ValueError) as exc:

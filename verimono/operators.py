@@ -27,7 +27,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ._kernels import _TINY, _mx, _norm, _sqrt, batch_column, dot_rows
+from ._kernels import (_INF, _TINY, _mx, _norm, _sqrt, bad_lam, bad_param, batch_column, check_lam, dot_rows,
+                       real_array)
 from ._params import as_param
 from ._values import checked_value, subgradient_contains
 from .errors import InvalidProblem, NotMonotone, OutsideDomain
@@ -57,7 +58,8 @@ class Operator:
 
     def yosida(self, x: np.ndarray, lam: float, t: float = 0.0) -> np.ndarray:
         """Yosida approximation ``Y_λ x = (x - J_λ x)/λ``, an element of ``F(t, J_λ x)``."""
-        x = np.asarray(x, dtype=float)
+        lam = check_lam(lam, f"{self.name}.yosida")
+        x = real_array(x)
         return (x - self.resolvent(x, lam, t)) / lam
 
     def min_norm(self, x: np.ndarray, t: float = 0.0) -> np.ndarray:
@@ -146,8 +148,18 @@ def _scalar_fn(param) -> Callable[[float], float]:
         v = fn(t)
         if type(v) is float:
             return v
-        return float(np.asarray(v, dtype=float))
+        return float(real_array(v, f"{param.name}({t!r})"))
     return call
+
+
+def _weight_at(param, t: float, owner: str, what: str) -> np.ndarray:
+    """A nonnegative weight ``param(t)`` of a convex function, checked at ``t`` when it moves (constants are
+    checked once, at construction); :class:`NotMonotone` naming ``t`` otherwise (also for ``nan``)."""
+    c = param(t)
+    if not param.constant and not (float(c) >= 0.0 if c.ndim == 0 else (c >= 0).all()):
+        raise bad_param(owner, what, c, t, "must be >= 0 (a negative weight makes the operator non-monotone)",
+                        NotMonotone)
+    return c
 
 
 def _check_dim(op: Operator, x: np.ndarray) -> np.ndarray:
@@ -175,7 +187,8 @@ class _FromResolvent(Operator):
         self._contains_takes_tol = contains is not None and _accepts(contains, 4)
 
     def resolvent(self, x, lam, t=0.0):
-        return np.asarray(self._resolvent(x, lam, t), dtype=float)
+        lam = check_lam(lam, f"{self.name}.resolvent")
+        return real_array(self._resolvent(real_array(x), lam, t), f"the resolvent of {self.name}")
 
     def provides(self, member):
         if member == "contains" and self._value is not None:
@@ -272,11 +285,20 @@ class Linear(Operator):
                 self._cache_inv = inv
                 self._cache_lam = lam
             return self._cache_inv
-        return np.linalg.inv(np.eye(self.dim) + lam * self._M(t)).T
+        return np.linalg.inv(np.eye(self.dim) + lam * self._M_at(t)).T
+
+    def _M_at(self, t: float) -> np.ndarray:
+        """``M(t)``, checked at this ``t``: square of the operator's size, finite, ``M + Mᵀ ⪰ 0`` (a moving
+        ``M`` validated at ``t = 0`` only once gave ``x(1) = -11197`` for ``M(t) = 1 - 20t``)."""
+        M = self._M(t)
+        if M.shape != (self.dim, self.dim) or not np.isfinite(M).all():
+            raise bad_param(self.name, "M(t)", M, t, f"must be a finite {self.dim}x{self.dim} matrix")
+        _require_monotone_matrix(M, "M", t)
+        return M
 
     def resolvent(self, x, lam, t=0.0):
-        x = np.asarray(x, dtype=float)
-        W = self._inverse(float(lam), t)
+        x = real_array(x)
+        W = self._inverse(check_lam(lam, f"{self.name}.resolvent"), t)
         if x.ndim == 1:
             return x @ W
         # a stack of (1, n) @ (n, n) products: each row is computed exactly as the single point x @ W
@@ -289,14 +311,16 @@ class Linear(Operator):
     def _kernel(self, x0):
         if not _own(self, Linear) or not self.static or x0.ndim != 1:
             return None
-        inverse = self._inverse
+        inverse, name = self._inverse, self.name
 
         def step(x, lam, t):
+            if not 0.0 < lam < _INF:
+                raise bad_lam(lam, name)
             return x @ inverse(lam, t)
         return step
 
     def min_norm(self, x, t=0.0):
-        return np.asarray(x, dtype=float) @ self._M(t).T
+        return real_array(x) @ (self._M(t) if self.static else self._M_at(t)).T
 
     def project_domain(self, x, t=0.0):
         return np.array(x, dtype=float)
@@ -307,12 +331,13 @@ class Linear(Operator):
         return bool(np.max(np.abs(np.asarray(y) - Mx)) <= tol)
 
 
-def _require_monotone_matrix(M: np.ndarray, what: str) -> None:
+def _require_monotone_matrix(M: np.ndarray, what: str, t: float | None = None) -> None:
     sym = 0.5 * (M + M.T)
     lmin = float(np.linalg.eigvalsh(sym)[0]) if M.size else 0.0
     if lmin < -tolerance(M):
+        at = "" if t is None else f" at t = {t!r}"
         raise NotMonotone(f"{what} + {what}ᵀ must be positive semidefinite for a monotone operator; "
-                          f"its smallest eigenvalue is {2 * lmin:.3g}")
+                          f"its smallest eigenvalue{at} is {2 * lmin:.3g}")
 
 
 def _nonnegative(value: np.ndarray, what: str) -> None:
@@ -342,13 +367,18 @@ class NormSubdifferential(Operator):
     def c(self, t: float = 0.0) -> float:
         return self._c(t)
 
+    def _c_at(self, t):
+        """``c(t)``, checked ``≥ 0`` at this ``t`` when it moves (a negative weight is not monotone)."""
+        return _weight_at(self._c, t, self.name, "c(t)")
+
     def _col(self, t, x):
         """``c(t)`` shaped to broadcast against the norms ``(..., 1)`` of ``x`` (a batch ``(B,)`` per row)."""
-        return batch_column(self._c(t), x, "c")
+        return batch_column(self._c_at(t), x, "c")
 
     def resolvent(self, x, lam, t=0.0):
         # J x = x max(|x| - λc, 0)/|x|, written so that x = 0 gives 0 without a 0/0
-        x = np.asarray(x, dtype=float)
+        lam = check_lam(lam, f"{self.name}.resolvent")
+        x = real_array(x)
         nrm = _norm(x)
         return x * (_mx(nrm - lam * self._col(t, x), 0.0) / _mx(nrm, _TINY))
 
@@ -358,11 +388,17 @@ class NormSubdifferential(Operator):
     def _kernel(self, x0):
         if not _own(self, NormSubdifferential) or x0.ndim != 1 or self._c(0.0).ndim:
             return None
-        c = _scalar_fn(self._c)
+        c, name = _scalar_fn(self._c), self.name
 
         def step(x, lam, t):
+            if not 0.0 < lam < _INF:
+                raise bad_lam(lam, name)
+            ct = c(t)
+            if not ct >= 0.0:       # also catches nan
+                raise bad_param(name, "c(t)", ct, t, "must be >= 0 (a negative weight is not monotone)",
+                                NotMonotone)
             nrm = _sqrt(x.dot(x))
-            return x * (max(nrm - lam * c(t), 0.0) / max(nrm, _TINY))
+            return x * (max(nrm - lam * ct, 0.0) / max(nrm, _TINY))
         return step
 
     def min_norm(self, x, t=0.0):
@@ -376,7 +412,7 @@ class NormSubdifferential(Operator):
 
     def contains(self, x, y, t=0.0, tol=None):
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
-        c = float(self._c(t))
+        c = float(self._c_at(t))
         tol = tolerance(c, y) if tol is None else tol
         nx = float(np.linalg.norm(x))
         if nx <= tol and np.linalg.norm(y) <= c + tol:  # x within tol of 0, where F = the ball cB
@@ -401,8 +437,9 @@ class L1Subdifferential(Operator):
         _nonnegative(c0, "c(0)")
 
     def resolvent(self, x, lam, t=0.0):
-        x = np.asarray(x, dtype=float)
-        return np.sign(x) * _mx(np.abs(x) - lam * self._c(t), 0.0)
+        lam = check_lam(lam, f"{self.name}.resolvent")
+        x = real_array(x)
+        return np.sign(x) * _mx(np.abs(x) - lam * _weight_at(self._c, t, self.name, "c(t)"), 0.0)
 
     def _accepts_batches(self):
         return _own(self, L1Subdifferential)
@@ -410,29 +447,33 @@ class L1Subdifferential(Operator):
     def _kernel(self, x0):
         if not _own(self, L1Subdifferential):
             return None
-        sign, absolute = np.sign, np.abs
+        sign, absolute, name = np.sign, np.abs, self.name
         if self._c.constant:
             c = self._c(0.0)
 
             def step(x, lam, t):
+                if not 0.0 < lam < _INF:
+                    raise bad_lam(lam, name)
                 return sign(x) * _mx(absolute(x) - lam * c, 0.0)
         else:
             cfn = self._c
 
             def step(x, lam, t):
-                return sign(x) * _mx(absolute(x) - lam * cfn(t), 0.0)
+                if not 0.0 < lam < _INF:
+                    raise bad_lam(lam, name)
+                return sign(x) * _mx(absolute(x) - lam * _weight_at(cfn, t, name, "c(t)"), 0.0)
         return step
 
     def min_norm(self, x, t=0.0):
-        x = np.asarray(x, dtype=float)
-        return np.sign(x) * self._c(t)
+        x = real_array(x)
+        return np.sign(x) * _weight_at(self._c, t, self.name, "c(t)")
 
     def project_domain(self, x, t=0.0):
         return np.array(x, dtype=float)
 
     def contains(self, x, y, t=0.0, tol=None):
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
-        c = np.broadcast_to(self._c(t), x.shape)
+        c = np.broadcast_to(_weight_at(self._c, t, self.name, "c(t)"), x.shape)
         tol = tolerance(c, y) if tol is None else tol
         at_kink = (np.abs(x) <= tol) & (np.abs(y) <= c + tol)  # x_i within tol of 0: F_i = [-c_i, c_i]
         on_branch = (x != 0.0) & (np.abs(y - c * np.sign(x)) <= tol)
@@ -452,6 +493,7 @@ class NormalCone(Operator):
         self.static = getattr(S, "static", False)
 
     def resolvent(self, x, lam, t=0.0):
+        check_lam(lam, f"{self.name}.resolvent")  # J_λ = proj for every λ > 0, and only for those
         return self.S.project(x, t)
 
     def _accepts_batches(self):
@@ -464,9 +506,11 @@ class NormalCone(Operator):
         step = kern(x0) if kern is not None else None
         if step is not None:
             return step  # a set's kernel is step(x, lam, t) = proj_{S(t)} x already
-        project = self.S.project
+        project, name = self.S.project, self.name
 
         def step(x, lam, t):
+            if not 0.0 < lam < _INF:
+                raise bad_lam(lam, name)
             return project(x, t)
         return step
 
@@ -504,8 +548,9 @@ class Shifted(Operator):
         return self._Phi(t)
 
     def resolvent(self, x, lam, t=0.0):
+        lam = check_lam(lam, f"{self.name}.resolvent")
         p = self._Phi(t)
-        return self.F.resolvent(np.asarray(x, dtype=float) + p, lam, t) - p
+        return self.F.resolvent(real_array(x) + p, lam, t) - p
 
     def _accepts_batches(self):
         return _own(self, Shifted) and self.F._accepts_batches()
@@ -561,8 +606,14 @@ class LogBarrier(Operator):
         if np.any(self._c(0.0) <= 0):
             raise InvalidProblem("LogBarrier needs c > 0")
 
+    def _c_at(self, t):
+        c = self._c(t)
+        if not self._c.constant and not np.all(c > 0):
+            raise bad_param(self.name, "c(t)", c, t, "must be > 0")
+        return c
+
     def resolvent(self, x, lam, t=0.0):
-        return self._resolve(np.asarray(x, dtype=float), lam, self._c(t))
+        return self._resolve(real_array(x), check_lam(lam, f"{self.name}.resolvent"), self._c_at(t))
 
     @staticmethod
     def _resolve(x, lam, c):
@@ -576,12 +627,22 @@ class LogBarrier(Operator):
     def _kernel(self, x0):
         if not _own(self, LogBarrier):
             return None
-        resolve = self._resolve
+        resolve, name = self._resolve, self.name
         if self._c.constant:
             c = self._c(0.0)
-            return lambda x, lam, t: resolve(x, lam, c)
-        cfn = self._c
-        return lambda x, lam, t: resolve(x, lam, cfn(t))
+
+            def step(x, lam, t):
+                if not 0.0 < lam < _INF:
+                    raise bad_lam(lam, name)
+                return resolve(x, lam, c)
+            return step
+        c_at = self._c_at
+
+        def moving(x, lam, t):
+            if not 0.0 < lam < _INF:
+                raise bad_lam(lam, name)
+            return resolve(x, lam, c_at(t))
+        return moving
 
     def min_norm(self, x, t=0.0):
         x = np.asarray(x, dtype=float)

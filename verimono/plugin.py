@@ -34,6 +34,8 @@ from typing import Any
 
 import pytest
 
+from .atomic import ensure_writable_dir
+from .errors import OutputNotWritable
 from .results import FAILED, XFAIL, CheckResult, Report, listening
 
 _KEY = pytest.StashKey["_Collector"]()
@@ -81,6 +83,11 @@ def pytest_configure(config: pytest.Config) -> None:
         except SchemaError as exc:
             raise pytest.UsageError(f"verimono baseline unusable: {exc}") from None
     worker = hasattr(config, "workerinput")  # a pytest-xdist worker: ships its records, writes nothing
+    if out and not worker:   # checked before the session's work, not after it
+        try:
+            ensure_writable_dir(out)
+        except OutputNotWritable as exc:
+            raise pytest.UsageError(f"--verimono-report: {exc}") from None
     collector = _Collector(None if worker else (Path(out) if out else None), None if worker else baseline,
                            profile, worker=worker)
     config.stash[_KEY] = collector

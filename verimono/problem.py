@@ -61,6 +61,8 @@ def _as_order(order: Any) -> Order | None:
 
 
 def _finite_array(value: Any, what: str) -> np.ndarray:
+    if np.iscomplexobj(value):   # np.array(z, dtype=float) would drop the imaginary part silently
+        raise InvalidProblem(f"{what} must be real, got complex values {value!r:.80}")
     try:
         arr = np.array(value, dtype=float)
     except (TypeError, ValueError) as exc:

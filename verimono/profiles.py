@@ -29,7 +29,11 @@ class Profile:
     ``max_examples``: the hypothesis profile's examples per test (pytest suites); ``law_examples``:
     examples per operator law in ``verimono run`` (which runs every law on many operators, so fewer);
     ``generated_subjects``: operators and problems drawn from ``verimono.strategies`` per run;
-    ``derandomize``: fixed seeds (0 unless ``--seed``), so every job produces the same records.
+    ``derandomize``: fixed seeds (0 unless ``--seed``), so every job produces the same records;
+    ``unit_timeout``: seconds one unit (one law on one operator, one check of one stepper) may take before
+    it is stopped and recorded as failed (:mod:`verimono.timeouts`; ``--timeout`` overrides).  The slowest
+    catalog unit takes about 5 s here (a law at n = 10^6, ci profile, loaded 2-core machine), so the
+    defaults stop only what does not finish.
     """
 
     name: str
@@ -37,13 +41,16 @@ class Profile:
     law_examples: int
     generated_subjects: int
     derandomize: bool
+    unit_timeout: float = 120.0
 
 
 _EFFORT = {
-    "dev": Profile("dev", max_examples=25, law_examples=10, generated_subjects=3, derandomize=False),
-    "ci": Profile("ci", max_examples=50, law_examples=20, generated_subjects=6, derandomize=True),
+    "dev": Profile("dev", max_examples=25, law_examples=10, generated_subjects=3, derandomize=False,
+                   unit_timeout=60.0),
+    "ci": Profile("ci", max_examples=50, law_examples=20, generated_subjects=6, derandomize=True,
+                  unit_timeout=120.0),
     "thorough": Profile("thorough", max_examples=500, law_examples=200, generated_subjects=30,
-                        derandomize=False),
+                        derandomize=False, unit_timeout=600.0),
 }
 
 

@@ -1,8 +1,15 @@
 """Result records: what every check returns.
 
 Checks never print or assert.  Each returns :class:`CheckResult` records — the check's name, its
-subject, a status (``passed``, ``failed``, ``skipped``, ``xfail``), the worst observed ratio against the
-check's bound, and a counterexample that reproduces a failure.  pytest, the HTML report and the CI gate
+subject, a status (``passed``, ``failed``, ``skipped``, ``xfail``, ``undecided``), the worst observed ratio
+against the check's bound, and a counterexample that reproduces a failure.
+
+``undecided`` is a limitation of the harness itself (the search engine cannot draw inputs of this size,
+a stage ran out of memory): neither a pass nor a failure of the subject.  ``verimono`` exits 2 ("could
+not decide") on it when nothing failed, the gate treats a record that passed and is now undecided as a
+regression (it verifies nothing), and pytest reports it as a failure of the test run, never as a pass.
+A record that claims ``passed`` with a non-finite ``worst`` is a contradiction (a NaN ratio compares false
+against every bound); it is turned into ``failed`` on construction.  pytest, the HTML report and the CI gate
 are thin consumers of these records, collected in a :class:`Report`.
 
 Saving and loading: the JSON schema of ``results.json`` and ``baseline.json`` — one document, versioned.
@@ -73,8 +80,15 @@ from .display import render
 from .convergence import NORMS, ConvergenceStudy
 from .errors import SchemaError
 
-PASSED, FAILED, SKIPPED, XFAIL = "passed", "failed", "skipped", "xfail"
-STATUSES = (PASSED, FAILED, SKIPPED, XFAIL)
+PASSED, FAILED, SKIPPED, XFAIL, UNDECIDED = "passed", "failed", "skipped", "xfail", "undecided"
+STATUSES = (PASSED, FAILED, SKIPPED, XFAIL, UNDECIDED)
+
+
+def _finite_number(x: Any) -> bool:
+    try:
+        return math.isfinite(float(x))
+    except (TypeError, ValueError):
+        return False
 
 
 @dataclasses.dataclass
@@ -100,11 +114,17 @@ class CheckResult:
     def __post_init__(self) -> None:
         if self.status not in STATUSES:
             raise ValueError(f"status must be one of {STATUSES}, got {self.status!r}")
+        if self.status == PASSED and self.worst is not None and not _finite_number(self.worst):
+            # an unearned pass: a nan/inf ratio satisfies no bound
+            self.status = FAILED
+            self.message = (f"the check reported a pass with a non-finite worst ratio {self.worst!r}; "
+                            f"a non-finite value is never a pass" + (f" ({self.message})" if self.message else ""))
 
     @property
     def ok(self) -> bool:
-        """True unless the check failed (skips and expected failures are not failures)."""
-        return self.status != FAILED
+        """True unless the check failed or could not decide (skips and expected failures are not failures;
+        an undecided record verified nothing, so it is not ok either)."""
+        return self.status not in (FAILED, UNDECIDED)
 
     @property
     def key(self) -> str:
@@ -201,9 +221,14 @@ class Report:
     def by_check(self, name: str) -> list[CheckResult]:
         return [r for r in self.results if r.check == name]
 
+    @property
+    def undecided(self) -> list[CheckResult]:
+        return [r for r in self.results if r.status == UNDECIDED]
+
     def summary(self) -> str:
+        """``"N passed, N failed, N skipped, N xfail"`` (and ``", N undecided"`` when there are any)."""
         c = self.counts
-        return ", ".join(f"{c[s]} {s}" for s in STATUSES)
+        return ", ".join(f"{c[s]} {s}" for s in STATUSES if s != UNDECIDED or c[s])
 
     def __repr__(self) -> str:
         """``Report(N passed, N failed, N skipped, N xfail)``, then the counts and the failures."""
@@ -231,11 +256,10 @@ class Report:
         return loads(text)
 
     def save(self, path: str | Path) -> Path:
-        """Write :meth:`to_json` to ``path`` (parents created); returns the path."""
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(self.to_json(), encoding="utf-8")
-        return path
+        """Write :meth:`to_json` to ``path`` atomically (parents created); returns the path."""
+        from .atomic import write_text
+
+        return write_text(path, self.to_json())   # temporary file + rename: never a truncated document
 
     @classmethod
     def load(cls, path: str | Path) -> "Report":
@@ -490,7 +514,19 @@ def loads(text: str, source: str = "<string>") -> Report:
         data = json.loads(text)
     except json.JSONDecodeError as exc:
         raise SchemaError(f"{source} is not valid JSON ({exc})") from None
-    return report_from_dict(data)
+    except RecursionError:      # pathologically nested arrays/objects: unreadable, not a crash
+        raise SchemaError(f"{source} is nested too deeply to be a verimono document") from None
+    except (ValueError, MemoryError) as exc:
+        raise SchemaError(f"{source} cannot be parsed ({type(exc).__name__}: {exc})") from None
+    try:
+        return report_from_dict(data)
+    except RecursionError:
+        raise SchemaError(f"{source} is nested too deeply to be a verimono document") from None
+    except SchemaError:
+        raise
+    except (TypeError, AttributeError, KeyError, IndexError, ValueError, OverflowError) as exc:
+        # a field of an unexpected type that the type checks did not anticipate: unreadable
+        raise SchemaError(f"{source} is malformed ({type(exc).__name__}: {exc})") from None
 
 
 def load(path: str | Path) -> Report:

@@ -22,7 +22,8 @@ from typing import Any, Callable
 import numpy as np
 
 from ._params import as_param
-from ._kernels import _TINY, _mn, _mx, _sqrt, batch_column, dot_rows
+from ._kernels import (_INF, _TINY, _mn, _mx, _sqrt, bad_lam, bad_param, batch_column, dot_rows, finite_point,
+                       real_array)
 from .errors import InvalidProblem
 from .tolerances import tolerance
 
@@ -102,13 +103,23 @@ class Ball(ConvexSet):
     def _accepts_batches(self):
         return _own(self, Ball)
 
+    def _radius_at(self, t):
+        """``radius(t)``, checked ``≥ 0`` (a nonempty ball) at this ``t`` when it moves."""
+        r = self._r(t)
+        if not self._r.constant and not np.all(r >= 0):
+            raise bad_param(self.name, "radius(t)", r, t, "must be >= 0 (the ball is empty)")
+        return r
+
     def project(self, x, t=0.0):
+        return self._project(finite_point(x, f"the point projected onto {self.name}"), t)
+
+    def _project(self, x, t):
+        """:meth:`project` of a finite float array (the solve loop checks finiteness per block instead)."""
         # points inside are returned unchanged (not as c + (x - c), which may differ in the last bit)
-        x = np.asarray(x, dtype=float)
         c = self._c(t)
         d = x - c
         nrm = np.sqrt(dot_rows(d, d))[..., None]
-        r = batch_column(self._r(t), x, "radius")
+        r = batch_column(self._radius_at(t), x, "radius")
         outside = nrm > r
         if not outside.any():  # the common case along a trajectory: nothing to project
             return x.copy()
@@ -116,12 +127,23 @@ class Ball(ConvexSet):
         return np.where(outside, c + d * (r / _mx(nrm, _mx(r, _TINY))), x)
 
     def _kernel(self, x0):
-        if not _own(self, Ball) or x0.ndim != 1 or self._r(0.0).ndim or self._c(0.0).ndim != 1:
+        if not _own(self, Ball):
             return None
+        name = self.name
+        if x0.ndim != 1 or self._r(0.0).ndim or self._c(0.0).ndim != 1:
+            project = self._project
+
+            def batch_step(x, lam, t):
+                if not 0.0 < lam < _INF:
+                    raise bad_lam(lam, name)
+                return project(x, t)
+            return batch_step
         if self.static:
             c, r = self._c(0.0), float(self._r(0.0))
 
             def step(x, lam, t):
+                if not 0.0 < lam < _INF:
+                    raise bad_lam(lam, name)
                 d = x - c
                 nrm = _sqrt(d.dot(d))
                 if nrm > r:
@@ -132,10 +154,14 @@ class Ball(ConvexSet):
         rfn = self._r
 
         def step(x, lam, t):
+            if not 0.0 < lam < _INF:
+                raise bad_lam(lam, name)
             c = center(t)
             d = x - c
             nrm = _sqrt(d.dot(d))
             r = float(rfn(t))
+            if not r >= 0.0:         # also nan; a radius crossing 0 used to divide by zero
+                raise bad_param(name, "radius(t)", r, t, "must be >= 0 (the ball is empty)")
             if nrm > r:
                 return c + d * (r / nrm)
             return x
@@ -166,27 +192,44 @@ class Box(ConvexSet):
     def _accepts_batches(self):
         return _own(self, Box)
 
+    def _bounds_at(self, t):
+        """``(lower(t), upper(t))``, checked ``lower ≤ upper`` (a nonempty box) at this ``t`` when they move."""
+        lo, hi = self._lo(t), self._hi(t)
+        if not self.static and not np.all(lo <= hi):
+            raise bad_param(self.name, "lower(t) - upper(t)", np.asarray(lo) - np.asarray(hi), t,
+                            "must be <= 0 (the box is empty)")
+        return lo, hi
+
     def project(self, x, t=0.0):
-        return _mn(_mx(np.asarray(x, dtype=float), self._lo(t)), self._hi(t))
+        lo, hi = self._bounds_at(t)
+        return _mn(_mx(finite_point(x, f"the point projected onto {self.name}"), lo), hi)
 
     def _kernel(self, x0):
         if not _own(self, Box):
             return None
         lo, hi = _fast(self._lo), _fast(self._hi)
+        name = self.name
         if self._lo.constant and self._hi.constant:
             lo0, hi0 = lo(0.0), hi(0.0)
 
             def step(x, lam, t):
+                if not 0.0 < lam < _INF:
+                    raise bad_lam(lam, name)
                 return _mn(_mx(x, lo0), hi0)
         else:
+            bounds = self._bounds_at
+
             def step(x, lam, t):
-                return _mn(_mx(x, lo(t)), hi(t))
+                if not 0.0 < lam < _INF:
+                    raise bad_lam(lam, name)
+                lo_t, hi_t = bounds(t)
+                return _mn(_mx(x, lo_t), hi_t)
         return step
 
 
 def _bound(value, name):
     """Bounds may be infinite (unlike other parameters)."""
-    arr = np.array(value, dtype=float)
+    arr = np.array(real_array(value, name), dtype=float)
     if np.any(np.isnan(arr)):
         raise InvalidProblem(f"{name} must not be NaN")
     arr.setflags(write=False)
@@ -220,10 +263,16 @@ class HalfSpace(ConvexSet):
     def _accepts_batches(self):
         return _own(self, HalfSpace)
 
+    def _normal_at(self, t):
+        a = self._a(t)
+        if not self._a.constant and not (np.isfinite(a).all() and a.dot(a) > 0.0):
+            raise bad_param(self.name, "normal(t)", a, t, "must be finite and nonzero")
+        return a
+
     def project(self, x, t=0.0):
         # inner products row by row (dot_rows, not x @ a): the same summation for a point and a batch row
-        x = np.asarray(x, dtype=float)
-        a, b = self._a(t), self._b(t)
+        x = finite_point(x, f"the point projected onto {self.name}")
+        a, b = self._normal_at(t), self._b(t)
         excess = _mx(dot_rows(x, a)[..., None] - b, 0.0) / a.dot(a)
         return x - excess * a
 
@@ -231,11 +280,16 @@ class HalfSpace(ConvexSet):
         if not _own(self, HalfSpace) or x0.ndim != 1 or self._b(0.0).ndim:
             return None
         normal = _fast(self._a)
+        name = self.name
         if self._a.constant:
             aa0 = float(self._a(0.0).dot(self._a(0.0)))
-            norm2 = lambda a: aa0  # noqa: E731
+            norm2 = lambda a, t: aa0  # noqa: E731
         else:
-            norm2 = lambda a: float(a.dot(a))  # noqa: E731
+            def norm2(a, t):
+                aa = float(a.dot(a))
+                if not 0.0 < aa < _INF:
+                    raise bad_param(name, "normal(t)", a, t, "must be finite and nonzero")
+                return aa
         if self._b.constant:
             b0 = float(self._b(0.0))
             offset = lambda t: b0  # noqa: E731
@@ -244,8 +298,10 @@ class HalfSpace(ConvexSet):
             offset = lambda t: float(bfn(t))  # noqa: E731
 
         def step(x, lam, t):
+            if not 0.0 < lam < _INF:
+                raise bad_lam(lam, name)
             a = normal(t)
-            return x - (max(float(x.dot(a)) - offset(t), 0.0) / norm2(a)) * a
+            return x - (max(float(x.dot(a)) - offset(t), 0.0) / norm2(a, t)) * a
         return step
 
 
@@ -302,7 +358,7 @@ class Polyhedron(ConvexSet):
         """
         from .qp import solve_qp
 
-        x = np.asarray(x, dtype=float)
+        x = finite_point(x, f"the point projected onto {self.name}")
         G, h, A, b = self.data(t)
         inside = self._inside(x, G, h, A, b)
         if x.ndim == 1:
@@ -343,8 +399,12 @@ class Translated(ConvexSet):
         kern = getattr(self.S, "_kernel", None)
         inner = kern(x0) if kern is not None else None
         if inner is None:
-            project = self.S.project
-            inner = lambda x, lam, t: project(x, t)  # noqa: E731
+            project, name = self.S.project, self.name
+
+            def inner(x, lam, t):
+                if not 0.0 < lam < _INF:
+                    raise bad_lam(lam, name)
+                return project(x, t)
         shift = _fast(self._c)
 
         def step(x, lam, t):

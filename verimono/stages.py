@@ -36,6 +36,7 @@ from .grids import uniform_grid
 from .results import FAILED, PASSED, SKIPPED, XFAIL, CheckResult, Report, to_jsonable
 from .executors import SerialRunner, Unit
 from .stepping import solve
+from .timeouts import run_unit
 
 #: how many points of a trajectory the report keeps for its plot (enough for a smooth curve)
 TRAJECTORY_SAMPLES = 400
@@ -233,7 +234,8 @@ def _convergence_unit(stepper: Callable, problem: Any) -> Report:
     from .checks.orders import check_convergence_order
 
     report = Report()
-    rec = report.add(check_convergence_order(stepper, problem))
+    rec = report.add(run_unit(lambda: check_convergence_order(stepper, problem), check="convergence_order",
+                              subject=f"{_name(stepper)} on {problem.name}"))
     if rec.study is not None:
         report.studies.append(rec.study)
     try:
@@ -363,8 +365,10 @@ def trajectory_laws_stage(profile: Profile, context: RunContext) -> Report:
 def _checks_unit(checks: list[tuple[str, Callable]], subject: Any) -> Report:
     """Every ``check(subject)`` of one battery, in order (``meta["records_per_check"]``: how many each gave)."""
     report, sizes = Report(), []
-    for _, check in checks:
-        out = check(subject)
+    for name, check in checks:
+        law, _, problem_name = name.partition("[")
+        # each check under the unit time budget: one that does not return is a failed record, the rest go on
+        out = run_unit(lambda: check(subject), check=law, subject=f"{_name(subject)} on {problem_name[:-1]}")
         before = len(report)
         report.extend(out) if isinstance(out, Report) else report.add(out)
         sizes.append(len(report) - before)
@@ -389,7 +393,12 @@ def assumptions_stage(profile: Profile, context: RunContext) -> Report:
 def _assumptions_unit(check_assumptions: Callable, p: Any, seed: int | None) -> Report:
     """One reference's assumption records, its ``assumptions_thm_main`` record included."""
     report = Report()
-    report.extend(check_assumptions(p, seed=0 if seed is None else seed))
+    rep = run_unit(lambda: check_assumptions(p, seed=0 if seed is None else seed), check="assumptions",
+                   subject=p.name)
+    if isinstance(rep, CheckResult):    # the unit ran out of its time budget: a failed record, go on
+        report.add(rep)
+    else:
+        report.extend(rep)
     return report
 
 
@@ -408,7 +417,8 @@ def section7_stage(profile: Profile, context: RunContext) -> Report:
     problems = [p for p in (example.ramp_problem(), example.sine_problem()) if p.name not in in_catalog]
     for i, p in enumerate(problems):
         context.progress(i, len(problems) + 1, p.name)
-        rec = report.add(check_convergence_order(stepper, p))
+        rec = report.add(run_unit(lambda: check_convergence_order(stepper, p), check="convergence_order",
+                                  subject=f"{_name(stepper)} on {p.name}"))
         if rec.study is not None:
             report.studies.append(rec.study)
         report.trajectories.append(sample_trajectory(stepper, p))

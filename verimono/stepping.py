@@ -22,6 +22,7 @@ from typing import Any, Callable, Iterator
 
 import numpy as np
 
+from ._kernels import real_array
 from .claims import Claim
 from .errors import InvalidProblem, SolverFailure
 from .grids import validate_grid
@@ -40,8 +41,8 @@ class Trajectory:
 
     def __init__(self, t: np.ndarray, x: np.ndarray, problem: Problem | None = None,
                  extras: dict[str, np.ndarray] | None = None) -> None:
-        self.t = np.asarray(t, dtype=float)
-        self.x = np.asarray(x, dtype=float)
+        self.t = real_array(t, "trajectory times")
+        self.x = real_array(x, "trajectory states")
         if self.x.shape[0] != self.t.shape[0]:
             raise InvalidProblem(f"trajectory has {self.x.shape[0]} states for {self.t.shape[0]} times")
         self.problem = problem
@@ -184,10 +185,12 @@ def _march(problem: Problem, t: np.ndarray, block: int) -> Iterator[tuple[int, n
     hs, ts, dU = cells(0)
     buf = np.empty((block,) + x0.shape)
     buf[0] = x0
-    first = np.asarray(step(_drift(x0, hs[0], f, dU, 0), hs[0], ts[0]), dtype=float)
-    if first.shape != x0.shape:
-        raise SolverFailure(f"the resolvent of {op.name} returned shape {first.shape} "
-                            f"for a point of shape {x0.shape}")
+    shape = x0.shape
+    first = step(_drift(x0, hs[0], f, dU, 0, shape, 1, t, problem), hs[0], ts[0])
+    if type(first) is not np.ndarray or first.dtype != np.float64:
+        first = real_array(first, f"the resolvent of {op.name} at step 1")
+    if first.shape != shape:
+        raise _bad_shape(first, 1, t, problem)
     buf[1] = first
     xk = first
     row, k, start = 2, 1, 0     # next free row of buf; next step computes x_{k+1}; grid index of buf[0]
@@ -201,14 +204,27 @@ def _march(problem: Problem, t: np.ndarray, block: int) -> Iterator[tuple[int, n
                 base = k
                 hs, ts, dU = cells(k)
             lo = k - base
-            if plain:
-                for i, hk, tk in zip(range(row, row + m), hs[lo:lo + m], ts[lo:lo + m]):
-                    xk = step(xk, hk, tk)
-                    buf[i] = xk
-            else:
-                for i, j in zip(range(row, row + m), range(k, k + m)):
-                    xk = step(_drift(xk, hs[j - base], f, dU, j - base), hs[j - base], ts[j - base])
-                    buf[i] = xk
+            # every step's shape is checked (one tuple comparison: a value of another shape would be
+            # broadcast into the row silently — a scalar into every component); finiteness is checked
+            # per block, vectorized, by _check_finite
+            try:
+                if plain:
+                    for i, hk, tk in zip(range(row, row + m), hs[lo:lo + m], ts[lo:lo + m]):
+                        xk = step(xk, hk, tk)
+                        if xk.shape != shape:
+                            raise _bad_shape(xk, start + i, t, problem)
+                        buf[i] = xk
+                else:
+                    for i, j in zip(range(row, row + m), range(k, k + m)):
+                        xk = step(_drift(xk, hs[j - base], f, dU, j - base, shape, j + 1, t, problem),
+                                  hs[j - base], ts[j - base])
+                        if xk.shape != shape:
+                            raise _bad_shape(xk, start + i, t, problem)
+                        buf[i] = xk
+            except AttributeError:
+                if not hasattr(xk, "shape"):   # a resolvent returning a list or a float
+                    raise _bad_shape(xk, start + i, t, problem) from None
+                raise
             k += m
             row += m
         out = buf[:row]
@@ -231,10 +247,27 @@ def _check_finite(out, start, before, t, problem):
                         f"of {problem.operator.name} returned {out[bad]} from x = {prev}")
 
 
-def _drift(xk, hk, f, dU, k):
+def _bad_shape(value, k, t, problem) -> SolverFailure:
+    """The error for a resolvent value of the wrong shape (or no array at all) at step ``k``."""
+    shape = getattr(value, "shape", None)
+    what = f"shape {shape}" if shape is not None else f"a {type(value).__name__}"
+    return SolverFailure(f"the resolvent of {problem.operator.name} returned {what} for a point of shape "
+                         f"{problem.x0.shape} at step {k} (t = {t[k]:g}) of {problem.name}")
+
+
+def _drift(xk, hk, f, dU, k, shape=None, step=0, t=None, problem=None):
+    """``x_k + h f(x_k) + ∫u`` for the cell ``k`` of the current block (``step``: the index of the state it
+    leads to, for messages); ``f(x_k)`` must have the state's shape — a scalar would be broadcast."""
     z = xk
     if f is not None:
-        z = z + hk * np.asarray(f(xk), dtype=float)
+        fx = f(xk)
+        if type(fx) is not np.ndarray or fx.dtype != np.float64:
+            fx = real_array(fx, "f(x)")
+        if shape is not None and fx.shape != shape:
+            where = f" at step {step} (t = {t[step - 1]:g}, evaluated at x_{step - 1})" if t is not None else ""
+            raise SolverFailure(f"f returned shape {fx.shape} for a state of shape {shape}{where} of "
+                                f"{problem.name if problem is not None else 'the problem'}")
+        z = z + hk * fx
     if dU is not None:
         z = z + dU[k]
     return z

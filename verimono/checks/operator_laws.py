@@ -38,7 +38,9 @@ from hypothesis import strategies as st
 from ..errors import VerimonoError
 from ..operators import Operator
 from ..profiles import UnknownProfile, active_profile, get_profile
-from ..results import FAILED, PASSED, SKIPPED, CheckResult, Report
+from ..errors import InvalidCheckArgument, UnitTimeout
+from ..results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult, Report
+from ..timeouts import current_budget, time_limit
 from .core import Law, Member, Outcome, law as _declare, laws_of, run as _run_law
 from ..strategies import points, step_sizes, times
 from .._reproducible import no_local_constants
@@ -60,9 +62,33 @@ _GRADES = tuple(10.0 ** k for k in range(0, 13, 2))
 
 # -- samples ----------------------------------------------------------------------------------------
 
+#: above this dimension the points of a sample are drawn by NumPy from a seed (and a kind) that hypothesis
+#: draws and shrinks: hypothesis draws each coordinate through its byte buffer, which cannot hold vectors of
+#: ~500 floats (``Unsatisfiable``) — image- and PDE-sized operators (10^4–10^6 unknowns) need NumPy
+NUMPY_DIM = 64
+#: kinds of NumPy-drawn points: dense uniform in ``[-scale, scale]^n``, sparse (90% exact zeros: the kinks
+#: of norms and boxes), and the zero vector (the kink of every norm)
+NUMPY_KINDS = ("uniform", "sparse", "zero")
+
+
+def numpy_point(n: int, recipe: dict[str, Any]) -> np.ndarray:
+    """The point of ``R^n`` a recipe ``{"seed", "kind", "scale"}`` stands for (deterministic)."""
+    kind, scale = recipe["kind"], float(recipe["scale"])
+    if kind == "zero":
+        return np.zeros(n)
+    rng = np.random.default_rng(int(recipe["seed"]))
+    x = rng.uniform(-scale, scale, n)
+    if kind == "sparse":
+        x[rng.random(n) < 0.9] = 0.0
+    return x
+
+
 @dataclasses.dataclass(frozen=True)
 class Sample:
-    """Inputs of one evaluation: points ``x1, x2``, step sizes ``λ = lam, μ = mu, ν = nu`` and time ``t``."""
+    """Inputs of one evaluation: points ``x1, x2``, step sizes ``λ = lam, μ = mu, ν = nu`` and time ``t``.
+
+    ``recipe`` (large dimensions only) says how NumPy drew the points, so that a sample of a million
+    coordinates is recorded and replayed by a few numbers instead of its coordinates."""
 
     x1: np.ndarray
     x2: np.ndarray
@@ -70,33 +96,69 @@ class Sample:
     mu: float
     nu: float
     t: float
+    recipe: dict[str, Any] | None = dataclasses.field(default=None, compare=False)
 
     def to_dict(self) -> dict[str, Any]:
-        return {"x1": self.x1.tolist(), "x2": self.x2.tolist(), "lam": self.lam, "mu": self.mu,
-                "nu": self.nu, "t": self.t}
+        scalars = {"lam": self.lam, "mu": self.mu, "nu": self.nu, "t": self.t}
+        if self.recipe is not None:
+            return {"recipe": dict(self.recipe), **scalars}
+        return {"x1": self.x1.tolist(), "x2": self.x2.tolist(), **scalars}
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> "Sample":
+        if "recipe" in d:
+            return _from_recipe(d["recipe"], float(d["lam"]), float(d["mu"]), float(d["nu"]), float(d["t"]))
         return cls(np.asarray(d["x1"], dtype=float), np.asarray(d["x2"], dtype=float), float(d["lam"]),
                    float(d["mu"]), float(d["nu"]), float(d["t"]))
 
     def __repr__(self) -> str:
+        if self.recipe is not None:
+            return (f"Sample.from_dict({{'recipe': {self.recipe!r}, 'lam': {self.lam!r}, 'mu': {self.mu!r}, "
+                    f"'nu': {self.nu!r}, 't': {self.t!r}}})")
         f = lambda a: np.array2string(a, precision=17, separator=", ")  # noqa: E731 - exact replay
         return (f"Sample(x1={f(self.x1)}, x2={f(self.x2)}, lam={self.lam!r}, mu={self.mu!r}, "
                 f"nu={self.nu!r}, t={self.t!r})")
+
+
+def _from_recipe(recipe: dict[str, Any], lam: float, mu: float, nu: float, t: float) -> Sample:
+    n = int(recipe["n"])
+    x1 = numpy_point(n, recipe["x1"])
+    if recipe.get("near"):
+        x2 = x1 + numpy_point(n, recipe["x2"])
+    else:
+        x2 = numpy_point(n, recipe["x2"])
+    return Sample(x1, x2, lam, mu, nu, t, recipe=recipe)
+
+
+def _numpy_recipes(scale: float) -> st.SearchStrategy[dict[str, Any]]:
+    return st.fixed_dictionaries({"seed": st.integers(0, 2 ** 32 - 1), "kind": st.sampled_from(NUMPY_KINDS),
+                                  "scale": st.sampled_from([scale, scale / 10.0, scale * 1e-4])})
 
 
 def law_samples(n: int, horizon: float = 1.0) -> st.SearchStrategy[Sample]:
     """Samples for the laws on ``R^n``: ``x1`` from :func:`verimono.strategies.points`, ``x2`` either
     independent or within ``10^-2`` of ``x1`` (local violations), ``λ, μ, ν ∈ [10^-3, 10]`` and
     ``t ∈ [0, horizon]``; everything shrinks toward 0, 1 and ``t = 0``.  The strategy is built once per
-    ``(n, horizon)`` (building strategies inside every draw cost more than evaluating the law)."""
+    ``(n, horizon)`` (building strategies inside every draw cost more than evaluating the law).
+
+    For ``n > NUMPY_DIM`` the points come from :func:`numpy_point` (seed, kind and scale drawn and shrunk by
+    hypothesis; shrinking goes toward the zero vector and seed 0), the step sizes and time as above."""
     return _law_samples(int(n), float(horizon))
 
 
 @functools.lru_cache(maxsize=128)
 def _law_samples(n: int, horizon: float) -> st.SearchStrategy[Sample]:
-    pts, near, steps, when, coin = points(n), points(n, 1e-2), step_sizes(), times(horizon), st.booleans()
+    steps, when, coin = step_sizes(), times(horizon), st.booleans()
+    if n > NUMPY_DIM:
+        @st.composite
+        def _recipe(draw):
+            near = draw(coin, label="x2 near x1")
+            recipe = {"n": n, "near": near, "x1": draw(_numpy_recipes(10.0), label="x1"),
+                      "x2": draw(_numpy_recipes(1e-2 if near else 10.0), label="x2")}
+            lam, mu, nu = (draw(steps, label=k) for k in ("lam", "mu", "nu"))
+            return _from_recipe(recipe, lam, mu, nu, draw(when, label="t"))
+        return _recipe()
+    pts, near = points(n), points(n, 1e-2)
 
     @st.composite
     def _draw(draw):
@@ -123,6 +185,14 @@ def _point(value: Any, like: np.ndarray, member: str) -> np.ndarray:
     if not np.all(np.isfinite(y)):
         raise _BadOutput(f"{member} returned non-finite values {y}")
     return y
+
+
+def _listed(a: np.ndarray) -> Any:
+    """A point for a counterexample: its coordinates, or for ``n > NUMPY_DIM`` a summary (the sample's
+    recipe replays it; a million coordinates per record would swamp the report)."""
+    if a.size <= NUMPY_DIM:
+        return a.tolist()
+    return f"<{a.size} values, |.|_inf = {float(np.max(np.abs(a))):.6g}>"
 
 
 def _J(op: Operator, x: np.ndarray, lam: float, t: float) -> np.ndarray:
@@ -168,14 +238,14 @@ def _resolvent_single_valued(op, s):
     tau = _tol(s.x1, a, b)
     return Outcome.compare(_nrm(a - b) + (math.inf if moved > 0 else 0.0), 0.0, tau,
                  "|J_λx - J_λx| over two calls" + (f" (the call modified its input by {moved:.3g})" if moved else ""),
-                 {"J_first": a.tolist(), "J_second": b.tolist(), "input_modified_by": moved})
+                 {"J_first": _listed(a), "J_second": _listed(b), "input_modified_by": moved})
 
 
 def _resolvent_nonexpansive(op, s):
     a, b = _J(op, s.x1, s.lam, s.t), _J(op, s.x2, s.lam, s.t)
     tau = _tol(s.x1, s.x2, a, b)
     return Outcome.compare(_nrm(a - b), _nrm(s.x1 - s.x2), 4 * tau, "|J_λx1 - J_λx2| ≤ |x1 - x2|",
-                 {"J1": a.tolist(), "J2": b.tolist()})
+                 {"J1": _listed(a), "J2": _listed(b)})
 
 
 def _resolvent_firmly_nonexpansive(op, s):
@@ -183,14 +253,14 @@ def _resolvent_firmly_nonexpansive(op, s):
     dJ, dx = a - b, s.x1 - s.x2
     tau = _tol(s.x1, s.x2, a, b)
     return Outcome.compare(float(dJ @ dJ), float(dJ @ dx), 4 * tau * (_nrm(dJ) + _nrm(dx) + tau),
-                 "|J_λx1 - J_λx2|² ≤ ⟨J_λx1 - J_λx2, x1 - x2⟩", {"J1": a.tolist(), "J2": b.tolist()})
+                 "|J_λx1 - J_λx2|² ≤ ⟨J_λx1 - J_λx2, x1 - x2⟩", {"J1": _listed(a), "J2": _listed(b)})
 
 
 def _resolvent_in_domain(op, s):
     a = _J(op, s.x1, s.lam, s.t)
     p = _point(op.project_domain(a.copy(), s.t), a, "project_domain")
     return Outcome.compare(_nrm(p - a), 0.0, 2 * _tol(s.x1, a), "dist(J_λx, cl dom F(t,·)) = 0",
-                 {"J": a.tolist(), "proj_dom_J": p.tolist()})
+                 {"J": _listed(a), "proj_dom_J": _listed(p)})
 
 
 def _resolvent_identity(op, s):
@@ -200,7 +270,7 @@ def _resolvent_identity(op, s):
     b = _J(op, z, s.mu, s.t)
     tau = _tol(s.x1, a, z)
     return Outcome.compare(_nrm(a - b), 0.0, tau * (4.0 + abs(1.0 - r)),
-                 "J_λx = J_μ((μ/λ)x + (1 - μ/λ)J_λx)", {"J_lam": a.tolist(), "J_mu_of_z": b.tolist(), "z": z.tolist()})
+                 "J_λx = J_μ((μ/λ)x + (1 - μ/λ)J_λx)", {"J_lam": _listed(a), "J_mu_of_z": _listed(b), "z": _listed(z)})
 
 
 def _resolvent_limit(op, s):
@@ -210,7 +280,7 @@ def _resolvent_limit(op, s):
         lam = s.lam * 4.0 ** (-k)
         d = _nrm(_J(op, x, lam, s.t) - x)
         ev = Outcome.compare(d, lam * _nrm(y0), tau * (4.0 + lam / s.nu), "|J_λx - x| ≤ λ|y| for x = J_νx1, y = Y_νx1 ∈ F(x)",
-                   {"x": x.tolist(), "y": y0.tolist(), "lam_at_worst": lam})
+                   {"x": _listed(x), "y": _listed(y0), "lam_at_worst": lam})
         if worst is None or not ev.ratio <= worst.ratio:
             worst = ev
     return worst
@@ -224,14 +294,14 @@ def _monotone(op, s):
     ey = ex * (1.0 / s.lam + 1.0 / s.mu)
     return Outcome.compare(-float(dx @ dy), 0.0, 2 * (ex * _nrm(dy) + ey * _nrm(dx) + ex * ey),
                  "⟨x_a - x_b, y_a - y_b⟩ ≥ 0 for (x_a, y_a) = (J_λx1, Y_λx1), (x_b, y_b) = (J_μx2, Y_μx2)",
-                 {"xa": a.tolist(), "ya": ya.tolist(), "xb": b.tolist(), "yb": yb.tolist()})
+                 {"xa": _listed(a), "ya": _listed(ya), "xb": _listed(b), "yb": _listed(yb)})
 
 
 def _yosida_lipschitz(op, s):
     a, b = _J(op, s.x1, s.lam, s.t), _J(op, s.x2, s.lam, s.t)
     dY = ((s.x1 - a) - (s.x2 - b)) / s.lam
     return Outcome.compare(s.lam * _nrm(dY), _nrm(s.x1 - s.x2), 4 * _tol(s.x1, s.x2, a, b),
-                 "λ|Y_λx1 - Y_λx2| ≤ |x1 - x2|", {"J1": a.tolist(), "J2": b.tolist()})
+                 "λ|Y_λx1 - Y_λx2| ≤ |x1 - x2|", {"J1": _listed(a), "J2": _listed(b)})
 
 
 def _yosida_monotone(op, s):
@@ -239,7 +309,7 @@ def _yosida_monotone(op, s):
     dx = s.x1 - s.x2
     dY = (dx - (a - b)) / s.lam
     return Outcome.compare(-float(dY @ dx), 0.0, 4 * _tol(s.x1, s.x2, a, b) * _nrm(dx) / s.lam,
-                 "⟨Y_λx1 - Y_λx2, x1 - x2⟩ ≥ 0", {"J1": a.tolist(), "J2": b.tolist()})
+                 "⟨Y_λx1 - Y_λx2, x1 - x2⟩ ≥ 0", {"J1": _listed(a), "J2": _listed(b)})
 
 
 def _yosida_in_graph(op, s):
@@ -248,7 +318,7 @@ def _yosida_in_graph(op, s):
     tol = _tol(s.x1, a, s.lam * y) * (2.0 + 2.0 / s.lam)
     g = _graded_membership(op, a, y, s.t, tol)
     return Outcome.compare(g, 0.0, 1.0, "Y_λx ∈ F(t, J_λx) (ratio: tolerance multiple needed)",
-                 {"J": a.tolist(), "Y": y.tolist(), "tol": tol})
+                 {"J": _listed(a), "Y": _listed(y), "tol": tol})
 
 
 def _yosida_nonincreasing(op, s):
@@ -259,7 +329,7 @@ def _yosida_nonincreasing(op, s):
     ylo, yhi = (s.x1 - a) / lo, (s.x1 - b) / hi
     tau = _tol(s.x1, a, b)
     return Outcome.compare(_nrm(yhi), _nrm(ylo), 4 * tau * (1.0 / lo + 1.0 / hi),
-                 "|Y_μx| ≤ |Y_λx| for λ ≤ μ", {"lam": lo, "mu": hi, "Y_lam": ylo.tolist(), "Y_mu": yhi.tolist()})
+                 "|Y_μx| ≤ |Y_λx| for λ ≤ μ", {"lam": lo, "mu": hi, "Y_lam": _listed(ylo), "Y_mu": _listed(yhi)})
 
 
 def _yosida_bounded_by_min_norm(op, s):
@@ -268,7 +338,7 @@ def _yosida_bounded_by_min_norm(op, s):
     a = _J(op, x, s.lam, s.t)
     y = (x - a) / s.lam
     return Outcome.compare(_nrm(y), _nrm(f0), 4 * _tol(x, a) / s.lam + 2 * tau / s.lam + _tol(f0),
-                 "|Y_λx| ≤ |F^0(t, x)| for x = J_νx1 ∈ dom F", {"x": x.tolist(), "Y": y.tolist(), "F0": f0.tolist()})
+                 "|Y_λx| ≤ |F^0(t, x)| for x = J_νx1 ∈ dom F", {"x": _listed(x), "Y": _listed(y), "F0": _listed(f0)})
 
 
 def _yosida_limit(op, s):
@@ -284,7 +354,7 @@ def _yosida_limit(op, s):
         gap, slack = abs(f0 - y), _tol(f0, y) + 2 * tx / lam
         gaps.append(gap)
         lams.append(lam)
-        info = {"x": x.tolist(), "|F0|": f0, "lams": lams, "gaps": gaps}
+        info = {"x": _listed(x), "|F0|": f0, "lams": lams, "gaps": gaps}
         if gap <= slack:
             return Outcome.compare(gap, 0.0, slack, "|Y_λx| → |F^0(t, x)| as λ → 0 (gap within tolerance)", info)
         if y <= 2 * tx / lam and _only_within_rounding(op, x, np.zeros_like(x), s.t, 2 * tx):
@@ -368,13 +438,13 @@ def _min_norm_in_graph(op, s):
     tol = 2 * _tol(x, f0)
     g = _graded_membership(op, x, f0, s.t, tol)
     return Outcome.compare(g, 0.0, 1.0, "F^0(t, x) ∈ F(t, x) (ratio: tolerance multiple needed)",
-                 {"x": x.tolist(), "F0": f0.tolist(), "tol": tol})
+                 {"x": _listed(x), "F0": _listed(f0), "tol": tol})
 
 
 def _min_norm_least(op, s):
     x, y0, tau = _domain_pair(op, s)
     f0 = _F0(op, x, s.t)
-    info = {"x": x.tolist(), "y": y0.tolist(), "F0": f0.tolist()}
+    info = {"x": _listed(x), "y": _listed(y0), "F0": _listed(f0)}
     try:   # y0 must be certified in F(t, x) where that can be tested (else yosida_in_graph fails)
         if not op.contains(x.copy(), y0.copy(), s.t, _tol(x, y0) * (2.0 + 2.0 / s.nu)):
             return Outcome.compare(0.0, 0.0, 1.0, "uncertified y0 ∉ F(t, x) (contains rejects it): sample inconclusive", info,
@@ -504,6 +574,8 @@ def run_law(law: Law | str, op: Operator, *, seed: int | None = None, examples: 
     law can neither hold nor fail there) are counted in ``details["inconclusive"]``; a record whose every
     evaluated sample was inconclusive is skipped with the reason, never passed."""
     law = LAWS[law] if isinstance(law, str) else law
+    if examples is not None:
+        examples = _positive_examples(examples)
     if sample is None:  # the search is seeded (a fresh recorded seed when none is given)
         seed = fresh_seed() if seed is None else int(seed)
     rec = _run_law(law, operator=op, call=lambda: _search(law, op, seed, examples, horizon, sample))
@@ -550,8 +622,9 @@ def _search(law: Law, op: Operator, seed: int | None, examples: int | None, hori
     profile = None
     if examples is None:
         examples, profile = default_examples()
-    examples = int(examples)
+    examples = _positive_examples(examples)
     state = _State()
+    harness = ""
 
     def body(s: Sample, search: bool = True) -> None:
         try:
@@ -577,12 +650,18 @@ def _search(law: Law, op: Operator, seed: int | None, examples: int | None, hori
         body(s, True)
 
     flaky, swept = "", 0
+    timed_out = ""
+    limit = current_budget()
+    unit = f"{law.name} on {_subject(op)}"
     if sample is not None:
         s = Sample.from_dict(sample) if isinstance(sample, dict) else sample
         try:
-            body(s, search=False)
+            with time_limit(limit, unit):
+                body(s, search=False)
         except _Violation:
             pass
+        except UnitTimeout as exc:
+            timed_out = str(exc)
     else:
         test = settings(database=None, max_examples=max(1, examples), deadline=None, derandomize=False,
                         verbosity=Verbosity.quiet, print_blob=False, suppress_health_check=list(HealthCheck),
@@ -590,15 +669,20 @@ def _search(law: Law, op: Operator, seed: int | None, examples: int | None, hori
             given(law_samples(op.dim, horizon))(searched))
         test = hypothesis.seed(seed)(test)
         try:
-            with no_local_constants():   # the same seed draws the same samples whatever was imported
+            with no_local_constants(), time_limit(limit, unit):   # the same seed draws the same samples
                 test()
         except _Violation:
             pass
+        except UnitTimeout as exc:   # a resolvent that does not return: a failure of the operator, named
+            timed_out = str(exc)
         except hypothesis.errors.Flaky as exc:  # a failure that did not reproduce on replay
             flaky = f" (not reproducible on replay: {type(exc).__name__}; the operator is not deterministic)"
-        if state.fail_eval is None and state.unsupported is None:
+        except (hypothesis.errors.HypothesisException, MemoryError, RecursionError) as exc:
+            # the search engine itself gave up (inputs it cannot draw, memory): a limitation of the harness,
+            # not of the operator — undecided, never failed and never passed
+            harness = f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"
+        if state.fail_eval is None and state.unsupported is None and not (timed_out or harness):
             swept = _sweep(law, op, seed, horizon, state, body)
-    duration = time.perf_counter() - start
     duration = time.perf_counter() - start
     subject = _subject(op)
     base = dict(check=law.name, subject=subject, seed=seed, duration=duration)
@@ -607,6 +691,15 @@ def _search(law: Law, op: Operator, seed: int | None, examples: int | None, hori
     if profile is not None:
         details["profile"] = profile
 
+    if timed_out and state.fail_eval is None:
+        details["timeout"], details["elapsed"] = limit, duration
+        return CheckResult(status=FAILED, message=f"timed out: {timed_out} ({state.runs} samples evaluated "
+                                                  "before)", details=details, **base)
+    if state.fail_eval is None and harness:
+        return CheckResult(status=UNDECIDED, message=f"the harness could not search this operator "
+                                                     f"({harness}; {state.runs} samples evaluated before); "
+                                                     "a limitation of verimono, not a failure of the operator",
+                           details=details, **base)
     if state.fail_eval is None and state.unsupported is not None:
         return CheckResult(status=SKIPPED, message=f"needs a member the operator lacks: {state.unsupported} "
                                                    f"({state.runs} samples evaluated before)",
@@ -621,6 +714,8 @@ def _search(law: Law, op: Operator, seed: int | None, examples: int | None, hori
                f"at {s!r}{flaky}")
         return CheckResult(status=FAILED, worst=max(state.worst, ev.ratio), bound=BOUND, counterexample=cex,
                            message=msg, details=details, **base)
+    if state.runs == 0:        # nothing was evaluated: never a pass
+        return CheckResult(status=UNDECIDED, message="no sample was evaluated", details=details, **base)
     if state.runs and state.inconclusive == state.runs:
         return CheckResult(status=SKIPPED, message=f"all {state.runs} samples inconclusive (e.g. "
                                                    f"{state.inconclusive_what})", details=details, **base)
@@ -632,6 +727,18 @@ def _search(law: Law, op: Operator, seed: int | None, examples: int | None, hori
     counted = f"{state.runs} samples" + (f" ({state.inconclusive} inconclusive)" if state.inconclusive else "")
     return CheckResult(status=PASSED, worst=worst, bound=BOUND,
                        message=counted + (f"; {flaky}" if flaky else ""), details=details, **base)
+
+
+def _positive_examples(examples: Any) -> int:
+    """``examples`` as a positive integer; :class:`InvalidCheckArgument` otherwise (0 examples verify
+    nothing, and used to be searched once and reported as a pass)."""
+    try:
+        n = int(examples)
+    except (TypeError, ValueError):
+        raise InvalidCheckArgument(f"examples must be a positive integer, got {examples!r}") from None
+    if isinstance(examples, bool) or n != examples or n < 1:
+        raise InvalidCheckArgument(f"examples must be a positive integer, got {examples!r}")
+    return n
 
 
 def check_resolvent_single_valued(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult:
@@ -800,7 +907,9 @@ def check_operator(op: Operator, *, seed: int | None = None, examples: int | Non
     if examples is None:
         examples, profile = default_examples()
     else:
-        profile = None
+        examples, profile = _positive_examples(examples), None
+    if not (isinstance(horizon, (int, float)) and math.isfinite(horizon) and horizon >= 0):
+        raise InvalidCheckArgument(f"horizon must be a finite time >= 0, got {horizon!r}")
     report = Report(meta={"subject": _subject(op), "seed": seed, "examples": examples, "horizon": horizon,
                           **({"profile": profile} if profile else {})})
     for _, check in operator_checks(op, seed=seed, examples=examples, horizon=horizon):

@@ -959,17 +959,36 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
     selects laws, ``orders=False`` keeps the laws only.  The records are those of :func:`stepper_checks`, the
     same generator :func:`verimono.testing.parametrize_with_checks` turns into pytest cases.
     """
+    from ..errors import InvalidCheckArgument
+    from ..timeouts import run_unit
+
+    if problems is not None:
+        problems = list(problems)
+        if not problems:
+            raise InvalidCheckArgument("check_stepper was given an empty list of problems: it would verify "
+                                       "nothing (pass problems=None for the whole catalog)")
     stepper = with_claim(stepper, scheme, order)
     seed = 0 if seed is None else int(seed)
     selected = () if laws is False else (LAWS if laws is True else tuple(laws))
     report = Report()
     for _name_, check in stepper_checks(stepper, problems, seed=seed, generated=generated, laws=selected,
                                         orders=orders, executor=executor):
-        rec = check(stepper)
+        law, _, problem_name = _name_.partition("[")
+        # a stepper that never returns: a failed record naming the unit, and the battery goes on
+        rec = run_unit(lambda: check(stepper), check=law,
+                       subject=f"{_stepper_name(stepper)} on {problem_name[:-1]}")
         report.add(rec)
         if rec.study is not None:
             report.studies.append(rec.study)
+    if not len(report):
+        raise InvalidCheckArgument("check_stepper selected no check (no law, no order): it would verify nothing")
     return report
+
+
+def _stepper_name(stepper: Any) -> str:
+    from ..convergence import _name
+
+    return _name(stepper)
 
 
 __all__ = ["LAWS", "CHECKS", "check_contraction", "check_unique_limit", "check_in_domain", "check_domain_vanishing",

@@ -33,7 +33,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import linprog
 
-from ..errors import VerimonoError
+from ..errors import InvalidCheckArgument, VerimonoError
 from ..results import FAILED, PASSED, SKIPPED, CheckResult, Report
 from ..tolerances import EPS, RTOL, STALL_RATIO, STALL_WINDOW, tolerance
 from .lcp import is_psd, lcp_alpha, lcp_residual, sol_polyhedron, solve_lcp
@@ -296,7 +296,18 @@ def _least_norm_record(system, rng, samples: int) -> CheckResult:
 
 
 def check_hypotheses(system, T: float, *, samples: int = 64, seed: int = 0) -> Report:
-    """Evidence for each hypothesis of the Section 7 theorems on ``[0, T]`` (see the module docstring)."""
+    """Evidence for each hypothesis of the Section 7 theorems on ``[0, T]`` (see the module docstring).
+
+    ``T`` must be a finite positive horizon and ``samples`` a positive integer
+    (:class:`verimono.InvalidCheckArgument` otherwise: an empty interval is evidence of nothing)."""
+    import math
+
+    if isinstance(T, bool) or not isinstance(T, (int, float, np.integer, np.floating)) \
+            or not math.isfinite(float(T)) or T <= 0:
+        raise InvalidCheckArgument(f"check_hypotheses needs a finite horizon T > 0, got {T!r}")
+    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
+        raise InvalidCheckArgument(f"samples must be a positive integer, got {samples!r}")
+    T = float(T)
     subj = system.name
     out = Report(meta={"evidence": EVIDENCE})
     rng = np.random.default_rng(seed)

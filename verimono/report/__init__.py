@@ -9,6 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from ..atomic import ensure_writable_dir, replace_all
 from .html import render
 
 
@@ -19,12 +20,30 @@ def write(report: Any, out_dir: str | Path, *, changes: Any = None) -> dict[str,
     :func:`verimono.gate.compare`: the report knows nothing of the gate) fill the report's "changes against
     the baseline" section.
     """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    json_path = report.save(out / "results.json")
-    html_path = out / "report.html"
-    html_path.write_text(render(report, changes=changes), encoding="utf-8")
+    out = ensure_writable_dir(out_dir)
+    # one run id in both files; both rendered in memory, written to temporaries, then renamed together
+    # (verimono.atomic): a full disk or an interrupt leaves the previous pair or the new pair, never a mix
+    report.meta["run_id"] = new_run_id()
+    json_path, html_path = out / "results.json", out / "report.html"
+    text = report.to_json()
+    html = render(report, changes=changes)
+    replace_all({json_path: text, html_path: html})
     return {"json": json_path, "html": html_path}
 
 
-__all__ = ["write"]
+def new_run_id() -> str:
+    """A fresh identifier shared by the ``results.json`` and ``report.html`` of one write."""
+    import uuid
+
+    return uuid.uuid4().hex[:16]
+
+
+def html_run_id(html: str) -> str | None:
+    """The run id a ``report.html`` was rendered for (``None`` if it carries none)."""
+    import re
+
+    m = re.search(r'<meta name="verimono-run-id" content="([0-9a-f]+)"', html)
+    return m.group(1) if m else None
+
+
+__all__ = ["write", "new_run_id", "html_run_id"]

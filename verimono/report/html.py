@@ -22,7 +22,7 @@ from collections import Counter, defaultdict
 from html import escape
 from typing import Any
 
-from ..results import FAILED, PASSED, SKIPPED, STATUSES, XFAIL, CheckResult, Report, environment, to_jsonable
+from ..results import FAILED, PASSED, SKIPPED, STATUSES, UNDECIDED, XFAIL, CheckResult, Report, environment, to_jsonable
 from .plots import convergence_plot, trajectory_plot
 
 SECTIONS = ("summary", "changes", "convergence", "trajectories", "laws", "failures", "performance", "timings",
@@ -54,7 +54,7 @@ p.note { color:var(--mute); margin:4px 0 10px; }
 .card { min-width:130px; padding:10px 16px; border-radius:8px; border:1px solid var(--line); background:#fafbfc; }
 .card .n { font-size:28px; font-weight:700; } .card .l { color:var(--mute); font-size:12px; text-transform:uppercase; letter-spacing:.04em; }
 .card.passed .n { color:var(--ok); } .card.failed .n { color:var(--bad); } .card.skipped .n { color:var(--skip); }
-.card.xfail .n { color:var(--xf); } .card.regressions .n { color:var(--bad); }
+.card.xfail .n { color:var(--xf); } .card.regressions .n { color:var(--bad); } .card.undecided .n { color:var(--bad); }
 table { border-collapse:collapse; width:100%; font-size:13px; }
 th, td { text-align:left; padding:5px 8px; border-bottom:1px solid var(--line); vertical-align:top; }
 th { background:#f0f2f5; font-weight:600; position:sticky; top:37px; }
@@ -62,7 +62,7 @@ td.num, th.num { text-align:right; font-variant-numeric:tabular-nums; white-spac
 tr.failed td { background:#fff5f5; }
 .badge { display:inline-block; padding:1px 7px; border-radius:10px; font-size:11px; font-weight:600; color:#fff; text-transform:uppercase; }
 .badge.passed { background:var(--ok); } .badge.failed, .badge.error, .badge.regression { background:var(--bad); }
-.badge.skipped { background:var(--skip); } .badge.xfail { background:var(--xf); } .badge.change { background:#1f5fbf; }
+.badge.skipped { background:var(--skip); } .badge.xfail { background:var(--xf); } .badge.undecided { background:#8e24aa; } .badge.change { background:#1f5fbf; }
 .grid { display:grid; grid-template-columns:repeat(auto-fill, minmax(420px, 1fr)); gap:14px; }
 figure { margin:0; border:1px solid var(--line); border-radius:6px; padding:6px; background:#fff; }
 figure svg { width:100%; height:auto; display:block; }
@@ -201,7 +201,9 @@ def _import_stepper(target: str) -> str:
 
 
 def _command(rec: CheckResult, meta: dict[str, Any]) -> str:
-    cmd = ["verimono", meta.get("command") or "run"]
+    """The ``verimono`` command line reproducing ``rec``; every word passes through :func:`shlex.quote`
+    (a results file is data: a target such as ``x; touch /tmp/x #`` must paste as one argument)."""
+    cmd = ["verimono", str(meta.get("command") or "run")]
     if meta.get("command") == "check" and meta.get("target"):
         cmd.append(str(meta["target"]))
     cmd += ["--profile", str(meta.get("profile") or "ci")]
@@ -214,8 +216,8 @@ def _command(rec: CheckResult, meta: dict[str, Any]) -> str:
     if isinstance(rec.details.get("reference"), str):
         refs = [rec.details["reference"]]  # the one reference the counterexample needs (the run says which)
     for name in refs or []:
-        cmd += ["--reference", shlex.quote(str(name))]
-    return " ".join(cmd)
+        cmd += ["--reference", str(name)]
+    return " ".join(shlex.quote(w) for w in cmd)
 
 
 # -- sections --------------------------------------------------------------------------------------
@@ -226,6 +228,10 @@ def _summary(report: Report, changes: Any) -> str:
     ok = report.ok
     nreg = len(changes.regressions) if changes is not None else None
     verdict = ("All checks hold" if ok else f"{c[FAILED]} check{'s' if c[FAILED] != 1 else ''} failed")
+    if c.get(UNDECIDED):
+        verdict += f" · {c[UNDECIDED]} undecided (a limitation of the harness: nothing verified there)"
+    if report.meta.get("incomplete"):
+        verdict = "INCOMPLETE run (interrupted; resume with verimono run --resume) · " + verdict
     if nreg:
         verdict += f" · {nreg} regression{'s' if nreg != 1 else ''} against the baseline"
     cards = "".join(f'<div class="card {s}"><div class="n">{c[s]}</div><div class="l">{s}</div></div>'
@@ -468,10 +474,11 @@ def render(report: Report, *, changes: Any = None, title: str = "verimono report
     m = report.meta
     sub = " · ".join(_e(x) for x in (
         f"verimono {m.get('command') or ''} {m.get('target') or ''}".strip(), f"profile {m.get('profile')}",
-        m.get("created") or "", report.summary()) if x)
+        m.get("created") or "", report.summary(), f"run {m['run_id']}" if m.get("run_id") else "") if x)
     return (f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
             f'<meta name="viewport" content="width=device-width, initial-scale=1">'
-            f"<title>{_e(title)}</title><style>{CSS}</style></head><body>"
+            + (f'<meta name="verimono-run-id" content="{_e(m["run_id"])}">' if m.get("run_id") else "")
+            + f"<title>{_e(title)}</title><style>{CSS}</style></head><body>"
             f"<header><h1>{_e(title)}</h1><div class=\"sub\">{sub}</div></header><nav>{nav}</nav>"
             f"<main>{sections}</main></body></html>\n")
 

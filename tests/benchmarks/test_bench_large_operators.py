@@ -1,0 +1,27 @@
+"""Issue 14, item 4: ``check_operator`` on image- and PDE-sized operators.
+
+A correct closed-form operator (``F = ∂((1 + t)|·|)``, block soft thresholding) must pass every law at
+``n = 2000`` within 10 s and at ``n = 10^6`` within 60 s on the reference machine (2 cores), with the
+``ci`` profile's 20 examples per law; points are drawn by NumPy above ``NUMPY_DIM`` coordinates.  With
+``--benchmark-disable`` (the normal test run) the large case uses ``n = 20000`` and the loose sanity bound.
+Measured here, loaded machine: n = 2000 in 4.6 s, n = 10^6 in 35.6 s.
+"""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+
+import verimono as vm
+
+
+@pytest.mark.parametrize("n, seconds", [(2000, 10.0), (10 ** 6, 60.0)], ids=["n=2000", "n=1e6"])
+def test_check_operator_on_a_large_correct_operator(gate, n, seconds):
+    n = n if n <= 2000 else gate.size(n, 20_000)
+    op = vm.NormSubdifferential(lambda t: 1.0 + t, dim=n)
+    start = time.perf_counter()
+    rep = vm.check_operator(op, seed=0, examples=20)
+    elapsed = time.perf_counter() - start
+    assert rep.ok and rep.counts["passed"] == 15, rep.summary()
+    assert elapsed <= gate.bound(seconds), f"{elapsed:.1f} s at n = {n}"
