@@ -39,6 +39,7 @@ import numpy as np
 
 from ._jsonable import to_jsonable
 from .display import render
+from ._kernels import real_array
 from .errors import InvalidProblem
 from .grids import uniform_grid, validate_grid
 from .problem import Order, Problem
@@ -508,8 +509,6 @@ def _unwrap(obj):
 
 def _timed_run(stepper, problem, grid):
     start = time.perf_counter()
-    from ._kernels import real_array
-
     x = real_array(stepper(problem, grid), f"the values of stepper {_name(stepper)}")   # complex: an error
     if x.shape != (len(grid),) + problem.x0.shape:
         raise InvalidProblem(f"stepper {_name(stepper)} returned shape {x.shape}, expected "

@@ -75,6 +75,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator
 
+from .atomic import write_text
 from ._jsonable import to_jsonable
 from .display import render
 from .convergence import NORMS, ConvergenceStudy
@@ -257,8 +258,6 @@ class Report:
 
     def save(self, path: str | Path) -> Path:
         """Write :meth:`to_json` to ``path`` atomically (parents created); returns the path."""
-        from .atomic import write_text
-
         return write_text(path, self.to_json())   # temporary file + rename: never a truncated document
 
     @classmethod

@@ -24,6 +24,8 @@ from contextlib import contextmanager
 from typing import Callable, Iterator
 
 from .errors import InvalidCheckArgument, UnitTimeout
+from .profiles import UnknownProfile, active_profile, get_profile
+from .results import FAILED, CheckResult
 
 _OVERRIDE: list[float | None] = []
 
@@ -58,7 +60,6 @@ def current_budget() -> float | None:
     """The budget of a unit started now: the innermost :func:`budget`, else the profile's ``unit_timeout``."""
     if _OVERRIDE and _OVERRIDE[-1] is not None:
         return _OVERRIDE[-1]
-    from .profiles import UnknownProfile, active_profile, get_profile
 
     try:
         return get_profile(active_profile()).unit_timeout
@@ -113,7 +114,6 @@ def time_limit(seconds: float | None, unit: str) -> Iterator[None]:
 def run_unit(fn: Callable[[], object], *, check: str, subject: str, seconds: float | None = None):
     """``fn()`` under the unit budget (``seconds``, else :func:`current_budget`); a timeout becomes a
     *failed* :class:`verimono.CheckResult` ``check[subject]`` naming the unit and the elapsed time."""
-    from .results import FAILED, CheckResult
 
     limit = current_budget() if seconds is None else seconds
     start = time.perf_counter()

@@ -50,6 +50,9 @@ from ..grids import graded_grid, random_grid, uniform_grid, validate_grid
 from ..operators import L1Subdifferential, Linear, NormalCone, NormSubdifferential, Operator
 from ..problem import Problem
 from ..claims import claim_of, with_claim
+from ..convergence import _name as _convergence_name
+from ..errors import InvalidCheckArgument
+from ..timeouts import run_unit
 from ..results import FAILED, PASSED, SKIPPED, CheckResult, Report
 from ..stepping import Trajectory
 from ..tolerances import (DOMAIN_ORDER_SLACK, LIMIT_EXTRA_LEVELS, LIMIT_RATIO_FLOOR, LIMIT_TAIL_SAFETY,
@@ -959,9 +962,6 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
     selects laws, ``orders=False`` keeps the laws only.  The records are those of :func:`stepper_checks`, the
     same generator :func:`verimono.testing.parametrize_with_checks` turns into pytest cases.
     """
-    from ..errors import InvalidCheckArgument
-    from ..timeouts import run_unit
-
     if problems is not None:
         problems = list(problems)
         if not problems:
@@ -986,9 +986,7 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
 
 
 def _stepper_name(stepper: Any) -> str:
-    from ..convergence import _name
-
-    return _name(stepper)
+    return _convergence_name(stepper)
 
 
 __all__ = ["LAWS", "CHECKS", "check_contraction", "check_unique_limit", "check_in_domain", "check_domain_vanishing",
