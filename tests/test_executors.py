@@ -17,7 +17,8 @@ from verimono.results import CheckResult, Report
 REF = ["--reference", "moving box", "--reference", "t|x| (n=1)"]
 RUN = ["run", "--profile", "ci", "--stage", "convergence", "--stage", "assumptions", *REF]
 #: keys whose values are timings (seconds, or when the document was written): all that may differ
-TIMING_KEYS = {"duration", "timings", "calibration", "created"}
+#: what differs between two runs of the same battery: timings, and the run id both output files carry
+TIMING_KEYS = {"duration", "timings", "calibration", "created", "run_id"}
 
 STEPPERS = '''
 import multiprocessing, os, signal, time

@@ -92,7 +92,10 @@ def test_interrupt_during_rendering_leaves_a_consistent_pair(tmp_path, monkeypat
     def interrupted(*a, **k):
         raise KeyboardInterrupt
 
+    import verimono.report as report_pkg
+
     monkeypatch.setattr(html, "render", interrupted)
+    monkeypatch.setattr(report_pkg, "render", interrupted)      # write() renders through its own import
     with pytest.raises(KeyboardInterrupt):
         write(_report(tag="second"), tmp_path)
     monkeypatch.undo()
@@ -259,13 +262,11 @@ def test_timeout_must_be_positive():
 
 # -- large operators -------------------------------------------------------------------------------------
 
-def test_check_operator_passes_a_correct_operator_at_n_2000_within_10_s():
+def test_check_operator_passes_a_correct_operator_at_n_2000():
+    """The time target (≤ 10 s) is a benchmark: tests/benchmarks/test_bench_large_operators.py."""
     op = vm.NormSubdifferential(lambda t: 1.0 + t, dim=2000)
-    start = time.perf_counter()
     rep = vm.check_operator(op, seed=0, examples=20)
-    elapsed = time.perf_counter() - start
     assert rep.counts["passed"] == 15 and rep.ok, rep.summary()
-    assert elapsed <= 10.0, elapsed
     # a recorded sample of 2000 coordinates is a recipe of a few numbers, and it replays
     from verimono.checks.operator_laws import Sample, run_law
 

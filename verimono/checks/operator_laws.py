@@ -681,7 +681,9 @@ def _search(law: Law, op: Operator, seed: int | None, examples: int | None, hori
             # the search engine itself gave up (inputs it cannot draw, memory): a limitation of the harness,
             # not of the operator — undecided, never failed and never passed
             harness = f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"
-        if state.fail_eval is None and state.unsupported is None and not (timed_out or harness):
+        # the scale sweep spells out its points: for n > NUMPY_DIM the NumPy recipes cover the scales instead
+        if (state.fail_eval is None and state.unsupported is None and not (timed_out or harness)
+                and op.dim <= NUMPY_DIM):
             swept = _sweep(law, op, seed, horizon, state, body)
     duration = time.perf_counter() - start
     subject = _subject(op)
