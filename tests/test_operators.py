@@ -252,3 +252,27 @@ def test_resolvent_rows_batches_only_what_declares_it():
                                rtol=1e-14)
     sub = Counting(0.7, dim=2)
     assert not sub._accepts_batches() and resolvent_rows(sub, X, 0.4).shape == X.shape and calls == [(2,)] * 5
+
+
+def test_catalog_subdifferentials_state_their_function_and_pass_the_value_laws():
+    """NormSubdifferential and L1Subdifferential are ∂g of known g, so the prox laws run on them (instead of
+    being skipped); a value off by a factor 2 is caught by every value law."""
+    import numpy as np
+    import verimono as vm
+    from verimono.checks.prox_laws import VALUE_LAWS
+
+    names = {name for name, _, _ in VALUE_LAWS}
+    norm = vm.NormSubdifferential(lambda t: 1.0 + t, dim=3)
+    l1 = vm.L1Subdifferential([1.0, 2.0, 0.5], dim=3)
+    x = np.array([3.0, -4.0, 0.0])
+    assert norm.value(x, 1.0) == 10.0 and l1.value(x) == 11.0
+    for op in (norm, l1):
+        rep = vm.check_operator(op, seed=0)
+        assert rep.ok and all(r.status == "passed" for r in rep if r.check in names), rep.summary()
+
+    class Doubled(vm.L1Subdifferential):
+        def value(self, x, t=0.0):
+            return 2.0 * super().value(x, t)
+
+    failed = {r.check for r in vm.check_operator(Doubled(1.0, dim=3), seed=0).failures}
+    assert failed == names

@@ -401,6 +401,13 @@ class NormSubdifferential(Operator):
             return x * (max(nrm - lam * ct, 0.0) / max(nrm, _TINY))
         return step
 
+    def value(self, x, t=0.0):
+        """``g(t, x) = c(t)|x|`` (``F(t,·) = ∂g(t,·)``): the value laws check the resolvent is its prox."""
+        c = np.asarray(self._c_at(t), dtype=float)
+        if c.ndim:
+            raise NotImplementedError(f"{self.name}: a value needs one weight c(t), not a batch of them")
+        return float(c) * float(np.linalg.norm(np.asarray(x, dtype=float)))
+
     def min_norm(self, x, t=0.0):
         x = np.asarray(x, dtype=float)
         nrm = _norm(x)
@@ -463,6 +470,11 @@ class L1Subdifferential(Operator):
                     raise bad_lam(lam, name)
                 return sign(x) * _mx(absolute(x) - lam * _weight_at(cfn, t, name, "c(t)"), 0.0)
         return step
+
+    def value(self, x, t=0.0):
+        """``g(t, x) = Σ c_i(t)|x_i|`` (``F(t,·) = ∂g(t,·)``): the value laws check the resolvent is its prox."""
+        c = np.asarray(_weight_at(self._c, t, self.name, "c(t)"), dtype=float)
+        return float(np.sum(c * np.abs(np.asarray(x, dtype=float))))
 
     def min_norm(self, x, t=0.0):
         x = real_array(x)
