@@ -122,3 +122,16 @@ def test_verimono_check_on_a_bare_resolvent_says_to_wrap_it(tmp_path):
     assert out.returncode == 2, out
     assert "operator_from_resolvent(soft_threshold" in out.stderr and "step size" in out.stderr
     assert "Traceback" not in out.stderr
+
+
+def test_assumption_records_go_through_the_one_outcome_and_fail_on_nan():
+    """The assumption laws build their records from the core's Outcome: a NaN ratio is a failure, not a
+    pass (``nan > 1`` is False, which the old comparison took for a pass)."""
+    from verimono.checks.assumptions import _verdict
+
+    class S:
+        problem = get("t|x| (n=1)")
+
+    rec = _verdict("assumption_A1", S, math.nan, None, {}, lambda c: "violated", "held")
+    assert rec.status == "failed" and "nan" in rec.message
+    assert _verdict("assumption_A1", S, 0.5, None, {}, lambda c: "violated", "held").status == "passed"

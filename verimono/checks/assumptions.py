@@ -50,7 +50,7 @@ from ..errors import OutsideDomain, VerimonoError
 from ..operators import resolvent_rows
 from ..problem import Problem
 from ..results import FAILED, PASSED, SKIPPED, XFAIL, CheckResult, Report
-from .core import law as _declare, laws_of, run as _run
+from .core import Outcome, law as _declare, laws_of, record, run as _run
 from ..tolerances import GROWTH_FLAG, RTOL, STALL_RATIO, STALL_WINDOW, quotient_tolerance, tolerance
 from .jumps import find_jumps, jump_time
 
@@ -102,12 +102,13 @@ def _min_norm(op, z, t):
 
 def _verdict(name: str, S: _Samples, worst: float, counter: dict | None, details: dict,
              failed: Callable[[dict], str], passed: str) -> CheckResult:
-    """The record of a sampled ratio ``worst`` against the bound 1: failed (with ``failed(counter)`` as the
-    message and ``counter`` as the counterexample) when a sample exceeds it."""
-    bad = worst > 1.0
-    return CheckResult(name, _subject(S.problem), FAILED if bad else PASSED, worst=worst, bound=1.0,
-                       message=failed(counter) if bad else passed, counterexample=counter if bad else None,
-                       details=details)
+    """The record of a sampled ratio ``worst`` against the bound 1 (the core's one :class:`Outcome`): failed,
+    with ``failed(counter)`` as the message and ``counter`` as the counterexample, when a sample exceeds it
+    or the ratio is not a number."""
+    outcome = Outcome(float(worst), counter=dict(counter or {}), details=details)
+    return record(name, _subject(S.problem), outcome, passed=passed,
+                  failed=(failed(counter) if counter else f"{name}: the sampled ratio is {worst}")
+                  if outcome.failed else None)
 
 
 def _a1(S: _Samples) -> CheckResult:
