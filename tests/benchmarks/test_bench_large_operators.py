@@ -23,5 +23,5 @@ def test_check_operator_on_a_large_correct_operator(gate, n, seconds):
     start = time.perf_counter()
     rep = vm.check_operator(op, seed=0, examples=20)
     elapsed = time.perf_counter() - start
-    assert rep.ok and rep.counts["passed"] == 15, rep.summary()
+    assert rep.ok and rep.counts["passed"] == 18, rep.summary()   # every law but prox_minimiser (n <= 4 only)
     assert elapsed <= gate.bound(seconds), f"{elapsed:.1f} s at n = {n}"
