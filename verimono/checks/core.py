@@ -32,7 +32,7 @@ import time
 from typing import Any, Callable, Iterable
 
 from ..claims import Claim, claim_of
-from ..errors import NotApplicable, VerimonoError
+from ..errors import NotApplicable
 from ..results import FAILED, PASSED, SKIPPED, CheckResult
 
 SUBJECTS = ("operator", "stepper", "problem")
@@ -250,11 +250,6 @@ def record(name: str, subject: str, outcome: Outcome, *, passed: str, failed: st
     msg = failed or counter.pop("message", "") or f"{name} violated"
     return CheckResult(name, subject, FAILED, worst=outcome.worst, bound=bound, counterexample=counter,
                        message=msg, details=dict(outcome.details), **kw)
-
-
-def caught(exc: BaseException) -> bool:
-    """Exceptions that fail a subject (bad values, unsolvable steps) rather than reveal a harness bug."""
-    return isinstance(exc, (VerimonoError, ArithmeticError, ValueError))
 
 
 __all__ = ["Outcome", "Law", "law", "laws_of", "REGISTRY", "run", "record", "Member", "Claimed", "Holds",
