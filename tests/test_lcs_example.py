@@ -11,6 +11,7 @@ from verimono import solve, uniform_grid
 from verimono.lcs import check_hypotheses
 from verimono.pseudo_distance import pseudo_distance_lower_bound
 from verimono.reference import lcs_example as E
+from verimono.tolerances import RTOL
 
 
 def _enumerated_least_norm_lcp(M, q, tol=1e-12):
@@ -82,7 +83,7 @@ def test_H_closed_form_min_norm_membership_and_domain():
             assert H.project_domain(np.array([x]))[0] == pytest.approx(-v2, rel=1e-10, abs=1e-10 * (1 + abs(x)))
 
 
-@pytest.mark.parametrize("scale", [1e-12, 1e-9, 1e-6, 1.0, 1e3])
+@pytest.mark.parametrize("scale", [1e-12, 1e-9, 2.0 ** -23, 1e-6, 1.0, 1e3])
 def test_one_step_problem_is_solved_to_relative_accuracy_at_every_scale(scale):
     # H(t, ·) of the ramp reference near t = 0: v = (−t, 0), the one-step LCP has data of size t.  A rank
     # decision relative to |M| used to drop the constraint qᵀ(z − z̄) = 0 (SolverFailure at t = 1e-9 in a
@@ -93,7 +94,10 @@ def test_one_step_problem_is_solved_to_relative_accuracy_at_every_scale(scale):
     for x, h in [(0.0, 1.0), (0.0, 0.1), (-2.0 * t, 1.0), (3.0 * t, 0.5)]:
         closed = E.closed_form_resolvent(x, h, -t, 0.0)
         assert H.resolvent(np.array([x]), h, t)[0] == pytest.approx(closed, rel=1e-9, abs=0)
-    for x in (0.0, 5.0 * t):                      # the edge of dom H = [0, ∞) and the inside: H^0 = −t
+    # the edge of dom H = [0, ∞) and the inside: H^0 = −t.  At x = 1 the data have size 1: above RTOL the
+    # multipliers (1, t) are certified unique and H^0 is exact (their SOL, a wedge of angle t, made the selection
+    # QP fail its KKT check at t = 2^-23); below, −t is resolved only relative to 1
+    for x in (0.0, 5.0 * t) + ((1.0,) if t > RTOL else ()):
         assert H.min_norm(np.array([x]), t)[0] == pytest.approx(-t, rel=1e-9, abs=0)
 
 

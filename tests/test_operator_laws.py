@@ -8,6 +8,7 @@ import pytest
 
 import zoo
 import zoo_prox
+import verimono as vm
 from verimono import Report, operator_from_resolvent
 from verimono.checks import LAWS, OPERATOR_CHECKS, check_operator, operator_checks, run_law
 from verimono.strategies import catalog
@@ -281,3 +282,49 @@ def test_lcs_min_norm_on_the_boundary_of_dom_H():
     x = H.resolvent(np.full(3, -2.0), 1.0, 0.0)
     assert np.linalg.norm(H.min_norm(x, 0.0)) <= 1e-8
     assert H.contains(x, (np.full(3, -2.0) - x) / 1.0, 0.0)
+
+
+#: the sample of the false alarm in the no-false-alarm sweep (issue 13): H of the paper's Example, v = (−t, 0)
+_THIN_WEDGE = {"x1": [1.0], "x2": [0.0], "lam": 1.0, "mu": 1.0, "nu": 1.0, "t": 2.0 ** -23}
+
+
+@pytest.mark.parametrize("law", ["yosida_in_graph", "yosida_bounded_by_min_norm", "yosida_limit",
+                                 "min_norm_in_graph", "min_norm_least"])
+def test_the_example_H_at_a_thin_wedge_passes(law):
+    """At x = 1, t = 2^-23 the multipliers (1, t) of H(t, x) are unique, but their SOL is cut out by rows t apart
+    in angle: the selection QP failed verimono's KKT check and five laws recorded the operator as failed.
+    The certified-unique multipliers now skip the selection, and the laws hold there (H^0 = −t exactly)."""
+    from verimono.reference import lcs_example as E
+
+    H = E.example_system(lambda s: np.array([-s, 0.0])).operator()
+    rec = run_law(law, H, sample=_THIN_WEDGE)
+    assert rec.status == "passed", str(rec)
+    assert H.min_norm(np.array([1.0]), 2.0 ** -23)[0] == -(2.0 ** -23)
+
+
+def _resolvent_whose_qp_gives_up(region):
+    """The resolvent of N_[0,∞)ⁿ (projection onto the orthant) that raises UnverifiedSolution — verimono's QP
+    giving up — wherever ``region(x)`` holds, as verimono's own Polyhedron does on degenerate data."""
+    def J(x, lam, t):
+        if region(x):
+            raise vm.UnverifiedSolution("no QP back-end produced a verified solution (simulated)")
+        return np.maximum(x, 0.0)
+    return J
+
+
+def test_a_limit_of_verimonos_own_solvers_is_undecided_never_failed_nor_passed():
+    """UnverifiedSolution raised inside an operator is a limit of the harness: a sample it stops is not
+    evidence against the operator (no failure) and not evidence for it (counted; every sample stopped is
+    undecided).  A plain SolverFailure of the operator's own making still fails it."""
+    everywhere = vm.operator_from_resolvent(_resolvent_whose_qp_gives_up(lambda x: True), 2, name="gives up")
+    rec = run_law("resolvent_nonexpansive", everywhere, seed=1, examples=10)
+    assert rec.status == "undecided" and "decided none" in rec.message, str(rec)
+    sometimes = vm.operator_from_resolvent(_resolvent_whose_qp_gives_up(lambda x: x[0] > 2.0), 2, name="sometimes")
+    rec = run_law("resolvent_nonexpansive", sometimes, seed=1, examples=30)
+    assert rec.status == "passed" and rec.details["harness_limited"] > 0, str(rec)
+    assert "undecided by verimono's own solvers" in rec.message
+
+    def raises(x, lam, t):
+        raise vm.SolverFailure("the user's own solver failed")
+    rec = run_law("resolvent_single_valued", vm.operator_from_resolvent(raises, 2, name="own"), seed=1, examples=5)
+    assert rec.status == "failed" and "SolverFailure" in rec.message, str(rec)   # the root cause, as any raise

@@ -8,7 +8,7 @@ Data flow one way: Problem → stepper → Trajectory → checks → results →
 from .errors import (BadTarget, BatchStepError, IncompatibleBaseline, InfeasibleStep, InvalidCheckArgument,
                      InvalidClaim, InvalidGrid, InvalidProblem, MissingOptionalDependency, NotMonotone,
                      OutsideDomain, SchemaError, SolverFailure, StageUnavailable, UnitTimeout, UnknownProfile,
-                     UnknownStage, VerimonoError)
+                     UnknownStage, UnverifiedSolution, VerimonoError)
 from .grids import graded_grid, random_grid, refine, uniform_grid, validate_grid
 from .operators import (L1Subdifferential, Linear, LogBarrier, NormalCone, NormSubdifferential, Operator,
                         Shifted, operator_from_resolvent)
@@ -52,7 +52,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "VerimonoError", "InvalidProblem", "InvalidGrid", "OutsideDomain", "NotMonotone", "InfeasibleStep",
-    "BatchStepError", "SolverFailure", "UnknownProfile", "UnknownStage", "StageUnavailable", "BadTarget", "SchemaError",
+    "BatchStepError", "SolverFailure", "UnverifiedSolution", "UnknownProfile", "UnknownStage", "StageUnavailable", "BadTarget", "SchemaError",
     "IncompatibleBaseline", "MissingOptionalDependency", "InvalidClaim",
     "InvalidCheckArgument", "UnitTimeout",
     "Operator", "operator_from_resolvent", "operator_from_prox", "ProxOperator", "ProxOutputError", "Linear",

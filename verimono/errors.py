@@ -37,6 +37,13 @@ class SolverFailure(VerimonoError, ArithmeticError):
     """Every numerical back-end failed to produce a solution that passes verification."""
 
 
+class UnverifiedSolution(SolverFailure):
+    """verimono's own numerical machinery (its QP and LCP back-ends, its splitting iterations) produced no
+    answer that passes its verification, on data that have one: a limit of the harness, not evidence against
+    the operator or the problem.  A law evaluation that meets it is inconclusive (``undecided`` when no sample
+    was decided), never a failure of the subject and never a pass."""
+
+
 class InvalidClaim(VerimonoError, ValueError):
     """A stepper claim that cannot be stated (unknown scheme, nonpositive order, not callable)."""
 

@@ -6,7 +6,7 @@ is trusted: each candidate is polished by re-solving the equality-constrained pr
 active set, and accepted only when verimono's own KKT check passes — primal feasibility, and a
 nonnegative multiplier combination of the active rows reproducing ``-(Pz + q)`` (a nonnegative least
 squares residual), both to ``QP_RTOL`` relative to the data.  When no candidate passes,
-:class:`verimono.SolverFailure` is raised with every back-end's reason.
+:class:`verimono.UnverifiedSolution` (a :class:`verimono.SolverFailure`) is raised with every back-end's reason.
 
 The problem is equilibrated first (:func:`equilibrate`): constraint rows scaled to unit length, the
 objective to ``max |P| = 1``, and the variable to ``z = s·y`` with ``s`` the size of the data
@@ -26,7 +26,7 @@ import warnings
 import numpy as np
 from scipy.optimize import nnls
 
-from .errors import InfeasibleStep, SolverFailure
+from .errors import InfeasibleStep, UnverifiedSolution
 from .tolerances import QP_RTOL
 
 #: back-ends tried in order, with the options that make them accurate
@@ -152,7 +152,7 @@ def _unit_rows(E, e, kind, ref):
 #: resolution: the row ``1.4e-37 z₂ ≥ -1`` of an LCP whose matrix has a 1.4e-37 entry made ``s = 7e36`` and
 #: turned a verified ``y = -1e-37`` into a multiplier ``z = -0.67`` (found by the Section 7 operator property).
 #: Far rows are solved without and checked on the answer: a minimiser that satisfies them is the minimiser
-#: with them (its feasible set only shrank around it); one that violates them is a ``SolverFailure``.
+#: with them (its feasible set only shrank around it); one that violates them is a ``UnverifiedSolution``.
 FAR = 1.0 / float(np.finfo(float).eps)
 
 
@@ -246,7 +246,7 @@ def solve_qp(P, q, G=None, h=None, A=None, b=None, *, backends=None, scale: floa
     those units, i.e. relative to the size of the data at every scale.
 
     Raises :class:`InfeasibleStep` when the constraints admit no point (every back-end reports
-    infeasibility and none returns a point), :class:`SolverFailure` when candidates exist but none
+    infeasibility and none returns a point), :class:`UnverifiedSolution` when candidates exist but none
     verifies.
     """
     # writable copies: back-ends such as DAQP reject read-only buffers (constant parameters are read-only)
@@ -270,4 +270,4 @@ def solve_qp(P, q, G=None, h=None, A=None, b=None, *, backends=None, scale: floa
             reasons.append(label + reason)
     if not got_point:
         raise InfeasibleStep("no back-end found a feasible point: " + "; ".join(reasons))
-    raise SolverFailure("no QP back-end produced a verified solution: " + "; ".join(reasons))
+    raise UnverifiedSolution("no QP back-end produced a verified solution: " + "; ".join(reasons))

@@ -13,7 +13,8 @@ a law that does not apply is a skip whose reason comes from the declaration:
   Lipschitz constant for ``f``, no initial jump, ...).
 
 :func:`run` is the one driver: it owns the timing, the exception-to-status policy (a member the subject
-lacks at run time is a skip; any other exception is a failure of the subject, with its type and message)
+lacks at run time is a skip; :class:`verimono.UnverifiedSolution` — verimono's own solvers gave no verified
+answer — is ``undecided``; any other exception is a failure of the subject, with its type and message)
 and stamps the law's label on the record.  Law bodies return an :class:`Outcome` (the one outcome type:
 the worst observed ratio against the bound 1, where, and what was compared) or a finished record.
 
@@ -32,8 +33,8 @@ import time
 from typing import Any, Callable, Iterable
 
 from ..claims import Claim, claim_of
-from ..errors import NotApplicable
-from ..results import FAILED, PASSED, SKIPPED, CheckResult
+from ..errors import NotApplicable, UnverifiedSolution
+from ..results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
 
 SUBJECTS = ("operator", "stepper", "problem")
 
@@ -231,6 +232,9 @@ def run(decl: Law | Callable, *args: Any, operator: Any = None, stepper: Any = N
         rec = CheckResult(decl.name, subject, SKIPPED, message=str(exc))
     except NotImplementedError as exc:
         rec = CheckResult(decl.name, subject, SKIPPED, message=f"not available: {exc}")
+    except UnverifiedSolution as exc:   # a limit of the harness: never a failure of the subject, never a pass
+        rec = CheckResult(decl.name, subject, UNDECIDED, message=f"verimono's own solvers gave no verified answer: "
+                          f"{exc}", details={"exception": type(exc).__name__})
     except Exception as exc:   # the subject raised on a valid input: a failure of the subject, never a crash
         rec = CheckResult(decl.name, subject, FAILED, message=f"{type(exc).__name__}: {exc}",
                           details={"exception": type(exc).__name__})

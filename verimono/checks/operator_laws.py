@@ -38,7 +38,7 @@ from hypothesis import strategies as st
 from ..errors import VerimonoError
 from ..operators import Operator
 from ..profiles import UnknownProfile, active_profile, get_profile
-from ..errors import InvalidCheckArgument, UnitTimeout
+from ..errors import InvalidCheckArgument, UnitTimeout, UnverifiedSolution
 from ..results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult, Report
 from ..timeouts import current_budget, time_limit
 from .core import Law, Member, Outcome, law as _declare, laws_of, run as _run_law
@@ -505,6 +505,10 @@ class _Violation(Exception):
     """Raised inside the hypothesis test when a sample breaks the law (so hypothesis shrinks it)."""
 
 
+#: marks an evaluation that verimono's own numerical machinery could not decide (:class:`UnverifiedSolution`)
+HARNESS_LIMIT = "harness_limit"
+
+
 @dataclasses.dataclass
 class _State:
     runs: int = 0
@@ -517,6 +521,7 @@ class _State:
     found_by: str = ""
     inconclusive: int = 0
     inconclusive_what: str = ""
+    harness_limited: int = 0
 
 
 def _evaluate(law: Law, op: Operator, s: Sample) -> Outcome:
@@ -524,6 +529,9 @@ def _evaluate(law: Law, op: Operator, s: Sample) -> Outcome:
         return law.evaluate(op, s)
     except NotImplementedError:
         raise
+    except UnverifiedSolution as exc:   # verimono's own solvers could not decide this sample: a harness limit
+        return Outcome.compare(0.0, 0.0, 1.0, f"verimono's solver gave no verified answer ({exc})",
+                               {HARNESS_LIMIT: str(exc)}, inconclusive=True)
     except Exception as exc:  # an operator that raises on a valid input fails that input
         return Outcome.compare(math.inf, 0.0, 1.0, f"raised {type(exc).__name__}: {exc}")
 
@@ -595,11 +603,15 @@ ROOT_LAW = "resolvent_single_valued"
 
 def root_cause(op: Operator, horizon: float = 1.0) -> str | None:
     """Why ``op.resolvent`` cannot be evaluated at all — it raises (or returns no point of shape ``(n,)``)
-    at ``x = 0`` or ``x = (1, ..., 1)`` with ``λ = 1``, ``t ∈ {0, horizon}`` — or ``None``."""
+    at ``x = 0`` or ``x = (1, ..., 1)`` with ``λ = 1``, ``t ∈ {0, horizon}`` — or ``None``.  verimono's own
+    solvers giving up there (:class:`UnverifiedSolution`) is no cause of the operator's: the laws then meet it
+    sample by sample."""
     for x in (np.zeros(op.dim), np.ones(op.dim)):
         for t in (0.0, float(horizon)):
             try:
                 y = np.asarray(op.resolvent(x.copy(), 1.0, t))
+            except UnverifiedSolution:
+                continue
             except Exception as exc:   # noqa: BLE001 - any exception is the root cause we report
                 return f"the resolvent raises {type(exc).__name__}: {exc} at x = {x[:3].tolist()}..., λ = 1, t = {t:g}"
             if y.shape != x.shape:
@@ -636,6 +648,7 @@ def _search(law: Law, op: Operator, seed: int | None, examples: int | None, hori
         if ev.inconclusive:
             state.inconclusive += 1
             state.inconclusive_what = ev.what
+            state.harness_limited += HARNESS_LIMIT in ev.info
             return
         r = ev.ratio
         if state.worst_eval is None or not r <= state.worst:
@@ -689,7 +702,7 @@ def _search(law: Law, op: Operator, seed: int | None, examples: int | None, hori
     subject = _subject(op)
     base = dict(check=law.name, subject=subject, seed=seed, duration=duration)
     details = {"item": law.label, "examples": examples, "evaluations": state.runs, "horizon": horizon,
-               "inconclusive": state.inconclusive, "sweep": swept}
+               "inconclusive": state.inconclusive, "harness_limited": state.harness_limited, "sweep": swept}
     if profile is not None:
         details["profile"] = profile
 
@@ -718,6 +731,11 @@ def _search(law: Law, op: Operator, seed: int | None, examples: int | None, hori
                            message=msg, details=details, **base)
     if state.runs == 0:        # nothing was evaluated: never a pass
         return CheckResult(status=UNDECIDED, message="no sample was evaluated", details=details, **base)
+    if state.runs and state.harness_limited == state.runs:
+        return CheckResult(status=UNDECIDED, message=f"verimono's own solvers decided none of the {state.runs} "
+                                                     f"samples (e.g. {state.inconclusive_what}); a limitation of "
+                                                     "verimono, not a failure of the operator",
+                           details=details, **base)
     if state.runs and state.inconclusive == state.runs:
         return CheckResult(status=SKIPPED, message=f"all {state.runs} samples inconclusive (e.g. "
                                                    f"{state.inconclusive_what})", details=details, **base)
@@ -727,6 +745,8 @@ def _search(law: Law, op: Operator, seed: int | None, examples: int | None, hori
                                  "rhs": state.worst_eval.rhs, "slack": state.worst_eval.slack}
     worst = state.worst if state.worst_eval is not None else None
     counted = f"{state.runs} samples" + (f" ({state.inconclusive} inconclusive)" if state.inconclusive else "")
+    if state.harness_limited:
+        counted += f", {state.harness_limited} of them undecided by verimono's own solvers"
     return CheckResult(status=PASSED, worst=worst, bound=BOUND,
                        message=counted + (f"; {flaky}" if flaky else ""), details=details, **base)
 

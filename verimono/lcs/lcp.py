@@ -38,7 +38,7 @@ from typing import Callable
 import numpy as np
 from scipy.optimize import linprog
 
-from ..errors import InfeasibleStep, InvalidProblem, SolverFailure, VerimonoError
+from ..errors import InfeasibleStep, InvalidProblem, UnverifiedSolution, VerimonoError
 from ..qp import solve_qp
 from ..tolerances import POLISH_RTOL, QP_RTOL, RTOL
 
@@ -336,7 +336,7 @@ def solve_lcp(M, q, *, least_norm: bool = True, backends: tuple[str, ...] | None
     one-step problem of size ``h`` or ``t`` is solved as accurately as one of size 1.
 
     Raises :class:`verimono.InfeasibleStep` when there is no solution (for PSD ``M``: ``q ∉ Q_M^+``, with a
-    certificate ``ζ ∈ Q_M``, ``⟨q, ζ⟩ < 0``), :class:`verimono.SolverFailure` when solutions exist but no
+    certificate ``ζ ∈ Q_M``, ``⟨q, ζ⟩ < 0``), :class:`verimono.UnverifiedSolution` when solutions exist but no
     back-end produced one that passes the residual check.
     """
     M, q = _validate(M, q)
@@ -391,11 +391,11 @@ def _solve_unit(M, q, least_norm, backends) -> LCPResult:
         if not _feasible(M, q):
             _raise_infeasible(M, q, True if psd else False, reasons + ["FEA(q, M) is empty (linear programming)"])
         if psd:
-            raise SolverFailure("LCP(q, M) with PSD M is feasible, hence solvable (Proposition p:lcp2), but no "
+            raise UnverifiedSolution("LCP(q, M) with PSD M is feasible, hence solvable (Proposition p:lcp2), but no "
                                 "back-end produced a verified solution: " + "; ".join(reasons))
         if n <= ENUM_MAX and "enumerate" in (backends or GENERAL_BACKENDS):
             _raise_infeasible(M, q, False, reasons + [f"none of the 2^{n} complementary pieces holds a solution"])
-        raise SolverFailure("no back-end produced a verified solution of LCP(q, M) (non-PSD M, undecided): "
+        raise UnverifiedSolution("no back-end produced a verified solution of LCP(q, M) (non-PSD M, undecided): "
                             + "; ".join(reasons))
     w = M @ zbar + q
     scale = lcp_scale(M, q, zbar)
@@ -413,7 +413,7 @@ def _solve_unit(M, q, least_norm, backends) -> LCPResult:
                 ok, _, _ = _verified(M, q, zp)
                 zl = zp if ok and abs(zp @ zp - zl @ zl) <= RTOL * (1 + zl @ zl) else zl
             if not ok:
-                raise SolverFailure("least-norm QP over SOL(q, M) returned a point that fails the LCP residual check")
+                raise UnverifiedSolution("least-norm QP over SOL(q, M) returned a point that fails the LCP residual check")
             z, certified, used = zl, True, used + "+least-norm QP"
         elif n <= ENUM_MAX:
             zl, status = _enum_backend(M, q, least_norm=True)
@@ -467,11 +467,11 @@ def solve_box(M, q, lower, upper, *, least_norm: bool = True, info: bool = False
         if _verified(big, qq, zz)[0]:
             lam, certified = lower + zz[:m], True
         else:
-            raise SolverFailure("least-norm QP over the relay solution set failed the residual check")
+            raise UnverifiedSolution("least-norm QP over the relay solution set failed the residual check")
     res_val = box_residual(M, q, lam, lower, upper)
     scale = lcp_scale(M, q, lam) + float(np.abs(lower).max(initial=0.0))
     if res_val > QP_RTOL * scale:
-        raise SolverFailure(f"box problem residual {res_val:.3g} exceeds {QP_RTOL:g}·{scale:.3g}")
+        raise UnverifiedSolution(f"box problem residual {res_val:.3g} exceeds {QP_RTOL:g}·{scale:.3g}")
     out = LCPResult(lam, M @ lam + q, res_val, scale, r.backend, psd, r.unique, certified, r.reasons)
     return out if info else lam
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 
-from ..errors import InvalidProblem, NotMonotone, SolverFailure
+from ..errors import InvalidProblem, NotMonotone, UnverifiedSolution
 from ..operators import Operator
 from ..tolerances import QP_RTOL, RTOL, tolerance
 from .lcp import LCPResult, lcp_scale, solve_box, solve_lcp
@@ -201,7 +201,7 @@ class OperatorRelation(Relation):
             if np.abs(nat).max() <= QP_RTOL * gamma * scale:
                 break
         else:
-            raise SolverFailure(f"Douglas–Rachford for {self.name} did not reach residual {QP_RTOL:g} "
+            raise UnverifiedSolution(f"Douglas–Rachford for {self.name} did not reach residual {QP_RTOL:g} "
                                 f"in {self.MAX_ITER} iterations (last {np.abs(nat).max():.3g})")
         z = -zeta
         return LCPResult(z, M @ z + q, float(np.abs(nat).max()), scale, "douglas-rachford", True, None, False)

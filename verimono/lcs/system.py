@@ -403,19 +403,25 @@ class LCSOperator(Operator):
         data are infeasible lies outside the domain by a rounding error of the computation that produced
         it (a resolvent of unit-size data returns ``-4e-16`` for the edge ``0`` of ``dom H = [0, ∞)``),
         whose size ``H`` cannot know: its data are then solved relative to a unit floor, i.e. as the
-        nearest point of the domain."""
+        nearest point of the domain.  When the multipliers are provably unique (the rank certificate of
+        :func:`verimono.lcs.lcp.unique_certificate`) there is nothing to select: the selection QP is skipped, as it
+        must be where that unique point is the apex of a thin wedge (the Example at ``t = 2⁻²³``, whose
+        ``SOL`` is cut out by rows ``t`` apart in angle, no back-end verifies to ``QP_RTOL``)."""
         rel, s = self._box(), self.system
         v = s.v(t)
         eta, scale = s.C @ x + v, s.q_scale(x, v)
         lo, hi = rel.bounds(s.m)
         big, qq, fin = _box_lcp(s.D, eta, lo, hi)
         try:   # a solution proves x ∈ dom H(t): the linear program is needed only when there is none
-            zbar = solve_lcp(big, qq, least_norm=False, scale=scale)
+            r = solve_lcp(big, qq, least_norm=False, scale=scale, info=True)
         except InfeasibleStep:
             if not _feasible(big, qq):
                 raise OutsideDomain(f"x = {x} is not in dom H(t={t}): Cx + v(t) ∉ im(𝓜 + D)") from None
             scale = 1.0 + scale
-            zbar = solve_lcp(big, qq, least_norm=False, scale=scale)
+            r = solve_lcp(big, qq, least_norm=False, scale=scale, info=True)
+        zbar = r.z
+        if r.unique is True:
+            return lo + zbar[:s.m]
         k = big.shape[0]
         P = np.zeros((k, k))
         P[:s.m, :s.m] = P_lam
