@@ -25,7 +25,7 @@ def _svg(fig: Any) -> str:
     buf = io.StringIO()
     salt = f"vm{next(_COUNTER)}"
     with matplotlib.rc_context({"svg.hashsalt": salt, "svg.fonttype": "none"}):
-        fig.savefig(buf, format="svg", bbox_inches="tight",
+        fig.savefig(buf, format="svg",
                     metadata={"Creator": None, "Date": None, "Format": None, "Type": None})
     text = buf.getvalue()
     text = text[text.index("<svg"):]                       # drop the XML prolog and DOCTYPE
@@ -44,8 +44,13 @@ def _figure(width: float = 4.4, height: float = 3.1) -> Any:
 
     fig = Figure(figsize=(width, height), dpi=96)
     FigureCanvasAgg(fig)
-    fig.set_layout_engine("constrained")
+    fig.subplots_adjust(left=0.16, right=0.97, bottom=0.2, top=0.9)
     return fig
+
+
+def _decade(v: float, _pos: Any = None) -> str:
+    """A log-axis tick label as plain text (``1e-06``), not mathtext (parsed by pyparsing on every draw)."""
+    return f"{v:.0e}" if v > 0 else ""
 
 
 def _num(v: Any) -> float:
@@ -61,7 +66,7 @@ def convergence_figure(study: Any, ax: Any = None) -> Any:
     """Log-log errors against ``|Δ|`` for each norm, the fitted sup-norm slope with its 95% interval as a
     shaded wedge, the expected slope dashed, and the round-off floor dotted; drawn on ``ax`` (default: a
     new Agg figure).  Returns the matplotlib ``Figure``."""
-    from matplotlib.ticker import NullLocator
+    from matplotlib.ticker import FuncFormatter, NullLocator
 
     if ax is None:
         fig = _figure()
@@ -109,6 +114,8 @@ def convergence_figure(study: Any, ax: Any = None) -> Any:
         lo, hi = min(lo, floor / 3), max(hi, floor * 3)
     ax.set_xscale("log")
     ax.set_yscale("log")
+    ax.yaxis.set_major_formatter(FuncFormatter(_decade))   # plain text: mathtext costs most of the drawing
+    ax.yaxis.set_minor_locator(NullLocator())
     ax.set_ylim(lo, hi)
     ax.set_xlim(h.min() / 1.25, h.max() * 1.25)
     ax.set_xticks(h, [f"{v:.2g}" for v in h])  # label the studied meshes themselves
@@ -125,6 +132,11 @@ def convergence_figure(study: Any, ax: Any = None) -> Any:
 
 
 def trajectory_plot(sample: dict[str, Any]) -> str:
+    """:func:`trajectory_figure` as an inline ``<svg>``."""
+    return _svg(trajectory_figure(sample))
+
+
+def trajectory_figure(sample: dict[str, Any]) -> Any:
     """The discrete solution (markers) against the exact one (lines), component by component (≤ 4)."""
     fig = _figure()
     ax = fig.add_subplot()
@@ -146,7 +158,7 @@ def trajectory_plot(sample: dict[str, Any]) -> str:
     ax.set_title(f"{sample['problem']} (h = {float(sample['h']):.3g})", fontsize=10)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=6.5, loc="best", framealpha=0.85, ncol=2 if ncomp > 2 else 1)
-    return _svg(fig)
+    return fig
 
 
-__all__ = ["convergence_plot", "convergence_figure", "trajectory_plot"]
+__all__ = ["convergence_plot", "convergence_figure", "trajectory_plot", "trajectory_figure"]
