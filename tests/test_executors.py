@@ -5,6 +5,7 @@ becomes one failed record naming the unit while every other unit's records stay 
 from __future__ import annotations
 
 import json
+import os
 import textwrap
 from pathlib import Path
 
@@ -16,9 +17,9 @@ from verimono.results import CheckResult, Report
 
 REF = ["--reference", "moving box", "--reference", "t|x| (n=1)"]
 RUN = ["run", "--profile", "ci", "--stage", "convergence", "--stage", "assumptions", *REF]
-#: keys whose values are timings (seconds, or when the document was written): all that may differ
-#: what differs between two runs of the same battery: timings, and the run id both output files carry
-TIMING_KEYS = {"duration", "timings", "calibration", "created", "run_id"}
+#: what differs between two runs of the same battery: timings (seconds, or when the document was written),
+#: the run id both output files carry, and where the units ran (``meta.executor``)
+TIMING_KEYS = {"duration", "timings", "calibration", "calibrations", "created", "run_id", "executor"}
 
 STEPPERS = '''
 import multiprocessing, os, signal, time
@@ -55,7 +56,7 @@ def document(out: Path) -> dict:
 @pytest.fixture(scope="module")
 def serial_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("serial")
-    assert main([*RUN, "--out", str(out)]) == 0
+    assert main([*RUN, "--out", str(out), "--executor", "serial"]) == 0
     doc = document(out)
     assert len(doc["results"]) == 2 + 2 * 6 and len(doc["studies"]) == 2   # what the selection gives
     return doc
@@ -158,3 +159,25 @@ def test_a_bad_executor_is_a_usage_error(spec, tmp_path, capsys):
         make_runner(spec)
     assert main([*RUN, "--out", str(tmp_path), "--executor", spec]) == 2
     assert f"--executor {spec}" in capsys.readouterr().err
+
+
+def test_run_uses_every_core_by_default(monkeypatch, tmp_path, capsys):
+    """``verimono run`` defaults to ``auto``: process:N with N the cores (at most AUTO_MAX_WORKERS), serial
+    on one core; ``$VERIMONO_EXECUTOR`` overrides it.  The records are the serial run's (see above)."""
+    from verimono.executors import AUTO_MAX_WORKERS, ProcessRunner, SerialRunner, make_runner
+
+    monkeypatch.setattr(os, "cpu_count", lambda: 1)
+    assert isinstance(make_runner("auto"), SerialRunner)
+    monkeypatch.setattr(os, "cpu_count", lambda: 64)
+    runner = make_runner("auto")
+    assert isinstance(runner, ProcessRunner) and runner.workers == AUTO_MAX_WORKERS
+    monkeypatch.setattr(os, "cpu_count", lambda: 2)
+    monkeypatch.delenv("VERIMONO_EXECUTOR", raising=False)
+    assert main(["run", "--profile", "ci", "--stage", "convergence", "--reference", "t|x| (n=1)",
+                 "--out", str(tmp_path)]) == 0
+    assert "units run on process:2" in capsys.readouterr().err
+    assert json.loads((tmp_path / "results.json").read_text())["meta"]["executor"] == "process:2"
+    monkeypatch.setenv("VERIMONO_EXECUTOR", "serial")
+    assert main(["run", "--profile", "ci", "--stage", "convergence", "--reference", "t|x| (n=1)",
+                 "--out", str(tmp_path)]) == 0
+    assert json.loads((tmp_path / "results.json").read_text())["meta"]["executor"] == "serial"

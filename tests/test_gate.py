@@ -107,6 +107,21 @@ def test_timings_are_compared_as_same_job_ratios(base):
     assert any("timing" in m and "stage operator_laws" in m for m in reasons(base, cur))
 
 
+def test_stage_times_are_compared_only_between_runs_on_the_same_executor(base):
+    """A stage's wall time depends on how many workers ran its units: a serial run against a baseline made
+    on process:2 takes about twice as long without being slower (measured: operator_laws 6.8 s on process:2,
+    12.4 s serial), so those stage times are reported as not compared, never as a regression."""
+    cur = fresh(base)
+    base.meta["executor"], cur.meta["executor"] = "process:2", "serial"
+    cur.meta["stages"][0]["duration"] = 8.0 * TIMING_GROWTH * 1.2
+    comp = compare(base, cur)
+    assert comp.ok and any(c.kind == "timing" and "not compared" in c.message for c in comp.others)
+    cur.meta["executor"] = "process:2"          # the same executor: compared, and the slowdown regresses
+    assert any("timing" in m and "stage operator_laws" in m for m in reasons(base, cur))
+    del base.meta["executor"], cur.meta["executor"]   # results from before meta.executor: both serial
+    assert any("timing" in m and "stage operator_laws" in m for m in reasons(base, cur))
+
+
 def test_new_records_and_fixes_are_changes_not_regressions(base):
     cur = fresh(base)
     cur.add(CheckResult("monotone", "Box", "passed"))

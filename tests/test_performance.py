@@ -160,3 +160,11 @@ def test_the_memory_record_holds_in_a_fresh_process():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     status, ratio = json.loads(out.stdout.strip().splitlines()[-1])
     assert status == PASSED and ratio <= performance.MEMORY_TARGET, (status, ratio)
+
+
+def test_a_study_that_holds_whole_trajectories_fails_the_memory_record():
+    """A stepper returning whole arrays (any user stepper: only verimono's own solve streams) makes the study
+    hold a trajectory of every grid: the record must fail (2.3x measured), not pass on the coarse grids."""
+    rec = performance.check_memory(steps=performance.SIZES["ci"].memory_steps,
+                                   stepper=lambda problem, t: solve(problem, t))
+    assert rec.status == FAILED and rec.details["ratio"] > performance.MEMORY_TARGET, rec

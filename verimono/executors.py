@@ -3,7 +3,9 @@ studies) mapped over an executor, their results merged in the units' own order.
 
 ``verimono run --executor SPEC`` (and ``verimono check``) chooses where units run:
 
-* ``serial`` (the default): in this process, one after the other;
+* ``serial`` (the default of ``verimono check`` and of the Python API): in this process, one after the other;
+* ``auto`` (the default of ``verimono run``; ``$VERIMONO_EXECUTOR`` overrides): ``process:N`` with ``N`` the
+  machine's cores (at most :data:`AUTO_MAX_WORKERS`), serial on a one-core machine;
 * ``process:N``: ``N`` worker processes of this machine (started with ``spawn``);
 * ``tcp://host:port`` (any ``scheme://address``): the workers of a running ``dask.distributed`` scheduler
   (``pip install "verimono[dask]"``; verimono must be importable on the workers).
@@ -399,12 +401,20 @@ class DaskRunner:
             self.client.close()
 
 
+#: ``auto`` starts at most this many worker processes (a run has about 15 units per stage)
+AUTO_MAX_WORKERS = 4
+
+
 def make_runner(spec: Any = None, *, timeout: float | None = None) -> Any:
-    """A runner for ``spec``: ``None``/``"serial"``, ``"process:N"``, a ``scheme://address`` of a dask
+    """A runner for ``spec``: ``None``/``"serial"``, ``"auto"`` (``process:N`` with ``N`` this machine's cores,
+    at most :data:`AUTO_MAX_WORKERS`; serial on one core), ``"process:N"``, a ``scheme://address`` of a dask
     scheduler, or a ``distributed.Client``; :class:`BadExecutor` for anything else."""
     if spec is None or spec == "serial":
         return SerialRunner()
     if isinstance(spec, str):
+        if spec == "auto":   # every core of this machine, up to AUTO_MAX_WORKERS; serial on one core
+            n = min(os.cpu_count() or 1, AUTO_MAX_WORKERS)
+            return ProcessRunner(n, timeout) if n >= 2 else SerialRunner()
         if spec.startswith("process:"):
             try:
                 n = int(spec.partition(":")[2])
@@ -426,5 +436,5 @@ def make_runner(spec: Any = None, *, timeout: float | None = None) -> Any:
     raise BadExecutor(f"executor must be serial, process:N, a dask scheduler address or Client, got {spec!r}")
 
 
-__all__ = ["Unit", "UNIT_CHECK", "ship_by_value", "BadExecutor", "SerialRunner", "ProcessRunner", "DaskRunner", "make_runner",
+__all__ = ["Unit", "UNIT_CHECK", "AUTO_MAX_WORKERS", "ship_by_value", "BadExecutor", "SerialRunner", "ProcessRunner", "DaskRunner", "make_runner",
            "unit_failure", "run_payload"]

@@ -21,7 +21,8 @@
   record's order claim is no longer backed by any errors);
 * **incomplete** — results marked ``meta.incomplete`` (an interrupted run) are refused: exit status 2;
 * **timing** — a stage's duration divided by the calibration workload measured in the same job (or a
-  record's ``details["timing_ratio"]``, a same-job ratio) grows by more than ``TIMING_GROWTH``.
+  record's ``details["timing_ratio"]``, a same-job ratio) grows by more than ``TIMING_GROWTH``; stage
+  durations are compared only between runs on the same executor (``meta.executor``: serial, process:N, ...).
 
 Baseline and results must come from the same kind of run (command, target, profile and the selected
 stages and references), be well-formed documents of a readable schema version
@@ -252,6 +253,11 @@ def _compare_studies(base: Report, cur: Report, out: list[Change]) -> None:
 def _compare_timings(base: Report, cur: Report, out: list[Change]) -> None:
     bcal, ccal = base.meta.get("calibration"), cur.meta.get("calibration")
     if not (isinstance(bcal, (int, float)) and isinstance(ccal, (int, float)) and bcal > 0 and ccal > 0):
+        return
+    bex, cex = base.meta.get("executor") or "serial", cur.meta.get("executor") or "serial"
+    if bex != cex:   # a stage's wall time depends on how many workers ran its units: not comparable
+        out.append(Change("timing", "stages", f"stage times not compared: the baseline's units ran on {bex}, "
+                                              f"these on {cex}", False))
         return
     before = {s["name"]: s for s in base.meta.get("stages") or [] if isinstance(s, dict)}
     for s in cur.meta.get("stages") or []:

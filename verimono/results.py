@@ -31,7 +31,10 @@ Layout (schema ``verimono.results``, version ``SCHEMA_VERSION`` = ``MAJOR.MINOR`
         "selection": {"stages": [...] | null,          #   the --stage and --reference choices (null: all)
                       "references": [...] | null},
         "stages": [{"name", "status", "records", "duration", "message"}],   # one per stage, in order
-        "calibration": 0.012,                          #   seconds of a fixed NumPy workload, same job
+        "executor": "serial" | "process:2" | ...,      #   where the stages' units ran (stage times compare
+                                                       #   only between runs on the same executor)
+        "calibrations": [0.012, 0.013],                #   the workload timed before and after the stages
+        "calibration": 0.013,                          #   the slower of the two: the unit of stage times
         "duration": 93.5,                              #   seconds of the whole run (or pytest session)
         "data_dir": "/path/to/shared" | null,          #   Siconos reference data used, if any
         "environment": {...}                           #   see environment() below

@@ -245,6 +245,18 @@ def _feasible(M, q) -> bool:
     return res.status != 2
 
 
+def proved_solvable(M, q, scale: float | None = None) -> bool:
+    """A cheap proof that ``LCP(q, M)`` has a solution: Lemke's pivoting, on the data scaled as in
+    :func:`solve_lcp`, returns a point that passes the residual check.  ``False`` proves nothing."""
+    M, q = np.asarray(M, float), np.asarray(q, float)
+    if np.all(q >= 0):
+        return True
+    s = max(float(np.abs(q).max()), 0.0 if scale is None else float(scale))
+    beta = float(np.abs(M).max()) or 1.0
+    z, _ = lemke(M / beta, q / s)
+    return z is not None and bool(np.all(np.isfinite(z))) and _verified(M / beta, q / s, z)[0]
+
+
 def _infeasibility_certificate(M, q) -> np.ndarray | None:
     """``ζ ∈ Q_M = {ζ ≥ 0, Mζ ≥ 0, (M+Mᵀ)ζ = 0}`` with ``qᵀζ < 0`` (so ``q ∉ Q_M^+``), for PSD ``M``."""
     n = q.shape[0]

@@ -30,7 +30,7 @@ from ..problem import Problem
 from ..qp import solve_qp
 from ..stepping import Trajectory
 from ..tolerances import tolerance
-from .lcp import _box_lcp, _feasible, is_psd, select_over_sol, solve_lcp
+from .lcp import _box_lcp, _feasible, is_psd, proved_solvable, select_over_sol, solve_lcp
 from .kernel import BatchStepError
 from .relations import BoxRelation, as_relation
 
@@ -465,8 +465,10 @@ class LCSOperator(Operator):
         lo, hi = rel.bounds(s.m)
         if np.all(np.isfinite(hi)):
             return x.copy()  # bounded box: 𝓜 + D is surjective, dom H = R^n
-        big, qq, fin = _box_lcp(s.D, s.C @ x + s.v(t), lo, hi)
-        if _feasible(big, qq):
+        v = s.v(t)
+        big, qq, fin = _box_lcp(s.D, s.C @ x + v, lo, hi)
+        # a verified multiplier proves x ∈ dom H(t) at a fraction of the linear program's cost
+        if proved_solvable(big, qq, s.q_scale(x, v)) or _feasible(big, qq):
             return x.copy()
         # min ½|x' − x|² over {(x', z): z ≥ 0, D z + C x' + v ≥ 0} (complementarity: dom = C^{-1}(Q_D^+ − v))
         if not rel.is_lcp:
