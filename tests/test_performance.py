@@ -168,3 +168,20 @@ def test_a_study_that_holds_whole_trajectories_fails_the_memory_record():
     rec = performance.check_memory(steps=performance.SIZES["ci"].memory_steps,
                                    stepper=lambda problem, t: solve(problem, t))
     assert rec.status == FAILED and rec.details["ratio"] > performance.MEMORY_TARGET, rec
+
+
+def test_on_worker_processes_the_memory_record_runs_beside_the_timed_ones(monkeypatch):
+    """With an idle worker the memory record (bytes, not seconds) runs there while the timed records run
+    here; the records, their order and the memory verdict are those of the serial stage."""
+    from verimono.executors import ProcessRunner
+
+    monkeypatch.setitem(performance.SIZES, "ci", SMALL)
+    runner = ProcessRunner(2)
+    try:
+        rep = STAGES["performance"].fn(get_profile("ci"), RunContext(executor=runner))
+    finally:
+        runner.close()
+    assert [r.check for r in rep][-3:] == ["performance_lcs_step", "performance_lcs_batch", "performance_memory"]
+    assert len(rep) == 15
+    mem = rep.results[-1]
+    assert mem.status == PASSED and mem.details["ratio"] <= performance.MEMORY_TARGET, str(mem)

@@ -461,7 +461,25 @@ def performance_stage(profile: Profile, context: RunContext) -> Report:
     """The issue 6 targets as records (``verimono.performance``), at the sizes of ``profile``; each
     record's ``details["timing_ratio"]`` is gated against the baseline by ratio, never by seconds."""
     perf = optional_module("verimono.performance")
-    return perf.performance_report(perf.SIZES[profile.name], stepper=context.stepper, progress=context.progress)
+    aside = None
+    if getattr(context.executor, "workers", 1) >= 2:   # a worker is idle: the memory record runs there
+        def aside(steps: int, stepper: Any) -> Callable[[], CheckResult]:
+            import concurrent.futures
+
+            unit = Unit("performance", "memory", _memory_unit, (steps, stepper))
+            pool = concurrent.futures.ThreadPoolExecutor(1)
+            future = pool.submit(context.executor.map, [unit], profile.name, lambda done, total, label: None)
+            pool.shutdown(wait=False)
+            return lambda: future.result()[0].results[0]
+    return perf.performance_report(perf.SIZES[profile.name], stepper=context.stepper, progress=context.progress,
+                                   aside=aside)
+
+
+def _memory_unit(steps: int, stepper: Any) -> Report:
+    """The memory record (:func:`verimono.performance.check_memory`) as a unit of work."""
+    from .performance import check_memory
+
+    return Report([check_memory(steps=steps, stepper=stepper)])
 
 
 __all__ = ["STAGES", "Stage", "RunContext", "StageUnavailable", "UnknownStage", "register_stage",
