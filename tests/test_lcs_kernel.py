@@ -12,15 +12,8 @@ from verimono.lcs import kernel as K
 from verimono.lcs.siconos_cases import diode_bridge, filippov, relay_oscillator
 from verimono.performance import minimal_lcs
 
-
-def random_passive(rng, n=3, m=2):
-    """A + Aᵀ ⪯ 0, C = Bᵀ, D = RᵀR + skew with rank-1 R: ker(D + Dᵀ) ≠ {0}, SOL need not be a singleton."""
-    S = rng.normal(size=(n, n))
-    A = (S - S.T) - 0.3 * np.diag(rng.uniform(size=n))
-    B = rng.normal(size=(n, m))
-    R = rng.normal(size=(1, m))
-    Dk = rng.normal(size=(m, m))
-    return A, B, B.T.copy(), R.T @ R + (Dk - Dk.T)
+# A + Aᵀ ⪯ 0, C = Bᵀ, D = RᵀR + skew with rank-1 R: ker(D + Dᵀ) ≠ {0}, so SOL need not be a singleton
+from test_lcs_system import random_passive
 
 
 def step_by_step(sys, x0, t, theta, gamma=None):

@@ -477,9 +477,7 @@ def performance_stage(profile: Profile, context: RunContext) -> Report:
 
 def _memory_unit(steps: int, stepper: Any) -> Report:
     """The memory record (:func:`verimono.performance.check_memory`) as a unit of work."""
-    from .performance import check_memory
-
-    return Report([check_memory(steps=steps, stepper=stepper)])
+    return Report([optional_module("verimono.performance").check_memory(steps=steps, stepper=stepper)])
 
 
 __all__ = ["STAGES", "Stage", "RunContext", "StageUnavailable", "UnknownStage", "register_stage",
