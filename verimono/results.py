@@ -34,7 +34,7 @@ Layout (schema ``verimono.results``, version ``SCHEMA_VERSION`` = ``MAJOR.MINOR`
         "executor": "serial" | "process:2" | ...,      #   where the stages' units ran (stage times compare
                                                        #   only between runs on the same executor)
         "calibrations": [0.012, 0.013],                #   the workload timed before and after the stages
-        "calibration": 0.013,                          #   the slower of the two: the unit of stage times
+        "calibration": 0.012,                          #   the faster of the two: the unit of stage times
         "duration": 93.5,                              #   seconds of the whole run (or pytest session)
         "data_dir": "/path/to/shared" | null,          #   Siconos reference data used, if any
         "environment": {...}                           #   see environment() below
