@@ -75,12 +75,19 @@ def _directions(x, p, n, seed_like) -> list[np.ndarray]:
     return dirs
 
 
+def _prox_point(op, s, what):
+    """``(p, g(p))`` for ``p = J_λ(x1)`` at the sample, or the outcome recording ``p ∉ dom g`` for ``what``."""
+    p = _J(op, s.x1, s.lam, s.t)
+    gp = _g(op, p, s.t)
+    return (p, gp) if math.isfinite(gp) else _outside(p, gp, what)
+
+
 def _prox_inequality(op, s):
     x, lam, t = s.x1, s.lam, s.t
-    p = _J(op, x, lam, t)
-    gp = _g(op, p, t)
-    if not math.isfinite(gp):
-        return _outside(p, gp, "prox inequality")
+    got = _prox_point(op, s, "prox inequality")
+    if isinstance(got, Outcome):
+        return got
+    p, gp = got
     cands = [("x2", s.x2), ("x1", x), ("0", np.zeros_like(x))]
     for k, (lab, v) in enumerate((("J_μ x2", s.x2), ("J_μ x1", x), ("J_ν x2", s.x2))):
         try:
@@ -109,10 +116,10 @@ def _phi(op, z, x, lam, t):
 
 def _prox_optimal(op, s):
     x, lam, t = s.x1, s.lam, s.t
-    p = _J(op, x, lam, t)
-    gp = _g(op, p, t)
-    if not math.isfinite(gp):
-        return _outside(p, gp, "optimality")
+    got = _prox_point(op, s, "optimality")
+    if isinstance(got, Outcome):
+        return got
+    p, gp = got
     fp = lam * gp + 0.5 * float((p - x) @ (p - x))
     s0 = 1.0 + float(np.max(np.abs(p), initial=0.0))
     tau, dxp = tolerance(x, p), _nrm(x - p)
@@ -147,10 +154,10 @@ def _prox_minimiser(op, s):
                                "(sample inconclusive)", {}, inconclusive=True)
     from scipy.optimize import minimize
 
-    p = _J(op, x, lam, t)
-    gp = _g(op, p, t)
-    if not math.isfinite(gp):
-        return _outside(p, gp, "independent minimiser")
+    got = _prox_point(op, s, "independent minimiser")
+    if isinstance(got, Outcome):
+        return got
+    p, gp = got
     fp = lam * gp + 0.5 * float((p - x) @ (p - x))
     big = 1e300
 
