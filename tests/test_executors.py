@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from verimono.cli import main
-from verimono.executors import BadExecutor, SerialRunner, Unit, make_runner
+from verimono.executors import BadExecutor, ProcessRunner, SerialRunner, Unit, make_runner
 from verimono.results import CheckResult, Report
 
 REF = ["--reference", "moving box", "--reference", "t|x| (n=1)"]
@@ -181,3 +181,22 @@ def test_run_uses_every_core_by_default(monkeypatch, tmp_path, capsys):
     assert main(["run", "--profile", "ci", "--stage", "convergence", "--reference", "t|x| (n=1)",
                  "--out", str(tmp_path)]) == 0
     assert json.loads((tmp_path / "results.json").read_text())["meta"]["executor"] == "serial"
+
+
+def test_prestarted_workers_run_the_first_units_and_close_cleanly():
+    """``prestart`` launches the workers without waiting (verimono run calibrates meanwhile); the first map
+    uses them, and closing a runner whose launched workers never ran a unit leaves no process behind."""
+    runner = ProcessRunner(2)
+    runner.prestart()
+    launched = [proc for proc, _ in runner._launched]
+    assert len(launched) == 2 and all(p.is_alive() for p in launched)
+    units = [Unit("s", "a", _ok, ("a",)), Unit("s", "b", _ok, ("b",))]
+    reports = runner.map(units, None, lambda done, total, label: None)
+    assert [r.key for rep in reports for r in rep] == ["law[a]", "law[b]"]
+    assert sorted(proc.pid for proc, _ in runner._pool) == sorted(p.pid for p in launched)   # no new start
+    runner.close()
+    idle = ProcessRunner(2)
+    idle.prestart()
+    procs = [proc for proc, _ in idle._launched]
+    idle.close()
+    assert not any(p.is_alive() for p in procs)

@@ -122,6 +122,8 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
     if executor is not None and context.executor is None:
         print(f"verimono: units run on {runner.spec}", file=sys.stderr)
     context.executor = context.executor if context.executor is not None else runner
+    if hasattr(runner, "prestart"):   # workers import while this process calibrates and builds the catalog
+        runner.prestart()
     cal = calibrate()
     start = time.perf_counter()
     def done(stage, rep, info):
