@@ -328,3 +328,54 @@ def test_a_limit_of_verimonos_own_solvers_is_undecided_never_failed_nor_passed()
         raise vm.SolverFailure("the user's own solver failed")
     rec = run_law("resolvent_single_valued", vm.operator_from_resolvent(raises, 2, name="own"), seed=1, examples=5)
     assert rec.status == "failed" and "SolverFailure" in rec.message, str(rec)   # the root cause, as any raise
+
+
+def test_a_law_sees_the_numpy_draws_then_a_short_hypothesis_search_then_the_sweep():
+    """examples NumPy draws, then examples // HYPOTHESIS_SHARE hypothesis examples (at least HYPOTHESIS_MIN),
+    then the scale sweep: every sample counted once in details["evaluations"]."""
+    from verimono.checks import operator_laws as L
+    from verimono.reference import get
+
+    op = get("t|x| (n=3)").operator
+    for examples in (4, 20, 40):
+        r = run_law("resolvent_nonexpansive", op, seed=3, examples=examples)
+        hyp = max(L.HYPOTHESIS_MIN, examples // L.HYPOTHESIS_SHARE)
+        assert r.status == "passed" and r.details["evaluations"] == examples + hyp + r.details["sweep"], r.details
+
+
+def test_a_violation_only_the_draws_meet_is_shrunk_and_replays(monkeypatch):
+    """With hypothesis confined to one harmless sample (x1 = x2 = 0), the explicit step's violation comes from
+    the NumPy draws: recorded as theirs, shrunk greedily, and replayed by sample=."""
+    from hypothesis import strategies as st
+
+    from verimono.checks import operator_laws as L
+
+    harmless = st.just(L.Sample(np.zeros(2), np.zeros(2), 1.0, 1.0, 1.0, 0.0))
+    monkeypatch.setattr(L, "law_samples", lambda n, horizon=1.0: harmless)
+    monkeypatch.setattr(L, "_sweep", lambda *a, **k: 0)          # nor the sweep: only the draws can find it
+    r = run_law("resolvent_nonexpansive", zoo.build("explicit_step"), seed=0, examples=20)
+    assert r.status == "failed" and r.counterexample["found_by"] == "NumPy draws (shrunk greedily)", str(r)
+    again = run_law("resolvent_nonexpansive", zoo.build("explicit_step"), sample=r.counterexample)
+    assert again.status == "failed", str(again)
+    monkeypatch.setattr(L, "HYPOTHESIS_MIN", 0)
+    monkeypatch.setattr(L, "law_draws", lambda *a, **k: [])     # without the draws nothing finds it
+    assert run_law("resolvent_nonexpansive", zoo.build("explicit_step"), seed=0, examples=20).status == "passed"
+
+
+def test_law_draws_are_seeded_in_range_and_favour_simple_values():
+    """The NumPy draws follow law_samples: x1 in [-10, 10]^n, x2 within 1e-2 of x1 about half the time, step
+    sizes in [1e-3, 10] (the strategy's simple ones about half the time), t in [0, T]; the same seed draws
+    the same samples, another seed others."""
+    from verimono.checks.operator_laws import Sample
+    from verimono.checks.sweep import law_draws
+
+    a = law_draws(3, 5, 2.0, 400, Sample)
+    assert [s.to_dict() for s in a] == [s.to_dict() for s in law_draws(3, 5, 2.0, 400, Sample)]
+    assert [s.to_dict() for s in a] != [s.to_dict() for s in law_draws(3, 6, 2.0, 400, Sample)]
+    x1 = np.array([s.x1 for s in a])
+    assert np.all(np.abs(x1) <= 10.0) and 0.15 < np.mean(np.isin(x1, (0.0, 0.5, -0.5, 1.0, -1.0, 2.0, -2.0))) < 0.5
+    near = np.mean([np.max(np.abs(s.x2 - s.x1)) <= 1e-2 for s in a])
+    assert 0.35 < near < 0.65
+    steps = np.array([[s.lam, s.mu, s.nu] for s in a])
+    assert np.all((steps >= 1e-3) & (steps <= 10.0)) and 0.35 < np.mean(np.isin(steps, (1.0, 0.5, 2.0, 0.1, 10.0, 1e-3))) < 0.65
+    assert all(0.0 <= s.t <= 2.0 for s in a) and 0.35 < np.mean([s.t in (0.0, 1.0, 2.0) for s in a]) < 0.65

@@ -68,6 +68,44 @@ def sweep_samples(op, seed: int, horizon: float, count: int, make: Callable) -> 
     return out
 
 
+#: the values hypothesis's float strategies favour, drawn here as often: ends of the range, 0, ±1, ±1/2, ±2
+_NASTY = (0.0, 1.0, -1.0, 0.5, -0.5, 2.0, -2.0, 10.0, -10.0)
+#: the simple step sizes and times of :func:`verimono.strategies.step_sizes` / :func:`~verimono.strategies.times`
+_SIMPLE_STEPS = (1.0, 0.5, 2.0, 0.1, 10.0, 1e-3)
+
+
+def law_draws(n: int, seed: int, horizon: float, count: int, make: Callable, scale: float = 10.0) -> list:
+    """``count`` samples like :func:`verimono.checks.operator_laws.law_samples` draws them — ``x1`` in
+    ``[-scale, scale]^n``, ``x2`` independent or within ``10^-2`` of ``x1`` (half each), ``λ, μ, ν`` in
+    ``[10^-3, 10]``, ``t`` in ``[0, horizon]`` — with hypothesis's preference for simple values (each coordinate
+    is one of 0, ±1/2, ±1, ±2, ±scale a quarter of the time, a small integer another eighth; half the step
+    sizes and times are the strategies' simple ones), but drawn by NumPy from ``default_rng(seed)``, about a
+    hundred times faster than hypothesis's engine draws a sample."""
+    rng = np.random.default_rng([int(seed) % (2 ** 63), int(n), int(count), 1])
+
+    def point(size: float) -> np.ndarray:
+        u = rng.uniform(-size, size, n)
+        pick = rng.uniform(size=n)
+        nasty = np.array(_NASTY) * (size / 10.0)
+        u = np.where(pick < 0.25, nasty[rng.integers(len(nasty), size=n)], u)
+        return np.where((pick >= 0.25) & (pick < 0.375), np.rint(u), u)
+
+    def step() -> float:
+        if rng.uniform() < 0.5:
+            return float(_SIMPLE_STEPS[rng.integers(len(_SIMPLE_STEPS))])
+        return float(10.0 ** rng.uniform(-3.0, 1.0)) if rng.uniform() < 0.5 else float(rng.uniform(1e-3, 10.0))
+
+    out = []
+    for _ in range(count):
+        x1 = point(scale)
+        x2 = x1 + point(1e-2) if rng.uniform() < 0.5 else point(scale)
+        lam, mu, nu = step(), step(), step()
+        t = (0.0, float(horizon), 0.5 * horizon)[rng.integers(3)] if rng.uniform() < 0.5 else \
+            float(rng.uniform(0.0, horizon))
+        out.append(make(x1, x2, lam, mu, nu, float(t)))
+    return out
+
+
 def _simpler_floats(v: float) -> list[float]:
     if v == 0.0:
         return []
@@ -118,4 +156,4 @@ def shrink(sample, fails: Callable[[object], bool], replace: Callable, budget: i
     return sample, calls
 
 
-__all__ = ["SCALES", "SWEEP_BY_PROFILE", "SWEEP_CAP", "sweep_count", "sweep_samples", "shrink"]
+__all__ = ["SCALES", "SWEEP_BY_PROFILE", "SWEEP_CAP", "sweep_count", "sweep_samples", "law_draws", "shrink"]
