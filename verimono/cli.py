@@ -122,9 +122,14 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
     if executor is not None and context.executor is None:
         print(f"verimono: units run on {runner.spec}", file=sys.stderr)
     context.executor = context.executor if context.executor is not None else runner
-    if hasattr(runner, "prestart"):   # workers import while this process calibrates and builds the catalog
+    cal = calibrate()                 # on a quiet machine, before any worker starts
+    if hasattr(runner, "prestart"):   # the workers import while this process builds the catalog
         runner.prestart()
-    cal = calibrate()
+    if getattr(runner, "workers", 1) >= 2:   # this process waits on the workers: draw the report's first
+        import threading                     # figure meanwhile (matplotlib's import and font cache)
+
+        from .report.plots import warm_up
+        threading.Thread(target=warm_up, name="verimono-report-warm-up", daemon=True).start()
     start = time.perf_counter()
     def done(stage, rep, info):
         progress.done(stage, rep, info)

@@ -323,7 +323,14 @@ class ProcessRunner:
         return [r for r in results]  # type: ignore[misc]
 
     def close(self, kill: bool = False) -> None:
-        for w in self._pool + self._launched:
+        workers = self._pool + self._launched
+        if not kill:   # ask every worker to stop first, so that they shut down together
+            for _, conn in workers:
+                try:
+                    conn.send_bytes(b"")
+                except OSError:
+                    pass
+        for w in workers:
             self._stop(w, kill=kill)
         self._pool, self._launched = [], []
 
