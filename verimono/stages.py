@@ -406,53 +406,74 @@ def _assumptions_unit(check_assumptions: Callable, p: Any, seed: int | None) -> 
 def section7_stage(profile: Profile, context: RunContext) -> Report:
     """The complementarity systems of the paper (``verimono.reference.lcs_example``): convergence order
     of the stepper under test on each, a trajectory sample, and the evidence for the hypotheses of the
-    Section 7 theorems (``verimono.lcs.check_hypotheses``)."""
+    Section 7 theorems (``verimono.lcs.check_hypotheses``); one unit per record (or per system)."""
     example = optional_module("verimono.reference.lcs_example")
-    lcs = optional_module("verimono.lcs")
-    from .checks.orders import check_convergence_order
-
+    optional_module("verimono.lcs")
     stepper = solve if context.stepper is None else context.stepper
-    report = Report()
     in_catalog = {p.name for p in context.catalog()}  # already studied by the convergence stage
     problems = [p for p in (example.ramp_problem(), example.sine_problem()) if p.name not in in_catalog]
-    for i, p in enumerate(problems):
-        context.progress(i, len(problems) + 1, p.name)
-        rec = report.add(run_unit(lambda: check_convergence_order(stepper, p), check="convergence_order",
-                                  subject=f"{_name(stepper)} on {p.name}"))
-        if rec.study is not None:
-            report.studies.append(rec.study)
-        report.trajectories.append(sample_trajectory(stepper, p))
     seed = context.seed_for(profile)
-    report.add(example.check_closed_form_resolvent(seed=0 if seed is None else seed))
+    seed = 0 if seed is None else seed
+    units = [Unit("section7", p.name, _convergence_unit, (stepper, p)) for p in problems]
+    units += [Unit("section7", "closed-form resolvent", _record_unit, ("check_closed_form_resolvent", seed))]
     if hasattr(example, "check_batched_scheme"):   # a batch of trajectories in one simulate (issue 15)
-        report.add(example.check_batched_scheme(seed=0 if seed is None else seed))
-    report.add(example.check_pseudo_distance_unbounded())
+        units.append(Unit("section7", "batched scheme", _record_unit, ("check_batched_scheme", seed)))
+    units.append(Unit("section7", "unbounded pseudo-distance", _record_unit, ("check_pseudo_distance_unbounded",)))
     # def:dis against the exact d_H of catalog sets, and the Picard step of Section 6 (issue 13)
-    from .checks.picard import check_picard
+    units.append(Unit("section7", "pseudo-distance", _pseudo_distance_unit, (seed,)))
+    units += [Unit("section7", f"Picard step on {p.name}", _picard_unit, (stepper, p)) for p in context.catalog()
+              if p.f is not None and p.lipschitz is not None]
+    units += [Unit("section7", f"hypotheses ({label})", _hypotheses_unit, (label, seed)) for label in _INPUTS]
+    return _merged(context.run_units(profile, units))
+
+
+#: the Example's inputs whose hypotheses Section 7 checks (a name each: units travel by name, not by lambda)
+_INPUTS = {"v = (−t, 0)": lambda t: np.array([-t, 0.0]), "v = (sin t, 0)": lambda t: np.array([np.sin(t), 0.0])}
+
+
+def _record_unit(name: str, *args: Any) -> Report:
+    """One record of ``verimono.reference.lcs_example`` (``name(*args)``, ``args`` the seed if any)."""
+    fn = getattr(optional_module("verimono.reference.lcs_example"), name)
+    return Report([fn(seed=args[0]) if args else fn()])
+
+
+def _pseudo_distance_unit(seed: int) -> Report:
     from .checks.pseudo_distance import check_pseudo_distance
-    report.add(check_pseudo_distance(seed=0 if seed is None else seed))
-    for p in context.catalog():
-        if p.f is not None and p.lipschitz is not None:
-            report.add(check_picard(stepper, p))
-    for label, v in (("v = (−t, 0)", lambda t: np.array([-t, 0.0])),
-                     ("v = (sin t, 0)", lambda t: np.array([np.sin(t), 0.0]))):
-        rep = lcs.check_hypotheses(example.example_system(v), 2.0, seed=0 if seed is None else seed)
-        for r in rep.results:
-            r.subject = f"{r.subject} ({label})"
-        report.extend(rep)
-    return report
+
+    return Report([check_pseudo_distance(seed=seed)])
+
+
+def _picard_unit(stepper: Callable, problem: Any) -> Report:
+    from .checks.picard import check_picard
+
+    return Report([check_picard(stepper, problem)])
+
+
+def _hypotheses_unit(label: str, seed: int) -> Report:
+    """The Section 7 hypotheses of the Example with input ``label``, each record's subject naming it."""
+    example = optional_module("verimono.reference.lcs_example")
+    rep = optional_module("verimono.lcs").check_hypotheses(example.example_system(_INPUTS[label]), 2.0, seed=seed)
+    for r in rep.results:
+        r.subject = f"{r.subject} ({label})"
+    return rep
 
 
 @register_stage("siconos", "agreement with the Siconos reference trajectories in the shared data folder")
 def siconos_stage(profile: Profile, context: RunContext) -> Report:
     """Agreement with the Siconos reference trajectories (needs ``../shared`` or ``--data DIR``)."""
-    mod = optional_module("verimono.lcs")
-    fn = getattr(mod, "check_siconos", None)
-    if fn is None:
-        raise StageUnavailable("verimono.lcs has no check_siconos(data_dir)")
+    cases = optional_module("verimono.lcs.siconos_cases")
     if context.data_dir is None:
         raise StageUnavailable("Siconos reference data not found: pass --data DIR or set VERIMONO_SHARED")
-    return fn(Path(context.data_dir))
+    data = Path(context.data_dir)
+    units = [Unit("siconos", name, _siconos_unit, ("check_siconos_case", name, data)) for name in cases.CASES]
+    units.append(Unit("siconos", "LCP test files", _siconos_unit, ("check_siconos_lcps", data)))
+    return _merged(context.run_units(profile, units))
+
+
+def _siconos_unit(name: str, *args: Any) -> Report:
+    """``verimono.lcs.siconos_cases.<name>(*args)`` as a report (one trajectory case, or the LCP files)."""
+    out = getattr(optional_module("verimono.lcs.siconos_cases"), name)(*args)
+    return out if isinstance(out, Report) else Report([out])
 
 
 @register_stage("performance", "verimono against bare baselines, as same-job ratios: per-step overhead, "
