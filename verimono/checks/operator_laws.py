@@ -610,7 +610,7 @@ def _sweep(law: Law, op: Operator, seed: int, horizon: float, state: "_State", b
 
 def run_law(law: Law | str, op: Operator, *, seed: int | None = None, examples: int | None = None,
             horizon: float = 1.0, sample: Sample | dict | None = None) -> CheckResult:
-    """Check one law on ``op`` by hypothesis search (or on one given ``sample``).
+    """Check one law on ``op``: NumPy draws, a hypothesis search and the scale sweep (or one given ``sample``).
 
     ``examples=None``: the active profile's effort (:func:`default_examples`).  Inconclusive samples (the
     law can neither hold nor fail there) are counted in ``details["inconclusive"]``; a record whose every
