@@ -200,3 +200,32 @@ def test_prestarted_workers_run_the_first_units_and_close_cleanly():
     procs = [proc for proc, _ in idle._launched]
     idle.close()
     assert not any(p.is_alive() for p in procs)
+
+
+def test_auto_runs_serially_when_its_workers_cannot_start(monkeypatch, capsys):
+    """``auto`` is best effort: when no worker can start (a script read from standard input cannot be
+    re-imported by a spawned process) it says why and runs the units serially, recording ``serial``;
+    an explicit ``process:N`` fails instead.  The reason names the worker's exit status."""
+    import sys as _sys
+
+    def exits(self, count):
+        started = []
+        for _ in range(max(0, count)):
+            parent, child = self._ctx.Pipe(duplex=True)
+            proc = self._ctx.Process(target=_sys.exit, args=(1,))
+            proc.start()
+            child.close()
+            started.append((proc, parent))
+        return started
+
+    monkeypatch.setattr(ProcessRunner, "_launch", exits)
+    units = [Unit("s", "a", _ok, ("a",)), Unit("s", "b", _ok, ("b",))]
+    with pytest.raises(BadExecutor, match="exited with status 1 before it was ready"):
+        ProcessRunner(2).map(units, None, lambda done, total, label: None)
+    monkeypatch.setattr(os, "cpu_count", lambda: 2)
+    runner = make_runner("auto")
+    reports = runner.map(units, None, lambda done, total, label: None)
+    assert [r.key for rep in reports for r in rep] == ["law[a]", "law[b]"]
+    assert runner.spec == "serial" and runner.workers == 1
+    assert "running the units serially" in capsys.readouterr().err
+    runner.close()

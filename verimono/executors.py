@@ -5,7 +5,8 @@ studies) mapped over an executor, their results merged in the units' own order.
 
 * ``serial`` (the default of ``verimono check`` and of the Python API): in this process, one after the other;
 * ``auto`` (the default of ``verimono run``; ``$VERIMONO_EXECUTOR`` overrides): ``process:N`` with ``N`` the
-  machine's cores (at most :data:`AUTO_MAX_WORKERS`), serial on a one-core machine;
+  machine's cores (at most :data:`AUTO_MAX_WORKERS`), serial on a one-core machine or, saying why, when no
+  worker can start (a script read from standard input cannot be re-imported by a spawned process);
 * ``process:N``: ``N`` worker processes of this machine (started with ``spawn``);
 * ``tcp://host:port`` (any ``scheme://address``): the workers of a running ``dask.distributed`` scheduler
   (``pip install "verimono[dask]"``; verimono must be importable on the workers).
@@ -27,6 +28,7 @@ from __future__ import annotations
 import dataclasses
 import multiprocessing
 import os
+import sys
 import time
 import traceback
 from collections import deque
@@ -200,10 +202,13 @@ class ProcessRunner:
     """``N`` spawned worker processes, each running one unit at a time; a worker that dies or overruns
     ``timeout`` is replaced and its unit becomes a failed record (see the module docstring)."""
 
-    def __init__(self, workers: int, timeout: float | None = None) -> None:
+    def __init__(self, workers: int, timeout: float | None = None, *, fallback: bool = False) -> None:
         if workers < 1:
             raise BadExecutor(f"process:N needs N >= 1, got {workers}")
         self.workers, self.timeout = int(workers), timeout
+        #: ``auto``: when the workers cannot start, say so and run the units serially instead
+        self.fallback = fallback
+        self._serial: SerialRunner | None = None
         self.spec = f"process:{self.workers}"
         self._ctx = multiprocessing.get_context("spawn")
         self._pool: list[tuple[Any, Any]] = []  # (process, connection)
@@ -238,10 +243,14 @@ class ProcessRunner:
             except (EOFError, OSError):
                 ready = False
             if not ready:
+                w[0].join(timeout=1.0)   # a worker that died: its own exit status, before any kill
+                code = w[0].exitcode
                 for x in started:
                     self._stop(x, kill=True)
-                raise BadExecutor(f"a worker process of {self.spec} did not start within "
-                                  f"{WORKER_START_TIMEOUT:g} s (exit status {w[0].exitcode})")
+                raise BadExecutor(f"a worker process of {self.spec} " + (
+                    f"exited with status {code} before it was ready (a spawned process re-imports the main "
+                    "module: run verimono from a file or the command line, not from standard input)"
+                    if code not in (None, -9) else f"did not start within {WORKER_START_TIMEOUT:g} s"))
         return started
 
     @staticmethod
@@ -264,7 +273,17 @@ class ProcessRunner:
         results: list[Report | None] = [None] * len(units)
         pending = deque(range(len(units)))
         busy: dict[Any, tuple[tuple[Any, Any], int, float]] = {}   # conn -> (worker, unit index, start)
-        self._pool += self._start(min(self.workers, len(units)) - len(self._pool))
+        if self._serial is not None:
+            return self._serial.map(units, profile, progress)
+        try:
+            self._pool += self._start(min(self.workers, len(units)) - len(self._pool))
+        except BadExecutor as exc:
+            if not self.fallback:
+                raise
+            print(f"verimono: {exc}; running the units serially", file=sys.stderr)
+            self.close(kill=True)
+            self.workers, self.spec, self._serial = 1, "serial", SerialRunner()
+            return self._serial.map(units, profile, progress)
         idle = list(self._pool)
         done = 0
         progress(0, len(units), "")
@@ -435,7 +454,7 @@ def make_runner(spec: Any = None, *, timeout: float | None = None) -> Any:
     if isinstance(spec, str):
         if spec == "auto":   # every core of this machine, up to AUTO_MAX_WORKERS; serial on one core
             n = min(os.cpu_count() or 1, AUTO_MAX_WORKERS)
-            return ProcessRunner(n, timeout) if n >= 2 else SerialRunner()
+            return ProcessRunner(n, timeout, fallback=True) if n >= 2 else SerialRunner()
         if spec.startswith("process:"):
             try:
                 n = int(spec.partition(":")[2])
