@@ -69,14 +69,8 @@ def test_stage_time_in_calibration_units(gate, request, name):
                              f"> budget {budget:.0f} (calibration {cal:.4f} s)")
 
 
-def test_pytest_properties_in_calibration_units(gate):
-    """The whole property suite at the ci profile when timed; in the normal test run (which runs the
-    suite itself anyway) one family, ``-k contraction``, to keep the measurement path exercised."""
-    if not PROPERTIES.is_dir():
-        pytest.fail(f"{PROPERTIES} is missing: run the benchmarks from a checkout")
-    select = [] if gate.enabled else ["-k", "contraction"]
-    cmd = [sys.executable, "-m", "pytest", str(PROPERTIES), "-q", "-p", "no:cacheprovider", *select]
-    env = dict(os.environ, HYPOTHESIS_PROFILE="ci")
+def _timed_subprocess(gate, cmd: list[str], env: dict[str, str]) -> tuple[subprocess.CompletedProcess, float]:
+    """``cmd`` run once from the checkout, timed by pytest-benchmark: ``(completed process, seconds)``."""
     seconds: list[float] = []
 
     def run():
@@ -85,14 +79,26 @@ def test_pytest_properties_in_calibration_units(gate):
         seconds.append(time.perf_counter() - start)
         return done
 
-    cal = calibrate()
     done = gate.benchmark.pedantic(run, rounds=1, iterations=1, warmup_rounds=0)
-    ratio, budget = seconds[-1] / cal, gate.bound(PROPERTIES_BUDGET)
+    return done, seconds[-1]
+
+
+def test_pytest_properties_in_calibration_units(gate):
+    """The whole property suite at the ci profile when timed; in the normal test run (which runs the
+    suite itself anyway) one family, ``-k contraction``, to keep the measurement path exercised."""
+    if not PROPERTIES.is_dir():
+        pytest.fail(f"{PROPERTIES} is missing: run the benchmarks from a checkout")
+    select = [] if gate.enabled else ["-k", "contraction"]
+    cmd = [sys.executable, "-m", "pytest", str(PROPERTIES), "-q", "-p", "no:cacheprovider", *select]
+    env = dict(os.environ, HYPOTHESIS_PROFILE="ci")
+    cal = calibrate()
+    done, seconds = _timed_subprocess(gate, cmd, env)
+    ratio, budget = seconds / cal, gate.bound(PROPERTIES_BUDGET)
     summary = (done.stdout.strip().splitlines() or [""])[-1]
-    gate.benchmark.extra_info.update({"seconds": seconds[-1], "calibration_s": cal, "ratio": ratio,
+    gate.benchmark.extra_info.update({"seconds": seconds, "calibration_s": cal, "ratio": ratio,
                                       "budget": budget, "summary": summary, "timed": gate.enabled})
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-2000:]
-    assert ratio <= budget, (f"pytest properties: {seconds[-1]:.2f} s = {ratio:.1f} calibration units > budget "
+    assert ratio <= budget, (f"pytest properties: {seconds:.2f} s = {ratio:.1f} calibration units > budget "
                              f"{budget:.0f} ({summary})")
 
 
@@ -108,21 +114,13 @@ def test_verimono_run_ci_in_calibration_units(gate, tmp_path):
     select = [] if gate.enabled else ["--stage", "section7"]
     cmd = [sys.executable, "-m", "verimono.cli", "run", "--profile", "ci", "--out", str(tmp_path), *select]
     env = {k: v for k, v in os.environ.items() if k != "VERIMONO_EXECUTOR"}   # the user's default: auto
-    seconds: list[float] = []
-
-    def run():
-        start = time.perf_counter()
-        done = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=PROPERTIES.parent)
-        seconds.append(time.perf_counter() - start)
-        return done
-
     before = calibrate()
-    done = gate.benchmark.pedantic(run, rounds=1, iterations=1, warmup_rounds=0)
+    done, seconds = _timed_subprocess(gate, cmd, env)
     cal = min(before, calibrate())   # the steadier unit, as verimono run itself takes it
-    ratio, budget = seconds[-1] / cal, gate.bound(RUN_TARGET_S / REFERENCE_CALIBRATION_S)
-    gate.benchmark.extra_info.update({"seconds": seconds[-1], "calibration_s": cal, "ratio": ratio,
+    ratio, budget = seconds / cal, gate.bound(RUN_TARGET_S / REFERENCE_CALIBRATION_S)
+    gate.benchmark.extra_info.update({"seconds": seconds, "calibration_s": cal, "ratio": ratio,
                                       "budget": budget, "timed": gate.enabled})
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-2000:]
-    assert ratio <= budget, (f"verimono run --profile ci: {seconds[-1]:.2f} s = {ratio:.1f} calibration units > "
+    assert ratio <= budget, (f"verimono run --profile ci: {seconds:.2f} s = {ratio:.1f} calibration units > "
                              f"budget {budget:.0f} (target {RUN_TARGET_S:g} s at calibration "
                              f"{REFERENCE_CALIBRATION_S:g} s)")

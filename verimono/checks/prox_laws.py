@@ -20,6 +20,7 @@ negative or small ratio holds.  Slacks: ``τ = tolerance(x, p, z)`` per point (t
 
 from __future__ import annotations
 
+import functools
 import math
 import zlib
 
@@ -75,19 +76,22 @@ def _directions(x, p, n, seed_like) -> list[np.ndarray]:
     return dirs
 
 
-def _prox_point(op, s, what):
-    """``(p, g(p))`` for ``p = J_λ(x1)`` at the sample, or the outcome recording ``p ∉ dom g`` for ``what``."""
-    p = _J(op, s.x1, s.lam, s.t)
-    gp = _g(op, p, s.t)
-    return (p, gp) if math.isfinite(gp) else _outside(p, gp, what)
+def _at_prox_point(what):
+    """A value law evaluated at ``p = J_λ(x1)``: ``body(op, s, p, g(p))``, or the outcome recording
+    ``p ∉ dom g`` (for ``what``) when ``g(p) = ∞``."""
+    def decorate(body):
+        @functools.wraps(body)
+        def evaluate(op, s):
+            p = _J(op, s.x1, s.lam, s.t)
+            gp = _g(op, p, s.t)
+            return body(op, s, p, gp) if math.isfinite(gp) else _outside(p, gp, what)
+        return evaluate
+    return decorate
 
 
-def _prox_inequality(op, s):
+@_at_prox_point("prox inequality")
+def _prox_inequality(op, s, p, gp):
     x, lam, t = s.x1, s.lam, s.t
-    got = _prox_point(op, s, "prox inequality")
-    if isinstance(got, Outcome):
-        return got
-    p, gp = got
     cands = [("x2", s.x2), ("x1", x), ("0", np.zeros_like(x))]
     for k, (lab, v) in enumerate((("J_μ x2", s.x2), ("J_μ x1", x), ("J_ν x2", s.x2))):
         try:
@@ -114,12 +118,9 @@ def _phi(op, z, x, lam, t):
     return lam * _g(op, z, t) + 0.5 * float((z - x) @ (z - x))
 
 
-def _prox_optimal(op, s):
+@_at_prox_point("optimality")
+def _prox_optimal(op, s, p, gp):
     x, lam, t = s.x1, s.lam, s.t
-    got = _prox_point(op, s, "optimality")
-    if isinstance(got, Outcome):
-        return got
-    p, gp = got
     fp = lam * gp + 0.5 * float((p - x) @ (p - x))
     s0 = 1.0 + float(np.max(np.abs(p), initial=0.0))
     tau, dxp = tolerance(x, p), _nrm(x - p)
@@ -147,17 +148,18 @@ def _prox_optimal(op, s):
 
 
 def _prox_minimiser(op, s):
-    x, lam, t = s.x1, s.lam, s.t
-    n = x.size
-    if n > MINIMISER_MAX_DIM:
+    if s.x1.size > MINIMISER_MAX_DIM:
         return Outcome.compare(0.0, 0.0, 1.0, f"independent minimiser runs only for n ≤ {MINIMISER_MAX_DIM} "
                                "(sample inconclusive)", {}, inconclusive=True)
+    return _minimised(op, s)
+
+
+@_at_prox_point("independent minimiser")
+def _minimised(op, s, p, gp):
     from scipy.optimize import minimize
 
-    got = _prox_point(op, s, "independent minimiser")
-    if isinstance(got, Outcome):
-        return got
-    p, gp = got
+    x, lam, t = s.x1, s.lam, s.t
+    n = x.size
     fp = lam * gp + 0.5 * float((p - x) @ (p - x))
     big = 1e300
 
