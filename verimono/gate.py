@@ -26,7 +26,7 @@
 
 Baseline and results must come from the same kind of run (command, target, profile and the selected
 stages and references), be well-formed documents of a readable schema version
-(:mod:`verimono.report.schema` type-checks every field the gate reads), and the baseline must hold at
+(:mod:`verimono.schema` type-checks every field the gate reads), and the baseline must hold at
 least one executed record; otherwise :class:`IncompatibleBaseline` / ``SchemaError`` — the gate fails
 closed with exit status 2.
 """
@@ -40,7 +40,7 @@ from pathlib import Path
 from typing import Any
 
 from .convergence import ORDER_SLACK
-from .errors import IncompatibleBaseline, IncompatibleResults, SchemaError
+from .errors import IncompatibleBaseline, IncompatibleResults
 from .results import FAILED, PASSED, SKIPPED, UNDECIDED, XFAIL, Report, load
 
 #: smallest drop of a fitted slope that counts as a regression when both intervals are narrower: slopes

@@ -44,6 +44,8 @@ class Operator:
 
     #: True when ``F(t,·)`` does not depend on ``t``.
     static: bool = False
+    #: True when ``dom F(t,·) = R^n`` for every ``t`` (so (A3) holds with ``φ ≡ 0``).
+    full_domain: bool = False
 
     def __init__(self, dim: int, name: str | None = None) -> None:
         if int(dim) != dim or dim < 1:
@@ -79,6 +81,10 @@ class Operator:
         """``g(t, x)`` when ``F(t,·) = ∂g(t,·)`` is a subdifferential and ``g`` is known (``+inf`` outside
         ``dom g``); enables the value laws of :mod:`verimono.checks.prox_laws`."""
         raise NotImplementedError(f"{self.name} does not provide the function value g")
+
+    def growth(self, t: float = 0.0) -> float:
+        """``σ(t)`` of (LG) known from the operator itself: ``|F^0(t, x)| ≤ σ(t)(1 + |x|)`` on ``dom F(t,·)``."""
+        raise NotImplementedError(f"{self.name} does not state the growth σ of (LG)")
 
     def provides(self, member: str) -> bool:
         """Whether this operator provides ``member`` (``"min_norm"``, ``"project_domain"``, ``"contains"``, ``"value"``):
@@ -169,7 +175,7 @@ def _check_dim(op: Operator, x: np.ndarray) -> np.ndarray:
     return x
 
 
-def _provides(op: Any, member: str) -> bool:
+def provides(op: Any, member: str) -> bool:
     """``op.provides(member)`` for operators that say, else whether ``op`` has the member at all."""
     says = getattr(op, "provides", None)
     return bool(says(member)) if callable(says) else callable(getattr(op, member, None))
@@ -263,6 +269,7 @@ class Linear(Operator):
             raise InvalidProblem(f"M must be a square matrix, got shape {M0.shape}")
         super().__init__(M0.shape[0], name or "Linear")
         self.static = self._M.constant
+        self.full_domain = True
         _require_monotone_matrix(M0, "M")
         self._cache_lam: float | None = None
         self._cache_inv: np.ndarray | None = None
@@ -322,6 +329,10 @@ class Linear(Operator):
     def min_norm(self, x, t=0.0):
         return real_array(x) @ (self._M(t) if self.static else self._M_at(t)).T
 
+    def growth(self, t=0.0):
+        """``|M(t)x| ≤ ‖M(t)‖₂ |x|``."""
+        return float(np.linalg.norm(self._M(t) if self.static else self._M_at(t), 2))
+
     def project_domain(self, x, t=0.0):
         return np.array(x, dtype=float)
 
@@ -359,6 +370,7 @@ class NormSubdifferential(Operator):
         super().__init__(dim, name or "NormSubdifferential")
         self._c = as_param(c, "c")
         self.static = self._c.constant
+        self.full_domain = True
         c0 = self._c(0.0)
         if c0.ndim > 1:
             raise InvalidProblem(f"c must be a scalar or a batch of shape (B,), got shape {c0.shape}")
@@ -417,6 +429,10 @@ class NormSubdifferential(Operator):
     def project_domain(self, x, t=0.0):
         return np.array(x, dtype=float)
 
+    def growth(self, t=0.0):
+        """``|F^0(t, x)| ≤ c(t)`` for every ``x``."""
+        return float(np.linalg.norm(self.min_norm(np.ones(self.dim), t)))
+
     def contains(self, x, y, t=0.0, tol=None):
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
         c = float(self._c_at(t))
@@ -438,6 +454,7 @@ class L1Subdifferential(Operator):
         super().__init__(dim, name or "L1Subdifferential")
         self._c = as_param(c, "c")
         self.static = self._c.constant
+        self.full_domain = True
         c0 = self._c(0.0)
         if c0.ndim and c0.shape != (dim,):
             raise InvalidProblem(f"c must be a scalar or have shape ({dim},), got {c0.shape}")
@@ -483,6 +500,10 @@ class L1Subdifferential(Operator):
     def project_domain(self, x, t=0.0):
         return np.array(x, dtype=float)
 
+    def growth(self, t=0.0):
+        """``|F^0(t, x)| ≤ |c(t)|`` (Euclidean norm of the weights) for every ``x``."""
+        return float(np.linalg.norm(self.min_norm(np.ones(self.dim), t)))
+
     def contains(self, x, y, t=0.0, tol=None):
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
         c = np.broadcast_to(_weight_at(self._c, t, self.name, "c(t)"), x.shape)
@@ -503,6 +524,10 @@ class NormalCone(Operator):
         super().__init__(S.dim, name or f"NormalCone({getattr(S, 'name', type(S).__name__)})")
         self.S = S
         self.static = getattr(S, "static", False)
+
+    def growth(self, t=0.0):
+        """``F^0 = 0`` on the domain of a normal cone."""
+        return 0.0
 
     def resolvent(self, x, lam, t=0.0):
         check_lam(lam, f"{self.name}.resolvent")  # J_λ = proj for every λ > 0, and only for those
@@ -585,7 +610,7 @@ class Shifted(Operator):
         return step
 
     def provides(self, member):
-        return Operator.provides(self, member) and _provides(self.F, member)
+        return Operator.provides(self, member) and provides(self.F, member)
 
     def min_norm(self, x, t=0.0):
         return self.F.min_norm(np.asarray(x, dtype=float) + self._Phi(t), t)
@@ -676,6 +701,7 @@ class LogBarrier(Operator):
 
 __all__ = [
     "Operator",
+    "provides",
     "operator_from_resolvent",
     "Linear",
     "NormSubdifferential",
