@@ -532,7 +532,7 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--stage", action="append", choices=list(STAGES), metavar="NAME",
                        help="run only this stage (repeatable); stages: " + ", ".join(STAGES))
         p.add_argument("--seed", type=int, default=None, help="seed for the randomized batteries")
-        p.add_argument("--data", default=None, help="shared data folder (Siconos references); default ../shared")
+        p.add_argument("--data", default=None, help="Siconos data (DIR/siconos/{refs,lcp}); default: the packaged data")
         p.add_argument("--reference", action="append", metavar="NAME",
                        help="use only this analytic reference (repeatable; default: the whole catalog)")
         p.add_argument("--timeout", type=float, default=None, metavar="S",

@@ -188,19 +188,23 @@ def calibrate(repeats: int = 3) -> float:
     return best
 
 
-def locate_data(explicit: str | os.PathLike | None = None) -> Path | None:
-    """The shared data folder: ``explicit``, else ``$VERIMONO_SHARED``, else ``../shared`` beside the
-    current directory or beside the verimono checkout; ``None`` when none exists."""
+def locate_data(explicit: str | os.PathLike | None = None) -> Path:
+    """The data folder of the siconos stage: ``explicit``, else ``$VERIMONO_SHARED`` if it is a folder, else
+    the Siconos data shipped in the package (``verimono/data``); a given folder must hold that layout."""
+    from .lcs.siconos import PACKAGED_DATA, siconos_root
+
+    env = os.environ.get("VERIMONO_SHARED")
     if explicit is not None:
         path = Path(explicit)
-        if not path.is_dir():
-            raise StageUnavailable(f"data folder {path} does not exist")
-        return path
-    candidates = []
-    if os.environ.get("VERIMONO_SHARED"):
-        candidates.append(Path(os.environ["VERIMONO_SHARED"]))
-    candidates += [Path.cwd().parent / "shared", Path(__file__).resolve().parents[1].parent / "shared"]
-    return next((c for c in candidates if c.is_dir()), None)
+    elif env and Path(env).is_dir():
+        path = Path(env)
+    else:
+        return PACKAGED_DATA
+    try:
+        siconos_root(path)
+    except FileNotFoundError as exc:
+        raise StageUnavailable(f"data folder {path}: {exc}") from None
+    return path
 
 
 def _name(obj: Any) -> str:
@@ -458,13 +462,11 @@ def _hypotheses_unit(label: str, seed: int) -> Report:
     return rep
 
 
-@register_stage("siconos", "agreement with the Siconos reference trajectories in the shared data folder")
+@register_stage("siconos", "agreement with the Siconos reference trajectories shipped in verimono/data")
 def siconos_stage(profile: Profile, context: RunContext) -> Report:
-    """Agreement with the Siconos reference trajectories (needs ``../shared`` or ``--data DIR``)."""
+    """Agreement with the Siconos reference trajectories (the packaged data, or ``--data DIR``)."""
     cases = optional_module("verimono.lcs.siconos_cases")
-    if context.data_dir is None:
-        raise StageUnavailable("Siconos reference data not found: pass --data DIR or set VERIMONO_SHARED")
-    data = Path(context.data_dir)
+    data = Path(context.data_dir) if context.data_dir is not None else cases.PACKAGED_DATA
     units = [Unit("siconos", name, _siconos_unit, ("check_siconos_case", name, data)) for name in cases.CASES]
     units.append(Unit("siconos", "LCP test files", _siconos_unit, ("check_siconos_lcps", data)))
     return _merged(context.run_units(profile, units))
