@@ -185,11 +185,15 @@ def _baseline_for(args: argparse.Namespace) -> Report | None:
 
     path = getattr(args, "baseline", None)
     if path:
-        return load(path)
+        baseline = load(path)
+        baseline.source = str(path)   # named in the `verimono gate` command _finish suggests
+        return baseline
     default = Path("reports/baseline.json")
     if default.is_file():
         try:
-            return load(default)
+            baseline = load(default)
+            baseline.source = str(default)
+            return baseline
         except VerimonoError as exc:
             print(f"verimono: ignoring {default}: {exc}", file=sys.stderr)
     return None
@@ -244,6 +248,8 @@ def _finish(report: Report, out: Path, baseline: Report | None) -> int:
         print(f"  {r}")
     line = f"verimono: {report.summary()}"
     if changes is not None:
+        for ln in changes.regression_lines(getattr(baseline, "source", None), paths["json"]):
+            print(ln)
         line += f"; against the baseline: {changes.summary()}"
     print(line)
     print(f"verimono: wrote {paths['html']} and {paths['json']}")
