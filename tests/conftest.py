@@ -11,8 +11,6 @@ from pathlib import Path
 
 import pytest
 
-REPO = Path(__file__).resolve().parent.parent
-
 # `verimono run` uses every core by default (`--executor auto`); the many small in-process runs of the
 # tests would each start worker processes (about 1.5 s of spawning and imports apiece), so the tests run
 # serially unless a test asks otherwise (test_executors covers the default and process:N)
