@@ -72,11 +72,15 @@ def _baseline_for(args: argparse.Namespace) -> Report | None:
 
     path = getattr(args, "baseline", None)
     if path:
-        return load(path)
+        baseline = load(path)
+        baseline.source = str(path)   # named in the `verimono gate` command _finish suggests
+        return baseline
     default = Path("reports/baseline.json")
     if default.is_file():
         try:
-            return load(default)
+            baseline = load(default)
+            baseline.source = str(default)
+            return baseline
         except VerimonoError as exc:
             print(f"verimono: ignoring {default}: {exc}", file=sys.stderr)
     return None
@@ -121,6 +125,8 @@ def _finish(report: Report, out: Path, baseline: Report | None) -> int:
         print(f"  {r}")
     line = f"verimono: {report.summary()}"
     if changes is not None:
+        for ln in changes.regression_lines(getattr(baseline, "source", None), paths["json"]):
+            print(ln)
         line += f"; against the baseline: {changes.summary()}"
     print(line)
     print(f"verimono: wrote {paths['html']} and {paths['json']}")
@@ -278,7 +284,7 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--stage", action="append", choices=list(STAGES), metavar="NAME",
                        help="run only this stage (repeatable); stages: " + ", ".join(STAGES))
         p.add_argument("--seed", type=int, default=None, help="seed for the randomized batteries")
-        p.add_argument("--data", default=None, help="shared data folder (Siconos references); default ../shared")
+        p.add_argument("--data", default=None, help="Siconos data (DIR/siconos/{refs,lcp}); default: the packaged data")
         p.add_argument("--reference", action="append", metavar="NAME",
                        help="use only this analytic reference (repeatable; default: the whole catalog)")
         p.add_argument("--timeout", type=float, default=None, metavar="S",

@@ -1,10 +1,12 @@
-"""The Siconos reference systems of ``shared/siconos/CASES.md`` and the agreement check on them.
+"""The Siconos reference systems of ``verimono/data/siconos/CASES.md`` and the agreement check on them.
 
 Each case is the system, initial state, θ (and γ for the θ-γ variant), step ``h`` and the columns of the
 ``.ref`` file that hold the state.  :func:`check_siconos` simulates every case with
 :meth:`LinearRelationSystem.simulate` and records the maximum state error relative to the state's scale
 over all rows (bound ``SICONOS_RTOL``), and solves every LCP test file (residual ``≤ SICONOS_RTOL`` relative
-to the data, or :class:`verimono.InfeasibleStep` for the files that have no solution).
+to the data, or :class:`verimono.InfeasibleStep` for the files that have no solution).  ``data_dir`` is a
+data folder as :func:`verimono.lcs.siconos.siconos_root` reads it; by default the data shipped in the package
+(``PACKAGED_DATA``).
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ from ..errors import InfeasibleStep, VerimonoError
 from ..results import FAILED, PASSED, CheckResult, Report
 from .lcp import lcp_residual, solve_lcp
 from .relations import Complementarity, Relay
-from .siconos import read_lcp, read_ref
+from .siconos import PACKAGED_DATA, read_lcp, read_ref, ref_path, siconos_root
 from .system import LinearRelationSystem
 
 #: required agreement with Siconos, relative to the state's scale (issue 4; Siconos' own tests use 1e-12,
@@ -99,14 +101,9 @@ CASES: dict[str, SiconosCase] = {c.file: c for c in [
 ]}
 
 
-def _siconos_root(data_dir: Path) -> Path:
-    data_dir = Path(data_dir)
-    return data_dir / "siconos" if (data_dir / "siconos").is_dir() else data_dir
-
-
-def simulate_case(case: SiconosCase, data_dir: Path):
+def simulate_case(case: SiconosCase, data_dir: Path = PACKAGED_DATA):
     """``(trajectory, reference rows, seconds)`` for one case."""
-    ref = read_ref(_siconos_root(data_dir) / "refs" / case.file)
+    ref = read_ref(ref_path(siconos_root(data_dir), case.file))
     t = np.arange(ref.shape[0]) * case.h
     start = time.perf_counter()
     tr = case.make().simulate(case.x0, t, theta=case.theta, gamma=case.gamma)
@@ -119,7 +116,7 @@ def state_error(case: SiconosCase, tr, ref) -> float:
     return float((np.abs(tr.x[:, :X.shape[1]] - X).max(axis=0) / np.abs(X).max(axis=0)).max())
 
 
-def check_siconos(data_dir: Path) -> Report:
+def check_siconos(data_dir: Path = PACKAGED_DATA) -> Report:
     """Agreement records for every Siconos trajectory and LCP test file found under ``data_dir``."""
     report = Report()
     for name in CASES:
@@ -128,11 +125,11 @@ def check_siconos(data_dir: Path) -> Report:
     return report
 
 
-def check_siconos_case(name: str, data_dir: Path) -> CheckResult:
+def check_siconos_case(name: str, data_dir: Path = PACKAGED_DATA) -> CheckResult:
     """The agreement record of the Siconos trajectory ``name`` (a key of :data:`CASES`)."""
     case = CASES[name]
     try:
-        tr, ref, seconds = simulate_case(case, _siconos_root(data_dir))
+        tr, ref, seconds = simulate_case(case, data_dir)
     except (VerimonoError, OSError) as exc:
         return CheckResult("siconos_agreement", case.file, FAILED, message=f"{type(exc).__name__}: {exc}")
     err = state_error(case, tr, ref)
@@ -144,10 +141,18 @@ def check_siconos_case(name: str, data_dir: Path) -> CheckResult:
                        details={"error": err, "rows": int(ref.shape[0])}, duration=seconds)
 
 
-def check_siconos_lcps(data_dir: Path) -> Report:
+def check_siconos_lcps(data_dir: Path = PACKAGED_DATA) -> Report:
     """One record per Siconos LCP test file (``lcp/*.dat``): solved to the residual, or reported infeasible
-    where it has no solution."""
-    return Report([_check_lcp_file(path) for path in sorted((_siconos_root(data_dir) / "lcp").glob("*.dat"))])
+    where it has no solution; one failed record when the data folder holds no LCP file."""
+    try:
+        root = siconos_root(data_dir)
+    except FileNotFoundError as exc:
+        return Report([CheckResult("siconos_lcp", "LCP test files", FAILED, message=str(exc))])
+    paths = sorted((root / "lcp").glob("*.dat"))
+    if not paths:
+        return Report([CheckResult("siconos_lcp", "LCP test files", FAILED,
+                                   message=f"no LCP test file (lcp/*.dat) in {root}")])
+    return Report([_check_lcp_file(path) for path in paths])
 
 
 def _check_lcp_file(path: Path) -> CheckResult:

@@ -281,14 +281,12 @@ def _hypotheses_unit(label: str, seed: int) -> Report:
     return rep
 
 
-@register_stage("siconos", "agreement with the Siconos reference trajectories in the shared data folder")
+@register_stage("siconos", "agreement with the Siconos reference trajectories shipped in verimono/data")
 def siconos_stage(profile: Profile, context: RunContext) -> Report:
-    """Agreement with the Siconos reference trajectories (needs ``../shared`` or ``--data DIR``)."""
+    """Agreement with the Siconos reference trajectories (the packaged data, or ``--data DIR``)."""
     from ..lcs import siconos_cases as cases
 
-    if context.data_dir is None:
-        raise StageUnavailable("Siconos reference data not found: pass --data DIR or set VERIMONO_SHARED")
-    data = Path(context.data_dir)
+    data = Path(context.data_dir) if context.data_dir is not None else cases.PACKAGED_DATA
     units = [Unit("siconos", name, _siconos_unit, ("check_siconos_case", name, data)) for name in cases.CASES]
     units.append(Unit("siconos", "LCP test files", _siconos_unit, ("check_siconos_lcps", data)))
     return _merged(context.run_units(profile, units))

@@ -153,19 +153,23 @@ def _reference_names() -> frozenset[str]:
     return frozenset(p.name for p in catalog())
 
 
-def locate_data(explicit: str | os.PathLike | None = None) -> Path | None:
-    """The shared data folder: ``explicit``, else ``$VERIMONO_SHARED``, else ``../shared`` beside the
-    current directory or beside the verimono checkout; ``None`` when none exists."""
+def locate_data(explicit: str | os.PathLike | None = None) -> Path:
+    """The data folder of the siconos stage: ``explicit``, else ``$VERIMONO_SHARED`` if it is a folder, else
+    the Siconos data shipped in the package (``verimono/data``); a given folder must hold that layout."""
+    from ..lcs.siconos import PACKAGED_DATA, siconos_root
+
+    env = os.environ.get("VERIMONO_SHARED")
     if explicit is not None:
         path = Path(explicit)
-        if not path.is_dir():
-            raise StageUnavailable(f"data folder {path} does not exist")
-        return path
-    candidates = []
-    if os.environ.get("VERIMONO_SHARED"):
-        candidates.append(Path(os.environ["VERIMONO_SHARED"]))
-    candidates += [Path.cwd().parent / "shared", Path(__file__).resolve().parents[2].parent / "shared"]
-    return next((c for c in candidates if c.is_dir()), None)
+    elif env and Path(env).is_dir():
+        path = Path(env)
+    else:
+        return PACKAGED_DATA
+    try:
+        siconos_root(path)
+    except FileNotFoundError as exc:
+        raise StageUnavailable(f"data folder {path}: {exc}") from None
+    return path
 
 
 __all__ = ["STAGES", "Stage", "RunContext", "register_stage", "run_stages", "locate_data"]
