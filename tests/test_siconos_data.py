@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from verimono.checks import siconos as siconos_checks
 from verimono.lcs import siconos_cases
 from verimono.lcs.siconos import PACKAGED_DATA, read_lcp, read_ref, ref_path, siconos_root
 
@@ -89,12 +90,12 @@ def test_locate_data_defaults_to_the_packaged_data_and_checks_a_given_folder(tmp
     monkeypatch.setenv("VERIMONO_SHARED", str(tmp_path))
     assert locate_data() == tmp_path
     assert ref_path(siconos_root(tmp_path), "CircuitRLCD.ref") == plain
-    mine = siconos_cases.check_siconos_case("CircuitRLCD.ref", tmp_path)
-    packaged = siconos_cases.check_siconos_case("CircuitRLCD.ref")
+    mine = siconos_checks.check_siconos_case("CircuitRLCD.ref", tmp_path)
+    packaged = siconos_checks.check_siconos_case("CircuitRLCD.ref")
     assert mine.status == "passed" and mine.details == packaged.details
-    assert [r.subject for r in siconos_cases.check_siconos_lcps(tmp_path)] == ["lcp_deudeu.dat"]
+    assert [r.subject for r in siconos_checks.check_siconos_lcps(tmp_path)] == ["lcp_deudeu.dat"]
     (tmp_path / "siconos" / "lcp" / "lcp_deudeu.dat").unlink()   # an empty lcp/ fails, never passes silently
-    (rec,) = siconos_cases.check_siconos_lcps(tmp_path)
+    (rec,) = siconos_checks.check_siconos_lcps(tmp_path)
     assert rec.status == "failed" and "no LCP test file" in rec.message
 
 

@@ -25,6 +25,7 @@ from ..timeouts import run_unit
 from ..checks.core import laws_of
 from ..checks.core import subject_name as _name
 from ..checks.pseudo_distance import check_pseudo_distance
+from ..checks.siconos import check_siconos_case, check_siconos_lcps
 from .registry import RunContext, register_stage
 
 #: how many points of a trajectory the report keeps for its plot (enough for a smooth curve)
@@ -287,16 +288,14 @@ def siconos_stage(profile: Profile, context: RunContext) -> Report:
     from ..lcs import siconos_cases as cases
 
     data = Path(context.data_dir) if context.data_dir is not None else cases.PACKAGED_DATA
-    units = [Unit("siconos", name, _siconos_unit, ("check_siconos_case", name, data)) for name in cases.CASES]
-    units.append(Unit("siconos", "LCP test files", _siconos_unit, ("check_siconos_lcps", data)))
+    units = [Unit("siconos", name, _siconos_unit, (check_siconos_case, name, data)) for name in cases.CASES]
+    units.append(Unit("siconos", "LCP test files", _siconos_unit, (check_siconos_lcps, data)))
     return _merged(context.run_units(profile, units))
 
 
-def _siconos_unit(name: str, *args: Any) -> Report:
-    """``verimono.lcs.siconos_cases.<name>(*args)`` as a report (one trajectory case, or the LCP files)."""
-    from ..lcs import siconos_cases
-
-    out = getattr(siconos_cases, name)(*args)
+def _siconos_unit(check: Callable, *args: Any) -> Report:
+    """``check(*args)`` (one Siconos trajectory case, or the LCP files) as a report."""
+    out = check(*args)
     return out if isinstance(out, Report) else Report([out])
 
 

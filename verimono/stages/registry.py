@@ -30,6 +30,7 @@ from typing import Any, Callable, Iterable
 from ..checks.core import classify
 from ..errors import StageUnavailable, UnknownStage
 from ..executors import SerialRunner
+from ..lcs.siconos import PACKAGED_DATA, siconos_root
 from ..profiles import Profile
 from ..results import FAILED, SKIPPED, CheckResult, Report
 
@@ -156,8 +157,6 @@ def _reference_names() -> frozenset[str]:
 def locate_data(explicit: str | os.PathLike | None = None) -> Path:
     """The data folder of the siconos stage: ``explicit``, else ``$VERIMONO_SHARED`` if it is a folder, else
     the Siconos data shipped in the package (``verimono/data``); a given folder must hold that layout."""
-    from ..lcs.siconos import PACKAGED_DATA, siconos_root
-
     env = os.environ.get("VERIMONO_SHARED")
     if explicit is not None:
         path = Path(explicit)
