@@ -1,0 +1,399 @@
+"""Manufactured solutions for ``x' ∈ -F(t, x) + f(x) + u(t)``: an exact solution for any operator.
+
+Pick a path ``z(t)`` and ``μ > 0`` and set
+
+    x*(t) = J_{μF(t,·)}(z(t)),     y*(t) = (z(t) - x*(t))/μ ∈ F(t, x*(t)),     u = x*' + y* - f(x*).
+
+``y*`` is the Yosida approximation ``Y_μ(t, z(t))``, which lies in ``F(t, J_μ z)`` for every ``t``
+(Proposition ``prop:maxmon-resolvent-Yosida``), so ``x*' = -y* + f(x*) + u`` with ``y* ∈ F(t, x*)``
+wherever ``x*'`` exists, and ``x*(t) ∈ dom F(t,·)`` for every ``t`` (the range of a resolvent is the
+domain).
+
+**Regularity relied on.**  ``x*`` must be absolutely continuous (the paper's notion of solution,
+Section 3: ``x ∈ AC``, ``x(t) ∈ dom F(t,·)`` and the inclusion for almost all ``t``).  By nonexpansiveness,
+
+    |x*(t) - x*(s)| ≤ |z(t) - z(s)| + sup_{w ∈ z([0,T])} |J_{μF(t,·)} w - J_{μF(s,·)} w|,
+
+so ``x*`` is Lipschitz when ``z`` is and ``t ↦ J_{μF(t,·)}`` is Lipschitz on the path's range — for the
+normal cone of ``Ball(c(t), r(t))`` with modulus ``|c'| + |r'|``, for ``∂(c(t)|·|)`` with ``μ|c'|``, for a
+translated operator ``F_0(· + e(t))`` with ``2|e'|`` (the complementarity examples below).  Then ``y*`` is
+Lipschitz, ``u ∈ L^∞`` (it exists a.e.), and ``x*`` is *the* solution from ``x0 = x*(0)``: two solutions
+``x1, x2`` satisfy ``½ d/dt |x1 - x2|² ≤ L |x1 - x2|²`` by monotonicity of ``F(t,·)`` and the Lipschitz
+constant ``L`` of ``f`` (the input cancels).  What is assumed, not checked: ``z`` Lipschitz and the
+resolvent Lipschitz in ``t``; what is measured: the Lipschitz constants of ``x*`` and ``y*`` on a fine
+adaptive sample (:attr:`ManufacturedSolution.lipschitz_x`, ``lipschitz_y``), and a jump of ``x*`` is an
+:class:`InvalidProblem`.
+
+**The input without a derivative.**  The scheme consumes ``∫_{t_k}^{t_{k+1}} u`` per cell
+(:meth:`verimono.Problem.input_increments`), which the primitive
+
+    U(t) = ∫_0^t u = x*(t) - x*(0) + ∫_0^t (y* - f(x*)) ds
+
+gives with no derivative at all.  ``g = y* - f(x*)`` is Lipschitz but kinks where ``x*`` does (where the
+resolvent switches regime: a constraint engages or releases, the soft threshold starts or stops
+clipping), so it is integrated on an adaptive partition of ``[0, T]``: a cell is accepted when 8-point
+Gauss–Legendre on it and on its two halves agree to ``rtol · (1 + max|g|)`` times its length, else it is
+halved.  The kinks end up inside cells of length ``≲ 1e-10 T`` (reported in :attr:`kinks`); on every other
+cell ``g`` is smooth and ``U(t)`` adds 8-point Gauss–Legendre on ``[cell start, t]`` to the tabulated
+integral.  :attr:`quadrature_error` sums the cells' estimates (``≈ 1e-13`` for unit data): against
+scheme errors ``≥ 1e-6`` it is invisible.  The pointwise ``u(t)`` (for laws that need ``|u|``, and for
+users) takes ``x*'`` from ``velocity`` when given, else from Richardson-extrapolated central differences
+(error ``O(δ⁶)``, estimated) — one-sided, away from the kink, when a detected kink or the ends of
+``[0, T]`` lie within the stencil, or when the central estimate's error is large; at a kink ``u`` is the
+right limit.
+
+**Expected order of the proximal scheme: 1, derived.**  With ``e_k = x_k - x*(t_k)`` and
+``y_{k+1} = (x_k + h f(x_k) + ∫u - x_{k+1})/h ∈ F(t_{k+1}, x_{k+1})``,
+
+    e_{k+1} + h (y_{k+1} - y*(t_{k+1})) = e_k + ∫_{t_k}^{t_{k+1}} (y*(s) - y*(t_{k+1})) ds + h f(x_k) - ∫ f(x*),
+
+and ``⟨y_{k+1} - y*(t_{k+1}), e_{k+1}⟩ ≥ 0`` (monotonicity of ``F(t_{k+1},·)``, both selections at the same
+time) gives ``|e_{k+1}| ≤ (1 + hL)|e_k| + h² (Lip y* + L Lip x*)/2``, hence
+
+    max_k |x_k - x*(t_k)| ≤ h (Lip y* + L Lip x*) (e^{LT} - 1)/(2L)        (T h Lip y*/2 when L = 0),
+
+with ``h`` the largest step (:meth:`ManufacturedSolution.error_bound`).  It needs only a selection of
+bounded variation along the solution and ``x0 ∈ dom F(0,·)``, the hypotheses of Rulla's order 1 for
+``∂φ`` with a fixed ``φ`` (SIAM J. Numer. Anal. 33, 1996; ``x0 ∈ D(∂φ)``, BV forcing) — here for any
+time-dependent maximal monotone ``F``.  The order is not more than 1 in general: ``x*'`` jumps at the kinks.
+An operator evaluated at ``t_k`` instead of ``t_{k+1}`` is an ``O(h)`` perturbation of this scheme when
+``F`` moves Lipschitz in ``t``: it also converges with order 1, so only a problem with an order above 1
+(:func:`moving_box`) catches it by its order.
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+from typing import Any, Callable, Sequence
+
+import numpy as np
+
+from .errors import InvalidProblem
+from .problem import Order, Problem
+
+#: 8-point Gauss–Legendre on [-1, 1]: exact for polynomials of degree 15
+_XI, _W = np.polynomial.legendre.leggauss(8)
+#: cells shorter than this fraction of T mark a kink (a smooth integrand is accepted far above it; not a power
+#: of 2, which the halved cells' lengths would straddle by rounding)
+_KINK_FRACTION = 1e-7
+#: no cell is halved below this fraction of T (a jump of y*, e.g. a jumping weight c(t), stops here)
+_MIN_FRACTION = 2.0 ** -44
+#: at most this many values of x* and U are kept per solution (a study evaluates every grid node)
+_CACHE_SIZE = 1 << 20
+
+
+def lissajous(dim: int, amplitude: float = 1.5, center: Any = 0.0) -> Callable[[float], np.ndarray]:
+    """The default path ``z(t) = center + amplitude (cos t, sin 2t, cos 3t, sin 4t, ...)`` in ``R^dim``.
+
+    Smooth and ``2π``-periodic; in 2-D a figure eight through ``center`` (at ``t = π/2, 3π/2``) reaching
+    ``amplitude`` away.  With the default amplitude ``1.5`` about the origin it leaves and re-enters sets
+    of unit size there (the unit ball, boxes of half-width 1) and passes through the kinks of weights
+    ``μc ≲ 1`` (``∂(c|·|)``, ``∂(c|·|_1)``): the nonsmooth part of ``F`` is active part of the time.
+    """
+    if int(dim) != dim or dim < 1:
+        raise InvalidProblem(f"dim must be a positive integer, got {dim!r}")
+    c = np.broadcast_to(np.asarray(center, dtype=float), (int(dim),)).copy()
+    a = float(amplitude)
+    k = np.arange(1, int(dim) + 1, dtype=float)
+    phase = np.where(k % 2 == 1, 0.0, -0.5 * math.pi)     # cos for odd k, sin for even k
+
+    def path(t: float) -> np.ndarray:
+        return c + a * np.cos(k * float(t) + phase)
+    path.__name__ = f"lissajous(dim={int(dim)}, amplitude={a:g})"
+    return path
+
+
+class ManufacturedSolution:
+    """``x*(t) = J_{μF(t,·)}(z(t))`` with its selection ``y*``, input ``u`` and primitive ``U`` (see the module).
+
+    Calling it gives ``x*(t)`` (it is the problem's ``exact``).  Built once: the adaptive partition of
+    ``[0, T]`` with ``∫ (y* - f(x*))`` tabulated, the kinks, the measured Lipschitz constants.
+    """
+
+    def __init__(self, operator: Any, path: Callable[[float], Any], mu: float, T: float,
+                 f: Callable | None = None, *, velocity: Callable | None = None, kinks: Sequence[float] = (),
+                 cells: int = 64, rtol: float = 1e-13) -> None:
+        if not hasattr(operator, "resolvent") or not hasattr(operator, "dim"):
+            raise InvalidProblem(f"operator must be a verimono.Operator, got {operator!r}")
+        if not callable(path):
+            raise InvalidProblem(f"path must be a callable of t returning ({operator.dim},), got {path!r}")
+        try:
+            mu, T = float(mu), float(T)
+        except (TypeError, ValueError):
+            raise InvalidProblem(f"mu and T must be numbers, got mu = {mu!r}, T = {T!r}") from None
+        if not (0.0 < mu < math.inf and 0.0 < T < math.inf):
+            raise InvalidProblem(f"need 0 < mu < inf and 0 < T < inf, got mu = {mu!r}, T = {T!r}")
+        for what, fn in (("f", f), ("velocity", velocity)):
+            if fn is not None and not callable(fn):
+                raise InvalidProblem(f"{what} must be callable, got {fn!r}")
+        self.operator, self.path, self.mu, self.T, self.f = operator, path, mu, T, f
+        self._velocity = velocity
+        self.n = int(operator.dim)
+        self._x_cache: dict[float, np.ndarray] = {}
+        self._U_cache: dict[float, np.ndarray] = {}
+        z0 = self.z(0.0)
+        if z0.shape != (self.n,):
+            raise InvalidProblem(f"path(0) must have shape ({self.n},), got {z0.shape}")
+        self.x0 = self.x(0.0)
+        self._tabulate(int(cells), float(rtol), sorted({float(k) for k in kinks if 0.0 < float(k) < T}))
+
+    # -- the solution, pointwise --------------------------------------------------------------------
+    def z(self, t: float) -> np.ndarray:
+        """The path ``z(t)``."""
+        return np.asarray(self.path(float(t)), dtype=float)
+
+    def x(self, t: float) -> np.ndarray:
+        """``x*(t) = J_{μF(t,·)}(z(t))``."""
+        t = float(t)
+        v = self._x_cache.get(t)
+        if v is None:
+            v = self._resolve(t)[0]
+            _remember(self._x_cache, t, v)
+        return v.copy()
+
+    __call__ = x
+
+    def y(self, t: float) -> np.ndarray:
+        """``y*(t) = (z(t) - x*(t))/μ ∈ F(t, x*(t))``."""
+        return self._resolve(float(t))[1]
+
+    def _xs(self, t: float) -> np.ndarray:
+        return self._resolve(t)[0]
+
+    def _resolve(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        z = self.z(t)
+        x = np.asarray(self.operator.resolvent(z, self.mu, t), dtype=float)
+        if x.shape != (self.n,) or not np.all(np.isfinite(x)) or not np.all(np.isfinite(z)):
+            raise InvalidProblem(f"J_(mu F(t))(z(t)) at t = {t!r} is {x!r} for z(t) = {z!r}: need finite ({self.n},)")
+        return x, (z - x) / self.mu
+
+    def _g(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(y* - f(x*), x*, y*)`` at ``t``: the integrand of ``U`` besides ``x*``."""
+        x, y = self._resolve(t)
+        g = y if self.f is None else y - np.asarray(self.f(x), dtype=float)
+        return g, x, y
+
+    # -- the input ----------------------------------------------------------------------------------
+    def U(self, t: float) -> np.ndarray:
+        """``∫_0^t u = x*(t) - x*(0) + ∫_0^t (y* - f(x*))`` (tabulated partition plus 8-point Gauss on the rest)."""
+        t = float(t)
+        v = self._U_cache.get(t)
+        if v is not None:
+            return v.copy()
+        if not -1e-12 * self.T <= t <= self.T * (1.0 + 1e-12):
+            raise InvalidProblem(f"the manufactured input is tabulated on [0, {self.T:g}], not at t = {t!r}")
+        t = min(max(t, 0.0), self.T)
+        i = min(bisect.bisect_right(self._starts, t) - 1, len(self._starts) - 1)
+        a = self._starts[i]
+        v = self.x(t) - self.x0 + self._cum[i]
+        if t > a:
+            v = v + self._gauss(a, t)[0]
+        _remember(self._U_cache, t, v)
+        return v.copy()
+
+    def u(self, t: float) -> np.ndarray:
+        """``u(t) = x*'(t) + y*(t) - f(x*(t))`` (a.e.; the right limit at a kink)."""
+        g, _, _ = self._g(float(t))
+        return self.velocity(t) + g
+
+    def velocity(self, t: float) -> np.ndarray:
+        """``x*'(t)``: the given formula, else the finite difference of :meth:`velocity_with_error`."""
+        return self.velocity_with_error(t)[0]
+
+    def velocity_with_error(self, t: float, delta: float | None = None) -> tuple[np.ndarray, float]:
+        """``(x*'(t), error estimate)``: Richardson-extrapolated differences (module docstring), ``(v, 0)``
+        from a given formula.  Central ``δ, δ/2, δ/4`` (error ``O(δ⁶)``) unless a kink or an end of ``[0, T]``
+        lies within ``δ``; then one-sided 3-point ``δ, δ/2, δ/4`` (``O(δ⁴)``) away from it."""
+        t = float(t)
+        if self._velocity is not None:
+            return np.asarray(self._velocity(t), dtype=float), 0.0
+        d0 = 1e-3 * self.T if delta is None else float(delta)
+        near = 1e-9 * self.T           # a kink this close is at t (kinks are located to about 1e-10 T)
+        left = max([0.0] + [k for k in self.kinks if k < t - near])
+        right = min([self.T] + [k for k in self.kinks if k > t + near])
+        at_kink = any(abs(k - t) <= near for k in self.kinks)
+        tried: list[tuple[np.ndarray, float]] = []
+
+        def good(r):
+            return r[1] <= 1e-7 * (1.0 + float(np.max(np.abs(r[0]))))
+
+        if not at_kink and t - left >= 1.5 * d0 and right - t >= 1.5 * d0:
+            tried.append(self._central(t, d0))
+            if good(tried[-1]):
+                return tried[-1]
+        # one-sided, away from the obstacle: forward first (the right limit at a kink), then backward
+        if right - t > near:
+            tried.append(self._one_sided(t, min(d0, (right - t) / 2.5), +1.0))
+        if t - left > near and not (tried and good(tried[-1])):
+            tried.append(self._one_sided(t, min(d0, (t - left) / 2.5), -1.0))
+        if not tried:
+            raise InvalidProblem(f"no finite-difference stencil fits at t = {t!r}")
+        return min(tried, key=lambda r: r[1])
+
+    def _central(self, t, d):
+        xs = self._xs
+        D = [(xs(t + s) - xs(t - s)) / (2.0 * s) for s in (d, d / 2.0, d / 4.0)]
+        R1 = [(4.0 * D[1] - D[0]) / 3.0, (4.0 * D[2] - D[1]) / 3.0]
+        R2 = (16.0 * R1[1] - R1[0]) / 15.0
+        return R2, float(np.max(np.abs(R2 - R1[1])))
+
+    def _one_sided(self, t, d, sign):
+        def D(s):
+            s = sign * s
+            return (-3.0 * self._xs(t) + 4.0 * self._xs(t + s) - self._xs(t + 2.0 * s)) / (2.0 * s)
+        D0, D1, D2 = D(d), D(d / 2.0), D(d / 4.0)       # error c2 δ² + c3 δ³ + ...
+        R1 = [(4.0 * D1 - D0) / 3.0, (4.0 * D2 - D1) / 3.0]
+        R2 = (8.0 * R1[1] - R1[0]) / 7.0
+        return R2, float(np.max(np.abs(R2 - R1[1])))
+
+    # -- the adaptive table ---------------------------------------------------------------------------
+    def _gauss(self, a: float, b: float):
+        """8-point Gauss–Legendre ``∫_a^b g`` and the samples ``(s, x*(s), y*(s))`` it used."""
+        half, mid = 0.5 * (b - a), 0.5 * (a + b)
+        total = np.zeros(self.n)
+        samples = []
+        for xi, w in zip(_XI, _W):
+            s = mid + half * xi
+            g, x, y = self._g(s)
+            total += (half * w) * g
+            samples.append((s, x, y))
+        return total, samples
+
+    def _tabulate(self, cells: int, rtol: float, given: list[float]) -> None:
+        if cells < 1:
+            raise InvalidProblem(f"cells must be >= 1, got {cells}")
+        T = self.T
+        edges = sorted(set(np.linspace(0.0, T, cells + 1).tolist()) | set(given))
+        first = [(a, b, self._gauss(a, b)) for a, b in zip(edges[:-1], edges[1:])]
+        scale = 1.0 + max(float(np.max(np.abs(y))) for _, _, (_, smp) in first for _, _, y in smp)
+        if self.f is not None:
+            scale += max(float(np.max(np.abs(np.asarray(self.f(x), dtype=float)))) for _, _, (_, smp) in first
+                         for _, x, _ in smp)
+        tol = max(rtol, 64.0 * np.finfo(float).eps) * scale
+        pieces: list[tuple[float, float, np.ndarray, float]] = []
+        samples: list[tuple[float, np.ndarray, np.ndarray]] = []
+
+        def refine(a, b, whole):
+            m = 0.5 * (a + b)
+            (lv, ls), (rv, rs) = self._gauss(a, m), self._gauss(m, b)
+            diff = float(np.max(np.abs(whole[0] - lv - rv)))
+            if diff <= tol * (b - a) or b - a <= _MIN_FRACTION * T:
+                if b - a <= _MIN_FRACTION * T:
+                    self._check_continuous(a, b)
+                pieces.extend([(a, m, lv, 0.5 * diff), (m, b, rv, 0.5 * diff)])
+                samples.extend(ls + rs)
+                return
+            refine(a, m, (lv, ls))
+            refine(m, b, (rv, rs))
+
+        for a, b, whole in first:
+            refine(a, b, whole)
+        self._starts = [p[0] for p in pieces]
+        cum = np.zeros((len(pieces), self.n))
+        acc = np.zeros(self.n)
+        for i, p in enumerate(pieces):
+            cum[i] = acc
+            acc = acc + p[2]
+        self._cum = cum
+        self.quadrature_error = float(sum(p[3] for p in pieces))
+        self.cells = len(pieces)
+        # kinks: the shortest cell of each run of short cells (the refinement closes in on a kink)
+        found, run = [], []
+        for a, b, _, _ in pieces + [(T, T, None, 0.0)]:
+            if b - a < _KINK_FRACTION * T and b > a:
+                run.append((b - a, 0.5 * (a + b)))
+            elif run:
+                found.append(min(run)[1])
+                run = []
+        self.kinks = tuple(sorted(set(found) | set(given)))
+        samples.sort(key=lambda s: s[0])
+        s = np.array([p[0] for p in samples])
+        X = np.array([p[1] for p in samples])
+        Y = np.array([p[2] for p in samples])
+        ds = np.diff(s)
+        ok = ds > 1e-9 * T        # secants over shorter gaps are round-off
+        self.lipschitz_x = float(np.max(np.linalg.norm(np.diff(X, axis=0)[ok], axis=1) / ds[ok]))
+        self.lipschitz_y = float(np.max(np.linalg.norm(np.diff(Y, axis=0)[ok], axis=1) / ds[ok]))
+
+    def _check_continuous(self, a: float, b: float) -> None:
+        xa, xb = self.x(a), self.x(b)
+        if np.max(np.abs(xb - xa)) > 1e-8 * (1.0 + float(np.max(np.abs(xa)))):
+            raise InvalidProblem(f"x*(t) = J_(mu F(t))(z(t)) jumps near t = {a:.12g} (from {xa} to {xb}): the "
+                                 "path z and t ↦ F(t,·) must make it Lipschitz (module docstring)")
+
+    # -- what the scheme should do ----------------------------------------------------------------------
+    def error_bound(self, h: float, lipschitz: float | None = None, t: float | None = None) -> float:
+        """The derived bound on ``max_{t_k ≤ t} |x_k - x*(t_k)|`` of the proximal scheme with largest step ``h``:
+        ``h (Lip y* + L Lip x*)(e^{Lt} - 1)/(2L)`` (``t h Lip y*/2`` for ``L = 0``), ``t = T`` by default, with
+        the measured Lipschitz constants — an estimate of a bound, whose constants are sampled, not proved."""
+        if self.f is not None and lipschitz is None:
+            raise InvalidProblem("the bound needs the Lipschitz constant of f (lipschitz=...)")
+        L = 0.0 if self.f is None else float(lipschitz)
+        t = self.T if t is None else float(t)
+        growth = t if L == 0.0 else math.expm1(L * t) / L
+        return float(h) * (self.lipschitz_y + L * self.lipschitz_x) * growth / 2.0
+
+    def order(self, lipschitz: float | None = None) -> Order:
+        """The derived :class:`Order` of the proximal scheme here: 1 (module docstring)."""
+        bound = ""
+        if self.f is None or lipschitz is not None:
+            bound = f"; here sup error <= {self.error_bound(1.0, lipschitz):.3g} h with the measured constants"
+        return Order(1.0, "manufactured solution (verimono.manufactured): y* = (z - x*)/mu in F(t, x*) at every t "
+                          "and monotonicity of F(t_(k+1),.) give |e_(k+1)| <= (1 + hL)|e_k| + h^2 (Lip y* + L Lip x*)/2"
+                          ", order 1 (for a fixed subdifferential: Rulla 1996, x0 in D(dphi), BV forcing)" + bound,
+                     regularity=1.0,
+                     regularity_source=f"x* = J_(mu F(t))(z(t)) is Lipschitz and x*' jumps where the resolvent "
+                                       f"switches regime ({len(self.kinks)} kinks detected): order 1 at most")
+
+    def describe(self) -> str:
+        """One paragraph: the construction, the kinks, the quadrature error, the measured constants."""
+        ks = ", ".join(f"{k:.6g}" for k in self.kinks[:12]) + (" ..." if len(self.kinks) > 12 else "")
+        return (f"manufactured: x* = J_(mu F(t))(z(t)) with z = {getattr(self.path, '__name__', 'path')}, "
+                f"mu = {self.mu:g}; kinks of x* at t = [{ks}]; int u over cells from U (adaptive 8-point "
+                f"Gauss-Legendre, {self.cells} cells, error estimate {self.quadrature_error:.2g}); measured "
+                f"Lip x* = {self.lipschitz_x:.4g}, Lip y* = {self.lipschitz_y:.4g}")
+
+    def __repr__(self) -> str:
+        return f"ManufacturedSolution({self.operator.name}, mu={self.mu:g}, T={self.T:g}, kinks={len(self.kinks)})"
+
+
+def _remember(cache: dict, key: float, value: np.ndarray) -> None:
+    if len(cache) >= _CACHE_SIZE:
+        cache.clear()
+    cache[key] = value
+
+
+def manufactured_problem(operator: Any, *, T: float, path: Callable[[float], Any] | None = None, mu: float = 1.0,
+                         f: Callable | None = None, lipschitz: float | None = None, name: str | None = None,
+                         order: Any = None, steps: Sequence[float] | None = None, velocity: Callable | None = None,
+                         kinks: Sequence[float] = (), **problem_kw: Any) -> Problem:
+    """A :class:`verimono.Problem` whose exact solution is ``x*(t) = J_{μF(t,·)}(z(t))`` (module docstring).
+
+    ``operator`` is ``F``; ``path`` is ``z`` (default :func:`lissajous`: a figure eight of amplitude 1.5
+    about the origin, which leaves and re-enters unit-size sets); ``mu`` is ``μ``; ``f`` and its Lipschitz
+    constant ``lipschitz`` as in :class:`verimono.Problem`.  The problem has ``x0 = x*(0)``,
+    ``exact`` = the :class:`ManufacturedSolution` (``problem.exact.y``, ``.kinks``, ``.error_bound``),
+    ``U`` (what the scheme uses: ``∫u`` per cell with no derivative) and ``u`` (pointwise, a.e.), the
+    derived order 1 unless ``order`` says otherwise, ``steps`` ``T/50, ..., T/800`` by default, and a
+    description in ``notes``.  ``velocity(t) = x*'(t)`` in closed form, when known, replaces the finite
+    differences of ``u``; ``kinks`` (times where ``x*'`` jumps, when known) become cell edges.  Other
+    keywords (``phi``, ``sigma``, ``theta``) go to :class:`verimono.Problem`.  Built eagerly (a few thousand
+    resolvents), so a module can hold ``problem = manufactured_problem(...)``.
+    """
+    clash = sorted(set(problem_kw) & {"x0", "exact", "u", "U", "notes", "initial_jump"})
+    if clash:
+        raise InvalidProblem(f"manufactured_problem sets {', '.join(clash)} itself")
+    dim = getattr(operator, "dim", None)
+    if dim is None:
+        raise InvalidProblem(f"operator must be a verimono.Operator, got {operator!r}")
+    sol = ManufacturedSolution(operator, lissajous(dim) if path is None else path, mu, T, f, velocity=velocity,
+                               kinks=kinks)
+    return Problem(operator, sol.x0, T, f=f, u=sol.u, U=sol.U, exact=sol,
+                   order=sol.order(lipschitz) if order is None else order,
+                   name=name or f"manufactured {getattr(operator, 'name', 'F')}", lipschitz=lipschitz,
+                   steps=[T / k for k in (50, 100, 200, 400, 800)] if steps is None else steps,
+                   notes=sol.describe(), **problem_kw)
+
+
+__all__ = ["manufactured_problem", "ManufacturedSolution", "lissajous"]
