@@ -15,7 +15,8 @@ system and estimator laws, each with its paper label and requirements) and makes
 * estimators — the pseudo-distance (:mod:`.pseudo_distance`).
 
 The names below load their module on first use, so ``import verimono.checks.core`` (the run's stage registry
-does) does not load hypothesis and every law.
+does) does not load hypothesis and every law; ``verimono.checks.REGISTRY`` and ``verimono.checks.laws_of``
+come with every battery's laws registered.
 """
 
 from __future__ import annotations
@@ -40,7 +41,8 @@ _HOMES = {
 
 def __getattr__(name: str):
     home = _HOMES.get(name)
-    if home == "core":
+    if home == "core":   # the registry, with every law registered: load the batteries first
+        from . import assumptions, operator_battery, section7, stepper_battery  # noqa: F401
         from . import core as module
     elif home == "assumptions":
         from . import assumptions as module
