@@ -17,6 +17,8 @@ import sys
 import tomllib
 from pathlib import Path
 
+import pytest
+
 
 REPO = Path(__file__).resolve().parent.parent
 
@@ -348,12 +350,12 @@ def test_function_local_imports_are_for_optional_or_heavy_modules():
 #: the first layer one of whose prefixes names it (``verimono.checks`` covers ``verimono.checks.core``, ...)
 LAYERS = (
     ("foundations", ("verimono.errors", "verimono.tolerances", "verimono._jsonable", "verimono._params",
-                     "verimono._kernels", "verimono._reproducible", "verimono.display", "verimono.environment",
-                     "verimono.atomic", "verimono.profiles")),
-    ("numerics", ("verimono.grids", "verimono.problem", "verimono.operators", "verimono._values", "verimono.sets",
+                     "verimono._rows", "verimono._validate", "verimono._reproducible", "verimono.display", "verimono.environment",
+                     "verimono.atomic", "verimono.profiles", "verimono.naming")),
+    ("numerics", ("verimono.grids", "verimono.problem", "verimono.operators", "verimono._subgradients", "verimono.sets",
                   "verimono.qp", "verimono.prox", "verimono.stepping", "verimono.claims", "verimono.convergence",
                   "verimono.pseudo_distance", "verimono.lcs", "verimono.reference", "verimono.strategies",
-                  "verimono.data")),
+                  "verimono.manufactured", "verimono.data")),
     ("records", ("verimono.schema", "verimono.results", "verimono.timeouts", "verimono.calibration")),
     ("checks", ("verimono.checks", "verimono.performance")),
     ("runs", ("verimono.executors", "verimono.stages", "verimono.runs", "verimono.gate", "verimono.report",
@@ -365,8 +367,8 @@ LAYERS = (
 
 def layer_of(module: str) -> int:
     """The index of ``module``'s layer in :data:`LAYERS`."""
-    for i, (_, prefixes) in enumerate(LAYERS):
-        if any(module == p or module.startswith(p + ".") for p in prefixes):
+    for i, (_, prefixes) in enumerate(LAYERS):   # "verimono" names the top package (the facade) only
+        if any(module == p or (p != "verimono" and module.startswith(p + ".")) for p in prefixes):
             return i
     raise KeyError(f"{module} is in no layer of LAYERS: add it where it belongs")
 
@@ -389,6 +391,9 @@ def test_the_layer_order_is_seen_failing(tmp_path):
     (tmp_path / "pkg" / "results.py").write_text("from .errors import f\n")
     (tmp_path / "pkg" / "cli.py").write_text("from .results import R\n")
     assert upward_imports(tmp_path) == ["verimono.errors (foundations) → verimono.results (records)"]
+    (tmp_path / "pkg" / "newcomer.py").write_text("from .errors import f\n")
+    with pytest.raises(KeyError, match="verimono.newcomer is in no layer"):
+        upward_imports(tmp_path)
 
 
 def test_every_module_imports_only_its_layer_and_the_ones_below():

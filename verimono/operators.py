@@ -27,10 +27,10 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ._kernels import (_INF, _TINY, _mx, _norm, _sqrt, bad_lam, bad_param, batch_column, check_lam, dot_rows,
-                       real_array)
 from ._params import as_param
-from ._values import checked_value, subgradient_contains
+from ._rows import _INF, _TINY, _mx, _norm, _sqrt, dot_rows
+from ._subgradients import checked_value, subgradient_contains
+from ._validate import bad_lam, bad_param, batch_column, check_lam, real_array
 from .errors import InvalidProblem, NotMonotone, OutsideDomain
 from .tolerances import tolerance
 
@@ -254,7 +254,17 @@ def operator_from_resolvent(resolvent: Callable[[np.ndarray, float, float], Any]
     return _FromResolvent(resolvent, dim, min_norm, project_domain, contains, name, value)
 
 
-class Linear(Operator):
+class _EverywhereDefined(Operator):
+    """An operator defined on all of ``R^n`` at every ``t`` (``dom F(t,·) = R^n``): (A3) holds with ``φ ≡ 0``,
+    and the projection onto the domain is the identity."""
+
+    full_domain = True
+
+    def project_domain(self, x, t=0.0):
+        return np.array(x, dtype=float)
+
+
+class Linear(_EverywhereDefined):
     """``F(t, x) = M(t) x`` with ``M + Mᵀ ⪰ 0`` (``M`` need not be symmetric).
 
     Monotone because ``⟨M(x-y), x-y⟩ ≥ 0``; continuous and everywhere defined, hence maximal.
@@ -269,7 +279,6 @@ class Linear(Operator):
             raise InvalidProblem(f"M must be a square matrix, got shape {M0.shape}")
         super().__init__(M0.shape[0], name or "Linear")
         self.static = self._M.constant
-        self.full_domain = True
         _require_monotone_matrix(M0, "M")
         self._cache_lam: float | None = None
         self._cache_inv: np.ndarray | None = None
@@ -333,9 +342,6 @@ class Linear(Operator):
         """``|M(t)x| ≤ ‖M(t)‖₂ |x|``."""
         return float(np.linalg.norm(self._M(t) if self.static else self._M_at(t), 2))
 
-    def project_domain(self, x, t=0.0):
-        return np.array(x, dtype=float)
-
     def contains(self, x, y, t=0.0, tol=None):
         Mx = self.min_norm(x, t)
         tol = tolerance(Mx, y) if tol is None else tol
@@ -357,7 +363,7 @@ def _nonnegative(value: np.ndarray, what: str) -> None:
                           "a negative weight makes the operator non-monotone")
 
 
-class NormSubdifferential(Operator):
+class NormSubdifferential(_EverywhereDefined):
     """``F(t, ·) = ∂(c(t)‖·‖₂)``: ``F(t, x) = c x/|x|`` for ``x ≠ 0`` and the ball ``c B`` at 0.
 
     The paper's example ``g(t, x) = t|x|`` is ``c(t) = t``.  ``J_λ x = max(1 - λc/|x|, 0) x``
@@ -370,7 +376,6 @@ class NormSubdifferential(Operator):
         super().__init__(dim, name or "NormSubdifferential")
         self._c = as_param(c, "c")
         self.static = self._c.constant
-        self.full_domain = True
         c0 = self._c(0.0)
         if c0.ndim > 1:
             raise InvalidProblem(f"c must be a scalar or a batch of shape (B,), got shape {c0.shape}")
@@ -426,9 +431,6 @@ class NormSubdifferential(Operator):
         # 0 where |x| is 0 or underflows (x·x < tiny): F^0(0) = 0; the max only avoids a 0/0 warning
         return np.where(nrm > 0.0, self._col(t, x) * x / _mx(nrm, _TINY), 0.0)
 
-    def project_domain(self, x, t=0.0):
-        return np.array(x, dtype=float)
-
     def growth(self, t=0.0):
         """``|F^0(t, x)| ≤ c(t)`` for every ``x``."""
         return float(np.linalg.norm(self.min_norm(np.ones(self.dim), t)))
@@ -443,7 +445,7 @@ class NormSubdifferential(Operator):
         return bool(nx > 0.0 and np.linalg.norm(y - c * x / nx) <= tol)
 
 
-class L1Subdifferential(Operator):
+class L1Subdifferential(_EverywhereDefined):
     """``F(t, ·) = ∂(Σ_i c_i(t)|x_i|)`` (``c`` a scalar or a vector of weights).
 
     Componentwise: ``c_i sgn(x_i)`` for ``x_i ≠ 0`` and ``[-c_i, c_i]`` at 0;
@@ -454,7 +456,6 @@ class L1Subdifferential(Operator):
         super().__init__(dim, name or "L1Subdifferential")
         self._c = as_param(c, "c")
         self.static = self._c.constant
-        self.full_domain = True
         c0 = self._c(0.0)
         if c0.ndim and c0.shape != (dim,):
             raise InvalidProblem(f"c must be a scalar or have shape ({dim},), got {c0.shape}")
@@ -496,9 +497,6 @@ class L1Subdifferential(Operator):
     def min_norm(self, x, t=0.0):
         x = real_array(x)
         return np.sign(x) * _weight_at(self._c, t, self.name, "c(t)")
-
-    def project_domain(self, x, t=0.0):
-        return np.array(x, dtype=float)
 
     def growth(self, t=0.0):
         """``|F^0(t, x)| ≤ |c(t)|`` (Euclidean norm of the weights) for every ``x``."""

@@ -34,6 +34,7 @@ import time
 from typing import Any, Callable, Iterable
 
 from ..claims import Claim, claim_of
+from ..naming import subject_name
 from ..errors import (InvalidCheckArgument, NotApplicable, StageUnavailable, UnitTimeout, UnverifiedSolution)
 from ..operators import provides
 from ..results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
@@ -116,17 +117,6 @@ def worst_of(outcomes: Iterable[Outcome]) -> Outcome | None:
 
 
 # -- the subject's name -----------------------------------------------------------------------------
-
-def subject_name(obj: Any) -> str:
-    """The name of a subject, decided once and used for every record of it, whatever its status — it is
-    the key the gate compares: its ``name`` (an operator's, a problem's, a :class:`verimono.Stepper`'s),
-    else its ``__name__`` (a function), else its type's name."""
-    for attr in ("name", "__name__"):
-        value = getattr(obj, attr, None)
-        if isinstance(value, str) and value:
-            return value
-    return type(obj).__name__
-
 
 def stepper_subject(stepper: Any, problem: Any) -> str:
     """The subject of a stepper's record on a problem (or a problem's name): ``"<stepper> on <problem>"``."""
