@@ -183,7 +183,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
     if kind == "operator":
         stages, ctx = ["operator_laws"], _context(args, operators=[(args.target, obj)])
     elif kind == "stepper":
-        obj = with_claim(obj, args.scheme, args.order)
+        obj = with_claim(obj, args.scheme, args.order, solve_tol=args.solve_tol)
         stages, ctx = ["convergence", "trajectory_laws"], _context(args, stepper=obj)
         kind = "stepper" + ("" if claim_of(obj).proximal else f" claiming {claim_of(obj).describe()}")
     else:
@@ -318,6 +318,9 @@ def build_parser() -> argparse.ArgumentParser:
                             "for a bare callable) or 'any' (it only converges with --order)")
     check.add_argument("--order", type=float, default=None,
                        help="the convergence order a --scheme any stepper claims (default 1)")
+    check.add_argument("--solve-tol", type=float, default=None, metavar="TAU",
+                       help="the accuracy of the stepper's inner solve per step (relative to 1 + |x|): errors at "
+                            "what it accumulates pass as exact to it")
     check.set_defaults(func=_cmd_check, stage=None)
 
     base = sub.add_parser("baseline", help="record the current results as the gate's baseline")
