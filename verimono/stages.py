@@ -37,6 +37,7 @@ from .results import FAILED, PASSED, SKIPPED, XFAIL, CheckResult, Report, to_jso
 from .executors import SerialRunner, Unit
 from .stepping import solve
 from .timeouts import run_unit
+from . import timing
 
 #: how many points of a trajectory the report keeps for its plot (enough for a smooth curve)
 TRAJECTORY_SAMPLES = 400
@@ -172,20 +173,13 @@ def _reference_names() -> frozenset[str]:
 
 
 def calibrate(repeats: int = 3) -> float:
-    """Seconds of a fixed NumPy-and-Python workload like the harness's (best of ``repeats``).
+    """Seconds of a fixed NumPy-and-Python workload like the harness's (best of ``repeats``):
+    :func:`verimono.timing.calibrate`, where the time budgets (:mod:`verimono.timeouts`) find it too.
 
     Stage durations divided by this number are comparable between jobs on different machines: the gate
     compares these ratios, measured in the same job, never absolute seconds.
     """
-    best = float("inf")
-    for _ in range(repeats):
-        x, lo, hi = np.array([0.3, -0.2, 0.9]), -np.ones(3) * 0.5, np.ones(3) * 0.5
-        start = time.perf_counter()
-        for k in range(20000):
-            x = np.clip(x - 1e-3 * np.sin(k * 1e-3) * x, lo, hi)
-        np.linalg.solve(np.eye(60) * 4.0 + np.ones((60, 60)), np.ones(60))
-        best = min(best, time.perf_counter() - start)
-    return best
+    return timing.calibrate(repeats)
 
 
 def locate_data(explicit: str | os.PathLike | None = None) -> Path | None:
