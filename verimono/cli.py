@@ -5,7 +5,8 @@
                  [--unit-timeout S]
         The whole verification (every registered stage, see ``verimono.stages``); writes DIR/results.json
         and DIR/report.html (DIR defaults to reports/).  Exit 0 when every check holds, 1 when one fails,
-        2 when nothing failed but a check was undecided (a limitation of the harness).
+        2 when nothing failed but a check was undecided (a limitation of the harness) — except a speed the machine
+        was too noisy to judge (a timing record undecided for "timing noise"), which exits 0 and says so.
         The output folder is checked writable before any work; both files are written atomically with one
         run id.  An interrupt (Ctrl-C, SIGTERM) writes the finished stages to a results file marked
         incomplete (the gate refuses it, exit 2) and exits 130; ``--resume`` runs the stages that file lacks
@@ -123,6 +124,9 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
         print(f"verimono: units run on {runner.spec}", file=sys.stderr)
     context.executor = context.executor if context.executor is not None else runner
     cal = calibrate()                 # on a quiet machine, before any worker starts
+    from .timing import MachineProbe, set_calibration
+
+    set_calibration(cal)              # the unit of this process's time budgets (verimono.timeouts)
     if hasattr(runner, "prestart"):   # the workers import while this process builds the catalog
         runner.prestart()
     if getattr(runner, "workers", 1) >= 2:   # this process waits on the workers: draw the report's first
@@ -131,7 +135,10 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
         from .report.plots import warm_up
         threading.Thread(target=warm_up, name="verimono-report-warm-up", daemon=True).start()
     start = time.perf_counter()
+    probe = MachineProbe()
+
     def done(stage, rep, info):
+        info.update(probe.lap())      # how busy the machine was during the stage: the gate's evidence
         progress.done(stage, rep, info)
         if on_done is not None:
             on_done(stage, rep, info)
@@ -225,10 +232,14 @@ def order_table(report: Report) -> list[str]:
 
 def _exit_status(report: Report) -> int:
     """1 when a check failed; else 2 when one was undecided (nothing failed, but not everything was
-    verified: a limitation of the harness is never a pass); else 0."""
+    verified: a limitation of the harness is never a pass); else 0.  A timing record undecided because the
+    machine was too noisy to judge a speed (``verimono.timing.is_noise_undecided``) does not count: the
+    machine's load is not the code's defect, and the summary line says that speed was not judged."""
+    from .timing import is_noise_undecided
+
     if report.failures:
         return EXIT_FAILED
-    if report.undecided or report.meta.get("incomplete"):
+    if any(not is_noise_undecided(r) for r in report.undecided) or report.meta.get("incomplete"):
         return EXIT_UNDECIDED
     return EXIT_OK
 
@@ -243,6 +254,12 @@ def _finish(report: Report, out: Path, baseline: Report | None) -> int:
     for r in report.failures:
         print(f"  {r}")
     line = f"verimono: {report.summary()}"
+    from .timing import is_noise_undecided
+
+    noisy = [r for r in report.undecided if is_noise_undecided(r)]
+    if noisy:
+        line += (f"; speed could not be judged here: {len(noisy)} timing record{'s' if len(noisy) != 1 else ''} "
+                 "undecided, the machine too noisy (not a failure)")
     if changes is not None:
         line += f"; against the baseline: {changes.summary()}"
     print(line)

@@ -140,7 +140,8 @@ def run_stages(names: Iterable[str] | None, profile: Profile, context: RunContex
             rep = stage.fn(profile, context)
             if not isinstance(rep, Report):
                 raise TypeError(f"stage {n} returned {type(rep).__name__}, expected a verimono.Report")
-            status, message = ("failed" if not rep.ok else "passed"), rep.summary()
+            status = "failed" if rep.failures else ("undecided" if not rep.ok else "passed")
+            message = rep.summary()
         except StageUnavailable as exc:
             rep = Report([_stage_record(n, SKIPPED, str(exc), time.perf_counter() - start)])
             status, message = "skipped", str(exc)
