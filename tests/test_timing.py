@@ -1,14 +1,77 @@
-"""Timing that holds on a busy machine, deterministically tested: the gate's noise-aware stage-time rule,
-and the exit status of a run whose only undecided records are speeds the machine was too noisy to judge.  (The estimator and the decision rule:
+"""Timing that holds on a busy machine, deterministically tested: time budgets in calibration units
+(:mod:`verimono.timeouts`), the gate's noise-aware stage-time rule, and the exit status of a run whose only
+undecided records are speeds the machine was too noisy to judge.  (The estimator and the decision rule:
 ``tests/test_performance.py``; verdicts on real timings: the benchmark tier.)"""
 
 from __future__ import annotations
 
 import copy
 
-from verimono import timing
+import pytest
+
+from verimono import timeouts, timing
 from verimono.gate import CALIBRATION_DRIFT, TIMING_GROWTH, compare
+from verimono.profiles import STAGE_BUDGETS, get_profile
 from verimono.results import PASSED, UNDECIDED, CheckResult, Report
+
+
+@pytest.fixture
+def calibrated():
+    """This process's calibration set to 0.1 s for the test, then forgotten (measured again when needed)."""
+    timing.set_calibration(0.1)
+    yield 0.1
+    timing.set_calibration(None)
+
+
+# -- budgets in calibration units --------------------------------------------------------------------------
+
+
+def test_unit_budgets_are_calibration_units_times_this_machines_calibration(calibrated, monkeypatch):
+    monkeypatch.setenv("HYPOTHESIS_PROFILE", "ci")
+    ci = get_profile("ci")
+    assert timeouts.current_budget() == pytest.approx(ci.unit_budget * 0.1) == pytest.approx(ci.unit_timeout)
+    src = timeouts.budget_source()
+    assert src == {"seconds": pytest.approx(ci.unit_budget * 0.1), "source": "profile ci", "units": ci.unit_budget,
+                   "calibration": 0.1}
+    timing.set_calibration(0.3)                    # a machine three times slower gets three times the seconds
+    assert timeouts.current_budget() == pytest.approx(ci.unit_budget * 0.3)
+    assert timeouts.stage_budget("performance") == pytest.approx(STAGE_BUDGETS["performance"] * 0.3)
+    assert timeouts.stage_budget("performance", "thorough") == pytest.approx(STAGE_BUDGETS["performance"] * 3.0)
+    assert timeouts.stage_budget("no such stage") is None
+    with timeouts.budget(5.0):                     # --timeout S: explicit seconds, whatever the calibration
+        assert timeouts.current_budget() == 5.0 and timeouts.budget_source() == {"seconds": 5.0, "source": "explicit"}
+    assert timeouts.current_budget() == pytest.approx(ci.unit_budget * 0.3)
+
+
+def test_the_calibration_is_measured_once_and_cached(monkeypatch):
+    calls = []
+    monkeypatch.setattr(timing, "calibrate", lambda repeats=3: calls.append(repeats) or 0.05)
+    timing.set_calibration(None)
+    try:
+        assert timeouts.calibration() == 0.05 and timeouts.calibration() == 0.05 and calls == [3]
+        assert timeouts.in_seconds(100) == pytest.approx(5.0)
+    finally:
+        timing.set_calibration(None)
+    with pytest.raises(ValueError):
+        timing.set_calibration(0.0)
+
+
+def test_a_unit_over_its_scaled_budget_is_stopped_and_says_why(monkeypatch):
+    if not timeouts.supported():
+        pytest.skip("no SIGALRM here")
+    monkeypatch.setenv("HYPOTHESIS_PROFILE", "dev")
+    timing.set_calibration(1e-4)                   # 800 units x 0.1 ms = 0.08 s
+    try:
+        def spin():
+            while True:
+                pass
+
+        rec = timeouts.run_unit(spin, check="law", subject="spinner")
+    finally:
+        timing.set_calibration(None)
+    assert rec.status == "failed" and "time budget of 0.08 s" in rec.message
+    assert rec.details["budget"] == {"seconds": pytest.approx(0.08), "source": "profile dev", "units": 800.0,
+                                     "calibration": 1e-4}
 
 
 # -- the gate: stage times judged only on a quiet machine ------------------------------------------------------

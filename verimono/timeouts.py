@@ -1,11 +1,17 @@
 """Time budgets for units of work: a resolvent or stepper that never returns must not hang a run.
 
-A *unit* is one law on one operator, or one check of one stepper.  Its budget (seconds) is, in order:
-the innermost :func:`budget` block (``verimono run/check --timeout S`` opens one around the whole run),
-else the active profile's ``unit_timeout`` (:mod:`verimono.profiles`).  :func:`time_limit` enforces it
-with ``SIGALRM`` (a one-shot real-time timer): the unit's code is interrupted where it is — inside a
-user's Python loop too — and :class:`verimono.UnitTimeout` is raised at the ``with`` block, naming the
-unit and the elapsed time.  :func:`run_unit` turns that into a *failed* record so the run goes on.
+A *unit* is one law on one operator, or one check of one stepper.  Its budget is, in order: the innermost
+:func:`budget` block, in seconds (``verimono run/check --timeout S`` opens one around the whole run), else
+the active profile's ``unit_budget`` (:mod:`verimono.profiles`), stated in *calibration units*: multiples of
+:func:`verimono.timing.calibrate`, a fixed NumPy-and-Python workload.  In seconds that is ``units x`` the
+calibration measured in this process (:func:`calibration`: measured once, best of 3, about 0.2 s, then
+cached; ``verimono run`` supplies the one it measures at its start), so a slower or busier machine — where
+the workload, like everything else, takes longer — gets proportionally more time, and a unit is stopped
+for not finishing, not for running on a loaded runner.  Stage budgets (:func:`stage_budget`) are stated the
+same way.  :func:`time_limit` enforces a budget with ``SIGALRM`` (a one-shot real-time timer): the unit's
+code is interrupted where it is — inside a user's Python loop too — and :class:`verimono.UnitTimeout` is
+raised at the ``with`` block, naming the unit and the elapsed time.  :func:`run_unit` turns that into a
+*failed* record so the run goes on.
 
 The interrupt is raised as an internal ``BaseException`` while it travels through the unit's code, so a
 check's own ``except Exception`` (which turns an operator's error into a failed sample) or hypothesis'
@@ -24,7 +30,8 @@ from contextlib import contextmanager
 from typing import Callable, Iterator
 
 from .errors import InvalidCheckArgument, UnitTimeout
-from .profiles import UnknownProfile, active_profile, get_profile
+from . import timing
+from .profiles import Profile, UnknownProfile, active_profile, get_profile
 from .results import FAILED, CheckResult
 
 _OVERRIDE: list[float | None] = []
@@ -56,15 +63,54 @@ def budget(seconds: float | None) -> Iterator[None]:
         _OVERRIDE.pop()
 
 
-def current_budget() -> float | None:
-    """The budget of a unit started now: the innermost :func:`budget`, else the profile's ``unit_timeout``."""
-    if _OVERRIDE and _OVERRIDE[-1] is not None:
-        return _OVERRIDE[-1]
+def calibration() -> float:
+    """Seconds of the calibration workload in this process (:func:`verimono.timing.calibration`: measured
+    once and cached; :func:`verimono.timing.set_calibration` supplies one measured elsewhere)."""
+    return timing.calibration()
 
+
+def in_seconds(units: float) -> float:
+    """Seconds of ``units`` calibration units on this machine: ``units x`` :func:`calibration`."""
+    return float(units) * calibration()
+
+
+def _profile() -> Profile | None:
     try:
-        return get_profile(active_profile()).unit_timeout
+        return get_profile(active_profile())
     except UnknownProfile:
         return None
+
+
+def budget_source() -> dict[str, object]:
+    """Where the budget of a unit started now comes from: ``{"seconds": S, "source": "explicit"}`` inside a
+    :func:`budget` block; else ``{"seconds": S, "source": "profile <name>", "units": U, "calibration": C}``
+    with ``S = U x C``; ``{"seconds": None, ...}`` when there is none (an unknown profile)."""
+    if _OVERRIDE and _OVERRIDE[-1] is not None:
+        return {"seconds": _OVERRIDE[-1], "source": "explicit"}
+    profile = _profile()
+    if profile is None:
+        return {"seconds": None, "source": "none"}
+    cal = calibration()
+    return {"seconds": profile.unit_budget * cal, "source": f"profile {profile.name}", "units": profile.unit_budget,
+            "calibration": cal}
+
+
+def current_budget() -> float | None:
+    """Seconds a unit started now may take: the innermost :func:`budget` (explicit seconds), else the active
+    profile's ``unit_budget`` calibration units x :func:`calibration`; ``None`` for an unknown profile."""
+    if _OVERRIDE and _OVERRIDE[-1] is not None:
+        return _OVERRIDE[-1]
+    profile = _profile()
+    return None if profile is None else in_seconds(profile.unit_budget)
+
+
+def stage_budget(stage: str, profile: str | Profile | None = None) -> float | None:
+    """Seconds stage ``stage`` may take at ``profile`` (default: the active one): its budget in calibration
+    units (:data:`verimono.profiles.STAGE_BUDGETS` x the profile's ``stage_budget_scale``) x
+    :func:`calibration`; ``None`` when no budget is stated for it."""
+    p = profile if isinstance(profile, Profile) else get_profile(profile or active_profile())
+    units = p.stage_budget_units(stage)
+    return None if units is None else in_seconds(units)
 
 
 def supported() -> bool:
@@ -122,8 +168,11 @@ def run_unit(fn: Callable[[], object], *, check: str, subject: str, seconds: flo
             return fn()
     except UnitTimeout as exc:
         elapsed = time.perf_counter() - start
-        return CheckResult(check, subject, FAILED, message=f"timed out: {exc}", duration=elapsed,
-                           details={"timeout": limit, "elapsed": elapsed})
+        details: dict[str, object] = {"timeout": limit, "elapsed": elapsed}
+        if seconds is None:
+            details["budget"] = budget_source()
+        return CheckResult(check, subject, FAILED, message=f"timed out: {exc}", duration=elapsed, details=details)
 
 
-__all__ = ["budget", "current_budget", "time_limit", "run_unit", "supported"]
+__all__ = ["budget", "current_budget", "budget_source", "stage_budget", "calibration", "in_seconds", "time_limit",
+           "run_unit", "supported"]
