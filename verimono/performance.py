@@ -511,10 +511,11 @@ def performance_report(sizes: Sizes, *, stepper: Callable | None = None,
     seconds, so it needs no quiet core) and returns a function that waits for it; the timed records run here
     meanwhile (the memory-bound batch record after it has finished), and the memory record still comes last.
 
-    The machine's state around the timed records — the calibration workload (:func:`verimono.timing.calibrate`)
-    before the first and after the last, and the load average — is recorded in every timed record's
-    ``details["machine"]``: the evidence, beside each record's own, of why a speed could not be judged."""
-    machine: dict[str, Any] = {"calibration_before": timing.calibrate(), "loadavg_before": timing.loadavg()}
+    The machine's state around the timed records — the calibration workload on the wall and own-time clocks
+    (:func:`verimono.timing.calibrate_both`) before the first and after the last, their drift, and the load
+    average — is recorded in every timed record's ``details["machine"]``: the evidence, beside each record's
+    own, of why a speed could not be judged."""
+    machine: dict[str, Any] = {"calibration_before": timing.calibrate_both(), "loadavg_before": timing.loadavg()}
     mr = sizes.max_rounds
     jobs: list[tuple[str, Callable[[], CheckResult]]] = []
     for kind in PER_STEP_KINDS:
@@ -551,9 +552,11 @@ def performance_report(sizes: Sizes, *, stepper: Callable | None = None,
         progress(i, len(jobs), label)
         report.add(job())
     progress(len(jobs), len(jobs), "")
-    machine.update({"calibration_after": timing.calibrate(), "loadavg_after": timing.loadavg()})
-    machine["calibration_drift"] = round(max(machine["calibration_before"], machine["calibration_after"]) /
-                                         min(machine["calibration_before"], machine["calibration_after"]), 4)
+    machine.update({"calibration_after": timing.calibrate_both(), "loadavg_after": timing.loadavg()})
+    machine["calibration_drift"] = {   # the larger of the two over the smaller, per clock
+        clock: round(max(machine["calibration_before"][clock], machine["calibration_after"][clock]) /
+                     min(machine["calibration_before"][clock], machine["calibration_after"][clock]), 4)
+        for clock in ("wall", "own")}
     for r in report.results:
         if "timing_interval" in r.details:
             r.details["machine"] = dict(machine)
