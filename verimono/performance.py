@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import threading
 import time
 import tracemalloc
 from typing import Any, Callable
@@ -247,11 +248,14 @@ class Rounds:
         return [s.own / scale for s in self.samples[side]]
 
     def evidence(self) -> dict[str, Any]:
-        """The noise evidence of these rounds: the clock, the fraction of their wall time spent waiting for
-        a CPU, and the 1-minute load average now."""
+        """The noise evidence of these rounds: the clock, the fractions of their wall time spent waiting for a
+        CPU (other processes' time, not counted) and off the CPU otherwise (sleeping, I/O, waiting for the GIL:
+        counted), and the 1-minute load average now."""
         every = self.samples["subject"] + self.samples["baseline"]
         wall = sum(s.wall for s in every)
-        return {"clock": timing.CLOCK, "waited_fraction": round(sum(s.waited for s in every) / wall, 4) if wall else 0.0,
+        frac = (lambda x: round(x / wall, 4) if wall else 0.0)  # noqa: E731
+        return {"clock": timing.CLOCK, "waited_fraction": frac(sum(s.waited for s in every)),
+                "blocked_fraction": frac(sum(max(s.own - s.cpu, 0.0) for s in every)),
                 "subject_wall_s": [s.wall for s in self.samples["subject"]],
                 "baseline_wall_s": [s.wall for s in self.samples["baseline"]],
                 "loadavg": timing.loadavg()}
@@ -299,7 +303,8 @@ def ratio_record(check: str, subject: str, subj_t: list[float], base_t: list[flo
     if status == UNDECIDED:
         extra = {"undecided_reason": timing.NOISE_REASON,
                  "noise": {"interval": [lo, hi], "spread": j.spread, "rounds": j.rounds,
-                           "waited_fraction": ev.get("waited_fraction"), "loadavg": ev.get("loadavg"),
+                           "waited_fraction": ev.get("waited_fraction"), "blocked_fraction": ev.get("blocked_fraction"),
+                           "loadavg": ev.get("loadavg"),
                            "clock": ev.get("clock", timing.CLOCK)}}
         waited = ev.get("waited_fraction")
         close = hi / lo < 1.1 if lo > 0 and math.isfinite(hi) else False
@@ -501,6 +506,19 @@ def check_memory(*, steps: int, n: int = 10, stepper: Callable | None = None) ->
         duration=s_sec + b_sec)
 
 
+def _quiet_process(timeout: float = 60.0) -> list[str]:
+    """Wait (at most ``timeout`` s each) for this process's own background threads (``verimono-*``, e.g. the
+    report's matplotlib warm-up that ``verimono run`` starts beside worker processes) before timing: a thread
+    holding the GIL makes the timed code wait off the CPU, which the own-time clock rightly counts — measured,
+    it inflated the first record's rounds 3-5x under ``verimono run --stage performance``."""
+    joined = []
+    for th in threading.enumerate():
+        if th is not threading.current_thread() and th.name.startswith("verimono-") and th.is_alive():
+            th.join(timeout)
+            joined.append(th.name)
+    return joined
+
+
 def performance_report(sizes: Sizes, *, stepper: Callable | None = None,
                        progress: Callable[[int, int, str], None] = lambda done, total, label: None,
                        aside: Callable[[int, Callable | None], Callable[[], CheckResult]] | None = None) -> Report:
@@ -515,7 +533,8 @@ def performance_report(sizes: Sizes, *, stepper: Callable | None = None,
     (:func:`verimono.timing.calibrate_both`) before the first and after the last, their drift, and the load
     average — is recorded in every timed record's ``details["machine"]``: the evidence, beside each record's
     own, of why a speed could not be judged."""
-    machine: dict[str, Any] = {"calibration_before": timing.calibrate_both(), "loadavg_before": timing.loadavg()}
+    machine: dict[str, Any] = {"joined_threads": _quiet_process()}
+    machine.update({"calibration_before": timing.calibrate_both(), "loadavg_before": timing.loadavg()})
     mr = sizes.max_rounds
     jobs: list[tuple[str, Callable[[], CheckResult]]] = []
     for kind in PER_STEP_KINDS:
