@@ -77,11 +77,13 @@ def test_a_unit_over_its_scaled_budget_is_stopped_and_says_why(monkeypatch):
 # -- the gate: stage times judged only on a quiet machine ------------------------------------------------------
 
 
-def run_report(duration: float, calibrations: list[float], cpu_waiting: float | None = 0.01) -> Report:
+def run_report(duration: float, calibrations: list[float], cpu_waiting: float | None = 0.01,
+               foreign_cpu: float | None = 0.02) -> Report:
     rep = Report([CheckResult("monotone", "Box", PASSED, worst=0.5, bound=1.0)])
     stage = {"name": "operator_laws", "duration": duration, "status": "passed", "records": 1}
-    if cpu_waiting is not None:
-        stage["cpu_waiting"] = cpu_waiting
+    for key, value in (("cpu_waiting", cpu_waiting), ("foreign_cpu", foreign_cpu)):
+        if value is not None:
+            stage[key] = value
     rep.meta.update({"command": "run", "profile": "ci", "target": None, "calibrations": calibrations,
                      "calibration": min(calibrations), "stages": [stage]})
     return Report.from_dict(rep.to_dict())
@@ -106,15 +108,47 @@ def test_a_3x_stage_slowdown_on_a_quiet_machine_regresses():
 
 
 def test_a_grown_stage_time_on_a_busy_machine_is_not_judged():
-    # other work shared the cores during the stage (PSI): the growth is reported, not a regression
-    regs, others = stage_changes(run_report(12.0, [0.05, 0.051], cpu_waiting=0.7))
-    assert not regs and len(others) == 1 and "not judged" in others[0].message and "70%" in others[0].message
+    # other processes shared the cores and tasks waited for them: the growth is reported, not a regression
+    regs, others = stage_changes(run_report(12.0, [0.05, 0.051], cpu_waiting=0.7, foreign_cpu=0.6))
+    assert not regs and len(others) == 1 and "not judged" in others[0].message
+    assert "waited for a CPU 70%" in others[0].message and "outside the run used 60%" in others[0].message
     # the machine's speed changed between the run's start and end: no single unit describes the stage
-    regs, others = stage_changes(run_report(16.0, [0.05, 0.08], cpu_waiting=None))
+    regs, others = stage_changes(run_report(16.0, [0.05, 0.08], cpu_waiting=None, foreign_cpu=None))
     assert not regs and "calibrations at the run's start and end differ by 1.60x" in others[0].message
-    # without PSI and with agreeing calibrations the stage time is judged (the calibration alone as evidence)
-    regs, _ = stage_changes(run_report(12.0, [0.05, 0.051], cpu_waiting=None))
+    # one of the two signs recorded: it decides
+    regs, _ = stage_changes(run_report(12.0, [0.05, 0.051], cpu_waiting=None, foreign_cpu=0.5))
+    assert not regs
+    regs, _ = stage_changes(run_report(12.0, [0.05, 0.051], cpu_waiting=0.5, foreign_cpu=None))
+    assert not regs
+    # neither recorded and agreeing calibrations: judged (the calibrations alone as evidence)
+    regs, _ = stage_changes(run_report(12.0, [0.05, 0.051], cpu_waiting=None, foreign_cpu=None))
     assert [c.key for c in regs] == ["stage operator_laws"]
+
+
+def test_a_run_contending_with_itself_is_still_judged():
+    """Waiting for a CPU caused by the run's own worker processes (40% in a quiet run's first stage) is part of
+    the stage's normal time, in the baseline too: with little foreign CPU a 3x slowdown still regresses."""
+    regs, _ = stage_changes(run_report(12.0, [0.05, 0.051], cpu_waiting=0.4, foreign_cpu=0.03))
+    assert [c.key for c in regs] == ["stage operator_laws"]
+    # another process busy on an otherwise idle core, no contention: judged too
+    regs, _ = stage_changes(run_report(12.0, [0.05, 0.051], cpu_waiting=0.02, foreign_cpu=0.45))
+    assert [c.key for c in regs] == ["stage operator_laws"]
+
+
+def test_the_probe_counts_the_runs_own_processes_as_its_own():
+    """A child process's CPU time is the run's (``_tree_cpu_s``), not foreign."""
+    import subprocess
+    import sys
+
+    before = timing._tree_cpu_s()
+    if before is None:
+        pytest.skip("no /proc here")
+    subprocess.run([sys.executable, "-c", "import time\nt = time.process_time()\nwhile time.process_time() - t < 0.3: pass"],
+                   check=True)
+    assert timing._tree_cpu_s() - before >= 0.29
+    lap = timing.MachineProbe().lap()
+    assert set(lap) == {"cpu_waiting", "foreign_cpu", "loadavg"}
+    assert all(lap[k] is None or 0.0 <= lap[k] <= 1.0 for k in ("cpu_waiting", "foreign_cpu"))
 
 
 def test_a_timing_noise_undecided_record_is_a_change_not_a_regression():

@@ -39,11 +39,14 @@ is evidence of the machine, not of the code, unless the measurement rules that o
   artefact of which end was measured.  Growth beyond ``TIMING_GROWTH`` is a regression only when the machine
   was quiet enough for stage times to mean anything: its two calibrations agree within
   ``CALIBRATION_DRIFT`` (else the machine's speed changed during the run, and no single unit describes it),
-  and, where the run recorded it (Linux PSI, ``meta.stages[i].cpu_waiting``), some task waited for a CPU
-  during at most ``verimono.timing.BUSY_WAITING`` of the stage's wall time (else other work shared the
-  cores: a CPU spinner per core makes that 60-100%, an idle machine 0-2%).  Otherwise the growth is reported
-  as a change, "not judged", with the evidence.  A real 3x slowdown on a quiet machine stays caught: 3x in
-  units taken at the slower calibration, whose drift is at most 1.25x, is still above 2x.
+  and the stage did not run on a busy machine: where the run recorded them (``meta.stages[i]``, by
+  :class:`verimono.timing.MachineProbe`), *busy* means some task waited for a CPU during more than
+  ``BUSY_WAITING`` (10%) of the stage's wall time (Linux PSI, ``cpu_waiting``) *and* processes outside the run
+  used more than ``BUSY_FOREIGN`` (10%) of the machine's CPU capacity (``foreign_cpu``) — contention, and
+  not the run's own (its worker processes importing beside the main one make a quiet run's first stage
+  wait 40%, with 0-5% foreign); with one of the two recorded, that one decides.  Otherwise the growth is
+  reported as a change, "not judged", with the evidence.  A real 3x slowdown on a quiet machine stays
+  caught: 3x in units taken at the slower calibration, whose drift is at most 1.25x, is still above 2x.
 
 Baseline and results must come from the same kind of run (command, target, profile and the selected
 stages and references), be well-formed documents of a readable schema version
@@ -63,7 +66,7 @@ from typing import Any
 from .convergence import ORDER_SLACK
 from .errors import IncompatibleBaseline, IncompatibleResults
 from .results import FAILED, PASSED, SKIPPED, UNDECIDED, XFAIL, Report, load
-from .timing import BUSY_WAITING, is_noise_undecided
+from .timing import BUSY_FOREIGN, BUSY_WAITING, is_noise_undecided
 
 #: smallest drop of a fitted slope that counts as a regression when both intervals are narrower: slopes
 #: are refitted on the same grids, so they reproduce to round-off on one machine and to ~1e-3 across
@@ -310,9 +313,13 @@ def _stage_unjudged(cur_cals: list[float], stage: dict[str, Any]) -> str | None:
     drift = max(cur_cals) / min(cur_cals)
     if drift > CALIBRATION_DRIFT:
         why.append(f"the calibrations at the run's start and end differ by {drift:.2f}x (> {CALIBRATION_DRIFT}x)")
-    waiting = stage.get("cpu_waiting")
-    if _number(waiting) and waiting > BUSY_WAITING:
-        why.append(f"some task waited for a CPU {waiting:.0%} of the stage's time (> {BUSY_WAITING:.0%})")
+    waiting, foreign = stage.get("cpu_waiting"), stage.get("foreign_cpu")
+    signs = [(x > limit, text.format(x)) for x, limit, text in (
+        (waiting, BUSY_WAITING, "some task waited for a CPU {:.0%} of the stage's time"),
+        (foreign, BUSY_FOREIGN, "processes outside the run used {:.0%} of the machine's CPU"))
+        if _number(x)]
+    if signs and all(busy for busy, _ in signs):
+        why.append("the machine was busy: " + " and ".join(text for _, text in signs))
     return "; ".join(why) or None
 
 
@@ -339,8 +346,7 @@ def _compare_timings(base: Report, cur: Report, out: list[Change]) -> None:
             if why is None:
                 out.append(Change("timing", f"stage {s['name']}", what, True))
             else:
-                out.append(Change("timing", f"stage {s['name']}", f"{what}: not judged, the machine was busy ({why})",
-                                  False))
+                out.append(Change("timing", f"stage {s['name']}", f"{what}: not judged ({why})", False))
 
 
 def compare(baseline: Report, current: Report) -> Comparison:

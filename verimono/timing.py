@@ -46,8 +46,9 @@ are stated in its units (``verimono gate``), and so are the time budgets of :mod
 (:func:`calibration` measures it once per process and caches it).
 
 **Machine probes** (:class:`MachineProbe`): the fraction of wall time during which some task on the
-machine was runnable but waiting for a CPU (Linux PSI, ``/proc/pressure/cpu``, ``some``), and the load
-average — the evidence the gate uses to decide whether a grown stage time can be judged at all.
+machine was runnable but waiting for a CPU (Linux PSI, ``/proc/pressure/cpu``, ``some``), the share of the
+machine's CPU used by processes outside this run, and the load average — the evidence the gate uses to
+decide whether a grown stage time can be judged at all.
 """
 
 from __future__ import annotations
@@ -68,10 +69,14 @@ ALPHA = 0.05
 LOOKS = 2
 #: ``details["undecided_reason"]`` of a timing record that could not be judged because of the machine
 NOISE_REASON = "timing noise"
-#: fraction of a stage's wall time with some task waiting for a CPU (PSI ``some``) above which the machine
-#: counts as busy: an idle machine reads 0-2%, a run's own workers a few percent more, a CPU spinner per core
-#: beside the run 60-100%
+#: a stage ran on a *busy* machine when both exceed their limit: some task waited for a CPU (PSI ``some``)
+#: more than BUSY_WAITING of its wall time — there was contention — and processes outside the run used more
+#: than BUSY_FOREIGN of the machine's CPU capacity — it was not the run's own (:class:`MachineProbe`).
+#: Measured on this 2-core machine: a quiet ``verimono run --profile ci`` (process:2) reads waiting 1-4% per
+#: stage but 40% in its first, where its workers import beside the main process, and foreign 0-5%; beside
+#: two CPU spinners and a memory hog, or other developers' test runs, waiting 85-100% and foreign 50-100%
 BUSY_WAITING = 0.10
+BUSY_FOREIGN = 0.10
 
 _SCHEDSTAT = "/proc/thread-self/schedstat"
 _PSI_CPU = "/proc/pressure/cpu"
@@ -326,24 +331,79 @@ def loadavg() -> float | None:
         return None
 
 
+def _machine_busy_s() -> float | None:
+    """CPU seconds (since boot) the whole machine spent busy — user, nice, system, irq, softirq and steal
+    (the hypervisor's) — from ``/proc/stat``, or ``None``."""
+    try:
+        with open("/proc/stat") as f:
+            fields = [int(x) for x in f.readline().split()[1:9]]
+        return (fields[0] + fields[1] + fields[2] + fields[5] + fields[6] + fields[7]) / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError):
+        return None
+
+
+def _tree_cpu_s() -> float | None:
+    """CPU seconds used so far by this process and its descendants (live ones from ``/proc/<pid>/stat``, with
+    what they reaped; reaped ones from ``getrusage``), or ``None`` off Linux."""
+    try:
+        import resource
+
+        tick = os.sysconf("SC_CLK_TCK")
+        parent: dict[int, int] = {}
+        times: dict[int, float] = {}
+        for name in os.listdir("/proc"):
+            if not name.isdigit():
+                continue
+            try:
+                with open(f"/proc/{name}/stat") as f:
+                    rest = f.read().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            parent[int(name)] = int(rest[1])
+            times[int(name)] = sum(int(x) for x in rest[11:15]) / tick   # utime stime cutime cstime
+        me, tree, frontier = os.getpid(), set(), [os.getpid()]
+        while frontier:
+            pid = frontier.pop()
+            kids = [c for c, pp in parent.items() if pp == pid and c not in tree]
+            tree.update(kids)
+            frontier += kids
+        own = resource.getrusage(resource.RUSAGE_SELF)
+        reaped = resource.getrusage(resource.RUSAGE_CHILDREN)
+        return own.ru_utime + own.ru_stime + reaped.ru_utime + reaped.ru_stime + sum(times[p] for p in tree if p != me)
+    except (OSError, ValueError, IndexError, ImportError):
+        return None
+
+
 class MachineProbe:
-    """How busy the machine was between laps: ``lap()`` returns ``{"cpu_waiting": f, "loadavg": L}``, ``f``
-    the fraction of the wall time since the previous lap (or since construction) during which some task
-    was runnable but waiting for a CPU (``None`` without PSI)."""
+    """How busy the machine was between laps, and with what: ``lap()`` returns
+
+    * ``cpu_waiting`` — the fraction of the wall time since the previous lap (or construction) during which
+      some task was runnable but waiting for a CPU (Linux PSI ``some``); the run's own processes count too
+      (its worker processes importing beside the main one read 40% in a quiet run's first stage);
+    * ``foreign_cpu`` — the fraction of the machine's CPU capacity (wall time x cores) used by processes
+      *outside* this process and its descendants (``/proc/stat`` busy time minus the tree's CPU time): 0-5%
+      on a quiet machine, 60-100% with a CPU spinner per core beside the run;
+    * ``loadavg`` — the 1-minute load average.
+
+    ``None`` for what the platform does not expose."""
 
     def __init__(self) -> None:
-        self._t, self._psi = time.perf_counter(), _psi_some_us()
+        self._t, self._psi, self._busy, self._tree = time.perf_counter(), _psi_some_us(), _machine_busy_s(), _tree_cpu_s()
 
     def lap(self) -> dict[str, Any]:
-        t, psi = time.perf_counter(), _psi_some_us()
-        waiting = None
-        if psi is not None and self._psi is not None and t > self._t:
-            waiting = round(min(max((psi - self._psi) * 1e-6 / (t - self._t), 0.0), 1.0), 4)
-        self._t, self._psi = t, psi
-        return {"cpu_waiting": waiting, "loadavg": loadavg()}
+        t, psi, busy, tree = time.perf_counter(), _psi_some_us(), _machine_busy_s(), _tree_cpu_s()
+        dt = t - self._t
+        waiting = foreign = None
+        if psi is not None and self._psi is not None and dt > 0:
+            waiting = round(min(max((psi - self._psi) * 1e-6 / dt, 0.0), 1.0), 4)
+        if None not in (busy, self._busy, tree, self._tree) and dt > 0:
+            foreign = round(min(max((busy - self._busy - (tree - self._tree)) / (dt * (os.cpu_count() or 1)), 0.0),
+                                1.0), 4)
+        self._t, self._psi, self._busy, self._tree = t, psi, busy, tree
+        return {"cpu_waiting": waiting, "foreign_cpu": foreign, "loadavg": loadavg()}
 
 
-__all__ = ["ALPHA", "LOOKS", "NOISE_REASON", "BUSY_WAITING", "CLOCK", "CLOCK_DESCRIPTION", "Sample", "timed",
+__all__ = ["ALPHA", "LOOKS", "NOISE_REASON", "BUSY_WAITING", "BUSY_FOREIGN", "CLOCK", "CLOCK_DESCRIPTION", "Sample", "timed",
            "order_rank", "median_interval", "Judgement", "decide", "judge", "is_noise_undecided", "calibrate",
            "calibrate_both",
            "calibration", "set_calibration", "loadavg", "MachineProbe"]
