@@ -147,3 +147,45 @@ def test_a_lost_vectorisation_fails_the_ensemble_record():
     rec = performance.check_ensemble(op, "box", batch=100, steps=5, rounds=9, problem_kw=kw, stepper=row_by_row)
     assert rec.status == FAILED and rec.details["identical"]
     assert rec.details["ratio"] < 3 and rec.details["timing_ratio"] > 1 / 3
+
+
+# -- the gate on stage times --------------------------------------------------------------------------------
+
+
+def test_a_3x_slower_stage_is_a_gate_regression_unless_the_machine_was_busy(monkeypatch):
+    """Three real runs of a stage doing a fixed amount of work (the calibration workload, about 1 s): the
+    baseline, the same again, and three times the work.  The same work never regresses, busy machine or not;
+    3x the work regresses — or, when the run shows a busy machine, is reported as "not judged" with that
+    evidence; on a quiet machine (foreign CPU at most 10% in both runs) it must regress."""
+    from verimono.cli import execute
+    from verimono.gate import compare
+    from verimono.results import CheckResult, Report
+    from verimono.stages import STAGES, RunContext, Stage
+
+    work = {"repeats": 17}
+
+    def stage(profile, context):
+        for _ in range(work["repeats"]):
+            timing._workload()
+        return Report([CheckResult("work", "fixed", PASSED)])
+
+    monkeypatch.setitem(STAGES, "bench_work", Stage("bench_work", stage, "a fixed amount of work"))
+
+    def run():
+        return execute(command="run", profile_name="ci", stages=["bench_work"], context=RunContext())
+
+    base, same = run(), run()
+    work["repeats"] *= 3
+    slow = run()
+    info = lambda rep: rep.meta["stages"][0]  # noqa: E731
+    assert compare(base, same).ok, [str(c) for c in compare(base, same).changes]
+    comp = compare(base, slow)
+    timing_changes = [c for c in comp.changes if c.kind == "timing"]
+    assert len(timing_changes) == 1, [str(c) for c in comp.changes]
+    change = timing_changes[0]
+    quiet = all(isinstance(info(r).get("foreign_cpu"), float) and info(r)["foreign_cpu"] <= timing.BUSY_FOREIGN
+                for r in (base, slow))
+    if change.regression:
+        assert change.key == "stage bench_work"
+    else:
+        assert "not judged" in change.message and not quiet, (change, info(base), info(slow))
