@@ -22,7 +22,7 @@ from hypothesis import strategies as st
 
 from verimono import Problem, solve
 from verimono import strategies as vs
-from verimono.checks.trajectory_laws import CHECKS, LAWS
+from verimono.checks.stepper_battery import CHECKS, LAWS
 from verimono.errors import OutsideDomain, VerimonoError
 from verimono.results import FAILED, SKIPPED
 from verimono.testing import describe, parametrize_with_checks

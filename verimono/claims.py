@@ -31,6 +31,7 @@ from typing import Any, Callable
 import numpy as np
 
 from .errors import InvalidClaim
+from .naming import subject_name
 
 PROXIMAL, ANY = "proximal", "any"
 SCHEMES = (PROXIMAL, ANY)
@@ -139,8 +140,7 @@ def with_claim(stepper: Callable, scheme: str | None = None, order: Any = None,
         return stepper
     if scheme is None:
         scheme = ANY if order is not None else claim_of(stepper).scheme
-    name = getattr(stepper, "__name__", None) or getattr(stepper, "name", None)
-    return Stepper(stepper, scheme=scheme, order=order, name=name, contracts=contracts)
+    return Stepper(stepper, scheme=scheme, order=order, name=subject_name(stepper), contracts=contracts)
 
 
 __all__ = ["Claim", "Stepper", "claim_of", "with_claim", "make_claim", "InvalidClaim", "PROXIMAL", "ANY",

@@ -39,9 +39,10 @@ import numpy as np
 
 from ._jsonable import to_jsonable
 from .display import render
-from ._kernels import real_array
+from ._validate import real_array
 from .errors import InvalidProblem
 from .grids import uniform_grid, validate_grid
+from .naming import subject_name
 from .problem import Order, Problem
 from .stepping import solve, stream
 from .tolerances import EPS
@@ -332,10 +333,6 @@ class Sampler:
         self._prev = (t[-1:].copy(), x[-1:].copy())
 
 
-def _name(obj: Any) -> str:
-    return getattr(obj, "__name__", None) or getattr(obj, "name", None) or type(obj).__name__
-
-
 def convergence_study(stepper: Callable, problem: Problem, steps: Sequence[Any] | None = None, *,
                       reference_refinement: int = 8, executor: Any = None) -> ConvergenceStudy:
     """Run ``stepper`` on a sequence of grids and estimate its convergence order.
@@ -375,7 +372,7 @@ def convergence_study(stepper: Callable, problem: Problem, steps: Sequence[Any] 
     floor = ROUNDOFF_FACTOR * EPS * scale
     mesh = [float(np.max(np.diff(g))) for g in grids]
     fits = {n: fit_order(mesh, errors[n], floor) for n in NORMS}
-    return ConvergenceStudy(problem.name, _name(stepper), mesh, [len(g) - 1 for g in grids], errors, fits,
+    return ConvergenceStudy(problem.name, subject_name(stepper), mesh, [len(g) - 1 for g in grids], errors, fits,
                             problem.order, reference, floor, [r[-1] for r in results[:len(grids)]])
 
 
@@ -494,7 +491,7 @@ class _Portable:
         try:
             return (pickle.loads, (cloudpickle.dumps(obj),))
         except Exception as exc:
-            raise InvalidProblem(f"cannot send {_name(obj)} to the executor's workers: cloudpickle cannot "
+            raise InvalidProblem(f"cannot send {subject_name(obj)} to the executor's workers: cloudpickle cannot "
                                  f"serialise it ({type(exc).__name__}: {exc}); use executor='process' (forked "
                                  "workers inherit it) or 'serial'") from None
 
@@ -509,9 +506,9 @@ def _unwrap(obj):
 
 def _timed_run(stepper, problem, grid):
     start = time.perf_counter()
-    x = real_array(stepper(problem, grid), f"the values of stepper {_name(stepper)}")   # complex: an error
+    x = real_array(stepper(problem, grid), f"the values of stepper {subject_name(stepper)}")   # complex: an error
     if x.shape != (len(grid),) + problem.x0.shape:
-        raise InvalidProblem(f"stepper {_name(stepper)} returned shape {x.shape}, expected "
+        raise InvalidProblem(f"stepper {subject_name(stepper)} returned shape {x.shape}, expected "
                              f"{(len(grid),) + problem.x0.shape}")
     return x, time.perf_counter() - start
 

@@ -50,7 +50,7 @@ is evidence of the machine, not of the code, unless the measurement rules that o
 
 Baseline and results must come from the same kind of run (command, target, profile and the selected
 stages and references), be well-formed documents of a readable schema version
-(:mod:`verimono.report.schema` type-checks every field the gate reads), and the baseline must hold at
+(:mod:`verimono.schema` type-checks every field the gate reads), and the baseline must hold at
 least one executed record; otherwise :class:`IncompatibleBaseline` / ``SchemaError`` — the gate fails
 closed with exit status 2.
 """
@@ -91,6 +91,8 @@ CALIBRATION_DRIFT = 1.25
 #: the norms whose order estimates are gated against the baseline (the final-time error of several
 #: references sits at round-off on some grids, so its slope is not a stable statistic)
 GATED_NORMS = ("sup", "l2")
+#: how many regressions ``verimono run`` and ``verimono check`` list before pointing to ``verimono gate``
+LISTED_REGRESSIONS = 10
 #: run facts that must agree between a baseline and the results it gates (``selection``: the stages and
 #: references chosen with --stage / --reference; a battery that is selected but skipped still regresses)
 COMPATIBLE_KEYS = ("command", "target", "profile", "selection")
@@ -138,6 +140,17 @@ class Comparison:
 
     def to_dict(self) -> dict[str, Any]:
         return {"ok": self.ok, "compared": self.compared, "changes": [dataclasses.asdict(c) for c in self.changes]}
+
+    def regression_lines(self, baseline: str | Path | None = None, results: str | Path | None = None,
+                         limit: int = LISTED_REGRESSIONS) -> list[str]:
+        """The first ``limit`` regressions as ``verimono gate`` prints them, then how many more and the
+        ``verimono gate`` command that lists them all (``baseline``, ``results``: the two documents' paths)."""
+        regs = self.regressions
+        lines = [f"  {c}" for c in regs[:limit]]
+        if len(regs) > limit:
+            lines.append(f"  … and {len(regs) - limit} more; `verimono gate --baseline {baseline or 'BASELINE'} "
+                         f"--results {results or 'RESULTS'}` lists all")
+        return lines
 
 
 def check_baseline(baseline: Report) -> None:
@@ -372,4 +385,5 @@ def gate(baseline: str | Path | Report, results: str | Path | Report) -> Compari
 
 
 __all__ = ["Change", "Comparison", "compare", "gate", "check_baseline", "check_runs_compatible",
-           "IncompatibleBaseline", "IncompatibleResults", "ORDER_DROP_FLOOR", "ERROR_GROWTH", "TIMING_GROWTH", "TIMING_MIN_SECONDS", "CALIBRATION_DRIFT"]
+           "IncompatibleBaseline", "IncompatibleResults", "LISTED_REGRESSIONS", "ORDER_DROP_FLOOR", "ERROR_GROWTH",
+           "TIMING_GROWTH", "TIMING_MIN_SECONDS", "CALIBRATION_DRIFT"]

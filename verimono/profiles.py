@@ -18,12 +18,11 @@ import dataclasses
 import os
 
 from .errors import UnknownProfile
-from .timing import calibration
 
 PROFILES = ("dev", "ci", "thorough")
 
 
-#: what :func:`verimono.timing.calibrate` read on the machine where the budgets below were set (a 2-core EPYC
+#: what :func:`verimono.calibration.calibrate` read on the machine where the budgets below were set (a 2-core EPYC
 #: under KVM): there, a budget of U calibration units is U x 0.0776 s
 REFERENCE_CALIBRATION_S = 0.0776
 
@@ -43,13 +42,13 @@ class Profile:
     examples per operator law in ``verimono run`` (which runs every law on many operators, so fewer);
     ``generated_subjects``: operators and problems drawn from ``verimono.strategies`` per run;
     ``derandomize``: fixed seeds (0 unless ``--seed``), so every job produces the same records;
-    ``unit_budget``: *calibration units* (multiples of :func:`verimono.timing.calibrate`, about 0.06-0.08 s
+    ``unit_budget``: *calibration units* (multiples of :func:`verimono.calibration.calibrate`, about 0.06-0.08 s
     on a 2-core EPYC) one unit (one law on one operator, one check of one stepper) may take before it is
-    stopped and recorded as failed (:mod:`verimono.timeouts`; ``--timeout S`` overrides it in seconds).  In
-    units, a slower or busier machine — whose calibration reads longer — gets proportionally more seconds.
-    The slowest catalog unit takes about 5 s (65 units) on a loaded 2-core machine (a law at n = 10^6,
-    ``ci``), so the defaults (60, 124 and 620 s where the calibration reads 0.0776 s) stop only what does not
-    finish.  ``stage_budget_scale``: the factor on :data:`STAGE_BUDGETS` (stated for ``ci``).
+    stopped (:mod:`verimono.timeouts`, which states it in seconds; ``--timeout S`` overrides it in seconds): a
+    law stopped after samples that all held is undecided, anything else stopped is failed.  In units, a slower
+    or busier machine — whose calibration reads longer — gets proportionally more seconds.  The slowest
+    catalog unit takes about 5 s (65 units) on a loaded 2-core machine (a law at n = 10^6, ``ci``), so the
+    defaults (62, 124 and 621 s where the calibration reads 0.0776 s) stop only what does not finish.  ``stage_budget_scale``: the factor on :data:`STAGE_BUDGETS` (stated for ``ci``).
     """
 
     name: str
@@ -59,12 +58,6 @@ class Profile:
     derandomize: bool
     unit_budget: float = 1600.0
     stage_budget_scale: float = 1.0
-
-    @property
-    def unit_timeout(self) -> float:
-        """Seconds of ``unit_budget`` on this machine: ``unit_budget`` x this process's calibration
-        (:func:`verimono.timing.calibration`, measured once and cached)."""
-        return self.unit_budget * calibration()
 
     def stage_budget_units(self, stage: str) -> float | None:
         """The calibration units stage ``stage`` may take at this profile (``None``: no budget stated)."""

@@ -3,7 +3,7 @@
 A *unit* is one law on one operator, or one check of one stepper.  Its budget is, in order: the innermost
 :func:`budget` block, in seconds (``verimono run/check --timeout S`` opens one around the whole run), else
 the active profile's ``unit_budget`` (:mod:`verimono.profiles`), stated in *calibration units*: multiples of
-:func:`verimono.timing.calibrate`, a fixed NumPy-and-Python workload.  In seconds that is ``units x`` the
+:func:`verimono.calibration.calibrate`, a fixed NumPy-and-Python workload.  In seconds that is ``units x`` the
 calibration measured in this process (:func:`calibration`: measured once, best of 3, about 0.2 s, then
 cached; ``verimono run`` supplies the one it measures at its start), so a slower or busier machine — where
 the workload, like everything else, takes longer — gets proportionally more time, and a unit is stopped
@@ -30,7 +30,7 @@ from contextlib import contextmanager
 from typing import Callable, Iterator
 
 from .errors import InvalidCheckArgument, UnitTimeout
-from . import timing
+from . import calibration as _calibration
 from .profiles import Profile, UnknownProfile, active_profile, get_profile
 from .results import FAILED, CheckResult
 
@@ -64,9 +64,9 @@ def budget(seconds: float | None) -> Iterator[None]:
 
 
 def calibration() -> float:
-    """Seconds of the calibration workload in this process (:func:`verimono.timing.calibration`: measured
-    once and cached; :func:`verimono.timing.set_calibration` supplies one measured elsewhere)."""
-    return timing.calibration()
+    """Seconds of the calibration workload in this process (:func:`verimono.calibration.calibration`: measured
+    once and cached; :func:`verimono.calibration.set_calibration` supplies one measured elsewhere)."""
+    return _calibration.calibration()
 
 
 def in_seconds(units: float) -> float:

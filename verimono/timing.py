@@ -1,6 +1,6 @@
 """Speed verdicts that hold on a busy machine: the clock, the estimator, the decision rule, and the machine probes.
 
-Everything here is small and dependency-free (NumPy for the calibration workload only), so that
+Everything here is small and dependency-free (the calibration workload is :mod:`verimono.calibration`'s), so that
 :mod:`verimono.performance` (the timed records), :mod:`verimono.gate` (timing comparisons with a baseline)
 and :mod:`verimono.timeouts` (budgets in calibration units) share one definition of each.
 
@@ -41,9 +41,10 @@ process waited for a CPU, the load average and the calibration before and after.
 verdict, pass or fail, has probability at most ``ALPHA`` = 5% when the true median sits on the target,
 and far less away from it.
 
-**Calibration** (:func:`calibrate`): a fixed NumPy-and-Python workload, best of ``repeats``; stage times
-are stated in its units (``verimono gate``), and so are the time budgets of :mod:`verimono.timeouts`
-(:func:`calibration` measures it once per process and caches it).
+**Calibration** (:mod:`verimono.calibration`, re-exported here): a fixed NumPy-and-Python workload, best of
+``repeats``; stage times are stated in its units (``verimono gate``), and so are the time budgets of
+:mod:`verimono.timeouts` (:func:`calibration` measures it once per process and caches it);
+:func:`calibrate_both` times it on both clocks.
 
 **Machine probes** (:class:`MachineProbe`): the fraction of wall time during which some task on the
 machine was runnable but waiting for a CPU (Linux PSI, ``/proc/pressure/cpu``, ``some``), the share of the
@@ -60,7 +61,7 @@ import statistics
 import time
 from typing import Any, Callable, Sequence
 
-import numpy as np
+from .calibration import calibrate, calibration, set_calibration, workload
 
 #: one-sided error of each verdict (pass or fail) when the true median ratio sits exactly on the target;
 #: split between the two looks at the data (Bonferroni), ``ALPHA / LOOKS`` per look and side
@@ -261,51 +262,12 @@ def is_noise_undecided(record: Any) -> bool:
 # -- calibration -------------------------------------------------------------------------------------------
 
 
-def _workload() -> None:
-    x, lo, hi = np.array([0.3, -0.2, 0.9]), -np.ones(3) * 0.5, np.ones(3) * 0.5
-    for k in range(20000):
-        x = np.clip(x - 1e-3 * np.sin(k * 1e-3) * x, lo, hi)
-    np.linalg.solve(np.eye(60) * 4.0 + np.ones((60, 60)), np.ones(60))
-
-
-def calibrate(repeats: int = 3) -> float:
-    """Seconds of a fixed NumPy-and-Python workload like the harness's (best of ``repeats``, wall clock;
-    about 0.06 s each on a 2-core EPYC).  Stage durations and time budgets are stated in multiples of it."""
-    best = float("inf")
-    for _ in range(repeats):
-        start = time.perf_counter()
-        _workload()
-        best = min(best, time.perf_counter() - start)
-    return best
-
-
 def calibrate_both(repeats: int = 3) -> dict[str, float]:
     """The calibration workload on both clocks, best of ``repeats``: ``{"wall": s, "own": s}``.  On a busy
     machine the wall figure grows with the load and the own figure (:func:`timed`) does not; both growing
     means the code itself ran slower (cache and memory-bandwidth contention, a slower CPU clock)."""
-    samples = [timed(_workload)[1] for _ in range(repeats)]
+    samples = [timed(workload)[1] for _ in range(repeats)]
     return {"wall": min(s.wall for s in samples), "own": min(s.own for s in samples)}
-
-
-_CALIBRATION: list[float] = []
-
-
-def calibration() -> float:
-    """This process's calibration (seconds of :func:`calibrate`), measured once (best of 3, ~0.2 s) on the
-    first call and cached; :func:`set_calibration` supplies one measured elsewhere in the process."""
-    if not _CALIBRATION:
-        _CALIBRATION.append(calibrate())
-    return _CALIBRATION[0]
-
-
-def set_calibration(seconds: float | None) -> None:
-    """Use ``seconds`` as this process's calibration (``None``: forget it, measure again when needed)."""
-    _CALIBRATION.clear()
-    if seconds is not None:
-        s = float(seconds)
-        if not (s > 0 and math.isfinite(s)):
-            raise ValueError(f"a calibration is a positive number of seconds, got {seconds!r}")
-        _CALIBRATION.append(s)
 
 
 # -- machine probes --------------------------------------------------------------------------------------------

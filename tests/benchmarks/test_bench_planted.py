@@ -157,7 +157,7 @@ def test_a_3x_slower_stage_is_a_gate_regression_unless_the_machine_was_busy(monk
     baseline, the same again, and three times the work.  The same work never regresses, busy machine or not;
     3x the work regresses — or, when the run shows a busy machine, is reported as "not judged" with that
     evidence; on a quiet machine (foreign CPU at most 10% in both runs) it must regress."""
-    from verimono.cli import execute
+    from verimono.runs import execute
     from verimono.gate import compare
     from verimono.results import CheckResult, Report
     from verimono.stages import STAGES, RunContext, Stage
@@ -166,7 +166,7 @@ def test_a_3x_slower_stage_is_a_gate_regression_unless_the_machine_was_busy(monk
 
     def stage(profile, context):
         for _ in range(work["repeats"]):
-            timing._workload()
+            timing.workload()
         return Report([CheckResult("work", "fixed", PASSED)])
 
     monkeypatch.setitem(STAGES, "bench_work", Stage("bench_work", stage, "a fixed amount of work"))

@@ -22,7 +22,8 @@ from collections import Counter, defaultdict
 from html import escape
 from typing import Any
 
-from ..results import FAILED, PASSED, SKIPPED, STATUSES, UNDECIDED, XFAIL, CheckResult, Report, environment, to_jsonable
+from ..environment import environment
+from ..results import FAILED, PASSED, SKIPPED, STATUSES, UNDECIDED, XFAIL, CheckResult, Report, to_jsonable
 from .plots import convergence_plot, trajectory_plot
 
 SECTIONS = ("summary", "changes", "convergence", "trajectories", "laws", "failures", "performance", "timings",
@@ -479,8 +480,8 @@ def render(report: Report, *, changes: Any = None, title: str = "verimono report
     sub = " · ".join(_e(x) for x in (
         f"verimono {m.get('command') or ''} {m.get('target') or ''}".strip(), f"profile {m.get('profile')}",
         m.get("created") or "", report.summary(), f"run {m['run_id']}" if m.get("run_id") else "") if x)
-    return (f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
-            f'<meta name="viewport" content="width=device-width, initial-scale=1">'
+    return ('<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
+            '<meta name="viewport" content="width=device-width, initial-scale=1">'
             + (f'<meta name="verimono-run-id" content="{_e(m["run_id"])}">' if m.get("run_id") else "")
             + f"<title>{_e(title)}</title><style>{CSS}</style></head><body>"
             f"<header><h1>{_e(title)}</h1><div class=\"sub\">{sub}</div></header><nav>{nav}</nav>"
