@@ -6,6 +6,7 @@ undecided records are speeds the machine was too noisy to judge.  (The estimator
 from __future__ import annotations
 
 import copy
+import time
 
 import pytest
 
@@ -185,3 +186,116 @@ def test_speed_that_could_not_be_judged_does_not_fail_the_run(tmp_path, capsys):
     assert _exit_status(rep) == EXIT_UNDECIDED      # any other undecided record still exits 2
     rep.add(CheckResult("law", "Cone", "failed"))
     assert _exit_status(rep) == 1
+
+
+# -- a law out of budget: undecided when everything it evaluated held, failed when a call does not return -------
+
+
+needs_alarm = pytest.mark.skipif(not timeouts.supported(), reason="no SIGALRM here")
+
+
+def _sleep_then(seconds: float):
+    def run():
+        time.sleep(seconds)
+    return run
+
+
+@needs_alarm
+def test_a_unit_stopped_after_samples_that_all_held_is_undecided():
+    def law():
+        time.sleep(0.05)
+        timeouts.note_progress(1, True, "partitions")
+        time.sleep(10)                            # the next evaluation: slow, not hung (0.45 s < 20 x 0.05 s)
+
+    rec = timeouts.run_unit(law, check="law", subject="slow stepper", seconds=0.5)
+    assert rec.status == UNDECIDED, rec
+    assert rec.details["undecided_reason"] == timeouts.TIME_BUDGET_REASON == "time budget"
+    assert rec.details["evaluated"] == 1 and "after 1 partition, all of which held" in rec.message
+
+
+@needs_alarm
+def test_a_unit_stopped_after_a_violation_or_in_a_call_that_does_not_return_fails():
+    def violated():
+        timeouts.note_progress(2, False, "partitions")
+        time.sleep(10)
+
+    rec = timeouts.run_unit(violated, check="law", subject="s", seconds=0.3)
+    assert rec.status == "failed" and "not all of which held" in rec.message
+
+    def hangs():
+        timeouts.note_progress(3, True)             # three quick samples held, then a call that never returns
+        while True:
+            pass
+
+    rec = timeouts.run_unit(hangs, check="law", subject="s", seconds=0.3)
+    assert rec.status == "failed" and "a call that does not return" in rec.message, rec
+    assert rec.details["in_flight"] > timeouts.HANG_MULTIPLE * rec.details["slowest"]
+
+    rec = timeouts.run_unit(_sleep_then(10), check="law", subject="s", seconds=0.2)   # nothing returned
+    assert rec.status == "failed" and rec.message.startswith("timed out")
+    timeouts.note_progress(1, True)                  # outside a unit: nothing to note
+    assert not timeouts._PROGRESS
+
+
+@needs_alarm
+def test_a_stepper_law_out_of_budget_after_partitions_that_held_is_undecided():
+    """``check_stepper`` runs each law under the unit budget; a correct but slow stepper on a loaded machine is
+    undecided (time budget, k partitions), a stepper that hangs on its second partition still fails."""
+    import verimono as vm
+    from verimono.reference import get
+
+    problem = get("t|x| (n=1)")
+
+    def slow(p, t):                                  # two partitions of 0.3 s each: the second is stopped
+        time.sleep(0.3)
+        return vm.solve(p, t)
+
+    with timeouts.budget(0.5):
+        rep = vm.check_stepper(slow, [problem], laws=["in_domain"], orders=False)
+    (rec,) = rep.results
+    assert rec.status == UNDECIDED and rec.details["undecided_reason"] == "time budget", rec
+    assert rec.details["evaluated"] >= 1 and "all of which held" in rec.message
+
+    calls = []
+
+    def hangs_on_the_second(p, t):
+        calls.append(len(t))
+        while len(calls) > 1:
+            pass
+        return vm.solve(p, t)
+
+    with timeouts.budget(0.5):
+        rep = vm.check_stepper(hangs_on_the_second, [problem], laws=["in_domain"], orders=False)
+    (rec,) = rep.results
+    assert rec.status == "failed" and "a call that does not return" in rec.message, rec
+
+
+@needs_alarm
+def test_an_operator_law_out_of_budget_after_samples_that_held_is_undecided():
+    import numpy as np
+
+    import verimono as vm
+    from verimono.checks.search import run_law
+
+    def slow(x, lam, t):
+        time.sleep(0.004)
+        return np.asarray(x, dtype=float) / (1.0 + lam)
+
+    op = vm.operator_from_resolvent(slow, 2, name="slow")
+    with timeouts.budget(0.4):
+        rec = run_law("resolvent_nonexpansive", op, seed=0, examples=500)
+    assert rec.status == UNDECIDED and rec.details["undecided_reason"] == "time budget", rec
+    assert "all of which held" in rec.message
+
+    def hangs_later(x, lam, t):                      # a few samples hold, then a call never returns
+        x = np.asarray(x, dtype=float)
+        while len(seen) >= 20:
+            pass
+        seen.append(1)
+        return x / (1.0 + lam)
+
+    seen: list[int] = []
+    op = vm.operator_from_resolvent(hangs_later, 2, name="hangs later")
+    with timeouts.budget(0.4):
+        rec = run_law("resolvent_nonexpansive", op, seed=0, examples=500)
+    assert rec.status == "failed" and "does not return" in rec.message and rec.details["evaluations"] >= 2, rec
