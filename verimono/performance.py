@@ -1,4 +1,4 @@
-"""Performance records (issue 6): verimono against bare baselines, as ratios measured in one process.
+"""Performance records: verimono against bare baselines, as ratios measured in one process.
 
 Each ``check_*`` function times verimono and a bare baseline doing the same work in interleaved rounds
 (:class:`Rounds`: the order alternating, on each call's *own time* — wall time minus its wait for a CPU,
@@ -39,21 +39,21 @@ from .results import FAILED, PASSED, UNDECIDED, CheckResult, Report
 from .sets import Ball, Box
 from .stepping import solve
 
-#: issue 6, target 1: ``solve`` within 1.5x a bare NumPy loop doing the same arithmetic
+#: per-step overhead: ``solve`` within 1.5x a bare NumPy loop doing the same arithmetic
 PER_STEP_TARGET = 1.5
-#: issue 6, target 2: a batch of 1000 at least 30x faster than 1000 separate solves
+#: ensembles: a batch of 1000 at least 30x faster than 1000 separate solves
 ENSEMBLE_TARGET = 30.0
-#: issue 15, target 1: DiodeBridge ``simulate`` (θ = 1/2, h = 1e-6) within 5x a Python loop doing one 2×2
+#: the LCS kernel: DiodeBridge ``simulate`` (θ = 1/2, h = 1e-6) within 5x a Python loop doing one 2×2
 #: matrix–vector product per step (the floor of any Python step loop), per step
 LCS_TARGET = 5.0
-#: issue 15, target 2: a batch of B DiodeBridge trajectories at most 0.25x the floor loop's cost per
+#: batched LCS: a batch of B DiodeBridge trajectories at most 0.25x the floor loop's cost per
 #: trajectory-step (Siconos' C ``lcp_lexicolemke`` takes 0.23 µs per step where the floor takes about 1 µs)
 LCS_BATCH_TARGET = 0.25
 #: simulate's trajectory must agree with the step-by-step verified solver (:func:`minimal_lcs`) to this,
 #: relative to the trajectory's size: the two differ by the rounding of the kernel's precomputed maps
 #: (measured 3e-14; the Siconos references are matched to 1e-10)
 LCS_AGREEMENT = 1e-12
-#: issue 6, target 6: a streamed study holds at most one trajectory's bytes
+#: memory: a streamed study holds at most one trajectory's bytes
 MEMORY_TARGET = 1.0
 #: the smallest positive double (a norm of 0 divides to 0, as in the catalog's kernels)
 TINY = 5e-324
@@ -86,9 +86,9 @@ class Sizes:
     max_rounds: int = 27
 
 
-#: ``thorough``: the issue's sizes; ``ci`` and ``dev``: a few seconds on 2 cores, with fewer steps (the ratios
+#: ``thorough``: the full sizes; ``ci`` and ``dev``: a few seconds on 2 cores, with fewer steps (the ratios
 #: move by less than their round-to-round spread), but B = 1000 and a 10^5-step memory study; DiodeBridge keeps
-#: the issue's 5000 steps (its one-off cost, building the maps of the patterns met, ~2 ms, would be most of a
+#: its 5000 steps (its one-off cost, building the maps of the patterns met, ~2 ms, would be most of a
 #: 1000-step run) and its batch runs 200 steps (the study's fixed ~3.6 MiB of per-block buffers exceed one
 #: trajectory below ~75 000 steps at n = 10).
 #: Rounds: 9 is the fewest whose order-statistics bounds at 97.5% one-sided leave out one outlying round on
@@ -166,7 +166,7 @@ def per_step_case(kind: str, n: int):
 
 
 def floor_loop(A, x0, K):
-    """The floor of a Python step loop (issue 15): one 2×2 matrix–vector product per step, nothing else."""
+    """The floor of a Python step loop: one 2×2 matrix–vector product per step, nothing else."""
     x = x0
     for _ in range(K):
         x = A @ x
@@ -174,7 +174,7 @@ def floor_loop(A, x0, K):
 
 
 def minimal_lcs(system, sm, x0, K):
-    """The step-by-step loop of ``simulate`` before issue 15: precomputed step matrices ``sm`` and the
+    """The step-by-step loop of ``simulate`` before its kernel: precomputed step matrices ``sm`` and the
     relation's warm-started verified one-step solver every step (the reference ``simulate`` must agree with)."""
     E, G, C, D, step = sm.E, sm.G, system.C, system.D, sm.step
     v = system.v(0.0)
@@ -398,7 +398,7 @@ def check_ensemble(op, label: str, *, batch: int, steps: int, rounds: int, max_r
 
 def check_lcs_step(*, steps: int, rounds: int, max_rounds: int | None = None, runner: Runner | None = None,
                    simulate: Callable | None = None) -> CheckResult:
-    """Target 1 of issue 15: ``DiodeBridge.simulate`` (EulerMoreauOSI, θ = 1/2, h = 1e-6) against
+    """The LCS kernel: ``DiodeBridge.simulate`` (EulerMoreauOSI, θ = 1/2, h = 1e-6) against
     :func:`floor_loop` with the same number of steps; the trajectory must agree with the step-by-step
     verified solver (:func:`minimal_lcs`, untimed) to ``LCS_AGREEMENT``.  ``simulate(system, x0, t, theta)``
     replaces the system's own (a planted slowdown in the benchmarks)."""
@@ -429,7 +429,7 @@ def check_lcs_step(*, steps: int, rounds: int, max_rounds: int | None = None, ru
 
 def check_lcs_batch(*, batch: int, steps: int, rounds: int, max_rounds: int | None = None,
                     runner: Runner | None = None, seed: int = 15) -> CheckResult:
-    """Target 2 of issue 15: ``simulate`` of ``batch`` DiodeBridge trajectories, per trajectory-step, against
+    """Batched LCS: ``simulate`` of ``batch`` DiodeBridge trajectories, per trajectory-step, against
     :func:`floor_loop` per step (run for ``max(steps, 2000)`` steps); rows 0, B/2 and B−1 must equal
     their single runs bit for bit (untimed).  ``subject_s``/``baseline_s`` are seconds per trajectory-step
     and per floor step."""

@@ -10,7 +10,7 @@ rounds, up to 27 when the interval straddles the target) and checks the verdict 
 * the correct code is never failed (passed, or undecided with the noise evidence);
 * the old gross regressions (a 20x stepper, a kernel that sleeps, a lost vectorisation) still fail.
 
-Run them idle and under ``../shared/tools/stress -n 2 -- python -m pytest tests/benchmarks/test_bench_planted.py``.
+Run them idle and under ``../shared/tools/stress -n 2 -- python -m pytest -m timing tests/benchmarks/test_bench_planted.py``.
 """
 
 from __future__ import annotations
@@ -24,7 +24,8 @@ from verimono import performance, timing
 from verimono.results import FAILED, PASSED, UNDECIDED
 from verimono.stepping import solve
 
-pytestmark = pytest.mark.benchmark   # wall-clock: never in the default test run
+#: wall-clock: the ``timing`` tier (``pytest -m timing``, on a quiet machine), never in the default test run
+pytestmark = [pytest.mark.benchmark, pytest.mark.timing]
 
 CI = performance.SIZES["ci"]
 #: the evidence of a quiet measurement: the per-round ratios' interquartile range within 10% of their median
