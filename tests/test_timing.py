@@ -126,6 +126,17 @@ def test_a_grown_stage_time_on_a_busy_machine_is_not_judged():
     assert [c.key for c in regs] == ["stage operator_laws"]
 
 
+def test_a_slowdown_hidden_by_a_drifting_calibration_is_shown_not_dropped():
+    """A busy run whose end calibration doubled: 3x the work reads only 1.5x in units of the slower calibration,
+    3x in units of the faster one; it is not judged, but listed with the evidence (not silently passed)."""
+    regs, others = stage_changes(run_report(12.0, [0.05, 0.1], cpu_waiting=0.8, foreign_cpu=0.7))
+    assert not regs and len(others) == 1, others
+    assert "up to 3.0x growth" in others[0].message and "not judged" in others[0].message
+    # the same reading from a run that can be judged (no drift, quiet): within 2x, nothing to say
+    regs, others = stage_changes(run_report(4.0 * 1.9, [0.05, 0.05]))
+    assert not regs and not others
+
+
 def test_a_run_contending_with_itself_is_still_judged():
     """Waiting for a CPU caused by the run's own worker processes (40% in a quiet run's first stage) is part of
     the stage's normal time, in the baseline too: with little foreign CPU a 3x slowdown still regresses."""
