@@ -32,7 +32,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from .claims import SCHEMES, claim_of, with_claim
-from .errors import BadTarget, InvalidCheckArgument, NothingToResume, VerimonoError
+from .errors import BadTarget, InvalidCheckArgument, NothingToResume, SchemaError, VerimonoError
 from .profiles import PROFILES, active_profile
 from .progress import Progress
 from .results import SKIPPED, Report
@@ -93,10 +93,10 @@ def _changes(baseline: Report | None, report: Report) -> Any:
 
     try:
         check_runs_compatible(baseline, report)
-    except IncompatibleBaseline as exc:
+        return compare(baseline, report)
+    except (IncompatibleBaseline, SchemaError) as exc:   # shown only; `verimono gate` decides (exit 2)
         print(f"verimono: not comparing with the baseline: {exc}", file=sys.stderr)
         return None
-    return compare(baseline, report)
 
 
 def order_table(report: Report) -> list[str]:

@@ -33,7 +33,9 @@ Layout (schema ``verimono.results``, version ``SCHEMA_VERSION`` = ``MAJOR.MINOR`
 A record's ``details`` are free-form; keys that producers hand to consumers: ``study`` (a convergence-order
 record's study, read back as a :class:`ConvergenceStudy`), ``stage`` and ``reference`` (set by the run),
 ``reproduce``, ``reproduce_python``, ``example`` (what the report's reproduction shows), ``error`` and
-``timing_ratio`` (compared by the gate).
+``timing_ratio`` (compared by the gate), ``xfail_declared`` (why an ``xfail`` was expected) and
+``unearned_pass`` (a pass claimed with a non-finite worst ratio, turned into a failure).  A record's key
+``check[subject]`` is unique in a document: the gate refuses one that repeats a key.
 
 Non-finite floats are written as the strings ``"inf"``, ``"-inf"``, ``"nan"`` (strict JSON has no such
 numbers) and read back as floats where the field is numeric; ``null`` in a numeric list (errors, slopes)
