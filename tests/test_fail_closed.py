@@ -186,3 +186,49 @@ def test_the_committed_baselines_xfails_pass_against_fresh_records():
     assert comp.ok, [str(c) for c in comp.regressions]
     now = {r.key: r for r in fresh}
     assert all(now[r.key].status == "xfail" and now[r.key].details.get("xfail_declared") for r in xfails)
+
+
+def _subprocess_env() -> dict[str, str]:
+    """The environment of a child that imports the very verimono under test."""
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
+    env["PYTHONPATH"] = os.pathsep.join([str(Path(vm.__file__).resolve().parent.parent),
+                                         env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+    return env
+
+
+def _limited(seconds: int = 60):
+    """A child with at most 2 GiB of address space: a read that never ends fails instead of swapping."""
+    import resource
+
+    def limit():
+        resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
+
+    return {"preexec_fn": limit, "timeout": seconds, "capture_output": True, "text": True, "env": _subprocess_env()}
+
+
+@pytest.mark.parametrize("kind", ["/dev/zero", "fifo", "folder"])
+@pytest.mark.parametrize("role", ["--baseline", "--results"])
+def test_reading_a_device_fifo_or_folder_exits_2_without_hanging(tmp_path, kind, role):
+    good = _report().save(tmp_path / "good.json")
+    if kind == "fifo":
+        bad = tmp_path / "fifo.json"
+        os.mkfifo(bad)
+    else:
+        bad = tmp_path if kind == "folder" else Path(kind)
+    files = {"--baseline": good, "--results": good, role: bad}
+    proc = subprocess.run([sys.executable, "-m", "verimono.cli", "gate", "--baseline", str(files["--baseline"]),
+                           "--results", str(files["--results"])], **_limited())
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr
+    assert f"{bad} is " in proc.stderr and ("not a regular file" in proc.stderr or "a folder" in proc.stderr)
+
+
+def test_a_document_over_the_size_limit_exits_2(tmp_path, capsys, monkeypatch):
+    good = _report().save(tmp_path / "good.json")
+    monkeypatch.setenv("VERIMONO_MAX_DOCUMENT_MIB", str(512 / (1 << 20)))   # 512 bytes
+    code, text = _gate(capsys, good, good)
+    assert code == 2 and "larger than the limit" in text and "VERIMONO_MAX_DOCUMENT_MIB" in text
+    monkeypatch.setenv("VERIMONO_MAX_DOCUMENT_MIB", "lots")
+    code, text = _gate(capsys, good, good)
+    assert code == 2 and "must be a positive number of MiB" in text
+    monkeypatch.delenv("VERIMONO_MAX_DOCUMENT_MIB")
+    assert _gate(capsys, good, good)[0] == 0
