@@ -196,6 +196,28 @@ def _subprocess_env() -> dict[str, str]:
     return env
 
 
+@pytest.mark.parametrize("umask, mode", [(0o022, 0o644), (0o027, 0o640), (0o077, 0o600)])
+def test_output_files_honour_the_umask(tmp_path, umask, mode):
+    from verimono.report import write
+
+    old = os.umask(umask)
+    try:
+        paths = write(_report(), tmp_path / "out")
+        saved = _report().save(tmp_path / "baseline.json")
+    finally:
+        os.umask(old)
+    for p in (paths["json"], paths["html"], saved):
+        assert stat.S_IMODE(p.stat().st_mode) == mode, p
+
+
+def test_a_replaced_file_keeps_its_own_mode_as_with_open(tmp_path):
+    path = tmp_path / "baseline.json"
+    _report().save(path)
+    path.chmod(0o664)
+    _report().save(path)
+    assert stat.S_IMODE(path.stat().st_mode) == 0o664
+
+
 def _limited(seconds: int = 60):
     """A child with at most 2 GiB of address space: a read that never ends fails instead of swapping."""
     import resource

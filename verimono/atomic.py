@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import os
 import signal
+import stat
 import tempfile
 import threading
 from contextlib import contextmanager
@@ -21,10 +22,42 @@ from typing import Iterator, Mapping
 from .errors import OutputNotWritable
 
 
+def _umask() -> int:
+    """The process umask, read without changing it where Linux says it (``/proc/self/status``); elsewhere
+    by setting and restoring it."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def file_mode(path: Path) -> int:
+    """The permission bits ``open(path, "w")`` would leave ``path`` with: its own when it exists (a regular
+    file), else ``0o666`` less the umask."""
+    try:
+        st = os.stat(path)
+        if stat.S_ISREG(st.st_mode):
+            return stat.S_IMODE(st.st_mode)
+    except OSError:
+        pass
+    return 0o666 & ~_umask()
+
+
 def _temp_for(path: Path, text: str) -> Path:
-    """Write ``text`` to a new temporary file next to ``path`` (same filesystem) and return its path."""
+    """Write ``text`` to a new temporary file next to ``path`` (same filesystem, the mode of
+    :func:`file_mode`) and return its path."""
     fd, tmp = tempfile.mkstemp(dir=str(path.parent), prefix=f".{path.name}.", suffix=".tmp")
     try:
+        try:
+            os.fchmod(fd, file_mode(path))
+        except (OSError, AttributeError):   # a filesystem without modes, or no fchmod: keep mkstemp's
+            pass
         with os.fdopen(fd, "w", encoding="utf-8") as fh:
             fh.write(text)
             fh.flush()
