@@ -188,12 +188,171 @@ def test_the_committed_baselines_xfails_pass_against_fresh_records():
     assert all(now[r.key].status == "xfail" and now[r.key].details.get("xfail_declared") for r in xfails)
 
 
+# -- 2. a run in progress is visible ---------------------------------------------------------------------
+
+KILLER = textwrap.dedent('''
+    import os, signal, sys
+    import verimono.stages as stages
+    from verimono.cli import main
+
+    real = stages.STAGES["convergence"]
+
+    def killed(profile, context):
+        os.kill(os.getpid(), signal.SIGKILL)
+
+    stages.STAGES["convergence"] = stages.Stage("convergence", killed, real.description)
+    sys.exit(main(sys.argv[1:]))
+''')
+
+
 def _subprocess_env() -> dict[str, str]:
     """The environment of a child that imports the very verimono under test."""
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
     env["PYTHONPATH"] = os.pathsep.join([str(Path(vm.__file__).resolve().parent.parent),
                                          env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
     return env
+
+
+def test_a_killed_run_is_visible_and_its_stale_pair_is_refused(tmp_path, capsys):
+    """``kill -9`` during ``verimono run`` over a complete pair left that pair, which the gate then passed
+    as this run's, and ``--resume`` called "a complete run"."""
+    out, base = tmp_path / "out", tmp_path / "baseline.json"
+    assert main(["run", *ONE_REF, "--out", str(out)]) == 0
+    old_id = load(out / "results.json").meta["run_id"]
+    assert main(["baseline", "--from", str(out / "results.json"), "--out", str(base)]) == 0
+    assert _gate(capsys, base, out / "results.json")[0] == 0
+
+    proc = subprocess.run([sys.executable, "-c", KILLER, "run", *ONE_REF, "--out", str(out)],
+                          env=_subprocess_env(), capture_output=True, text=True, timeout=300)
+    assert proc.returncode == -signal.SIGKILL, proc.stderr[-2000:]
+    assert load(out / "results.json").meta["run_id"] == old_id          # the stale pair is still there ...
+    mark = json.loads((out / "results.json.in-progress").read_text())    # ... beside the killed run's mark
+    assert mark["run_id"] != old_id and mark["command"] == "run"
+
+    code, text = _gate(capsys, base, out / "results.json")
+    assert code == 2 and "never completed" in text and mark["run_id"] in text
+    capsys.readouterr()
+    assert main(["run", *ONE_REF, "--out", str(out), "--resume"]) == 2
+    err = capsys.readouterr().err
+    assert mark["run_id"] in err and "never completed" in err and old_id in err
+    assert main(["baseline", "--from", str(out / "results.json"), "--out", str(tmp_path / "b2.json")]) == 2
+
+    assert main(["run", *ONE_REF, "--out", str(out)]) == 0               # a run that completes clears it
+    assert not (out / "results.json.in-progress").exists()
+    assert _gate(capsys, base, out / "results.json")[0] == 0
+
+
+def test_the_mark_is_written_before_the_work_with_the_run_id_of_the_results(tmp_path, monkeypatch):
+    import verimono.stages as stages
+    from verimono.atomic import in_progress
+
+    out, seen = tmp_path / "out", []
+    real = stages.STAGES["convergence"]
+
+    def spy(profile, context):
+        seen.append(in_progress(out / "results.json"))
+        return real.fn(profile, context)
+
+    monkeypatch.setitem(stages.STAGES, "convergence", stages.Stage("convergence", spy, real.description))
+    assert main(["run", *ONE_REF, "--out", str(out)]) == 0
+    assert seen[0] is not None and seen[0]["run_id"] == load(out / "results.json").meta["run_id"]
+    assert seen[0]["pid"] == os.getpid() and in_progress(out / "results.json") is None
+
+
+def test_resume_names_the_run_it_continues(tmp_path, monkeypatch, capsys):
+    import verimono.stages as stages
+
+    out = tmp_path / "out"
+    real = stages.STAGES["section7"]
+
+    def interrupt(profile, context):
+        raise KeyboardInterrupt
+
+    monkeypatch.setitem(stages.STAGES, "section7", stages.Stage("section7", interrupt, real.description))
+    args = ["run", "--stage", "convergence", "--stage", "section7", "--reference", "moving box", "--profile", "ci",
+            "--executor", "serial", "--out", str(out)]
+    assert main(args) == 130
+    partial = load(out / "results.json")
+    assert not (out / "results.json.in-progress").exists()          # its own pair, marked incomplete, is there
+    monkeypatch.setitem(stages.STAGES, "section7", real)
+    capsys.readouterr()
+    assert main([*args, "--resume"]) == 0
+    assert f"resuming run {partial.meta['run_id']}" in capsys.readouterr().err
+    full = load(out / "results.json")
+    assert full.meta["resumed_from"] == partial.meta["run_id"] != full.meta["run_id"]
+
+
+def test_the_advice_after_an_interrupted_check_names_a_command_that_exists(tmp_path, monkeypatch, capsys):
+    import verimono.stages as stages
+
+    (tmp_path / "good.py").write_text("from verimono.stepping import solve\n")
+    real = stages.STAGES["convergence"]
+
+    def interrupt(profile, context):
+        raise KeyboardInterrupt
+
+    monkeypatch.setitem(stages.STAGES, "convergence", stages.Stage("convergence", interrupt, real.description))
+    target = f"{tmp_path / 'good.py'}:solve"
+    assert main(["check", target, "--profile", "ci", "--out", str(tmp_path / "o")]) == 130
+    err = capsys.readouterr().err
+    assert "check --resume" not in err
+    assert "run the same command again" in err and f"verimono check {target} --profile ci --out" in err
+
+
+# -- 3. faults end cleanly -------------------------------------------------------------------------------
+
+def _failing_pair_writes(monkeypatch, code: int = errno.ENOSPC) -> None:
+    """The pair's temporaries fail as on a full disk (the small in-progress mark still fits)."""
+    import verimono.atomic as atomic
+
+    real = atomic._temp_for
+
+    def temp_for(path, text):
+        if path.name in ("results.json", "report.html", "baseline.json", "r.html"):
+            raise OSError(code, os.strerror(code))
+        return real(path, text)
+
+    monkeypatch.setattr(atomic, "_temp_for", temp_for)
+
+
+@pytest.mark.parametrize("code", [errno.ENOSPC, errno.EACCES, errno.EROFS])
+def test_a_full_disk_at_the_end_of_a_run_exits_2_in_one_line_and_keeps_the_results(tmp_path, monkeypatch, capsys,
+                                                                                     code):
+    out, spill = tmp_path / "out", tmp_path / "spill"
+    spill.mkdir()
+    assert main(["run", *ONE_REF, "--out", str(out)]) == 0
+    before = (out / "results.json").read_text(), (out / "report.html").read_text()
+    monkeypatch.setattr(tempfile, "tempdir", str(spill))
+    _failing_pair_writes(monkeypatch, code)
+    capsys.readouterr()
+    assert main(["run", *ONE_REF, "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    last = err.strip().splitlines()[-1]
+    assert "Traceback" not in err and last.startswith("verimono run: cannot write ")
+    assert str(out / "results.json") in last and os.strerror(code) in last and "unchanged" in last
+    (kept,) = spill.glob("verimono-results-*.json")
+    run = load(kept)
+    assert str(kept) in last and [r.key for r in run] == [r.key for r in load(out / "results.json")]
+    assert ((out / "results.json").read_text(), (out / "report.html").read_text()) == before
+    mark = json.loads((out / "results.json.in-progress").read_text())   # this run never wrote its pair ...
+    assert mark["run_id"] == run.meta["run_id"]
+    assert main(["gate", "--baseline", str(kept), "--results", str(out / "results.json")]) == 2   # ... the gate says so
+
+
+def test_a_full_disk_for_report_and_baseline_exits_2_in_one_line(tmp_path, monkeypatch, capsys):
+    _report().save(tmp_path / "results.json")
+    (tmp_path / "r.html").write_text("old")
+    _report().save(tmp_path / "baseline.json")
+    before = (tmp_path / "baseline.json").read_text()
+    _failing_pair_writes(monkeypatch)
+    capsys.readouterr()
+    assert main(["report", "--results", str(tmp_path / "results.json"), "--out", str(tmp_path / "r.html")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"cannot write {tmp_path / 'r.html'}: No space left on device" in err
+    assert main(["baseline", "--from", str(tmp_path / "results.json"), "--out", str(tmp_path / "baseline.json")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"cannot write {tmp_path / 'baseline.json'}" in err
+    assert (tmp_path / "r.html").read_text() == "old" and (tmp_path / "baseline.json").read_text() == before
 
 
 @pytest.mark.parametrize("umask, mode", [(0o022, 0o644), (0o027, 0o640), (0o077, 0o600)])

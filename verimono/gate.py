@@ -38,6 +38,9 @@ closed with exit status 2.  It fails closed too (the inputs cannot fool it) when
   record that passed, its ``worst``, ``bound``, ``details["error"]`` or ``details["timing_ratio"]`` (or
   a pass it claimed with a non-finite worst ratio, ``details["unearned_pass"]``): NaN compares false
   against every threshold, so such a baseline would let any result pass — :class:`IncompatibleBaseline`;
+* the results (or baseline) file carries the in-progress mark of a run that never completed
+  (:func:`verimono.atomic.in_progress`: killed, or stopped by an error, after older files were there) —
+  :class:`IncompatibleResults`.
 """
 
 from __future__ import annotations
@@ -48,6 +51,7 @@ from collections import Counter
 from pathlib import Path
 from typing import Any
 
+from .atomic import in_progress
 from .convergence import ORDER_SLACK
 from .errors import IncompatibleBaseline, IncompatibleResults, SchemaError
 from .results import FAILED, PASSED, SKIPPED, UNDECIDED, UNEARNED_PASS, XFAIL, XFAIL_DECLARED, Report, load
@@ -370,11 +374,27 @@ def compare(baseline: Report, current: Report) -> Comparison:
     return Comparison(changes, len(baseline.results), dict(baseline.meta))
 
 
+def check_completed(path: str | Path, what: str = "results") -> None:
+    """Raise :class:`IncompatibleResults` when ``path`` carries the in-progress mark of a run that has not
+    completed (:func:`verimono.atomic.in_progress`): whatever ``path`` holds is not that run's output."""
+    run = in_progress(path)
+    if run is not None:
+        started = f", started {run['started']}" if run.get("started") else ""
+        pid = f", pid {run['pid']}" if run.get("pid") else ""
+        raise IncompatibleResults(
+            f"the {what} {path} are not the output of the last run there: run {run.get('run_id')} "
+            f"(verimono {run.get('command') or '?'}{started}{pid}) marked them in progress and never completed "
+            f"(killed, stopped by an error, or still running; its mark: {run['mark']}); gate the files of a "
+            "run that completed")
+
+
 def gate(baseline: str | Path | Report, results: str | Path | Report) -> Comparison:
-    """Load both documents (fail closed: :class:`SchemaError` / :class:`IncompatibleBaseline`, see the
-    module docstring) and compare."""
+    """Load both documents (fail closed: :class:`SchemaError` / :class:`IncompatibleBaseline` /
+    :class:`IncompatibleResults`, see the module docstring) and compare."""
     docs = {}
     for what, doc in (("baseline", baseline), ("results", results)):
+        if not isinstance(doc, Report):
+            check_completed(doc, what)
         docs[what] = doc if isinstance(doc, Report) else load(doc)
         rep = docs[what]
         if rep.meta.get("incomplete"):
@@ -389,6 +409,6 @@ def gate(baseline: str | Path | Report, results: str | Path | Report) -> Compari
 
 
 __all__ = ["Change", "Comparison", "compare", "gate", "check_baseline", "check_runs_compatible",
-           "check_unique_keys", "baseline_nonfinite",
+           "check_unique_keys", "check_completed", "baseline_nonfinite",
            "IncompatibleBaseline", "IncompatibleResults", "LISTED_REGRESSIONS", "ORDER_DROP_FLOOR", "ERROR_GROWTH",
            "TIMING_GROWTH", "TIMING_MIN_SECONDS"]

@@ -22,7 +22,10 @@ Layout (schema ``verimono.results``, version ``SCHEMA_VERSION`` = ``MAJOR.MINOR`
         "calibration": 0.012,                          #   the faster of the two: the unit of stage times
         "duration": 93.5,                              #   seconds of the whole run (or pytest session)
         "data_dir": "/path/to/shared" | null,          #   Siconos reference data used, if any
-        "environment": {...}                           #   :func:`verimono.environment.environment`
+        "environment": {...},                          #   :func:`verimono.environment.environment`
+        "run_id": "3f2a9c0d1e4b5a67",                  #   shared with report.html (and the in-progress mark)
+        "incomplete": true, "finished_stages": [...],  #   only in an interrupted run's results
+        "resumed_from": "9b8a..."                      #   the run id a `--resume` continued
       },
       "results": [CheckResult.to_dict(), ...],         # every record: check, subject, status, worst, bound,
                                                        #   counterexample, message, seed, details, duration
