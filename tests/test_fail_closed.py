@@ -377,6 +377,36 @@ def test_a_replaced_file_keeps_its_own_mode_as_with_open(tmp_path):
     assert stat.S_IMODE(path.stat().st_mode) == 0o664
 
 
+@pytest.fixture
+def odd_targets(tmp_path, monkeypatch):
+    (tmp_path / "exits.py").write_text("import sys\nsys.exit(0)\n")
+    (tmp_path / "boom_issue25.py").write_text("raise TypeError('not at import time, please')\n")
+    (tmp_path / "folder.py").mkdir()
+    os.mkfifo(tmp_path / "fifo.py")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    return tmp_path
+
+
+@pytest.mark.parametrize("target, reason", [
+    ("../../../../etc/passwd:x", "MODULE must be a dotted module name"),
+    ("/etc/passwd:x", "MODULE must be a dotted module name"),
+    ("mod with spaces:x", "MODULE must be a dotted module name"),
+    ("verimono:no such", "OBJECT must be a dotted Python name"),
+    ("{d}/exits.py:x", "SystemExit"),
+    ("boom_issue25:x", "TypeError: not at import time"),
+    ("{d}/folder.py:x", "not a regular file"),
+    ("{d}/fifo.py:x", "not a regular file"),
+    ("{d}/../{name}/missing.py:x", "does not exist"),
+], ids=["relative path", "absolute path", "spaces", "bad object", "sys.exit at import", "error at import",
+        "folder", "fifo", "missing file"])
+def test_a_target_that_is_not_module_object_is_bad_usage(odd_targets, tmp_path, capsys, target, reason):
+    target = target.format(d=odd_targets, name=odd_targets.name)
+    code = main(["check", target, "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert code == 2 and err.startswith("verimono check: ") and reason in err and "Traceback" not in err
+    assert not (tmp_path / "o").exists()                     # refused before any output
+
+
 def _limited(seconds: int = 60):
     """A child with at most 2 GiB of address space: a read that never ends fails instead of swapping."""
     import resource

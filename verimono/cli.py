@@ -18,7 +18,9 @@
         cannot be written (a full disk, an unwritable folder) the previous pair stays, the results are kept
         in the temporary folder, and a one-line message names both paths (exit 2).
     verimono check MODULE:OBJECT [--profile P] [--out DIR] [--seed N]
-        The operator battery on an operator, or the stepper battery on a stepper ``f(problem, t_grid)``.
+        The operator battery on an operator, or the stepper battery on a stepper ``f(problem, t_grid)``;
+        MODULE is a dotted module name or a ``.py`` file (anything else: exit 2).  Its files are marked and
+        written as ``run``'s; after an interrupt, run the same command again (it has no ``--resume``).
     verimono baseline [--out reports/baseline.json] [--from RESULTS] [run options]
         Record the current results (runs the verification, or copies RESULTS) as the gate's baseline.
     verimono gate --baseline FILE [--results reports/results.json]
