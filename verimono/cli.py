@@ -11,7 +11,10 @@
         incomplete (the gate refuses it, exit 2) and exits 130; ``--resume`` runs the stages that file lacks
         and completes it (it names the run id it continues; the result records it in ``meta.resumed_from``).
         ``--timeout S``: seconds per unit of work (one law on one operator, one check of one stepper;
-        default: the profile's), beyond which the unit is stopped and recorded as failed.
+        default: the profile's), beyond which the unit is stopped and recorded as failed.  ``--timeout`` and
+        ``--unit-timeout`` must be finite numbers of seconds > 0, checked before any work (exit 2
+        otherwise): ``inf`` is refused, every unit has a bound so that a subject that hangs cannot hang
+        the run — give a large number for a generous budget.
         Before any work the run marks DIR/results.json in progress (``results.json.in-progress``, with its
         run id) and removes the mark once its pair is written: files beside a mark that stays (a run killed,
         or stopped by an error) are not that run's, and the gate refuses them (exit 2).  When the pair
@@ -37,6 +40,7 @@ Exit status 2 always means "could not decide" (bad usage, unreadable input); it 
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import shlex
 import sys
@@ -138,6 +142,21 @@ def _start(out: Path, command: str, resumes: str | None = None) -> str:
     mark_in_progress(out / "results.json", run_id, command=command, pid=os.getpid(), host=socket.gethostname(),
                      started=dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"), resumes=resumes)
     return run_id
+
+
+def _seconds(text: str) -> float:
+    """``--timeout`` / ``--unit-timeout``: a finite number of seconds > 0 (``inf`` is refused: every unit
+    keeps a bound, so that a subject that hangs cannot hang the run)."""
+    try:
+        seconds = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number of seconds > 0, got {text!r}") from None
+    if seconds == math.inf:
+        raise argparse.ArgumentTypeError(f"got {text!r}, but every unit needs a finite budget (so that a subject "
+                                         "that hangs cannot hang the run); give a large number of seconds instead")
+    if not (math.isfinite(seconds) and seconds > 0):
+        raise argparse.ArgumentTypeError(f"must be a finite number of seconds > 0, got {text!r}")
+    return seconds
 
 
 def _finish(report: Report, out: Path, baseline: Report | None, run_id: str | None = None) -> int:
@@ -343,14 +362,14 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--data", default=None, help="Siconos data (DIR/siconos/{refs,lcp}); default: the packaged data")
         p.add_argument("--reference", action="append", metavar="NAME",
                        help="use only this analytic reference (repeatable; default: the whole catalog)")
-        p.add_argument("--timeout", type=float, default=None, metavar="S",
+        p.add_argument("--timeout", type=_seconds, default=None, metavar="S",
                        help="seconds per unit of work (one law on one operator, one check of one stepper) "
                             "before it is stopped and recorded as failed (default: the profile's)")
         p.add_argument("--executor", default=None, metavar="SPEC",
                        help="where the stages' independent units run: serial, auto (every core, at most 4 "
                             "worker processes; the default of run, $VERIMONO_EXECUTOR overrides), process:N (N "
                             "worker processes), or a dask.distributed scheduler address such as tcp://host:8786")
-        p.add_argument("--unit-timeout", type=float, default=None, metavar="SECONDS",
+        p.add_argument("--unit-timeout", type=_seconds, default=None, metavar="SECONDS",
                        help="with --executor: a stage unit (a subject's battery) still running after this long "
                             "becomes a failed record")
 
