@@ -462,3 +462,13 @@ def test_time_budgets_are_validated_before_any_work(tmp_path, capsys, flag, valu
     err = capsys.readouterr().err
     assert info.value.code == 2 and flag in err and reason in err
     assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("seed", ["-1", "abc", "1.5"])
+def test_a_bad_seed_on_the_command_line_is_refused_before_any_work(tmp_path, capsys, seed):
+    """``verimono check … --seed -1`` failed 7 trajectory laws of a correct stepper ("expected
+    non-negative integer"), exit 1."""
+    with pytest.raises(SystemExit) as info:
+        main(["check", "verimono.stepping:solve", "--seed", seed, "--out", str(tmp_path / "o")])
+    assert info.value.code == 2 and "--seed: must be a non-negative integer" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()

@@ -159,6 +159,18 @@ def _seconds(text: str) -> float:
     return seconds
 
 
+def _seed(text: str) -> int:
+    """``--seed``: a non-negative integer, checked before any work (a bad seed is misuse, never a failure
+    charged to the subject)."""
+    try:
+        seed = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a non-negative integer, got {text!r}") from None
+    if seed < 0:
+        raise argparse.ArgumentTypeError(f"must be a non-negative integer, got {text!r}")
+    return seed
+
+
 def _finish(report: Report, out: Path, baseline: Report | None, run_id: str | None = None) -> int:
     from .report import write
 
@@ -358,7 +370,7 @@ def build_parser() -> argparse.ArgumentParser:
                        else "dev", help="effort and hypothesis profile (default: ci when $CI is set, else dev)")
         p.add_argument("--stage", action="append", choices=list(STAGES), metavar="NAME",
                        help="run only this stage (repeatable); stages: " + ", ".join(STAGES))
-        p.add_argument("--seed", type=int, default=None, help="seed for the randomized batteries")
+        p.add_argument("--seed", type=_seed, default=None, help="seed for the randomized batteries")
         p.add_argument("--data", default=None, help="Siconos data (DIR/siconos/{refs,lcp}); default: the packaged data")
         p.add_argument("--reference", action="append", metavar="NAME",
                        help="use only this analytic reference (repeatable; default: the whole catalog)")
