@@ -472,3 +472,15 @@ def test_a_bad_seed_on_the_command_line_is_refused_before_any_work(tmp_path, cap
         main(["check", "verimono.stepping:solve", "--seed", seed, "--out", str(tmp_path / "o")])
     assert info.value.code == 2 and "--seed: must be a non-negative integer" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
+
+
+def test_the_issue_25_probe_holds(capsys):
+    """tools/probe_issue25.py: at least 60 new bad inputs, every one typed, bounded and explained."""
+    import importlib.util
+
+    path = Path(__file__).resolve().parent.parent / "tools" / "probe_issue25.py"
+    spec = importlib.util.spec_from_file_location("probe_issue25", path)
+    probe = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(probe)
+    assert len(probe.CASES) >= 60
+    assert probe.run_probe(show=False) == 0, capsys.readouterr().out
