@@ -10,14 +10,28 @@
         The output folder is checked writable before any work; both files are written atomically with one
         run id.  An interrupt (Ctrl-C, SIGTERM) writes the finished stages to a results file marked
         incomplete (the gate refuses it, exit 2) and exits 130; ``--resume`` runs the stages that file lacks
-        and completes it.  ``--timeout S``: seconds per unit of work (one law on one operator, one check of
-        one stepper; default: the profile's), beyond which the unit is stopped and recorded as failed.
+        and completes it (it names the run id it continues; the result records it in ``meta.resumed_from``).
+        ``--timeout S``: seconds per unit of work (one law on one operator, one check of one stepper;
+        default: the profile's), beyond which the unit is stopped and recorded as failed.  ``--timeout`` and
+        ``--unit-timeout`` must be finite numbers of seconds > 0, checked before any work (exit 2
+        otherwise): ``inf`` is refused, every unit has a bound so that a subject that hangs cannot hang
+        the run — give a large number for a generous budget.
+        Before any work the run marks DIR/results.json in progress (``results.json.in-progress``, with its
+        run id) and removes the mark once its pair is written: files beside a mark that stays (a run killed,
+        or stopped by an error) are not that run's, and the gate refuses them (exit 2).  When the pair
+        cannot be written (a full disk, an unwritable folder) the previous pair stays, the results are kept
+        in the temporary folder, and a one-line message names both paths (exit 2).
     verimono check MODULE:OBJECT [--profile P] [--out DIR] [--seed N]
-        The operator battery on an operator, or the stepper battery on a stepper ``f(problem, t_grid)``.
+        The operator battery on an operator, or the stepper battery on a stepper ``f(problem, t_grid)``;
+        MODULE is a dotted module name or a ``.py`` file (anything else: exit 2).  Its files are marked and
+        written as ``run``'s; after an interrupt, run the same command again (it has no ``--resume``).
     verimono baseline [--out reports/baseline.json] [--from RESULTS] [run options]
         Record the current results (runs the verification, or copies RESULTS) as the gate's baseline.
     verimono gate --baseline FILE [--results reports/results.json]
-        Exit 1 and print why on a regression; exit 2 when either file is missing, garbled or incompatible.
+        Exit 1 and print why on a regression; exit 2 when either file is missing, garbled, incompatible,
+        repeats a record key, is not a regular file or is larger than the document limit
+        (``$VERIMONO_MAX_DOCUMENT_MIB``, default 256), when the baseline holds a non-finite figure, or when
+        the results are those of a run that never completed (see ``verimono.gate``).
     verimono report [--results reports/results.json] [--out reports/report.html] [--baseline FILE]
         Re-render the HTML report from a results file.
 
@@ -27,13 +41,15 @@ Exit status 2 always means "could not decide" (bad usage, unreadable input); it 
 from __future__ import annotations
 
 import argparse
+import math
 import os
+import shlex
 import sys
 from pathlib import Path
 from typing import Any, Callable
 
 from .claims import SCHEMES, claim_of, with_claim
-from .errors import BadTarget, InvalidCheckArgument, NothingToResume, VerimonoError
+from .errors import BadTarget, InvalidCheckArgument, NothingToResume, OutputNotWritable, SchemaError, VerimonoError
 from .profiles import PROFILES, active_profile
 from .progress import Progress
 from .results import SKIPPED, Report
@@ -94,10 +110,10 @@ def _changes(baseline: Report | None, report: Report) -> Any:
 
     try:
         check_runs_compatible(baseline, report)
-    except IncompatibleBaseline as exc:
+        return compare(baseline, report)
+    except (IncompatibleBaseline, SchemaError) as exc:   # shown only; `verimono gate` decides (exit 2)
         print(f"verimono: not comparing with the baseline: {exc}", file=sys.stderr)
         return None
-    return compare(baseline, report)
 
 
 def order_table(report: Report) -> list[str]:
@@ -115,11 +131,52 @@ def order_table(report: Report) -> list[str]:
     return [fmt.format(*head)] + [fmt.format(*r) for r in rows]
 
 
-def _finish(report: Report, out: Path, baseline: Report | None) -> int:
+def _start(out: Path, command: str, resumes: str | None = None) -> str:
+    """Mark ``out/results.json`` in progress for a new run (before any work) and return its run id."""
+    import datetime as dt
+    import socket
+
+    from .atomic import mark_in_progress
+    from .report import new_run_id
+
+    run_id = new_run_id()
+    mark_in_progress(out / "results.json", run_id, command=command, pid=os.getpid(), host=socket.gethostname(),
+                     started=dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"), resumes=resumes)
+    return run_id
+
+
+def _seconds(text: str) -> float:
+    """``--timeout`` / ``--unit-timeout``: a finite number of seconds > 0 (``inf`` is refused: every unit
+    keeps a bound, so that a subject that hangs cannot hang the run)."""
+    try:
+        seconds = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number of seconds > 0, got {text!r}") from None
+    if seconds == math.inf:
+        raise argparse.ArgumentTypeError(f"got {text!r}, but every unit needs a finite budget (so that a subject "
+                                         "that hangs cannot hang the run); give a large number of seconds instead")
+    if not (math.isfinite(seconds) and seconds > 0):
+        raise argparse.ArgumentTypeError(f"must be a finite number of seconds > 0, got {text!r}")
+    return seconds
+
+
+def _seed(text: str) -> int:
+    """``--seed``: a non-negative integer, checked before any work (a bad seed is misuse, never a failure
+    charged to the subject)."""
+    try:
+        seed = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a non-negative integer, got {text!r}") from None
+    if seed < 0:
+        raise argparse.ArgumentTypeError(f"must be a non-negative integer, got {text!r}")
+    return seed
+
+
+def _finish(report: Report, out: Path, baseline: Report | None, run_id: str | None = None) -> int:
     from .report import write
 
     changes = _changes(baseline, report)
-    paths = write(report, out, changes=changes)
+    paths = write(report, out, changes=changes, run_id=run_id)
     for line in order_table(report):
         print(line)
     for r in report.failures:
@@ -143,7 +200,7 @@ def _finish(report: Report, out: Path, baseline: Report | None) -> int:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from .atomic import ensure_writable_dir
+    from .atomic import ensure_writable_dir, in_progress
     from .results import load
     from .timeouts import budget
 
@@ -151,10 +208,18 @@ def _cmd_run(args: argparse.Namespace) -> int:
     baseline = _baseline_for(args)
     previous, stages = None, args.stage
     if args.resume:
-        previous = load(out / "results.json") if (out / "results.json").is_file() else None
+        results, killed = out / "results.json", in_progress(out / "results.json")
+        previous = load(results) if results.is_file() else None
         if previous is None or not previous.meta.get("incomplete"):
-            raise NothingToResume(f"nothing to resume: {out / 'results.json'} is "
-                                  f"{'absent' if previous is None else 'a complete run'}")
+            what = "absent" if previous is None else f"the complete run {previous.meta.get('run_id')}"
+            if killed is not None:
+                raise NothingToResume(f"nothing to resume: run {killed.get('run_id')} (started "
+                                      f"{killed.get('started') or '?'}) never completed and recorded no finished "
+                                      f"stage (it was killed or stopped by an error); {results} is {what}, "
+                                      "not that run's: run again without --resume")
+            raise NothingToResume(f"nothing to resume: {results} is {what}")
+        print(f"verimono: resuming run {previous.meta.get('run_id')} (finished: "
+              f"{', '.join(previous.meta.get('finished_stages') or []) or 'none'})", file=sys.stderr)
         if previous.meta.get("profile") != args.profile:
             raise NothingToResume(f"the interrupted run used profile {previous.meta.get('profile')!r}, not "
                                   f"{args.profile!r}; resume it with the same options")
@@ -166,17 +231,21 @@ def _cmd_run(args: argparse.Namespace) -> int:
         if args.seed is None and previous.meta.get("seed") is not None:
             args.seed = previous.meta["seed"]
 
+    ctx = _context(args)                          # bad references or data: exit 2 before the mark
+    run_id = _start(out, "run", resumes=None if previous is None else previous.meta.get("run_id"))
+
     def run(on_done):
         with budget(args.timeout):
-            return execute(command="run", profile_name=args.profile, stages=stages, context=_context(args),
+            return execute(command="run", profile_name=args.profile, stages=stages, context=ctx,
                            progress=Progress(), on_done=on_done, **_executor_options(args))
 
-    report = interruptible(run, out, command="run", profile=args.profile, stages=args.stage, previous=previous)
+    report = interruptible(run, out, command="run", profile=args.profile, stages=args.stage, previous=previous,
+                           run_id=run_id)
     if isinstance(report, int):
         return report
     if previous is not None:
         report = merge_resumed(previous, report)
-    return _finish(report, out, baseline)
+    return _finish(report, out, baseline, run_id)
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
@@ -199,27 +268,31 @@ def _cmd_check(args: argparse.Namespace) -> int:
     from .timeouts import budget
 
     out = ensure_writable_dir(args.out)           # before any work
+    baseline = _baseline_for(args)                # a baseline that cannot be read: exit 2 before the work
     if getattr(args, "executor", None) not in (None, "serial"):
         from .executors import ship_by_value
 
         ship_by_value(obj)  # its module need not be importable on the workers
     print(f"verimono: checking {args.target} as a {kind}", file=sys.stderr)
+    run_id = _start(out, "check")
 
     def run(on_done):
         with budget(args.timeout):
             return execute(command="check", profile_name=args.profile, stages=stages, context=ctx,
                            target=args.target, progress=Progress(), on_done=on_done, **_executor_options(args))
 
-    report = interruptible(run, out, command="check", profile=args.profile, stages=stages)
+    again = shlex.join(["verimono", *getattr(args, "argv", ["check", args.target])])
+    report = interruptible(run, out, command="check", profile=args.profile, stages=stages, run_id=run_id,
+                           advice=f"`verimono check` has no --resume: run the same command again (`{again}`)")
     if isinstance(report, int):
         return report
     report.meta.setdefault("target", args.target)
     if report.results and all(r.status == SKIPPED for r in report.results):
-        _finish(report, out, None)
+        _finish(report, out, None, run_id)
         print(f"verimono: no {kind} battery could run here: " +
               "; ".join(r.message for r in report.results), file=sys.stderr)
         return EXIT_UNDECIDED
-    return _finish(report, out, _baseline_for(args))
+    return _finish(report, out, baseline, run_id)
 
 
 def _cmd_baseline(args: argparse.Namespace) -> int:
@@ -228,6 +301,9 @@ def _cmd_baseline(args: argparse.Namespace) -> int:
 
     ensure_writable_file(args.out)                # before any work
     if args.from_results:
+        from .gate import check_completed
+
+        check_completed(args.from_results)        # the files of a run that never completed: exit 2
         report = load(args.from_results)
         if report.meta.get("incomplete"):
             raise NothingToResume(f"{args.from_results} is an interrupted run (marked incomplete): finish it "
@@ -236,7 +312,18 @@ def _cmd_baseline(args: argparse.Namespace) -> int:
         report = execute(command="run", profile_name=args.profile, stages=args.stage, context=_context(args),
                          progress=Progress(), **_executor_options(args))
     report.trajectories = []  # plot samples only: the gate never reads them, and they are half the size
-    path = report.save(args.out)
+    try:
+        path = report.save(args.out)
+    except OutputNotWritable as exc:
+        if args.from_results:                     # its records are in the file it was copied from
+            raise
+        from .atomic import keep_elsewhere
+
+        try:
+            kept = f"the baseline's records are kept in {keep_elsewhere(report.to_json(), 'verimono-baseline.json')}"
+        except OSError as again:
+            kept = f"the baseline's records could not be kept elsewhere either ({again.strerror or again})"
+        raise OutputNotWritable(f"{exc}; {kept}") from None
     print(f"verimono: baseline of {report.summary()} (profile {report.meta.get('profile')}) written to {path}")
     if not report.ok:
         print("verimono: warning: the baseline records failing checks; the gate will only catch new ones",
@@ -290,18 +377,18 @@ def build_parser() -> argparse.ArgumentParser:
                        else "dev", help="effort and hypothesis profile (default: ci when $CI is set, else dev)")
         p.add_argument("--stage", action="append", choices=list(STAGES), metavar="NAME",
                        help="run only this stage (repeatable); stages: " + ", ".join(STAGES))
-        p.add_argument("--seed", type=int, default=None, help="seed for the randomized batteries")
+        p.add_argument("--seed", type=_seed, default=None, help="seed for the randomized batteries")
         p.add_argument("--data", default=None, help="Siconos data (DIR/siconos/{refs,lcp}); default: the packaged data")
         p.add_argument("--reference", action="append", metavar="NAME",
                        help="use only this analytic reference (repeatable; default: the whole catalog)")
-        p.add_argument("--timeout", type=float, default=None, metavar="S",
+        p.add_argument("--timeout", type=_seconds, default=None, metavar="S",
                        help="seconds per unit of work (one law on one operator, one check of one stepper) "
                             "before it is stopped and recorded as failed (default: the profile's)")
         p.add_argument("--executor", default=None, metavar="SPEC",
                        help="where the stages' independent units run: serial, auto (every core, at most 4 "
                             "worker processes; the default of run, $VERIMONO_EXECUTOR overrides), process:N (N "
                             "worker processes), or a dask.distributed scheduler address such as tcp://host:8786")
-        p.add_argument("--unit-timeout", type=float, default=None, metavar="SECONDS",
+        p.add_argument("--unit-timeout", type=_seconds, default=None, metavar="SECONDS",
                        help="with --executor: a stage unit (a subject's battery) still running after this long "
                             "becomes a failed record")
 
@@ -361,6 +448,7 @@ def main(argv: list[str] | None = None) -> int:
     from threadpoolctl import threadpool_limits
 
     args = build_parser().parse_args(argv)
+    args.argv = list(sys.argv[1:] if argv is None else argv)   # the command as given (advice after an interrupt)
     func: Callable[[argparse.Namespace], int] = args.func
     try:
         with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):

@@ -122,7 +122,12 @@ class UnitTimeout(VerimonoError, TimeoutError):
 
 
 class OutputNotWritable(VerimonoError, OSError):
-    """An output folder or file cannot be created or written (checked before any work is done)."""
+    """An output folder or file cannot be created or written (checked before any work is done, and when a
+    write fails: a full disk, an unwritable folder).  Its text is one line naming the path; ``errno`` and
+    ``filename`` are those of the ``OSError`` it stands for."""
+
+    def __str__(self) -> str:
+        return str(self.args[0]) if len(self.args) == 1 else OSError.__str__(self)
 
 
 class NothingToResume(VerimonoError, ValueError):

@@ -4,7 +4,9 @@
 ``verimono gate`` exit 1.  A regression is
 
 * **status** — a record that passed (or was an expected failure) now fails, or a record that passed is
-  now skipped (a battery that stopped running verifies nothing);
+  now skipped (a battery that stopped running verifies nothing), or a record that passed is now ``xfail``
+  without a declaration (``details["xfail_declared"]``, set for the xfails of ``expected_failed_checks``
+  and of Theorem ``thm:main``'s (LG)-or-(YB) alternative; a declared one is a change, not a regression);
 * **removed** — a record of the baseline is absent now;
 * **count** — the number of executed (non-skipped) records of a check, or in total, shrinks;
 * **order** — a convergence order estimate falls below its theoretical order (interval's upper end plus
@@ -55,7 +57,17 @@ Baseline and results must come from the same kind of run (command, target, profi
 stages and references), be well-formed documents of a readable schema version
 (:mod:`verimono.schema` type-checks every field the gate reads), and the baseline must hold at
 least one executed record; otherwise :class:`IncompatibleBaseline` / ``SchemaError`` — the gate fails
-closed with exit status 2.
+closed with exit status 2.  It fails closed too (the inputs cannot fool it) when
+
+* a document repeats a record key ``check[subject]`` (either copy could be "the" record: a failure
+  would hide behind a pass) — ``SchemaError`` naming the key;
+* a figure the baseline vouches for is not a finite number — a study's error in a gated norm, and, of a
+  record that passed, its ``worst``, ``bound``, ``details["error"]`` or ``details["timing_ratio"]`` (or
+  a pass it claimed with a non-finite worst ratio, ``details["unearned_pass"]``): NaN compares false
+  against every threshold, so such a baseline would let any result pass — :class:`IncompatibleBaseline`;
+* the results (or baseline) file carries the in-progress mark of a run that never completed
+  (:func:`verimono.atomic.in_progress`: killed, or stopped by an error, after older files were there) —
+  :class:`IncompatibleResults`.
 """
 
 from __future__ import annotations
@@ -66,9 +78,10 @@ from collections import Counter
 from pathlib import Path
 from typing import Any
 
+from .atomic import in_progress
 from .convergence import ORDER_SLACK
-from .errors import IncompatibleBaseline, IncompatibleResults
-from .results import FAILED, PASSED, SKIPPED, UNDECIDED, XFAIL, Report, load
+from .errors import IncompatibleBaseline, IncompatibleResults, SchemaError
+from .results import FAILED, PASSED, SKIPPED, UNDECIDED, UNEARNED_PASS, XFAIL, XFAIL_DECLARED, Report, load
 from .timing import BUSY_FOREIGN, BUSY_WAITING, is_noise_undecided
 
 #: smallest drop of a fitted slope that counts as a regression when both intervals are narrower: slopes
@@ -156,12 +169,66 @@ class Comparison:
         return lines
 
 
-def check_baseline(baseline: Report) -> None:
-    """Raise :class:`IncompatibleBaseline` unless ``baseline`` has executed (non-skipped) records: a
-    baseline without any vouches for nothing, and every run would pass against it."""
+def check_unique_keys(report: Report, what: str = "the results") -> None:
+    """Raise ``SchemaError`` naming the key when two records of ``report`` share a key ``check[subject]``:
+    records are matched by key, so a repeated one makes the comparison ambiguous (a failed copy would
+    hide behind a passed one)."""
+    seen: dict[str, int] = {}
+    dupes: list[str] = []
+    for i, r in enumerate(report.results):
+        j = seen.setdefault(r.key, i)
+        if j != i:
+            dupes.append(f"{r.key!r} (records {j} and {i})")
+    if dupes:
+        more = f" and {len(dupes) - 3} more" if len(dupes) > 3 else ""
+        raise SchemaError(f"{what}: the record key {', '.join(dupes[:3])}{more} occurs more than once; each "
+                          "check[subject] must occur once (which copy would the gate compare?)")
+
+
+def _figure_is_finite(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def baseline_nonfinite(baseline: Report) -> list[str]:
+    """Every figure the gate compares against that the baseline holds as a non-finite number (or
+    ``null``, a string): a study's errors in the gated norms; a passed record's ``worst``, ``bound``,
+    ``details["error"]``, ``details["timing_ratio"]``; a pass claimed with a non-finite worst ratio."""
+    bad: list[str] = []
+    for r in baseline.results:
+        if UNEARNED_PASS in r.details:
+            bad.append(f"{r.key}: {r.details[UNEARNED_PASS]}")
+        if r.status != PASSED:
+            continue
+        for name, v in (("worst", r.worst), ("bound", r.bound)):
+            if v is not None and not _figure_is_finite(v):
+                bad.append(f"{r.key}: {name} = {v!r}")
+        for name in ("error", "timing_ratio"):
+            if name in r.details and not _figure_is_finite(r.details[name]):
+                bad.append(f"{r.key}: details[{name!r}] = {r.details[name]!r}")
+    for st in baseline.studies:
+        if not hasattr(st, "errors"):
+            continue
+        for norm in GATED_NORMS:
+            for h, e in zip(st.mesh, st.errors.get(norm, [])):
+                if not _figure_is_finite(e):
+                    bad.append(f"{st.stepper} on {st.problem}: {norm} error at h={h:.3g} = {e!r}")
+    return bad
+
+
+def check_baseline(baseline: Report, what: str = "the baseline") -> None:
+    """Raise :class:`IncompatibleBaseline` unless ``baseline`` is usable: it has executed (non-skipped)
+    records (a baseline without any vouches for nothing, and every run would pass against it), and every
+    figure the gate compares against is finite (:func:`baseline_nonfinite`); ``SchemaError`` when it
+    repeats a record key (:func:`check_unique_keys`)."""
     if not any(r.status != SKIPPED for r in baseline.results):
         raise IncompatibleBaseline(f"the baseline has no executed records ({len(baseline.results)} records, "
                                    "all skipped or none); regenerate it with `verimono baseline`")
+    check_unique_keys(baseline, what)
+    bad = baseline_nonfinite(baseline)
+    if bad:
+        more = f"; and {len(bad) - 3} more" if len(bad) > 3 else ""
+        raise IncompatibleBaseline(f"{what} is unusable: it holds non-finite figures that no result could "
+                                   f"exceed ({'; '.join(bad[:3])}{more}); regenerate it with `verimono baseline`")
 
 
 def check_runs_compatible(baseline: Report, current: Report) -> None:
@@ -203,6 +270,13 @@ def _compare_records(base: Report, cur: Report, out: list[Change]) -> None:
             out.append(Change("status", key, f"{b.status} → failed: {c.message or _why(c)}", True))
         elif b.status == PASSED and c.status == SKIPPED:
             out.append(Change("status", key, f"passed → skipped: {c.message}", True))
+        elif b.status == PASSED and c.status == XFAIL:
+            declared = c.details.get(XFAIL_DECLARED)
+            if isinstance(declared, str) and declared.strip():
+                out.append(Change("status", key, f"passed → xfail, declared: {declared}", False))
+            else:
+                out.append(Change("status", key, f"passed → xfail without a declaration (no "
+                                  f"details[{XFAIL_DECLARED!r}]): {c.message}", True))
         elif b.status in (PASSED, XFAIL) and c.status == UNDECIDED:
             noise = is_noise_undecided(c)   # the machine, not the code: a change (see Timing above)
             out.append(Change("status", key, f"{b.status} → undecided: {c.message}", not noise))
@@ -375,7 +449,14 @@ def _compare_timings(base: Report, cur: Report, out: list[Change]) -> None:
 
 
 def compare(baseline: Report, current: Report) -> Comparison:
-    """Every change from ``baseline`` to ``current`` (see the module docstring for what regresses)."""
+    """Every change from ``baseline`` to ``current`` (see the module docstring for what regresses);
+    ``SchemaError`` when either repeats a record key, :class:`IncompatibleBaseline` when the baseline
+    holds a non-finite figure (:func:`check_baseline`'s rules beyond emptiness)."""
+    check_unique_keys(baseline, "the baseline")
+    check_unique_keys(current, "the results")
+    bad = baseline_nonfinite(baseline)
+    if bad:
+        check_baseline(baseline)        # raises, naming the figures
     changes: list[Change] = []
     _compare_records(baseline, current, changes)
     _compare_studies(baseline, current, changes)
@@ -383,19 +464,41 @@ def compare(baseline: Report, current: Report) -> Comparison:
     return Comparison(changes, len(baseline.results), dict(baseline.meta))
 
 
+def check_completed(path: str | Path, what: str = "results") -> None:
+    """Raise :class:`IncompatibleResults` when ``path`` carries the in-progress mark of a run that has not
+    completed (:func:`verimono.atomic.in_progress`): whatever ``path`` holds is not that run's output."""
+    run = in_progress(path)
+    if run is not None:
+        started = f", started {run['started']}" if run.get("started") else ""
+        pid = f", pid {run['pid']}" if run.get("pid") else ""
+        raise IncompatibleResults(
+            f"the {what} {path} are not the output of the last run there: run {run.get('run_id')} "
+            f"(verimono {run.get('command') or '?'}{started}{pid}) marked them in progress and never completed "
+            f"(killed, stopped by an error, or still running; its mark: {run['mark']}); gate the files of a "
+            "run that completed")
+
+
 def gate(baseline: str | Path | Report, results: str | Path | Report) -> Comparison:
-    """Load both documents (fail closed: :class:`SchemaError` / :class:`IncompatibleBaseline`) and compare."""
-    base = baseline if isinstance(baseline, Report) else load(baseline)
-    cur = results if isinstance(results, Report) else load(results)
-    for what, rep in (("baseline", base), ("results", cur)):
+    """Load both documents (fail closed: :class:`SchemaError` / :class:`IncompatibleBaseline` /
+    :class:`IncompatibleResults`, see the module docstring) and compare."""
+    docs = {}
+    for what, doc in (("baseline", baseline), ("results", results)):
+        if not isinstance(doc, Report):
+            check_completed(doc, what)
+        docs[what] = doc if isinstance(doc, Report) else load(doc)
+        rep = docs[what]
         if rep.meta.get("incomplete"):
             raise IncompatibleResults(f"the {what} come from an interrupted run (finished stages: "
                                       f"{', '.join(rep.meta.get('finished_stages') or []) or 'none'}); finish it "
                                       "with `verimono run --resume` before gating")
+        check_unique_keys(rep, f"the {what}" + ("" if isinstance(doc, Report) else f" {doc}"))
+    base, cur = docs["baseline"], docs["results"]
+    check_baseline(base, "the baseline" + ("" if isinstance(baseline, Report) else f" {baseline}"))
     check_runs_compatible(base, cur)
     return compare(base, cur)
 
 
 __all__ = ["Change", "Comparison", "compare", "gate", "check_baseline", "check_runs_compatible",
+           "check_unique_keys", "check_completed", "baseline_nonfinite",
            "IncompatibleBaseline", "IncompatibleResults", "LISTED_REGRESSIONS", "ORDER_DROP_FLOOR", "ERROR_GROWTH",
            "TIMING_GROWTH", "TIMING_MIN_SECONDS", "CALIBRATION_DRIFT"]

@@ -36,7 +36,7 @@ import pytest
 
 from .atomic import ensure_writable_dir
 from .errors import OutputNotWritable
-from .results import FAILED, XFAIL, CheckResult, Report, listening
+from .results import FAILED, XFAIL, XFAIL_DECLARED, CheckResult, Report, listening
 
 _KEY = pytest.StashKey["_Collector"]()
 
@@ -189,7 +189,7 @@ class _Collector:
 
     def pytest_runtest_logreport(self, report: pytest.TestReport) -> None:
         """Records from a worker; then: a test marked xfail that failed as declared has its failed records
-        as expected failures."""
+        as expected failures, the xfail's reason in ``details["xfail_declared"]``."""
         if self.worker:
             return
         if report.when == "call":
@@ -204,6 +204,7 @@ class _Collector:
                 if r.status == FAILED:
                     r.status = XFAIL
                     r.message = f"expected failure ({wasxfail}): {r.message}"
+                    r.details[XFAIL_DECLARED] = wasxfail or "declared with pytest.mark.xfail"
 
     @pytest.hookimpl(tryfirst=True)
     def pytest_pyfunc_call(self, pyfuncitem: pytest.Function) -> None:

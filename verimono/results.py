@@ -9,8 +9,13 @@ verimono's own solvers gave no verified answer): neither a pass nor a failure of
 exits 2 ("could not decide") on it when nothing failed, the gate treats a record that passed and is now
 undecided as a regression (it verifies nothing), and pytest reports it as a failure of the test run, never
 as a pass.  A record that claims ``passed`` with a non-finite ``worst`` is a contradiction (a NaN ratio
-compares false against every bound); it is turned into ``failed`` on construction.  pytest, the HTML
-report and the CI gate are thin consumers of these records, collected in a :class:`Report`.
+compares false against every bound); it is turned into ``failed`` on construction, and
+``details["unearned_pass"]`` says what it claimed (so a baseline holding one is refused by the gate).  An
+``xfail`` record that was declared — by ``expected_failed_checks`` of :mod:`verimono.testing` (a pytest xfail)
+or by Theorem ``thm:main`` needing only one of (LG), (YB) — carries the declaration's reason in
+``details["xfail_declared"]``; the gate counts a passed record that became ``xfail`` without one as a
+regression.  pytest, the HTML report and the CI gate are thin consumers of these records, collected in a
+:class:`Report`.
 
 Saving and loading: :meth:`Report.save` and :func:`load` write and read the versioned JSON document of
 :mod:`verimono.schema` (its docstring states the layout).
@@ -36,6 +41,10 @@ from .schema import SCHEMA_NAME, SCHEMA_VERSION, check_compatible
 
 PASSED, FAILED, SKIPPED, XFAIL, UNDECIDED = "passed", "failed", "skipped", "xfail", "undecided"
 STATUSES = (PASSED, FAILED, SKIPPED, XFAIL, UNDECIDED)
+#: ``details`` key of an ``xfail`` record: the reason its failure was declared expected
+XFAIL_DECLARED = "xfail_declared"
+#: ``details`` key of a record that claimed ``passed`` with a non-finite worst ratio (now ``failed``)
+UNEARNED_PASS = "unearned_pass"
 
 
 def _finite_number(x: Any) -> bool:
@@ -71,6 +80,7 @@ class CheckResult:
         if self.status == PASSED and self.worst is not None and not _finite_number(self.worst):
             # an unearned pass: a nan/inf ratio satisfies no bound
             self.status = FAILED
+            self.details = {**self.details, UNEARNED_PASS: f"passed with worst = {self.worst!r}"}
             self.message = (f"the check reported a pass with a non-finite worst ratio {self.worst!r}; "
                             f"a non-finite value is never a pass" + (f" ({self.message})" if self.message else ""))
 
@@ -331,6 +341,7 @@ def listening(fn: Callable[[Any], None]) -> Iterator[None]:
         _LISTENERS.remove(fn)
 
 
-__all__ = ["PASSED", "FAILED", "SKIPPED", "XFAIL", "STATUSES", "CheckResult", "Report", "to_jsonable", "emit",
+__all__ = ["PASSED", "FAILED", "SKIPPED", "XFAIL", "STATUSES", "XFAIL_DECLARED", "UNEARNED_PASS", "CheckResult",
+           "Report", "to_jsonable", "emit",
            "listening", "SCHEMA_NAME", "SCHEMA_VERSION", "VERSIONED", "OPTIONAL", "SchemaError", "environment",
            "report_to_dict", "report_from_dict", "check_compatible", "loads", "load"]

@@ -99,9 +99,12 @@ EXIT_INTERRUPTED = 130
 
 
 def interruptible(run: Callable[[Callable], Report], out: Path, *, command: str, profile: str,
-                   stages: list[str] | None, previous: Report | None = None) -> Report | int:
+                   stages: list[str] | None, previous: Report | None = None, run_id: str | None = None,
+                   advice: str | None = None) -> Report | int:
     """``run(on_done)`` with SIGTERM treated as an interrupt; on an interrupt write the stages finished so
-    far (with ``previous``'s, when resuming) to ``out`` marked ``incomplete`` and return the exit status."""
+    far (with ``previous``'s, when resuming) to ``out`` marked ``incomplete`` (as the run ``run_id``) and
+    return the exit status.  ``advice``: how to go on, printed after the interrupt (default: ``verimono
+    run --resume``, which only ``run`` has)."""
     import signal
 
     finished: list[tuple[Report, dict]] = []
@@ -124,11 +127,13 @@ def interruptible(run: Callable[[Callable], Report], out: Path, *, command: str,
         partial.meta.update({"command": command, "profile": profile, "incomplete": True,
                              "finished_stages": done,
                              "selection": partial.meta.get("selection") or {"stages": stages, "references": None}})
+        if previous is not None and previous.meta.get("run_id"):
+            partial.meta["resumed_from"] = previous.meta["run_id"]
 
-        paths = write(partial, out)
+        paths = write(partial, out, run_id=run_id)
         print(f"\nverimono: interrupted; the {len(done)} finished stage(s) ({', '.join(done) or 'none'}) are in "
-              f"{paths['json']}, marked incomplete; continue with `verimono {command} --resume`",
-              file=sys.stderr)
+              f"{paths['json']}, marked incomplete; "
+              f"{advice or f'continue with `verimono {command} --resume`'}", file=sys.stderr)
         return EXIT_INTERRUPTED
     finally:
         if old is not None:
@@ -142,13 +147,15 @@ def _main_thread() -> bool:
 
 
 def merge_resumed(previous: Report, rest: Report) -> Report:
-    """The interrupted run's finished stages followed by the resumed ones: one complete report."""
+    """The interrupted run's finished stages followed by the resumed ones: one complete report
+    (``meta.resumed_from``: the run id of the interrupted run it continues)."""
     merged = Report(meta=dict(rest.meta))
     merged.extend(previous)
     merged.extend(rest)
     merged.meta["stages"] = list(previous.meta.get("stages") or []) + list(rest.meta.get("stages") or [])
     merged.meta["selection"] = previous.meta.get("selection")
     merged.meta["resumed"] = True
+    merged.meta["resumed_from"] = previous.meta.get("run_id")
     for key in ("incomplete", "finished_stages"):
         merged.meta.pop(key, None)
     return merged

@@ -22,7 +22,10 @@ Layout (schema ``verimono.results``, version ``SCHEMA_VERSION`` = ``MAJOR.MINOR`
         "calibration": 0.012,                          #   the faster of the two: the unit of stage times
         "duration": 93.5,                              #   seconds of the whole run (or pytest session)
         "data_dir": "/path/to/shared" | null,          #   Siconos reference data used, if any
-        "environment": {...}                           #   :func:`verimono.environment.environment`
+        "environment": {...},                          #   :func:`verimono.environment.environment`
+        "run_id": "3f2a9c0d1e4b5a67",                  #   shared with report.html (and the in-progress mark)
+        "incomplete": true, "finished_stages": [...],  #   only in an interrupted run's results
+        "resumed_from": "9b8a..."                      #   the run id a `--resume` continued
       },
       "results": [CheckResult.to_dict(), ...],         # every record: check, subject, status, worst, bound,
                                                        #   counterexample, message, seed, details, duration
@@ -33,7 +36,9 @@ Layout (schema ``verimono.results``, version ``SCHEMA_VERSION`` = ``MAJOR.MINOR`
 A record's ``details`` are free-form; keys that producers hand to consumers: ``study`` (a convergence-order
 record's study, read back as a :class:`ConvergenceStudy`), ``stage`` and ``reference`` (set by the run),
 ``reproduce``, ``reproduce_python``, ``example`` (what the report's reproduction shows), ``error`` and
-``timing_ratio`` (compared by the gate).
+``timing_ratio`` (compared by the gate), ``xfail_declared`` (why an ``xfail`` was expected) and
+``unearned_pass`` (a pass claimed with a non-finite worst ratio, turned into a failure).  A record's key
+``check[subject]`` is unique in a document: the gate refuses one that repeats a key.
 
 Non-finite floats are written as the strings ``"inf"``, ``"-inf"``, ``"nan"`` (strict JSON has no such
 numbers) and read back as floats where the field is numeric; ``null`` in a numeric list (errors, slopes)
@@ -49,6 +54,8 @@ from __future__ import annotations
 import datetime as _dt
 import json
 import math
+import os
+import stat
 from pathlib import Path
 from typing import Any
 
@@ -242,16 +249,71 @@ def parse(text: str, source: str = "<string>") -> Any:
         raise SchemaError(f"{source} cannot be parsed ({type(exc).__name__}: {exc})") from None
 
 
-def read_text(path: str | Path) -> str:
-    """The text of the document at ``path``; :class:`SchemaError` (with the path) if it cannot be read."""
-    path = Path(path)
+#: largest document :func:`read_text` reads, in MiB (``$VERIMONO_MAX_DOCUMENT_MIB`` overrides it): the
+#: committed baseline of a ci run is 0.6 MiB and a results file with its plot samples a few MiB, so this
+#: leaves room for the largest runs while a wrong path (a device, a log) cannot exhaust memory
+MAX_DOCUMENT_MIB = 256
+MAX_DOCUMENT_ENV = "VERIMONO_MAX_DOCUMENT_MIB"
+
+
+def max_document_bytes() -> int:
+    """The size limit of a document in bytes: ``$VERIMONO_MAX_DOCUMENT_MIB`` (a positive number of MiB) or
+    :data:`MAX_DOCUMENT_MIB`; :class:`SchemaError` on a value that is not a positive number."""
+    raw = os.environ.get(MAX_DOCUMENT_ENV, "").strip()
+    if not raw:
+        return MAX_DOCUMENT_MIB << 20
     try:
-        return path.read_text(encoding="utf-8")
+        mib = float(raw)
+    except ValueError:
+        mib = math.nan
+    if not (math.isfinite(mib) and mib > 0):
+        raise SchemaError(f"${MAX_DOCUMENT_ENV} must be a positive number of MiB, got {raw!r}")
+    return max(1, int(mib * (1 << 20)))
+
+
+def read_text(path: str | Path) -> str:
+    """The text of the document at ``path``; :class:`SchemaError` (with the path) if it cannot be read.
+
+    Only a regular file is read (a FIFO, ``/dev/zero`` or a folder is refused without reading or blocking:
+    it is opened non-blocking and checked with ``fstat`` first), and at most :func:`max_document_bytes`
+    of it: a larger file is refused, never read whole."""
+    path = Path(path)
+    limit = max_document_bytes()
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0))
     except FileNotFoundError:
         raise SchemaError(f"{path} does not exist") from None
-    except (OSError, UnicodeDecodeError) as exc:
+    except (OSError, ValueError) as exc:   # ValueError: an embedded NUL byte
+        raise SchemaError(f"{path} cannot be read: {getattr(exc, 'strerror', None) or exc}") from None
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            kind = "a folder" if stat.S_ISDIR(st.st_mode) else "not a regular file (a device, FIFO or socket)"
+            raise SchemaError(f"{path} is {kind}: a verimono document is a JSON file")
+        if st.st_size > limit:
+            raise SchemaError(f"{path} is {st.st_size / (1 << 20):.1f} MiB, larger than the limit of "
+                              f"{limit / (1 << 20):.4g} MiB for a verimono document (${MAX_DOCUMENT_ENV} raises it)")
+        if hasattr(os, "set_blocking"):
+            os.set_blocking(fd, True)
+        chunks, size = [], 0
+        while size <= limit:
+            chunk = os.read(fd, min(1 << 20, limit + 1 - size))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            size += len(chunk)
+        if size > limit:      # it grew while being read
+            raise SchemaError(f"{path} is larger than the limit of {limit / (1 << 20):.4g} MiB for a verimono "
+                              f"document (${MAX_DOCUMENT_ENV} raises it)")
+        return b"".join(chunks).decode("utf-8")
+    except OSError as exc:
+        raise SchemaError(f"{path} cannot be read: {exc.strerror or exc}") from None
+    except UnicodeDecodeError as exc:
         raise SchemaError(f"{path} cannot be read: {exc}") from None
+    finally:
+        os.close(fd)
 
 
 __all__ = ["SCHEMA_NAME", "SCHEMA_VERSION", "RECORD_FIELDS", "SchemaError", "document", "check_compatible",
-           "check_meta", "record_fields", "study_from_dict", "parse", "read_text"]
+           "check_meta", "record_fields", "study_from_dict", "parse", "read_text", "max_document_bytes",
+           "MAX_DOCUMENT_MIB", "MAX_DOCUMENT_ENV"]

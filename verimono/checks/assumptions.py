@@ -48,7 +48,7 @@ import numpy as np
 from ..errors import OutsideDomain
 from ..operators import resolvent_rows
 from ..problem import Problem
-from ..results import FAILED, PASSED, SKIPPED, XFAIL, CheckResult, Report
+from ..results import FAILED, PASSED, SKIPPED, XFAIL, XFAIL_DECLARED, CheckResult, Report
 from .search import valid_seed
 from .core import Outcome, law, laws_of, run, subject_name
 from .subjects import require_problem
@@ -449,13 +449,16 @@ def run_composite(decl: Any, problem: Problem, records: dict[str, CheckResult]) 
 def thm_main(problem: Problem, records: dict[str, CheckResult]) -> Outcome:
     """Theorem ``thm:main`` needs (A1)–(A3) and *one of* (LG) or (YB): a composite law over the records of
     the five assumptions.  When exactly one of (LG), (YB) has evidence against it and the other has
-    evidence for it, that record becomes an expected failure (``xfail``, saying which alternative holds);
-    this record fails when any remaining assumption record failed."""
+    evidence for it, that record becomes an expected failure (``xfail``, saying which alternative holds, the
+    declaration in ``details["xfail_declared"]``); this record fails when any remaining assumption record
+    failed."""
     lg, yb = records.get("assumption_LG"), records.get("assumption_YB")
     for this, other, name in ((lg, yb, "(YB)"), (yb, lg, "(LG)")):
         if this is not None and other is not None and this.status == FAILED and other.status == PASSED:
             this.status = XFAIL
             this.message = f"the alternative hypothesis {name} has evidence for it; {this.message}"
+            this.details = {**this.details,
+                            XFAIL_DECLARED: f"thm:main needs (LG) or (YB); {name} has evidence for it"}
     bad = [r.check for r in records.values() if r.status == FAILED]
     return Outcome(None, status=FAILED if bad else PASSED, details={"evidence": EVIDENCE, "from": sorted(records)},
                    message=("evidence against " + ", ".join(bad)) if bad else

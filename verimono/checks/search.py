@@ -24,7 +24,9 @@ when verimono's own solvers decided none.  The unit's time budget (:mod:`verimon
 whole search (in calibration units: a slower or busier machine gets more seconds): a search that runs out
 of time after samples that all held is undecided (time budget, ``k`` samples); an operator call that never
 returns fails — the first one, or one that ran :data:`verimono.timeouts.HANG_MULTIPLE` x longer than every
-sample before it.
+sample before it.  The root-cause probe before the search runs under the budget too
+(:func:`bounded_root_cause`): a resolvent that does not return within it is the root cause, probed once per
+operator, so a battery on a hanging operator costs one budget, not one per call.
 """
 
 from __future__ import annotations
@@ -142,6 +144,30 @@ def root_cause(op: Any, horizon: float = 1.0) -> str | None:
             if y.shape != x.shape:
                 return f"the resolvent returns shape {y.shape} for a point of shape {x.shape} (λ = 1, t = {t:g})"
     return None
+
+
+#: operators whose root-cause probe ran out of time, ``id → (operator, horizon, cause)`` (the most recent
+#: :data:`SLOW_MEMORY`): the other laws of the battery take the cause without calling the operator again
+_SLOW: dict[int, tuple[Any, float, str]] = {}
+SLOW_MEMORY = 16
+
+
+def bounded_root_cause(op: Any, horizon: float = 1.0) -> str | None:
+    """:func:`root_cause` under the unit's time budget: a resolvent that does not return within it is the
+    root cause (remembered for ``op``, so the next law does not wait for it again)."""
+    hit = _SLOW.get(id(op))
+    if hit is not None and hit[0] is op and hit[1] == horizon:
+        return hit[2]
+    try:
+        with time_limit(current_budget(), f"the root-cause probe of {subject_name(op)}"):
+            return root_cause(op, horizon)
+    except UnitTimeout as exc:
+        cause = f"the resolvent does not return within the time budget at x = 0, λ = 1 ({exc})"
+    _SLOW.pop(id(op), None)
+    _SLOW[id(op)] = (op, horizon, cause)
+    while len(_SLOW) > SLOW_MEMORY:
+        _SLOW.pop(next(iter(_SLOW)))
+    return cause
 
 
 class _Violation(Exception):
@@ -378,7 +404,7 @@ def run_law(decl: Law | str, op: Any, *, seed: int | None = None, examples: int 
     def evaluate() -> CheckResult:
         start = time.perf_counter()
         base = dict(check=decl.name, subject=subject, seed=seed)
-        cause = root_cause(op, horizon) if sample is None else None
+        cause = bounded_root_cause(op, horizon) if sample is None else None
         if cause is not None:
             why = {**details, "root_cause": cause}
             if decl.name == ROOT_LAW:
@@ -405,6 +431,6 @@ def operator_law(name: str, label: str, *requires: Any) -> Callable:
     return law(name, label, subject="operator", driver=run_law, requires=requires)
 
 
-__all__ = ["run_law", "operator_law", "evaluate_sample", "root_cause", "fresh_seed", "default_examples",
+__all__ = ["run_law", "operator_law", "evaluate_sample", "root_cause", "bounded_root_cause", "fresh_seed", "default_examples",
            "positive_examples", "valid_seed", "valid_horizon", "DEFAULT_EXAMPLES", "BOUND", "ROOT_LAW",
            "HARNESS_LIMIT", "HYPOTHESIS_SHARE", "HYPOTHESIS_MIN"]

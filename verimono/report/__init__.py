@@ -9,25 +9,40 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from ..atomic import ensure_writable_dir, replace_all
+from ..atomic import clear_in_progress, ensure_writable_dir, keep_elsewhere, replace_all
+from ..errors import OutputNotWritable
 from .html import render
 
 
-def write(report: Any, out_dir: str | Path, *, changes: Any = None) -> dict[str, Path]:
+def write(report: Any, out_dir: str | Path, *, changes: Any = None, run_id: str | None = None) -> dict[str, Path]:
     """Write ``out_dir/results.json`` and ``out_dir/report.html``; returns their paths.
 
     ``changes`` (a :class:`verimono.gate.Comparison`, computed by the caller with
     :func:`verimono.gate.compare`: the report knows nothing of the gate) fill the report's "changes against
-    the baseline" section.
+    the baseline" section.  ``run_id``: the id of the run that marked ``results.json`` in progress
+    (:func:`verimono.atomic.mark_in_progress`; default a fresh one); once the pair is in place that mark
+    is removed.  When the pair cannot be written (a full disk, an unwritable folder) the previous pair
+    stays, the results are kept in the temporary folder, and :class:`verimono.OutputNotWritable` names
+    both paths in one line.
     """
-    out = ensure_writable_dir(out_dir)
     # one run id in both files; both rendered in memory, written to temporaries, then renamed together
     # (verimono.atomic): a full disk or an interrupt leaves the previous pair or the new pair, never a mix
-    report.meta["run_id"] = new_run_id()
-    json_path, html_path = out / "results.json", out / "report.html"
+    report.meta["run_id"] = run_id = run_id or new_run_id()
+    json_path, html_path = Path(out_dir) / "results.json", Path(out_dir) / "report.html"
     text = report.to_json()
-    html = render(report, changes=changes)
-    replace_all({json_path: text, html_path: html})
+    try:
+        out = ensure_writable_dir(out_dir)
+        html = render(report, changes=changes)
+        replace_all({json_path: text, html_path: html})
+    except OutputNotWritable as exc:
+        try:
+            kept = f"this run's results are kept in {keep_elsewhere(text, f'verimono-results-{run_id}.json')}"
+        except OSError as again:
+            kept = f"this run's results could not be kept elsewhere either ({again.strerror or again})"
+        err = OutputNotWritable(f"{exc}; {kept}")
+        err.errno, err.filename = exc.errno, exc.filename
+        raise err from None
+    clear_in_progress(out / "results.json", run_id)
     return {"json": json_path, "html": html_path}
 
 

@@ -15,13 +15,13 @@ import numpy as np
 
 from .. import performance
 from .._jsonable import to_jsonable
-from ..errors import StageUnavailable, VerimonoError
+from ..errors import StageUnavailable
 from ..executors import Unit
 from ..grids import uniform_grid
 from ..profiles import Profile
 from ..results import SKIPPED, CheckResult, Report
 from ..stepping import solve
-from ..timeouts import run_unit
+from ..timeouts import current_budget, run_unit, time_limit
 from ..checks.core import laws_of
 from ..checks.core import subject_name as _name
 from ..checks.pseudo_distance import check_pseudo_distance
@@ -59,9 +59,13 @@ def _convergence_unit(stepper: Callable, problem: Any) -> Report:
                               subject=f"{_name(stepper)} on {problem.name}"))
     if rec.study is not None:
         report.studies.append(rec.study)
+    if rec.details.get("timeout") is not None:      # the stepper ran out of time: no unbounded extra call
+        rec.details["trajectory_error"] = "not sampled: the unit ran out of time"
+        return report
     try:
-        report.trajectories.append(sample_trajectory(stepper, problem))
-    except (VerimonoError, ArithmeticError, ValueError) as exc:
+        with time_limit(current_budget(), f"the trajectory sample of {rec.subject}"):
+            report.trajectories.append(sample_trajectory(stepper, problem))
+    except Exception as exc:  # noqa: BLE001 - a plot sample: its failure (a UnitTimeout too) is noted, not fatal
         rec.details["trajectory_error"] = f"{type(exc).__name__}: {exc}"
     return report
 
