@@ -24,6 +24,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
+from ..arrays import as_float64
 from ..claims import claim_of
 from ..errors import NotApplicable, VerimonoError
 from ..grids import uniform_grid
@@ -79,9 +80,9 @@ def perturbed_starts(problem: Problem, seed: int = 0, scales: Sequence[float] = 
         z = x0 + s * scale * d / np.linalg.norm(d)
         if not problem.initial_jump:
             try:
-                z = np.asarray(op.project_domain(z, 0.0), dtype=float)
+                z = as_float64(op.project_domain(z, 0.0))
             except NotImplementedError:
-                z = np.asarray(op.resolvent(z, 1e-3 * problem.T, 0.0), dtype=float)
+                z = as_float64(op.resolvent(z, 1e-3 * problem.T, 0.0))
         if np.linalg.norm(z - x0) > tolerance(x0, z) * 10:
             out.append(z)
     return out
@@ -105,7 +106,7 @@ def run_starts(stepper: Callable, problem: Problem, starts: Sequence[np.ndarray]
     """
     if getattr(stepper, "batched", False) and starts:
         try:
-            xs = np.asarray(stepper(problem.replace(x0=np.stack([problem.x0, *starts])), grid), dtype=float)
+            xs = as_float64(stepper(problem.replace(x0=np.stack([problem.x0, *starts])), grid))
         except (VerimonoError, ArithmeticError, ValueError, TypeError, IndexError):
             xs = None
         if (xs is not None and xs.shape == (len(grid), len(starts) + 1) + problem.x0.shape
@@ -162,7 +163,7 @@ def domain_distances(stepper: Callable, p: Problem, t: np.ndarray) -> tuple[np.n
     x = run_stepper(stepper, p, t)
     d = np.zeros(len(t))
     for k in range(1 if p.initial_jump else 0, len(t)):
-        d[k] = float(np.linalg.norm(np.asarray(p.operator.project_domain(x[k], float(t[k])), dtype=float) - x[k]))
+        d[k] = float(np.linalg.norm(as_float64(p.operator.project_domain(x[k], float(t[k]))) - x[k]))
     return x, d
 
 
@@ -206,7 +207,7 @@ def check_in_domain(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int =
     x = run_stepper(stepper, p, t)
     ratios, dists = np.zeros(len(t)), np.zeros(len(t))
     for k in range(1 if p.initial_jump else 0, len(t)):
-        q = np.asarray(p.operator.project_domain(x[k], float(t[k])), dtype=float)
+        q = as_float64(p.operator.project_domain(x[k], float(t[k])))
         dists[k] = float(np.linalg.norm(q - x[k]))
         ratios[k] = dists[k] / tolerance(x[k], q)
     bad = np.flatnonzero(ratios > 1.0)
@@ -242,7 +243,7 @@ def check_selections(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int 
     for k in range(len(h)):
         xk1, yk, tk1 = x[k + 1], y[k], float(t[k + 1])
         mu = 0.5 * h[k]
-        back = np.asarray(op.resolvent(xk1 + mu * yk, mu, tk1), dtype=float)
+        back = as_float64(op.resolvent(xk1 + mu * yk, mu, tk1))
         ratios[k] = float(np.linalg.norm(back - xk1)) / tolerance(xk1, mu * yk, x[k])
         if contains_available:
             try:
