@@ -227,6 +227,10 @@ def check_selections(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int 
     """``y_{k+1} = (z_k - x_{k+1})/h_{k+1} ∈ F(t_{k+1}, x_{k+1})`` (``eq:iteration``), ``z_k = x_k + h f(x_k)
     + ∫u``: through ``operator.contains`` and through ``J_μ(x_{k+1} + μ y_{k+1}) = x_{k+1}`` at ``μ = h/2``.
 
+    A failure names the discrete velocity it tested with the terms the problem has (``f``, ``u``) and their
+    values, and says first when ``x_{k+1}`` lies outside ``cl dom F(t_{k+1},·)`` — where ``F`` is empty and no
+    velocity can be a selection.
+
     Tolerance: :func:`verimono.tolerances.quotient_tolerance` (a difference quotient divides the
     round-off of the states by ``h``).
 
@@ -255,14 +259,49 @@ def check_selections(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int 
         worst = max(worst, 1.0 + float(np.sum(~member)))   # membership is boolean: count the misses
     bad = np.flatnonzero((ratios > 1.0) | ~member)
     k = int(bad[0]) if bad.size else int(np.argmax(ratios))
+    velocity, terms = _velocity(p, t, x, k)
     counter = {"k": k + 1, "t_k": t[k + 1], "x_k": x[k], "x_k_plus_1": x[k + 1], "h": h[k], "selection": y[k],
-               "contains": bool(member[k]), "resolvent_residual_ratio": ratios[k],
-               "message": f"y = (x_k - x_(k+1))/h = {np.array2string(y[k], precision=6)} is not in "
-                          f"F(t_(k+1), x_(k+1)) at k+1 = {k + 1}, t = {t[k + 1]:.6g} "
-                          f"(contains: {bool(member[k])}, |J(x + mu y) - x|/tol = {ratios[k]:.3g})"}
-    return Outcome(worst, k + 1, counter, {"contains_used": contains_available, "misses": int(np.sum(~member))},
-                   message="(x_k - x_(k+1))/h in F(t_(k+1), x_(k+1)) at every step"
+               "velocity": velocity, **terms,
+               "contains": bool(member[k]), "resolvent_residual_ratio": ratios[k]}
+    outside = _outside_domain(op, x[k + 1], float(t[k + 1])) if bad.size else None
+    msg = (f"the discrete velocity y = {velocity} = {np.array2string(y[k], precision=6)} is not in "
+           f"F(t_(k+1), x_(k+1)) at k+1 = {k + 1}, t = {t[k + 1]:.6g}"
+           + "".join(f", {name} = {np.array2string(v, precision=6)}" for name, v in terms.items())
+           + f" (contains: {bool(member[k])}, |J(x + mu y) - x|/tol = {ratios[k]:.3g})")
+    if outside is not None:     # the real cause first: no velocity is a selection outside dom F
+        counter["distance_to_domain"] = outside
+        msg = (f"x_(k+1) = {np.array2string(x[k + 1], precision=6)} lies outside cl dom F(t_(k+1), ·) (distance "
+               f"{outside:.3g}) at k+1 = {k + 1}, t = {t[k + 1]:.6g}, where F is empty; so " + msg)
+    counter["message"] = msg
+    return Outcome(worst, k + 1, counter, {"contains_used": contains_available, "misses": int(np.sum(~member)),
+                                           "velocity": velocity},
+                   message=f"the discrete velocity {velocity} in F(t_(k+1), x_(k+1)) at every step"
                            + ("" if contains_available else " (resolvent characterisation only: no contains)"))
+
+
+def _velocity(p: Problem, t: np.ndarray, x: np.ndarray, k: int) -> tuple[str, dict[str, np.ndarray]]:
+    """The discrete velocity ``selections`` tests, as a formula naming the terms this problem has
+    (``f``, ``u``), and those terms' values in cell ``k``."""
+    formula, terms = "(x_k", {}
+    if p.f is not None:
+        formula += " + h f(x_k)"
+        terms["f(x_k)"] = as_float64(p.f(x[k]))
+    dU = p.input_increments(t[k:k + 2])
+    if dU is not None:
+        formula += " + ∫u"
+        terms["∫u"] = np.asarray(dU[0], dtype=float)
+    return formula + " - x_(k+1))/h", terms
+
+
+def _outside_domain(op: Any, x: np.ndarray, t: float) -> float | None:
+    """The distance of ``x`` to ``cl dom F(t,·)`` when it is beyond the tolerance, else ``None`` (also when
+    the operator cannot project onto its domain)."""
+    try:
+        q = as_float64(op.project_domain(x, t))
+    except (NotImplementedError, VerimonoError, ArithmeticError, ValueError):
+        return None
+    d = float(np.linalg.norm(q - x))
+    return d if d > tolerance(x, q) else None
 
 
 __all__ = ["check_contraction", "check_in_domain", "check_selections", "domain_vanishing", "perturbed_starts",
