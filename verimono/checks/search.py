@@ -43,6 +43,7 @@ from ..errors import InvalidCheckArgument, UnitTimeout
 from ..profiles import UnknownProfile, active_profile, get_profile
 from ..results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
 from ..timeouts import current_budget, time_limit
+from .batches import prefetched
 from .core import REGISTRY, Law, Outcome, classify, law, run, subject_name
 from .samples import NUMPY_DIM, Sample, law_samples
 from .sweep import law_draws, shrink, sweep_count, sweep_samples
@@ -196,16 +197,18 @@ class _Search:
 
     def first_violation(self, samples: list[Sample]) -> tuple[Sample, Outcome] | None:
         """Evaluate ``samples`` in order; the first that breaks the law with its outcome (taken out of the
-        state, so that a later phase searches afresh), or ``None``."""
-        for s in samples:
-            try:
-                self.evaluate(s)
-            except _Violation:
-                found = (self.failing, self.failure)
-                self.failure = self.failing = None
-                return found
-            if self.unsupported is not None:
-                break
+        state, so that a later phase searches afresh), or ``None``.  A batched operator evaluates their
+        points in batched calls first (:func:`verimono.checks.batches.prefetched`)."""
+        with prefetched(self.op, samples):
+            for s in samples:
+                try:
+                    self.evaluate(s)
+                except _Violation:
+                    found = (self.failing, self.failure)
+                    self.failure = self.failing = None
+                    return found
+                if self.unsupported is not None:
+                    break
         return None
 
 
