@@ -55,3 +55,54 @@ def test_prox_tv_recipes():
     tv = lambda x: float(np.abs(np.diff(x)).sum())   # noqa: E731
     _ok(vm.operator_from_prox(lambda x, lam: ptv.tv1_1d(x, lam * 0.5), value=lambda x: 0.5 * tv(x), shape=5,
                               name="prox_tv.tv1_1d"))
+
+
+# -- JAX and PyTorch: the recipes of docs/prox-libraries.md, executed from its code blocks ------------------------
+def _recipes(heading):
+    """The objects the first ``python`` code block under ``heading`` in docs/prox-libraries.md defines."""
+    import pathlib
+    import re
+
+    doc = (pathlib.Path(__file__).parents[1] / "docs" / "prox-libraries.md").read_text()
+    section = doc[doc.index(heading):]
+    namespace: dict = {}
+    exec(re.search(r"```python\n(.*?)```", section, re.S).group(1), namespace)   # noqa: S102 - the doc's recipe
+    return namespace
+
+
+def _float32_ok(op):
+    rep = _ok(op)
+    assert {r.details["dtype"] for r in rep if r.status == "passed"} == {"float32"}, "judged at float32"
+    return rep
+
+
+def test_jax_recipes():
+    pytest.importorskip("jax", reason="JAX is not installed (pip install 'verimono[arrays]')")
+    pytest.importorskip("jaxopt", reason="jaxopt is not installed (pip install 'verimono[arrays]')")
+    from jaxopt.prox import prox_lasso
+
+    ns = _recipes("## JAX (jaxopt)")
+    for name in ("lasso", "ball", "batched"):
+        _float32_ok(ns[name])
+    assert ns["lasso"].array == "jax" and ns["batched"].batched
+    # the weight applied twice: the exact prox of 4|x|_1, not of the stated g = 2|x|_1
+    twice = vm.operator_from_prox(lambda x, scaling: prox_lasso(x, 2.0, 2 * scaling), step="scaling",
+                                  value=ns["l1_value"], shape=3, name="weight twice")
+    assert "prox_inequality" in {r.check for r in vm.check_operator(twice, seed=0).failures}
+
+
+def test_pytorch_recipes():
+    torch = pytest.importorskip("torch", reason="PyTorch is not installed (pip install 'verimono[arrays]')")
+    pytest.importorskip("proxtorch", reason="ProxTorch is not installed (pip install 'verimono[arrays]')")
+    from proxtorch.operators import L1
+
+    ns = _recipes("## PyTorch (ProxTorch)")
+    for name in ("torch_l1", "torch_ball", "torch_batched"):
+        _float32_ok(ns[name])
+    # the weight forgotten: L1(alpha=1) given the value of L1(alpha=2)
+    forgot = vm.operator_from_prox(L1(alpha=1.0).prox, value=ns["value"], shape=3, array="torch", name="weight forgotten")
+    assert "prox_inequality" in {r.check for r in vm.check_operator(forgot, seed=0).failures}
+    # the prox receives tensors (declared), the laws float64 NumPy
+    seen = []
+    op = vm.operator_from_prox(lambda x, lam: seen.append(type(x)) or ns["l1"].prox(x, lam), shape=3, array="torch")
+    assert op.resolvent([1.0, -2.0, 0.1], 0.5).dtype == np.float64 and seen == [torch.Tensor]

@@ -254,3 +254,23 @@ def test_yb_bounds_skip_where_f0_overflows_at_the_edge_of_the_domain():
         rec = check(vm.solve, p)
         assert rec.status == "skipped", rec
     assert "not finite" in check_bounds_yb(vm.solve, p).message
+
+
+def test_selections_names_the_discrete_velocity_and_first_a_state_outside_the_domain():
+    """Issue 23, item 4: the message names the quantity tested — the discrete velocity with the f and u terms
+    the problem has, and their values — and, when x_(k+1) lies outside dom F, says so first."""
+    rec = CHECKS["selections"](drops_input, get("Lipschitz field and input"))
+    assert rec.status == FAILED
+    assert "discrete velocity y = (x_k + h f(x_k) + ∫u - x_(k+1))/h" in rec.message, rec.message
+    assert "f(x_k) = [" in rec.message and "∫u = [" in rec.message
+    assert rec.counterexample["velocity"] == "(x_k + h f(x_k) + ∫u - x_(k+1))/h"
+    plain = CHECKS["selections"](wrong_time, get("t|x| (n=1)"))
+    assert plain.message.startswith("the discrete velocity y = (x_k - x_(k+1))/h = "), plain.message
+    from verimono import NormalCone, sets
+
+    ball = Problem(NormalCone(sets.Ball([0.0, 0.0], 1.0)), [0.5, 0.0], 1.0, name="unit ball")
+    tripled = lambda p, t: np.asarray(solve(p, t)) * np.r_[1.0, [3.0] * (len(t) - 1)][:, None]   # noqa: E731
+    out = CHECKS["selections"](tripled, ball)
+    assert out.status == FAILED and out.message.startswith("x_(k+1) = [1.5 0. ] lies outside"), out.message
+    assert "outside cl dom F" in out.message.split(";")[0] and out.counterexample["distance_to_domain"] > 0
+    assert CHECKS["selections"](solve, get("moving box")).message.startswith("the discrete velocity (x_k")

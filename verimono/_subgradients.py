@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from .errors import ProxOutputError
-from .tolerances import RTOL, tolerance
+from .tolerances import current_rtol, tolerance
 
 #: sampled points ``z`` of the subgradient inequality in :meth:`ProxOperator.contains`
 CONTAINS_POINTS = 24
@@ -56,7 +56,7 @@ def subgradient_contains(op: Any, x, y, t: float = 0.0, tol: float | None = None
         if gz == math.inf:
             continue
         d = float(np.linalg.norm(z - x))
-        if gx + float(y @ (z - x)) > gz + tol * (1.0 + d) * (1.0 + ny) + RTOL * (1.0 + max(abs(gx), abs(gz))):
+        if gx + float(y @ (z - x)) > gz + tol * (1.0 + d) * (1.0 + ny) + current_rtol() * (1.0 + max(abs(gx), abs(gz))):
             return False
     return True
 

@@ -10,7 +10,7 @@ none, against a fine-grid solution of the same stepper, which the result says):
 The order in each norm is the slope of ``log e`` against ``log |Δ|`` (``|Δ| = max_k h_k``) by least
 squares — valid for any step ratio — with a 95% Student-t confidence interval.  Errors at the floor of a
 grid are dropped; if every error is there the scheme is exact on the grids.  The floor is round-off,
-``ROUNDOFF_FACTOR · ε · scale``, plus — for a stepper that states the accuracy ``τ`` of its inner solve
+``ROUNDOFF_FACTOR · ε · scale`` (in the precision the stepper computes in, :func:`verimono.tolerances.roundoff_floor`), plus — for a stepper that states the accuracy ``τ`` of its inner solve
 (``Stepper(..., solve_tol=τ)``) — what ``K`` inexact steps of a nonexpansive scheme can accumulate,
 ``K τ (1 + scale)`` (:func:`solve_floor`).
 
@@ -58,12 +58,15 @@ from .grids import uniform_grid, validate_grid
 from .naming import subject_name
 from .problem import Order, Problem
 from .stepping import solve, stream
-from .tolerances import EPS
+from .arrays import as_float64
+from .tolerances import ROUNDOFF_STEPS, coarser, judged_precision, observe, roundoff_floor
 
 NORMS = ("sup", "l2", "final")
 #: errors below ROUNDOFF_FACTOR * eps * (1 + max|x|) are round-off (≈ 2e-12 for unit-size states):
-#: a K-step scheme accumulates O(K eps) rounding, and K ≤ 1e4 in the catalog's studies
-ROUNDOFF_FACTOR = 1e4
+#: a K-step scheme accumulates O(K eps) rounding, and K ≤ 1e4 in the catalog's studies.  A stepper computing
+#: in a coarser precision (observed from its states) gets that precision's floor,
+#: :func:`verimono.tolerances.roundoff_floor` (float32: 1.2e-5)
+ROUNDOFF_FACTOR = ROUNDOFF_STEPS
 #: local slopes that spread by more than this are not yet in the asymptotic regime
 ASYMPTOTIC_SPREAD = 0.25
 #: an order estimate "reaches" p when its interval's upper end is within this of p; the slack absorbs
@@ -433,18 +436,20 @@ def convergence_study(stepper: Callable, problem: Problem, steps: Sequence[Any] 
         fine_t = uniform_grid(problem.T, steps=_cells_finer_than(grids, problem.T) * reference_refinement)
         executor = _choose_executor(executor, len(fine_t) + sum(len(g) for g in grids))
         nodes = functools.reduce(np.union1d, grids)       # the fine solution is needed only there
-        at_nodes = _run_jobs(stepper, problem, [(fine_t, "sample", nodes)], executor)[0][0]
+        at_nodes, _, _, at_precision = _run_jobs(stepper, problem, [(fine_t, "sample", nodes)], executor)[0]
         jobs = [(g, "errors", at_nodes[np.searchsorted(nodes, g)]) for g in grids]
         results = _run_jobs(stepper, problem, jobs, executor)
         reference = f"fine-grid solution of the same stepper (h = {problem.T / (len(fine_t) - 1):.3g})"
-    errors = {n: [errs[n] for errs, _, _ in results] for n in NORMS}
-    scale = max([1.0] + [sc for _, sc, _ in results if math.isfinite(sc)])
-    floor = ROUNDOFF_FACTOR * EPS * scale
+    errors = {n: [errs[n] for errs, _, _, _ in results] for n in NORMS}
+    scale = max([1.0] + [sc for _, sc, _, _ in results if math.isfinite(sc)])
+    precision = coarser(*[r[3] for r in results], *([at_precision] if problem.exact is None else []))
+    observe(precision)          # jobs run in other processes report it here
+    floor = roundoff_floor(scale, precision)
     mesh = [float(np.max(np.diff(g))) for g in grids]
     floors = None if not solve_tol else [floor + solve_floor(len(g) - 1, solve_tol, scale) for g in grids]
     fits = {n: fit_order(mesh, errors[n], floor if floors is None else floors) for n in NORMS}
     return ConvergenceStudy(problem.name, subject_name(stepper), mesh, [len(g) - 1 for g in grids], errors, fits,
-                            problem.order, reference, floor, [r[-1] for r in results[:len(grids)]], floors,
+                            problem.order, reference, floor, [r[2] for r in results[:len(grids)]], floors,
                             solve_tol or None)
 
 
@@ -453,12 +458,19 @@ PARALLEL_MIN_STEPS = 200_000
 
 
 def _job(stepper, problem, grid, want, ref=None):
-    """One grid: ``(errors, scale, seconds)`` when ``want == "errors"`` (against the exact solution, or
-    against ``ref``, the reference values at the grid's nodes), ``(values at the times ref, None,
-    seconds)`` when ``want == "sample"``.
+    """One grid: ``(errors, scale, seconds, precision)`` when ``want == "errors"`` (against the exact
+    solution, or against ``ref``, the reference values at the grid's nodes), ``(values at the times ref,
+    None, seconds, precision)`` when ``want == "sample"``.
 
-    ``seconds`` is the stepper's own time (streaming: the blocks' production, not the error sums).
+    ``seconds`` is the stepper's own time (streaming: the blocks' production, not the error sums);
+    ``precision`` the one the stepper's states were computed in (:mod:`verimono.tolerances`).
     """
+    with judged_precision() as precision:
+        out = _job_values(stepper, problem, grid, want, ref)
+    return (*out, precision.name)
+
+
+def _job_values(stepper, problem, grid, want, ref=None):
     stepper, problem = _unwrap(stepper), _unwrap(problem)
     sink = ErrorAccumulator(problem, ref) if want == "errors" else Sampler(ref)
     if stepper is solve:
@@ -578,7 +590,11 @@ def _unwrap(obj):
 
 def _timed_run(stepper, problem, grid):
     start = time.perf_counter()
-    x = real_array(stepper(problem, grid), f"the values of stepper {subject_name(stepper)}")   # complex: an error
+    x = stepper(problem, grid)
+    try:
+        x = as_float64(x)                   # any array library; its precision observed
+    except (TypeError, ValueError):
+        x = real_array(x, f"the values of stepper {subject_name(stepper)}")   # complex: an error
     if x.shape != (len(grid),) + problem.x0.shape:
         raise InvalidProblem(f"stepper {subject_name(stepper)} returned shape {x.shape}, expected "
                              f"{(len(grid),) + problem.x0.shape}")

@@ -9,7 +9,8 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from .errors import InvalidProblem, OutsideDomain
-from .tolerances import tolerance
+from .arrays import as_float64, precision_of
+from .tolerances import coarser, current_precision, rtol_for, tolerance
 
 
 @dataclasses.dataclass(frozen=True)
@@ -180,11 +181,15 @@ class Problem:
 
     def _check_initial_point(self) -> None:
         try:
-            p = np.asarray(self.operator.project_domain(self.x0, 0.0))
+            raw = self.operator.project_domain(self.x0, 0.0)
         except NotImplementedError:
             return  # cannot be checked; the operator laws report the missing member
+        # at the precision the operator computes in (a float32 projection of x0 ∈ dom F moves it by its
+        # rounding), the coarser of the one under judgement and the projection's own deciding
+        precision = coarser(current_precision().name, precision_of(raw))
+        p = as_float64(raw)
         dist = float(np.max(np.abs(p - self.x0)))
-        if dist > tolerance(self.x0):
+        if dist > tolerance(self.x0, rtol=rtol_for(precision)):
             raise OutsideDomain(f"x0 = {self.x0} lies outside cl dom F(0,·) (distance {dist:.3g} to its "
                                 "projection); pass initial_jump=True to start with the catching-up jump")
 

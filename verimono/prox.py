@@ -12,6 +12,15 @@ flattening adapter (row-major ``reshape``, an isometry of the Frobenius norm ont
 every law and tolerance is the one of ``R^{mn}``; the user's ``prox`` and ``value`` always receive arrays
 of ``shape``.  A ``prox`` returning a tuple (``(p, info)``) is rejected with :class:`ProxOutputError`
 unless ``unwrap=`` says which element is the point — never unwrapped silently.
+
+Array libraries and precision (:mod:`verimono.arrays`): a prox that computes with JAX, PyTorch, CuPy or an
+array-API namespace receives its own array type — declared (``array="jax"``, ``array="torch"``, a
+namespace module; ``dtype=`` for another precision than the library's default) or detected from what it
+returns on its first call — and its outputs are converted to NumPy float64 for the laws, their precision
+reported: a float32 prox is judged at float32 precision (:mod:`verimono.tolerances`).  ``step=`` says how
+the step is passed (positionally, as a keyword such as ``scaling``, or not at all for a projection), and
+``batched=True`` declares a prox that maps a batch ``(B, *shape)`` with steps ``(B,)`` at once (vmapped,
+vectorised): the search then evaluates its NumPy draws and its sweep a batch at a time.
 """
 
 from __future__ import annotations
@@ -23,6 +32,7 @@ import numpy as np
 
 from ._subgradients import (CONTAINS_POINTS, ProxOutputError, checked_value, contains_points,  # noqa: F401 - re-exported
                       subgradient_contains)
+from .arrays import MAX_BATCH, Boundary, array_kind, as_float64, padded, take_prefetched
 from .errors import InvalidProblem
 from .operators import Operator
 
@@ -43,12 +53,25 @@ def _arity(fn: Callable, with_t: int) -> bool:
     return third.default is inspect.Parameter.empty or third.name in ("t", "time")
 
 
+def _time_keyword(fn: Callable) -> str | None:
+    """The name of ``fn``'s time parameter (``t`` or ``time``) when it has one."""
+    import inspect
+
+    try:
+        params = inspect.signature(fn).parameters
+    except (TypeError, ValueError):
+        return None
+    return next((n for n in ("t", "time") if n in params), None)
+
+
 class ProxOperator(Operator):
     """``F(t, ·) = ∂g(t, ·)`` given by ``prox(X, lam[, t])`` (and ``value(X[, t]) = g(t, X)``) on arrays of
     ``shape``; presented to the laws as an operator on ``R^{prod(shape)}`` (row-major flattening)."""
 
     def __init__(self, prox: Callable, *, value: Callable | None = None, shape: Any = None,
-                 dim: int | None = None, name: str | None = None, unwrap: int | Callable | None = None) -> None:
+                 dim: int | None = None, name: str | None = None, unwrap: int | Callable | None = None,
+                 array: Any = None, dtype: Any = None, device: Any = None, batched: bool = False,
+                 step: str | bool | None = None) -> None:
         if not callable(prox):
             raise InvalidProblem("prox must be callable as prox(x, lam) or prox(x, lam, t)")
         if value is not None and not callable(value):
@@ -63,14 +86,33 @@ class ProxOperator(Operator):
         if dim is not None and int(dim) != math.prod(shape):
             raise InvalidProblem(f"dim={dim} does not match shape={shape}")
         super().__init__(math.prod(shape), name or getattr(prox, "__name__", "prox"))
+        if step is not None and step is not False and not (isinstance(step, str) and step.isidentifier()):
+            raise InvalidProblem(f"step must be None (prox(x, lam)), a keyword name such as 'scaling' "
+                                 f"(prox(x, scaling=lam)) or False (prox(x): a projection), got {step!r}")
         self.shape = shape
         self._prox, self._value, self._unwrap = prox, value, unwrap
-        self._prox_t = _arity(prox, 3)
+        self._step = step
+        if step is None:
+            self._prox_t = _arity(prox, 3)
+        elif step is False:
+            self._prox_t = _arity(prox, 2)
+        else:
+            self._prox_t = _time_keyword(prox)
         self._value_t = value is not None and _arity(value, 2)
+        self._io = Boundary(array_kind(array, dtype=dtype, device=device))
+        #: the prox maps a batch (B, *shape) with steps (B,) (and times (B,)) at once
+        self.batched = bool(batched)
+        #: prox values of a batch evaluated ahead of the laws (verimono.checks.batches)
+        self._prefetched: dict | None = None
+
+    @property
+    def array(self) -> str:
+        """The array library the prox computes with (declared or detected; ``"numpy"`` until detected)."""
+        return self._io.name
 
     # -- the adapter ------------------------------------------------------------------------------
     def _shaped(self, x: np.ndarray) -> np.ndarray:
-        x = np.asarray(x, dtype=float)
+        x = as_float64(x)
         if x.shape != (self.dim,):
             raise InvalidProblem(f"{self.name} acts on R^{self.dim} (arrays of shape {self.shape}, flattened); "
                                  f"got a point of shape {x.shape}")
@@ -84,7 +126,7 @@ class ProxOperator(Operator):
                                   f"{self.shape}; pass unwrap=0 (or the index or function that picks the point) "
                                   "to operator_from_prox")
         try:
-            p = np.asarray(out, dtype=float)
+            p = self._io.returned(out)
         except (TypeError, ValueError) as exc:
             raise ProxOutputError(f"{self.name}: prox returned {type(out).__name__}, not an array of shape "
                                   f"{self.shape} ({exc})") from None
@@ -92,21 +134,74 @@ class ProxOperator(Operator):
             raise ProxOutputError(f"{self.name}: prox returned shape {p.shape} for a point of shape {self.shape}")
         return p.reshape(self.dim)
 
+    def _call(self, X: Any, lam: Any, t: Any) -> Any:
+        """The user's prox on ``X`` (already in its array type) with the step and time as it takes them."""
+        args, kw = [X], {}
+        if self._step is None:
+            args.append(lam)
+        elif self._step is not False:
+            kw[self._step] = lam
+        if self._prox_t:
+            if isinstance(self._prox_t, str):
+                kw[self._prox_t] = t
+            else:
+                args.append(t)
+        return self._prox(*args, **kw)
+
     # -- the contract ------------------------------------------------------------------------------
     def resolvent(self, x, lam, t=0.0):
-        x = np.asarray(x, dtype=float)
-        if x.ndim == 2:   # a batch of flattened points, one call per row
+        x = as_float64(x)
+        if x.ndim == 2:   # a batch of flattened points: one call per row, or one batched call
+            if self.batched:
+                return self.resolvent_batch(x, np.full(x.shape[0], float(lam)), np.full(x.shape[0], float(t)))
             return np.array([self.resolvent(r, lam, t) for r in x]).reshape(x.shape)
-        X = self._shaped(x)
-        out = self._prox(X, lam, t) if self._prox_t else self._prox(X, lam)
-        return self._point(out)
+        if self.batched:
+            hit = take_prefetched(self._prefetched, x, lam, t)
+            if hit is not None:
+                return hit
+            return self.resolvent_batch(x[None], np.array([float(lam)]), np.array([float(t)]))[0]
+        X = self._io.given(self._shaped(x))
+        return self._point(self._call(X, lam, t))
+
+    def resolvent_batch(self, X: np.ndarray, lams: np.ndarray, ts: np.ndarray) -> np.ndarray:
+        """``J_{λ_i}(X_i)`` at ``t_i`` for the rows of ``X`` ``(B, dim)`` in batched calls of the prox (chunks
+        of at most :data:`verimono.arrays.MAX_BATCH` rows padded to a power of two, so that a jitted prox
+        compiles for a few shapes); a prox not declared ``batched`` is called row by row."""
+        X = as_float64(X)
+        lams, ts = np.asarray(lams, dtype=float), np.asarray(ts, dtype=float)
+        if X.ndim != 2 or X.shape[1] != self.dim or lams.shape != (X.shape[0],) or ts.shape != (X.shape[0],):
+            raise InvalidProblem(f"{self.name}: a batch is points (B, {self.dim}) with steps and times (B,); got "
+                                 f"{X.shape}, {lams.shape}, {ts.shape}")
+        if not self.batched:
+            return np.array([self.resolvent(r, lam, t) for r, lam, t in zip(X, lams, ts)]).reshape(X.shape)
+        out = np.empty_like(X)
+        for lo in range(0, X.shape[0], MAX_BATCH):
+            rows = min(MAX_BATCH, X.shape[0] - lo)
+            pick = np.r_[np.arange(lo, lo + rows), np.full(padded(rows) - rows, lo)]
+            Xb = self._io.given(X[pick].reshape((pick.size,) + self.shape))
+            res = self._call(Xb, self._io.given(lams[pick]), self._io.given(ts[pick]) if self._prox_t else None)
+            if self._unwrap is not None:
+                res = self._unwrap(res) if callable(self._unwrap) else res[self._unwrap]
+            elif isinstance(res, tuple):
+                raise ProxOutputError(f"{self.name}: the batched prox returned a tuple of {len(res)} items, not "
+                                      f"an array of shape {(pick.size,) + self.shape}; pass unwrap=0")
+            try:
+                P = self._io.returned(res)
+            except (TypeError, ValueError) as exc:
+                raise ProxOutputError(f"{self.name}: the batched prox returned {type(res).__name__}, not an "
+                                      f"array of shape {(pick.size,) + self.shape} ({exc})") from None
+            if P.shape != (pick.size,) + self.shape:
+                raise ProxOutputError(f"{self.name}: the batched prox returned shape {P.shape} for a batch of "
+                                      f"shape {(pick.size,) + self.shape}")
+            out[lo:lo + rows] = P[:rows].reshape(rows, self.dim)
+        return out
 
     def value(self, x, t=0.0) -> float:
         """``g(t, x)`` (``+inf`` outside ``dom g``) of a flattened point."""
         if self._value is None:
             return super().value(x, t)
-        X = self._shaped(x)
-        return checked_value(self, self._value(X, t) if self._value_t else self._value(X))
+        X = self._io.given(self._shaped(x))
+        return checked_value(self, self._io.scalar(self._value(X, t) if self._value_t else self._value(X)))
 
     def contains(self, x, y, t=0.0, tol=None):
         """Evidence for ``y ∈ ∂g(t, x)`` from ``value`` (:func:`subgradient_contains`)."""
@@ -120,21 +215,41 @@ class ProxOperator(Operator):
         return Operator.provides(self, member)
 
     def __repr__(self) -> str:
-        return f"{self.name}(shape={self.shape})"
+        lib = self._io.name
+        return f"{self.name}(shape={self.shape}" + ("" if lib == "numpy" else f", array={lib!r}") + ")"
 
 
 def operator_from_prox(prox: Callable, *, value: Callable | None = None, shape: Any = None,
-                       name: str | None = None, unwrap: int | Callable | None = None) -> ProxOperator:
+                       name: str | None = None, unwrap: int | Callable | None = None, array: Any = None,
+                       dtype: Any = None, device: Any = None, batched: bool = False,
+                       step: str | bool | None = None) -> ProxOperator:
     """``F = ∂g`` from ``prox(x, lam) = argmin_z lam·g(z) + |z - x|²/2`` (or ``prox(x, lam, t)`` for a
     time-dependent ``g``), on arrays of ``shape`` (an int ``n`` or a tuple; the Frobenius inner product).
 
     ``value(x)`` or ``value(x, t)`` is ``g`` (``+inf`` outside its domain): it enables the value laws
     (prox inequality, optimality, Moreau envelope) and the membership test of ``yosida_in_graph``.
     ``unwrap`` picks the point from a prox returning a tuple (an index or a function); without it a tuple
-    is a :class:`ProxOutputError`.  The arity of ``prox``/``value`` decides whether ``t`` is passed."""
+    is a :class:`ProxOutputError`.  The arity of ``prox``/``value`` decides whether ``t`` is passed.
+
+    ``step``: how ``λ`` is passed — ``None`` positionally (``prox(x, lam)``), a keyword name
+    (``step="scaling"``: ``prox(x, scaling=lam)``, as JAX libraries take it; ``t`` then goes as ``t=`` if the
+    prox has such a parameter), or ``False`` for a prox that takes no step (``prox(x)``: a projection,
+    the prox of an indicator for every ``λ``).
+
+    ``array``: the array library the prox computes with — ``"jax"``, ``"torch"``, ``"cupy"``, ``"numpy"``, or
+    an array-API namespace (module or importable name); ``None`` detects it from what the first call
+    returns.  ``dtype`` the precision its inputs are converted to (default the library's:
+    float32 for JAX without x64 and for PyTorch); ``device`` where (PyTorch, JAX, array-API).  Outputs of
+    any library are converted to NumPy float64 for the laws and their precision recorded: a float32 prox
+    is judged at float32 precision (:mod:`verimono.tolerances`).
+
+    ``batched=True``: ``prox`` maps a batch — points ``(B, *shape)``, steps ``(B,)`` (and times ``(B,)``) —
+    to ``(B, *shape)`` (``jax.vmap``, ``torch.vmap`` or vectorised code); the search then evaluates its
+    NumPy draws and its sweep a batch at a time (:mod:`verimono.checks.batches`)."""
     if shape is None:
         raise InvalidProblem("operator_from_prox needs shape= (an int n for R^n, or a tuple such as (m, n))")
-    return ProxOperator(prox, value=value, shape=shape, name=name, unwrap=unwrap)
+    return ProxOperator(prox, value=value, shape=shape, name=name, unwrap=unwrap, array=array, dtype=dtype,
+                        device=device, batched=batched, step=step)
 
 
 __all__ = ["ProxOperator", "ProxOutputError", "operator_from_prox", "subgradient_contains", "contains_points", "CONTAINS_POINTS"]

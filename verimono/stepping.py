@@ -23,11 +23,13 @@ from typing import Any, Callable, Iterator
 import numpy as np
 
 from ._validate import real_array
+from .arrays import as_float64
 from .claims import Claim
 from .errors import InvalidProblem, SolverFailure
 from .grids import validate_grid
 from .operators import resolvent_kernel
 from .problem import Problem
+from .tolerances import judged_precision
 
 
 class Trajectory:
@@ -40,9 +42,12 @@ class Trajectory:
     """
 
     def __init__(self, t: np.ndarray, x: np.ndarray, problem: Problem | None = None,
-                 extras: dict[str, np.ndarray] | None = None) -> None:
+                 extras: dict[str, np.ndarray] | None = None, precision: str = "float64") -> None:
         self.t = real_array(t, "trajectory times")
         self.x = real_array(x, "trajectory states")
+        #: the precision the states were computed in (the coarsest of the resolvent's and f's outputs); the
+        #: states are stored in float64, and a law judging this trajectory judges it at this precision
+        self.precision = precision
         if self.x.shape[0] != self.t.shape[0]:
             raise InvalidProblem(f"trajectory has {self.x.shape[0]} states for {self.t.shape[0]} times")
         self.problem = problem
@@ -58,6 +63,12 @@ class Trajectory:
 
     def __len__(self) -> int:
         return self.t.shape[0]
+
+    @property
+    def dtype(self) -> str:
+        """The precision the states were computed in (:attr:`precision`): what a conversion for the laws
+        reports (:func:`verimono.arrays.as_float64`), so a float32 operator's trajectory is judged at float32."""
+        return self.precision
 
     @property
     def h(self) -> np.ndarray:
@@ -128,9 +139,10 @@ def solve(problem: Problem, t_grid: Any) -> Trajectory:
         raise InvalidProblem(f"solve expects a verimono.Problem, got {type(problem).__name__}")
     t = validate_grid(t_grid, problem.T)
     x = None
-    for _, x in _march(problem, t, t.size):
-        pass
-    return Trajectory(t, x, problem)
+    with judged_precision() as precision:      # the resolvent's and f's precision, observed as they return
+        for _, x in _march(problem, t, t.size):
+            pass
+    return Trajectory(t, x, problem, precision=precision.name)
 
 
 #: solve accepts a batch ``x0`` of shape ``(B, n)`` (checks may run many initial points in one call)
@@ -188,7 +200,7 @@ def _march(problem: Problem, t: np.ndarray, block: int) -> Iterator[tuple[int, n
     shape = x0.shape
     first = step(_drift(x0, hs[0], f, dU, 0, shape, 1, t, problem), hs[0], ts[0])
     if type(first) is not np.ndarray or first.dtype != np.float64:
-        first = real_array(first, f"the resolvent of {op.name} at step 1")
+        first = _returned(first, f"the resolvent of {op.name} at step 1")
     if first.shape != shape:
         raise _bad_shape(first, 1, t, problem)
     buf[1] = first
@@ -237,6 +249,15 @@ def _march(problem: Problem, t: np.ndarray, block: int) -> Iterator[tuple[int, n
         row = 0
 
 
+def _returned(value: Any, what: str) -> np.ndarray:
+    """A value the problem's members returned, as float64 with its precision observed (a float32 resolvent
+    makes a float32 trajectory, :attr:`Trajectory.precision`); any array library's arrays are converted."""
+    try:
+        return as_float64(value)
+    except (TypeError, ValueError):
+        return real_array(value, what)      # the typed error for complex or non-numeric values
+
+
 def _check_finite(out, start, before, t, problem):
     if np.isfinite(out).all():
         return
@@ -262,7 +283,7 @@ def _drift(xk, hk, f, dU, k, shape=None, step=0, t=None, problem=None):
     if f is not None:
         fx = f(xk)
         if type(fx) is not np.ndarray or fx.dtype != np.float64:
-            fx = real_array(fx, "f(x)")
+            fx = _returned(fx, "f(x)")
         if shape is not None and fx.shape != shape:
             where = f" at step {step} (t = {t[step - 1]:g}, evaluated at x_{step - 1})" if t is not None else ""
             raise SolverFailure(f"f returned shape {fx.shape} for a state of shape {shape}{where} of "

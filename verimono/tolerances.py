@@ -10,9 +10,48 @@ violation a genuinely wrong resolvent produces on inputs of unit size.
 A comparison ``a <= b`` is accepted when ``a <= b + tolerance(scale)``, where ``scale`` is the size of
 the inputs involved (``max |x|``, ``|λ| |y|``, ...): absolute tolerances would be wrong for inputs of
 size 1e6 and meaningless for inputs of size 1e-6.
+
+**Precision.**  Everything above is the judgement of a subject computing in float64.  A subject computing
+in float32 or half precision rounds ``~ 2^29`` resp. ``2^42`` times more coarsely; judged at ``RTOL`` its
+rounding alone breaks the exact identities (a correct float32 projection fails ``resolvent_identity`` with
+``lhs 2.11e-05 > slack 1.89e-05``).  The relative tolerance is therefore a function of the precision the
+subject computes in (:func:`rtol_for`), chosen to keep float64's balance between the two risks:
+
+* *headroom over the subject's rounding* — correct code must pass: ``RTOL`` is ``4.5·10^7`` float64 ulps
+  (``RTOL/EPS``), 7.65 decades above float64's unit roundoff;
+* *distance to real violations* — wrong code must fail: a genuinely wrong resolvent violates the laws by
+  ``10^-2 … 1`` relative (a lost factor 2 in ``λ``, the wrong set, a forgotten input term), which is
+  ``10^6 … 10^8`` times ``RTOL``, 8 decades below violations of unit size.
+
+float64 places its tolerance in the geometric middle of that range (``RTOL ≈ 0.67·sqrt(EPS)``: 7.65 decades
+of headroom, 8 decades of distance).  Every other precision is put at the same place, ``rtol(p) =
+RTOL·sqrt(eps(p)/EPS)`` (:data:`RTOL_BY_PRECISION`): float32 ``2.3e-4`` (3.3 decades = 1950 ulps of
+headroom, 3.6 decades below unit violations, so a violation of ``10^-2`` is still 43 times its slack),
+float16 ``2.1e-2`` and bfloat16 ``5.9e-2`` (1.3 resp. 0.9 decades either side: half precision can only
+tell violations of about 10% and more from rounding — a limit of the arithmetic, not of the harness).
+A smaller float32 tolerance (``1e-5``, 84 ulps) would leave correct float32 code, whose errors grow with
+the conditioning of the law's arithmetic, little headroom over its rounding; a larger one (``10^-3``) would
+sit within 10 times of the ``10^-3``-sized violations of the zoo's stepper that leaves the domain.
+Measured (``docs/prox-libraries.md``): judged at float64's ``RTOL``, correct float32 proxes of jaxopt and
+ProxTorch fail up to 10 laws by 1.2–5.6 times their slack; at float32's they pass, and the float32
+versions of the zoo's broken operators and steppers are all still caught (``tests/test_precision.py``).
+
+The precision of a subject is what it computes in, detected from what it returns (the dtype of its outputs)
+and from what it is given (the dtype its declared array library converts inputs to), the coarser deciding:
+every conversion of a subject's output to float64 for the arithmetic of the laws reports the dtype it
+dropped (:func:`observe`) to the precision under which the law is judged (:func:`judged_precision`, opened
+for every law by :func:`verimono.checks.core.run`, which states it in the record), and :func:`tolerance`
+uses that precision's ``rtol``.  Outside a judged evaluation,
+and for a float64 subject, ``tolerance`` is exactly the float64 one.
 """
 
 from __future__ import annotations
+
+import contextlib
+import contextvars
+import dataclasses
+import math
+from typing import Any, Iterator
 
 import numpy as np
 
@@ -24,8 +63,135 @@ QP_RTOL = 1e-10
 EPS = float(np.finfo(float).eps)
 
 
-def tolerance(*scales: float, rtol: float = RTOL) -> float:
-    """Tolerance for a comparison between quantities of size ``max(scales)``: ``rtol * (1 + max)``."""
+# -- precision: the tolerance of a subject computing in float32 or half precision ---------------------
+
+#: unit roundoff (machine epsilon) of the floating-point precisions a subject may compute in, by dtype name
+EPS_BY_PRECISION = {"float64": 2.0 ** -52, "float32": 2.0 ** -23, "float16": 2.0 ** -10, "bfloat16": 2.0 ** -7}
+#: the relative tolerance a subject computing in each precision is judged at (module docstring):
+#: ``RTOL·sqrt(eps/EPS)``, the place of float64's ``RTOL`` between rounding and unit-sized violations
+RTOL_BY_PRECISION = {p: RTOL * math.sqrt(e / EPS_BY_PRECISION["float64"]) for p, e in EPS_BY_PRECISION.items()}
+RTOL_BY_PRECISION["float64"] = RTOL
+#: two calls of a subject at the same input agree bit for bit in any precision when it is deterministic;
+#: reductions summed in a varying order (threads, GPUs) differ by a few ulps of its precision.  The
+#: single-valuedness law allows this many ulps (never less than the float64 tolerance ``RTOL``, so float64
+#: subjects are judged as before): 4 float32 ulps are ``4.8e-7``, where a random perturbation of 1e-6
+#: — a float32 solver with a random start — stays visible
+REPEAT_ULPS = 4
+
+
+def precision_name(dtype: Any) -> str | None:
+    """The precision of ``dtype`` (a NumPy, JAX, PyTorch or array-API dtype, or its name) as a key of
+    :data:`EPS_BY_PRECISION`: complex types by their real part; ``None`` for integers, booleans and what is
+    not a floating-point type (exact, or nothing a subject computes in)."""
+    if dtype is None:
+        return None
+    name = getattr(dtype, "name", None)
+    if not isinstance(name, str):
+        name = str(dtype)
+    name = name.rsplit(".", 1)[-1]                 # "torch.float32" -> "float32"
+    name = {"complex128": "float64", "complex64": "float32"}.get(name, name)
+    if name in EPS_BY_PRECISION:
+        return name
+    try:                                           # other floating types NumPy (or ml_dtypes) knows
+        eps = float(np.finfo(dtype).eps)
+    except (TypeError, ValueError):
+        return None
+    return min(EPS_BY_PRECISION, key=lambda p: abs(math.log(EPS_BY_PRECISION[p] / eps)))
+
+
+def coarser(*precisions: str | None) -> str:
+    """The coarsest of ``precisions`` (``None`` entries ignored; float64 when there is none)."""
+    out = "float64"
+    for p in precisions:
+        if p is not None and EPS_BY_PRECISION[p] > EPS_BY_PRECISION[out]:
+            out = p
+    return out
+
+
+def rtol_for(precision: str | None) -> float:
+    """The relative tolerance of a subject computing in ``precision`` (:data:`RTOL_BY_PRECISION`)."""
+    return RTOL_BY_PRECISION[precision or "float64"]
+
+
+@dataclasses.dataclass
+class Precision:
+    """The precision a law judges its subject at: the coarsest one observed (float64 until a coarser dtype
+    is seen), with its ``rtol`` and ``eps``."""
+
+    name: str = "float64"
+
+    def observe(self, precision: str | None) -> None:
+        self.name = coarser(self.name, precision)
+
+    @property
+    def rtol(self) -> float:
+        return RTOL_BY_PRECISION[self.name]
+
+    @property
+    def eps(self) -> float:
+        return EPS_BY_PRECISION[self.name]
+
+    def details(self) -> dict[str, Any]:
+        """What a record states about the precision it was judged at."""
+        return {"dtype": self.name, "rtol": self.rtol}
+
+    def note(self) -> str:
+        """A suffix for messages: empty for float64, else the precision and its tolerance."""
+        return "" if self.name == "float64" else f" (judged at {self.name} precision: rtol {self.rtol:.2g})"
+
+
+_JUDGED: contextvars.ContextVar[Precision | None] = contextvars.ContextVar("verimono_precision", default=None)
+
+
+@contextlib.contextmanager
+def judged_precision(initial: str | None = None) -> Iterator[Precision]:
+    """Judge what runs inside at the precision the subject is observed to compute in (starting from
+    ``initial``, float64 by default); yields the :class:`Precision`, which coarsens as :func:`observe` is
+    told of coarser dtypes.  Nested, the inner judgement reports to the outer one as well."""
+    outer = _JUDGED.get()
+    p = Precision(coarser(initial))
+    token = _JUDGED.set(p)
+    try:
+        yield p
+    finally:
+        _JUDGED.reset(token)
+        if outer is not None:
+            outer.observe(p.name)
+
+
+def observe(dtype: Any) -> None:
+    """Report that a subject returned (or was given) values of ``dtype``: the judgement in progress, if
+    any, coarsens to it.  Called by every conversion of a subject's values to float64."""
+    p = _JUDGED.get()
+    if p is not None:
+        name = precision_name(dtype)
+        if name is not None and name != "float64":
+            p.observe(name)
+
+
+def current_precision() -> Precision:
+    """The precision under judgement (float64 outside any)."""
+    p = _JUDGED.get()
+    return Precision() if p is None else p
+
+
+def current_rtol() -> float:
+    """The relative tolerance of the precision under judgement (``RTOL`` outside any)."""
+    p = _JUDGED.get()
+    return RTOL if p is None else p.rtol
+
+
+def current_eps() -> float:
+    """The unit roundoff of the precision under judgement (``EPS`` outside any)."""
+    p = _JUDGED.get()
+    return EPS if p is None else p.eps
+
+
+def tolerance(*scales: float, rtol: float | None = None) -> float:
+    """Tolerance for a comparison between quantities of size ``max(scales)``: ``rtol * (1 + max)``, with
+    ``rtol`` the precision's under judgement (``RTOL`` for float64 and outside any judgement)."""
+    if rtol is None:
+        rtol = current_rtol()
     m = 0.0
     for s in scales:
         a = float(np.max(np.abs(s))) if np.size(s) else 0.0
@@ -49,7 +215,7 @@ ACTIVE_SET_COND = 1e-3 * RTOL / EPS
 # -- trajectory laws and assumption evidence (verimono.checks.trajectory_laws / .assumptions) ----------
 
 
-def quotient_tolerance(h: float, *scales: float, rtol: float = RTOL) -> float:
+def quotient_tolerance(h: float, *scales: float, rtol: float | None = None) -> float:
     """Tolerance for a difference quotient ``(a - b)/h`` of quantities of size ``max(scales)``.
 
     Each of ``a``, ``b`` carries a relative error ``rtol``; dividing by the step ``h`` divides nothing
@@ -57,6 +223,32 @@ def quotient_tolerance(h: float, *scales: float, rtol: float = RTOL) -> float:
     ``(x_k - x_{k+1})/h_{k+1} ∈ F(t_{k+1}, x_{k+1})`` and for Yosida values ``(x - J_λ x)/λ``.
     """
     return tolerance(*scales, rtol=rtol) / float(h)
+
+
+#: the most steps a convergence study's run takes (the catalog's: K ≤ 1e4): its rounding floor
+ROUNDOFF_STEPS = 10_000
+
+
+def roundoff_floor(scale: float, precision: str | None = None) -> float:
+    """The error below which a ``K``-step run (``K ≤ ROUNDOFF_STEPS``) in ``precision`` may show nothing but
+    rounding, for states of size ``scale``: errors below it are not fitted by a convergence study.
+
+    float64: the worst case, ``K·eps·scale`` (``2.2e-12``) — far below every discretisation error studied,
+    so the pessimism costs nothing.  Coarser precisions: the worst case would swallow ordinary
+    discretisation errors (``1.2e-3`` in float32, where the catalog's studies reach ``3e-6``), so the floor
+    is the typical accumulation of independent roundings, ``sqrt(K)·eps·scale`` (float32: ``1.2e-5``; the
+    catalog's float32 runs of exact schemes stay below ``5e-8``)."""
+    p = precision or "float64"
+    k = ROUNDOFF_STEPS if p == "float64" else math.sqrt(ROUNDOFF_STEPS)
+    return k * EPS_BY_PRECISION[p] * float(scale)
+
+
+def repeat_tolerance(*scales: float) -> float:
+    """Tolerance of two calls of a subject at the same input (single-valuedness): ``REPEAT_ULPS`` ulps of
+    the precision under judgement times ``1 + max(scales)``, never less than the float64 :func:`tolerance`
+    (``RTOL``): repeatability, unlike an identity, does not degrade with the precision's rounding."""
+    t = tolerance(*scales, rtol=RTOL)
+    return max(t, REPEAT_ULPS * current_eps() * (t / RTOL))
 
 
 #: ``unique_limit`` assumes no rate (the paper gives none; ``c = 0.1 t^{-0.9}`` converges like ``h^{0.1}``):

@@ -21,7 +21,10 @@ else, once:
   record (:func:`run`), for one sample of a search, and for a stage of a run alike;
 * **the record** (:func:`record`) of an outcome: passed when its ratio is within its bound, failed with
   the counterexample otherwise, never passed on a non-finite ratio;
-* **the subject's name** (:func:`subject_name`), decided once whatever the status.
+* **the subject's name** (:func:`subject_name`), decided once whatever the status;
+* **the precision** a law judges its subject at (:func:`verimono.tolerances.judged_precision`): the
+  coarsest dtype the subject returned or was given while the law ran, stated in the record
+  (``details["dtype"]``, ``details["rtol"]``; a failure's message names a precision other than float64).
 """
 
 from __future__ import annotations
@@ -38,6 +41,7 @@ from ..naming import subject_name
 from ..errors import (InvalidCheckArgument, NotApplicable, StageUnavailable, UnitTimeout, UnverifiedSolution)
 from ..operators import provides
 from ..results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
+from ..tolerances import judged_precision
 
 SUBJECTS = ("operator", "stepper", "problem", "system", "estimator")
 
@@ -298,13 +302,18 @@ def run(decl: Law, subject: str, evaluate: Callable[[], Any], *, operator: Any =
     if why:
         rec = CheckResult(decl.name, subject, SKIPPED, message=why, seed=seed)
     else:
-        try:
-            out = evaluate()
-            rec = out if isinstance(out, CheckResult) else record(decl.name, subject, out, seed=seed)
-        except InvalidCheckArgument:
-            raise
-        except Exception as exc:  # noqa: BLE001 - the one policy decides what an exception means
-            rec = record_of_exception(decl.name, subject, exc, seed=seed)
+        with judged_precision() as precision:
+            try:
+                out = evaluate()
+                rec = out if isinstance(out, CheckResult) else record(decl.name, subject, out, seed=seed)
+            except InvalidCheckArgument:
+                raise
+            except Exception as exc:  # noqa: BLE001 - the one policy decides what an exception means
+                rec = record_of_exception(decl.name, subject, exc, seed=seed)
+        # the precision the subject was judged at, stated in every record it decided (tolerances.py)
+        rec.details.update(precision.details())
+        if rec.status == FAILED and precision.note():
+            rec.message += precision.note()
     rec.details.setdefault("label", decl.label)
     if rec.duration is None:
         rec.duration = time.perf_counter() - start

@@ -1,5 +1,8 @@
 """An operator's members as the laws evaluate them: every returned value checked to be a finite point of
-the input's shape, norms computed without underflow, points shortened for counterexamples."""
+the input's shape and converted to NumPy float64 for the laws' arithmetic — from any array library, its
+precision reported to the judgement in progress (:func:`verimono.arrays.as_float64`), so that a float32
+subject is judged at float32 precision — norms computed without underflow, points shortened for
+counterexamples."""
 
 from __future__ import annotations
 
@@ -8,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from ..arrays import as_float64
 from .samples import NUMPY_DIM
 
 
@@ -16,8 +20,9 @@ class _BadOutput(Exception):
 
 
 def point(value: Any, like: np.ndarray, member: str) -> np.ndarray:
-    """``value`` as a float array of ``like``'s shape with finite entries; ``_BadOutput`` otherwise."""
-    y = np.asarray(value, dtype=float)
+    """``value`` as a float64 array of ``like``'s shape with finite entries (its precision observed);
+    ``_BadOutput`` otherwise."""
+    y = as_float64(value)
     if y.shape != like.shape:
         raise _BadOutput(f"{member} returned shape {y.shape} for a point of shape {like.shape}")
     if not np.all(np.isfinite(y)):
@@ -37,7 +42,10 @@ def min_norm(op: Any, x: np.ndarray, t: float) -> np.ndarray:
 
 def value(op: Any, z: Any, t: float) -> float:
     """``g(t, z)`` of an operator ``F = ∂g`` that states ``g``."""
-    return float(op.value(np.array(z, dtype=float), t))
+    v = op.value(np.array(z, dtype=float), t)
+    if type(v) is not float:
+        v = as_float64(v)
+    return float(v)
 
 
 def norm(v: Any) -> float:

@@ -4,7 +4,9 @@ minimal section, each one decorated evaluator ``check_<law>(op, s) -> Outcome``.
 Every law is an inequality ``lhs ≤ rhs`` that holds exactly for a maximal monotone ``F(t,·)``; in
 floating point it is accepted when ``lhs ≤ rhs + slack``, with ``slack`` built from
 :func:`verimono.tolerances.tolerance` of the magnitudes involved (divided by ``λ`` where a Yosida value
-``(x - J_λ x)/λ`` amplifies the resolvent's error).  The recorded ratio of a sample is
+``(x - J_λ x)/λ`` amplifies the resolvent's error), at the relative tolerance of the precision the operator
+computes in (float64: ``RTOL = 1e-8``; float32: ``2.3e-4``; :data:`verimono.tolerances.RTOL_BY_PRECISION`),
+which the search detects from what the operator returns and records (``details["dtype"]``, ``["rtol"]``).  The recorded ratio of a sample is
 ``lhs / (rhs + slack)`` and every check's bound is 1: ratios near 1 mean "tight" (e.g.
 ``|J_λx - J_λy|² / ⟨J_λx - J_λy, x - y⟩`` for firm nonexpansiveness), and for laws with ``rhs = 0``
 (identities, membership) the ratio counts violations in units of the stated tolerance.
@@ -26,7 +28,7 @@ import math
 import numpy as np
 
 from ..errors import VerimonoError
-from ..tolerances import EPS, LIMIT_FLOOR, STALL_RATIO, STALL_WINDOW, tolerance
+from ..tolerances import LIMIT_FLOOR, STALL_RATIO, STALL_WINDOW, current_eps, repeat_tolerance, tolerance
 from .core import Member, Outcome
 from .members import listed, min_norm, norm, point, resolvent
 from .samples import Sample
@@ -57,12 +59,13 @@ def _domain_pair(op, s: Sample) -> tuple[np.ndarray, np.ndarray, float]:
 def check_resolvent_single_valued(op, s):
     """Proposition prop:maxmon-resolvent-Yosida i–ii:
     ``J_λ`` is defined on all of ``R^n`` and single-valued — two calls on the same ``x``
-    return the same finite point of shape ``(n,)`` and leave ``x`` unchanged (ratio: |difference|/tol)."""
+    return the same finite point of shape ``(n,)`` and leave ``x`` unchanged (ratio: |difference|/tol, the
+    tolerance of repeated calls: :func:`verimono.tolerances.repeat_tolerance`)."""
     x = s.x1.copy()
     a = point(op.resolvent(x, s.lam, s.t), s.x1, "resolvent")
     moved = norm(x - s.x1)
     b = resolvent(op, s.x1, s.lam, s.t)
-    tau = tolerance(s.x1, a, b)
+    tau = repeat_tolerance(s.x1, a, b)
     return Outcome.compare(norm(a - b) + (math.inf if moved > 0 else 0.0), 0.0, tau,
                  "|J_λx - J_λx| over two calls" + (f" (the call modified its input by {moved:.3g})" if moved else ""),
                  {"J_first": listed(a), "J_second": listed(b), "input_modified_by": moved})
@@ -247,7 +250,7 @@ def check_yosida_limit(op, s):
         return Outcome.compare(0.0, 0.0, slack, f"|Y_λx| → |F^0(t, x)|: F^0 jumps within {KINK_PROBE * lams[-1] * (1.0 + f0):.2g} "
                      "of x, where the gap closes only below the sweep's rounding floor λ = "
                      f"{lams[-1]:.3g} (sample inconclusive)", info, inconclusive=True)
-    if _closing_below_floor(gaps, 8 * EPS * (1.0 + float(np.max(np.abs(x)))) / lams[-1]):
+    if _closing_below_floor(gaps, 8 * current_eps() * (1.0 + float(np.max(np.abs(x)))) / lams[-1]):
         return Outcome.compare(0.0, 0.0, slack, "|Y_λx| → |F^0(t, x)|: the gap is still closing, ever faster, at the rounding "
                      "floor (a kink of F closer to x than λ|F^0| resolves; sample inconclusive)", info,
                      inconclusive=True)

@@ -27,6 +27,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ..arrays import as_float64
 from ..claims import claim_of
 from ..grids import graded_grid, random_grid, uniform_grid, validate_grid
 from ..problem import Problem
@@ -52,7 +53,7 @@ def single(problem: Problem) -> Problem:
 
 def run_stepper(stepper: Callable, problem: Problem, grid: np.ndarray) -> np.ndarray:
     """``stepper(problem, grid)`` as a float array of shape ``(K+1, n)``, finite (else ``ValueError``)."""
-    x = np.asarray(stepper(problem, grid), dtype=float)
+    x = as_float64(stepper(problem, grid))      # any array library; its precision is observed
     if x.shape != (len(grid),) + problem.x0.shape:
         raise ValueError(f"stepper {stepper_subject(stepper, problem).split(' on ')[0]} returned shape {x.shape}, "
                          f"expected {(len(grid),) + problem.x0.shape}")

@@ -27,7 +27,7 @@ import zlib
 
 import numpy as np
 
-from ..tolerances import RTOL, tolerance
+from ..tolerances import current_rtol, tolerance
 from .core import Member, Outcome
 from .members import norm as _nrm
 from .members import resolvent as _J
@@ -41,8 +41,9 @@ PERTURBATIONS = (1e-4, 1e-2, 1.0)
 
 
 def _tolf(*values: float) -> float:
-    """:func:`verimono.tolerances.tolerance` of scalars, in Python floats (called per perturbation)."""
-    return RTOL * (1.0 + max(abs(v) for v in values))
+    """:func:`verimono.tolerances.tolerance` of scalars, in Python floats (called per perturbation), at the
+    precision under judgement."""
+    return current_rtol() * (1.0 + max(abs(v) for v in values))
 
 
 _VALUE = Member("value")

@@ -48,6 +48,7 @@ from ..profiles import UnknownProfile, active_profile, get_profile
 from ..results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
 from ..timeouts import (HANG_MULTIPLE, TIME_BUDGET_REASON, current_budget, never_returned, note_progress,
                         time_limit)
+from .batches import prefetched
 from .core import REGISTRY, Law, Outcome, classify, law, run, subject_name
 from .samples import NUMPY_DIM, Sample, law_samples
 from .sweep import law_draws, shrink, sweep_count, sweep_samples
@@ -239,16 +240,18 @@ class _Search:
 
     def first_violation(self, samples: list[Sample]) -> tuple[Sample, Outcome] | None:
         """Evaluate ``samples`` in order; the first that breaks the law with its outcome (taken out of the
-        state, so that a later phase searches afresh), or ``None``."""
-        for s in samples:
-            try:
-                self.evaluate(s)
-            except _Violation:
-                found = (self.failing, self.failure)
-                self.failure = self.failing = None
-                return found
-            if self.unsupported is not None:
-                break
+        state, so that a later phase searches afresh), or ``None``.  A batched operator evaluates their
+        points in batched calls first (:func:`verimono.checks.batches.prefetched`)."""
+        with prefetched(self.op, samples):
+            for s in samples:
+                try:
+                    self.evaluate(s)
+                except _Violation:
+                    found = (self.failing, self.failure)
+                    self.failure = self.failing = None
+                    return found
+                if self.unsupported is not None:
+                    break
         return None
 
 

@@ -24,6 +24,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
+from ..arrays import as_float64
 from ..claims import claim_of
 from ..errors import NotApplicable, VerimonoError
 from ..grids import uniform_grid
@@ -79,9 +80,9 @@ def perturbed_starts(problem: Problem, seed: int = 0, scales: Sequence[float] = 
         z = x0 + s * scale * d / np.linalg.norm(d)
         if not problem.initial_jump:
             try:
-                z = np.asarray(op.project_domain(z, 0.0), dtype=float)
+                z = as_float64(op.project_domain(z, 0.0))
             except NotImplementedError:
-                z = np.asarray(op.resolvent(z, 1e-3 * problem.T, 0.0), dtype=float)
+                z = as_float64(op.resolvent(z, 1e-3 * problem.T, 0.0))
         if np.linalg.norm(z - x0) > tolerance(x0, z) * 10:
             out.append(z)
     return out
@@ -105,7 +106,7 @@ def run_starts(stepper: Callable, problem: Problem, starts: Sequence[np.ndarray]
     """
     if getattr(stepper, "batched", False) and starts:
         try:
-            xs = np.asarray(stepper(problem.replace(x0=np.stack([problem.x0, *starts])), grid), dtype=float)
+            xs = as_float64(stepper(problem.replace(x0=np.stack([problem.x0, *starts])), grid))
         except (VerimonoError, ArithmeticError, ValueError, TypeError, IndexError):
             xs = None
         if (xs is not None and xs.shape == (len(grid), len(starts) + 1) + problem.x0.shape
@@ -162,7 +163,7 @@ def domain_distances(stepper: Callable, p: Problem, t: np.ndarray) -> tuple[np.n
     x = run_stepper(stepper, p, t)
     d = np.zeros(len(t))
     for k in range(1 if p.initial_jump else 0, len(t)):
-        d[k] = float(np.linalg.norm(np.asarray(p.operator.project_domain(x[k], float(t[k])), dtype=float) - x[k]))
+        d[k] = float(np.linalg.norm(as_float64(p.operator.project_domain(x[k], float(t[k]))) - x[k]))
     return x, d
 
 
@@ -206,7 +207,7 @@ def check_in_domain(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int =
     x = run_stepper(stepper, p, t)
     ratios, dists = np.zeros(len(t)), np.zeros(len(t))
     for k in range(1 if p.initial_jump else 0, len(t)):
-        q = np.asarray(p.operator.project_domain(x[k], float(t[k])), dtype=float)
+        q = as_float64(p.operator.project_domain(x[k], float(t[k])))
         dists[k] = float(np.linalg.norm(q - x[k]))
         ratios[k] = dists[k] / tolerance(x[k], q)
     bad = np.flatnonzero(ratios > 1.0)
@@ -226,6 +227,10 @@ def check_selections(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int 
     """``y_{k+1} = (z_k - x_{k+1})/h_{k+1} ∈ F(t_{k+1}, x_{k+1})`` (``eq:iteration``), ``z_k = x_k + h f(x_k)
     + ∫u``: through ``operator.contains`` and through ``J_μ(x_{k+1} + μ y_{k+1}) = x_{k+1}`` at ``μ = h/2``.
 
+    A failure names the discrete velocity it tested with the terms the problem has (``f``, ``u``) and their
+    values, and says first when ``x_{k+1}`` lies outside ``cl dom F(t_{k+1},·)`` — where ``F`` is empty and no
+    velocity can be a selection.
+
     Tolerance: :func:`verimono.tolerances.quotient_tolerance` (a difference quotient divides the
     round-off of the states by ``h``).
 
@@ -242,7 +247,7 @@ def check_selections(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int 
     for k in range(len(h)):
         xk1, yk, tk1 = x[k + 1], y[k], float(t[k + 1])
         mu = 0.5 * h[k]
-        back = np.asarray(op.resolvent(xk1 + mu * yk, mu, tk1), dtype=float)
+        back = as_float64(op.resolvent(xk1 + mu * yk, mu, tk1))
         ratios[k] = float(np.linalg.norm(back - xk1)) / tolerance(xk1, mu * yk, x[k])
         if contains_available:
             try:
@@ -254,14 +259,49 @@ def check_selections(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int 
         worst = max(worst, 1.0 + float(np.sum(~member)))   # membership is boolean: count the misses
     bad = np.flatnonzero((ratios > 1.0) | ~member)
     k = int(bad[0]) if bad.size else int(np.argmax(ratios))
+    velocity, terms = _velocity(p, t, x, k)
     counter = {"k": k + 1, "t_k": t[k + 1], "x_k": x[k], "x_k_plus_1": x[k + 1], "h": h[k], "selection": y[k],
-               "contains": bool(member[k]), "resolvent_residual_ratio": ratios[k],
-               "message": f"y = (x_k - x_(k+1))/h = {np.array2string(y[k], precision=6)} is not in "
-                          f"F(t_(k+1), x_(k+1)) at k+1 = {k + 1}, t = {t[k + 1]:.6g} "
-                          f"(contains: {bool(member[k])}, |J(x + mu y) - x|/tol = {ratios[k]:.3g})"}
-    return Outcome(worst, k + 1, counter, {"contains_used": contains_available, "misses": int(np.sum(~member))},
-                   message="(x_k - x_(k+1))/h in F(t_(k+1), x_(k+1)) at every step"
+               "velocity": velocity, **terms,
+               "contains": bool(member[k]), "resolvent_residual_ratio": ratios[k]}
+    outside = _outside_domain(op, x[k + 1], float(t[k + 1])) if bad.size else None
+    msg = (f"the discrete velocity y = {velocity} = {np.array2string(y[k], precision=6)} is not in "
+           f"F(t_(k+1), x_(k+1)) at k+1 = {k + 1}, t = {t[k + 1]:.6g}"
+           + "".join(f", {name} = {np.array2string(v, precision=6)}" for name, v in terms.items())
+           + f" (contains: {bool(member[k])}, |J(x + mu y) - x|/tol = {ratios[k]:.3g})")
+    if outside is not None:     # the real cause first: no velocity is a selection outside dom F
+        counter["distance_to_domain"] = outside
+        msg = (f"x_(k+1) = {np.array2string(x[k + 1], precision=6)} lies outside cl dom F(t_(k+1), ·) (distance "
+               f"{outside:.3g}) at k+1 = {k + 1}, t = {t[k + 1]:.6g}, where F is empty; so " + msg)
+    counter["message"] = msg
+    return Outcome(worst, k + 1, counter, {"contains_used": contains_available, "misses": int(np.sum(~member)),
+                                           "velocity": velocity},
+                   message=f"the discrete velocity {velocity} in F(t_(k+1), x_(k+1)) at every step"
                            + ("" if contains_available else " (resolvent characterisation only: no contains)"))
+
+
+def _velocity(p: Problem, t: np.ndarray, x: np.ndarray, k: int) -> tuple[str, dict[str, np.ndarray]]:
+    """The discrete velocity ``selections`` tests, as a formula naming the terms this problem has
+    (``f``, ``u``), and those terms' values in cell ``k``."""
+    formula, terms = "(x_k", {}
+    if p.f is not None:
+        formula += " + h f(x_k)"
+        terms["f(x_k)"] = as_float64(p.f(x[k]))
+    dU = p.input_increments(t[k:k + 2])
+    if dU is not None:
+        formula += " + ∫u"
+        terms["∫u"] = np.asarray(dU[0], dtype=float)
+    return formula + " - x_(k+1))/h", terms
+
+
+def _outside_domain(op: Any, x: np.ndarray, t: float) -> float | None:
+    """The distance of ``x`` to ``cl dom F(t,·)`` when it is beyond the tolerance, else ``None`` (also when
+    the operator cannot project onto its domain)."""
+    try:
+        q = as_float64(op.project_domain(x, t))
+    except (NotImplementedError, VerimonoError, ArithmeticError, ValueError):
+        return None
+    d = float(np.linalg.norm(q - x))
+    return d if d > tolerance(x, q) else None
 
 
 __all__ = ["check_contraction", "check_in_domain", "check_selections", "domain_vanishing", "perturbed_starts",
