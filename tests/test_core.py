@@ -110,6 +110,19 @@ def test_thm_main_is_a_composite_law_over_the_assumption_records():
     assert out.status == "failed" and "assumption_LG" in out.message and "assumption_YB" in out.message
 
 
+def test_check_on_a_bare_resolvent_says_to_wrap_it_in_process(tmp_path, capsys):
+    """The in-process counterpart of the next test (a subprocess, tier ``slow``)."""
+    from verimono.cli import main
+
+    mod = tmp_path / "myprox_inproc.py"
+    mod.write_text("import numpy as np\ndef soft_threshold(x, lam, t=0.0):\n"
+                   "    return np.sign(x) * np.maximum(np.abs(x) - lam, 0.0)\n")
+    assert main(["check", f"{mod}:soft_threshold", "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert "operator_from_resolvent(soft_threshold" in err and "step size" in err
+
+
+@pytest.mark.slow
 def test_verimono_check_on_a_bare_resolvent_says_to_wrap_it(tmp_path):
     mod = tmp_path / "myprox.py"
     mod.write_text(textwrap.dedent("""

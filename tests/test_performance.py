@@ -52,6 +52,7 @@ def test_stage_records_names_and_statuses(monkeypatch):
     Report.from_dict(rep.to_dict())  # serialisable into results.json
 
 
+@pytest.mark.timing
 def test_a_slowed_stepper_fails_the_per_step_record():
     rec = performance.check_per_step("box", 3, steps=2000, rounds=3, stepper=slow_solve)
     assert rec.status == FAILED and rec.details["identical"]
@@ -59,6 +60,7 @@ def test_a_slowed_stepper_fails_the_per_step_record():
     assert "target ≤ 1.5x" in rec.message
 
 
+@pytest.mark.timing
 def test_a_slowed_operator_kernel_fails_the_per_step_record(monkeypatch):
     import verimono.stepping as stepping
 
@@ -77,6 +79,7 @@ def test_a_slowed_operator_kernel_fails_the_per_step_record(monkeypatch):
     assert rec.status == FAILED and rec.details["identical"], rec
 
 
+@pytest.mark.timing
 def test_a_lost_vectorisation_fails_the_ensemble_record():
     def row_by_row(problem, t):  # the batch solved one member at a time: right values, no speed-up
         if problem.x0.ndim == 1:
@@ -90,6 +93,23 @@ def test_a_lost_vectorisation_fails_the_ensemble_record():
     rec = performance.check_ensemble(op, "box", batch=100, steps=5, rounds=2, problem_kw=kw, stepper=row_by_row)
     assert rec.status == FAILED and rec.details["identical"]
     assert rec.details["ratio"] < 3 and rec.details["timing_ratio"] > 1 / 3
+
+
+def test_a_ratio_past_its_target_fails_the_record():
+    """The clock-free counterpart of the three timed tests above (tier ``timing``): the record's verdict from
+    given round times — a subject 3x its baseline fails a ≤ 1.5x target, 1.2x passes; a batch only 10x
+    faster fails a ≥ 30x speed-up target, 100x passes; the median of the rounds decides."""
+    per_step = performance.PER_STEP_TARGET
+    slow = performance.ratio_record("performance_per_step", "box n=3", [3.0, 2.9, 3.1], [1.0] * 3, target=per_step)
+    assert slow.status == FAILED and slow.details["ratio"] == pytest.approx(3.0) and slow.worst == pytest.approx(2.0)
+    assert "target ≤ 1.5x" in slow.message and slow.counterexample["ratio"] == pytest.approx(3.0)
+    ok = performance.ratio_record("performance_per_step", "box n=3", [1.2, 9.0, 1.1], [1.0] * 3, target=per_step)
+    assert ok.status == PASSED and ok.details["ratio"] == pytest.approx(1.2)       # one slow round: the median
+    ens = performance.ENSEMBLE_TARGET
+    lost = performance.ratio_record("performance_ensemble", "box B=100", [0.1] * 3, [1.0] * 3, target=ens, speedup=True)
+    assert lost.status == FAILED and lost.details["ratio"] == pytest.approx(10.0) and lost.worst == pytest.approx(3.0)
+    fast = performance.ratio_record("performance_ensemble", "box B=100", [0.01] * 3, [1.0] * 3, target=ens, speedup=True)
+    assert fast.status == PASSED and fast.details["timing_ratio"] == pytest.approx(0.01)
 
 
 def test_different_results_fail_the_record_without_raising():
@@ -147,6 +167,7 @@ def test_the_report_shows_the_measured_ratios():
     assert "No performance records" in render(Report())
 
 
+@pytest.mark.slow
 def test_the_memory_record_holds_in_a_fresh_process():
     """The study's peak is the study's, not the imports and caches of a process's first study: in a fresh
     process (as under ``--executor process:N``, whose workers ran the earlier stages, or ``--stage
@@ -162,6 +183,7 @@ def test_the_memory_record_holds_in_a_fresh_process():
     assert status == PASSED and ratio <= performance.MEMORY_TARGET, (status, ratio)
 
 
+@pytest.mark.slow
 def test_a_study_that_holds_whole_trajectories_fails_the_memory_record():
     """A stepper returning whole arrays (any user stepper: only verimono's own solve streams) makes the study
     hold a trajectory of every grid: the record must fail (2.3x measured), not pass on the coarse grids."""
@@ -170,6 +192,7 @@ def test_a_study_that_holds_whole_trajectories_fails_the_memory_record():
     assert rec.status == FAILED and rec.details["ratio"] > performance.MEMORY_TARGET, rec
 
 
+@pytest.mark.slow
 def test_on_worker_processes_the_memory_record_runs_beside_the_timed_ones(monkeypatch):
     """With an idle worker the memory record (bytes, not seconds) runs there while the timed records run
     here; the records, their order and the memory verdict are those of the serial stage."""
