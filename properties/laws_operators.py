@@ -19,7 +19,8 @@ from hypothesis import strategies as st
 
 from verimono import NormalCone, Shifted
 from verimono import strategies as vs
-from verimono.checks.operator_laws import LAWS, law_samples, operator_checks
+from verimono.checks.operator_battery import LAWS, operator_checks
+from verimono.checks.samples import law_samples
 from verimono.profiles import active_profile, get_profile
 from verimono.results import FAILED
 from verimono.testing import describe, parametrize_with_checks
@@ -109,10 +110,12 @@ def test_laws_on_generated_operators(family):
 def test_every_law_has_a_check_naming_its_paper_item():
     """Each law of the table has its own ``check_<law>`` in the registry, and that check's docstring names
     the paper item the law states (``Law.label``) — a law renamed, re-pointed or left undocumented fails."""
-    from verimono.checks import operator_laws
+    import importlib
+
+    from verimono.checks.operator_battery import OPERATOR_CHECKS
 
     for name, law in LAWS.items():
-        fn = getattr(operator_laws, f"check_{name}", None)
-        assert fn is not None and operator_laws.OPERATOR_CHECKS.get(name) is fn, name
+        fn = getattr(importlib.import_module(law.evaluate.__module__), f"check_{name}", None)
+        assert fn is not None and OPERATOR_CHECKS.get(name) is fn, name
         doc = " ".join((fn.__doc__ or "").split())
         assert law.label in doc, f"check_{name} does not name its paper item {law.label!r}"

@@ -188,7 +188,7 @@ def test_t_non_auto_YB_claim_is_false_for_a_shifted_operator():
     |Y^G_λ(s+λ, ξ)| = |Y^F_λ(λ)| = 1 for every λ — (YB) fails for every θ; the evidence grows like 1/λ.
     bounds_yb therefore skips problems with an input, and says why."""
     import verimono as vm
-    from verimono.checks.trajectory_laws import check_bounds_yb
+    from verimono.checks.bounds import check_bounds_yb
     from verimono.operators import Shifted
 
     F = vm.NormSubdifferential(1.0, dim=1)

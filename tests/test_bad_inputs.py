@@ -72,7 +72,7 @@ CASES = [
     ("examples<0", lambda: vm.check_operator(NSUB, examples=-3, seed=0), InvalidCheckArgument, "examples"),
     ("examples fractional", lambda: vm.check_operator(NSUB, examples=2.5, seed=0), InvalidCheckArgument,
      "examples"),
-    ("run_law examples=0", lambda: __import__("verimono.checks.operator_laws", fromlist=["x"]).run_law(
+    ("run_law examples=0", lambda: __import__("verimono.checks.search", fromlist=["x"]).run_law(
         "monotone", NSUB, examples=0, seed=0), InvalidCheckArgument, "examples"),
     ("horizon<0", lambda: vm.check_operator(NSUB, examples=2, seed=0, horizon=-1.0), InvalidCheckArgument,
      "horizon"),
@@ -245,7 +245,7 @@ def test_a_passed_record_with_nan_worst_is_failed():
 
 def test_examples_zero_is_refused_not_passed():
     """``check_operator(x ↦ 2x, examples=0)`` reported "9 passed"; with examples it fails."""
-    from verimono.checks import operator_laws as ol
+    from verimono.checks import search as ol
 
     rec = ol.run_law("monotone", NSUB, seed=0, examples=3)
     assert rec.status == "passed" and rec.details["evaluations"] > 0

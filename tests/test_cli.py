@@ -10,7 +10,7 @@ import textwrap
 import pytest
 
 from verimono.cli import main
-from verimono.report.schema import load
+from verimono.results import load
 
 REF = ["--reference", "moving box", "--reference", "t|x| (n=1)"]
 
@@ -170,7 +170,8 @@ def test_report_rerenders_from_results(good_check, tmp_path):
 def test_a_py_target_is_the_file_itself_not_a_module_of_the_same_name(tmp_path):
     """load_target("…/types.py:solve") imported the standard library's types (already in sys.modules), and
     a second lagged.py the first one: the file named is the module loaded."""
-    from verimono.cli import BadTarget, load_target
+    from verimono.errors import BadTarget
+    from verimono.targets import load_target
 
     (tmp_path / "types.py").write_text("def solve(problem, t):\n    return 'mine'\n")
     assert load_target(f"{tmp_path}/types.py:solve")(None, None) == "mine"
@@ -207,7 +208,8 @@ class _Stream:
 
 
 def test_progress_on_a_terminal_shows_units_and_the_current_subject(monkeypatch):
-    from verimono.cli import Progress, execute
+    from verimono.progress import Progress
+    from verimono.runs import execute
     from verimono.reference import get
     from verimono.stages import RunContext
 
@@ -228,7 +230,7 @@ def test_progress_on_a_terminal_shows_units_and_the_current_subject(monkeypatch)
 
 
 def test_progress_is_quiet_and_line_oriented_off_a_terminal_or_under_ci(monkeypatch):
-    from verimono.cli import Progress
+    from verimono.progress import Progress
 
     class Stage:
         name = "operator_laws"

@@ -13,9 +13,9 @@ import pytest
 import verimono as vm
 from verimono.checks import core
 from verimono.checks.assumptions import ASSUMPTION_LAWS, check_assumptions
-from verimono.checks.operator_laws import LAWS as OPERATOR_LAWS, ROOT_LAW
-from verimono.checks.prox_laws import VALUE_LAWS
-from verimono.checks.trajectory_laws import CHECKS, LAWS as STEPPER_LAWS
+from verimono.checks.operator_battery import LAWS as OPERATOR_LAWS
+from verimono.checks.search import ROOT_LAW
+from verimono.checks.stepper_battery import CHECKS, LAWS as STEPPER_LAWS
 from verimono.reference import get
 from verimono.results import CheckResult
 
@@ -39,16 +39,18 @@ def _declarations() -> dict[int, core.Law]:
 def test_every_law_is_declared_once_with_its_label_and_subject_kind():
     reg = core.REGISTRY
     assert set(OPERATOR_LAWS) == set(reg["operator"])
-    assert {name for name, _, _ in VALUE_LAWS} <= set(OPERATOR_LAWS) and ROOT_LAW in OPERATOR_LAWS
+    assert ROOT_LAW in OPERATOR_LAWS
     # declared once: a second declaration of a name replaces the first in the registry, leaving the first
     # function's declaration out of it
     declared = list(_declarations().values())
     assert declared and all(reg[d.subject].get(d.name) is d for d in declared), [d.name for d in declared]
-    assert set(STEPPER_LAWS) | {"convergence_order"} == set(reg["stepper"])
+    assert set(STEPPER_LAWS) | {"convergence_order"} == set(core.laws_of("stepper", battery=True))
     assert set(ASSUMPTION_LAWS) | {"assumptions_thm_main"} == set(reg["problem"])
     for kind, laws in reg.items():
         for name, decl in laws.items():
             assert decl.name == name and decl.subject == kind and decl.label, decl
+            # the decorator made the public check: the driver applied to the law, documented by the evaluator
+            assert decl.public.__name__ == f"check_{name}" and decl.public.law is decl and decl.doc
     assert list(CHECKS) == list(STEPPER_LAWS)
 
 
@@ -160,14 +162,34 @@ def test_verimono_check_on_a_bare_resolvent_says_to_wrap_it(tmp_path):
     assert "Traceback" not in out.stderr
 
 
-def test_assumption_records_go_through_the_one_outcome_and_fail_on_nan():
-    """The assumption laws build their records from the core's Outcome: a NaN ratio is a failure, not a
-    pass (``nan > 1`` is False, which the old comparison took for a pass)."""
-    from verimono.checks.assumptions import _verdict
+def test_a_nan_outcome_is_a_failed_record_never_a_pass():
+    """Every law's record is built from the core's Outcome: a NaN ratio is a failure, not a pass
+    (``nan > 1`` is False, which an old comparison took for a pass)."""
+    rec = core.record("assumption_A1", "p", core.Outcome(math.nan, message="held"))
+    assert rec.status == "failed"
+    assert core.record("assumption_A1", "p", core.Outcome(0.5, message="held")).status == "passed"
 
-    class S:
-        problem = get("t|x| (n=1)")
+def test_a_subject_has_one_name_whatever_the_status():
+    """A stepper whose ``__name__`` and ``name`` differ is named once (its ``name``), whether the law runs or
+    is skipped: the gate's key does not change with the status."""
+    def my_stepper(problem, t_grid):
+        return vm.solve(problem, t_grid).x
+    my_stepper.name = "My stepper"
+    p = get("moving box")
+    ran = CHECKS["in_domain"](my_stepper, p)                 # runs: the problem's operator projects
+    skipped = CHECKS["bounds_yb"](my_stepper, p)             # skipped: the problem states no θ
+    assert ran.status == "passed" and skipped.status == "skipped"
+    assert ran.subject == skipped.subject == "My stepper on moving box"
+    assert core.subject_name(vm.Stepper(my_stepper, name="S")) == "S"
+    assert core.subject_name(my_stepper) == "My stepper" and core.subject_name(lambda: 0) == "<lambda>"
 
-    rec = _verdict("assumption_A1", S, math.nan, None, {}, lambda c: "violated", "held")
-    assert rec.status == "failed" and "nan" in rec.message
-    assert _verdict("assumption_A1", S, 0.5, None, {}, lambda c: "violated", "held").status == "passed"
+
+def test_the_readme_shows_a_law_as_it_is_declared():
+    """README "How a check is built": its operator-law excerpt is the code of verimono/checks/operator_laws.py."""
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    readme = (root / "README.md").read_text(encoding="utf-8")
+    section = readme.split("## How a check is built", 1)[1]
+    excerpt = section.split("```py\n", 1)[1].split("```", 1)[0]
+    assert excerpt.strip() and excerpt in (root / "verimono" / "checks" / "operator_laws.py").read_text(encoding="utf-8")

@@ -8,7 +8,7 @@ import pytest
 
 from verimono.checks import check_stepper
 from verimono.gate import ERROR_GROWTH, TIMING_GROWTH, IncompatibleBaseline, compare, gate
-from verimono.report.schema import SchemaError
+from verimono.results import SchemaError
 from verimono.results import CheckResult, Report
 from verimono.stepping import solve
 

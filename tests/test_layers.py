@@ -19,6 +19,7 @@ from pathlib import Path
 
 import pytest
 
+
 REPO = Path(__file__).resolve().parent.parent
 
 
@@ -225,8 +226,16 @@ def test_import_graph_has_no_cycle():
         " → ".join(cycle_path(graph, c)) for c in found)
 
 
+def facades(repo: Path = REPO) -> set[str]:
+    """The packages' ``__init__`` modules: they re-export their package's names (some on first use)."""
+    return {m for m, path in module_files(package_roots(repo)).items() if path.name == "__init__.py"}
+
+
 def test_layers_have_no_cycle():
-    graph = layers(import_graph())
+    """Between subpackages; a facade's re-export of a name defined in another layer
+    (``verimono.lcs.check_hypotheses``, from :mod:`verimono.checks.section7`) is not an edge of its package."""
+    inner = facades()
+    graph = layers({m: set() if m in inner else targets for m, targets in import_graph().items()})
     found = cycles(graph)
     assert not found, "import cycles between subpackages (function-local imports count):\n" + "\n".join(
         " → ".join(cycle_path(graph, c)) for c in found)
@@ -257,7 +266,7 @@ def test_import_verimono_loads_only_the_core():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     loaded, names = out.splitlines()
     assert loaded == "", f"`import verimono` loads {loaded}"
-    assert names == "verimono.checks.trajectory_laws verimono.lcs verimono.strategies.partitions"
+    assert names == "verimono.checks.stepper_battery verimono.lcs verimono.strategies.partitions"
 
 
 # -- function-local imports: only for what is optional or heavy ---------------------------------------------
@@ -306,7 +315,7 @@ def misplaced_local_imports(repo: Path = REPO) -> list[str]:
     heavy = heavy_modules(repo)
     out = []
     for module, path in files.items():
-        if module in ENTRY_POINTS:
+        if module in ENTRY_POINTS or path.name == "__init__.py":   # a facade loads its names on first use
             continue
         for i in import_statements(module, path.read_text(encoding="utf-8"), known,
                                    is_package=path.name == "__init__.py"):
@@ -334,3 +343,62 @@ def test_function_local_imports_are_for_optional_or_heavy_modules():
     package is imported at the top (the entry points excepted: they load everything where it is used)."""
     found = misplaced_local_imports()
     assert not found, "function-local imports of light modules (import them at the top):\n" + "\n".join(found)
+
+
+# -- the order of the layers -----------------------------------------------------------------------------------
+
+#: the layers, bottom up: a module imports only from its own layer and the ones below it.  A module belongs to
+#: the first layer one of whose prefixes names it (``verimono.checks`` covers ``verimono.checks.core``, ...)
+LAYERS = (
+    ("foundations", ("verimono.errors", "verimono.tolerances", "verimono._jsonable", "verimono._params",
+                     "verimono._rows", "verimono._validate", "verimono._reproducible", "verimono.display", "verimono.environment",
+                     "verimono.atomic", "verimono.profiles", "verimono.naming")),
+    ("numerics", ("verimono.grids", "verimono.problem", "verimono.operators", "verimono._subgradients", "verimono.sets",
+                  "verimono.qp", "verimono.prox", "verimono.stepping", "verimono.claims", "verimono.convergence",
+                  "verimono.pseudo_distance", "verimono.lcs", "verimono.reference", "verimono.strategies",
+                  "verimono.manufactured", "verimono.data")),
+    ("records", ("verimono.schema", "verimono.results", "verimono.timeouts", "verimono.calibration",
+                 "verimono.timing")),
+    ("checks", ("verimono.checks", "verimono.performance")),
+    ("runs", ("verimono.executors", "verimono.stages", "verimono.runs", "verimono.gate", "verimono.report",
+              "verimono.progress")),
+    ("entry points", ("verimono.cli", "verimono.plugin", "verimono.testing", "verimono.targets",
+                      "verimono.properties", "verimono")),
+)
+
+
+def layer_of(module: str) -> int:
+    """The index of ``module``'s layer in :data:`LAYERS`."""
+    for i, (_, prefixes) in enumerate(LAYERS):   # "verimono" names the top package (the facade) only
+        if any(module == p or (p != "verimono" and module.startswith(p + ".")) for p in prefixes):
+            return i
+    raise KeyError(f"{module} is in no layer of LAYERS: add it where it belongs")
+
+
+def upward_imports(repo: Path = REPO) -> list[str]:
+    """Imports of a module of a higher layer (``where → target``).  A package's ``__init__`` only re-exports
+    (``verimono.lcs.check_hypotheses``): it is a facade of its package, outside the order (cycles still count)."""
+    files = module_files(package_roots(repo))
+    graph = import_graph(repo)
+    return sorted(f"{m} ({LAYERS[layer_of(m)][0]}) → {t} ({LAYERS[layer_of(t)][0]})"
+                  for m, targets in graph.items() if files[m].name != "__init__.py"
+                  for t in targets if layer_of(t) > layer_of(m))
+
+
+def test_the_layer_order_is_seen_failing(tmp_path):
+    (tmp_path / "pyproject.toml").write_text('[tool.setuptools.package-dir]\n"verimono" = "pkg"\n')
+    (tmp_path / "pkg").mkdir()
+    (tmp_path / "pkg" / "__init__.py").write_text("from .cli import main\n")
+    (tmp_path / "pkg" / "errors.py").write_text("def f():\n    from .results import R\n")
+    (tmp_path / "pkg" / "results.py").write_text("from .errors import f\n")
+    (tmp_path / "pkg" / "cli.py").write_text("from .results import R\n")
+    assert upward_imports(tmp_path) == ["verimono.errors (foundations) → verimono.results (records)"]
+    (tmp_path / "pkg" / "newcomer.py").write_text("from .errors import f\n")
+    with pytest.raises(KeyError, match="verimono.newcomer is in no layer"):
+        upward_imports(tmp_path)
+
+
+def test_every_module_imports_only_its_layer_and_the_ones_below():
+    """numerics, then records, then checks, then runs, then entry points (:data:`LAYERS`)."""
+    found = upward_imports()
+    assert not found, "imports against the layer order:\n" + "\n".join(found)

@@ -35,7 +35,7 @@ def test_explicit_alpha_bounds_every_solution_and_is_attained():
 def test_a_wrong_alpha_is_caught_with_its_counterexample(monkeypatch):
     """Seen failing: 1/λ_max instead of 1/λ_min (α = 1/4 here) is exceeded by a sampled q.  The old record
     had no α to check (it reported the sampled maximum as α)."""
-    from verimono.lcs import hypotheses
+    from verimono.checks import section7 as hypotheses
 
     monkeypatch.setattr(hypotheses, "lcp_alpha", alpha_min_max_slip)
     (r,) = check_hypotheses(_system(np.diag([1.0, 4.0])), 1.0).by_check("lcs.least_norm_growth")

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from verimono import solve, uniform_grid
+from verimono.checks import example as example_checks
 from verimono.lcs import check_hypotheses
 from verimono.pseudo_distance import pseudo_distance_lower_bound
 from verimono.reference import lcs_example as E
@@ -208,7 +209,8 @@ def test_least_norm_growth_fails_on_a_wrong_selection(monkeypatch, offset, law):
     """Adding an element of the recession direction (0, 1) of SOL(q, D) (q2 = 0) keeps a solution but not
     the least-norm one: in absolute units it breaks z*(sq) = s z*(q) (|z|/|q| ~ 1/s), proportional to |q|
     it is caught by the shorter solution.  Seen failing: the old record passed whatever solve_lcp returned."""
-    from verimono.lcs import hypotheses, solve_lcp
+    from verimono.checks import section7 as hypotheses
+    from verimono.lcs import solve_lcp
 
     def wrong(M, q, **kw):
         z = solve_lcp(M, q, **kw)
@@ -234,23 +236,21 @@ def test_pseudo_distance_tool_on_explicit_graph_points():
 
 def test_example_records_for_the_run_stage(monkeypatch):
     """The records `verimono run` shows: closed-form resolvent and unbounded pseudo-distance."""
-    from verimono.reference import lcs_example
-
-    assert lcs_example.check_closed_form_resolvent(samples=50).status == "passed"
-    rec = lcs_example.check_pseudo_distance_unbounded()
+    assert example_checks.check_closed_form_resolvent(samples=50).status == "passed"
+    rec = example_checks.check_pseudo_distance_unbounded()
     assert rec.status == "passed"
     assert all(b >= (r + 1) / 2 for r, b in zip(rec.details["rho"], rec.details["bound"]))
     # seen failing: a closed form with the wrong sign of v1 is caught with its counterexample
-    monkeypatch.setattr(lcs_example, "closed_form_resolvent",
+    monkeypatch.setattr(example_checks, "closed_form_resolvent",
                         lambda x, h, v1, v2: np.maximum(np.asarray(x, float) + h * max(v1, 0.0), -v2))
-    bad = lcs_example.check_closed_form_resolvent(samples=50)
+    bad = example_checks.check_closed_form_resolvent(samples=50)
     assert bad.status == "failed" and {"x", "h", "v"} <= set(bad.counterexample)
 
 
 def test_batched_scheme_record_passes_and_fails_on_an_unchecked_kernel(monkeypatch):
     """The Section 7 stage's batched record: 64 trajectories in one simulate equal the closed-form scheme; a
     batch kernel that accepts every guess unchecked (seen failing) breaks it."""
-    rec = E.check_batched_scheme()
+    rec = example_checks.check_batched_scheme()
     assert rec.status == "passed" and rec.worst <= 1.0
     from verimono.lcs import kernel as K
 
@@ -261,5 +261,5 @@ def test_batched_scheme_record_passes_and_fails_on_an_unchecked_kernel(monkeypat
         return Y, np.isfinite(Y).all(axis=0)
 
     monkeypatch.setattr(K.StepKernel, "_eval_T", unchecked)
-    bad = E.check_batched_scheme()
+    bad = example_checks.check_batched_scheme()
     assert bad.status == "failed" and bad.worst > 1e3 and {"row", "step"} <= set(bad.counterexample)

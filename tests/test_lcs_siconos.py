@@ -1,4 +1,4 @@
-"""Agreement with Siconos' EulerMoreauOSI(θ) references (../shared/siconos/CASES.md)."""
+"""Agreement with Siconos' EulerMoreauOSI(θ) references (verimono/data/siconos/CASES.md)."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from verimono.lcs import check_siconos, read_lcp, read_ref, siconos_cases
+from verimono.lcs.siconos import ref_path
 
 CASES = siconos_cases.CASES
 
@@ -43,8 +44,8 @@ def test_cap_filter_unique_multiplier_column(siconos_dir):
 
 
 def test_reference_reader(siconos_dir):
-    assert read_ref(siconos_dir / "refs" / "DiodeBridge.ref").shape == (5000, 8)
-    assert read_ref(siconos_dir / "refs" / "SimpleExampleRelay_py.ref").shape == (1001, 7)  # no header
+    assert read_ref(ref_path(siconos_dir, "DiodeBridge.ref")).shape == (5000, 8)
+    assert read_ref(ref_path(siconos_dir, "SimpleExampleRelay_py.ref")).shape == (1001, 7)  # no header
 
 
 def test_check_siconos_records_every_case_and_lcp_file(siconos_dir):

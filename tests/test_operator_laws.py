@@ -108,7 +108,8 @@ def test_yosida_limit_at_a_kink_reached_through_rounded_shifts():
     one-sample record is skipped, never passed — and a wrong λ must still fail."""
     import numpy as np
     import verimono as vm
-    from verimono.checks.operator_laws import Sample, check_yosida_limit
+    from verimono.checks.operator_laws import check_yosida_limit
+    from verimono.checks.samples import Sample
 
     op = vm.Shifted(vm.Shifted(vm.NormSubdifferential(1.0), [0.1]), [0.2])
     sample = Sample(np.zeros(1), np.zeros(1), 1.0, 1.0, 1.0, 0.0)
@@ -130,7 +131,8 @@ def test_yosida_limit_next_to_a_kink_closer_than_the_rounding_floor():
     there until λ passes the kink; it fails at a point away from kinks."""
     import numpy as np
     import verimono as vm
-    from verimono.checks.operator_laws import Sample, check_yosida_limit
+    from verimono.checks.operator_laws import check_yosida_limit
+    from verimono.checks.samples import Sample
 
     op = vm.Shifted(vm.L1Subdifferential(1.0, dim=2), lambda t: np.array([t, t]))
     s = Sample(np.array([1.0, 1e-8]), np.zeros(2), 1.0, 1.0, 1.0, 1.0)
@@ -150,7 +152,8 @@ def test_yosida_limit_where_min_norm_and_resolvent_round_a_kink_differently():
     is inconclusive; the same operator away from its kinks passes, and a wrong λ there fails."""
     import numpy as np
     import verimono as vm
-    from verimono.checks.operator_laws import Sample, check_yosida_limit
+    from verimono.checks.operator_laws import check_yosida_limit
+    from verimono.checks.samples import Sample
 
     c = np.array([2.0, 0.5])
     soft = lambda z, lam, t: np.sign(z) * np.maximum(np.abs(z) - lam * c, 0.0)          # noqa: E731
@@ -171,7 +174,8 @@ def test_laws_on_points_closer_than_the_square_root_of_the_smallest_double():
     random dev-profile run on LogBarrier, where J rounds to neighbouring doubles)."""
     import numpy as np
     import verimono as vm
-    from verimono.checks.operator_laws import Sample, check_yosida_monotone
+    from verimono.checks.operator_laws import check_yosida_monotone
+    from verimono.checks.samples import Sample
 
     s = Sample(np.zeros(1), np.array([-1.882470261721448e-250]), 0.5, 1.0, 1.0, 0.0)
     assert check_yosida_monotone(vm.LogBarrier(1.0), sample=s).status == "passed"
@@ -206,7 +210,8 @@ def _rejecting(contains_result=False):
 
 def test_min_norm_least_with_an_always_rejecting_contains_is_never_passed():
     """Every y0 is uncertified: each sample is inconclusive, counted, and the record is skipped, not passed."""
-    from verimono.checks.operator_laws import Sample, check_min_norm_least
+    from verimono.checks.operator_laws import check_min_norm_least
+    from verimono.checks.samples import Sample
 
     r = check_min_norm_least(_rejecting(), seed=0, examples=15)
     assert r.status == "skipped", str(r)
@@ -221,7 +226,8 @@ def test_min_norm_least_with_an_always_rejecting_contains_is_never_passed():
 def test_inconclusive_samples_of_yosida_limit_are_counted():
     """The rounding-kink sample of yosida_limit is inconclusive: alone it gives a skip; counted in details."""
     import verimono as vm
-    from verimono.checks.operator_laws import Sample, check_yosida_limit
+    from verimono.checks.operator_laws import check_yosida_limit
+    from verimono.checks.samples import Sample
 
     op = vm.Shifted(vm.Shifted(vm.NormSubdifferential(1.0), [0.1]), [0.2])
     r = check_yosida_limit(op, sample=Sample(np.zeros(1), np.zeros(1), 1.0, 1.0, 1.0, 0.0))
@@ -333,7 +339,7 @@ def test_a_limit_of_verimonos_own_solvers_is_undecided_never_failed_nor_passed()
 def test_a_law_sees_the_numpy_draws_then_a_short_hypothesis_search_then_the_sweep():
     """examples NumPy draws, then examples // HYPOTHESIS_SHARE hypothesis examples (at least HYPOTHESIS_MIN),
     then the scale sweep: every sample counted once in details["evaluations"]."""
-    from verimono.checks import operator_laws as L
+    from verimono.checks import search as L
     from verimono.reference import get
 
     op = get("t|x| (n=3)").operator
@@ -348,9 +354,9 @@ def test_a_violation_only_the_draws_meet_is_shrunk_and_replays(monkeypatch):
     the NumPy draws: recorded as theirs, shrunk greedily, and replayed by sample=."""
     from hypothesis import strategies as st
 
-    from verimono.checks import operator_laws as L
+    from verimono.checks import samples, search as L
 
-    harmless = st.just(L.Sample(np.zeros(2), np.zeros(2), 1.0, 1.0, 1.0, 0.0))
+    harmless = st.just(samples.Sample(np.zeros(2), np.zeros(2), 1.0, 1.0, 1.0, 0.0))
     monkeypatch.setattr(L, "law_samples", lambda n, horizon=1.0: harmless)
     monkeypatch.setattr(L, "_sweep", lambda *a, **k: 0)          # nor the sweep: only the draws can find it
     r = run_law("resolvent_nonexpansive", zoo.build("explicit_step"), seed=0, examples=20)
@@ -366,7 +372,7 @@ def test_law_draws_are_seeded_in_range_and_favour_simple_values():
     """The NumPy draws follow law_samples: x1 in [-10, 10]^n, x2 within 1e-2 of x1 about half the time, step
     sizes in [1e-3, 10] (the strategy's simple ones about half the time), t in [0, T]; the same seed draws
     the same samples, another seed others."""
-    from verimono.checks.operator_laws import Sample
+    from verimono.checks.samples import Sample
     from verimono.checks.sweep import law_draws
 
     a = law_draws(3, 5, 2.0, 400, Sample)

@@ -260,9 +260,9 @@ def test_catalog_subdifferentials_state_their_function_and_pass_the_value_laws()
     being skipped); a value off by a factor 2 is caught by every value law."""
     import numpy as np
     import verimono as vm
-    from verimono.checks.prox_laws import VALUE_LAWS
+    from verimono.checks.operator_battery import LAWS
 
-    names = {name for name, _, _ in VALUE_LAWS}
+    names = {name for name, decl in LAWS.items() if decl.evaluate.__module__ == "verimono.checks.prox_laws"}
     norm = vm.NormSubdifferential(lambda t: 1.0 + t, dim=3)
     l1 = vm.L1Subdifferential([1.0, 2.0, 0.5], dim=3)
     x = np.array([3.0, -4.0, 0.0])

@@ -45,6 +45,22 @@ def test_reference_catalog_imports_from_the_installed_wheel(wheel, tmp_path):
     assert out[0].startswith(str(tmp_path)) and int(out[1]) >= 12
 
 
+def test_wheel_ships_the_siconos_data_and_reads_them_from_a_bare_directory(wheel, tmp_path):
+    """The Siconos reference data are package data: every file of verimono/data/siconos is in the wheel, and
+    the installed package's check_siconos finds them with nothing beside it (29 records, all passing)."""
+    names = set(zipfile.ZipFile(wheel).namelist())
+    data = [f.relative_to(REPO).as_posix() for f in (REPO / "verimono" / "data" / "siconos").rglob("*") if f.is_file()]
+    assert len(data) == 33 and not set(data) - names, sorted(set(data) - names)
+    site = tmp_path / "site"
+    zipfile.ZipFile(wheel).extractall(site)
+    code = ("from verimono.lcs import check_siconos; from verimono.lcs.siconos import PACKAGED_DATA; "
+            "r = check_siconos(); print(PACKAGED_DATA); print(len(r), r.ok)")
+    env = {k: v for k, v in os.environ.items() if k != "VERIMONO_SHARED"} | {"PYTHONPATH": str(site)}
+    out = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, check=True,
+                         capture_output=True, text=True).stdout.split()
+    assert out == [str(site / "verimono" / "data"), "29", "True"]
+
+
 def quick_start_commands() -> list[str]:
     text = (REPO / "README.md").read_text()
     assert text.lstrip().startswith("#"), "README must start with a heading"

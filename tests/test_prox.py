@@ -12,9 +12,8 @@ import pytest
 import zoo_prox
 import verimono as vm
 from verimono.checks import LAWS, check_operator, run_law
-from verimono.checks.prox_laws import VALUE_LAWS
 
-VALUE = [name for name, _, _ in VALUE_LAWS]
+VALUE = [name for name, decl in LAWS.items() if decl.evaluate.__module__ == "verimono.checks.prox_laws"]
 #: laws that judge the operator through g: the value laws and yosida_in_graph (through the value-based contains)
 THROUGH_VALUE = set(VALUE) | {"yosida_in_graph"}
 SEEDS = range(20)

@@ -18,8 +18,8 @@ SCRIPT = textwrap.dedent('''
     if sys.argv[1] == "import":
         import user_constants          # an unrelated module of the user, full of numeric literals
     if sys.argv[2] == "unguarded":     # the mechanism verimono switches off, left on
-        import contextlib, verimono.checks.operator_laws as ol
-        ol.no_local_constants = contextlib.nullcontext
+        import contextlib, verimono.checks.search as search
+        search.no_local_constants = contextlib.nullcontext
     import verimono as vm
     soft = lambda x, lam: np.sign(x) * np.maximum(np.abs(x) - lam, 0.0)
     op = vm.operator_from_prox(soft, value=lambda x: float(np.abs(x).sum()), shape=2, name="soft")

@@ -1,5 +1,5 @@
 """The README's Python examples run as written: the "Verify your own solver" walk-through, the
-"How a check is built" example and the solver-core example (their assertions are the walk-through's claims)."""
+"Checking your own problem" example, the "How a check is built" example and the solver-core example (their assertions are the walk-through's claims)."""
 
 from __future__ import annotations
 
@@ -37,7 +37,8 @@ def _printed_as_claimed(args: tuple, claim: str) -> None:
     assert text == claim, f"README claims {claim!r}, the code prints {text!r}"
 
 
-@pytest.mark.parametrize("section", ["Verify your own solver", "How a check is built", "The solver core"])
+@pytest.mark.parametrize("section", ["Verify your own solver", "Checking your own problem", "How a check is built",
+                                     "The solver core"])
 def test_readme_examples_run(section):
     blocks = python_blocks(section)
     assert blocks

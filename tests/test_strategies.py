@@ -299,11 +299,11 @@ def test_shift_constants_are_needed():
     from verimono.sets import Box
 
     u = vs.ACInput("const", np.array([2.0]), np.zeros(1))
-    g = vs.Stated(Linear([[1.0]]), phi=vs._ZERO, sigma=vs._Const(1.0), theta=vs._ZERO).shifted(u)
+    g = vs.Stated(Linear([[1.0]]), phi=vs.ZERO, sigma=vs.Constant(1.0), theta=vs.ZERO).shifted(u)
     assert g.theta is None                                    # (YB) fails for shifts (see Stated.shifted)
     f0 = float(np.linalg.norm(g.operator.min_norm(np.zeros(1), 1.0)))
     assert 1.0 < f0 == 2.0 <= g.sigma(1.0)
-    n = vs.Stated(NormalCone(Box([0.0], [1.0])), phi=vs._ZERO, sigma=vs._ZERO, theta=vs._ZERO).shifted(u)
+    n = vs.Stated(NormalCone(Box([0.0], [1.0])), phi=vs.ZERO, sigma=vs.ZERO, theta=vs.ZERO).shifted(u)
     z = n.operator.project_domain(np.array([1.0]), 0.0)                                  # 1 ∈ dom G(0)
     d = float(np.linalg.norm(z - n.operator.project_domain(z, 0.25)))
     assert d == pytest.approx(0.5) and d <= n.phi(0.25) - n.phi(0.0) + 1e-12

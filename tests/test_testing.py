@@ -4,11 +4,12 @@ three-line user battery."""
 
 from __future__ import annotations
 
+import importlib
 import re
 
 import pytest
 
-from verimono.checks.trajectory_laws import LAWS
+from verimono.checks.stepper_battery import LAWS
 from verimono.reference import get
 from verimono.testing import check_id, checks_for
 
@@ -132,25 +133,29 @@ def test_dropping_a_law_from_the_registry_is_a_shrunk_battery(monkeypatch):
     import pytest
 
     from verimono import Linear
-    from verimono.checks import operator_laws, trajectory_laws
     from verimono.testing import parametrize_with_checks
+
+    # the modules parametrize_with_checks imports (sys.modules): pytester's in-process runs restore
+    # sys.modules afterwards, which can leave a stale submodule attribute on the verimono.checks package
+    operator_battery = importlib.import_module("verimono.checks.operator_battery")
+    stepper_battery = importlib.import_module("verimono.checks.stepper_battery")
     from zoo_steppers import amplifier
 
     ops = [Linear([[1.0]], name="a"), Linear([[2.0]], name="b")]
     parametrize_with_checks(ops)                                        # the full battery: fine
-    reduced = {k: v for k, v in operator_laws.OPERATOR_CHECKS.items() if k != "monotone"}
-    monkeypatch.setattr(operator_laws, "OPERATOR_CHECKS", reduced)
+    reduced = {k: v for k, v in operator_battery.LAWS.items() if k != "monotone"}
+    monkeypatch.setattr(operator_battery, "LAWS", reduced)
     with pytest.raises(ValueError, match="checks were lost"):
         parametrize_with_checks(ops)
     monkeypatch.undo()
 
     problems = [get("t|x| (n=1)")]
     parametrize_with_checks([amplifier], problems=problems)
-    full = trajectory_laws.stepper_checks
+    full = stepper_battery.stepper_checks
 
     def one_less(*args, **kw):
         return list(full(*args, **kw))[:-1]
-    monkeypatch.setattr(trajectory_laws, "stepper_checks", one_less)
+    monkeypatch.setattr(stepper_battery, "stepper_checks", one_less)
     with pytest.raises(ValueError, match="checks were lost"):
         parametrize_with_checks([amplifier], problems=problems)
 

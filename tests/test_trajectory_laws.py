@@ -10,8 +10,9 @@ import pytest
 from verimono import Problem, solve, uniform_grid
 from verimono.checks import check_stepper
 from verimono.checks.sample_problems import sample_problem
-from verimono.checks.trajectory_laws import (CHECKS, LAWS, LGBounds, YBBounds, check_bounds_lg, check_contraction,
-                                             check_in_domain, reproduce, stepper_checks)
+from verimono.checks.bounds import LGBounds, YBBounds, check_bounds_lg
+from verimono.checks.stepper_battery import CHECKS, LAWS, reproduce, stepper_checks
+from verimono.checks.trajectory_laws import check_contraction, check_in_domain
 from verimono.reference import catalog, get
 from verimono.results import FAILED, PASSED, SKIPPED
 
@@ -55,7 +56,7 @@ def test_unique_limit_refines_past_meshes_coarser_than_the_problem():
     so every partition of mesh 0.1 or 0.025 gives 0 from its first cell on: distances 0, 0, then c·h at
     K = 160, which is not 'approaching' until a finer level shows the distance falling."""
     from verimono import NormSubdifferential
-    from verimono.checks.trajectory_laws import check_unique_limit
+    from verimono.checks.limits import check_unique_limit
 
     p = Problem(NormSubdifferential(2.0, dim=1), [0.03125], 1.0, name="dies out at t = 1/64")
     rec = check_unique_limit(solve, p)
@@ -72,7 +73,7 @@ def test_unique_limit_assumes_no_rate():
     must halve per 16-fold refinement, an assumed rate 1/4) failed here; the Cauchy criterion with each
     sequence's own tail passes, while the error against the exact solution falls."""
     from verimono.reference.subdifferential import slow_rate
-    from verimono.checks.trajectory_laws import check_unique_limit
+    from verimono.checks.limits import check_unique_limit
     from verimono import uniform_grid as ug
 
     p = slow_rate()
@@ -247,7 +248,7 @@ def test_yb_bounds_skip_where_f0_overflows_at_the_edge_of_the_domain():
     bounds say nothing there and the laws are skipped with the reason (found by a dev-profile search,
     which saw bounds_yb fail with ψ = nan and psi_interpolation raise)."""
     import verimono as vm
-    from verimono.checks.trajectory_laws import check_bounds_yb, check_psi_interpolation
+    from verimono.checks.bounds import check_bounds_yb, check_psi_interpolation
 
     p = vm.Problem(vm.LogBarrier(1.0), [7e-304], 1.0, theta=lambda s: 0.0, name="c/x at the edge")
     for check in (check_bounds_yb, check_psi_interpolation):

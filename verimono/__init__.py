@@ -19,6 +19,7 @@ from .results import CheckResult, Report
 from .stepping import Trajectory, solve, stream
 from .pseudo_distance import pseudo_distance_lower_bound
 from .convergence import ConvergenceStudy, ErrorAccumulator, convergence_study
+from .manufactured import manufactured_problem
 from . import sets
 
 
@@ -62,5 +63,5 @@ __all__ = [
     "uniform_grid", "graded_grid", "random_grid", "refine", "validate_grid",
     "CheckResult", "Report", "pseudo_distance_lower_bound", "lcs", "strategies",
     "convergence_study", "ConvergenceStudy", "check_stepper", "check_operator", "operator_checks",
-    "check_assumptions",
+    "check_assumptions", "manufactured_problem",
 ]

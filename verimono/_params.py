@@ -6,7 +6,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ._kernels import real_array
+from ._validate import real_array
 from .errors import InvalidProblem
 
 

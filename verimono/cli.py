@@ -5,7 +5,8 @@
                  [--unit-timeout S]
         The whole verification (every registered stage, see ``verimono.stages``); writes DIR/results.json
         and DIR/report.html (DIR defaults to reports/).  Exit 0 when every check holds, 1 when one fails,
-        2 when nothing failed but a check was undecided (a limitation of the harness).
+        2 when nothing failed but a check was undecided (a limitation of the harness) — except a speed the machine
+        was too noisy to judge (a timing record undecided for "timing noise"), which exits 0 and says so.
         The output folder is checked writable before any work; both files are written atomically with one
         run id.  An interrupt (Ctrl-C, SIGTERM) writes the finished stages to a results file marked
         incomplete (the gate refuses it, exit 2) and exits 130; ``--resume`` runs the stages that file lacks
@@ -26,134 +27,21 @@ Exit status 2 always means "could not decide" (bad usage, unreadable input); it 
 from __future__ import annotations
 
 import argparse
-import importlib
-import inspect
 import os
-import shutil
 import sys
-import time
 from pathlib import Path
-from typing import Any, Callable, TextIO
+from typing import Any, Callable
 
 from .claims import SCHEMES, claim_of, with_claim
-from .errors import BadTarget, NothingToResume, VerimonoError
-from .profiles import PROFILES, active_profile, get_profile, load_hypothesis_profile
+from .errors import BadTarget, InvalidCheckArgument, NothingToResume, VerimonoError
+from .profiles import PROFILES, active_profile
+from .progress import Progress
 from .results import SKIPPED, Report
-
-EXIT_OK, EXIT_FAILED, EXIT_UNDECIDED = 0, 1, 2
-
-
-# -- progress ----------------------------------------------------------------------------------------
-
-
-class Progress:
-    """Progress of a run: on a terminal, one redrawn line (stage, units done / total within it, the
-    current subject); otherwise — output not a terminal, or ``$CI`` set — quiet and line-oriented: one
-    plain line per finished stage, and within a long stage at most one line every ``interval`` seconds."""
-
-    def __init__(self, stream: TextIO | None = None, enabled: bool | None = None, interval: float = 60.0) -> None:
-        self.stream = stream or sys.stderr
-        if enabled is None:
-            enabled = self.stream.isatty() and not _ci()
-        self.tty = enabled
-        self.stage, self.index, self.total = "", 0, 1
-        self.width = min(shutil.get_terminal_size((100, 20)).columns, 120)
-        self.interval = interval
-        self._last_line = time.monotonic()
-
-    def start(self, stage: Any, index: int, total: int) -> None:
-        self.stage, self.index, self.total = stage.name, index, total
-        self._last_line = time.monotonic()
-        self.within(0, 1, "")
-
-    def within(self, done: int, total: int, label: str) -> None:
-        if not self.tty:
-            now = time.monotonic()
-            if total and 0 < done < total and now - self._last_line >= self.interval:
-                self._last_line = now
-                self.stream.write(f"[{self.index + 1}/{self.total}] {self.stage}: {done}/{total} units done"
-                                  + (f", at {label}" if label else "") + "\n")
-                self.stream.flush()
-            return
-        frac = (self.index + (done / total if total else 1.0)) / self.total
-        bar_w = 24
-        fill = int(round(frac * bar_w))
-        text = (f"\r[{'#' * fill}{'-' * (bar_w - fill)}] {frac * 100:3.0f}%  stage {self.index + 1}/{self.total} "
-                f"{self.stage}  {done}/{total} units  {label}")
-        self.stream.write(text[: self.width - 1].ljust(self.width - 1))
-        self.stream.flush()
-
-    def done(self, stage: Any, report: Report, info: dict) -> None:
-        line = (f"[{self.index + 1}/{self.total}] {stage.name}: {info['status']} — "
-                f"{info['records']} records, {info['duration']:.1f} s"
-                + (f" ({info['message']})" if info["status"] in ("skipped", "error") else f" ({report.summary()})"))
-        if self.tty:
-            self.stream.write("\r" + " " * (self.width - 1) + "\r")
-        self.stream.write(line + "\n")
-        self.stream.flush()
-
-
-def _ci() -> bool:
-    """``$CI`` set (non-empty, not ``0``/``false``/``no``), as CI services do."""
-    ci = os.environ.get("CI", "").strip().lower()
-    return bool(ci) and ci not in ("0", "false", "no")
+from .runs import (EXIT_FAILED, EXIT_OK, EXIT_UNDECIDED, execute, exit_status, interruptible, merge_resumed)
+from .targets import load_target
 
 
 # -- running -----------------------------------------------------------------------------------------
-
-
-def execute(*, command: str, profile_name: str, stages: list[str] | None, context: Any, target: str | None = None,
-            progress: Progress | None = None, executor: Any = None, unit_timeout: float | None = None,
-            on_done: Callable | None = None) -> Report:
-    """Run ``stages`` with ``context`` under a profile and return the merged, fully annotated report.
-
-    ``executor`` (``"process:N"``, a dask scheduler address or ``Client``; ``None``: serial) is where the
-    stages' independent units run (:mod:`verimono.executors`); ``unit_timeout`` bounds each unit there.
-    ``on_done(stage, report, info)`` is called after each stage (the interrupt handler keeps them)."""
-    from .executors import make_runner
-    from .report.schema import environment
-    from .stages import calibrate, run_stages
-
-    profile = get_profile(profile_name)
-    load_hypothesis_profile(profile_name)
-    progress = progress or Progress(enabled=False)
-    context.progress = progress.within
-    runner = make_runner(executor, timeout=unit_timeout)
-    if executor is not None and context.executor is None:
-        print(f"verimono: units run on {runner.spec}", file=sys.stderr)
-    context.executor = context.executor if context.executor is not None else runner
-    cal = calibrate()                 # on a quiet machine, before any worker starts
-    if hasattr(runner, "prestart"):   # the workers import while this process builds the catalog
-        runner.prestart()
-    if getattr(runner, "workers", 1) >= 2:   # this process waits on the workers: draw the report's first
-        import threading                     # figure meanwhile (matplotlib's import and font cache)
-
-        from .report.plots import warm_up
-        threading.Thread(target=warm_up, name="verimono-report-warm-up", daemon=True).start()
-    start = time.perf_counter()
-    def done(stage, rep, info):
-        progress.done(stage, rep, info)
-        if on_done is not None:
-            on_done(stage, rep, info)
-
-    try:
-        report = run_stages(stages, profile, context, on_start=progress.start, on_done=done)
-    finally:
-        runner.close()
-    duration = time.perf_counter() - start
-    # once more at the end: one calibration (best of 3 x 0.1 s) samples one moment of a shared machine and
-    # read 0.08-0.16 s here within an hour; noise only slows a workload down, so the faster of the two ends
-    # (best of 6) is the steadier unit, in the baseline and in the run gated against it alike
-    cals = [cal, calibrate()]
-    selection = {"stages": stages, "references": None if context.problems is None else
-                 [p.name for p in context.problems]}
-    report.meta.update({"command": command, "target": target, "profile": profile_name, "seed": context.seed,
-                        "selection": selection, "executor": getattr(runner, "spec", type(runner).__name__),
-                        "calibrations": cals,
-                        "calibration": min(cals), "duration": duration,
-                        "data_dir": None if context.data_dir is None else str(context.data_dir),
-                        "environment": environment()})
-    return report
 
 
 def _context(args: argparse.Namespace, **kw: Any) -> Any:
@@ -181,15 +69,19 @@ def _executor_options(args: argparse.Namespace) -> dict[str, Any]:
 
 def _baseline_for(args: argparse.Namespace) -> Report | None:
     """The baseline to show changes against: ``--baseline`` (must load) or reports/baseline.json if present."""
-    from .report.schema import load
+    from .results import load
 
     path = getattr(args, "baseline", None)
     if path:
-        return load(path)
+        baseline = load(path)
+        baseline.source = str(path)   # named in the `verimono gate` command _finish suggests
+        return baseline
     default = Path("reports/baseline.json")
     if default.is_file():
         try:
-            return load(default)
+            baseline = load(default)
+            baseline.source = str(default)
+            return baseline
         except VerimonoError as exc:
             print(f"verimono: ignoring {default}: {exc}", file=sys.stderr)
     return None
@@ -223,16 +115,6 @@ def order_table(report: Report) -> list[str]:
     return [fmt.format(*head)] + [fmt.format(*r) for r in rows]
 
 
-def _exit_status(report: Report) -> int:
-    """1 when a check failed; else 2 when one was undecided (nothing failed, but not everything was
-    verified: a limitation of the harness is never a pass); else 0."""
-    if report.failures:
-        return EXIT_FAILED
-    if report.undecided or report.meta.get("incomplete"):
-        return EXIT_UNDECIDED
-    return EXIT_OK
-
-
 def _finish(report: Report, out: Path, baseline: Report | None) -> int:
     from .report import write
 
@@ -243,66 +125,26 @@ def _finish(report: Report, out: Path, baseline: Report | None) -> int:
     for r in report.failures:
         print(f"  {r}")
     line = f"verimono: {report.summary()}"
+    from .timing import is_noise_undecided
+
+    noisy = [r for r in report.undecided if is_noise_undecided(r)]
+    if noisy:
+        line += (f"; speed could not be judged here: {len(noisy)} timing record{'s' if len(noisy) != 1 else ''} "
+                 "undecided, the machine too noisy (not a failure)")
     if changes is not None:
+        for ln in changes.regression_lines(getattr(baseline, "source", None), paths["json"]):
+            print(ln)
         line += f"; against the baseline: {changes.summary()}"
     print(line)
     print(f"verimono: wrote {paths['html']} and {paths['json']}")
     for r in report.undecided:
         print(f"  {r}")
-    return _exit_status(report)
-
-
-#: exit status of an interrupted run (the shell's convention for SIGINT)
-EXIT_INTERRUPTED = 130
-
-
-def _interruptible(run: Callable[[Callable], Report], out: Path, *, command: str, profile: str,
-                   stages: list[str] | None, previous: Report | None = None) -> Report | int:
-    """``run(on_done)`` with SIGTERM treated as an interrupt; on an interrupt write the stages finished so
-    far (with ``previous``'s, when resuming) to ``out`` marked ``incomplete`` and return the exit status."""
-    import signal
-
-    finished: list[tuple[Report, dict]] = []
-
-    def on_done(stage, rep, info):
-        finished.append((rep, info))
-
-    def term(signum, frame):
-        raise KeyboardInterrupt(f"signal {signum}")
-
-    old = signal.signal(signal.SIGTERM, term) if _main_thread() else None
-    try:
-        return run(on_done)
-    except KeyboardInterrupt:
-        partial = previous if previous is not None else Report(meta={"stages": []})
-        for rep, info in finished:
-            partial.extend(rep)
-            partial.meta.setdefault("stages", []).append(info)
-        done = [s["name"] for s in partial.meta.get("stages") or []]
-        partial.meta.update({"command": command, "profile": profile, "incomplete": True,
-                             "finished_stages": done,
-                             "selection": partial.meta.get("selection") or {"stages": stages, "references": None}})
-        from .report import write
-
-        paths = write(partial, out)
-        print(f"\nverimono: interrupted; the {len(done)} finished stage(s) ({', '.join(done) or 'none'}) are in "
-              f"{paths['json']}, marked incomplete; continue with `verimono {command} --resume`",
-              file=sys.stderr)
-        return EXIT_INTERRUPTED
-    finally:
-        if old is not None:
-            signal.signal(signal.SIGTERM, old)
-
-
-def _main_thread() -> bool:
-    import threading
-
-    return threading.current_thread() is threading.main_thread()
+    return exit_status(report)
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
     from .atomic import ensure_writable_dir
-    from .report.schema import load
+    from .results import load
     from .timeouts import budget
 
     out = ensure_writable_dir(args.out)           # before any work: a run must not be lost at the end
@@ -329,113 +171,30 @@ def _cmd_run(args: argparse.Namespace) -> int:
             return execute(command="run", profile_name=args.profile, stages=stages, context=_context(args),
                            progress=Progress(), on_done=on_done, **_executor_options(args))
 
-    report = _interruptible(run, out, command="run", profile=args.profile, stages=args.stage, previous=previous)
+    report = interruptible(run, out, command="run", profile=args.profile, stages=args.stage, previous=previous)
     if isinstance(report, int):
         return report
     if previous is not None:
-        report = _merge_resumed(previous, report)
+        report = merge_resumed(previous, report)
     return _finish(report, out, baseline)
 
 
-def _merge_resumed(previous: Report, rest: Report) -> Report:
-    """The interrupted run's finished stages followed by the resumed ones: one complete report."""
-    merged = Report(meta=dict(rest.meta))
-    merged.extend(previous)
-    merged.extend(rest)
-    merged.meta["stages"] = list(previous.meta.get("stages") or []) + list(rest.meta.get("stages") or [])
-    merged.meta["selection"] = previous.meta.get("selection")
-    merged.meta["resumed"] = True
-    for key in ("incomplete", "finished_stages"):
-        merged.meta.pop(key, None)
-    return merged
-
-
-def _load_file(path: Path) -> Any:
-    """The module in the file ``path`` itself — not whatever module of the same name is importable (a
-    ``types.py`` or a second ``lagged.py`` elsewhere); its folder is put on ``sys.path`` for its own
-    imports of neighbouring modules."""
-    import importlib.util
-
-    path = path.resolve()
-    if not path.is_file():
-        raise BadTarget(f"{path} does not exist")
-    name = f"verimono_target_{abs(hash(str(path))):x}_{path.stem}"
-    spec = importlib.util.spec_from_file_location(name, path)
-    if spec is None or spec.loader is None:
-        raise BadTarget(f"cannot load {path} as a Python module")
-    module = importlib.util.module_from_spec(spec)
-    if str(path.parent) not in sys.path:
-        sys.path.insert(0, str(path.parent))
-    sys.modules[name] = module           # dataclasses, pickling and relative lookups need it registered
-    try:
-        spec.loader.exec_module(module)
-    except Exception as exc:
-        sys.modules.pop(name, None)
-        raise BadTarget(f"cannot import {path}: {type(exc).__name__}: {exc}") from None
-    return module
-
-
-def load_target(spec: str) -> Any:
-    """Import ``MODULE:OBJECT`` (``MODULE`` may be a dotted name or a ``.py`` path; ``OBJECT`` dotted)."""
-    module_name, sep, attr = spec.partition(":")
-    if not sep or not module_name or not attr:
-        raise BadTarget(f"expected MODULE:OBJECT (e.g. mypackage.solvers:my_stepper), got {spec!r}")
-    if module_name.endswith(".py"):
-        obj: Any = _load_file(Path(module_name))
-    else:
-        if "" not in sys.path and os.getcwd() not in sys.path:
-            sys.path.insert(0, os.getcwd())
-        try:
-            obj = importlib.import_module(module_name)
-        except ImportError as exc:
-            raise BadTarget(f"cannot import {module_name!r}: {exc}") from None
-    for part in attr.split("."):
-        try:
-            obj = getattr(obj, part)
-        except AttributeError:
-            raise BadTarget(f"{module_name!r} has no attribute {attr!r}") from None
-    return obj
-
-
-#: second-parameter names that mark a callable as a resolvent ``J(x, lam, t)``, not a stepper ``(problem, t_grid)``
-_STEP_NAMES = {"lam", "lamb", "lmbda", "lambda_", "lmb", "gamma", "tau", "step", "h", "mu", "alpha", "rho", "eta"}
-
-
-def _looks_like_resolvent(fn: Any) -> str | None:
-    """Why ``fn`` looks like a resolvent or prox ``f(x, lam[, t])`` rather than a stepper, or ``None``."""
-    try:
-        params = [p for p in inspect.signature(fn).parameters.values()
-                  if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
-    except (TypeError, ValueError):
-        return None
-    if len(params) >= 2 and params[1].name.lower() in _STEP_NAMES:
-        names = ", ".join(p.name for p in params)
-        return (f"looks like a resolvent or proximal operator ({names}), not a stepper(problem, t_grid): its "
-                f"second parameter {params[1].name!r} is a step size")
-    return None
-
-
-def attr_of(spec: str) -> str:
-    return spec.partition(":")[2] or spec
-
-
 def _cmd_check(args: argparse.Namespace) -> int:
+    from .checks.subjects import kind_of
+
     obj = load_target(args.target)
-    if hasattr(obj, "resolvent") and hasattr(obj, "dim") and not isinstance(obj, type):
+    try:
+        kind = kind_of(obj)
+    except InvalidCheckArgument as exc:
+        raise BadTarget(f"{args.target}: {exc}") from None
+    if kind == "operator":
         stages, ctx = ["operator_laws"], _context(args, operators=[(args.target, obj)])
-        kind = "operator"
-    elif callable(obj) and not isinstance(obj, type):
-        hint = _looks_like_resolvent(obj)
-        if hint:
-            raise BadTarget(f"{args.target} {hint}: wrap it as an operator, e.g. in your module "
-                            f"`my_op = verimono.operator_from_resolvent({attr_of(args.target)}, dim=n)`, and check "
-                            f"MODULE:my_op")
-        obj = with_claim(obj, args.scheme, args.order)
+    elif kind == "stepper":
+        obj = with_claim(obj, args.scheme, args.order, solve_tol=args.solve_tol)
         stages, ctx = ["convergence", "trajectory_laws"], _context(args, stepper=obj)
         kind = "stepper" + ("" if claim_of(obj).proximal else f" claiming {claim_of(obj).describe()}")
     else:
-        raise BadTarget(f"{args.target} is neither an operator (with .dim and .resolvent) nor a stepper "
-                        "callable(problem, t_grid)")
+        raise BadTarget(f"{args.target} is a problem: `verimono check` takes an operator or a stepper")
     from .atomic import ensure_writable_dir
     from .timeouts import budget
 
@@ -451,7 +210,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
             return execute(command="check", profile_name=args.profile, stages=stages, context=ctx,
                            target=args.target, progress=Progress(), on_done=on_done, **_executor_options(args))
 
-    report = _interruptible(run, out, command="check", profile=args.profile, stages=stages)
+    report = interruptible(run, out, command="check", profile=args.profile, stages=stages)
     if isinstance(report, int):
         return report
     report.meta.setdefault("target", args.target)
@@ -465,7 +224,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
 
 def _cmd_baseline(args: argparse.Namespace) -> int:
     from .atomic import ensure_writable_file
-    from .report.schema import load
+    from .results import load
 
     ensure_writable_file(args.out)                # before any work
     if args.from_results:
@@ -507,7 +266,7 @@ def _cmd_gate(args: argparse.Namespace) -> int:
 
 def _cmd_report(args: argparse.Namespace) -> int:
     from .report.html import render
-    from .report.schema import load
+    from .results import load
 
     report = load(args.results)
     changes = _changes(load(args.baseline), report) if args.baseline else None
@@ -532,7 +291,7 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--stage", action="append", choices=list(STAGES), metavar="NAME",
                        help="run only this stage (repeatable); stages: " + ", ".join(STAGES))
         p.add_argument("--seed", type=int, default=None, help="seed for the randomized batteries")
-        p.add_argument("--data", default=None, help="shared data folder (Siconos references); default ../shared")
+        p.add_argument("--data", default=None, help="Siconos data (DIR/siconos/{refs,lcp}); default: the packaged data")
         p.add_argument("--reference", action="append", metavar="NAME",
                        help="use only this analytic reference (repeatable; default: the whole catalog)")
         p.add_argument("--timeout", type=float, default=None, metavar="S",
@@ -566,6 +325,9 @@ def build_parser() -> argparse.ArgumentParser:
                             "for a bare callable) or 'any' (it only converges with --order)")
     check.add_argument("--order", type=float, default=None,
                        help="the convergence order a --scheme any stepper claims (default 1)")
+    check.add_argument("--solve-tol", type=float, default=None, metavar="TAU",
+                       help="the accuracy of the stepper's inner solve per step (relative to 1 + |x|): errors at "
+                            "what it accumulates pass as exact to it")
     check.set_defaults(func=_cmd_check, stage=None)
 
     base = sub.add_parser("baseline", help="record the current results as the gate's baseline")

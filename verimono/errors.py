@@ -3,7 +3,7 @@
 Every error verimono raises because of what it was given derives from :class:`VerimonoError`, so a
 caller can catch one class.  Messages say what was wrong and what was expected.  Every public exception
 class of the package is defined here (the bottom layer, importing nothing), and re-exported where it is
-used (``verimono.stages.StageUnavailable``, ``verimono.report.schema.SchemaError``, ...).
+used (``verimono.stages.StageUnavailable``, ``verimono.schema.SchemaError``, ...).
 """
 
 from __future__ import annotations

@@ -27,10 +27,10 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ._kernels import (_INF, _TINY, _mx, _norm, _sqrt, bad_lam, bad_param, batch_column, check_lam, dot_rows,
-                       real_array)
 from ._params import as_param
-from ._values import checked_value, subgradient_contains
+from ._rows import _INF, _TINY, _mx, _norm, _sqrt, dot_rows
+from ._subgradients import checked_value, subgradient_contains
+from ._validate import bad_lam, bad_param, batch_column, check_lam, real_array
 from .errors import InvalidProblem, NotMonotone, OutsideDomain
 from .tolerances import tolerance
 
@@ -44,6 +44,8 @@ class Operator:
 
     #: True when ``F(t,·)`` does not depend on ``t``.
     static: bool = False
+    #: True when ``dom F(t,·) = R^n`` for every ``t`` (so (A3) holds with ``φ ≡ 0``).
+    full_domain: bool = False
 
     def __init__(self, dim: int, name: str | None = None) -> None:
         if int(dim) != dim or dim < 1:
@@ -79,6 +81,10 @@ class Operator:
         """``g(t, x)`` when ``F(t,·) = ∂g(t,·)`` is a subdifferential and ``g`` is known (``+inf`` outside
         ``dom g``); enables the value laws of :mod:`verimono.checks.prox_laws`."""
         raise NotImplementedError(f"{self.name} does not provide the function value g")
+
+    def growth(self, t: float = 0.0) -> float:
+        """``σ(t)`` of (LG) known from the operator itself: ``|F^0(t, x)| ≤ σ(t)(1 + |x|)`` on ``dom F(t,·)``."""
+        raise NotImplementedError(f"{self.name} does not state the growth σ of (LG)")
 
     def provides(self, member: str) -> bool:
         """Whether this operator provides ``member`` (``"min_norm"``, ``"project_domain"``, ``"contains"``, ``"value"``):
@@ -169,7 +175,7 @@ def _check_dim(op: Operator, x: np.ndarray) -> np.ndarray:
     return x
 
 
-def _provides(op: Any, member: str) -> bool:
+def provides(op: Any, member: str) -> bool:
     """``op.provides(member)`` for operators that say, else whether ``op`` has the member at all."""
     says = getattr(op, "provides", None)
     return bool(says(member)) if callable(says) else callable(getattr(op, member, None))
@@ -248,7 +254,17 @@ def operator_from_resolvent(resolvent: Callable[[np.ndarray, float, float], Any]
     return _FromResolvent(resolvent, dim, min_norm, project_domain, contains, name, value)
 
 
-class Linear(Operator):
+class _EverywhereDefined(Operator):
+    """An operator defined on all of ``R^n`` at every ``t`` (``dom F(t,·) = R^n``): (A3) holds with ``φ ≡ 0``,
+    and the projection onto the domain is the identity."""
+
+    full_domain = True
+
+    def project_domain(self, x, t=0.0):
+        return np.array(x, dtype=float)
+
+
+class Linear(_EverywhereDefined):
     """``F(t, x) = M(t) x`` with ``M + Mᵀ ⪰ 0`` (``M`` need not be symmetric).
 
     Monotone because ``⟨M(x-y), x-y⟩ ≥ 0``; continuous and everywhere defined, hence maximal.
@@ -322,8 +338,9 @@ class Linear(Operator):
     def min_norm(self, x, t=0.0):
         return real_array(x) @ (self._M(t) if self.static else self._M_at(t)).T
 
-    def project_domain(self, x, t=0.0):
-        return np.array(x, dtype=float)
+    def growth(self, t=0.0):
+        """``|M(t)x| ≤ ‖M(t)‖₂ |x|``."""
+        return float(np.linalg.norm(self._M(t) if self.static else self._M_at(t), 2))
 
     def contains(self, x, y, t=0.0, tol=None):
         Mx = self.min_norm(x, t)
@@ -346,7 +363,7 @@ def _nonnegative(value: np.ndarray, what: str) -> None:
                           "a negative weight makes the operator non-monotone")
 
 
-class NormSubdifferential(Operator):
+class NormSubdifferential(_EverywhereDefined):
     """``F(t, ·) = ∂(c(t)‖·‖₂)``: ``F(t, x) = c x/|x|`` for ``x ≠ 0`` and the ball ``c B`` at 0.
 
     The paper's example ``g(t, x) = t|x|`` is ``c(t) = t``.  ``J_λ x = max(1 - λc/|x|, 0) x``
@@ -414,8 +431,9 @@ class NormSubdifferential(Operator):
         # 0 where |x| is 0 or underflows (x·x < tiny): F^0(0) = 0; the max only avoids a 0/0 warning
         return np.where(nrm > 0.0, self._col(t, x) * x / _mx(nrm, _TINY), 0.0)
 
-    def project_domain(self, x, t=0.0):
-        return np.array(x, dtype=float)
+    def growth(self, t=0.0):
+        """``|F^0(t, x)| ≤ c(t)`` for every ``x``."""
+        return float(np.linalg.norm(self.min_norm(np.ones(self.dim), t)))
 
     def contains(self, x, y, t=0.0, tol=None):
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
@@ -427,7 +445,7 @@ class NormSubdifferential(Operator):
         return bool(nx > 0.0 and np.linalg.norm(y - c * x / nx) <= tol)
 
 
-class L1Subdifferential(Operator):
+class L1Subdifferential(_EverywhereDefined):
     """``F(t, ·) = ∂(Σ_i c_i(t)|x_i|)`` (``c`` a scalar or a vector of weights).
 
     Componentwise: ``c_i sgn(x_i)`` for ``x_i ≠ 0`` and ``[-c_i, c_i]`` at 0;
@@ -480,8 +498,9 @@ class L1Subdifferential(Operator):
         x = real_array(x)
         return np.sign(x) * _weight_at(self._c, t, self.name, "c(t)")
 
-    def project_domain(self, x, t=0.0):
-        return np.array(x, dtype=float)
+    def growth(self, t=0.0):
+        """``|F^0(t, x)| ≤ |c(t)|`` (Euclidean norm of the weights) for every ``x``."""
+        return float(np.linalg.norm(self.min_norm(np.ones(self.dim), t)))
 
     def contains(self, x, y, t=0.0, tol=None):
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
@@ -503,6 +522,10 @@ class NormalCone(Operator):
         super().__init__(S.dim, name or f"NormalCone({getattr(S, 'name', type(S).__name__)})")
         self.S = S
         self.static = getattr(S, "static", False)
+
+    def growth(self, t=0.0):
+        """``F^0 = 0`` on the domain of a normal cone."""
+        return 0.0
 
     def resolvent(self, x, lam, t=0.0):
         check_lam(lam, f"{self.name}.resolvent")  # J_λ = proj for every λ > 0, and only for those
@@ -585,7 +608,7 @@ class Shifted(Operator):
         return step
 
     def provides(self, member):
-        return Operator.provides(self, member) and _provides(self.F, member)
+        return Operator.provides(self, member) and provides(self.F, member)
 
     def min_norm(self, x, t=0.0):
         return self.F.min_norm(np.asarray(x, dtype=float) + self._Phi(t), t)
@@ -676,6 +699,7 @@ class LogBarrier(Operator):
 
 __all__ = [
     "Operator",
+    "provides",
     "operator_from_resolvent",
     "Linear",
     "NormSubdifferential",

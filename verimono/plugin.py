@@ -75,7 +75,7 @@ def pytest_configure(config: pytest.Config) -> None:
     baseline = None
     if baseline_path:
         from .gate import check_baseline
-        from .report.schema import SchemaError, load
+        from .results import SchemaError, load
 
         try:
             baseline = load(baseline_path)
@@ -175,13 +175,14 @@ class _Collector:
 
     def _receive(self, report: pytest.TestReport) -> None:
         """Records of a test that ran elsewhere (an xdist worker), carried by its call report."""
-        from .results import _record_from_dict, _study_from_dict, to_jsonable
+        from .results import CheckResult, to_jsonable
+        from .schema import record_fields, study_from_dict
 
         data = json.loads(getattr(report, self.ATTR))
         self.nodeid = report.nodeid
         try:
-            self.add(Report([_record_from_dict(d, i) for i, d in enumerate(data["results"])],
-                            [_study_from_dict(s, i) for i, s in enumerate(data["studies"])],
+            self.add(Report([CheckResult(**record_fields(d, i)) for i, d in enumerate(data["results"])],
+                            [study_from_dict(s, i) for i, s in enumerate(data["studies"])],
                             trajectories=to_jsonable(data["trajectories"])))
         finally:
             self.nodeid = None
@@ -227,7 +228,7 @@ class _Collector:
     def pytest_sessionfinish(self, session: pytest.Session, exitstatus: int) -> None:
         if self.worker:
             return
-        from .report.schema import environment
+        from .environment import environment
 
         self._in_collection_order()
         if self.hidden and session.exitstatus == pytest.ExitCode.OK:
@@ -235,7 +236,7 @@ class _Collector:
         self.report.meta.update({"duration": time.perf_counter() - self.start, "environment": environment()})
         if self.baseline is not None:
             from .gate import check_runs_compatible, compare
-            from .report.schema import SchemaError
+            from .results import SchemaError
 
             try:
                 check_runs_compatible(self.baseline, self.report)

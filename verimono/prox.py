@@ -21,7 +21,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ._values import (CONTAINS_POINTS, ProxOutputError, checked_value, contains_points,  # noqa: F401 - re-exported
+from ._subgradients import (CONTAINS_POINTS, ProxOutputError, checked_value, contains_points,  # noqa: F401 - re-exported
                       subgradient_contains)
 from .errors import InvalidProblem
 from .operators import Operator

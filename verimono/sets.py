@@ -22,8 +22,8 @@ from typing import Any, Callable
 import numpy as np
 
 from ._params import as_param
-from ._kernels import (_INF, _TINY, _mn, _mx, _sqrt, bad_lam, bad_param, batch_column, dot_rows, finite_point,
-                       real_array)
+from ._rows import _INF, _TINY, _mn, _mx, _sqrt, dot_rows
+from ._validate import bad_lam, bad_param, batch_column, finite_point, real_array
 from .errors import InvalidProblem
 from .tolerances import tolerance
 
@@ -160,7 +160,7 @@ class Ball(ConvexSet):
             d = x - c
             nrm = _sqrt(d.dot(d))
             r = float(rfn(t))
-            if not r >= 0.0:         # also nan; a radius crossing 0 used to divide by zero
+            if not r >= 0.0:         # also nan: a radius crossing 0 would divide by zero
                 raise bad_param(name, "radius(t)", r, t, "must be >= 0 (the ball is empty)")
             if nrm > r:
                 return c + d * (r / nrm)

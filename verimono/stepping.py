@@ -22,7 +22,7 @@ from typing import Any, Callable, Iterator
 
 import numpy as np
 
-from ._kernels import real_array
+from ._validate import real_array
 from .claims import Claim
 from .errors import InvalidProblem, SolverFailure
 from .grids import validate_grid

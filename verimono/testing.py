@@ -15,12 +15,12 @@ One pytest case per (subject, check), with stable readable ids ``<subject>-<chec
 is a function of the subject yielding ``(name, check)`` pairs with ``check(subject) -> CheckResult``
 (or a :class:`~verimono.results.Report`):
 
-* operators (anything with ``.resolvent`` and ``.dim``): ``verimono.checks.operator_laws.operator_checks(op)``,
+* operators (anything with ``.resolvent`` and ``.dim``): ``verimono.checks.operator_battery.operator_checks(op)``,
   the generator of :func:`verimono.check_operator`;
 * problems (:class:`verimono.Problem`): ``verimono.checks.assumptions.problem_checks(problem)``, the
   records of :func:`verimono.check_assumptions` (evidence for (A1)–(A3), (LG), (YB) and ``thm:main``);
 * steppers (any other callable ``stepper(problem, t_grid)``; a :class:`verimono.Stepper` states its claim):
-  ``verimono.checks.trajectory_laws.stepper_checks(stepper)``, the generator of
+  ``verimono.checks.stepper_battery.stepper_checks(stepper)``, the generator of
   :func:`verimono.check_stepper` (convergence orders on the references, trajectory laws on the references
   and on seeded sample problems).
 
@@ -50,9 +50,11 @@ from typing import Any, Callable, Iterable, Mapping
 
 import pytest
 
+from .checks.core import laws_of
+from .checks.core import subject_name as core_subject_name
+from .checks.subjects import kind_of
 from .profiles import active_profile
 from .profiles import load_hypothesis_profile as _load
-from .problem import Problem
 from .profiles import register_hypothesis_profiles as _register
 from .results import FAILED, SKIPPED, UNDECIDED, CheckResult, Report, to_jsonable
 
@@ -79,19 +81,9 @@ def load_hypothesis_profile(name: str | None = None) -> str:
 
 # -- subjects and their checks ----------------------------------------------------------------------
 
-def is_operator(subject: Any) -> bool:
-    """Operators are known through their resolvent: anything with ``.resolvent`` and ``.dim``."""
-    return hasattr(subject, "resolvent") and hasattr(subject, "dim")
-
-
-def is_problem(subject: Any) -> bool:
-    """Problems (:class:`verimono.Problem`) get the battery of assumption evidence."""
-    return isinstance(subject, Problem)
-
-
 def subject_name(subject: Any) -> str:
-    return (getattr(subject, "name", None) if is_operator(subject) or is_problem(subject) else None) or \
-        getattr(subject, "__name__", None) or getattr(subject, "name", None) or type(subject).__name__
+    """The subject's name, the one every record of it carries (:func:`verimono.checks.core.subject_name`)."""
+    return core_subject_name(subject)
 
 
 def _slug(text: str) -> str:
@@ -107,37 +99,31 @@ def check_id(name: str) -> str:
 
 def checks_for(subject: Any, *, seed: int | None = None, examples: int | None = None,
                problems: Iterable | None = None, generated: int = 4) -> list[tuple[str, Callable]]:
-    """The ``(name, check)`` pairs of ``subject`` from its module's generator (see the module docstring)."""
-    if is_operator(subject):
-        from .checks.operator_laws import operator_checks
+    """The ``(name, check)`` pairs of ``subject`` from its kind's battery (see the module docstring); what is
+    not a subject is refused (:class:`verimono.InvalidCheckArgument`, naming the wrapper that makes one)."""
+    kind = kind_of(subject)
+    if kind == "operator":
+        from .checks.operator_battery import operator_checks
 
         return list(operator_checks(subject, seed=seed, examples=examples))
-    if is_problem(subject):
+    if kind == "problem":
         from .checks.assumptions import problem_checks
 
         return list(problem_checks(subject, seed=0 if seed is None else seed))
-    if callable(subject):
-        from .checks.trajectory_laws import stepper_checks
+    from .checks.stepper_battery import stepper_checks
 
-        return list(stepper_checks(subject, problems, seed=0 if seed is None else seed, generated=generated))
-    raise TypeError(f"{subject!r} is neither an operator (with .resolvent and .dim) nor a stepper "
-                    "(a callable stepper(problem, t_grid))")
+    return list(stepper_checks(subject, problems, seed=0 if seed is None else seed, generated=generated))
 
 
 def registry_size(subject: Any, *, problems: Iterable | None = None, generated: int = 4) -> int:
-    """How many checks the full registry gives ``subject`` — counted from the law tables, not from the
-    generator, so that a generator or registry that lost a law shows as a shrunk battery:
-    ``len(operator_laws.LAWS)`` for an operator; for a stepper ``(1 + len(trajectory_laws.CHECKS))`` per
-    reference (``problems``, or the reference catalog) plus ``len(CHECKS)`` per generated problem."""
-    if is_operator(subject):
-        from .checks.operator_laws import LAWS
-
-        return len(LAWS)
-    if is_problem(subject):
-        from .checks.core import laws_of
-
-        return len(laws_of("problem"))
-    from .checks.trajectory_laws import CHECKS
+    """How many checks the full registry gives ``subject`` — counted from the registry, not from the
+    generator, so that a generator or registry that lost a law shows as a shrunk battery: the operator laws
+    for an operator, the problem laws for a problem; for a stepper ``(1 + len(CHECKS))`` per reference
+    (``problems``, or the reference catalog) plus ``len(CHECKS)`` per generated problem."""
+    kind = kind_of(subject)
+    if kind in ("operator", "problem"):
+        return len(laws_of(kind, battery=True))
+    from .checks.stepper_battery import CHECKS
 
     if problems is not None:
         return len(list(problems)) * (1 + len(CHECKS))
@@ -350,6 +336,6 @@ def battery_counts(config: Any) -> dict[str, int] | None:
     return None if plugin is None else plugin.counts()
 
 
-__all__ = ["parametrize_with_checks", "checks_for", "BoundCheck", "describe", "check_id", "is_operator",
-           "subject_name", "is_problem", "registry_size", "register_hypothesis_profiles", "load_hypothesis_profile", "battery_counts",
+__all__ = ["parametrize_with_checks", "checks_for", "BoundCheck", "describe", "check_id",
+           "subject_name", "registry_size", "register_hypothesis_profiles", "load_hypothesis_profile", "battery_counts",
            "BatteryCounter", "pytest_configure"]

@@ -41,16 +41,17 @@ say so); ``failed`` means a sample contradicts it (or the stated function) or th
 
 from __future__ import annotations
 
-import time
 from typing import Any, Callable
 
 import numpy as np
 
-from ..errors import OutsideDomain, VerimonoError
+from ..errors import OutsideDomain
 from ..operators import resolvent_rows
 from ..problem import Problem
 from ..results import FAILED, PASSED, SKIPPED, XFAIL, CheckResult, Report
-from .core import Outcome, law as _declare, laws_of, record, run as _run
+from .search import valid_seed
+from .core import Outcome, law, laws_of, run, subject_name
+from .subjects import require_problem
 from ..tolerances import GROWTH_FLAG, RTOL, STALL_RATIO, STALL_WINDOW, quotient_tolerance, tolerance
 from .jumps import find_jumps, jump_time
 
@@ -69,10 +70,6 @@ A2_TAIL_SAFETY = 2.0
 A2_LAMBDAS = (1e-1,)
 #: step sizes λ (relative to T) used to reach points of dom F(t,·) ever closer to its boundary
 LAMBDAS = (1.0, 1e-1, 1e-2, 1e-3)
-
-
-def _subject(problem: Problem) -> str:
-    return f"{problem.name}"
 
 
 class _Samples:
@@ -100,18 +97,36 @@ def _min_norm(op, z, t):
         return None
 
 
-def _verdict(name: str, S: _Samples, worst: float, counter: dict | None, details: dict,
-             failed: Callable[[dict], str], passed: str) -> CheckResult:
-    """The record of a sampled ratio ``worst`` against the bound 1 (the core's one :class:`Outcome`): failed,
-    with ``failed(counter)`` as the message and ``counter`` as the counterexample, when a sample exceeds it
-    or the ratio is not a number."""
-    outcome = Outcome(float(worst), counter=dict(counter or {}), details=details)
-    return record(name, _subject(S.problem), outcome, passed=passed,
-                  failed=(failed(counter) if counter else f"{name}: the sampled ratio is {worst}")
-                  if outcome.failed else None)
+def _sampled(name: str, worst: float, counter: dict | None, details: dict, failed: Callable[[dict], str],
+             passed: str) -> Outcome:
+    """The outcome of a sampled ratio ``worst`` against the bound 1: ``failed(counter)`` is the message when
+    a sample exceeds it (or the ratio is not a number), ``passed`` otherwise."""
+    out = Outcome(float(worst), counter=dict(counter or {}), details=details, message=passed)
+    if out.failed:
+        out.counter["message"] = failed(counter) if counter else f"{name}: the sampled ratio is {worst}"
+    return out
 
 
-def _a1(S: _Samples) -> CheckResult:
+def _growth(growth: float, evidence: dict, details: dict, failed: str, passed: str) -> Outcome:
+    """The evidence-from-growth outcome of (LG) and (YB) without a stated function: a sampled ratio growing
+    more than ``GROWTH_FLAG``-fold as ``λ`` shrinks 1000-fold is evidence the bound fails."""
+    if growth > GROWTH_FLAG:
+        return Outcome(growth, bound=GROWTH_FLAG, counter={**evidence, "message": failed}, details=details)
+    return Outcome(None, status=PASSED, details=details, message=passed)
+
+
+def run_assumption(decl: Any, problem: Problem, *, seed: int = 0, points: int = 12, times: int = 7) -> CheckResult:
+    """An assumption's law on ``problem``: its evaluator on the samples of ``seed`` (``points`` points around
+    ``x0``, ``times`` times in ``[0, T]``)."""
+    require_problem(problem)
+    samples = _Samples(problem, seed, points, times)
+    return run(decl, subject_name(problem), lambda: decl.evaluate(samples), problem=problem, seed=seed)
+
+
+@law("assumption_A1", "(A1)", subject="problem", driver=run_assumption)
+def check_assumption_A1(S: _Samples) -> Outcome:
+    """(A1): monotonicity ``⟨z1 - z2, y1 - y2⟩ ≥ 0`` on sampled graph pairs of ``F(t,·)`` (resolvent pairs
+    ``(J_λ p, Y_λ p)`` and ``(z, F^0(z))``).  A violation disproves (A1)."""
     worst, counter, pairs = -np.inf, None, 0
     for t in S.times:
         Z, Y, P = [], [], []
@@ -139,7 +154,7 @@ def _a1(S: _Samples) -> CheckResult:
         if ratio[m] > worst:
             worst = float(ratio[m])
             counter = {"t": t, "z1": Z[i[m]], "y1": Y[i[m]], "z2": Z[j[m]], "y2": Y[j[m]], "inner": inner[m]}
-    return _verdict("assumption_A1", S, max(worst, 0.0), counter, {"evidence": EVIDENCE, "pairs": pairs},
+    return _sampled("assumption_A1", max(worst, 0.0), counter, {"evidence": EVIDENCE, "pairs": pairs},
                     lambda c: f"<z1 - z2, y1 - y2> = {c['inner']:.3g} < 0 for graph points of F(t = {c['t']:.4g})",
                     f"no non-monotone pair among {pairs} sampled graph pairs ({EVIDENCE})")
 
@@ -181,7 +196,11 @@ def _right_limit(S: _Samples, t: float, lam: float, P: np.ndarray | None = None)
     return worst, counter, sequences, unsettled
 
 
-def _a2(S: _Samples) -> CheckResult:
+@law("assumption_A2", "(A2)", subject="problem", driver=run_assumption)
+def check_assumption_A2(S: _Samples) -> Outcome:
+    """(A2): outer semicontinuity from the right of ``t ↦ graph F(t,·)``: a settled right limit
+    ``lim J_λ(t+δ) p`` equals ``J_λ(t) p`` at the sampled times and at every jump of ``t ↦ J_λ(t) p`` found
+    between them (module docstring)."""
     """Right limits at the sampled times, then at every jump of ``t ↦ J_λ(t) p`` found between them
     (:func:`verimono.checks.jumps.find_jumps`): a jump bracketed by adjacent floats ``a < b`` happens at
     :func:`~verimono.checks.jumps.jump_time`; if that is ``a`` (``J_λ(a) p`` is the left value, the right
@@ -211,8 +230,8 @@ def _a2(S: _Samples) -> CheckResult:
             if w > worst:
                 worst, counter = w, dict(c, found_by="jump search", jump=j.size, bracket=[j.a, j.b])
         found.append(entry)
-    return _verdict(
-        "assumption_A2", S, worst, counter,
+    return _sampled(
+        "assumption_A2", worst, counter,
         {"evidence": EVIDENCE, "sequences": sequences, "unsettled": unsettled, "jumps": found,
          "jump_search": searched},
         lambda c: (f"J_λ(t+δ) p → {np.array2string(c['limit'], precision=4)} as δ ↓ 0 but J_λ(t) p = "
@@ -226,7 +245,11 @@ def _a2(S: _Samples) -> CheckResult:
         f"left value at its time; {EVIDENCE})")
 
 
-def _a3(S: _Samples) -> CheckResult:
+@law("assumption_A3", "(A3)", subject="problem", driver=run_assumption)
+def check_assumption_A3(S: _Samples) -> Outcome:
+    """(A3): ``sup_{z ∈ dom F(s)} dist(z, dom F(t)) ≤ φ(t) - φ(s)``: the least nondecreasing ``φ̂`` of the
+    sampled domain motion, compared with a stated ``φ``; a jump of the domain fails it (φ must be absolutely
+    continuous)."""
     op, ts = S.op, S.times
     n = len(ts)
     D = np.zeros((n, n))
@@ -246,15 +269,14 @@ def _a3(S: _Samples) -> CheckResult:
                "stated": S.problem.phi is not None}
     jump = _a3_jump(S, details)
     if jump is not None:
-        return CheckResult("assumption_A3", _subject(S.problem), FAILED, worst=jump["worst"], bound=1.0,
-                           details=details, counterexample=jump,
-                           message=f"dom F jumps at t ≈ {jump['t']!r}: sup_z dist(z, dom F(b)) over z ∈ dom F(a) "
+        return Outcome(jump["worst"], details=details, status=FAILED, counter={**jump, "message":
+                       f"dom F jumps at t ≈ {jump['t']!r}: sup_z dist(z, dom F(b)) over z ∈ dom F(a) "
                                    f"stays {jump['excess']:.4g} on brackets [a, b] around it down to width "
                                    f"{jump['bracket'][1] - jump['bracket'][0]:.2g} — no absolutely continuous φ "
-                                   f"bounds it ({EVIDENCE})")
+                                   f"bounds it ({EVIDENCE})"})
     if S.problem.phi is None:
-        return CheckResult("assumption_A3", _subject(S.problem), PASSED, details=details,
-                           message=f"estimated least φ: φ̂(T) - φ̂(0) = {phi_hat[-1]:.4g}, max rate {rate:.4g} "
+        return Outcome(None, status=PASSED, details=details,
+                       message=f"estimated least φ: φ̂(T) - φ̂(0) = {phi_hat[-1]:.4g}, max rate {rate:.4g} "
                                    f"({EVIDENCE})")
     phi = np.array([float(S.problem.phi(float(s))) for s in ts])
     worst, counter = 0.0, None
@@ -268,7 +290,7 @@ def _a3(S: _Samples) -> CheckResult:
                 worst, counter = r, {"s": ts[a], "t": ts[b], "z": arg[(a, b)], "dist": D[a, b], "phi_s": phi[a],
                                      "phi_t": phi[b]}
     details["phi_stated"] = phi
-    return _verdict("assumption_A3", S, worst, counter, details,
+    return _sampled("assumption_A3", worst, counter, details,
                     lambda c: f"dist(z, dom F(t)) = {c['dist']:.4g} > φ(t) - φ(s) = {c['phi_t'] - c['phi_s']:.4g} "
                               f"for z in dom F(s), s = {c['s']:.4g}, t = {c['t']:.4g}: the stated φ is contradicted",
                     f"stated φ bounds every sampled domain motion ({EVIDENCE})")
@@ -314,7 +336,10 @@ def _f0_norm(op, z, t, mu):
         return float(np.linalg.norm(op.yosida(z, mu, t))), "yosida lower estimate"
 
 
-def _lg(S: _Samples) -> CheckResult:
+@law("assumption_LG", "(LG)", subject="problem", driver=run_assumption)
+def check_assumption_LG(S: _Samples) -> Outcome:
+    """(LG): ``|F^0(t, z)| ≤ σ(t)(1 + |z|)``: the estimated ``σ̂`` against a stated ``σ``, or, without one,
+    growth of the sampled ratio as ``z`` nears the boundary of the domain (evidence that (LG) fails)."""
     op, sigma = S.op, S.problem.sigma
     by_lam = {}
     worst, counter, how = 0.0, None, "min_norm"
@@ -341,20 +366,20 @@ def _lg(S: _Samples) -> CheckResult:
     details = {"evidence": EVIDENCE, "times": S.times, "sigma_hat": sig_hat, "sup_ratio_by_lambda": by_lam,
                "growth": growth, "F0": how, "stated": sigma is not None}
     if sigma is not None:
-        return _verdict("assumption_LG", S, worst, counter, details,
+        return _sampled("assumption_LG", worst, counter, details,
                         lambda c: f"|F^0(t,z)| = {c['F0_norm']:.4g} > σ(t)(1 + |z|) at t = {c['t']:.4g}: the stated "
                                   "σ is contradicted",
                         f"stated σ bounds every sample ({EVIDENCE})")
-    if growth > GROWTH_FLAG:
-        return CheckResult("assumption_LG", _subject(S.problem), FAILED, worst=growth, bound=GROWTH_FLAG,
-                           details=details, counterexample={"sup_ratio_by_lambda": by_lam},
-                           message=f"sup |F^0(t,z)|/(1+|z|) grows {growth:.3g}-fold as z approaches the boundary "
-                                   f"of dom F: evidence that (LG) fails")
-    return CheckResult("assumption_LG", _subject(S.problem), PASSED, details=details,
-                       message=f"estimated σ̂ ≤ {float(np.max(sig_hat)):.4g} ({EVIDENCE}; F^0 by {how})")
+    return _growth(growth, {"sup_ratio_by_lambda": by_lam}, details,
+                   f"sup |F^0(t,z)|/(1+|z|) grows {growth:.3g}-fold as z approaches the boundary of dom F: evidence "
+                   "that (LG) fails",
+                   f"estimated σ̂ ≤ {float(np.max(sig_hat)):.4g} ({EVIDENCE}; F^0 by {how})")
 
 
-def _yb(S: _Samples) -> CheckResult:
+@law("assumption_YB", "(YB)/(YB')", subject="problem", driver=run_assumption)
+def check_assumption_YB(S: _Samples) -> Outcome:
+    """(YB)/(YB'): the Yosida increment ``|Y_λ(s+λ, z)| - |F^0(s, z)| ≤ θ(s+λ) - θ(s)`` against a stated
+    ``θ``, or, without one, growth of the increment per unit time like ``1/λ`` (evidence that (YB) fails)."""
     op, theta, T = S.op, S.problem.theta, S.T
     rates: dict[float, dict[str, float]] = {}
     worst = {"YB": 0.0, "YB'": 0.0}                          # a stated θ, judged per form
@@ -400,32 +425,28 @@ def _yb(S: _Samples) -> CheckResult:
         # while a (YB') violation says nothing about (YB): no verdict then
         if key == "YB'" and worst[key] > 1.0:
             c = counter[key]
-            return CheckResult("assumption_YB", _subject(S.problem), SKIPPED, details=details,
-                               message=f"the stated θ does not bound the (YB') increments (by {c['lhs'] - c['rhs']:.3g} "
-                                       f"at s = {c['s']:.4g}, λ = {c['lambda']:.3g}), but (YB') is stronger than (YB), "
-                                       "which needs |F^0(s, z)|: the operator has no min_norm")
-        return _verdict("assumption_YB", S, worst[key], counter[key], details,
+            return Outcome(None, status=SKIPPED, details=details,
+                           message=f"the stated θ does not bound the (YB') increments (by {c['lhs'] - c['rhs']:.3g} "
+                                   f"at s = {c['s']:.4g}, λ = {c['lambda']:.3g}), but (YB') is stronger than (YB), "
+                                   "which needs |F^0(s, z)|: the operator has no min_norm")
+        return _sampled("assumption_YB", worst[key], counter[key], details,
                         lambda c: f"{c['form']}: |Y_λ(s+λ,z)| exceeds θ(s+λ) - θ(s) + ... by "
                                   f"{c['lhs'] - c['rhs']:.3g} at s = {c['s']:.4g}, λ = {c['lambda']:.3g}: the stated "
                                   "θ is contradicted",
                         f"stated θ bounds every sampled Yosida increment ({key}; {EVIDENCE})")
-    if growth > GROWTH_FLAG:
-        return CheckResult("assumption_YB", _subject(S.problem), FAILED, worst=growth, bound=GROWTH_FLAG,
-                           details=details, counterexample={"rate_by_lambda": rates},
-                           message=f"the Yosida increment per unit time grows {growth:.3g}-fold as λ shrinks "
-                                   f"1000-fold (like 1/λ: a moving domain): evidence that ({key}) fails")
-    return CheckResult("assumption_YB", _subject(S.problem), PASSED, details=details,
-                       message=f"estimated θ̂(t) = {rho:.4g} t ({key}; {EVIDENCE})")
+    return _growth(growth, {"rate_by_lambda": rates}, details,
+                   f"the Yosida increment per unit time grows {growth:.3g}-fold as λ shrinks 1000-fold (like 1/λ: a "
+                   f"moving domain): evidence that ({key}) fails",
+                   f"estimated θ̂(t) = {rho:.4g} t ({key}; {EVIDENCE})")
 
 
-for _law_name, _fn, _label in (("assumption_A1", _a1, "(A1)"), ("assumption_A2", _a2, "(A2)"),
-                                ("assumption_A3", _a3, "(A3)"), ("assumption_LG", _lg, "(LG)"),
-                                ("assumption_YB", _yb, "(YB)/(YB')")):
-    _declare(_law_name, _label, subject="problem")(_fn)
+def run_composite(decl: Any, problem: Problem, records: dict[str, CheckResult]) -> CheckResult:
+    """A law over the records of the other assumptions of ``problem``."""
+    return run(decl, subject_name(problem), lambda: decl.evaluate(problem, records), problem=problem)
 
 
-@_declare("assumptions_thm_main", "thm:main: (A1)–(A3) and (LG) or (YB)", subject="problem")
-def thm_main(problem: Problem, records: dict[str, CheckResult]) -> CheckResult:
+@law("assumptions_thm_main", "thm:main: (A1)–(A3) and (LG) or (YB)", subject="problem", driver=run_composite)
+def thm_main(problem: Problem, records: dict[str, CheckResult]) -> Outcome:
     """Theorem ``thm:main`` needs (A1)–(A3) and *one of* (LG) or (YB): a composite law over the records of
     the five assumptions.  When exactly one of (LG), (YB) has evidence against it and the other has
     evidence for it, that record becomes an expected failure (``xfail``, saying which alternative holds);
@@ -436,10 +457,9 @@ def thm_main(problem: Problem, records: dict[str, CheckResult]) -> CheckResult:
             this.status = XFAIL
             this.message = f"the alternative hypothesis {name} has evidence for it; {this.message}"
     bad = [r.check for r in records.values() if r.status == FAILED]
-    return CheckResult("assumptions_thm_main", _subject(problem), FAILED if bad else PASSED,
-                       details={"evidence": EVIDENCE, "from": sorted(records)},
-                       message=("evidence against " + ", ".join(bad)) if bad else
-                       "no sample contradicts (A1)–(A3) and (LG) or (YB) — evidence, not proof")
+    return Outcome(None, status=FAILED if bad else PASSED, details={"evidence": EVIDENCE, "from": sorted(records)},
+                   message=("evidence against " + ", ".join(bad)) if bad else
+                   "no sample contradicts (A1)–(A3) and (LG) or (YB) — evidence, not proof")
 
 
 ASSUMPTION_LAWS = ("assumption_A1", "assumption_A2", "assumption_A3", "assumption_LG", "assumption_YB")
@@ -449,15 +469,14 @@ def check_assumptions(problem: Problem, *, seed: int = 0, points: int = 12, time
                       composite: bool = True) -> Report:
     """Sampled evidence for (A1), (A2), (A3), (LG) and (YB)/(YB') on ``problem`` (see the module docstring),
     then (``composite=True``) the composite law :func:`thm_main` of Theorem ``thm:main``."""
-    S = _Samples(problem, seed, points, times)
-    report = Report(meta={"subject": _subject(problem), "seed": seed, "evidence": EVIDENCE})
+    require_problem(problem)
+    seed = valid_seed(seed)
+    report = Report(meta={"subject": subject_name(problem), "seed": seed, "evidence": EVIDENCE})
     laws = laws_of("problem")
     for name in ASSUMPTION_LAWS:
-        rec = _run(laws[name], S, problem=problem)
-        rec.seed = seed
-        report.add(rec)
+        report.add(laws[name].check(problem, seed=seed, points=points, times=times))
     if composite:
-        rec = _run(thm_main.law, problem, {r.check: r for r in report.results}, problem=problem)
+        rec = thm_main(problem, {r.check: r for r in report.results})
         rec.seed = seed
         report.add(rec)
     return report

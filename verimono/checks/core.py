@@ -1,55 +1,62 @@
-"""The check core: a law declared once, one outcome type, one driver.
+"""The check core: a law declared once, one outcome type, one exception policy, one subject name.
 
-Every law of verimono — a law of an operator's resolvent, of a stepper's trajectories, or sampled
-evidence for an assumption of a problem — is a :class:`Law`: its record name, the paper's label, the
-kind of subject it judges (``"operator"``, ``"stepper"``, ``"problem"``), what it *requires* and the
-function that evaluates it.  Requirements are checked from the declaration **before anything runs**, so
-a law that does not apply is a skip whose reason comes from the declaration:
+Every law of verimono is one decorated *evaluator* returning an :class:`Outcome`::
 
-* :class:`Member` — an operator member (``min_norm``, ``contains``, ``project_domain``);
-* :class:`Claimed` — what a stepper claims (:mod:`verimono.claims`: ``scheme="proximal"``, or the
-  contraction claim);
-* :class:`Holds` — a condition on the problem with its reason (stated φ/σ/θ of (A3)/(LG)/(YB), a
-  Lipschitz constant for ``f``, no initial jump, ...).
+    @operator_law("monotone", "(A1)")
+    def check_monotone(op, s):
+        \"\"\"⟨x_a − x_b, y_a − y_b⟩ ≥ 0 on graph points of F(t,·).\"\"\"
+        ...
+        return Outcome.compare(lhs, rhs, slack, "what was compared", counterexample)
 
-:func:`run` is the one driver: it owns the timing, the exception-to-status policy (a member the subject
-lacks at run time is a skip; :class:`verimono.UnverifiedSolution` — verimono's own solvers gave no verified
-answer — is ``undecided``; any other exception is a failure of the subject, with its type and message)
-and stamps the law's label on the record.  Law bodies return an :class:`Outcome` (the one outcome type:
-the worst observed ratio against the bound 1, where, and what was compared) or a finished record.
+The decorator (:func:`law`, specialised per subject kind by the module that owns the kind's *driver*)
+registers a :class:`Law` — record name, the paper's label, subject kind, requirements, evaluator — and
+returns the public ``check_<name>``: the driver applied to that law.  A driver decides *where* the
+evaluator is evaluated (samples searched for an operator, the partitions of a stepper's battery, the
+sampled times of a problem's assumptions) and keeps the worst outcome; this module decides everything
+else, once:
 
-Adding a law is one decorated function in the module of its subject kind plus a member of the zoo of
-broken subjects that it catches::
-
-    @law("in_domain", "e:x k+1 props.1", subject="stepper", requires=(PROXIMAL_CLAIM,))
-    def check_in_domain(stepper, problem, *, seed=0): ...
+* **requirements** (:class:`Member`, :class:`Claimed`, :class:`Holds`) are judged before anything runs,
+  so a law that does not apply is a skip whose reason comes from the declaration;
+* **the exception policy** (:func:`classify`) maps what an evaluation raised to a status, for a whole
+  record (:func:`run`), for one sample of a search, and for a stage of a run alike;
+* **the record** (:func:`record`) of an outcome: passed when its ratio is within its bound, failed with
+  the counterexample otherwise, never passed on a non-finite ratio;
+* **the subject's name** (:func:`subject_name`), decided once whatever the status.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
+import inspect
 import math
 import time
 from typing import Any, Callable, Iterable
 
 from ..claims import Claim, claim_of
-from ..errors import NotApplicable, UnverifiedSolution
+from ..naming import subject_name
+from ..errors import (InvalidCheckArgument, NotApplicable, StageUnavailable, UnitTimeout, UnverifiedSolution)
+from ..operators import provides
 from ..results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
 
-SUBJECTS = ("operator", "stepper", "problem")
+SUBJECTS = ("operator", "stepper", "problem", "system", "estimator")
 
 
 # -- the one outcome type ---------------------------------------------------------------------------
 
 @dataclasses.dataclass
 class Outcome:
-    """What one evaluation of a law found: ``worst`` is the largest observed ``lhs / (rhs + slack)``
-    (the law holds when ``worst ≤ 1``), ``k`` the offending step (trajectory laws), ``counter`` the
-    counterexample, ``what`` the inequality compared.  ``inconclusive`` marks an evaluation that can
-    neither confirm nor refute the law there: counted, never a pass.  ``lhs``, ``rhs``, ``slack`` are
-    kept when the law is one inequality (:meth:`compare`).  A non-finite ``worst`` is a failure."""
+    """What an evaluation of a law found.
 
-    worst: float
+    ``worst`` is the largest observed ``lhs / (rhs + slack)``; the law holds when ``worst ≤ bound``
+    (a NaN never does); ``None`` for a law without a ratio, whose ``status`` then says.  ``k`` is the offending step of a trajectory, ``counter`` the counterexample (its
+    ``"message"`` is the record's message on a failure), ``message`` the record's message when the law
+    holds, ``what`` the inequality compared.  ``inconclusive`` marks an evaluation that can neither
+    confirm nor refute the law there (counted, never a pass); ``status`` an explicit status where the
+    ratio does not decide (an undecided search).  ``lhs``, ``rhs``, ``slack`` are kept when the law is
+    one inequality (:meth:`compare`)."""
+
+    worst: float | None
     k: int | None = None
     counter: dict[str, Any] = dataclasses.field(default_factory=dict)
     details: dict[str, Any] = dataclasses.field(default_factory=dict)
@@ -58,14 +65,22 @@ class Outcome:
     lhs: float | None = None
     rhs: float | None = None
     slack: float | None = None
+    bound: float = 1.0
+    message: str = ""
+    status: str | None = None
 
     @classmethod
     def compare(cls, lhs: float, rhs: float, slack: float, what: str, info: dict | None = None, *,
                 inconclusive: bool = False) -> "Outcome":
-        """The outcome of one inequality ``lhs ≤ rhs + slack``; ``worst = lhs / (rhs + slack)``, ``inf``
+        """The outcome of one inequality ``lhs ≤ rhs + slack``: ``worst = lhs / (rhs + slack)``, ``inf``
         when either side is not finite, and for ``rhs + slack = 0`` 0 or ``inf``."""
-        return cls(_ratio(lhs, rhs, slack), counter=dict(info or {}), what=what, inconclusive=inconclusive,
+        return cls(ratio(lhs, rhs, slack), counter=dict(info or {}), what=what, inconclusive=inconclusive,
                    lhs=float(lhs), rhs=float(rhs), slack=float(slack))
+
+    @classmethod
+    def inconclusive_sample(cls, what: str, info: dict | None = None) -> "Outcome":
+        """An evaluation that neither confirms nor refutes the law (``what`` says why)."""
+        return cls.compare(0.0, 0.0, 1.0, what, info, inconclusive=True)
 
     @property
     def ratio(self) -> float:
@@ -77,16 +92,70 @@ class Outcome:
 
     @property
     def failed(self) -> bool:
-        return not self.worst <= 1.0     # NaN fails
+        if self.worst is None:
+            return self.status == FAILED
+        return not self.worst <= self.bound     # NaN fails
 
 
-def _ratio(lhs: float, rhs: float, slack: float) -> float:
+def ratio(lhs: float, rhs: float, slack: float) -> float:
+    """``lhs / (rhs + slack)``; ``inf`` when a side is not finite; 0 or ``inf`` when the denominator is 0."""
     den = rhs + slack
     if not (math.isfinite(lhs) and math.isfinite(den)):
         return math.inf
     if den > 0.0:
         return lhs / den
     return 0.0 if lhs <= 0.0 else math.inf
+
+
+def worst_of(outcomes: Iterable[Outcome]) -> Outcome | None:
+    """The outcome with the largest ratio (a NaN ratio counts as the largest)."""
+    worst = None
+    for o in outcomes:
+        if worst is None or not o.worst <= worst.worst:
+            worst = o
+    return worst
+
+
+# -- the subject's name -----------------------------------------------------------------------------
+
+def stepper_subject(stepper: Any, problem: Any) -> str:
+    """The subject of a stepper's record on a problem (or a problem's name): ``"<stepper> on <problem>"``."""
+    return f"{subject_name(stepper)} on {problem if isinstance(problem, str) else subject_name(problem)}"
+
+
+# -- the one exception policy -----------------------------------------------------------------------
+
+def classify(exc: BaseException) -> tuple[str, str]:
+    """``(status, message)`` for an exception raised while a law was evaluated — the one policy of every
+    record, every sample of a search and every stage of a run:
+
+    * :class:`NotApplicable` (the law's hypotheses do not hold here) and :class:`StageUnavailable`:
+      skipped, with the reason;
+    * ``NotImplementedError`` (a member the subject lacks, met at run time): skipped;
+    * :class:`UnverifiedSolution` (verimono's own solvers gave no verified answer): undecided — a limit of
+      the harness is never a failure of the subject, and never a pass;
+    * :class:`UnitTimeout`: failed, naming the unit and its budget;
+    * anything else: a failure of the subject (it raised on a valid input), with the exception's type.
+
+    Misuse (:class:`InvalidCheckArgument`) is not classified: it propagates to the caller."""
+    if isinstance(exc, (NotApplicable, StageUnavailable)):
+        return SKIPPED, str(exc)
+    if isinstance(exc, NotImplementedError):
+        return SKIPPED, f"not available: {exc}"
+    if isinstance(exc, UnverifiedSolution):
+        return UNDECIDED, f"verimono's own solvers gave no verified answer: {exc}"
+    if isinstance(exc, UnitTimeout):
+        return FAILED, f"timed out: {exc}"
+    return FAILED, f"{type(exc).__name__}: {exc}"
+
+
+def record_of_exception(check: str, subject: str, exc: BaseException, **kw: Any) -> CheckResult:
+    """The record of a law whose evaluation raised ``exc`` (:func:`classify`)."""
+    status, message = classify(exc)
+    details = dict(kw.pop("details", None) or {})
+    if status != SKIPPED:
+        details.setdefault("exception", type(exc).__name__)
+    return CheckResult(check, subject, status, message=message, details=details, **kw)
 
 
 # -- requirements -----------------------------------------------------------------------------------
@@ -101,7 +170,7 @@ class Member:
         op = ctx.operator
         if op is None or provides(op, self.name):
             return None
-        return f"needs a member the operator lacks: {_subject_name(op)} does not provide {self.name}"
+        return f"needs a member the operator lacks: {subject_name(op)} does not provide {self.name}"
 
 
 @dataclasses.dataclass(frozen=True)
@@ -138,13 +207,6 @@ CONTRACTION_CLAIM = Claimed("contracts", "two solutions of a scheme that only co
                                          "step by step")
 
 
-def provides(op: Any, member: str) -> bool:
-    """Whether the operator provides ``member``: its ``provides(member)`` (:meth:`verimono.Operator.provides`)
-    where it says, else whether it has the member at all (a duck-typed operator)."""
-    says = getattr(op, "provides", None)
-    return bool(says(member)) if callable(says) else callable(getattr(op, member, None))
-
-
 @dataclasses.dataclass
 class Context:
     """What a law's requirements are judged on."""
@@ -158,7 +220,8 @@ class Context:
 
 @dataclasses.dataclass(frozen=True)
 class Law:
-    """A law declared once: record name, the paper's label, subject kind, requirements, evaluator."""
+    """A law declared once: record name, the paper's label, subject kind, requirements, evaluator, and the
+    driver that evaluates it on a subject (``driver(law, subject, ...) -> CheckResult``)."""
 
     name: str
     label: str
@@ -166,6 +229,11 @@ class Law:
     evaluate: Callable[..., Any]
     requires: tuple = ()
     doc: str = ""
+    driver: Callable[..., CheckResult] | None = dataclasses.field(default=None, compare=False, repr=False)
+    #: part of its kind's battery (``check_operator``, ``check_stepper``, ...); else run on its own
+    battery: bool = True
+    #: the public ``check_<name>`` the decorator made
+    public: Callable[..., CheckResult] | None = dataclasses.field(default=None, compare=False, repr=False)
 
     def unmet(self, ctx: Context) -> str | None:
         """The first unmet requirement's reason (``None`` when the law applies)."""
@@ -175,86 +243,90 @@ class Law:
                 return why
         return None
 
+    def check(self, *args: Any, **kwargs: Any) -> CheckResult:
+        """The law on a subject, through its driver (what the public ``check_<name>`` does)."""
+        return self.driver(self, *args, **kwargs)
+
 
 REGISTRY: dict[str, dict[str, Law]] = {kind: {} for kind in SUBJECTS}
 
 
-def law(name: str, label: str, *, subject: str, requires: Iterable = ()) -> Callable:
-    """Declare the decorated function as the law ``name`` of ``subject`` kind (registered in order)."""
+def law(name: str, label: str, *, subject: str, driver: Callable[..., CheckResult],
+        requires: Iterable = (), battery: bool = True) -> Callable[[Callable], Callable[..., CheckResult]]:
+    """Declare the decorated evaluator as the law ``name`` of ``subject`` kind (registered in declaration
+    order) and return the public check: ``driver`` applied to the law, with the evaluator's docstring and
+    the driver's keyword arguments (``check.law`` is the :class:`Law`).  ``battery=False``: a law run on
+    its own (by a stage of the run), not by its kind's battery."""
     if subject not in SUBJECTS:
         raise ValueError(f"subject must be one of {SUBJECTS}, got {subject!r}")
 
-    def deco(fn: Callable) -> Callable:
-        decl = Law(name, label, subject, fn, tuple(requires), (fn.__doc__ or "").strip())
+    def deco(evaluate: Callable) -> Callable[..., CheckResult]:
+        @functools.wraps(evaluate)
+        def check(*args: Any, **kwargs: Any) -> CheckResult:
+            return driver(decl, *args, **kwargs)
+
+        decl = Law(name, label, subject, evaluate, tuple(requires), inspect.cleandoc(evaluate.__doc__ or ""),
+                   driver, battery, check)
         REGISTRY[subject][name] = decl
-        fn.law = decl
-        return fn
+        params = list(inspect.signature(driver).parameters.values())[1:]
+        check.__signature__ = inspect.Signature(params, return_annotation=CheckResult)
+        check.__name__ = check.__qualname__ = f"check_{name}"
+        check.__wrapped__ = driver
+        check.law = decl
+        return check
     return deco
 
 
-def laws_of(subject: str) -> dict[str, Law]:
-    """The registered laws of a subject kind, in declaration order."""
-    return dict(REGISTRY[subject])
+def laws_of(subject: str, *, battery: bool | None = None) -> dict[str, Law]:
+    """The registered laws of a subject kind, in declaration order (``battery=True``: those of its
+    battery only)."""
+    return {n: d for n, d in REGISTRY[subject].items() if battery is None or d.battery == battery}
 
 
-# -- the driver -------------------------------------------------------------------------------------
+# -- running one law --------------------------------------------------------------------------------
 
-def _subject_name(obj: Any) -> str:
-    return getattr(obj, "name", None) or getattr(obj, "__name__", None) or type(obj).__name__
-
-
-def subject_of(decl: Law, *, operator: Any = None, stepper: Any = None, problem: Any = None) -> str:
-    """The record's subject: the operator's name, ``"<stepper> on <problem>"``, or the problem's name."""
-    if decl.subject == "operator":
-        return _subject_name(operator)
-    if decl.subject == "stepper":
-        return f"{_subject_name(stepper)} on {problem.name}"
-    return problem.name
-
-
-def run(decl: Law | Callable, *args: Any, operator: Any = None, stepper: Any = None, problem: Any = None,
-        call: Callable[[], CheckResult] | None = None, **kwargs: Any) -> CheckResult:
-    """Run one law: requirements first (a skip with the declaration's reason), then the evaluator
-    (``decl.evaluate(*args, **kwargs)``, or ``call()`` — a search driver around it) under the one
-    exception policy; the record gets its duration and the law's label (``details["label"]``)."""
-    decl = getattr(decl, "law", decl)
+def run(decl: Law, subject: str, evaluate: Callable[[], Any], *, operator: Any = None, stepper: Any = None,
+        problem: Any = None, seed: int | None = None) -> CheckResult:
+    """Run one law on one subject: its requirements first (a skip with the declaration's reason), then
+    ``evaluate()`` — an :class:`Outcome` or a finished record — under the one exception policy
+    (:func:`classify`).  The record gets the law's label and, where the evaluation did not measure its
+    own, its duration."""
     start = time.perf_counter()
     op = operator if operator is not None else getattr(problem, "operator", None)
     ctx = Context(operator=op, problem=problem, claim=None if stepper is None else claim_of(stepper))
-    subject = subject_of(decl, operator=operator, stepper=stepper, problem=problem)
     why = decl.unmet(ctx)
     if why:
-        return CheckResult(decl.name, subject, SKIPPED, message=why, details={"label": decl.label},
-                           duration=time.perf_counter() - start)
-    try:
-        rec = decl.evaluate(*args, **kwargs) if call is None else call()
-    except NotApplicable as exc:
-        rec = CheckResult(decl.name, subject, SKIPPED, message=str(exc))
-    except NotImplementedError as exc:
-        rec = CheckResult(decl.name, subject, SKIPPED, message=f"not available: {exc}")
-    except UnverifiedSolution as exc:   # a limit of the harness: never a failure of the subject, never a pass
-        rec = CheckResult(decl.name, subject, UNDECIDED, message=f"verimono's own solvers gave no verified answer: "
-                          f"{exc}", details={"exception": type(exc).__name__})
-    except Exception as exc:   # the subject raised on a valid input: a failure of the subject, never a crash
-        rec = CheckResult(decl.name, subject, FAILED, message=f"{type(exc).__name__}: {exc}",
-                          details={"exception": type(exc).__name__})
+        rec = CheckResult(decl.name, subject, SKIPPED, message=why, seed=seed)
+    else:
+        try:
+            out = evaluate()
+            rec = out if isinstance(out, CheckResult) else record(decl.name, subject, out, seed=seed)
+        except InvalidCheckArgument:
+            raise
+        except Exception as exc:  # noqa: BLE001 - the one policy decides what an exception means
+            rec = record_of_exception(decl.name, subject, exc, seed=seed)
     rec.details.setdefault("label", decl.label)
-    rec.duration = time.perf_counter() - start
+    if rec.duration is None:
+        rec.duration = time.perf_counter() - start
     return rec
 
 
-def record(name: str, subject: str, outcome: Outcome, *, passed: str, failed: str | None = None,
-           bound: float = 1.0, **kw: Any) -> CheckResult:
-    """The record of an :class:`Outcome` against ``bound``: passed with ``passed`` as message, or failed
-    with the counterexample and ``failed`` (default: the counterexample's ``message``)."""
-    if not outcome.failed:
-        return CheckResult(name, subject, PASSED, worst=outcome.worst, bound=bound, message=passed,
-                           details=dict(outcome.details), **kw)
+def record(name: str, subject: str, outcome: Outcome, **kw: Any) -> CheckResult:
+    """The record of an :class:`Outcome`: its explicit status, else passed when its ratio is within its
+    bound (message: ``outcome.message``), else failed with the counterexample (message: its
+    ``"message"``, else ``outcome.message``)."""
+    details = dict(outcome.details)
+    status = outcome.status or (FAILED if outcome.failed else PASSED)
+    ratio = {} if outcome.worst is None else {"worst": outcome.worst, "bound": outcome.bound}
+    if status != FAILED:
+        return CheckResult(name, subject, status, message=outcome.message, details=details,
+                           **(ratio if status == PASSED else {}), **kw)
     counter = dict(outcome.counter)
-    msg = failed or counter.pop("message", "") or f"{name} violated"
-    return CheckResult(name, subject, FAILED, worst=outcome.worst, bound=bound, counterexample=counter,
-                       message=msg, details=dict(outcome.details), **kw)
+    msg = counter.pop("message", "") or outcome.message or f"{name} violated"
+    return CheckResult(name, subject, FAILED, counterexample=counter or None, message=msg, details=details,
+                       **ratio, **kw)
 
 
-__all__ = ["Outcome", "Law", "law", "laws_of", "REGISTRY", "run", "record", "Member", "Claimed", "Holds",
-           "Context", "provides", "NotApplicable", "PROXIMAL_CLAIM", "CONTRACTION_CLAIM", "SUBJECTS", "subject_of"]
+__all__ = ["Outcome", "Law", "law", "laws_of", "REGISTRY", "run", "record", "record_of_exception", "classify",
+           "Member", "Claimed", "Holds", "Context", "provides", "NotApplicable", "PROXIMAL_CLAIM",
+           "CONTRACTION_CLAIM", "SUBJECTS", "subject_name", "stepper_subject", "ratio", "worst_of"]

@@ -1,6 +1,6 @@
 """Adaptive search for jumps of a sampled function of time ``t ↦ V(t) ∈ R^N``.
 
-The method of ``lcs.v_ac`` (:mod:`verimono.lcs.hypotheses`), for any vector-valued ``V``: on a grid of
+For any vector-valued ``V``: on a grid of
 ``JUMP_GRID`` cells, the cells with the largest increments ``|V(b) − V(a)|`` and those least like their
 neighbours' (``|ΔV_i − ½(ΔV_{i−1} + ΔV_{i+1})|``: a small jump on a steep slope) are bisected, keeping
 the half whose increment is further off the neighbours' trend, until no float lies strictly between the
@@ -12,7 +12,8 @@ Hölder-``p`` ``V`` with ``p > 0.006`` drops below that ratio).  Evidence, not p
 inside one grid cell is not seen.
 
 Used by ``assumption_A3`` (``V`` = projections of sample points onto ``dom F(t)``) and ``assumption_A2``
-(``V`` = resolvents ``J_λ(t) p``) in :mod:`verimono.checks.assumptions`.
+(``V`` = resolvents ``J_λ(t) p``) in :mod:`verimono.checks.assumptions`, and by ``lcs.v_ac`` (``V = v``) in
+:mod:`verimono.checks.section7`.
 """
 
 from __future__ import annotations
@@ -53,12 +54,13 @@ class Jump:
         return {"t": self.time, "bracket": [self.a, self.b], "jump": self.size, "increments": self.increments}
 
 
-def _bisect(value: Callable[[float], np.ndarray], a: float, b: float, va, vb, slope, floor: float):
+def _bisect(value: Callable[[float], np.ndarray], a: float, b: float, va, vb, slope, floor: float,
+            min_width: float = 0.0):
     seq, brackets = [float(np.linalg.norm(vb - va))], [(a, b)]
     for _ in range(JUMP_MAX_LEVELS):
         mid = 0.5 * (a + b)
-        if not a < mid < b:
-            break                      # adjacent floats: nothing left between them
+        if not a < mid < b or b - a <= min_width:
+            break                      # adjacent floats (or the width asked for): nothing left to split
         vm = value(mid)
         trend = slope * (0.5 * (b - a))
         if np.linalg.norm(vm - va - trend) >= np.linalg.norm(vb - vm - trend):    # the half off the trend
@@ -74,9 +76,10 @@ def _bisect(value: Callable[[float], np.ndarray], a: float, b: float, va, vb, sl
 
 
 def find_jumps(value: Callable[[float], np.ndarray], T: float, *, grid: int = JUMP_GRID,
-               candidates: int = JUMP_CANDIDATES) -> tuple[list[Jump], dict]:
+               candidates: int = JUMP_CANDIDATES, min_width: float = 0.0) -> tuple[list[Jump], dict]:
     """The stalled increments of ``value`` on ``[0, T]`` (see the module docstring), largest first, and
-    what was searched (``{"cells": ..., "bisected": ..., "floor": ...}``)."""
+    what was searched (``{"cells": ..., "bisected": ..., "floor": ...}``); brackets are split down to
+    adjacent floats, or to ``min_width`` when that is wider."""
     times = np.linspace(0.0, T, grid + 1)
     V = np.array([np.ravel(value(float(t))) for t in times])
     dV = np.diff(V, axis=0)
@@ -94,7 +97,7 @@ def find_jumps(value: Callable[[float], np.ndarray], T: float, *, grid: int = JU
         bisected += 1
         slope = 0.5 * (padded[i] + padded[i + 2]) / (times[i + 1] - times[i])
         stalled, a, b, va, vb, seq, brackets = _bisect(flat, float(times[i]), float(times[i + 1]), V[i], V[i + 1],
-                                                       slope, floor)
+                                                       slope, floor, min_width)
         if stalled:
             jumps.append(Jump(a, b, seq[-1], va, vb, seq, brackets))
     jumps.sort(key=lambda j: -j.size)

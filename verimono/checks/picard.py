@@ -22,17 +22,16 @@ which multiplies each iterate by ``1 + 5h``, passes: the factor is common to con
 from __future__ import annotations
 
 import math
-import time
 from typing import Callable
 
 import numpy as np
 
+from ..errors import NotApplicable
 from ..grids import uniform_grid, validate_grid
 from ..problem import Problem
-from ..results import FAILED, PASSED, SKIPPED, CheckResult
-from ..stepping import solve
 from ..tolerances import tolerance
-from .trajectory_laws import _name, _single, run_stepper
+from .core import Outcome
+from .partitions import run_stepper, stepper_law
 
 #: Picard iterates built (the bound is checked for ℓ = 1, ..., PICARD_ITERATIONS − 1)
 PICARD_ITERATIONS = 8
@@ -47,17 +46,14 @@ def _primitive(t: np.ndarray, values: np.ndarray) -> Callable[[float], np.ndarra
     return U
 
 
-def check_picard(stepper: Callable | None, problem: Problem, *, L: float | None = None,
-                 iterations: int = PICARD_ITERATIONS, grid: np.ndarray | None = None) -> CheckResult:
-    """``picard_step``: ``e: bound x l plus one to x l`` on the Picard iterates (module docstring)."""
-    stepper = solve if stepper is None else stepper
-    p = _single(problem)
+@stepper_law("picard_step", "e: bound x l plus one to x l", over_grids=False, battery=False)
+def check_picard(stepper: Callable, p: Problem, *, L: float | None = None, iterations: int = PICARD_ITERATIONS,
+                 grid: np.ndarray | None = None) -> Outcome:
+    """``picard_step``: ``e: bound x l plus one to x l`` on the Picard iterates built with ``stepper``
+    (module docstring); ``L`` overrides the problem's Lipschitz constant."""
     L = p.lipschitz if L is None else float(L)
-    subject = f"{_name(stepper)} on {p.name}"
-    start = time.perf_counter()
     if p.f is None or L is None:
-        return CheckResult("picard_step", subject, SKIPPED, duration=time.perf_counter() - start,
-                           message="needs a Lipschitz field f and its constant (the problem's lipschitz, or L=)")
+        raise NotApplicable("needs a Lipschitz field f and its constant (the problem's lipschitz, or L=)")
     t = uniform_grid(p.T, steps=PICARD_CELLS) if grid is None else validate_grid(grid, p.T)
     h = np.diff(t)
     dU = p.input_increments(t)
@@ -86,19 +82,15 @@ def check_picard(stepper: Callable | None, problem: Problem, *, L: float | None 
     limit_gap = float(np.max(np.linalg.norm(iterates[-1] - run_stepper(stepper, p, t), axis=1)))
     details = {"L": L, "iterations": iterations, "sup_differences": [float(np.max(e)) for e in E],
                "limit_gap": limit_gap, "cells": len(h)}
-    if worst <= 1.0:
-        return CheckResult("picard_step", subject, PASSED, worst=worst, bound=1.0, details=details,
-                           duration=time.perf_counter() - start,
-                           message=f"|x_(l+1) − x_l| ≤ (L τ)^l/l! |x_1 − x_0|_∞ for l < {iterations} (L = {L:g}; "
-                                   f"sup differences {', '.join(f'{d:.2g}' for d in details['sup_differences'])}; "
-                                   f"last iterate {limit_gap:.2g} from the scheme's solution)")
-    c = counter
-    return CheckResult("picard_step", subject, FAILED, worst=worst, bound=1.0, details=details,
-                       counterexample=c, duration=time.perf_counter() - start,
-                       message=f"Picard iterates {c['ell'] + 1} and {c['ell']} differ by {c['diff']:.4g} at τ = "
-                               f"{c['tau']:.4g} but (L τ)^l/l! |x_1 − x_0|_∞ = {c['bound']:.4g} with L = {L:g}, "
-                               f"l = {c['ell']} (e: bound x l plus one to x l): L is not a Lipschitz constant of "
-                               "f, or the step expands")
+    c = counter or {"ell": 0, "diff": 0.0, "tau": 0.0, "bound": 0.0}
+    return Outcome(worst, counter={**c, "message": f"Picard iterates {c['ell'] + 1} and {c['ell']} differ by "
+                                              f"{c['diff']:.4g} at τ = {c['tau']:.4g} but (L τ)^l/l! |x_1 − x_0|_∞ = "
+                                              f"{c['bound']:.4g} with L = {L:g}, l = {c['ell']} (e: bound x l plus one "
+                                              "to x l): L is not a Lipschitz constant of f, or the step expands"},
+                   details=details,
+                   message=f"|x_(l+1) − x_l| ≤ (L τ)^l/l! |x_1 − x_0|_∞ for l < {iterations} (L = {L:g}; sup differences "
+                           f"{', '.join(f'{d:.2g}' for d in details['sup_differences'])}; last iterate "
+                           f"{limit_gap:.2g} from the scheme's solution)")
 
 
 __all__ = ["check_picard", "PICARD_ITERATIONS", "PICARD_CELLS"]

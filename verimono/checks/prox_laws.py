@@ -12,9 +12,10 @@ one (a wrong weight, another norm's formula, a degenerate functional).  The More
 ``e_λ(x) = g(p) + |x - p|²/(2λ)`` is convex and differentiable with the ``1/λ``-Lipschitz gradient
 ``Y_λx = (x - p)/λ``, hence two-sided bounds between any two points.
 
-Each evaluator takes ``(op, s)`` with ``s`` a :class:`verimono.checks.operator_laws.Sample` and returns an
-:class:`Outcome` whose ratio is the violation in units of its slack (``(lhs - rhs)/slack``), so a
-negative or small ratio holds.  Slacks: ``τ = tolerance(x, p, z)`` per point (the resolvent's accuracy,
+Each law is a decorated evaluator ``check_<law>(op, s) -> Outcome`` (``s`` a
+:class:`verimono.checks.samples.Sample`) whose ratio is the violation in units of its slack
+(``(lhs - rhs)/slack``), so a negative or small ratio holds; it needs the operator's ``value`` (``g``), and
+is skipped before it runs on an operator that does not state it.  Slacks: ``τ = tolerance(x, p, z)`` per point (the resolvent's accuracy,
 :mod:`verimono.tolerances`), propagated through each side, plus ``tolerance`` of the function values.
 """
 
@@ -26,8 +27,12 @@ import zlib
 
 import numpy as np
 
-from .core import Outcome
 from ..tolerances import RTOL, tolerance
+from .core import Member, Outcome
+from .members import norm as _nrm
+from .members import resolvent as _J
+from .members import value as _g
+from .search import operator_law
 
 #: the independent minimiser (scipy.optimize, derivative-free Powell) runs only on R^n with n ≤ this
 MINIMISER_MAX_DIM = 4
@@ -35,26 +40,12 @@ MINIMISER_MAX_DIM = 4
 PERTURBATIONS = (1e-4, 1e-2, 1.0)
 
 
-def _J(op, x, lam, t):
-    y = np.asarray(op.resolvent(x.copy(), lam, t), dtype=float)
-    if y.shape != x.shape or not np.all(np.isfinite(y)):
-        raise ValueError(f"resolvent returned {y!r} for a point of shape {x.shape}")
-    return y
-
-
 def _tolf(*values: float) -> float:
     """:func:`verimono.tolerances.tolerance` of scalars, in Python floats (called per perturbation)."""
     return RTOL * (1.0 + max(abs(v) for v in values))
 
 
-def _g(op, z, t) -> float:
-    return float(op.value(np.array(z, dtype=float), t))
-
-
-def _nrm(v) -> float:
-    v = np.asarray(v, dtype=float)
-    m = float(np.max(np.abs(v), initial=0.0))
-    return 0.0 if m == 0.0 or not np.isfinite(m) else m * float(np.linalg.norm(v / m))
+_VALUE = Member("value")
 
 
 def _outside(p, gp, what) -> Outcome:
@@ -89,8 +80,11 @@ def _at_prox_point(what):
     return decorate
 
 
+@operator_law("prox_inequality", "prox inequality", _VALUE)
 @_at_prox_point("prox inequality")
-def _prox_inequality(op, s, p, gp):
+def check_prox_inequality(op, s, p, gp):
+    """The prox inequality ``⟨x - p, z - p⟩ ≤ λ(g(z) - g(p))`` for ``p = J_λx`` and ``z`` among ``x2``,
+    ``x1``, ``0`` and other resolvent values."""
     x, lam, t = s.x1, s.lam, s.t
     cands = [("x2", s.x2), ("x1", x), ("0", np.zeros_like(x))]
     for k, (lab, v) in enumerate((("J_μ x2", s.x2), ("J_μ x1", x), ("J_ν x2", s.x2))):
@@ -118,8 +112,12 @@ def _phi(op, z, x, lam, t):
     return lam * _g(op, z, t) + 0.5 * float((z - x) @ (z - x))
 
 
+@operator_law("prox_optimal", "prox optimality (perturbations)", _VALUE)
 @_at_prox_point("optimality")
-def _prox_optimal(op, s, p, gp):
+def check_prox_optimal(op, s, p, gp):
+    """The prox optimality (perturbations): ``p = J_λx`` minimises ``Φ(z) = λg(z) + |z - x|²/2``, 1-strongly:
+    ``Φ(p) + |δ|²/2 ≤ Φ(p + δ)`` for perturbations ``δ`` along coordinates, ``x - p``, ``p`` and seeded
+    directions."""
     x, lam, t = s.x1, s.lam, s.t
     fp = lam * gp + 0.5 * float((p - x) @ (p - x))
     s0 = 1.0 + float(np.max(np.abs(p), initial=0.0))
@@ -147,7 +145,11 @@ def _prox_optimal(op, s, p, gp):
                            {"p": p.tolist(), "z": z.tolist(), "Phi(p)": fp, "Phi(z)": fz})
 
 
-def _prox_minimiser(op, s):
+@operator_law("prox_minimiser", "prox optimality (independent minimiser)", _VALUE)
+def check_prox_minimiser(op, s):
+    """The prox optimality (independent minimiser): ``Φ(p) ≤ Φ(z*)`` for ``z*`` a minimiser of
+    ``Φ`` found by scipy's Powell from ``p``, ``x``, ``0`` (``n ≤ 4`` only: larger samples are
+    inconclusive)."""
     if s.x1.size > MINIMISER_MAX_DIM:
         return Outcome.compare(0.0, 0.0, 1.0, f"independent minimiser runs only for n ≤ {MINIMISER_MAX_DIM} "
                                "(sample inconclusive)", {}, inconclusive=True)
@@ -184,7 +186,10 @@ def _minimised(op, s, p, gp):
                            {"p": p.tolist(), "z_star": zbest.tolist(), "Phi(p)": fp, "Phi(z_star)": best})
 
 
-def _moreau_envelope(op, s):
+@operator_law("moreau_envelope", "Moreau envelope", _VALUE)
+def check_moreau_envelope(op, s):
+    """The Moreau envelope ``e_λ(x) = g(J_λx) + |x - J_λx|²/(2λ)`` is convex with the ``1/λ``-Lipschitz
+    gradient ``Y_λ``: ``e(x1) + ⟨Y_λx1, x2 - x1⟩ ≤ e(x2) ≤ e(x1) + ⟨Y_λx1, x2 - x1⟩ + |x2 - x1|²/(2λ)``."""
     lam, t = s.lam, s.t
     x1, x2 = s.x1, s.x2
     p1, p2 = _J(op, x1, lam, t), _J(op, x2, lam, t)
@@ -208,12 +213,5 @@ def _moreau_envelope(op, s):
     return low if not low.ratio <= high.ratio else high
 
 
-#: (law name, evaluator, label) of the value laws, in the order they run
-VALUE_LAWS = [
-    ("prox_inequality", _prox_inequality, "prox inequality"),
-    ("prox_optimal", _prox_optimal, "prox optimality (perturbations)"),
-    ("prox_minimiser", _prox_minimiser, "prox optimality (independent minimiser)"),
-    ("moreau_envelope", _moreau_envelope, "Moreau envelope"),
-]
-
-__all__ = ["VALUE_LAWS", "MINIMISER_MAX_DIM", "PERTURBATIONS"]
+__all__ = ["check_prox_inequality", "check_prox_optimal", "check_prox_minimiser", "check_moreau_envelope",
+           "MINIMISER_MAX_DIM", "PERTURBATIONS"]

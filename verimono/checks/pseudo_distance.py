@@ -21,7 +21,6 @@ and a few projected ascent steps from those towards the farthest points (:func:`
 
 from __future__ import annotations
 
-import time
 from typing import Any, Callable
 
 import numpy as np
@@ -29,8 +28,9 @@ import numpy as np
 from .. import sets
 from ..operators import NormalCone
 from ..pseudo_distance import pseudo_distance_lower_bound
-from ..results import FAILED, PASSED, CheckResult
+from ..results import CheckResult
 from ..tolerances import PSEUDO_DISTANCE_FACTOR, tolerance
+from .core import Outcome, law, run, subject_name
 
 #: step sizes of the sampled graph points: a large one (y ≈ 0 at boundary points) and a small one
 #: (|y| = dist/λ ≈ 1e6 dist, so s/(1 + s) is within 1e-6 of 1)
@@ -87,13 +87,19 @@ def _samples(C1, C2, centre: np.ndarray, rng) -> np.ndarray:
     return np.vstack([P, B1, B2, _ascend(C1, C2, B1[-DIRECTIONS:], reach), _ascend(C2, C1, B2[-DIRECTIONS:], reach)])
 
 
-def check_pseudo_distance(estimator: Callable | None = None, *, seed: int = 0) -> CheckResult:
-    """``pseudo_distance_hausdorff``: ``d_H/PSEUDO_DISTANCE_FACTOR ≤ estimator(N_C1, N_C2, samples) ≤ d_H``
-    on every pair of :func:`hausdorff_pairs` (see the module docstring).  ``estimator(F1, F2, samples,
-    lams=...)`` returns a number or a :class:`~verimono.pseudo_distance.PseudoDistanceBound`."""
+def run_estimator(decl: Any, estimator: Callable | None = None, *, seed: int = 0) -> CheckResult:
+    """A law of a pseudo-distance estimator (by default :func:`verimono.pseudo_distance_lower_bound`)."""
     est = pseudo_distance_lower_bound if estimator is None else estimator
-    name = getattr(est, "__name__", type(est).__name__)
-    start = time.perf_counter()
+    rec = run(decl, subject_name(est), lambda: decl.evaluate(est, seed=seed), seed=seed)
+    return rec
+
+
+@law("pseudo_distance_hausdorff", "def:dis", subject="estimator", driver=run_estimator)
+def check_pseudo_distance(est: Callable, *, seed: int = 0) -> Outcome:
+    """``d_H/PSEUDO_DISTANCE_FACTOR ≤ estimator(N_C1, N_C2, samples) ≤ d_H`` on every pair of
+    :func:`hausdorff_pairs` (module docstring).  ``estimator(F1, F2, samples, lams=...)`` returns a number or
+    a :class:`~verimono.pseudo_distance.PseudoDistanceBound`."""
+    name = subject_name(est)
     rng = np.random.default_rng(seed)
     worst, counter, rows = 0.0, None, []
     for label, C1, C2, dH, centre in hausdorff_pairs():
@@ -109,15 +115,15 @@ def check_pseudo_distance(estimator: Callable | None = None, *, seed: int = 0) -
             counter = {"pair": label, "d_H": dH, "value": value, "seed": seed,
                        "side": "above d_H: not a lower bound" if over >= under else
                                f"below d_H/{PSEUDO_DISTANCE_FACTOR:g}: too weak"}
-    ok = worst <= 1.0
-    msg = (f"d_H/{PSEUDO_DISTANCE_FACTOR:g} ≤ {name} ≤ d_H on {len(rows)} pairs of balls, boxes and half-spaces "
-           f"(ratios value/d_H {min(r['value'] / r['d_H'] for r in rows):.4g} … "
-           f"{max(r['value'] / r['d_H'] for r in rows):.4g}; dis(N_C1, N_C2) = d_H(C1, C2))") if ok else (
-           f"{name} gives {counter['value']:.6g} for d_H = {counter['d_H']:.6g} on {counter['pair']}: "
-           f"{counter['side']} (dis(N_C1, N_C2) = d_H(C1, C2), def:dis)")
-    return CheckResult("pseudo_distance_hausdorff", name, PASSED if ok else FAILED, worst=worst, bound=1.0,
-                       message=msg, details={"pairs": rows, "factor": PSEUDO_DISTANCE_FACTOR, "lams": LAMS},
-                       counterexample=None if ok else counter, seed=seed, duration=time.perf_counter() - start)
+    counter = counter or {"pair": "", "d_H": 0.0, "value": 0.0, "seed": seed, "side": ""}
+    ratios = [r["value"] / r["d_H"] for r in rows]
+    return Outcome(worst, details={"pairs": rows, "factor": PSEUDO_DISTANCE_FACTOR, "lams": LAMS},
+                   counter={**counter, "message": f"{name} gives {counter['value']:.6g} for d_H = {counter['d_H']:.6g} "
+                                                  f"on {counter['pair']}: {counter['side']} (dis(N_C1, N_C2) = "
+                                                  "d_H(C1, C2), def:dis)"},
+                   message=f"d_H/{PSEUDO_DISTANCE_FACTOR:g} ≤ {name} ≤ d_H on {len(rows)} pairs of balls, boxes and "
+                           f"half-spaces (ratios value/d_H {min(ratios):.4g} … {max(ratios):.4g}; "
+                           "dis(N_C1, N_C2) = d_H(C1, C2))")
 
 
 __all__ = ["check_pseudo_distance", "hausdorff_pairs", "LAMS", "DIRECTIONS"]

@@ -6,14 +6,26 @@ Proposition ``p:pass``) and evidence for the hypotheses of Theorems ``thm: linea
 ``e: linear case-comp``.
 """
 
-from .hypotheses import check_hypotheses
 from .kernel import BatchStepError, RowFailure
 from .lcp import LCPResult, box_residual, lcp_residual, lemke, solve_box, solve_lcp
 from .passivity import PassivityResult, is_passive
 from .relations import Complementarity, OperatorRelation, Relation, Relay
 from .siconos import read_lcp, read_ref
-from .siconos_cases import check_siconos
 from .system import LCSOperator, LinearRelationSystem
+
+
+def __getattr__(name: str):
+    """``check_hypotheses`` (the laws of Section 7, :mod:`verimono.checks.section7`) and ``check_siconos``
+    (agreement with Siconos, :mod:`verimono.checks.siconos`), loaded on first use."""
+    if name == "check_hypotheses":
+        from ..checks.section7 import check_hypotheses
+
+        return check_hypotheses
+    if name == "check_siconos":
+        from ..checks.siconos import check_siconos
+
+        return check_siconos
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 __all__ = [
     "LinearRelationSystem", "LCSOperator", "Relation", "Complementarity", "Relay", "OperatorRelation",

@@ -1,4 +1,4 @@
-"""The small-LCP kernel of :meth:`LinearRelationSystem.simulate` on a uniform grid (issue 15).
+"""The small-LCP kernel of :meth:`LinearRelationSystem.simulate` on a uniform grid.
 
 With the constant step matrices of a uniform grid (:class:`StepMatrices`), one ``EulerMoreauOSI(θ, γ)`` step
 is, for a fixed *pattern* ``s ∈ {0, 1, 2}^m`` of the box relation ``−w ∈ N_[l,u](z)`` (``s_i = 0``: ``z_i = l_i``,

@@ -18,7 +18,7 @@ import dataclasses
 
 import numpy as np
 
-from ..errors import InvalidProblem, MissingOptionalDependency, SolverFailure, VerimonoError
+from ..errors import InvalidProblem, MissingOptionalDependency, SolverFailure
 from ..tolerances import RTOL, SDP_RTOL, tolerance
 
 

@@ -1,4 +1,8 @@
-"""Readers for Siconos reference data (``../shared/siconos``, see its ``CASES.md``).
+"""Readers for Siconos reference data, and where those data live.
+
+The data ship with the package in ``verimono/data/siconos`` (:data:`PACKAGED_DATA`; their source, files
+and conversion are in ``PROVENANCE.md`` there, the systems in ``CASES.md``).  A data folder holds
+``siconos/refs/NAME.ref`` (or ``NAME.ref.gz``) and ``siconos/lcp/*.dat``, or is that ``siconos`` folder.
 
 * ``.ref`` trajectories: an optional header line ``"N ncols"``, then ``N`` rows of numbers
   (row ``k`` is ``t = k h``).
@@ -11,16 +15,49 @@
 
 from __future__ import annotations
 
+import gzip
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import InvalidProblem
 
+#: the data folder shipped with verimono (holds ``siconos/``): the default of ``verimono run``'s siconos stage
+PACKAGED_DATA = Path(__file__).resolve().parents[1] / "data"
+
+
+def siconos_root(data_dir) -> Path:
+    """The folder holding ``refs/`` and ``lcp/`` in ``data_dir`` (``data_dir/siconos`` or ``data_dir``
+    itself); :class:`FileNotFoundError` naming the expected layout when neither holds them."""
+    data_dir = Path(data_dir)
+    for root in (data_dir / "siconos", data_dir):
+        if (root / "refs").is_dir() and (root / "lcp").is_dir():
+            return root
+    raise FileNotFoundError(f"{data_dir} holds no Siconos reference data (expected siconos/refs/*.ref[.gz] "
+                            "and siconos/lcp/*.dat, as in verimono/data)")
+
+
+def ref_path(root, name: str) -> Path:
+    """``root/refs/name``, or its gzipped copy ``name.gz`` when only that exists (``root``: a
+    :func:`siconos_root`)."""
+    path = Path(root) / "refs" / name
+    gz = path.with_name(path.name + ".gz")
+    return gz if not path.exists() and gz.exists() else path
+
+
+def _read_text(path) -> str:
+    """The text of ``path``, decompressed when its name ends in ``.gz``."""
+    path = Path(path)
+    if path.suffix == ".gz":
+        with gzip.open(path, "rt", encoding="utf-8") as f:
+            return f.read()
+    return path.read_text()
+
 
 def read_ref(path) -> np.ndarray:
-    """Rows of a Siconos ``.ref`` file as an array ``(N, ncols)``; the header ``"N ncols"`` is checked."""
-    lines = [ln.split() for ln in Path(path).read_text().splitlines() if ln.strip()]
+    """Rows of a Siconos ``.ref`` file (or ``.ref.gz``) as an array ``(N, ncols)``; the header
+    ``"N ncols"`` is checked."""
+    lines = [ln.split() for ln in _read_text(path).splitlines() if ln.strip()]
     if not lines:
         raise InvalidProblem(f"{path} is empty")
     header = None
@@ -52,8 +89,9 @@ class _Tokens:
 
 
 def read_lcp(path) -> tuple[np.ndarray, np.ndarray]:
-    """``(M, q)`` of a Siconos numerics LCP ``.dat`` file (dense column-major or sparse-block storage)."""
-    tok = _Tokens(Path(path).read_text(), path)
+    """``(M, q)`` of a Siconos numerics LCP ``.dat`` file, or ``.dat.gz`` (dense column-major or sparse-block
+    storage)."""
+    tok = _Tokens(_read_text(path), path)
     n = tok.next(int)
     storage = tok.next(int)
     size0, size1 = tok.next(int), tok.next(int)
@@ -96,4 +134,4 @@ def _read_sbm(tok: _Tokens, n: int) -> np.ndarray:
     return M
 
 
-__all__ = ["read_ref", "read_lcp"]
+__all__ = ["PACKAGED_DATA", "siconos_root", "ref_path", "read_ref", "read_lcp"]

@@ -1,10 +1,9 @@
-"""The Siconos reference systems of ``shared/siconos/CASES.md`` and the agreement check on them.
-
-Each case is the system, initial state, θ (and γ for the θ-γ variant), step ``h`` and the columns of the
-``.ref`` file that hold the state.  :func:`check_siconos` simulates every case with
-:meth:`LinearRelationSystem.simulate` and records the maximum state error relative to the state's scale
-over all rows (bound ``SICONOS_RTOL``), and solves every LCP test file (residual ``≤ SICONOS_RTOL`` relative
-to the data, or :class:`verimono.InfeasibleStep` for the files that have no solution).
+"""The Siconos reference systems of ``verimono/data/siconos/CASES.md``: each case is the system, initial
+state, θ (and γ for the θ-γ variant), step ``h`` and the columns of the ``.ref`` file that hold the state;
+:func:`simulate_case` runs one with :meth:`LinearRelationSystem.simulate`.  The agreement laws on them are
+in :mod:`verimono.checks.siconos`.  ``data_dir`` is a data folder as
+:func:`verimono.lcs.siconos.siconos_root` reads it; by default the data shipped in the package
+(``PACKAGED_DATA``).
 """
 
 from __future__ import annotations
@@ -16,14 +15,11 @@ from typing import Callable
 
 import numpy as np
 
-from ..errors import InfeasibleStep, VerimonoError
-from ..results import FAILED, PASSED, CheckResult, Report
-from .lcp import lcp_residual, solve_lcp
 from .relations import Complementarity, Relay
-from .siconos import read_lcp, read_ref
+from .siconos import PACKAGED_DATA, read_ref, ref_path, siconos_root
 from .system import LinearRelationSystem
 
-#: required agreement with Siconos, relative to the state's scale (issue 4; Siconos' own tests use 1e-12,
+#: required agreement with Siconos, relative to the state's scale (Siconos' own tests use 1e-12,
 #: 1e-10 for θ-γ): both codes run the same scheme, so only round-off separates them
 SICONOS_RTOL = 1e-10
 #: LCP test files with no solution (CASES.md: ``lcp_Pang_isolated_sol_perturbed``)
@@ -99,14 +95,9 @@ CASES: dict[str, SiconosCase] = {c.file: c for c in [
 ]}
 
 
-def _siconos_root(data_dir: Path) -> Path:
-    data_dir = Path(data_dir)
-    return data_dir / "siconos" if (data_dir / "siconos").is_dir() else data_dir
-
-
-def simulate_case(case: SiconosCase, data_dir: Path):
+def simulate_case(case: SiconosCase, data_dir: Path = PACKAGED_DATA):
     """``(trajectory, reference rows, seconds)`` for one case."""
-    ref = read_ref(_siconos_root(data_dir) / "refs" / case.file)
+    ref = read_ref(ref_path(siconos_root(data_dir), case.file))
     t = np.arange(ref.shape[0]) * case.h
     start = time.perf_counter()
     tr = case.make().simulate(case.x0, t, theta=case.theta, gamma=case.gamma)
@@ -119,58 +110,5 @@ def state_error(case: SiconosCase, tr, ref) -> float:
     return float((np.abs(tr.x[:, :X.shape[1]] - X).max(axis=0) / np.abs(X).max(axis=0)).max())
 
 
-def check_siconos(data_dir: Path) -> Report:
-    """Agreement records for every Siconos trajectory and LCP test file found under ``data_dir``."""
-    report = Report()
-    for name in CASES:
-        report.add(check_siconos_case(name, data_dir))
-    report.extend(check_siconos_lcps(data_dir))
-    return report
-
-
-def check_siconos_case(name: str, data_dir: Path) -> CheckResult:
-    """The agreement record of the Siconos trajectory ``name`` (a key of :data:`CASES`)."""
-    case = CASES[name]
-    try:
-        tr, ref, seconds = simulate_case(case, _siconos_root(data_dir))
-    except (VerimonoError, OSError) as exc:
-        return CheckResult("siconos_agreement", case.file, FAILED, message=f"{type(exc).__name__}: {exc}")
-    err = state_error(case, tr, ref)
-    ok = err <= SICONOS_RTOL
-    return CheckResult("siconos_agreement", case.file, PASSED if ok else FAILED, worst=err / SICONOS_RTOL,
-                       bound=1.0, message=f"max relative state error {err:.2e} over {ref.shape[0]} rows",
-                       counterexample=None if ok else {"file": case.file, "theta": case.theta,
-                                                       "gamma": case.gamma, "h": case.h},
-                       details={"error": err, "rows": int(ref.shape[0])}, duration=seconds)
-
-
-def check_siconos_lcps(data_dir: Path) -> Report:
-    """One record per Siconos LCP test file (``lcp/*.dat``): solved to the residual, or reported infeasible
-    where it has no solution."""
-    return Report([_check_lcp_file(path) for path in sorted((_siconos_root(data_dir) / "lcp").glob("*.dat"))])
-
-
-def _check_lcp_file(path: Path) -> CheckResult:
-    M, q = read_lcp(path)
-    start = time.perf_counter()
-    try:
-        z = solve_lcp(M, q)
-    except InfeasibleStep as exc:
-        ok = path.name in INFEASIBLE_LCPS
-        return CheckResult("siconos_lcp", path.name, PASSED if ok else FAILED,
-                           message=("reported infeasible, as expected: " if ok else "wrongly reported infeasible: ")
-                           + str(exc)[:200], duration=time.perf_counter() - start)
-    except VerimonoError as exc:
-        return CheckResult("siconos_lcp", path.name, FAILED, message=f"{type(exc).__name__}: {exc}")
-    scale = 1.0 + np.abs(q).max() + np.abs(M).max() * np.abs(z).max()
-    res = lcp_residual(M, q, z) / scale
-    ok = res <= SICONOS_RTOL and path.name not in INFEASIBLE_LCPS
-    msg = (f"complementarity residual {res:.2e} (relative)" if path.name not in INFEASIBLE_LCPS
-           else "a solution was returned for an LCP that has none")
-    return CheckResult("siconos_lcp", path.name, PASSED if ok else FAILED, worst=res / SICONOS_RTOL, bound=1.0,
-                       message=msg, details={"error": res, "n": int(q.size)}, duration=time.perf_counter() - start)
-
-
-__all__ = ["CASES", "SiconosCase", "SICONOS_RTOL", "INFEASIBLE_LCPS", "check_siconos", "check_siconos_case",
-           "check_siconos_lcps", "simulate_case",
+__all__ = ["CASES", "SiconosCase", "SICONOS_RTOL", "INFEASIBLE_LCPS", "PACKAGED_DATA", "simulate_case",
            "state_error"]

@@ -4,7 +4,7 @@
 
 rewritten as ``x' ∈ −H(t, x) + u`` with ``H(t, x) = −Ax + B(𝓜 + D)^{-1}(Cx + v(t))`` (``e:defht``).
 
-One step of size ``h`` of Siconos' ``EulerMoreauOSI(θ)`` (``../shared/siconos/CASES.md``), with
+One step of size ``h`` of Siconos' ``EulerMoreauOSI(θ)`` (``verimono/data/siconos/CASES.md``), with
 ``W = I − hθA``:
 
     x_free = W^{-1}((I + h(1−θ)A) x_k + ∫_{t_k}^{t_{k+1}} u),

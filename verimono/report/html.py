@@ -22,7 +22,8 @@ from collections import Counter, defaultdict
 from html import escape
 from typing import Any
 
-from ..results import FAILED, PASSED, SKIPPED, STATUSES, UNDECIDED, XFAIL, CheckResult, Report, environment, to_jsonable
+from ..environment import environment
+from ..results import FAILED, PASSED, SKIPPED, STATUSES, UNDECIDED, XFAIL, CheckResult, Report, to_jsonable
 from .plots import convergence_plot, trajectory_plot
 
 SECTIONS = ("summary", "changes", "convergence", "trajectories", "laws", "failures", "performance", "timings",
@@ -405,15 +406,19 @@ def _performance(report: Report) -> str:
         spread = f"{_num(min(rounds), '.3g')} – {_num(max(rounds), '.3g')}" if len(rounds) > 1 else "–"
         if "subject_bytes" in d:
             spread = f"{_num(d['subject_bytes'] / 2**20, '.2f')} / {_num(d['baseline_bytes'] / 2**20, '.2f')} MiB"
+        iv = d.get("interval")
+        bounds = (f"{_num(iv[0], '.3g')} – {_num(iv[1], '.3g')}" if isinstance(iv, list) and len(iv) == 2 else "–")
         rows.append([_e(r.check.removeprefix("performance_")), _e(r.subject), _badge(r.status),
                      _num(d.get("ratio"), ".3g") + unit, f"{'≥' if speedup else '≤'} {_num(d.get('target'))}",
-                     spread, _num(d.get("rounds"), "d"), _num(d.get("timing_ratio"), ".3g"), _bar(_ratio(r))])
-    return ('<p class="note">verimono against a bare baseline doing the same work, timed in this job, '
-            "interleaved round by round; the median per-round ratio meets its target. The gate compares "
-            "the gated ratio (larger is worse) with the baseline's, never absolute seconds. Memory: peak "
-            "traced bytes of a streamed study over one trajectory's.</p>"
-            + _table(["check", "subject", "status", "measured", "target", "per-round range", "rounds",
-                      "gated ratio", "measured/target"], rows, (3, 4, 5, 6, 7),
+                     bounds, spread, _num(d.get("rounds"), "d"), _num(d.get("timing_ratio"), ".3g"), _bar(_ratio(r))])
+    return ('<p class="note">verimono against a bare baseline doing the same work, timed in this job on each '
+            "call's own time (wall time minus its wait for a CPU), interleaved round by round; the median "
+            "per-round ratio's order-statistics bounds meet its target (passed), miss it (failed), or straddle it "
+            "after every round the budget allows (undecided: the machine too noisy to judge a speed; not a "
+            "failure). The gate compares the gated ratio (larger is worse) with the baseline's, never absolute "
+            "seconds. Memory: peak traced bytes of a streamed study over one trajectory's.</p>"
+            + _table(["check", "subject", "status", "measured", "target", "bounds", "per-round range", "rounds",
+                      "gated ratio", "measured/target"], rows, (3, 4, 5, 6, 7, 8),
                      ["failed" if r.status == FAILED else "" for r in recs]))
 
 
@@ -475,8 +480,8 @@ def render(report: Report, *, changes: Any = None, title: str = "verimono report
     sub = " · ".join(_e(x) for x in (
         f"verimono {m.get('command') or ''} {m.get('target') or ''}".strip(), f"profile {m.get('profile')}",
         m.get("created") or "", report.summary(), f"run {m['run_id']}" if m.get("run_id") else "") if x)
-    return (f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
-            f'<meta name="viewport" content="width=device-width, initial-scale=1">'
+    return ('<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
+            '<meta name="viewport" content="width=device-width, initial-scale=1">'
             + (f'<meta name="verimono-run-id" content="{_e(m["run_id"])}">' if m.get("run_id") else "")
             + f"<title>{_e(title)}</title><style>{CSS}</style></head><body>"
             f"<header><h1>{_e(title)}</h1><div class=\"sub\">{sub}</div></header><nav>{nav}</nav>"

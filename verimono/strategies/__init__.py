@@ -35,15 +35,12 @@ here: ``verimono.strategies.<name>`` is the public spelling.
 
 from __future__ import annotations
 
-from .values import (ENTRY_FLOOR, MAX_CELLS, MAX_DIM, POINT_SCALE, SET_SCALE, _PRETTY, _ZERO, ACInput,
-                     TimeFunction, _Const, _dim, _entry, _fmt, _Grown, _kinds, _mat, _nonneg_time_functions,
-                     _NormOf, _PlusRate, _Rate, _vec, ac_inputs, floats, points, psd_matrices, step_sizes,
-                     time_functions, times)
-from .sets import MovingSet, _nonzero_vectors, _static_set, convex_sets, moving_sets
-from .operators import (LOGBARRIER_YB, Stated, _MatrixPath, _operator_of, catalog, catalog_operators,
-                        maximal_monotone_operators, monotone_linear_operators, stated_linear_operators,
-                        stated_moving_set_normal_cones, stated_operators, stated_subdifferential_operators,
-                        subdifferential_operators)
+from .values import (ENTRY_FLOOR, MAX_CELLS, MAX_DIM, POINT_SCALE, SET_SCALE, ZERO, ACInput, Constant, Rate,
+                     TimeFunction, ac_inputs, floats, points, psd_matrices, step_sizes, time_functions, times)
+from .sets import MovingSet, convex_sets, moving_sets
+from .operators import (LOGBARRIER_YB, Stated, catalog, catalog_operators, maximal_monotone_operators,
+                        monotone_linear_operators, stated_linear_operators, stated_moving_set_normal_cones,
+                        stated_operators, stated_subdifferential_operators, subdifferential_operators)
 from .systems import LCS_MU_FLOOR, PassiveSystem, lcs_operators, passive_systems
 from .partitions import grids
 
@@ -53,5 +50,5 @@ __all__ = [
     "subdifferential_operators", "maximal_monotone_operators", "catalog", "catalog_operators", "PassiveSystem",
     "passive_systems", "Stated", "stated_linear_operators", "stated_subdifferential_operators",
     "stated_moving_set_normal_cones", "stated_operators", "lcs_operators", "LCS_MU_FLOOR", "LOGBARRIER_YB",
-    "ACInput", "ac_inputs", "grids",
+    "ACInput", "ac_inputs", "grids", "Constant", "Rate", "ZERO", "ENTRY_FLOOR", "MAX_CELLS",
 ]

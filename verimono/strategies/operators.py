@@ -14,8 +14,8 @@ from .. import sets as _sets
 from ..operators import (L1Subdifferential, Linear, LogBarrier, NormalCone, NormSubdifferential, Operator,
                          Shifted)
 from .sets import MovingSet, convex_sets, moving_sets
-from .values import (_ZERO, ACInput, TimeFunction, _Const, _dim, _fmt, _Grown, _nonneg_time_functions, _NormOf,
-                     _PlusRate, _Rate, _vec, ac_inputs, floats, psd_matrices)
+from .values import (ZERO, ACInput, TimeFunction, Constant, _dim, _fmt, _Grown, _nonneg_time_functions, _NormOf,
+                     _PlusRate, Rate, _vec, ac_inputs, floats, psd_matrices)
 
 
 # -- linear operators ------------------------------------------------------------------------------
@@ -40,12 +40,12 @@ def stated_linear_operators(n: int | None = None, time_dependent: bool | None = 
         M0 = draw(psd_matrices(k), label="M0")
         td = draw(st.booleans(), label="time_dependent") if time_dependent is None else time_dependent
         if not td:
-            return Stated(Linear(M0, name=f"Linear[M={_fmt(M0)}]"), phi=_ZERO,
-                          sigma=_Const(float(np.linalg.norm(M0, 2))), theta=_ZERO)
+            return Stated(Linear(M0, name=f"Linear[M={_fmt(M0)}]"), phi=ZERO,
+                          sigma=Constant(float(np.linalg.norm(M0, 2))), theta=ZERO)
         M1 = draw(psd_matrices(k), label="M1")
         g = draw(st.sampled_from(["t", "t^2", "1+sin(t)"]), label="g")
         fn = _MatrixPath(M0, M1, g)
-        return Stated(Linear(fn, name=f"Linear[M(t)={fn!r}]"), phi=_ZERO, sigma=_NormOf(fn))
+        return Stated(Linear(fn, name=f"Linear[M(t)={fn!r}]"), phi=ZERO, sigma=_NormOf(fn))
     return _draw()
 
 
@@ -153,28 +153,28 @@ def stated_subdifferential_operators(n: int | None = None, time_dependent: bool 
         if kind == "norm":
             c = draw(_nonneg_time_functions(0.0, 5.0) if td else floats(0.0, 5.0).map(lambda v: TimeFunction(v, 0.0)))
             op = NormSubdifferential(c if td else c.a, k, name=f"NormSubdifferential[c={c!r}, n={k}]")
-            return Stated(op, phi=_ZERO, sigma=_NormOf(c), theta=_Rate(c.lipschitz))
+            return Stated(op, phi=ZERO, sigma=_NormOf(c), theta=Rate(c.lipschitz))
         if kind == "l1":
             if td:
                 c = draw(_nonneg_time_functions(0.0, 5.0))
                 op = L1Subdifferential(c, k, name=f"L1Subdifferential[c={c!r}, n={k}]")
                 root = float(np.sqrt(k))
-                return Stated(op, phi=_ZERO, sigma=_NormOf(c, root), theta=_Rate(root * c.lipschitz))
+                return Stated(op, phi=ZERO, sigma=_NormOf(c, root), theta=Rate(root * c.lipschitz))
             c = draw(_vec(k, 0.0, 5.0))
-            return Stated(L1Subdifferential(c, k, name=f"L1Subdifferential[c={_fmt(c)}]"), phi=_ZERO,
-                          sigma=_Const(float(np.linalg.norm(c))), theta=_ZERO)
+            return Stated(L1Subdifferential(c, k, name=f"L1Subdifferential[c={_fmt(c)}]"), phi=ZERO,
+                          sigma=Constant(float(np.linalg.norm(c))), theta=ZERO)
         if kind == "logbarrier":
             c = draw(_nonneg_time_functions(0.1, 5.0) if td else floats(0.1, 5.0).map(lambda v: TimeFunction(v, 0.0)))
             op = LogBarrier(c if td else c.a, k, name=f"LogBarrier[c={c!r}, n={k}]")
             cmin = float(c.a) - (abs(float(c.b)) if c.kind == "sin" else 0.0)
             rate = np.sqrt(k) * LOGBARRIER_YB * c.lipschitz ** 1.5 / cmin
-            return Stated(op, phi=_ZERO, theta=_Rate(float(rate)))
+            return Stated(op, phi=ZERO, theta=Rate(float(rate)))
         if kind == "quadratic":
             P = draw(psd_matrices(k, symmetric=True))
-            return Stated(Linear(P, name=f"Gradient[P={_fmt(P)}]"), phi=_ZERO,
-                          sigma=_Const(float(np.linalg.norm(P, 2))), theta=_ZERO)
+            return Stated(Linear(P, name=f"Gradient[P={_fmt(P)}]"), phi=ZERO,
+                          sigma=Constant(float(np.linalg.norm(P, 2))), theta=ZERO)
         S = draw(convex_sets(k))
-        return Stated(NormalCone(S, name=f"NormalCone[{S.name}]"), phi=_ZERO, sigma=_ZERO, theta=_ZERO)
+        return Stated(NormalCone(S, name=f"NormalCone[{S.name}]"), phi=ZERO, sigma=ZERO, theta=ZERO)
     return _draw()
 
 
@@ -185,7 +185,7 @@ def stated_moving_set_normal_cones(n: int | None = None, T: float = 1.0) -> st.S
     ``θ(s+λ) - θ(s) → 0`` bounds: (YB) fails and is not stated."""
     def build(ms: MovingSet) -> Stated:
         op = NormalCone(ms.set, name=f"NormalCone[{ms.set.name}]")
-        return Stated(op, phi=_Rate(ms.rate), sigma=_ZERO, theta=_ZERO if ms.rate == 0 else None)
+        return Stated(op, phi=Rate(ms.rate), sigma=ZERO, theta=ZERO if ms.rate == 0 else None)
     return moving_sets(n, T).map(build)
 
 

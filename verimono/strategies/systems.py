@@ -8,9 +8,10 @@ import dataclasses
 import numpy as np
 from hypothesis import strategies as st
 
-from ..lcs import Complementarity, LinearRelationSystem
+from ..lcs.relations import Complementarity
+from ..lcs.system import LinearRelationSystem
 from .operators import Stated
-from .values import _ZERO, TimeFunction, _Const, _dim, _fmt, _mat, _vec, floats
+from .values import ZERO, TimeFunction, Constant, _dim, _fmt, _mat, _vec, floats
 
 
 # -- passive systems --------------------------------------------------------------------------------
@@ -139,7 +140,7 @@ def lcs_operators(n: int | None = None, m: int | None = None, moving_v: bool | N
         sigma = None
         if mu > LCS_MU_FLOOR:
             nA, nB, nC = (float(np.linalg.norm(X, 2)) for X in (ps.A, ps.B, ps.C))
-            sigma = _Const(nA + nB * (nC + vmax) / mu)
-        static = None if mv else _ZERO
+            sigma = Constant(nA + nB * (nC + vmax) / mu)
+        static = None if mv else ZERO
         return Stated(system.operator(), phi=static, sigma=sigma, theta=static, system=system)
     return _draw()

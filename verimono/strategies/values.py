@@ -182,7 +182,7 @@ def psd_matrices(n: int | None = None, rank: int | None = None,
 # -- the functions of the paper's assumptions -----------------------------------------------------
 
 @dataclasses.dataclass(frozen=True)
-class _Const:
+class Constant:
     """``t ↦ value``."""
 
     value: float
@@ -195,7 +195,7 @@ class _Const:
 
 
 @dataclasses.dataclass(frozen=True)
-class _Rate:
+class Rate:
     """``t ↦ rate·t`` (nondecreasing for ``rate ≥ 0``; ``0`` is the constant function 0)."""
 
     rate: float
@@ -207,7 +207,7 @@ class _Rate:
         return "0" if self.rate == 0 else f"{self.rate:.4g}·t"
 
 
-_ZERO = _Rate(0.0)
+ZERO = Rate(0.0)
 
 
 @dataclasses.dataclass(frozen=True)

@@ -1,48 +1,13 @@
-"""Shared arithmetic of the catalog's fast per-step kernels (operators and sets).
-
-Row-wise inner products and norms are computed as the BLAS ``dot`` of each row, so a batch ``(B, n)``
-and its rows one by one give bit-identical results; the short aliases avoid attribute look-ups in the
-per-step loop.
-"""
+"""Validation of what the solver core is given: step sizes, points, time-dependent parameters — a typed
+:class:`verimono.InvalidProblem` naming what was wrong, never a silent NaN."""
 
 from __future__ import annotations
-
-import math
 
 import numpy as np
 
 from .errors import InvalidProblem
 
-_ar = np.add.reduce
-_mx, _mn = np.maximum, np.minimum
-_sqrt = math.sqrt
-#: the smallest positive double: ``max(r, _TINY) == r`` for every ``r > 0``, and ``0/_TINY == 0``
-_TINY = float(np.finfo(float).smallest_subnormal)
-
-
-if hasattr(np, "vecdot"):  # numpy >= 2
-    def dot_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        """Row-wise inner products over the last axis: the BLAS ``dot`` of each row, i.e. exactly
-        ``a_row.dot(b_row)`` for every row whatever the batch shape (batch ≡ separate, bit for bit)."""
-        return np.vecdot(a, b)
-else:  # pragma: no cover - numpy 1.x: a stack of (1, n) @ (n, 1) products, one BLAS dot per row
-    def dot_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        a, b = np.broadcast_arrays(a, b)
-        return np.matmul(a[..., None, :], b[..., :, None])[..., 0, 0]
-
-
-def _norm(x: np.ndarray) -> np.ndarray:
-    """Euclidean norm over the last axis, keeping it (works for (n,) and (B, n)).
-
-    Each row's squared norm is the BLAS dot of the row with itself (:func:`dot_rows`), exactly the
-    ``x.dot(x)`` of the single-point kernels, so a batch and its rows one by one give identical norms.
-    """
-    return np.sqrt(dot_rows(x, x))[..., None]
-
-
-
-
-_INF = math.inf
+_INF = float("inf")
 
 
 def bad_lam(lam: object, who: str) -> InvalidProblem:
@@ -106,3 +71,6 @@ def batch_column(p: np.ndarray, x: np.ndarray, what: str) -> np.ndarray:
         raise InvalidProblem(f"{what} is a batch of {p.shape[0]} values (one per operator): it applies to "
                              f"points of shape ({p.shape[0]}, n), got a point of shape {x.shape}")
     return p[:, None]
+
+
+__all__ = ["check_lam", "bad_lam", "real_array", "finite_point", "bad_param", "batch_column"]

@@ -1,214 +1,35 @@
-"""The verification run as a list of *stages*: a small registry ``name → callable(profile, context) → Report``.
+"""The stages verimono ships: convergence orders, operator laws, trajectory laws, assumptions, Section 7,
+Siconos agreement and speed — each a list of independent units of work run on the run's executor.
 
-``verimono run`` runs every registered stage in order (or those named with ``--stage``), merges their
-reports and records, per stage, its status, record count and duration in ``report.meta["stages"]``.
-
-A stage never prints and never raises: :func:`run_stages` turns an exception into one *failed* record
-``stage[<name>]`` (a crash fails the run) and :class:`StageUnavailable` — a battery whose module is not
-installed, or data that are absent — into one *skipped* record, so a missing battery is counted and the
-gate sees the count of checks shrink.
-
-To add a battery::
-
-    from verimono.stages import register_stage
-
-    @register_stage("my_laws", "what it verifies")
-    def my_laws(profile, context):          # profile: verimono.profiles.Profile; context: RunContext
-        return check_something(context.stepper, seed=context.seed)     # a verimono.Report
+Units travel to worker processes by pickling: each is a module-level function and its arguments, never a
+lambda.  The heavy modules (the checks, hypothesis, the reference catalog) are imported where a stage
+runs, so ``verimono --help`` stays light.
 """
 
 from __future__ import annotations
 
-import dataclasses
-import functools
-import importlib
-import os
-import time
-import traceback
 from pathlib import Path
 from typing import Any, Callable, Iterable
 
 import numpy as np
 
-from .errors import StageUnavailable, UnknownStage, VerimonoError
-from .profiles import Profile
-from .grids import uniform_grid
-from .results import FAILED, PASSED, SKIPPED, XFAIL, CheckResult, Report, to_jsonable
-from .executors import SerialRunner, Unit
-from .stepping import solve
-from .timeouts import run_unit
+from .. import performance
+from .._jsonable import to_jsonable
+from ..errors import StageUnavailable, VerimonoError
+from ..executors import Unit
+from ..grids import uniform_grid
+from ..profiles import Profile
+from ..results import SKIPPED, CheckResult, Report
+from ..stepping import solve
+from ..timeouts import run_unit
+from ..checks.core import laws_of
+from ..checks.core import subject_name as _name
+from ..checks.pseudo_distance import check_pseudo_distance
+from ..checks.siconos import check_siconos_case, check_siconos_lcps
+from .registry import RunContext, register_stage
 
 #: how many points of a trajectory the report keeps for its plot (enough for a smooth curve)
 TRAJECTORY_SAMPLES = 400
-
-
-@dataclasses.dataclass
-class RunContext:
-    """What every stage may use.
-
-    ``stepper`` is the time-stepper under test (``verimono.solve`` for ``verimono run``); ``problems``
-    the references (``None``: the whole catalog); ``operators`` extra operators to verify (``verimono
-    check`` on an operator); ``data_dir`` the shared data folder (Siconos references) or ``None``;
-    ``progress(done, total, label)`` reports progress within a stage.
-    """
-
-    stepper: Callable | None = None
-    problems: list[Any] | None = None
-    operators: list[tuple[str, Any]] | None = None
-    seed: int | None = None
-    data_dir: Path | None = None
-    progress: Callable[[int, int, str], None] = lambda done, total, label: None
-    executor: Any = None
-
-    _catalog: list[Any] | None = dataclasses.field(default=None, repr=False)
-
-    def catalog(self) -> list[Any]:
-        """``problems`` if given, else the reference catalog (built once per run)."""
-        if self.problems is not None:
-            return self.problems
-        if self._catalog is None:
-            from verimono.reference import catalog
-
-            self._catalog = catalog()
-        return self._catalog
-
-    def run_units(self, profile: Profile, units: list[Any]) -> list[Report]:
-        """The reports of ``units`` (:class:`verimono.executors.Unit`), in their order, run on
-        ``executor`` (serially here when it is ``None``); a unit that raises, whose worker dies or that
-        times out gives one failed record ``unit[<stage>: <label>]`` and the other units' records stay."""
-        runner = self.executor if self.executor is not None else SerialRunner()
-        return runner.map(units, profile.name, self.progress)
-
-    def seed_for(self, profile: Profile) -> int | None:
-        """The seed a randomized battery uses: ``seed`` if given, else 0 under a derandomized profile
-        (``ci``: the same records in every job), else ``None`` (a fresh seed, recorded in each record)."""
-        if self.seed is not None:
-            return self.seed
-        return 0 if profile.derandomize else None
-
-
-@dataclasses.dataclass(frozen=True)
-class Stage:
-    name: str
-    fn: Callable[[Profile, RunContext], Report]
-    description: str = ""
-
-
-STAGES: dict[str, Stage] = {}
-
-
-def register_stage(name: str, description: str = "") -> Callable:
-    """Decorator registering ``fn(profile, context) -> Report`` as the stage ``name`` (replaces same name)."""
-
-    def deco(fn: Callable[[Profile, RunContext], Report]) -> Callable:
-        STAGES[name] = Stage(name, fn, description or (fn.__doc__ or "").strip().split("\n")[0])
-        return fn
-
-    return deco
-
-
-def optional_module(name: str) -> Any:
-    """Import ``name``; :class:`StageUnavailable` if that module (not one of its imports) is missing."""
-    try:
-        return importlib.import_module(name)
-    except ModuleNotFoundError as exc:
-        if exc.name and (name == exc.name or name.startswith(exc.name + ".")):
-            raise StageUnavailable(f"{name} is not installed in this version of verimono") from None
-        raise
-
-
-def _stage_record(name: str, status: str, message: str, duration: float) -> CheckResult:
-    return CheckResult("stage", name, status, message=message, duration=duration)
-
-
-def run_stages(names: Iterable[str] | None, profile: Profile, context: RunContext,
-               on_start: Callable[[Stage, int, int], None] | None = None,
-               on_done: Callable[[Stage, Report, dict], None] | None = None) -> Report:
-    """Run the stages ``names`` (``None``: all, in registration order) and merge their reports."""
-    names = list(STAGES) if names is None else list(names)
-    for n in names:
-        if n not in STAGES:
-            raise UnknownStage(f"unknown stage {n!r}; registered stages: {', '.join(STAGES)}")
-    total = Report(meta={"stages": []})
-    for i, n in enumerate(names):
-        stage = STAGES[n]
-        if on_start:
-            on_start(stage, i, len(names))
-        start = time.perf_counter()
-        try:
-            rep = stage.fn(profile, context)
-            if not isinstance(rep, Report):
-                raise TypeError(f"stage {n} returned {type(rep).__name__}, expected a verimono.Report")
-            status, message = ("failed" if not rep.ok else "passed"), rep.summary()
-        except StageUnavailable as exc:
-            rep = Report([_stage_record(n, SKIPPED, str(exc), time.perf_counter() - start)])
-            status, message = "skipped", str(exc)
-        except Exception as exc:  # a crash is a failure of the run, recorded, never swallowed
-            tb = traceback.format_exc(limit=6)
-            rec = _stage_record(n, FAILED, f"{type(exc).__name__}: {exc}", time.perf_counter() - start)
-            rec.details["traceback"] = tb
-            rep = Report([rec])
-            status, message = "error", f"{type(exc).__name__}: {exc}"
-        duration = time.perf_counter() - start
-        info = {"name": n, "status": status, "records": len(rep), "duration": duration, "message": message}
-        for r in rep.results:
-            r.details.setdefault("stage", n)
-            cx = r.counterexample if isinstance(r.counterexample, dict) else {}
-            if isinstance(cx.get("problem"), str) and cx["problem"] in _reference_names():
-                r.details.setdefault("reference", cx["problem"])  # `--reference NAME` reproduces it
-        total.extend(rep)
-        total.meta["stages"].append(info)
-        if on_done:
-            on_done(stage, rep, info)
-    return total
-
-
-@functools.lru_cache(maxsize=1)
-def _reference_names() -> frozenset[str]:
-    """Names ``verimono run --reference NAME`` accepts (the reference catalog's)."""
-    from verimono.reference import catalog
-
-    return frozenset(p.name for p in catalog())
-
-
-def calibrate(repeats: int = 3) -> float:
-    """Seconds of a fixed NumPy-and-Python workload like the harness's (best of ``repeats``).
-
-    Stage durations divided by this number are comparable between jobs on different machines: the gate
-    compares these ratios, measured in the same job, never absolute seconds.
-    """
-    best = float("inf")
-    for _ in range(repeats):
-        x, lo, hi = np.array([0.3, -0.2, 0.9]), -np.ones(3) * 0.5, np.ones(3) * 0.5
-        start = time.perf_counter()
-        for k in range(20000):
-            x = np.clip(x - 1e-3 * np.sin(k * 1e-3) * x, lo, hi)
-        np.linalg.solve(np.eye(60) * 4.0 + np.ones((60, 60)), np.ones(60))
-        best = min(best, time.perf_counter() - start)
-    return best
-
-
-def locate_data(explicit: str | os.PathLike | None = None) -> Path | None:
-    """The shared data folder: ``explicit``, else ``$VERIMONO_SHARED``, else ``../shared`` beside the
-    current directory or beside the verimono checkout; ``None`` when none exists."""
-    if explicit is not None:
-        path = Path(explicit)
-        if not path.is_dir():
-            raise StageUnavailable(f"data folder {path} does not exist")
-        return path
-    candidates = []
-    if os.environ.get("VERIMONO_SHARED"):
-        candidates.append(Path(os.environ["VERIMONO_SHARED"]))
-    candidates += [Path.cwd().parent / "shared", Path(__file__).resolve().parents[1].parent / "shared"]
-    return next((c for c in candidates if c.is_dir()), None)
-
-
-def _name(obj: Any) -> str:
-    return getattr(obj, "__name__", None) or getattr(obj, "name", None) or type(obj).__name__
-
-
-# ---------------------------------------------------------------------------------------------------
-# the stages verimono ships
 
 
 def sample_trajectory(stepper: Callable, problem: Any, h: float | None = None) -> dict[str, Any]:
@@ -231,7 +52,7 @@ def sample_trajectory(stepper: Callable, problem: Any, h: float | None = None) -
 
 def _convergence_unit(stepper: Callable, problem: Any) -> Report:
     """One reference: its convergence-order record and study, and a trajectory sample for the plots."""
-    from .checks.orders import check_convergence_order
+    from ..checks.orders import check_convergence_order
 
     report = Report()
     rec = report.add(run_unit(lambda: check_convergence_order(stepper, problem), check="convergence_order",
@@ -275,12 +96,10 @@ def _catalog_operators(context: RunContext) -> list[tuple[str, Any]]:
 def _generated_operators(profile: Profile, seed: int | None) -> list[tuple[str, Any]]:
     """``profile.generated_subjects`` operators drawn from ``verimono.strategies.maximal_monotone_operators``
     in dimensions 1-3 (reproducibly from ``seed``; a fresh draw when ``seed`` is None)."""
-    strategies = optional_module("verimono.strategies")
-    family = getattr(strategies, "maximal_monotone_operators", None)
-    if family is None:
-        raise StageUnavailable("verimono.strategies has no maximal_monotone_operators")
     from hypothesis import HealthCheck, Phase, given, settings
     from hypothesis import seed as hseed
+
+    from ..strategies.operators import maximal_monotone_operators
 
     drawn: list[tuple[int, Any]] = []
     dims = (1, 2, 3)
@@ -289,7 +108,7 @@ def _generated_operators(profile: Profile, seed: int | None) -> list[tuple[str, 
         # skip hypothesis' first, simplest example (the zero operator) so the draws exercise real cases
         @settings(max_examples=per_dim + 1, derandomize=False, database=None, phases=[Phase.generate],
                   deadline=None, suppress_health_check=list(HealthCheck))
-        @given(family(n))
+        @given(maximal_monotone_operators(n))
         def collect(op):
             drawn.append((op.dim, op))
 
@@ -309,7 +128,8 @@ def operator_laws_stage(profile: Profile, context: RunContext) -> Report:
     """``check_operator`` on each catalog operator (or the user's) and on generated families.
 
     Records are renamed ``subject = <label>`` (the operator's problem or draw) so keys stay unique."""
-    laws = optional_module("verimono.checks.operator_laws")
+    from ..checks.operator_battery import check_operator
+
     report = Report()
     if context.operators is not None:
         subjects = list(context.operators)
@@ -320,7 +140,7 @@ def operator_laws_stage(profile: Profile, context: RunContext) -> Report:
         except StageUnavailable as exc:
             report.add(CheckResult("stage", "operator_laws: generated families", SKIPPED, message=str(exc)))
     units = [Unit("operator_laws", label, _operator_unit,
-                  (laws.check_operator, label, op, context.seed_for(profile), profile.law_examples))
+                  (check_operator, label, op, context.seed_for(profile), profile.law_examples))
              for label, op in subjects]
     return report.extend(_merged(context.run_units(profile, units)))
 
@@ -338,10 +158,11 @@ def _operator_unit(check_operator: Callable, label: str, op: Any, seed: int | No
 def trajectory_laws_stage(profile: Profile, context: RunContext) -> Report:
     """The trajectory laws of the stepper under test on every reference (and, without a user-given
     problem list, on ``profile.generated_subjects`` sampled problems)."""
-    mod = optional_module("verimono.checks.trajectory_laws")
+    from ..checks.stepper_battery import stepper_checks
+
     stepper = solve if context.stepper is None else context.stepper
     seed = context.seed_for(profile)
-    checks = list(mod.stepper_checks(stepper, context.problems, seed=0 if seed is None else seed,
+    checks = list(stepper_checks(stepper, context.problems, seed=0 if seed is None else seed,
                                      generated=profile.generated_subjects, orders=False))
     # one unit per subject problem (the battery of checks ``law[problem]`` on it), in first-seen order;
     # the records are then put back in the order of ``checks``, as a serial loop over them gives
@@ -383,9 +204,10 @@ def assumptions_stage(profile: Profile, context: RunContext) -> Report:
     Theorem ``thm:main`` needs (A1)–(A3) and *one of* (LG) or (YB): the composite law
     :func:`verimono.checks.assumptions.thm_main` states it (an ``xfail`` for the alternative that fails
     while the other holds, one ``assumptions_thm_main`` record per problem)."""
-    mod = optional_module("verimono.checks.assumptions")
+    from ..checks.assumptions import check_assumptions
+
     seed = context.seed_for(profile)
-    units = [Unit("assumptions", p.name, _assumptions_unit, (mod.check_assumptions, p, seed))
+    units = [Unit("assumptions", p.name, _assumptions_unit, (check_assumptions, p, seed))
              for p in context.catalog()]
     return _merged(context.run_units(profile, units))
 
@@ -407,19 +229,18 @@ def section7_stage(profile: Profile, context: RunContext) -> Report:
     """The complementarity systems of the paper (``verimono.reference.lcs_example``): convergence order
     of the stepper under test on each, a trajectory sample, and the evidence for the hypotheses of the
     Section 7 theorems (``verimono.lcs.check_hypotheses``); one unit per record (or per system)."""
-    example = optional_module("verimono.reference.lcs_example")
-    optional_module("verimono.lcs")
+    from verimono.reference import lcs_example as example
+
     stepper = solve if context.stepper is None else context.stepper
     in_catalog = {p.name for p in context.catalog()}  # already studied by the convergence stage
     problems = [p for p in (example.ramp_problem(), example.sine_problem()) if p.name not in in_catalog]
     seed = context.seed_for(profile)
     seed = 0 if seed is None else seed
     units = [Unit("section7", p.name, _convergence_unit, (stepper, p)) for p in problems]
-    units += [Unit("section7", "closed-form resolvent", _record_unit, ("check_closed_form_resolvent", seed))]
-    if hasattr(example, "check_batched_scheme"):   # a batch of trajectories in one simulate (issue 15)
-        units.append(Unit("section7", "batched scheme", _record_unit, ("check_batched_scheme", seed)))
-    units.append(Unit("section7", "unbounded pseudo-distance", _record_unit, ("check_pseudo_distance_unbounded",)))
-    # def:dis against the exact d_H of catalog sets, and the Picard step of Section 6 (issue 13)
+    units += [Unit("section7", "closed-form resolvent", _record_unit, ("example_resolvent_closed_form", seed)),
+              Unit("section7", "batched scheme", _record_unit, ("example_batched_scheme", seed)),
+              Unit("section7", "unbounded pseudo-distance", _record_unit, ("example_pseudo_distance_unbounded",))]
+    # def:dis against the exact d_H of catalog sets, and the Picard step of Section 6
     units.append(Unit("section7", "pseudo-distance", _pseudo_distance_unit, (seed,)))
     units += [Unit("section7", f"Picard step on {p.name}", _picard_unit, (stepper, p)) for p in context.catalog()
               if p.f is not None and p.lipschitz is not None]
@@ -432,56 +253,58 @@ _INPUTS = {"v = (−t, 0)": lambda t: np.array([-t, 0.0]), "v = (sin t, 0)": lam
 
 
 def _record_unit(name: str, *args: Any) -> Report:
-    """One record of ``verimono.reference.lcs_example`` (``name(*args)``, ``args`` the seed if any)."""
-    fn = getattr(optional_module("verimono.reference.lcs_example"), name)
-    return Report([fn(seed=args[0]) if args else fn()])
+    """The record of the Example's law ``name`` (:mod:`verimono.checks.example`; ``args``: its seed, if any)."""
+    from ..checks import example  # noqa: F401 - the Example's laws join the registry on import
+
+    check = laws_of("system")[name].public
+    return Report([check(seed=args[0]) if args else check()])
 
 
 def _pseudo_distance_unit(seed: int) -> Report:
-    from .checks.pseudo_distance import check_pseudo_distance
-
     return Report([check_pseudo_distance(seed=seed)])
 
 
 def _picard_unit(stepper: Callable, problem: Any) -> Report:
-    from .checks.picard import check_picard
+    from ..checks.picard import check_picard
 
     return Report([check_picard(stepper, problem)])
 
 
 def _hypotheses_unit(label: str, seed: int) -> Report:
     """The Section 7 hypotheses of the Example with input ``label``, each record's subject naming it."""
-    example = optional_module("verimono.reference.lcs_example")
-    rep = optional_module("verimono.lcs").check_hypotheses(example.example_system(_INPUTS[label]), 2.0, seed=seed)
+    from verimono.reference import lcs_example
+
+    from ..checks.section7 import check_hypotheses
+
+    rep = check_hypotheses(lcs_example.example_system(_INPUTS[label]), 2.0, seed=seed)
     for r in rep.results:
         r.subject = f"{r.subject} ({label})"
     return rep
 
 
-@register_stage("siconos", "agreement with the Siconos reference trajectories in the shared data folder")
+@register_stage("siconos", "agreement with the Siconos reference trajectories shipped in verimono/data")
 def siconos_stage(profile: Profile, context: RunContext) -> Report:
-    """Agreement with the Siconos reference trajectories (needs ``../shared`` or ``--data DIR``)."""
-    cases = optional_module("verimono.lcs.siconos_cases")
-    if context.data_dir is None:
-        raise StageUnavailable("Siconos reference data not found: pass --data DIR or set VERIMONO_SHARED")
-    data = Path(context.data_dir)
-    units = [Unit("siconos", name, _siconos_unit, ("check_siconos_case", name, data)) for name in cases.CASES]
-    units.append(Unit("siconos", "LCP test files", _siconos_unit, ("check_siconos_lcps", data)))
+    """Agreement with the Siconos reference trajectories (the packaged data, or ``--data DIR``)."""
+    from ..lcs import siconos_cases as cases
+
+    data = Path(context.data_dir) if context.data_dir is not None else cases.PACKAGED_DATA
+    units = [Unit("siconos", name, _siconos_unit, (check_siconos_case, name, data)) for name in cases.CASES]
+    units.append(Unit("siconos", "LCP test files", _siconos_unit, (check_siconos_lcps, data)))
     return _merged(context.run_units(profile, units))
 
 
-def _siconos_unit(name: str, *args: Any) -> Report:
-    """``verimono.lcs.siconos_cases.<name>(*args)`` as a report (one trajectory case, or the LCP files)."""
-    out = getattr(optional_module("verimono.lcs.siconos_cases"), name)(*args)
+def _siconos_unit(check: Callable, *args: Any) -> Report:
+    """``check(*args)`` (one Siconos trajectory case, or the LCP files) as a report."""
+    out = check(*args)
     return out if isinstance(out, Report) else Report([out])
 
 
 @register_stage("performance", "verimono against bare baselines, as same-job ratios: per-step overhead, "
                 "ensembles, DiodeBridge, memory")
 def performance_stage(profile: Profile, context: RunContext) -> Report:
-    """The issue 6 targets as records (``verimono.performance``), at the sizes of ``profile``; each
+    """The speed targets as records (:mod:`verimono.performance`), at the sizes of ``profile``; each
     record's ``details["timing_ratio"]`` is gated against the baseline by ratio, never by seconds."""
-    perf = optional_module("verimono.performance")
+
     aside = None
     if getattr(context.executor, "workers", 1) >= 2:   # a worker is idle: the memory record runs there
         def aside(steps: int, stepper: Any) -> Callable[[], CheckResult]:
@@ -492,14 +315,13 @@ def performance_stage(profile: Profile, context: RunContext) -> Report:
             future = pool.submit(context.executor.map, [unit], profile.name, lambda done, total, label: None)
             pool.shutdown(wait=False)
             return lambda: future.result()[0].results[0]
-    return perf.performance_report(perf.SIZES[profile.name], stepper=context.stepper, progress=context.progress,
+    return performance.performance_report(performance.SIZES[profile.name], stepper=context.stepper, progress=context.progress,
                                    aside=aside)
 
 
 def _memory_unit(steps: int, stepper: Any) -> Report:
     """The memory record (:func:`verimono.performance.check_memory`) as a unit of work."""
-    return Report([optional_module("verimono.performance").check_memory(steps=steps, stepper=stepper)])
+    return Report([performance.check_memory(steps=steps, stepper=stepper)])
 
 
-__all__ = ["STAGES", "Stage", "RunContext", "StageUnavailable", "UnknownStage", "register_stage",
-           "run_stages", "calibrate", "locate_data", "optional_module", "sample_trajectory"]
+__all__ = ["sample_trajectory", "TRAJECTORY_SAMPLES"]

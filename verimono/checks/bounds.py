@@ -1,0 +1,333 @@
+"""The a-priori bounds of the convergence proof (Section 5): lemmas ``lem:bndSeq``, ``lem:bndSeqYB`` and
+``lem:bndEquiCont``, with β, γ and ψ computed as the lemmas define them.
+
+* ``bounds_lg`` — lemma ``lem:bndSeq`` under (A3) and (LG): ``|x_k| ≤ β`` and
+  ``|x_k - x_{k-1}| ≤ ψ(t_k) - ψ(t_{k-1})`` with ``β, ψ`` of ``e:only beta``, ``eq:defPsi``; with an
+  input ``u``, applied to ``ξ_k = x_k - Φ(t_k)`` through lemma ``l:extinput`` (``φ̄ = φ + ∫|u|``,
+  ``σ̄ = σ (1 + ∫_0^T |u|)``).
+* ``bounds_yb`` — lemma ``lem:bndSeqYB`` under (YB): ``β = |x0| + αT``, ``ψ(t) = αt``,
+  ``α = 2(θ(T) - θ(0)) + |F^0(0, x0)|``.
+* ``psi_interpolation`` — lemma ``lem:bndEquiCont``: the ψ-interpolant ``x_Δ`` of ``e:x delta`` obeys
+  ``|x_Δ(τ̄) - x_Δ(τ)| ≤ ψ(τ̄) - ψ(τ)``.
+
+The constants φ, σ, θ are the problem's (stated), else what the operator declares of itself (a domain that
+does not move, a growth :meth:`verimono.Operator.growth`); a law whose constants are not known is skipped
+before the stepper runs.  They bind the proximal scheme only: the lemmas bound its iterates.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable, Iterable
+
+import numpy as np
+from scipy import integrate
+
+from ..errors import NotApplicable, OutsideDomain
+from ..operators import Operator, provides
+from ..problem import Problem
+from ..stepping import Trajectory
+from ..tolerances import tolerance
+from .core import PROXIMAL_CLAIM, Holds, Outcome
+from .partitions import run_stepper, single, stepper_law
+from .trajectory_laws import norms
+
+
+def _vals(fn: Callable, t: Iterable[float]) -> np.ndarray:
+    return np.array([float(fn(float(s))) for s in t])
+
+
+def _cell_integrals(fn: Callable, t: np.ndarray) -> np.ndarray:
+    """``∫_{t_k}^{t_{k+1}} fn`` on every cell (adaptive quadrature; ``fn`` may be non-smooth)."""
+    return np.array([integrate.quad(lambda s: float(fn(s)), a, b, limit=100)[0] for a, b in zip(t[:-1], t[1:])])
+
+
+def _cumulative(fn: Callable, t: np.ndarray) -> np.ndarray:
+    return np.concatenate([[0.0], np.cumsum(_cell_integrals(fn, t))])
+
+
+def _holds(*tests: Callable[[Problem], Any]) -> Holds:
+    """A requirement met when every test passes on the (first row of the) problem; the reason is the
+    :class:`NotApplicable` message of the first that does not."""
+    def check(problem: Problem) -> str | None:
+        p = single(problem)
+        for test in tests:
+            try:
+                test(p)
+            except NotApplicable as exc:
+                return str(exc)
+        return None
+    return Holds(check)
+
+
+def _either(*tests: Callable[[Problem], Any]) -> Holds:
+    """Met when at least one test passes (ψ of lem:bndSeq *or* of lem:bndSeqYB)."""
+    def check(problem: Problem) -> str | None:
+        reasons = [_holds(t).test(problem) for t in tests]
+        return None if any(r is None for r in reasons) else "no ψ available — " + "; ".join(reasons)
+    return Holds(check)
+
+
+def _phi_of(problem: Problem) -> tuple[Callable[[float], float], str]:
+    """φ of (A3): the problem's, or ``φ ≡ 0`` when ``dom F(t,·)`` cannot move (static or all of R^n)."""
+    if problem.phi is not None:
+        return problem.phi, "stated"
+    op = problem.operator
+    if getattr(op, "full_domain", False) or getattr(op, "static", False):
+        return (lambda t: 0.0), "derived: dom F(t) does not move"
+    raise NotApplicable("the problem states no φ of (A3) and the domain of F may move")
+
+
+def _sigma_of(problem: Problem) -> tuple[Callable[[float], float], str]:
+    """σ of (LG): the problem's, or the growth the operator states of itself (:meth:`verimono.Operator.growth`:
+    ``N_S`` has ``F^0 = 0``, ``Linear`` ``‖M(t)‖₂``, ``∂(c|·|)`` and ``∂(Σc_i|x_i|)`` ``|F^0(t, 1)|``)."""
+    if problem.sigma is not None:
+        return problem.sigma, "stated"
+    op = problem.operator
+    if provides(op, "growth"):
+        return op.growth, f"derived: the growth {op.name} states"
+    raise NotApplicable("the problem states no σ of (LG)")
+
+
+def _theta_of(problem: Problem) -> tuple[Callable[[float], float], str]:
+    """θ of (YB): the problem's, or ``θ ≡ 0`` for a static operator (Prop. ``prop:maxmon-resolvent-Yosida``
+    vi: ``|Y_λ x| ≤ |F^0(x)|``; the paper's remark after Theorem ``thm:main``)."""
+    if problem.theta is not None:
+        return problem.theta, "stated"
+    if getattr(problem.operator, "static", False):
+        return (lambda t: 0.0), "derived: static operator, theta constant"
+    raise NotApplicable("the problem states no θ of (YB)")
+
+
+class LGBounds:
+    """β, γ and ψ of lemma ``lem:bndSeq`` (``e:only beta``, ``eq:defPsi``, ``e:alpha and r alpha``,
+    ``e:gamma and r gamma``) for ``|x0|``, ``φ`` and ``σ`` on ``[0, T]``.
+
+    With an input (lemma ``l:extinput``) pass ``absu = |u|``: then ``φ̄ = φ + ∫_0^t |u|`` and
+    ``σ̄ = σ (1 + ∫_0^T |u|)`` are used.
+    """
+
+    def __init__(self, x0_norm: float, phi: Callable, sigma: Callable, T: float,
+                 absu: Callable | None = None, grid: np.ndarray | None = None) -> None:
+        self.phi0, self.sigma0, self.T, self.absu = phi, sigma, T, absu
+        self.grid = None if grid is None else np.asarray(grid, dtype=float)
+        if self.grid is not None:
+            # the proof uses (LG) only at the nodes, |F^0(t_k, ξ)| ≤ σ(t_k)(1 + |ξ|): on this partition ∫σ
+            # becomes the right Riemann sum Σ h_k σ(t_k) (exact for σ piecewise constant on the cells; the
+            # paper reaches ∫σ only along specially chosen partitions, via Lakshmikantham–Leela 3.3.1)
+            h = np.diff(self.grid)
+            self._sigma_nodes = np.concatenate([[0.0], np.cumsum(h * _vals(sigma, self.grid[1:]))])
+        self.u_total = 0.0 if absu is None else integrate.quad(absu, 0.0, T, limit=200)[0]
+        dphi = float(phi(T)) - float(phi(0.0))
+        if dphi < -tolerance(phi(T), phi(0.0)):
+            raise NotApplicable(f"φ must be nondecreasing; φ(T) - φ(0) = {dphi:.3g}")
+        dphi += self.u_total
+        int_sigma = (1.0 + self.u_total) * float(self._sigma_cumulative(np.array([0.0, T]))[-1])
+        self.alpha = x0_norm + dphi
+        self.beta = self.alpha + dphi + (1.0 + self.alpha) * int_sigma
+        self.gamma = self.beta + dphi
+
+    def _sigma_cumulative(self, pts: np.ndarray) -> np.ndarray:
+        """``∫_0^s σ`` at the increasing ``pts`` (from 0), or its Riemann-sum version on the partition."""
+        if self.grid is None:
+            return _cumulative(self.sigma0, pts)
+        return np.interp(pts, self.grid, self._sigma_nodes)
+
+    def psi_nodes(self, t: np.ndarray) -> np.ndarray:
+        """``ψ`` at the increasing points ``t`` (``t_0 = 0`` or not)."""
+        t = np.asarray(t, dtype=float)
+        pts = np.concatenate([[0.0], t]) if t[0] > 0 else t
+        phi = _vals(self.phi0, pts)
+        if self.absu is not None:
+            phi = phi + _cumulative(self.absu, pts)
+        out = pts + 2.0 * phi + (1.0 + self.gamma) * (1.0 + self.u_total) * self._sigma_cumulative(pts)
+        return out[1:] if t[0] > 0 else out
+
+    def psi_function(self, points: np.ndarray) -> Callable[[float], float]:
+        """``ψ`` tabulated at ``points`` (exact there), for :meth:`Trajectory.interpolate`."""
+        pts = np.unique(np.asarray(points, dtype=float))
+        table = dict(zip(pts.tolist(), self.psi_nodes(pts).tolist()))
+        return lambda s: table[float(s)] if float(s) in table else float(self.psi_nodes(np.array([s]))[-1])
+
+    def constants(self) -> dict:
+        return {"alpha": self.alpha, "beta": self.beta, "gamma": self.gamma}
+
+
+class YBBounds:
+    """β and ψ of lemma ``lem:bndSeqYB``: ``α = 2(θ(T) - θ(0)) + |F^0(0, x0)|``, ``β = |x0| + αT``,
+    ``ψ(t) = αt`` (``eq:betaYB``, ``eq:defPsiYB``)."""
+
+    def __init__(self, x0: np.ndarray, theta: Callable, op: Operator, T: float) -> None:
+        try:
+            f0 = float(np.linalg.norm(op.min_norm(x0, 0.0)))
+        except OutsideDomain:
+            raise NotApplicable("x0 is not in dom F(0,·) (lem:bndSeqYB needs |F^0(0, x0)|)") from None
+        if not np.isfinite(f0):   # x0 within rounding of the boundary: F^0 overflows (c/x at x = 7e-304)
+            raise NotApplicable(f"|F^0(0, x0)| = {f0} is not finite: x0 is at the edge of dom F(0,·), where "
+                        "lem:bndSeqYB's α is infinite and its bounds say nothing")
+        self.alpha = 2.0 * (float(theta(T)) - float(theta(0.0))) + f0
+        self.beta = float(np.linalg.norm(x0)) + self.alpha * T
+        self.f0 = f0
+
+    def psi_nodes(self, t: np.ndarray) -> np.ndarray:
+        return self.alpha * np.asarray(t, dtype=float)
+
+    def psi_function(self, points: np.ndarray) -> Callable[[float], float]:
+        return lambda s: self.alpha * float(s)
+
+    def constants(self) -> dict:
+        return {"alpha": self.alpha, "beta": self.beta, "F0_at_x0": self.f0}
+
+
+def _lg_requirements(p: Problem) -> None:
+    """What lem:bndSeq assumes of the problem (raises :class:`NotApplicable` with the reason)."""
+    if p.initial_jump:
+        raise NotApplicable("x0 is outside cl dom F(0,·) (catching-up jump): lem:bndSeq assumes x0 in the closure")
+    if p.f is not None:
+        raise NotApplicable("the bounds of the Lipschitz-perturbation theorem involve a constant C_1 that is not "
+                    "explicit; lem:bndSeq covers f = 0")
+    _phi_of(p), _sigma_of(p)
+    if p.u is None and p.U is not None:
+        raise NotApplicable("an input given only by its primitive U: ∫|u| is not available")
+
+
+def _yb_requirements(p: Problem) -> None:
+    """What lem:bndSeqYB assumes of the problem (raises :class:`NotApplicable` with the reason)."""
+    if p.initial_jump:
+        raise NotApplicable("x0 is outside dom F(0,·) (catching-up jump): lem:bndSeqYB assumes x0 in dom F(0,·)")
+    if p.f is not None:
+        raise NotApplicable("lem:bndSeqYB covers f = 0 (the Lipschitz theorem's constants are not explicit)")
+    if p.u is not None or p.U is not None:
+        raise NotApplicable("with an input, lem:bndSeqYB would apply to G(t, ξ) = F(t, ξ + Φ(t)) (l:extinput), but (YB) "
+                    "does not pass from F to G: t:non-auto's θ̄ = M_u + θ has the increments of θ (the constant "
+                    "cancels) while the defect |Φ(s+λ) − Φ(s)|/λ ≈ |u(s)| stays as λ → 0 (F = ∂|x|, u = 1: G "
+                    "fails (YB) for every θ)")
+    _theta_of(p)
+
+
+def _lg_setup(p: Problem, t: np.ndarray):
+    """Bounds of lem:bndSeq and the sequence they bound (``ξ_k = x_k - Φ(t_k)`` with an input)."""
+    _lg_requirements(p)
+    (phi, phi_src), (sigma, sigma_src) = _phi_of(p), _sigma_of(p)
+    shift = np.zeros((len(t), p.dim))
+    extra = {"phi": phi_src, "sigma": sigma_src}
+    absu = None
+    if p.u is not None or p.U is not None:
+        # lemma l:extinput: ξ = x - Φ solves the scheme of G(t, ξ) = F(t, ξ + Φ(t)), which satisfies (A3)
+        # with φ̄ = φ + ∫|u| and (LG) with σ (1 + |Φ|) ≤ σ (1 + ∫_0^T |u|)
+        if p.u is None:
+            raise NotApplicable("an input given only by its primitive U: ∫|u| is not available")
+        shift = np.concatenate([np.zeros((1, p.dim)), np.cumsum(p.input_increments(t), axis=0)])
+        absu = lambda s: float(np.linalg.norm(p.u(s)))  # noqa: E731
+        extra["via"] = "l:extinput (xi_k = x_k - Phi(t_k))"
+    return LGBounds(float(np.linalg.norm(p.x0)), phi, sigma, p.T, absu, grid=t), shift, extra
+
+
+def _yb_setup(p: Problem, t: np.ndarray):
+    _yb_requirements(p)
+    theta, src = _theta_of(p)
+    return YBBounds(p.x0, theta, p.operator, p.T), np.zeros((len(t), p.dim)), {"theta": src}
+
+
+def _bounded(stepper: Callable, p: Problem, t: np.ndarray, setup: Callable, label: str, passed: str) -> Outcome:
+    """``|ξ_k| ≤ β`` and ``|ξ_k - ξ_{k-1}| ≤ ψ(t_k) - ψ(t_{k-1})`` for the sequence ``ξ`` the lemma bounds
+    (``ξ = x`` without an input, ``x - Φ`` with one), with the lemma's β and ψ from ``setup``."""
+    bounds, shift, extra = setup(p, t)
+    x = run_stepper(stepper, p, t)
+    xi = x - shift
+    psi = bounds.psi_nodes(t)
+    nx = norms(xi)
+    steps = norms(np.diff(xi, axis=0))
+    dpsi = np.diff(psi)
+    r_beta = nx / (bounds.beta + tolerance(bounds.beta, nx))
+    r_step = steps / (dpsi + tolerance(xi, psi))
+    ratios = np.maximum(r_beta[1:], r_step)
+    bad = np.flatnonzero(ratios > 1.0)
+    k = int(bad[0]) + 1 if bad.size else int(np.argmax(ratios)) + 1
+    which = "|x_k| <= beta" if r_beta[k] >= r_step[k - 1] else "|x_k - x_(k-1)| <= psi(t_k) - psi(t_(k-1))"
+    counter = {"k": k, "t_k": t[k], "x_k": xi[k], "x_k_minus_1": xi[k - 1], "bound": which,
+               "norm_x_k": nx[k], "step": steps[k - 1], "psi_increment": dpsi[k - 1], **bounds.constants(),
+               **extra,
+               "message": f"{label}: {which} fails at k = {k}, t_k = {t[k]:.6g}: |x_k| = {nx[k]:.6g}, "
+                          f"beta = {bounds.beta:.6g}, |x_k - x_(k-1)| = {steps[k - 1]:.6g}, "
+                          f"psi increment = {dpsi[k - 1]:.6g}"}
+    details = {**bounds.constants(), **extra, "max_ratio_beta": float(np.max(r_beta)),
+               "max_ratio_psi": float(np.max(r_step))}
+    return Outcome(float(np.max(ratios)), k, counter, details, message=passed)
+
+
+@stepper_law("bounds_lg", "lem:bndSeq", PROXIMAL_CLAIM, _holds(_lg_requirements))
+def check_bounds_lg(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int = 0) -> Outcome:
+    """Lemma ``lem:bndSeq`` (under (A3), (LG)): ``|x_k| ≤ β``, ``|x_k - x_{k-1}| ≤ ψ(t_k) - ψ(t_{k-1})``.
+
+    ``β = α + φ(T) - φ(0) + (1 + α)∫_0^T σ``, ``ψ(t) = t + 2φ(t) + (1 + γ)∫_0^t σ``, ``α = |x0| + φ(T) -
+    φ(0)``, ``γ = β + φ(T) - φ(0)``.  For non-constant σ the lemma holds on fine enough partitions (the
+    proof's piecewise-constant approximation); the default partitions have 40 cells.
+
+    Claim: ``proximal`` — the lemma bounds the iterates of the paper's scheme on the given partition.
+    """
+    return _bounded(stepper, p, t, _lg_setup, "lem:bndSeq",
+                    "|x_k| <= beta and |x_k - x_(k-1)| <= psi(t_k) - psi(t_(k-1)) (lem:bndSeq)")
+
+
+@stepper_law("bounds_yb", "lem:bndSeqYB", PROXIMAL_CLAIM, _holds(_yb_requirements))
+def check_bounds_yb(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int = 0) -> Outcome:
+    """Lemma ``lem:bndSeqYB`` (under (YB), ``|Δ| < Λ``): ``|x_k| ≤ |x0| + αT`` and
+    ``|x_k - x_{k-1}| ≤ α h_k`` with ``α = 2(θ(T) - θ(0)) + |F^0(0, x0)|``.
+
+    Claim: ``proximal`` — the lemma bounds the iterates of the paper's scheme on the given partition."""
+    return _bounded(stepper, p, t, _yb_setup, "lem:bndSeqYB",
+                    "|x_k| <= |x0| + alpha T and |x_k - x_(k-1)| <= alpha h_k (lem:bndSeqYB)")
+
+
+# -- ψ-interpolation --------------------------------------------------------------------------------
+
+@stepper_law("psi_interpolation", "lem:bndEquiCont", PROXIMAL_CLAIM, _either(_lg_requirements, _yb_requirements))
+def check_psi_interpolation(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int = 0,
+                            samples: int = 40) -> Outcome:
+    """Lemma ``lem:bndEquiCont``: ``|x_Δ(τ̄) - x_Δ(τ)| ≤ ψ(τ̄) - ψ(τ)`` for the ψ-interpolant ``e:x delta``.
+
+    ``ψ`` from lem:bndSeq and/or lem:bndSeqYB (whichever applies); ``x_Δ`` from
+    :meth:`verimono.Trajectory.interpolate` with ``kind="psi"``; all pairs among the nodes, cell
+    midpoints and ``samples`` random times.
+
+    Claim: ``proximal`` — ``x_Δ`` interpolates the proximal iterates with the ψ of their lemmas.
+    """
+    setups = []
+    reasons = []
+    for label, setup in (("lem:bndSeq", _lg_setup), ("lem:bndSeqYB", _yb_setup)):
+        try:
+            setups.append((label,) + setup(p, t))
+        except NotApplicable as exc:
+            reasons.append(f"{label}: {exc}")
+    setups = [s for s in setups if not (isinstance(s[1], YBBounds) and s[1].alpha <= 0.0)]
+    if not setups:
+        raise NotApplicable("no ψ available — " + "; ".join(reasons) if reasons else "ψ ≡ 0 (α = 0)")
+    x = run_stepper(stepper, p, t)
+    rng = np.random.default_rng(seed)
+    tau = np.unique(np.concatenate([t, 0.5 * (t[:-1] + t[1:]), rng.uniform(0.0, p.T, samples)]))
+    worst, best, det = -np.inf, None, {}
+    for label, bounds, shift, extra in setups:
+        traj = Trajectory(t, x - shift, None)
+        psi = bounds.psi_function(np.union1d(t, tau))
+        X = traj.interpolate(tau, kind="psi", psi=psi)
+        P = np.array([psi(s) for s in tau])
+        i, j = np.triu_indices(len(tau), 1)
+        lhs = norms(X[j] - X[i])
+        rhs = P[j] - P[i]
+        ratio = lhs / (rhs + tolerance(X, P))
+        m = int(np.argmax(ratio))
+        det[label] = float(ratio[m])
+        if ratio[m] > worst:
+            worst = float(ratio[m])
+            k = int(np.searchsorted(t, tau[j[m]], side="left"))
+            best = {"k": max(1, min(k, len(t) - 1)), "lemma": label, "tau_low": tau[i[m]],
+                    "tau_high": tau[j[m]], "x_low": X[i[m]], "x_high": X[j[m]], "lhs": lhs[m], "rhs": rhs[m],
+                    **bounds.constants(),
+                    "message": f"{label}/lem:bndEquiCont: |x_D(tau') - x_D(tau)| = {lhs[m]:.6g} > "
+                               f"psi(tau') - psi(tau) = {rhs[m]:.6g} for tau = {tau[i[m]]:.6g}, "
+                               f"tau' = {tau[j[m]]:.6g}"}
+    return Outcome(worst, best["k"], best, {"worst_by_lemma": det, "pairs": len(tau) * (len(tau) - 1) // 2},
+                   message="|x_D(tau') - x_D(tau)| <= psi(tau') - psi(tau) (lem:bndEquiCont)")
+
+
+__all__ = ["check_bounds_lg", "check_bounds_yb", "check_psi_interpolation", "LGBounds", "YBBounds"]

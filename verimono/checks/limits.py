@@ -1,0 +1,163 @@
+"""The unique limit of the discrete solutions (Section 5.4): solutions on different partitions approach one
+limit as ``|Δ| → 0``, whatever the partitions' kind — judged without assuming a rate.
+
+The decorated evaluator ``check_unique_limit(stepper, problem, *, levels, seed) -> Outcome`` judges the
+stepper as a whole (:func:`verimono.checks.partitions.run_once`); it binds every convergent scheme, since
+the limit of ``x_Δ`` is the unique solution.
+"""
+
+from __future__ import annotations
+
+from typing import Callable, Sequence
+
+import numpy as np
+
+from ..problem import Problem
+from ..tolerances import LIMIT_EXTRA_LEVELS, LIMIT_RATIO_FLOOR, LIMIT_TAIL_SAFETY, tolerance
+from .core import Outcome
+from .partitions import limit_grids, run_stepper, stepper_law
+from .trajectory_laws import norms as _norms
+
+#: cells of the three refinement levels (|Δ| shrinks 16-fold)
+LIMIT_LEVELS = (10, 40, 160)
+
+
+def _interp(t: np.ndarray, x: np.ndarray, tau: np.ndarray) -> np.ndarray:
+    return np.stack([np.interp(tau, t, x[:, j]) for j in range(x.shape[1])], axis=-1)
+
+
+@stepper_law("unique_limit", "the limit of x_Δ is the unique solution (Section 5.4)", over_grids=False)
+def check_unique_limit(stepper: Callable, p: Problem, *, levels: Sequence[int] = LIMIT_LEVELS,
+                       seed: int = 0) -> Outcome:
+    """Solutions on different partitions approach one limit as ``|Δ| → 0`` (unique limit, Section 5.4).
+
+    No rate is assumed (the paper gives none: ``x' ∈ −∂(c(t)|x|)`` with ``c = 0.1 t^{-0.9}``, σ in L¹ but
+    unbounded, converges like ``h^{0.1}``, and its uniform and graded partitions even move *apart* until
+    ``K ≈ 1000``).  For each kind ``k`` of partition (uniform, random, graded) the solutions ``x^k_m`` on
+    ``K_m`` cells form a sequence; ``c_{k,m}`` is the sup distance between the piecewise-linear interpolants
+    of ``x^k_m`` and ``x^k_{m+1}`` (from the end of both first cells on: the first cell holds the
+    catching-up jump, or a transient faster than the mesh, that no interpolant resolves there).
+
+    Criterion — Cauchy, against each sequence's own trend: when the last ratio ``r = c_{k,M-1}/c_{k,M-2}``
+    is below 1, ``|x^k_M − x^k_∞| ≤ c_{k,M-1} r/(1 − r)`` (the a-posteriori bound of a geometrically
+    convergent sequence — Banach's fixed-point estimate; Aitken's Δ² model; any rate ``h^p``, ``p > 0``,
+    is geometric in ``m`` on 4-fold refinements, with ``r = 4^{-p}``), times ``LIMIT_TAIL_SAFETY`` = 4, with
+    ``r`` raised to ``LIMIT_RATIO_FLOOR = 1/4`` (a fall faster than order 1 between the coarse levels is
+    pre-asymptotic and does not extrapolate: the scheme is first order).
+    The law fails when two kinds' limits are provably apart, ``D(K_M) > tail_a + tail_b + tol`` with
+    ``D(K_M)`` the sup distance between their finest solutions (different limits, e.g. a stepper using
+    the mean step), or when a kind's differences do not shrink (``r ≥ 1``: not a Cauchy sequence) after up
+    to ``LIMIT_EXTRA_LEVELS`` further 4-fold refinements.  Those are granted while some kind's differences
+    still grow (``x' ∈ −∂(2|x|)`` from ``x0 = 1/32`` dies out at ``t = 1/64``: meshes 0.1 and 0.025 all
+    give 0 there, the differences are 0, then ``c h``).  Evidence, not proof: a sequence converging at
+    rate ``p`` gives ``tail ≈ 4/(4^p − 1)`` times its last difference, so a slow one is judged leniently.
+
+    Claim: any — every convergent scheme has a unique limit (Section 5.4: it is the unique solution).
+    """
+    levels = list(levels)
+    while len(levels) < 3:               # two differences per kind: the least the own-trend tail needs
+        levels.append(4 * levels[-1])
+    scale = [float(np.max(np.abs(p.x0)))]
+
+    def sup_dist(ga, xa, gb, xb, since=0.0):
+        tau = np.union1d(ga, gb)
+        tau = tau[tau >= max(ga[1], gb[1], since)]
+        if tau.size == 0:
+            return 0.0, float(ga[-1]), xa[-1], xb[-1]
+        dist = _norms(_interp(ga, xa, tau) - _interp(gb, xb, tau))
+        m = int(np.argmax(dist))
+        return float(dist[m]), float(tau[m]), _interp(ga, xa, tau[m:m + 1])[0], _interp(gb, xb, tau[m:m + 1])[0]
+
+    runs: list[tuple[dict, dict]] = []     # (grids, solutions) per level
+
+    def add_level(K: int) -> None:
+        gs = limit_grids(p.T, K, seed)
+        K0 = levels[0]
+        if K % K0 == 0:
+            # the random kind as a refinement sequence: the first level's random partition with every
+            # cell split in K/K0 equal parts (independent random partitions per level have errors C_m h_m
+            # with a random C_m, which no own-trend tail can extrapolate)
+            base = limit_grids(p.T, K0, seed)["random"]
+            sub = np.linspace(0.0, 1.0, K // K0 + 1)[:-1]
+            gs["random"] = np.append((base[:-1, None] + np.diff(base)[:, None] * sub[None, :]).ravel(), p.T)
+        sols = {g: run_stepper(stepper, p, t) for g, t in gs.items()}
+        scale[0] = max(scale[0], max(float(np.max(np.abs(x))) for x in sols.values()))
+        runs.append((gs, sols))
+
+    def cross(m: int, since: dict | None = None) -> tuple[float, dict | None]:
+        gs, sols = runs[m]
+        names, best, info = list(gs), 0.0, None
+        for i in range(len(names)):
+            for j in range(i + 1, len(names)):
+                a, b = names[i], names[j]
+                s0 = 0.0 if since is None else max(since[a], since[b])
+                d, tau, xa, xb = sup_dist(gs[a], sols[a], gs[b], sols[b], s0)
+                if d >= best:
+                    best, info = d, {"pair": [a, b], "tau": tau, "x_a": xa, "x_b": xb}
+        return best, info
+
+    def judge():
+        """Tails of each kind and the cross distance, both from the end of the first cells of the
+        coarsest level the tails use on (where the differences are measured)."""
+        tol = tolerance(scale[0])
+        kinds, M = list(runs[0][0]), len(runs) - 1
+        since = {k: float(runs[M - 2][0][k][1]) for k in kinds}
+        diffs = {k: [sup_dist(runs[m][0][k], runs[m][1][k], runs[m + 1][0][k], runs[m + 1][1][k], since[k])[0]
+                     for m in (M - 2, M - 1)] for k in kinds}
+        tails, ratios = {}, {}
+        for k, c in diffs.items():
+            if c[-1] <= tol:
+                tails[k], ratios[k] = c[-1], 0.0
+                continue
+            r = c[-1] / c[-2] if c[-2] > 0 else np.inf
+            ratios[k] = r
+            re = max(r, LIMIT_RATIO_FLOOR)      # a faster fall than order 1 is pre-asymptotic
+            tails[k] = LIMIT_TAIL_SAFETY * c[-1] * re / (1.0 - re) if r < 1.0 else np.inf
+        D, info = cross(M, since)
+        a, b = info["pair"] if info else (kinds[0], kinds[1])
+        gap = D - tails[a] - tails[b]
+        # a distance before the tails' region (first cells of the coarser levels) is not judged, but
+        # asks for a finer level; so do differences that do not shrink yet
+        D_all, _ = cross(M)
+        unresolved = any(r >= 1.0 for r in ratios.values()) or (
+            D_all > D and D_all > min(tails[x] + tails[y] for x in kinds for y in kinds if x < y) + tol)
+        return D, info, diffs, tails, ratios, gap, tol, unresolved
+
+    for K in levels:
+        add_level(K)
+    D, info, diffs, tails, ratios, gap, tol, unresolved = judge()
+    for _ in range(LIMIT_EXTRA_LEVELS):
+        if not unresolved or (gap > tol and all(r < 1.0 for r in ratios.values())):
+            break        # judged: no doubt left, or two settled kinds are provably apart
+        levels.append(4 * levels[-1])
+        add_level(levels[-1])
+        D, info, diffs, tails, ratios, gap, tol, unresolved = judge()
+    distances = [cross(m)[0] for m in range(len(runs))]
+    not_cauchy = [k for k, r in ratios.items() if r >= 1.0]
+    details = {"levels": levels, "distances": distances, "mesh": [p.T / K for K in levels],
+               "differences": diffs, "ratios": ratios, "tails": tails, "criterion": "Cauchy with own-trend tail"}
+    pair = info["pair"] if info else list(tails)[:2]
+    worst = D / (tails[pair[0]] + tails[pair[1]] + tol) if not not_cauchy else max(ratios.values())
+    if gap <= tol and not not_cauchy:
+        return Outcome(worst if gap > 0 else min(worst, 1.0), details=details,
+                       message=f"distance between partitions {distances[0]:.3g} -> {D:.3g}, within the "
+                               f"estimated distances to their limits {tails[info['pair'][0]]:.3g} + "
+                               f"{tails[info['pair'][1]]:.3g} (last ratios "
+                               f"{', '.join(f'{k} {r:.3g}' for k, r in ratios.items())}; no rate assumed)"
+                       if info else f"distance between partitions {D:.3g}")
+    counter = {"problem": p.name, "T": p.T, "x0": p.x0, "levels": levels, "seed": seed,
+               "distances": distances, "grid_kinds": list(runs[0][0]), "tails": tails, **(info or {})}
+    if not_cauchy:
+        msg = (f"no limit: on {', '.join(not_cauchy)} partitions the differences between successive refinements "
+               f"do not shrink ({'; '.join(f'{k}: ' + ', '.join(f'{c:.3g}' for c in diffs[k]) for k in not_cauchy)}"
+               f" for K = {levels})")
+    else:
+        msg = (f"solutions on different partitions converge to different limits: {info['pair'][0]} and "
+               f"{info['pair'][1]} are {D:.3g} apart at K = {levels[-1]} (t = {info['tau']:.4g}) while each is "
+               f"within {tails[info['pair'][0]]:.3g} and {tails[info['pair'][1]]:.3g} of its own limit "
+               f"(distances {', '.join(f'{d:.3g}' for d in distances)} for K = {levels})")
+    return Outcome(max(worst, 1.0 + 1e-12) if np.isfinite(worst) else worst, counter={**counter, "message": msg},
+                   details=details)
+
+
+__all__ = ["check_unique_limit", "LIMIT_LEVELS"]

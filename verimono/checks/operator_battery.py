@@ -1,0 +1,55 @@
+"""The battery of an operator: every operator law, one record each (scikit-learn's ``check_estimator``).
+
+:func:`operator_checks` yields ``(name, check)`` pairs — the one source of :func:`check_operator`, of
+:func:`verimono.testing.parametrize_with_checks` and of the ``operator_laws`` stage of ``verimono run``.
+"""
+
+from __future__ import annotations
+
+import functools
+from typing import Any, Callable, Iterator
+
+from ..results import Report
+from . import operator_laws, prox_laws  # noqa: F401 - the laws join the registry on import
+from .core import Law, laws_of, subject_name
+from .search import default_examples, fresh_seed, positive_examples, valid_horizon, valid_seed
+from .subjects import require_operator
+
+#: the operator laws (:class:`verimono.checks.core.Law`), in the order they run
+LAWS: dict[str, Law] = laws_of("operator")
+#: stable law name → its public check ``check(op, *, seed, examples, horizon, sample)``
+OPERATOR_CHECKS: dict[str, Callable[..., Any]] = {name: decl.public for name, decl in LAWS.items()}
+
+
+def operator_checks(op: Any = None, *, seed: int | None = None, examples: int | None = None,
+                    horizon: float = 1.0) -> Iterator[tuple[str, Callable[[Any], Any]]]:
+    """Yield ``(name, check)`` for every operator law, ``check(op) -> CheckResult`` with the given settings
+    bound.  Names are stable and unique; ``op`` is accepted for symmetry with the other subjects'
+    generators (every law applies to every operator; one that needs a member it lacks is a skip)."""
+    for name, decl in LAWS.items():
+        yield name, functools.partial(decl.public, seed=seed, examples=examples, horizon=horizon)
+
+
+def check_operator(op: Any, *, seed: int | None = None, examples: int | None = None,
+                   horizon: float = 1.0) -> Report:
+    """Run every operator law on ``op`` and return the :class:`verimono.Report` of their records.
+
+    ``seed`` makes the search reproducible (one fresh seed is drawn and recorded when ``None``);
+    ``examples`` is the effort per law (default: the active profile's ``law_examples``); times are sampled
+    in ``[0, horizon]``.  What is not an operator is refused before any law runs
+    (:class:`verimono.InvalidCheckArgument`, naming the wrapper that makes one)."""
+    require_operator(op)
+    seed = fresh_seed() if seed is None else valid_seed(seed)
+    if examples is None:
+        examples, profile = default_examples()
+    else:
+        examples, profile = positive_examples(examples), None
+    horizon = valid_horizon(horizon)
+    report = Report(meta={"subject": subject_name(op), "seed": seed, "examples": examples, "horizon": horizon,
+                          **({"profile": profile} if profile else {})})
+    for _, check in operator_checks(op, seed=seed, examples=examples, horizon=horizon):
+        report.add(check(op))
+    return report
+
+
+__all__ = ["LAWS", "OPERATOR_CHECKS", "operator_checks", "check_operator"]

@@ -1,0 +1,167 @@
+"""The drivers of the stepper laws: running a stepper on partitions of ``[0, T]`` and judging each.
+
+A *stepper* is a callable ``stepper(problem, t_grid)`` returning ``x_0, ..., x_K`` (shape ``(K+1, n)``).
+A stepper law is one decorated evaluator (:func:`stepper_law`), of one of two forms:
+
+* ``over_grids=True``: ``check_<law>(stepper, problem, t, **kw) -> Outcome`` judges the stepper's solution on
+  one partition ``t``.  The driver (:func:`run_on_grids`) evaluates it on every partition of the battery
+  (:func:`battery_grids`: uniform, random, graded, or those given), keeps the worst, and shrinks a failure to
+  the shortest prefix ``[0, t_k]`` of its partition that still fails (re-verified), so the counterexample
+  holds the problem, the partition, the initial point and the offending step;
+* otherwise ``check_<law>(stepper, problem, **kw) -> Outcome`` judges the stepper as a whole (a unique
+  limit over refinements, a convergence order): :func:`run_once`.
+
+The laws are stated per initial point: a batch problem is checked through its first row.  Requirements
+(what the stepper claims, what the problem states) are judged before the stepper runs; every exception
+is judged by the core's one policy (:func:`verimono.checks.core.classify`).  Under a unit's time budget
+(:func:`verimono.timeouts.run_unit`: ``check_stepper`` and the stepper stages run every law in one) a
+per-partition law states its progress partition by partition: stopped by the budget after partitions that
+all held, its record is *undecided* (time budget, ``k`` partitions), not a failure of the stepper; stopped
+before any partition returned, or after one that failed, it is failed.  A law of the stepper as a whole
+(:func:`run_once`: one evaluation, no partial evidence) stopped by the budget is failed.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable
+
+import numpy as np
+
+from ..claims import claim_of
+from ..grids import graded_grid, random_grid, uniform_grid, validate_grid
+from ..problem import Problem
+from ..results import PASSED
+from ..timeouts import note_progress
+from .core import Outcome, law, run, stepper_subject
+from .search import valid_seed
+from .subjects import require_problem, require_stepper
+
+#: cells of the default partitions (fine enough for the lemmas' bounds, fast enough for a battery)
+DEFAULT_CELLS = 40
+#: nonuniformity of the default random partition (cell lengths vary by a factor up to 4)
+RANDOM_SPREAD = 0.6
+#: the law's form for a stepper claiming only ``scheme="any"``, by law name (``in_domain``: a distance to
+#: the domain vanishing at the claimed order, instead of exact membership at every node)
+ANY_SCHEME_FORM: dict[str, Callable[..., Outcome]] = {}
+
+
+def single(problem: Problem) -> Problem:
+    """The laws are stated per initial point: a batch is checked through its first row."""
+    return problem.replace(x0=problem.x0[0]) if problem.batched else problem
+
+
+def run_stepper(stepper: Callable, problem: Problem, grid: np.ndarray) -> np.ndarray:
+    """``stepper(problem, grid)`` as a float array of shape ``(K+1, n)``, finite (else ``ValueError``)."""
+    x = np.asarray(stepper(problem, grid), dtype=float)
+    if x.shape != (len(grid),) + problem.x0.shape:
+        raise ValueError(f"stepper {stepper_subject(stepper, problem).split(' on ')[0]} returned shape {x.shape}, "
+                         f"expected {(len(grid),) + problem.x0.shape}")
+    if not np.all(np.isfinite(x)):
+        raise ValueError("the stepper returned non-finite states")
+    return x
+
+
+def default_grids(problem: Problem, seed: int = 0, cells: int = DEFAULT_CELLS) -> dict[str, np.ndarray]:
+    """A uniform and a random (nonuniform) partition of ``[0, T]`` with ``cells`` cells."""
+    return {"uniform": uniform_grid(problem.T, steps=cells),
+            "random": random_grid(problem.T, cells, seed=seed, spread=RANDOM_SPREAD)}
+
+
+def limit_grids(T: float, K: int, seed: int = 0) -> dict[str, np.ndarray]:
+    """Uniform, random and graded (``t_k = T (k/K)²``) partitions with ``K`` cells."""
+    return {"uniform": uniform_grid(T, steps=K), "random": random_grid(T, K, seed=seed, spread=RANDOM_SPREAD),
+            "graded": graded_grid(T, K, 2.0)}
+
+
+def battery_grids(grids: Any, problem: Problem, seed: int) -> dict[str, np.ndarray]:
+    """The partitions a law is judged on: ``grids`` (a dict or a list of increasing arrays from 0 to ``T``),
+    else :func:`default_grids`."""
+    if grids is None:
+        return default_grids(problem, seed)
+    if isinstance(grids, dict):
+        return {k: validate_grid(g, problem.T) for k, g in grids.items()}
+    return {f"grid{i}": validate_grid(g, problem.T) for i, g in enumerate(grids)}
+
+
+def _prefix_failure(decl: Any, stepper: Callable, p: Problem, grid: np.ndarray, k: int, kw: dict) -> Outcome | None:
+    """The law re-evaluated on the prefix ``[0, t_k]`` of ``grid``, when that still fails."""
+    try:
+        again = decl.evaluate(stepper, p.replace(T=float(grid[k])), grid[:k + 1].copy(), **kw)
+    except Exception:  # noqa: BLE001 - a prefix the law cannot evaluate is no smaller counterexample
+        return None
+    return again if again.failed else None
+
+
+def _held(out: Outcome) -> bool:
+    """Whether one partition's outcome is evidence that the law holds (decided, within its bound)."""
+    return not (out.failed or out.inconclusive) and out.status in (None, PASSED)
+
+
+def run_on_grids(decl: Any, stepper: Callable, problem: Problem, *, grids: Any = None, seed: int = 0,
+                 **kw: Any) -> Any:
+    """A per-partition law on every partition of the battery: the worst outcome, a failure shrunk to the
+    shortest failing prefix of its partition (module docstring)."""
+    require_stepper(stepper)
+    p = single(require_problem(problem))
+    seed = valid_seed(seed)
+    subject = stepper_subject(stepper, p)
+    any_form = ANY_SCHEME_FORM.get(decl.name)
+    if any_form is not None and grids is None and not claim_of(stepper).proximal:
+        return run(decl, subject, lambda: any_form(stepper, p, seed=seed), stepper=stepper, problem=p)
+    parts = battery_grids(grids, p, seed)
+    kw = {"seed": seed, **kw}
+
+    def evaluate() -> Outcome:
+        outcomes: dict[str, Outcome] = {}
+        for g, t in parts.items():
+            outcomes[g] = decl.evaluate(stepper, p, t, **kw)
+            # out of budget now, a law whose partitions all held is undecided, not failed (verimono.timeouts)
+            note_progress(len(outcomes), all(_held(o) for o in outcomes.values()), "partitions")
+        gname = max(outcomes, key=lambda g: outcomes[g].worst)
+        out = outcomes[gname]
+        out.details = {"worst_by_grid": {g: o.worst for g, o in outcomes.items()}, **out.details}
+        if not out.failed:
+            return out
+        grid = parts[gname]
+        counter = {"problem": p.name, "T": p.T, "x0": p.x0, "grid": grid, "grid_kind": gname, **out.counter,
+                   "shrunk": False}
+        if out.k is not None and 1 <= out.k < len(grid) - 1:
+            again = _prefix_failure(decl, stepper, p, grid, out.k, kw)
+            if again is not None:
+                counter = {"problem": p.name, "T": float(grid[out.k]), "x0": p.x0, "grid": grid[:out.k + 1],
+                           "grid_kind": f"{gname} prefix [0, t_{out.k}]", **again.counter, "shrunk": True}
+        out.counter = counter
+        return out
+
+    rec = run(decl, subject, evaluate, stepper=stepper, problem=p)
+    if rec.status == "failed" and rec.counterexample is None:      # the stepper raised: what it was given
+        rec.counterexample = {"problem": p.name, "x0": p.x0, "grids": dict(parts)}
+    return rec
+
+
+def run_once(decl: Any, stepper: Callable, problem: Problem, **kw: Any) -> Any:
+    """A law of the stepper as a whole: its evaluator once, under the core's policy."""
+    require_stepper(stepper)
+    p = single(require_problem(problem))
+    if "seed" in kw:
+        kw["seed"] = valid_seed(kw["seed"])
+    subject = stepper_subject(stepper, p)
+    rec = run(decl, subject, lambda: decl.evaluate(stepper, p, **kw), stepper=stepper, problem=p)
+    if rec.status == "failed" and rec.counterexample is None:      # the stepper raised: what it was given
+        rec.counterexample = {"problem": p.name, "T": p.T, "x0": p.x0,
+                              **{k: v for k, v in kw.items() if k in ("levels", "seed", "steps")}}
+    return rec
+
+
+def stepper_law(name: str, label: str, *requires: Any, over_grids: bool = True,
+                any_scheme: Callable[..., Outcome] | None = None, battery: bool = True) -> Callable:
+    """Declare a stepper law (module docstring); ``any_scheme`` is its form for a stepper claiming only
+    ``scheme="any"`` (judged once, not per partition)."""
+    if any_scheme is not None:
+        ANY_SCHEME_FORM[name] = any_scheme
+    return law(name, label, subject="stepper", driver=run_on_grids if over_grids else run_once, requires=requires,
+               battery=battery)
+
+
+__all__ = ["stepper_law", "run_on_grids", "run_once", "run_stepper", "single", "default_grids", "limit_grids",
+           "battery_grids", "DEFAULT_CELLS", "RANDOM_SPREAD", "ANY_SCHEME_FORM"]

@@ -1,0 +1,410 @@
+"""The driver of the operator laws: a search for a sample that breaks the law.
+
+A law of an operator is an evaluator ``law(op, sample) -> Outcome`` (:mod:`verimono.checks.core`); the
+search evaluates it, in order, on
+
+1. ``examples`` NumPy draws from the distribution of :func:`verimono.checks.samples.law_samples`
+   (:func:`verimono.checks.sweep.law_draws`, seeded by the record's seed);
+2. a hypothesis search (:func:`~verimono.checks.samples.law_samples`) that starts from the simplest samples,
+   climbs toward violations through :func:`hypothesis.target` on the ratio and shrinks a failing sample —
+   with ``examples // HYPOTHESIS_SHARE`` examples when the draws found nothing, with all ``examples`` when
+   one broke the law (a draw hypothesis does not meet again is shrunk greedily);
+3. the scale sweep (:mod:`verimono.checks.sweep`), points from ``10^-9`` to ``10^3`` and on the boundary
+   of the domain.
+
+Hypothesis's engine costs about 1.7 ms per example here against about 0.02 ms per NumPy draw.  One given
+``sample=`` (a :class:`~verimono.checks.samples.Sample` or its dict from a counterexample) is evaluated
+alone instead: that is how a failure is replayed and how outer ``@given`` tests drive the laws.
+
+A sample's exception is judged by the core's one policy (:func:`verimono.checks.core.classify`): a member
+the operator lacks stops the search (skipped), a limit of verimono's own solvers makes the sample
+inconclusive (counted in ``details["harness_limited"]``), anything else fails the sample.  Inconclusive
+samples are counted and never pass: a record whose every sample was inconclusive is skipped, undecided
+when verimono's own solvers decided none.  The unit's time budget (:mod:`verimono.timeouts`) bounds the
+whole search (in calibration units: a slower or busier machine gets more seconds): a search that runs out
+of time after samples that all held is undecided (time budget, ``k`` samples); an operator call that never
+returns fails — the first one, or one that ran :data:`verimono.timeouts.HANG_MULTIPLE` x longer than every
+sample before it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import random
+import time
+from typing import Any, Callable
+
+import hypothesis
+import hypothesis.errors
+import numpy as np
+from hypothesis import HealthCheck, Phase, Verbosity, given, settings
+
+from .._reproducible import no_local_constants
+from ..errors import InvalidCheckArgument, UnitTimeout
+from ..profiles import UnknownProfile, active_profile, get_profile
+from ..results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
+from ..timeouts import (HANG_MULTIPLE, TIME_BUDGET_REASON, current_budget, never_returned, note_progress,
+                        time_limit)
+from .core import REGISTRY, Law, Outcome, classify, law, run, subject_name
+from .samples import NUMPY_DIM, Sample, law_samples
+from .sweep import law_draws, shrink, sweep_count, sweep_samples
+
+#: examples per law when ``examples`` is not given and the active hypothesis profile is not one of
+#: verimono's (a user's own); otherwise the profile's ``law_examples`` governs (:func:`default_examples`)
+DEFAULT_EXAMPLES = 50
+#: every law's ratio ``lhs / (rhs + slack)`` must not exceed this
+BOUND = 1.0
+#: ratios handed to hypothesis.target are clipped to this (observations must be finite)
+TARGET_CAP = 1e12
+#: hypothesis searches with ``examples // HYPOTHESIS_SHARE`` examples (at least ``HYPOTHESIS_MIN``) after
+#: the NumPy draws found nothing, with all ``examples`` when a draw broke the law
+HYPOTHESIS_SHARE = 4
+HYPOTHESIS_MIN = 3
+#: the law that reports an operator whose resolvent raises on plain inputs (its statement: ``J_λ`` is
+#: defined on all of ``R^n``); every other law is then not evaluated, so the cause is reported once
+ROOT_LAW = "resolvent_single_valued"
+#: marks an evaluation that verimono's own numerical machinery could not decide
+HARNESS_LIMIT = "harness_limit"
+
+
+def fresh_seed() -> int:
+    """A new 32-bit seed (recorded in every result so that a run can be repeated)."""
+    return random.SystemRandom().getrandbits(32)
+
+
+def default_examples() -> tuple[int, str]:
+    """``(examples per law, profile)`` when ``examples`` is not given: the active profile's ``law_examples``
+    (``dev``/``ci``/``thorough``, :func:`verimono.profiles.active_profile`), else ``DEFAULT_EXAMPLES``."""
+    name = active_profile()
+    try:
+        return get_profile(name).law_examples, name
+    except UnknownProfile:
+        return DEFAULT_EXAMPLES, name
+
+
+def positive_examples(examples: Any) -> int:
+    """``examples`` as a positive integer; :class:`InvalidCheckArgument` otherwise (0 examples verify
+    nothing)."""
+    try:
+        n = int(examples)
+    except (TypeError, ValueError, OverflowError):
+        raise InvalidCheckArgument(f"examples must be a positive integer, got {examples!r}") from None
+    if isinstance(examples, bool) or n != examples or n < 1:
+        raise InvalidCheckArgument(f"examples must be a positive integer, got {examples!r}")
+    return n
+
+
+def valid_seed(seed: Any) -> int:
+    """``seed`` as a non-negative integer; :class:`InvalidCheckArgument` otherwise."""
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise InvalidCheckArgument(f"seed must be a non-negative integer, got {seed!r}")
+    return int(seed)
+
+
+def valid_horizon(horizon: Any) -> float:
+    """``horizon`` as a finite time ``≥ 0``; :class:`InvalidCheckArgument` otherwise."""
+    if isinstance(horizon, bool) or not isinstance(horizon, (int, float, np.integer, np.floating)) \
+            or not (math.isfinite(horizon) and horizon >= 0):
+        raise InvalidCheckArgument(f"horizon must be a finite time >= 0, got {horizon!r}")
+    return float(horizon)
+
+
+def evaluate_sample(decl: Law, op: Any, s: Sample) -> Outcome:
+    """``decl.evaluate(op, s)``, an exception judged by the core's policy: a member the operator lacks is
+    raised (it stops the search), a limit of verimono's solvers or a hypothesis that does not hold there
+    is an inconclusive sample, anything else a failed one."""
+    try:
+        return decl.evaluate(op, s)
+    except (InvalidCheckArgument, NotImplementedError):
+        raise
+    except Exception as exc:  # noqa: BLE001 - the core's policy decides
+        status, message = classify(exc)
+        if status == UNDECIDED:
+            return Outcome.inconclusive_sample(message, {HARNESS_LIMIT: str(exc)})
+        if status == SKIPPED:
+            return Outcome.inconclusive_sample(message)
+        return Outcome.compare(math.inf, 0.0, 1.0, f"raised {message}")
+
+
+def root_cause(op: Any, horizon: float = 1.0) -> str | None:
+    """Why ``op.resolvent`` cannot be evaluated at all — it raises (or returns no point of shape ``(n,)``)
+    at ``x = 0`` or ``x = (1, ..., 1)`` with ``λ = 1``, ``t ∈ {0, horizon}`` — or ``None``.  A limit of
+    verimono's own solvers there is no cause of the operator's: the laws meet it sample by sample."""
+    for x in (np.zeros(op.dim), np.ones(op.dim)):
+        for t in (0.0, float(horizon)):
+            try:
+                y = np.asarray(op.resolvent(x.copy(), 1.0, t))
+            except Exception as exc:  # noqa: BLE001 - any exception is the root cause we report
+                if classify(exc)[0] == UNDECIDED:
+                    continue
+                return f"the resolvent raises {type(exc).__name__}: {exc} at x = {x[:3].tolist()}..., λ = 1, t = {t:g}"
+            if y.shape != x.shape:
+                return f"the resolvent returns shape {y.shape} for a point of shape {x.shape} (λ = 1, t = {t:g})"
+    return None
+
+
+class _Violation(Exception):
+    """Raised inside the hypothesis test when a sample breaks the law (so hypothesis shrinks it)."""
+
+
+@dataclasses.dataclass
+class _Search:
+    """The state of one law's search on one operator: what was evaluated, the worst and the failing sample."""
+
+    decl: Law
+    op: Any
+    runs: int = 0
+    worst: Outcome | None = None
+    worst_sample: Sample | None = None
+    failure: Outcome | None = None
+    failing: Sample | None = None
+    unsupported: str | None = None
+    found_by: str = ""
+    inconclusive: int = 0
+    inconclusive_what: str = ""
+    harness_limited: int = 0
+    #: when the sample being evaluated now started (``None`` between samples), and the slowest that returned
+    in_flight: float | None = None
+    slowest: float = 0.0
+    violated: bool = False
+
+    def evaluate(self, s: Sample, climb: bool = False) -> None:
+        """Evaluate one sample; :class:`_Violation` when it breaks the law (``climb``: inside hypothesis,
+        whose ``target`` then climbs toward large ratios)."""
+        start = self.in_flight = time.perf_counter()   # left set when the unit's budget interrupts the sample
+        try:
+            out = evaluate_sample(self.decl, self.op, s)
+        except NotImplementedError as exc:
+            self.in_flight = None
+            self.unsupported = str(exc) or type(exc).__name__
+            return
+        self.in_flight, self.slowest = None, max(self.slowest, time.perf_counter() - start)
+        self.runs += 1
+        if out.inconclusive:
+            self.inconclusive += 1
+            self.inconclusive_what = out.what
+            self.harness_limited += HARNESS_LIMIT in out.info
+            self.note()
+            return
+        r = out.ratio
+        if self.worst is None or not r <= self.worst.ratio:
+            self.worst, self.worst_sample = out, s
+        if climb:
+            hypothesis.target(min(r, TARGET_CAP) if r == r else TARGET_CAP, label=self.decl.name)
+        if not r <= BOUND:
+            self.failure, self.failing, self.violated = out, s, True
+            self.note()
+            raise _Violation(self.decl.name)
+        self.note()
+
+    def note(self) -> None:
+        """The progress so far, for an outer unit whose budget may stop the search (verimono.timeouts)."""
+        note_progress(self.runs, not self.violated and self.inconclusive < self.runs)
+
+    def fails(self, s: Sample) -> bool:
+        return not evaluate_sample(self.decl, self.op, s).ratio <= BOUND
+
+    def shrunk_into(self, failing: Sample, how: str) -> None:
+        """Record the violation at ``failing``, shrunk greedily (:func:`verimono.checks.sweep.shrink`)."""
+        small, _ = shrink(failing, self.fails, dataclasses.replace)
+        self.failing, self.failure = small, evaluate_sample(self.decl, self.op, small)
+        self.found_by = how
+
+    def first_violation(self, samples: list[Sample]) -> tuple[Sample, Outcome] | None:
+        """Evaluate ``samples`` in order; the first that breaks the law with its outcome (taken out of the
+        state, so that a later phase searches afresh), or ``None``."""
+        for s in samples:
+            try:
+                self.evaluate(s)
+            except _Violation:
+                found = (self.failing, self.failure)
+                self.failure = self.failing = None
+                return found
+            if self.unsupported is not None:
+                break
+        return None
+
+
+def _hypothesis_search(state: _Search, seed: int, horizon: float, budget: int) -> None:
+    """Hypothesis's search: its simplest examples, its climb toward large ratios, its shrinking."""
+    def climb(s: Sample) -> None:
+        state.evaluate(s, climb=True)
+
+    test = settings(database=None, max_examples=max(1, budget), deadline=None, derandomize=False,
+                    verbosity=Verbosity.quiet, print_blob=False, suppress_health_check=list(HealthCheck),
+                    phases=(Phase.generate, Phase.target, Phase.shrink))(given(law_samples(state.op.dim, horizon))(climb))
+    hypothesis.seed(seed)(test)()
+
+
+def _search(decl: Law, op: Any, seed: int, examples: int, horizon: float) -> tuple[_Search, dict]:
+    """The three phases of the search (module docstring) under the unit's time budget."""
+    state, how = _Search(decl, op), {"timed_out": "", "harness": "", "flaky": "", "sweep": 0}
+    drawn = None
+    try:
+        with no_local_constants(), time_limit(current_budget(), f"{decl.name} on {subject_name(op)}"):
+            if op.dim <= NUMPY_DIM:
+                drawn = state.first_violation(law_draws(op.dim, seed, horizon, examples, Sample))
+            full = drawn is not None or op.dim > NUMPY_DIM
+            _hypothesis_search(state, seed, horizon, examples if full else max(HYPOTHESIS_MIN,
+                                                                               examples // HYPOTHESIS_SHARE))
+    except _Violation:
+        pass
+    except UnitTimeout as exc:
+        how["timed_out"] = str(exc)
+        how["in_flight"] = None if state.in_flight is None else time.perf_counter() - state.in_flight
+    except hypothesis.errors.Flaky as exc:  # a failure that did not reproduce on replay
+        how["flaky"] = f" (not reproducible on replay: {type(exc).__name__}; the operator is not deterministic)"
+    except (hypothesis.errors.HypothesisException, MemoryError, RecursionError) as exc:
+        # the search engine itself gave up (inputs it cannot draw, memory): a limit of the harness
+        how["harness"] = f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"
+    stopped = how["timed_out"] or how["harness"]
+    if state.failure is None and drawn is not None:      # hypothesis did not meet the draw's violation
+        if stopped:
+            (state.failing, state.failure), state.found_by = drawn, "NumPy draws"
+        else:
+            state.shrunk_into(drawn[0], "NumPy draws (shrunk greedily)")
+    # the scale sweep spells out its points: for n > NUMPY_DIM the NumPy recipes cover the scales instead
+    if state.failure is None and state.unsupported is None and not stopped and op.dim <= NUMPY_DIM:
+        how["sweep"] = _sweep(state, seed, horizon)
+    return state, how
+
+
+def _sweep(state: _Search, seed: int, horizon: float) -> int:
+    """The scale sweep after a search that found nothing; a violation is shrunk greedily into ``state``.
+    Returns the number of sweep samples."""
+    swept = sweep_samples(state.op, seed, horizon, sweep_count(active_profile(), state.decl.name), Sample)
+    found = state.first_violation(swept)
+    if found is not None:
+        state.shrunk_into(found[0], "sweep (shrunk greedily)")
+    return len(swept)
+
+
+def _replay(decl: Law, op: Any, sample: Sample | dict) -> tuple[_Search, dict]:
+    """The evaluation of one given sample (a replay), under the unit's time budget."""
+    state, how = _Search(decl, op), {"timed_out": "", "harness": "", "flaky": "", "sweep": 0}
+    s = Sample.from_dict(sample) if isinstance(sample, dict) else sample
+    try:
+        with time_limit(current_budget(), f"{decl.name} on {subject_name(op)}"):
+            state.evaluate(s)
+    except _Violation:
+        pass
+    except UnitTimeout as exc:
+        how["timed_out"] = str(exc)
+    return state, how
+
+
+def _verdict(state: _Search, how: dict, base: dict, details: dict, cex_extra: dict) -> CheckResult:
+    """The record of a finished search (the statuses of the module docstring)."""
+    runs = state.runs
+    if how["timed_out"] and state.failure is None:
+        details.update(timeout=True)
+        in_flight = how.get("in_flight")
+        if never_returned(in_flight, state.slowest) and runs:    # the sample in flight: a call that does not return
+            details.update(in_flight=in_flight, slowest=state.slowest)
+            return CheckResult(status=FAILED, details=details, **base,
+                               message=f"timed out: {how['timed_out']}; the sample in flight ran {in_flight:.1f} s, "
+                                       f"more than {HANG_MULTIPLE:g}x the slowest of the {runs} samples before it "
+                                       f"({state.slowest:.3g} s): a call that does not return")
+        if runs and state.inconclusive < runs:
+            details["undecided_reason"] = TIME_BUDGET_REASON
+            return CheckResult(status=UNDECIDED, details=details, **base,
+                               message=f"time budget exhausted after {runs} samples, all of which held "
+                                       f"({how['timed_out']}): too few samples for a verdict")
+        return CheckResult(status=FAILED, details=details, **base,
+                           message=f"timed out: {how['timed_out']} ({runs} samples evaluated before)")
+    if state.failure is None and how["harness"]:
+        return CheckResult(status=UNDECIDED, details=details, **base,
+                           message=f"the harness could not search this operator ({how['harness']}; {runs} samples "
+                                   "evaluated before); a limitation of verimono, not a failure of the operator")
+    if state.failure is None and state.unsupported is not None:
+        return CheckResult(status=SKIPPED, details=details, **base,
+                           message=f"needs a member the operator lacks: {state.unsupported} ({runs} samples "
+                                   "evaluated before)")
+    if state.failure is not None:
+        out, s = state.failure, state.failing
+        cex = {**s.to_dict(), **cex_extra, "ratio": out.ratio, "lhs": out.lhs, "rhs": out.rhs, "slack": out.slack,
+               **out.info}
+        if state.found_by:
+            cex["found_by"] = state.found_by
+        worst = out.ratio if state.worst is None else max(state.worst.ratio, out.ratio)
+        return CheckResult(status=FAILED, worst=worst, bound=BOUND, counterexample=cex, details=details, **base,
+                           message=f"{out.what}: lhs {out.lhs:.6g} > rhs {out.rhs:.6g} + slack {out.slack:.3g} "
+                                   f"at {s!r}{how['flaky']}")
+    if runs == 0:        # nothing was evaluated: never a pass
+        return CheckResult(status=UNDECIDED, message="no sample was evaluated", details=details, **base)
+    if state.harness_limited == runs:
+        return CheckResult(status=UNDECIDED, details=details, **base,
+                           message=f"verimono's own solvers decided none of the {runs} samples (e.g. "
+                                   f"{state.inconclusive_what}); a limitation of verimono, not a failure of the "
+                                   "operator")
+    if state.inconclusive == runs:
+        return CheckResult(status=SKIPPED, details=details, **base,
+                           message=f"all {runs} samples inconclusive (e.g. {state.inconclusive_what})")
+    if state.worst is not None:
+        details["worst_sample"] = state.worst_sample.to_dict()
+        details["worst_info"] = {"what": state.worst.what, "lhs": state.worst.lhs, "rhs": state.worst.rhs,
+                                 "slack": state.worst.slack}
+    counted = f"{runs} samples" + (f" ({state.inconclusive} inconclusive)" if state.inconclusive else "")
+    if state.harness_limited:
+        counted += f", {state.harness_limited} of them undecided by verimono's own solvers"
+    return CheckResult(status=PASSED, worst=None if state.worst is None else state.worst.ratio, bound=BOUND,
+                       message=counted + (f"; {how['flaky']}" if how["flaky"] else ""), details=details, **base)
+
+
+def run_law(decl: Law | str, op: Any, *, seed: int | None = None, examples: int | None = None,
+            horizon: float = 1.0, sample: Sample | dict | None = None) -> CheckResult:
+    """One law on ``op``: NumPy draws, a hypothesis search and the scale sweep, or one given ``sample``.
+
+    ``seed`` makes the search reproducible (a fresh one is drawn and recorded when ``None``); ``examples``
+    is the effort (default: the active profile's, :func:`default_examples`); times are sampled in
+    ``[0, horizon]``."""
+    if isinstance(decl, str):
+        decl = REGISTRY["operator"][decl]
+    horizon = valid_horizon(horizon)
+    profile = None
+    if examples is None:
+        examples, profile = default_examples()
+    examples = positive_examples(examples)
+    if sample is None:
+        seed = fresh_seed() if seed is None else valid_seed(seed)
+    elif seed is not None:
+        seed = valid_seed(seed)
+    subject = subject_name(op)
+    details = {"item": decl.label, "examples": examples, "evaluations": 0, "horizon": horizon}
+    if profile is not None:
+        details["profile"] = profile
+
+    def evaluate() -> CheckResult:
+        start = time.perf_counter()
+        base = dict(check=decl.name, subject=subject, seed=seed)
+        cause = root_cause(op, horizon) if sample is None else None
+        if cause is not None:
+            why = {**details, "root_cause": cause}
+            if decl.name == ROOT_LAW:
+                return CheckResult(status=FAILED, worst=math.inf, bound=BOUND, counterexample={"operator": repr(op)},
+                                   message=f"root cause: {cause}; the other laws are not evaluated", details=why,
+                                   **base)
+            return CheckResult(status=SKIPPED, details=why, **base,
+                               message=f"not evaluated: {cause} (the root cause is recorded once, as {ROOT_LAW})")
+        state, how = _search(decl, op, seed, examples, horizon) if sample is None else _replay(decl, op, sample)
+        rec = _verdict(state, how, base, {**details, "evaluations": state.runs, "inconclusive": state.inconclusive,
+                                          "harness_limited": state.harness_limited, "sweep": how["sweep"]},
+                       {"seed": seed, "examples": examples, "horizon": horizon, "operator": repr(op)})
+        rec.duration = time.perf_counter() - start
+        return rec
+
+    rec = run(decl, subject, evaluate, operator=op, seed=seed)
+    if rec.status == SKIPPED and "examples" not in rec.details:   # skipped from the declaration
+        rec.details.update(details)
+    return rec
+
+
+def operator_law(name: str, label: str, *requires: Any) -> Callable:
+    """Declare ``check_<name>(op, s) -> Outcome`` as an operator law driven by :func:`run_law`."""
+    return law(name, label, subject="operator", driver=run_law, requires=requires)
+
+
+__all__ = ["run_law", "operator_law", "evaluate_sample", "root_cause", "fresh_seed", "default_examples",
+           "positive_examples", "valid_seed", "valid_horizon", "DEFAULT_EXAMPLES", "BOUND", "ROOT_LAW",
+           "HARNESS_LIMIT", "HYPOTHESIS_SHARE", "HYPOTHESIS_MIN"]

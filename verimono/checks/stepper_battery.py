@@ -1,0 +1,132 @@
+"""The battery of a stepper: its convergence orders on the references, then every trajectory law on every
+problem (scikit-learn's ``check_estimator``).
+
+:func:`stepper_checks` yields ``(name, check)`` pairs, ``name = "<law>[<problem>]"`` — the one source of
+:func:`check_stepper`, of :func:`verimono.testing.parametrize_with_checks` and of the stepper stages of
+``verimono run``.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable, Iterable, Iterator, Sequence
+
+import numpy as np
+
+from ..claims import with_claim
+from ..errors import InvalidCheckArgument
+from ..problem import Problem
+from ..results import CheckResult, Report
+from ..timeouts import run_unit
+from . import bounds, limits, picard, trajectory_laws  # noqa: F401 - the laws join the registry on import
+from . import orders as _order_law  # noqa: F401 - convergence_order joins the registry on import
+from .core import laws_of, stepper_subject
+from .partitions import single
+from .sample_problems import sample_problems
+from .search import valid_seed
+from .subjects import require_problem, require_stepper
+
+#: the law judging the order a stepper reaches on a reference (on the references only)
+ORDER_LAW = "convergence_order"
+#: the trajectory laws of the battery, in the order they run (on every problem)
+LAWS: tuple[str, ...] = tuple(n for n in laws_of("stepper", battery=True) if n != ORDER_LAW)
+#: law name → its public check ``check(stepper, problem, ...)``
+CHECKS: dict[str, Callable[..., CheckResult]] = {n: laws_of("stepper")[n].public for n in LAWS}
+
+
+def reproduce(stepper: Callable, problem: Problem, record: CheckResult) -> CheckResult:
+    """Re-run the law of ``record`` on exactly the inputs of its counterexample."""
+    cx = record.counterexample or {}
+    law = CHECKS[record.check]
+    if record.check == "unique_limit":
+        return law(stepper, problem, levels=cx["levels"], seed=cx["seed"])
+    p = single(problem).replace(T=float(cx["T"]))
+    kw: dict[str, Any] = {"grids": [np.asarray(cx["grid"], dtype=float)]}
+    if "x0_prime" in cx:
+        kw["x0_primes"] = [np.asarray(cx["x0_prime"], dtype=float)]
+    return law(stepper, p, **kw)
+
+
+def _selected(laws: Sequence[str]) -> tuple[str, ...]:
+    unknown = [n for n in laws if n not in CHECKS]
+    if unknown:
+        raise InvalidCheckArgument(f"unknown trajectory laws {unknown}; the laws are {list(CHECKS)}")
+    return tuple(laws)
+
+
+def law_checks(problems: Iterable[Problem], laws: Sequence[str] = LAWS, seed: int = 0
+               ) -> Iterator[tuple[str, Callable[[Callable], CheckResult]]]:
+    """``(name, check)`` pairs: ``name = "<law>[<problem>]"``, ``check(stepper) -> CheckResult``."""
+    laws = _selected(laws)
+    for p in problems:
+        for law in laws:
+            fn = CHECKS[law]
+            yield f"{law}[{p.name}]", (lambda stepper, _fn=fn, _p=p: _fn(stepper, _p, seed=seed))
+
+
+def stepper_checks(stepper: Callable | None = None, problems: Iterable[Problem] | None = None, *,
+                   seed: int = 0, generated: int = 4, laws: Sequence[str] = LAWS, orders: bool = True,
+                   executor: Any = None) -> Iterator[tuple[str, Callable[[Callable], CheckResult]]]:
+    """The battery of a stepper, as ``(name, check)`` pairs.
+
+    ``problems=None``: the reference catalog (convergence orders and laws) plus ``generated`` sampled
+    problems (:func:`verimono.checks.sample_problems.sample_problems`, laws only).  ``stepper`` is unused
+    (the battery does not depend on it); it is accepted for the protocol ``stepper_checks(stepper)``.
+    """
+    seed = valid_seed(seed)
+    if problems is None:
+        from verimono.reference import catalog   # the catalog builds every reference: on first use only
+
+        refs = catalog()
+        extra = sample_problems(seed, generated)
+    else:
+        refs, extra = [require_problem(p) for p in problems], []
+    if orders:
+        order = laws_of("stepper")[ORDER_LAW].check
+        for p in refs:
+            yield f"{ORDER_LAW}[{p.name}]", (lambda s, _p=p: order(s, _p, executor=executor))
+    yield from law_checks(list(refs) + list(extra), laws, seed)
+
+
+def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, *, scheme: str | None = None,
+                  order: float | None = None, seed: int | None = None, executor: Any = None,
+                  laws: bool | Iterable[str] = True, generated: int = 4, orders: bool = True) -> Report:
+    """Result records for ``stepper``: convergence orders on the references, then the trajectory laws.
+
+    ``scheme``/``order`` state what the stepper claims (:class:`verimono.Stepper`; a bare callable
+    claims ``scheme="proximal"``, the paper's scheme): a law that needs more than the claim is skipped
+    with that reason, and ``convergence_order``/``in_domain`` hold an ``"any"`` scheme to its order.
+
+    ``problems=None`` means the whole catalog of :mod:`verimono.reference` (orders and laws) plus
+    ``generated`` seeded sample problems (laws only).  The records come first per problem for the
+    convergence orders (in the order of ``problems``), then one record per (problem, law);
+    ``laws=False`` keeps the orders only, a list of law names selects laws, ``orders=False`` keeps the laws
+    only.  What is not a stepper, a bad seed or an empty selection is refused before anything runs
+    (:class:`verimono.InvalidCheckArgument`).
+    """
+    require_stepper(stepper)
+    if problems is not None:
+        problems = list(problems)
+        if not problems:
+            raise InvalidCheckArgument("check_stepper was given an empty list of problems: it would verify "
+                                       "nothing (pass problems=None for the whole catalog)")
+        problems = [require_problem(p) for p in problems]
+    stepper = with_claim(stepper, scheme, order)
+    seed = 0 if seed is None else valid_seed(seed)
+    selected = () if laws is False else (LAWS if laws is True else _selected(tuple(laws)))
+    if not selected and not orders:
+        raise InvalidCheckArgument("check_stepper selected no check (no law, no order): it would verify nothing")
+    report = Report()
+    for name, check in stepper_checks(stepper, problems, seed=seed, generated=generated, laws=selected,
+                                      orders=orders, executor=executor):
+        law, _, problem_name = name.partition("[")
+        # a stepper that never returns: a failed record naming the unit, and the battery goes on
+        rec = run_unit(lambda: check(stepper), check=law, subject=stepper_subject(stepper, problem_name[:-1]))
+        report.add(rec)
+        if rec.study is not None:
+            report.studies.append(rec.study)
+    if not len(report):
+        raise InvalidCheckArgument("check_stepper selected no check (no law, no order): it would verify nothing")
+    return report
+
+
+__all__ = ["LAWS", "CHECKS", "ORDER_LAW", "stepper_checks", "check_stepper", "law_checks", "reproduce"]

@@ -1,0 +1,158 @@
+"""Running the verification: the stages of a run under a profile and an executor, interrupts, resuming.
+
+:func:`execute` runs stages with a context and returns the merged, annotated report (the run's facts in
+``report.meta``: command, profile, seed, selection, executor, calibration, duration, environment);
+:func:`interruptible` turns an interrupt (Ctrl-C, SIGTERM) into a results file of the finished stages
+marked incomplete; :func:`merge_resumed` completes such a run.  The command line
+(:mod:`verimono.cli`) is a thin layer over these.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+from typing import Any, Callable
+
+from .environment import environment
+from .executors import make_runner
+from .profiles import get_profile, load_hypothesis_profile
+from .progress import Progress
+from .report import write
+from .report.plots import warm_up
+from .results import Report
+from .stages import calibrate, run_stages
+from .calibration import set_calibration
+from .timing import MachineProbe, is_noise_undecided
+
+EXIT_OK, EXIT_FAILED, EXIT_UNDECIDED = 0, 1, 2
+
+
+def execute(*, command: str, profile_name: str, stages: list[str] | None, context: Any, target: str | None = None,
+            progress: Progress | None = None, executor: Any = None, unit_timeout: float | None = None,
+            on_done: Callable | None = None) -> Report:
+    """Run ``stages`` with ``context`` under a profile and return the merged, fully annotated report.
+
+    ``executor`` (``"process:N"``, a dask scheduler address or ``Client``; ``None``: serial) is where the
+    stages' independent units run (:mod:`verimono.executors`); ``unit_timeout`` bounds each unit there.
+    ``on_done(stage, report, info)`` is called after each stage (the interrupt handler keeps them)."""
+
+    profile = get_profile(profile_name)
+    load_hypothesis_profile(profile_name)
+    progress = progress or Progress(enabled=False)
+    context.progress = progress.within
+    runner = make_runner(executor, timeout=unit_timeout)
+    if executor is not None and context.executor is None:
+        print(f"verimono: units run on {runner.spec}", file=sys.stderr)
+    context.executor = context.executor if context.executor is not None else runner
+    cal = calibrate()                 # on a quiet machine, before any worker starts
+    set_calibration(cal)              # the unit of this process's time budgets (verimono.timeouts)
+    if hasattr(runner, "prestart"):   # the workers import while this process builds the catalog
+        runner.prestart()
+    if getattr(runner, "workers", 1) >= 2:   # this process waits on the workers: draw the report's first
+        import threading                     # figure meanwhile (matplotlib's import and font cache)
+
+        threading.Thread(target=warm_up, name="verimono-report-warm-up", daemon=True).start()
+    start = time.perf_counter()
+    probe = MachineProbe()
+
+    def done(stage, rep, info):
+        info.update(probe.lap())      # how busy the machine was during the stage: the gate's evidence
+        progress.done(stage, rep, info)
+        if on_done is not None:
+            on_done(stage, rep, info)
+
+    try:
+        report = run_stages(stages, profile, context, on_start=progress.start, on_done=done)
+    finally:
+        runner.close()
+    duration = time.perf_counter() - start
+    # once more at the end: one calibration (best of 3 x 0.1 s) samples one moment of a shared machine and
+    # read 0.08-0.16 s here within an hour; noise only slows a workload down, so the faster of the two ends
+    # (best of 6) is the steadier unit, in the baseline and in the run gated against it alike
+    cals = [cal, calibrate()]
+    selection = {"stages": stages, "references": None if context.problems is None else
+                 [p.name for p in context.problems]}
+    report.meta.update({"command": command, "target": target, "profile": profile_name, "seed": context.seed,
+                        "selection": selection, "executor": getattr(runner, "spec", type(runner).__name__),
+                        "calibrations": cals,
+                        "calibration": min(cals), "duration": duration,
+                        "data_dir": None if context.data_dir is None else str(context.data_dir),
+                        "environment": environment()})
+    return report
+
+
+def exit_status(report: Report) -> int:
+    """1 when a check failed; else 2 when one was undecided (nothing failed, but not everything was
+    verified: a limitation of the harness is never a pass); else 0.  A timing record undecided because the
+    machine was too noisy to judge a speed (:func:`verimono.timing.is_noise_undecided`) does not count: the
+    machine's load is not the code's defect, and the summary line says that speed was not judged."""
+    if report.failures:
+        return EXIT_FAILED
+    if any(not is_noise_undecided(r) for r in report.undecided) or report.meta.get("incomplete"):
+        return EXIT_UNDECIDED
+    return EXIT_OK
+
+
+#: exit status of an interrupted run (the shell's convention for SIGINT)
+EXIT_INTERRUPTED = 130
+
+
+def interruptible(run: Callable[[Callable], Report], out: Path, *, command: str, profile: str,
+                   stages: list[str] | None, previous: Report | None = None) -> Report | int:
+    """``run(on_done)`` with SIGTERM treated as an interrupt; on an interrupt write the stages finished so
+    far (with ``previous``'s, when resuming) to ``out`` marked ``incomplete`` and return the exit status."""
+    import signal
+
+    finished: list[tuple[Report, dict]] = []
+
+    def on_done(stage, rep, info):
+        finished.append((rep, info))
+
+    def term(signum, frame):
+        raise KeyboardInterrupt(f"signal {signum}")
+
+    old = signal.signal(signal.SIGTERM, term) if _main_thread() else None
+    try:
+        return run(on_done)
+    except KeyboardInterrupt:
+        partial = previous if previous is not None else Report(meta={"stages": []})
+        for rep, info in finished:
+            partial.extend(rep)
+            partial.meta.setdefault("stages", []).append(info)
+        done = [s["name"] for s in partial.meta.get("stages") or []]
+        partial.meta.update({"command": command, "profile": profile, "incomplete": True,
+                             "finished_stages": done,
+                             "selection": partial.meta.get("selection") or {"stages": stages, "references": None}})
+
+        paths = write(partial, out)
+        print(f"\nverimono: interrupted; the {len(done)} finished stage(s) ({', '.join(done) or 'none'}) are in "
+              f"{paths['json']}, marked incomplete; continue with `verimono {command} --resume`",
+              file=sys.stderr)
+        return EXIT_INTERRUPTED
+    finally:
+        if old is not None:
+            signal.signal(signal.SIGTERM, old)
+
+
+def _main_thread() -> bool:
+    import threading
+
+    return threading.current_thread() is threading.main_thread()
+
+
+def merge_resumed(previous: Report, rest: Report) -> Report:
+    """The interrupted run's finished stages followed by the resumed ones: one complete report."""
+    merged = Report(meta=dict(rest.meta))
+    merged.extend(previous)
+    merged.extend(rest)
+    merged.meta["stages"] = list(previous.meta.get("stages") or []) + list(rest.meta.get("stages") or [])
+    merged.meta["selection"] = previous.meta.get("selection")
+    merged.meta["resumed"] = True
+    for key in ("incomplete", "finished_stages"):
+        merged.meta.pop(key, None)
+    return merged
+
+
+__all__ = ["execute", "exit_status", "interruptible", "merge_resumed", "EXIT_OK", "EXIT_FAILED", "EXIT_UNDECIDED",
+           "EXIT_INTERRUPTED"]
