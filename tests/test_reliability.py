@@ -321,7 +321,7 @@ def test_check_operator_passes_a_correct_operator_at_n_2000():
     """The time target (≤ 10 s) is a benchmark: tests/benchmarks/test_bench_large_operators.py."""
     op = vm.NormSubdifferential(lambda t: 1.0 + t, dim=2000)
     rep = vm.check_operator(op, seed=0, examples=20)
-    from verimono.checks.operator_laws import LAWS
+    from verimono.checks.operator_battery import LAWS
 
     passed = {r.check for r in rep if r.status == "passed"}
     assert rep.ok and len(rep) == len(LAWS), rep.summary()
