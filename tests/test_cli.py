@@ -152,6 +152,7 @@ def test_unknown_reference_exits_2(tmp_path, capsys):
     assert "no reference named 'nope'" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_console_entry_exit_status_propagates(good_check, tmp_path):
     base = tmp_path / "b.json"
     base.write_text("garbage")

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pytest
 
+from verimono.checks.core import REGISTRY
 from verimono.cli import main
 from verimono.executors import BadExecutor, ProcessRunner, SerialRunner, Unit, make_runner
 from verimono.results import CheckResult, Report
@@ -58,7 +59,8 @@ def serial_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("serial")
     assert main([*RUN, "--out", str(out), "--executor", "serial"]) == 0
     doc = document(out)
-    assert len(doc["results"]) == 2 + 2 * 6 and len(doc["studies"]) == 2   # what the selection gives
+    # what the selection gives: one convergence record per reference, and per reference one per problem law
+    assert len(doc["results"]) == 2 + 2 * len(REGISTRY["problem"]) and len(doc["studies"]) == 2
     return doc
 
 
@@ -89,12 +91,14 @@ def killed_unit_intact(serial: dict, parallel: dict, how: str) -> None:
     assert [s for s in parallel["studies"]] == [s for s in serial["studies"] if s["problem"] != "moving box"]
 
 
+@pytest.mark.slow
 def test_process_executor_gives_the_serial_json(serial_run, tmp_path, capsys):
     assert main([*RUN, "--out", str(tmp_path), "--executor", "process:2"]) == 0
     assert "units run on process:2" in capsys.readouterr().err
     assert document(tmp_path) == serial_run
 
 
+@pytest.mark.slow
 def test_a_killed_worker_process_fails_its_unit_only(steppers, serial_check, tmp_path):
     code = main(["check", f"{steppers}:killer", "--profile", "ci", *REF, "--out", str(tmp_path),
                  "--executor", "process:2"])
@@ -102,6 +106,7 @@ def test_a_killed_worker_process_fails_its_unit_only(steppers, serial_check, tmp
     killed_unit_intact(serial_check, document(tmp_path), "worker process died (signal 9)")
 
 
+@pytest.mark.slow
 def test_a_unit_over_its_timeout_fails_and_the_run_goes_on(steppers, serial_check, tmp_path):
     code = main(["check", f"{steppers}:sleeper", "--profile", "ci", *REF, "--out", str(tmp_path),
                  "--executor", "process:2", "--unit-timeout", "15"])
@@ -123,11 +128,13 @@ def cluster():
             yield c
 
 
+@pytest.mark.slow
 def test_dask_local_cluster_gives_the_serial_json(cluster, serial_run, tmp_path):
     assert main([*RUN, "--out", str(tmp_path), "--executor", cluster.scheduler_address]) == 0
     assert document(tmp_path) == serial_run
 
 
+@pytest.mark.slow
 def test_a_killed_dask_worker_fails_its_unit_only(cluster, steppers, serial_check, tmp_path):
     code = main(["check", f"{steppers}:killer", "--profile", "ci", *REF, "--out", str(tmp_path),
                  "--executor", cluster.scheduler_address])
@@ -161,6 +168,20 @@ def test_a_bad_executor_is_a_usage_error(spec, tmp_path, capsys):
     assert f"--executor {spec}" in capsys.readouterr().err
 
 
+def test_auto_chooses_its_runner_from_the_cores_and_process_n_parses(monkeypatch):
+    """The process-free part of the next test (tier ``slow``): which runner a spec makes; none starts a worker."""
+    from verimono.executors import AUTO_MAX_WORKERS
+
+    monkeypatch.setattr(os, "cpu_count", lambda: 1)
+    assert isinstance(make_runner("auto"), SerialRunner) and isinstance(make_runner(None), SerialRunner)
+    monkeypatch.setattr(os, "cpu_count", lambda: 64)
+    auto, three = make_runner("auto"), make_runner("process:3", timeout=5.0)
+    assert isinstance(auto, ProcessRunner) and auto.workers == AUTO_MAX_WORKERS and auto.fallback
+    assert three.spec == "process:3" and three.timeout == 5.0 and not three.fallback
+    assert auto._pool == auto._launched == [] == three._pool == three._launched   # nothing was started
+
+
+@pytest.mark.slow
 def test_run_uses_every_core_by_default(monkeypatch, tmp_path, capsys):
     """``verimono run`` defaults to ``auto``: process:N with N the cores (at most AUTO_MAX_WORKERS), serial
     on one core; ``$VERIMONO_EXECUTOR`` overrides it.  The records are the serial run's (see above)."""
@@ -183,6 +204,7 @@ def test_run_uses_every_core_by_default(monkeypatch, tmp_path, capsys):
     assert json.loads((tmp_path / "results.json").read_text())["meta"]["executor"] == "serial"
 
 
+@pytest.mark.slow
 def test_prestarted_workers_run_the_first_units_and_close_cleanly():
     """``prestart`` launches the workers without waiting (verimono run calibrates meanwhile); the first map
     uses them, and closing a runner whose launched workers never ran a unit leaves no process behind."""
@@ -202,6 +224,7 @@ def test_prestarted_workers_run_the_first_units_and_close_cleanly():
     assert not any(p.is_alive() for p in procs)
 
 
+@pytest.mark.slow
 def test_auto_runs_serially_when_its_workers_cannot_start(monkeypatch, capsys):
     """``auto`` is best effort: when no worker can start (a script read from standard input cannot be
     re-imported by a spawned process) it says why and runs the units serially, recording ``serial``;

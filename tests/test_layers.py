@@ -254,6 +254,7 @@ NOT_AT_IMPORT = ("scipy.stats", "scipy.optimize", "hypothesis", "matplotlib", "q
                  "verimono.checks", "verimono.strategies", "verimono.lcs", "verimono.qp", "verimono.report")
 
 
+@pytest.mark.slow
 def test_import_verimono_loads_only_the_core():
     import subprocess
     import sys

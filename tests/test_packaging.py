@@ -24,6 +24,7 @@ def wheel(tmp_path_factory) -> Path:
     return path
 
 
+@pytest.mark.slow
 def test_wheel_contains_the_mapped_packages(wheel):
     names = zipfile.ZipFile(wheel).namelist()
     for init in (REPO / "verimono").rglob("__init__.py"):  # every subpackage of the source tree ships
@@ -33,6 +34,7 @@ def test_wheel_contains_the_mapped_packages(wheel):
         assert required in names, required
 
 
+@pytest.mark.slow
 def test_reference_catalog_imports_from_the_installed_wheel(wheel, tmp_path):
     zipfile.ZipFile(wheel).extractall(tmp_path)
     code = ("import verimono.reference as r, verimono; from verimono.reference import catalog; "

@@ -52,6 +52,7 @@ def run(pytester: pytest.Pytester, *args: str, status: str = "passed", **env: st
     return pytester.runpytest_subprocess(*_plugin_args(), "-p", "no:cacheprovider", *args)
 
 
+@pytest.mark.slow
 def test_report_option_writes_the_report_and_baseline_option_gates(pytester):
     first = run(pytester, "--verimono-report", "base")
     first.assert_outcomes(passed=3, xfailed=1)
@@ -78,6 +79,7 @@ def test_report_option_writes_the_report_and_baseline_option_gates(pytester):
                               "verimono gate: 1 regression*"])
 
 
+@pytest.mark.slow
 def test_garbled_baseline_is_a_usage_error(pytester):
     (pytester.path / "garbled.json").write_text("{not json")
     result = run(pytester, "--verimono-baseline=garbled.json")
@@ -85,6 +87,7 @@ def test_garbled_baseline_is_a_usage_error(pytester):
     result.stderr.fnmatch_lines(["*verimono baseline unusable*not valid JSON*"])
 
 
+@pytest.mark.slow
 def test_hypothesis_profiles_follow_the_environment(pytester):
     pytester.makepyfile(test_profile='''
         from hypothesis import settings
@@ -111,6 +114,7 @@ def _baseline_doc(command: str = "pytest") -> dict:
     return Report([rec], meta={"command": command, "target": None, "profile": "dev", "seed": None}).to_dict()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("breaks, reason", [
     (lambda d: d["results"].__setitem__(0, "passed"), "result record 0"),
     (lambda d: d["results"][0].update(details=None), "details"),
@@ -126,9 +130,65 @@ def test_unusable_baseline_is_a_usage_error(pytester, breaks, reason):
     result.stderr.fnmatch_lines([f"*verimono baseline unusable*{reason}*"])
 
 
+@pytest.mark.slow
 def test_baseline_of_another_kind_of_run_is_a_usage_error(pytester):
     (pytester.path / "run.json").write_text(json.dumps(_baseline_doc(command="run")))
     result = run(pytester, "--verimono-baseline=run.json")
     result.assert_outcomes(passed=3, xfailed=1)
     assert result.ret == pytest.ExitCode.USAGE_ERROR
     result.stdout.fnmatch_lines(["verimono gate: cannot compare*command: baseline 'run', results 'pytest'*"])
+
+
+# -- the plugin's parts in this process (the pytester sessions above are the slow tier) ----------------------
+
+def test_a_worker_ships_a_tests_records_and_the_controller_files_them_under_the_test():
+    """The xdist transport of the sessions above, hook by hook: the worker attaches the records of a test to
+    its call report, the controller reads them back; a call report without records is counted as hidden."""
+    from types import SimpleNamespace
+
+    from verimono.plugin import RecordSink, _Collector
+    from verimono.results import CheckResult
+
+    rec = CheckResult("my_law", "my operator", "failed", worst=2.0, bound=1.0, message="2 > 1")
+    worker = _Collector(None, None, "dev", worker=True)
+    worker.nodeid = "t.py::test_w"
+    assert RecordSink(worker).add(rec) is rec
+    worker.nodeid = None
+    wrapper = worker.pytest_runtest_makereport(SimpleNamespace(nodeid="t.py::test_w"), SimpleNamespace(when="call"))
+    next(wrapper)
+    call_report = SimpleNamespace(when="call", nodeid="t.py::test_w", skipped=False)
+    with pytest.raises(StopIteration):
+        wrapper.send(SimpleNamespace(get_result=lambda: call_report))
+    assert len(worker.report) == 0                                   # a worker keeps nothing once shipped
+
+    controller = _Collector(None, None, "dev")
+    controller.pytest_runtest_logreport(call_report)
+    (got,) = controller.report.results
+    assert (got.check, got.subject, got.status, got.worst, got.message) == \
+        ("my_law", "my operator", "failed", 2.0, "2 > 1")
+    assert got.details["pytest_nodeid"] == "t.py::test_w" and controller.hidden == []
+    controller.pytest_runtest_logreport(SimpleNamespace(when="call", nodeid="t.py::test_lost", skipped=False))
+    assert controller.hidden == ["t.py::test_lost"] and len(controller.report) == 1
+
+
+def test_checks_passed_as_arguments_are_recorded_and_the_sink_takes_records_only():
+    import verimono as vm
+    from verimono.plugin import RecordSink, _is_verimono_check, _recording
+    from verimono.results import CheckResult
+
+    assert _is_verimono_check(vm.check_operator) and _is_verimono_check(vm.check_stepper)
+    assert not _is_verimono_check(len) and not _is_verimono_check(vm.Problem)
+    rec = CheckResult("my_law", "op", "passed", worst=0.5, bound=1.0)
+    seen = []
+    assert _recording(lambda: rec, seen.append)() is rec and seen == [rec]
+
+    def failing():
+        err = AssertionError("my_law failed")
+        err.result = rec
+        raise err
+
+    with pytest.raises(AssertionError, match="my_law failed"):
+        _recording(failing, seen.append)()
+    assert seen == [rec, rec]                                        # the record an exception carries too
+    with pytest.raises(TypeError, match="takes a CheckResult or a Report"):
+        RecordSink(None).add("passed")

@@ -34,6 +34,14 @@ def test_lawful_bug_is_caught_only_through_value(member):
 
 
 @pytest.mark.parametrize("member", list(zoo_prox.LAWFUL))
+def test_no_false_alarm_on_the_correct_counterpart(member):
+    """Seed 0 of the next test, a 20-seed sweep (tier ``slow``)."""
+    _, good = zoo_prox.LAWFUL[member]()
+    assert check_operator(good, seed=0).ok
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("member", list(zoo_prox.LAWFUL))
 def test_no_false_alarm_on_the_correct_counterpart_over_20_seeds(member):
     _, good = zoo_prox.LAWFUL[member]()
     for seed in SEEDS:
@@ -132,6 +140,7 @@ def test_a_bug_confined_to_tiny_inputs_is_caught_at_every_seed(member):
         assert run_law(r.check, zoo_prox.THIN[member](), sample=r.counterexample).status == "failed", str(r)
 
 
+@pytest.mark.timing
 def test_time_of_check_operator_on_a_closed_form_prox():
     """Issue 16 asks ≤ 1 s per check_operator on a correct closed-form prox.  The machine these tests run on
     is shared and loaded, so the CPU time of this process is measured (wall time is printed): median of 3."""

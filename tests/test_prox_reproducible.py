@@ -42,6 +42,24 @@ def _records(tmp_path, imported: bool, guarded: bool = True):
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
+def test_the_guard_empties_the_local_constants_and_restores_them():
+    """The in-process part of the tests below (fresh processes, tier ``slow``): within the guard hypothesis'
+    pool of local constants is empty, and afterwards it is hypothesis' own again."""
+    from verimono._reproducible import no_local_constants
+
+    providers = pytest.importorskip("hypothesis.internal.conjecture.providers")
+    before = getattr(providers, "_get_local_constants", None)
+    with no_local_constants() as found:
+        if not found:
+            pytest.skip("this hypothesis has no local-constants mechanism to switch off")
+        from hypothesis.internal.constants_ast import Constants
+
+        assert providers._get_local_constants is not before
+        assert providers._get_local_constants() == Constants()
+    assert providers._get_local_constants is before
+
+
+@pytest.mark.slow
 def test_same_seed_same_records_with_and_without_an_unrelated_module(tmp_path):
     _constants_module(tmp_path)
     plain, imported = _records(tmp_path, False), _records(tmp_path, True)
@@ -49,6 +67,7 @@ def test_same_seed_same_records_with_and_without_an_unrelated_module(tmp_path):
     assert any(r[3] for r in plain)       # the records carry their worst samples: the comparison is not vacuous
 
 
+@pytest.mark.slow
 def test_without_the_guard_the_import_changes_the_samples(tmp_path):
     from verimono._reproducible import no_local_constants
 
@@ -59,6 +78,7 @@ def test_without_the_guard_the_import_changes_the_samples(tmp_path):
     assert _records(tmp_path, False, guarded=False) != _records(tmp_path, True, guarded=False)
 
 
+@pytest.mark.slow
 def test_a_fresh_process_reproduces_the_records_of_this_one(tmp_path):
     """This pytest process has imported many modules; a fresh one with the record's seed gets the same."""
     import numpy as np

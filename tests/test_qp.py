@@ -45,6 +45,7 @@ def test_projection_matches_slsqp_and_scales_exactly_with_the_data(data):
             np.testing.assert_allclose(zs / s, z, rtol=0, atol=1e-9 * (1 + np.abs(z).max()))
 
 
+@pytest.mark.slow
 def test_a_linear_term_far_larger_than_the_constraints_is_solved_and_returns():
     """min ½y₂² − c y₂ over {y₁ = 0, y ≥ 0, y₂ ≥ δ} with δ = 1e-108 c: the minimiser is (0, c).
 

@@ -7,6 +7,8 @@ from __future__ import annotations
 import importlib
 import re
 
+import pytest
+
 from verimono.checks.stepper_battery import LAWS
 from verimono.reference import get
 from verimono.testing import check_id, checks_for
@@ -39,6 +41,7 @@ def _ids(result):
     return [line.split("::", 1)[1] for line in result.outlines if "::test_battery[" in line]
 
 
+@pytest.mark.slow
 def test_ids_are_stable_readable_and_selectable(pytester):
     _write(pytester, {})
     first = _ids(pytester.runpytest_inprocess("--collect-only", "-q", "-p", "verimono.testing"))
@@ -50,6 +53,7 @@ def test_ids_are_stable_readable_and_selectable(pytester):
     res.assert_outcomes(passed=1)
 
 
+@pytest.mark.slow
 def test_strict_xfail_skips_counted_and_summary(pytester):
     # amplifier on t|x|: contraction fails (expected), in_domain passes (wrongly expected -> XPASS strict)
     _write(pytester, {"contraction[t|x| (n=1)]": "amplifies differences",
@@ -74,18 +78,21 @@ def test_strict_xfail_skips_counted_and_summary(pytester):
     assert "counterexample: problem='t|x| (n=1)'" in out          # failing records print their counterexample
 
 
+@pytest.mark.slow
 def test_unknown_expected_failure_is_an_error(pytester):
     _write(pytester, {"no_such_law": "typo"})
     res = pytester.runpytest_inprocess("-q")
     assert res.ret != 0 and "names checks that do not exist: ['no_such_law']" in res.stdout.str()
 
 
+@pytest.mark.slow
 def test_shrinking_battery_is_an_error(pytester):
     _write(pytester, {}, extra=", min_checks=100")
     res = pytester.runpytest_inprocess("-q")
     assert res.ret != 0 and "checks were lost" in res.stdout.str()
 
 
+@pytest.mark.slow
 def test_user_operator_in_three_lines(pytester):
     pytester.makepyfile(test_mine='''
 import numpy as np
@@ -102,6 +109,17 @@ def test_my_operator(subject, check): check(subject)
     assert outcomes.get("failed", 0) == 0 and outcomes.get("passed", 0) + outcomes.get("skipped", 0) == n
     assert outcomes.get("skipped", 0) >= 1            # no min_norm / contains: those laws are skipped, counted
     assert f"{n} collected, {n} ran" in res.stdout.str()
+
+
+def test_unknown_expected_failure_is_an_error_when_the_battery_is_built():
+    """The session-free counterpart of the pytester test above (tier ``slow``): the decorator itself refuses."""
+    from verimono.testing import parametrize_with_checks
+    from zoo_steppers import amplifier
+
+    problems = [get("t|x| (n=1)")]
+    parametrize_with_checks([amplifier], problems=problems, expected_failed_checks={"contraction[t|x| (n=1)]": "x"})
+    with pytest.raises(ValueError, match=re.escape("names checks that do not exist: ['no_such_law']")):
+        parametrize_with_checks([amplifier], problems=problems, expected_failed_checks={"no_such_law": "typo"})
 
 
 def test_check_id():
@@ -159,6 +177,7 @@ def test_battery(subject, check):
 '''
 
 
+@pytest.mark.slow
 def test_claims_and_problems_are_subjects_of_the_pytest_battery(pytester):
     """A declared scheme='any' stepper passes its battery with the proximal-only laws skipped (counted, with
     the declaration's reason); a Problem gets the assumption evidence, thm_main included."""

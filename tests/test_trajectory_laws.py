@@ -208,6 +208,7 @@ def test_battery_generator_is_the_runners():
     assert {r.check for r in rep.failures} >= {"contraction", "bounds_lg", "bounds_yb", "selections"}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("law", ["bounds_lg", "bounds_yb", "psi_interpolation"])
 def test_bound_laws_fail_on_generated_problems_with_the_breaking_stepper(law):
     """The properties of verimono.properties.laws_trajectories, fed the zoo stepper that breaks the law

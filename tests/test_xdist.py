@@ -12,6 +12,8 @@ from pathlib import Path
 
 import pytest
 
+pytestmark = pytest.mark.slow   # nested pytest sessions in subprocesses (pytester): the slow tier
+
 pytest.importorskip("xdist")  # the test extra installs it; without it there is nothing to verify here
 
 pytest_plugins = ["pytester"]

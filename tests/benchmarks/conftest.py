@@ -8,8 +8,8 @@ times.  The record's details land in ``benchmark.extra_info`` and so in the ``--
 
 With ``--benchmark-disable`` (the default ``addopts``: the suite then runs once inside the normal test run)
 each benchmark uses a smaller size, checks its results, and gates only on a loose sanity bound
-(``SANITY_FACTOR`` × the target) so that an overloaded machine does not fail the ordinary test run; run
-``pytest tests/benchmarks --benchmark-enable`` for the real gates and numbers.
+(``SANITY_FACTOR`` × the target); run ``pytest -m timing --benchmark-enable tests/benchmarks`` for the real
+gates and numbers.  Every test here is marked ``timing`` (below), so none runs in the default ``pytest``.
 """
 
 from __future__ import annotations
@@ -84,3 +84,9 @@ class RatioGate:
 @pytest.fixture
 def gate(benchmark) -> RatioGate:
     return RatioGate(benchmark)
+
+
+def pytest_itemcollected(item: pytest.Item) -> None:
+    """Every test in this folder times something: all are in the ``timing`` tier (``pytest -m timing``), out
+    of the default run, whose verdicts must not depend on how busy the machine is."""
+    item.add_marker(pytest.mark.timing)
