@@ -201,8 +201,8 @@ def check_v_ac(system: Any, T: float, *, samples: int, seed: int) -> Outcome:
     levels = [AC_GRID // 8, AC_GRID // 4, AC_GRID // 2, AC_GRID]
     largest = [float(np.linalg.norm(np.diff(V[::AC_GRID // k], axis=0), axis=1).max(initial=0.0)) for k in levels]
     min_width = AC_FLOOR * EPS * T
-    jumps, searched = find_jumps(lambda t: np.asarray(system.v(t), float), T, grid=AC_GRID,
-                                 candidates=AC_CANDIDATES, min_width=min_width)
+    jumps, searched = find_jumps(lambda t: np.asarray(system.v(t), float), T, grid=AC_GRID, shifts=0,
+                                 candidates=AC_CANDIDATES, extrema=AC_CANDIDATES, min_width=min_width)
     jump = None
     if jumps:
         j = jumps[0]
