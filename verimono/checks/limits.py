@@ -15,11 +15,9 @@ import numpy as np
 from ..problem import Problem
 from ..tolerances import LIMIT_EXTRA_LEVELS, LIMIT_RATIO_FLOOR, LIMIT_TAIL_SAFETY, tolerance
 from .core import Outcome
-from .partitions import limit_grids, refined_random_grid, run_stepper, stepper_law
+from .partitions import LIMIT_LEVELS, limit_grids, refined_random_grid, run_stepper, stepper_law
 from .trajectory_laws import norms as _norms
 
-#: cells of the three refinement levels (|Δ| shrinks 16-fold)
-LIMIT_LEVELS = (10, 40, 160)
 
 
 def _interp(t: np.ndarray, x: np.ndarray, tau: np.ndarray) -> np.ndarray:

@@ -32,6 +32,8 @@ from .subjects import require_problem, require_stepper
 
 #: cells of the default partitions (fine enough for the lemmas' bounds, fast enough for a battery)
 DEFAULT_CELLS = 40
+#: cells of the refinement levels of ``unique_limit`` (:mod:`verimono.checks.limits`; |Δ| shrinks 16-fold)
+LIMIT_LEVELS = (10, 40, 160)
 #: nonuniformity of the default random partition (cell lengths vary by a factor up to 4)
 RANDOM_SPREAD = 0.6
 #: the law's form for a stepper claiming only ``scheme="any"``, by law name (``in_domain``: a distance to
@@ -84,8 +86,6 @@ def every_battery_grid(problem: Problem, seed: int = 0) -> dict[str, np.ndarray]
     """Every partition the battery builds for ``problem``: :func:`default_grids`, the graded one of as many
     cells, and the convergence grids of ``unique_limit`` (:func:`limit_grids` at each of
     ``LIMIT_LEVELS``, the random kind refined from the first level's); duplicates dropped."""
-    from .limits import LIMIT_LEVELS      # limits imports this module
-
     T = problem.T
     out = dict(default_grids(problem, seed))
     out["graded"] = graded_grid(T, DEFAULT_CELLS, 2.0)
