@@ -23,3 +23,13 @@ def siconos_dir() -> Path:
     from verimono.lcs.siconos import PACKAGED_DATA, siconos_root
 
     return siconos_root(PACKAGED_DATA)
+
+
+def pytest_collection_modifyitems(config, items):
+    """Tests marked ``slow`` (minutes long) run only with ``VERIMONO_SLOW=1`` or when ``-m`` names them."""
+    if os.environ.get("VERIMONO_SLOW") == "1" or "slow" in (config.getoption("-m") or ""):
+        return
+    skip = pytest.mark.skip(reason="slow: set VERIMONO_SLOW=1 (or -m slow) to run it")
+    for item in items:
+        if "slow" in item.keywords:
+            item.add_marker(skip)
