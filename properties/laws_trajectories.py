@@ -62,7 +62,7 @@ FAMILIES = ("linear", "subdifferential", "moving_set", "any", "lcs")
 
 
 @st.composite
-def trajectory_problems(draw):
+def trajectory_problems(draw, families=FAMILIES):
     """A problem ``x' ∈ -F(t, x) + u`` of every generator family, ``x0 ∈ dom F(0,·)``, stating the φ, σ, θ of
     (A3), (LG), (YB) the generator knows (:class:`verimono.strategies.Stated`).
 
@@ -70,13 +70,13 @@ def trajectory_problems(draw):
     ``v``), as ``system.problem(x0, T)``.  An input ``u`` (lemma ``l:extinput``) comes with one problem in four:
     lem:bndSeqYB does not cover inputs, so more would leave bounds_yb untested on most draws."""
     n = draw(st.integers(1, 3), label="n")
-    kind = draw(st.sampled_from(FAMILIES), label="family")
+    kind = draw(st.sampled_from(families), label="family")
     if kind == "lcs":
         stated = draw(vs.lcs_operators(n, None, moving_v=False), label="H")
         op = stated.operator
         return stated.system.problem(_x0(op, draw), T, **stated.assumptions())
-    families = ("linear", "subdifferential", "moving_set") if kind == "any" else (kind,)
-    stated = draw(vs.stated_operators(n, T, families, shifted=None if kind == "any" else False), label="F")
+    bases = ("linear", "subdifferential", "moving_set") if kind == "any" else (kind,)
+    stated = draw(vs.stated_operators(n, T, bases, shifted=None if kind == "any" else False), label="F")
     op = stated.operator
     kw = {}
     if draw(st.sampled_from([False, False, False, True]), label="input"):
@@ -112,13 +112,17 @@ del _law
 
 # -- census: the laws must apply to most generated problems ------------------------------------------
 
-#: generated problems drawn (derandomized) for the census of skips
-CENSUS_EXAMPLES = 100
+#: generated problems drawn (derandomized) for the census of skips, per family of :data:`CENSUS_FAMILIES`
+CENSUS_EXAMPLES = 20
+#: every family is drawn on its own: hypothesis mixes constants of the modules already imported into its
+#: draws, so one derandomized stream over all families depends on which tests ran before (a whole-suite
+#: run drew no shifted operator in 100 draws where the file alone drew many)
+CENSUS_FAMILIES = FAMILIES
 #: a law skipped on more than this share of generated problems is not tested by its property (every skip
 #: counts as a pass inside @given): skips must be a minority.  Legitimate skips remain: (LG) fails for the
 #: log-barrier and is not explicit for a singular D + Dᵀ; (YB) fails for moving sets, is not stated for a
-#: moving matrix or a shift, and lem:bndSeqYB does not cover inputs (measured on the 100 draws: bounds_lg 10%,
-#: bounds_yb 34%, psi_interpolation 3%)
+#: moving matrix or a shift, and lem:bndSeqYB does not cover inputs (measured on 20 draws of each family: bounds_lg 15%,
+#: bounds_yb 36%, psi_interpolation 2%, contraction 3%)
 MAX_SKIP_SHARE = 0.5
 #: laws of the census (unique_limit needs no stated constant and never skips on a valid problem)
 CENSUS_LAWS = tuple(law for law in LAWS if law != "unique_limit")
@@ -127,28 +131,32 @@ CENSUS_LAWS = tuple(law for law in LAWS if law != "unique_limit")
 def test_laws_apply_to_most_generated_problems():
     """Skips of each law on ``trajectory_problems`` stay a minority (``≤ MAX_SKIP_SHARE``): a law whose
     property skips on most draws tests nothing while hypothesis counts every skip as a pass.  Counted on
-    ``CENSUS_EXAMPLES`` derandomized draws on an 8-cell partition (applicability does not depend on the mesh)."""
+    ``CENSUS_EXAMPLES`` derandomized draws of each family on an 8-cell partition (applicability does not
+    depend on the mesh)."""
     seen: dict[str, Counter] = {law: Counter() for law in CENSUS_LAWS}
     reasons: dict[str, Counter] = {law: Counter() for law in CENSUS_LAWS}
     kinds: Counter = Counter()
 
-    @settings(max_examples=CENSUS_EXAMPLES, derandomize=True, database=None, phases=[Phase.generate],
-              deadline=None, suppress_health_check=list(HealthCheck))
-    @given(problem=trajectory_problems())
-    def census(problem):
-        kinds[type(problem.operator).__name__] += 1
-        grid = np.linspace(0.0, T, 9)
-        for law in CENSUS_LAWS:
-            rec = CHECKS[law](solve, problem, grids={"census": grid})
-            seen[law][rec.status] += 1
-            if rec.status == SKIPPED:
-                reasons[law][rec.message[:90]] += 1
+    def census(family):
+        @settings(max_examples=CENSUS_EXAMPLES, derandomize=True, database=None, phases=[Phase.generate],
+                  deadline=None, suppress_health_check=list(HealthCheck))
+        @given(problem=trajectory_problems(families=(family,)))
+        def draw(problem):
+            kinds[type(problem.operator).__name__] += 1
+            grid = np.linspace(0.0, T, 9)
+            for law in CENSUS_LAWS:
+                rec = CHECKS[law](solve, problem, grids={"census": grid})
+                seen[law][rec.status] += 1
+                if rec.status == SKIPPED:
+                    reasons[law][rec.message[:90]] += 1
+        draw()
 
-    census()
+    for family in CENSUS_FAMILIES:
+        census(family)
     assert kinds["LCSOperator"] and kinds["Shifted"] and kinds["NormalCone"], kinds    # every family drawn
     for law in CENSUS_LAWS:
         total = sum(seen[law].values())
-        assert total == CENSUS_EXAMPLES
+        assert total == CENSUS_EXAMPLES * len(CENSUS_FAMILIES)
         assert seen[law][FAILED] == 0, (law, seen[law])
         share = seen[law][SKIPPED] / total
         assert share <= MAX_SKIP_SHARE, f"{law} skipped on {share:.0%} of generated problems: {dict(reasons[law])}"

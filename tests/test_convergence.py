@@ -8,7 +8,9 @@ import numpy as np
 import pytest
 
 import verimono as vm
+from verimono.checks import check_convergence_order
 from verimono.convergence import ORDER_SLACK, convergence_study, fit_order, grid_errors
+from verimono.reference import catalog, get
 
 
 @pytest.mark.parametrize("p", [0.5, 1.0, 2.0])
@@ -133,3 +135,99 @@ def test_fine_grid_study_is_the_interpolated_fine_solution_and_holds_no_trajecto
     peak, _, _ = peak_memory(lambda: convergence_study(vm.solve, p, steps, executor="serial"))
     fine_trajectory = (8 * 16000 + 1) * 10 * 8
     assert peak < 0.9 * fine_trajectory, (peak, fine_trajectory)
+
+
+# -- the floor of an inner solve, and no forgiven stall (solve_tol) ----------------------------------------
+
+def _trapezoid(tol):
+    """The trapezoidal rule on ``x' = -c(t) x/|x|`` (``t|x|``), its implicit step solved by a damped fixed
+    point stopped at ``tol`` relative to ``1 + |y|``: exact at the nodes but for what each solve leaves."""
+    def step(problem, t):
+        c = problem.operator.c
+        x = [np.asarray(problem.x0, float)]
+        for k in range(1, len(t)):
+            h, xk = t[k] - t[k - 1], x[-1]
+            if np.linalg.norm(xk) <= 0.5 * h * (c(t[k - 1]) + c(t[k])):     # the step reaches 0: extinction
+                x.append(np.zeros_like(xk))
+                continue
+
+            def target(y):
+                return xk - 0.5 * h * (c(t[k - 1]) * xk / np.linalg.norm(xk) + c(t[k]) * y / np.linalg.norm(y))
+            y = xk.copy()
+            for _ in range(500):
+                new = y + 0.5 * (target(y) - y)
+                done = np.linalg.norm(new - y) <= tol * (1.0 + np.linalg.norm(y))
+                y = new
+                if done:
+                    break
+            x.append(y)
+        return np.array(x)
+    return step
+
+
+def test_an_inner_solve_at_its_stated_tolerance_is_exact_to_it():
+    """Issue case: a trapezoid solving its step to 1e-10 is exact at the nodes of t|x| up to its solve; its
+    errors grow with K (each step leaves ~τ), so without the claim it is no order at all, and with
+    ``solve_tol`` every error is at its floor K·τ·(1 + scale)."""
+    p = get("t|x| (n=1)")
+    plain = check_convergence_order(vm.Stepper(_trapezoid(1e-10), scheme="any", order=2), p)
+    assert plain.status == "failed", plain.message
+    stated = check_convergence_order(
+        vm.Stepper(_trapezoid(1e-10), scheme="any", order=2, solve_tol=1e-10), p)
+    assert stated.status == "passed", stated.message
+    assert "exact to the stated solve tolerance 1e-10" in stated.message
+    study = stated.details["study"]
+    assert study.solve_tol == 1e-10
+    assert all(e <= f for e, f in zip(study.errors["sup"], study.grid_floors))
+    # the floor is no blanket: a looser solve than the stated one is not exact to it
+    loose = check_convergence_order(
+        vm.Stepper(_trapezoid(1e-5), scheme="any", order=2, solve_tol=1e-10), p)
+    assert loose.status == "failed", loose.message
+
+
+def _stalled(problem, t):
+    """Answers the two finest grids of the problem's study with the next-coarser solve (interpolated)."""
+    ks = sorted(int(round(problem.T / h)) for h in problem.steps)
+    if len(t) - 1 in ks[-2:]:
+        coarse = vm.uniform_grid(problem.T, steps=ks[-3])
+        xc = vm.solve(problem, coarse).x
+        return np.stack([np.interp(t, coarse, xc[:, j]) for j in range(xc.shape[1])], -1)
+    return vm.solve(problem, t).x
+
+
+def test_a_stall_far_above_the_floor_fails_and_is_not_pre_asymptotic():
+    """Issue case: it passed as 'measured 0.688 [0.381, 0.996], expected 1 (pre-asymptotic …)'."""
+    rec = check_convergence_order(_stalled, get("t|x| (n=1)"))
+    assert rec.status == "failed", rec.message
+    assert "stall" in rec.message and "pre-asymptotic" not in rec.message.split("stall")[0]
+
+
+def test_no_catalog_reference_stalls_under_solve():
+    for p in catalog():
+        study = convergence_study(vm.solve, p)
+        assert study.stall() is None, (p.name, study.stall())
+
+
+def test_solve_floor_accumulates_per_step_and_widens_only_with_a_claim():
+    from verimono.convergence import solve_floor
+
+    assert solve_floor(100, 1e-10, 3.0) == pytest.approx(100 * 1e-10 * 4.0)
+    p = get("t|x| (n=1)")
+    bare = convergence_study(vm.solve, p)
+    assert bare.floors is None and bare.solve_tol is None
+    claimed = convergence_study(vm.solve, p, solve_tol=1e-12)
+    assert claimed.solve_tol == 1e-12 and len(claimed.grid_floors) == len(claimed.mesh)
+    assert all(f > claimed.floor for f in claimed.grid_floors)
+    back = vm.convergence.ConvergenceStudy.from_dict(claimed.to_dict())
+    assert back.grid_floors == pytest.approx(claimed.grid_floors) and back.solve_tol == 1e-12
+
+
+def test_with_claim_keeps_what_is_not_given():
+    from verimono.claims import InvalidClaim, claim_of, with_claim
+
+    s = vm.Stepper(vm.solve, scheme="any", order=2, contracts=True)
+    c = claim_of(with_claim(s, solve_tol=1e-9))
+    assert (c.scheme, c.order, c.contracts, c.solve_tol) == ("any", 2.0, True, 1e-9)
+    for bad in (0, 1, -1e-3, float("nan"), "x", True):
+        with pytest.raises(InvalidClaim):
+            vm.Stepper(vm.solve, solve_tol=bad)

@@ -4,6 +4,7 @@ three-line user battery."""
 
 from __future__ import annotations
 
+import importlib
 import re
 
 from verimono.checks.stepper_battery import LAWS
@@ -114,8 +115,12 @@ def test_dropping_a_law_from_the_registry_is_a_shrunk_battery(monkeypatch):
     import pytest
 
     from verimono import Linear
-    from verimono.checks import operator_battery, stepper_battery
     from verimono.testing import parametrize_with_checks
+
+    # the modules parametrize_with_checks imports (sys.modules): pytester's in-process runs restore
+    # sys.modules afterwards, which can leave a stale submodule attribute on the verimono.checks package
+    operator_battery = importlib.import_module("verimono.checks.operator_battery")
+    stepper_battery = importlib.import_module("verimono.checks.stepper_battery")
     from zoo_steppers import amplifier
 
     ops = [Linear([[1.0]], name="a"), Linear([[2.0]], name="b")]

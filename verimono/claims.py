@@ -43,34 +43,53 @@ class Claim:
 
     ``scheme``: ``"proximal"`` or ``"any"``; ``order``: the convergence order claimed by an ``"any"``
     scheme (``None`` for the proximal scheme, whose order each reference states); ``contracts``: whether
-    two of its solutions obey ``|x_k - x'_k| ≤ e^{L t_k}|x_0 - x'_0|`` (always for the proximal scheme).
+    two of its solutions obey ``|x_k - x'_k| ≤ e^{L t_k}|x_0 - x'_0|`` (always for the proximal scheme);
+    ``solve_tol``: the accuracy of the stepper's inner solve (Newton, fixed point, an iterative prox) per
+    step, relative to ``1 + |x|`` — errors at what that accumulates pass as exact to it
+    (:func:`verimono.convergence.solve_floor`).
     """
 
     scheme: str = PROXIMAL
     order: float | None = None
     contracts: bool = True
+    solve_tol: float | None = None
 
     @property
     def proximal(self) -> bool:
         return self.scheme == PROXIMAL
 
     def describe(self) -> str:
+        tol = f", solve_tol={self.solve_tol:g}" if self.solve_tol else ""
         if self.proximal:
-            return "scheme='proximal'"
-        return f"scheme='any', order={self.order:g}" + (", contracts" if self.contracts else "")
+            return "scheme='proximal'" + tol
+        return f"scheme='any', order={self.order:g}" + (", contracts" if self.contracts else "") + tol
 
 
-def make_claim(scheme: str = PROXIMAL, order: Any = None, contracts: bool | None = None) -> Claim:
+def _solve_tol(value: Any) -> float | None:
+    if value is None:
+        return None
+    try:
+        tol = float(value)
+    except (TypeError, ValueError):
+        raise InvalidClaim(f"solve_tol must be a number in (0, 1), got {value!r}") from None
+    if isinstance(value, bool) or not (0.0 < tol < 1.0):
+        raise InvalidClaim(f"solve_tol must be a number in (0, 1) (a relative accuracy per step), got {value!r}")
+    return tol
+
+
+def make_claim(scheme: str = PROXIMAL, order: Any = None, contracts: bool | None = None,
+               solve_tol: Any = None) -> Claim:
     """Validate and normalise a claim (``order`` defaults to 1 for ``"any"``)."""
     if scheme not in SCHEMES:
         raise InvalidClaim(f"scheme must be one of {SCHEMES}, got {scheme!r}")
+    tol = _solve_tol(solve_tol)
     if scheme == PROXIMAL:
         if order is not None:
             raise InvalidClaim("the proximal scheme's order is stated per reference; order= is for scheme='any'")
         if contracts is False:
             raise InvalidClaim("the proximal scheme contracts (uniqueness argument, Section 6): "
                                "contracts=False needs scheme='any'")
-        return Claim(PROXIMAL, None, True)
+        return Claim(PROXIMAL, None, True, tol)
     order = 1.0 if order is None else order
     try:
         order = float(order)
@@ -78,25 +97,27 @@ def make_claim(scheme: str = PROXIMAL, order: Any = None, contracts: bool | None
         raise InvalidClaim(f"order must be a positive number, got {order!r}") from None
     if not (math.isfinite(order) and order > 0.0):
         raise InvalidClaim(f"order must be a positive finite number, got {order!r}")
-    return Claim(ANY, order, bool(contracts))
+    return Claim(ANY, order, bool(contracts), tol)
 
 
 class Stepper:
-    """A stepper with its claim: ``Stepper(fn, *, scheme="proximal", order=None, name=None)``.
+    """A stepper with its claim: ``Stepper(fn, *, scheme="proximal", order=None, name=None, contracts=None,
+    solve_tol=None)``.
 
     Calling it calls ``fn(problem, t_grid)``.  ``scheme="any"`` claims only convergence with order
-    ``order`` (default 1); ``contracts=True`` adds the contraction claim.  ``batched`` is inherited from
-    ``fn`` (a stepper accepting ``x0`` of shape ``(B, n)``).
+    ``order`` (default 1); ``contracts=True`` adds the contraction claim; ``solve_tol`` states the accuracy
+    of its inner solve (:class:`Claim`).  ``batched`` is inherited from ``fn`` (a stepper accepting ``x0``
+    of shape ``(B, n)``).
     """
 
     def __init__(self, fn: Callable, *, scheme: str = PROXIMAL, order: Any = None, name: str | None = None,
-                 contracts: bool | None = None) -> None:
+                 contracts: bool | None = None, solve_tol: Any = None) -> None:
         if not callable(fn):
             raise InvalidClaim(f"a stepper must be callable as stepper(problem, t_grid), got {fn!r}")
         if isinstance(fn, Stepper):
             fn = fn.fn
         self.fn = fn
-        self.claim = make_claim(scheme, order, contracts)
+        self.claim = make_claim(scheme, order, contracts, solve_tol)
         self.__name__ = name or getattr(fn, "__name__", None) or type(fn).__name__
         self.name = self.__name__
         self.__doc__ = getattr(fn, "__doc__", None)
@@ -134,13 +155,20 @@ def claim_of(stepper: Any) -> Claim:
 
 
 def with_claim(stepper: Callable, scheme: str | None = None, order: Any = None,
-               contracts: bool | None = None) -> Callable:
-    """``stepper`` with the claim given as keywords (unchanged when none is given)."""
-    if scheme is None and order is None and contracts is None:
+               contracts: bool | None = None, solve_tol: Any = None) -> Callable:
+    """``stepper`` with the claim given as keywords (unchanged when none is given); what is not given is kept
+    from the stepper's own claim."""
+    if scheme is None and order is None and contracts is None and solve_tol is None:
         return stepper
+    own = claim_of(stepper)
     if scheme is None:
-        scheme = ANY if order is not None else claim_of(stepper).scheme
-    return Stepper(stepper, scheme=scheme, order=order, name=subject_name(stepper), contracts=contracts)
+        scheme = ANY if order is not None else own.scheme
+    if scheme == own.scheme == ANY:
+        order = own.order if order is None else order
+        contracts = own.contracts if contracts is None else contracts
+    solve_tol = own.solve_tol if solve_tol is None else solve_tol
+    return Stepper(stepper, scheme=scheme, order=order, name=subject_name(stepper), contracts=contracts,
+                   solve_tol=solve_tol)
 
 
 __all__ = ["Claim", "Stepper", "claim_of", "with_claim", "make_claim", "InvalidClaim", "PROXIMAL", "ANY",

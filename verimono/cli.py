@@ -5,7 +5,8 @@
                  [--unit-timeout S]
         The whole verification (every registered stage, see ``verimono.stages``); writes DIR/results.json
         and DIR/report.html (DIR defaults to reports/).  Exit 0 when every check holds, 1 when one fails,
-        2 when nothing failed but a check was undecided (a limitation of the harness).
+        2 when nothing failed but a check was undecided (a limitation of the harness) — except a speed the machine
+        was too noisy to judge (a timing record undecided for "timing noise"), which exits 0 and says so.
         The output folder is checked writable before any work; both files are written atomically with one
         run id.  An interrupt (Ctrl-C, SIGTERM) writes the finished stages to a results file marked
         incomplete (the gate refuses it, exit 2) and exits 130; ``--resume`` runs the stages that file lacks
@@ -124,6 +125,12 @@ def _finish(report: Report, out: Path, baseline: Report | None) -> int:
     for r in report.failures:
         print(f"  {r}")
     line = f"verimono: {report.summary()}"
+    from .timing import is_noise_undecided
+
+    noisy = [r for r in report.undecided if is_noise_undecided(r)]
+    if noisy:
+        line += (f"; speed could not be judged here: {len(noisy)} timing record{'s' if len(noisy) != 1 else ''} "
+                 "undecided, the machine too noisy (not a failure)")
     if changes is not None:
         for ln in changes.regression_lines(getattr(baseline, "source", None), paths["json"]):
             print(ln)
@@ -183,7 +190,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
     if kind == "operator":
         stages, ctx = ["operator_laws"], _context(args, operators=[(args.target, obj)])
     elif kind == "stepper":
-        obj = with_claim(obj, args.scheme, args.order)
+        obj = with_claim(obj, args.scheme, args.order, solve_tol=args.solve_tol)
         stages, ctx = ["convergence", "trajectory_laws"], _context(args, stepper=obj)
         kind = "stepper" + ("" if claim_of(obj).proximal else f" claiming {claim_of(obj).describe()}")
     else:
@@ -318,6 +325,9 @@ def build_parser() -> argparse.ArgumentParser:
                             "for a bare callable) or 'any' (it only converges with --order)")
     check.add_argument("--order", type=float, default=None,
                        help="the convergence order a --scheme any stepper claims (default 1)")
+    check.add_argument("--solve-tol", type=float, default=None, metavar="TAU",
+                       help="the accuracy of the stepper's inner solve per step (relative to 1 + |x|): errors at "
+                            "what it accumulates pass as exact to it")
     check.set_defaults(func=_cmd_check, stage=None)
 
     base = sub.add_parser("baseline", help="record the current results as the gate's baseline")

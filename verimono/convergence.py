@@ -8,9 +8,22 @@ none, against a fine-grid solution of the same stepper, which the result says):
 * ``final``: ``|x_K - x(T)|``.
 
 The order in each norm is the slope of ``log e`` against ``log |Δ|`` (``|Δ| = max_k h_k``) by least
-squares — valid for any step ratio — with a 95% Student-t confidence interval.  Errors at the round-off
-floor (``ROUNDOFF_FACTOR · ε · scale``) are dropped; if every error is there the scheme is exact on the
-grid.  Data whose local slopes spread by more than ``ASYMPTOTIC_SPREAD`` are flagged pre-asymptotic.
+squares — valid for any step ratio — with a 95% Student-t confidence interval.  Errors at the floor of a
+grid are dropped; if every error is there the scheme is exact on the grids.  The floor is round-off,
+``ROUNDOFF_FACTOR · ε · scale``, plus — for a stepper that states the accuracy ``τ`` of its inner solve
+(``Stepper(..., solve_tol=τ)``) — what ``K`` inexact steps of a nonexpansive scheme can accumulate,
+``K τ (1 + scale)`` (:func:`solve_floor`).
+
+*Pre-asymptotic* and *stalled* are told apart by the local slopes (the slopes between successive grids,
+coarse to fine):
+
+* **pre-asymptotic** — the local slopes spread by more than ``ASYMPTOTIC_SPREAD``: the data have not
+  reached the regime ``e ≈ C h^p`` yet; said in the verdict, which is still that of the fit's interval;
+* **stalled** — the errors stop falling far above the floor: over the last two refinements they fall by
+  less than a quarter of the expected order, ``e_K / e_{K-2} > (h_K / h_{K-2})^{p/4}``, while
+  ``e_K > STALL_MARGIN`` times the floor.  A stall fails, whatever the fit's interval says (a stepper that
+  answers the finest grids with a coarser solve has a wide interval that still reaches ``p``), and is never
+  called pre-asymptotic.
 
 Performance: the grids run as independent jobs, in parallel through any ``concurrent.futures.Executor``
 (``executor=``; a ``dask.distributed`` client's ``get_executor()`` works the same), or a process pool
@@ -56,6 +69,20 @@ ASYMPTOTIC_SPREAD = 0.25
 #: an order estimate "reaches" p when its interval's upper end is within this of p; the slack absorbs
 #: the O(h) drift of the slope of C h^p (1 + O(h)) over the studied range
 ORDER_SLACK = 0.1
+#: a stall is judged only on errors this many times above their floor (closer to it, rounding and an
+#: inner solve's tolerance flatten any scheme's errors)
+STALL_MARGIN = 100.0
+#: over the last two refinements the errors of an order-p scheme fall like (h_K/h_{K-2})^p; falling by less
+#: than (h_K/h_{K-2})^{p·STALL_FRACTION} is a stall (a quarter of the order: the noisiest catalog study, a
+#: moving box of order 2 whose e/h² ranges over a factor 5, falls by (1/4)^1.5 there)
+STALL_FRACTION = 0.25
+
+
+def solve_floor(steps: int, solve_tol: float, scale: float) -> float:
+    """What ``steps`` inner solves of accuracy ``solve_tol`` (relative to ``1 + scale``) can add to the error
+    of a nonexpansive scheme: each step's error passes through later steps without growing (the
+    resolvent is nonexpansive, Proposition ``prop:maxmon-resolvent-Yosida`` ii), so they add up."""
+    return float(steps) * float(solve_tol) * (1.0 + float(scale))
 
 
 @dataclasses.dataclass
@@ -89,13 +116,14 @@ class OrderFit:
         return f"{self.slope:.3f} [{self.low:.3f}, {self.high:.3f}]"
 
 
-def fit_order(h: Sequence[float], e: Sequence[float], floor: float = 0.0) -> OrderFit:
-    """Fit ``e ≈ C h^p`` on the points above ``floor`` (see the module docstring).
+def fit_order(h: Sequence[float], e: Sequence[float], floor: float | Sequence[float] = 0.0) -> OrderFit:
+    """Fit ``e ≈ C h^p`` on the points above ``floor`` (one floor, or one per grid; see the module docstring).
 
     A non-finite error (``nan``/``inf``: a stepper that diverged or returned garbage) is never "below the
     floor": the fit is then ``nan`` with ``nonfinite`` listing the offending grids, and the study fails.
     """
     h, e = np.asarray(h, float), np.asarray(e, float)
+    floor = np.broadcast_to(np.asarray(floor, float), e.shape)
     bad = np.flatnonzero(~np.isfinite(e)).tolist()
     if bad:
         return OrderFit(math.nan, math.nan, math.nan, [], list(range(len(e))), [], False, nonfinite=bad)
@@ -135,11 +163,38 @@ class ConvergenceStudy:
     reference: str
     floor: float
     timings: list[float]
+    #: the floor of each grid (round-off plus what a stated inner-solve tolerance accumulates); ``None``:
+    #: ``floor`` on every grid
+    floors: list[float] | None = None
+    #: the accuracy of its inner solve the stepper stated, if any
+    solve_tol: float | None = None
 
     @property
     def order(self) -> OrderFit:
         """The sup-norm fit, the norm of the paper's convergence result."""
         return self.fits["sup"]
+
+    @property
+    def grid_floors(self) -> list[float]:
+        """The floor of each grid."""
+        return list(self.floors) if self.floors is not None else [self.floor] * len(self.mesh)
+
+    def stall(self) -> str | None:
+        """Why the errors stalled far above their floor (module docstring), or ``None``."""
+        exp, e, h, fl = self.expected, self.errors["sup"], self.mesh, self.grid_floors
+        if exp is None or exp.exact or len(e) < 3:
+            return None
+        order = sorted(range(len(h)), key=lambda i: -h[i])          # coarse to fine
+        a, b = order[-3], order[-1]
+        if not (e[b] > STALL_MARGIN * fl[b] and e[a] > 0 and h[b] < h[a]):
+            return None
+        limit = (h[b] / h[a]) ** (exp.value * STALL_FRACTION)
+        if e[b] / e[a] <= limit:
+            return None
+        return (f"the errors stall far above their floor: {e[a]:.3g} -> {e[b]:.3g} over the last two refinements "
+                f"(h {h[a]:.3g} -> {h[b]:.3g}) where order {exp.value:g} predicts {e[a] * (h[b] / h[a]) ** exp.value:.3g} "
+                f"(a fall by less than (h_K/h_(K-2))^(p/4) = {limit:.3g}, {e[b] / fl[b]:.3g}x the floor: a stall, "
+                "not a pre-asymptotic regime, whose local slopes rise toward p)")
 
     def verdict(self) -> tuple[bool, str]:
         """Whether the stepper reaches the expected order, with the reason."""
@@ -149,15 +204,22 @@ class ConvergenceStudy:
             return False, f"non-finite error: {bad} (the stepper diverged or returned non-finite values)"
         if exp is None:
             return True, "no expected order stated"
+        at = "the stated solve tolerance" if self.solve_tol else "round-off"
         if exp.exact:
             worst = max(self.errors["sup"])
             ok = fit.exact
-            return ok, (f"errors at round-off (max {worst:.2e} ≤ floor {self.floor:.2e})" if ok else
-                        f"expected exact at the nodes, max error {worst:.2e} > floor {self.floor:.2e}")
+            return ok, (f"errors at {at} (max {worst:.2e} ≤ floor {max(self.grid_floors):.2e})" if ok else
+                        f"expected exact at the nodes, max error {worst:.2e} > floor {max(self.grid_floors):.2e}")
         if fit.exact:
+            if self.solve_tol:
+                return True, (f"exact to the stated solve tolerance {self.solve_tol:g}: every error at its floor "
+                              f"(max {max(self.errors['sup']):.2e} ≤ {max(self.grid_floors):.2e})")
             return True, "errors at round-off: exceeds every order"
+        stall = self.stall()
+        if stall:
+            return False, f"measured {fit}, expected {exp.value:g}: {stall}"
         if math.isnan(fit.high):
-            return False, f"too few points above round-off to estimate an order (slope {fit.slope:.3f})"
+            return False, f"too few points above {at} to estimate an order (slope {fit.slope:.3f})"
         ok = fit.reaches(exp.value)
         msg = f"measured {fit}, expected {exp.value:g}"
         if fit.pre_asymptotic:
@@ -196,9 +258,11 @@ class ConvergenceStudy:
             f["local_slopes"] = [num(s) for s in f["local_slopes"]]
             fits[k] = OrderFit(**f)
         exp = None if d.get("expected") is None else Order(**d["expected"])
+        floors = d.get("floors")
         return cls(d["problem"], d["stepper"], [num(m) for m in d["mesh"]], list(d["steps"]),
                    {k: [num(x) for x in v] for k, v in d["errors"].items()}, fits, exp, d["reference"],
-                   num(d["floor"]), [num(x) for x in d["timings"]])
+                   num(d["floor"]), [num(x) for x in d["timings"]],
+                   None if floors is None else [num(x) for x in floors], num(d.get("solve_tol")))
 
 
 def study_text(study: Any) -> str:
@@ -334,7 +398,8 @@ class Sampler:
 
 
 def convergence_study(stepper: Callable, problem: Problem, steps: Sequence[Any] | None = None, *,
-                      reference_refinement: int = 8, executor: Any = None) -> ConvergenceStudy:
+                      reference_refinement: int = 8, executor: Any = None,
+                      solve_tol: float | None = None) -> ConvergenceStudy:
     """Run ``stepper`` on a sequence of grids and estimate its convergence order.
 
     ``steps`` are step sizes (uniform grids of ``[0, T]``) or explicit grids; by default the problem's
@@ -350,7 +415,12 @@ def convergence_study(stepper: Callable, problem: Problem, steps: Sequence[Any] 
     lambdas and closures (the reference catalog's) need no pickling with verimono's own process pool
     (forked workers inherit them); for other executors they travel by pickle, else by ``cloudpickle``
     (by value, with the parameters their closures captured).
+
+    ``solve_tol``: the accuracy of the stepper's inner solve, relative to the state's size (default: the
+    stepper's own claim, ``Stepper(..., solve_tol=τ)``); it raises each grid's floor by :func:`solve_floor`.
     """
+    if solve_tol is None:
+        solve_tol = getattr(getattr(stepper, "claim", None), "solve_tol", None)
     steps = problem.steps if steps is None else steps
     if not steps or len(steps) < 2:
         raise InvalidProblem("a convergence study needs at least two step sizes or grids")
@@ -371,9 +441,11 @@ def convergence_study(stepper: Callable, problem: Problem, steps: Sequence[Any] 
     scale = max([1.0] + [sc for _, sc, _ in results if math.isfinite(sc)])
     floor = ROUNDOFF_FACTOR * EPS * scale
     mesh = [float(np.max(np.diff(g))) for g in grids]
-    fits = {n: fit_order(mesh, errors[n], floor) for n in NORMS}
+    floors = None if not solve_tol else [floor + solve_floor(len(g) - 1, solve_tol, scale) for g in grids]
+    fits = {n: fit_order(mesh, errors[n], floor if floors is None else floors) for n in NORMS}
     return ConvergenceStudy(problem.name, subject_name(stepper), mesh, [len(g) - 1 for g in grids], errors, fits,
-                            problem.order, reference, floor, [r[-1] for r in results[:len(grids)]])
+                            problem.order, reference, floor, [r[-1] for r in results[:len(grids)]], floors,
+                            solve_tol or None)
 
 
 #: a study of at least this many steps in all runs in a process pool when ``executor=None``
@@ -513,5 +585,5 @@ def _timed_run(stepper, problem, grid):
     return x, time.perf_counter() - start
 
 
-__all__ = ["convergence_study", "ConvergenceStudy", "OrderFit", "fit_order", "grid_errors", "exact_on",
+__all__ = ["convergence_study", "ConvergenceStudy", "OrderFit", "fit_order", "grid_errors", "exact_on", "solve_floor",
            "ErrorAccumulator", "Sampler"]

@@ -20,9 +20,36 @@
 * **study** — a convergence study of the baseline that is absent now while its record remains (the
   record's order claim is no longer backed by any errors);
 * **incomplete** — results marked ``meta.incomplete`` (an interrupted run) are refused: exit status 2;
-* **timing** — a stage's duration divided by the calibration workload measured in the same job (or a
-  record's ``details["timing_ratio"]``, a same-job ratio) grows by more than ``TIMING_GROWTH``; stage
-  durations are compared only between runs on the same executor (``meta.executor``: serial, process:N, ...).
+* **timing** — judged only where the measurement supports it (see *Timing* below); stage durations are
+  compared only between runs on the same executor (``meta.executor``: serial, process:N, ...).
+
+*Timing.*  Contention only ever adds time, and it does not add it evenly: a grown number from a busy machine
+is evidence of the machine, not of the code, unless the measurement rules that out.  So:
+
+* a record's same-job ratio (``details["timing_ratio"]``, larger is worse) regresses when it grew by more than
+  ``TIMING_GROWTH`` *with confidence*: the lower end of its interval (``details["timing_interval"]``, the
+  order-statistics bound of the median per-round ratio, :mod:`verimono.timing`) exceeds ``TIMING_GROWTH``
+  times the baseline's ratio.  A record without an interval (the memory record, a deterministic byte count;
+  results from before intervals) compares its ratio itself;
+* a record that passed and is now ``undecided`` because timing noise kept its speed from being judged
+  (``details["undecided_reason"] == "timing noise"``) is a change, not a regression;
+* a stage's duration is stated in calibration units (seconds over the calibration workload of the same job).
+  The run measures that workload at its start and its end (``meta.calibrations``); the stage's units are
+  taken in the *slower* of the two, the baseline's in the *faster* of its own, so that growth is not an
+  artefact of which end was measured.  Growth beyond ``TIMING_GROWTH`` is a regression only when the machine
+  was quiet enough for stage times to mean anything: its two calibrations agree within
+  ``CALIBRATION_DRIFT`` (else the machine's speed changed during the run, and no single unit describes it),
+  and the stage did not run on a busy machine: where the run recorded them (``meta.stages[i]``, by
+  :class:`verimono.timing.MachineProbe`), *busy* means some task waited for a CPU during more than
+  ``BUSY_WAITING`` (10%) of the stage's wall time (Linux PSI, ``cpu_waiting``) *and* processes outside the run
+  used more than ``BUSY_FOREIGN`` (10%) of the machine's CPU capacity (``foreign_cpu``) — contention, and
+  not the run's own (its worker processes importing beside the main one make a quiet run's first stage
+  wait 40%, with 0-5% foreign); with one of the two recorded, that one decides.  Otherwise the growth is
+  reported as a change, "not judged", with the evidence — and so is a growth beyond ``TIMING_GROWTH`` in
+  units taken at the run's *faster* calibration only, when the run cannot be judged (a drifting or busy run
+  may hide a real slowdown in its slower calibration: it is shown, never silently dropped).  A real 3x
+  slowdown on a quiet machine stays caught: 3x in units taken at the slower calibration, whose drift is at
+  most 1.25x, is still above 2x.
 
 Baseline and results must come from the same kind of run (command, target, profile and the selected
 stages and references), be well-formed documents of a readable schema version
@@ -42,6 +69,7 @@ from typing import Any
 from .convergence import ORDER_SLACK
 from .errors import IncompatibleBaseline, IncompatibleResults
 from .results import FAILED, PASSED, SKIPPED, UNDECIDED, XFAIL, Report, load
+from .timing import BUSY_FOREIGN, BUSY_WAITING, is_noise_undecided
 
 #: smallest drop of a fitted slope that counts as a regression when both intervals are narrower: slopes
 #: are refitted on the same grids, so they reproduce to round-off on one machine and to ~1e-3 across
@@ -59,6 +87,10 @@ ERROR_IGNORE_BELOW = 1e-11
 TIMING_GROWTH = 2.0
 #: stages shorter than this (seconds, in both runs) are not timed: start-up noise dominates them
 TIMING_MIN_SECONDS = 0.5
+#: the largest ratio between a run's two calibrations (start, end) for which its stage times are judged:
+#: best-of-3 calibrations agree within ~10% on a quiet machine (0.057/0.057 s here), while load that comes or
+#: goes during a run moves one end by 1.4x and more
+CALIBRATION_DRIFT = 1.25
 #: the norms whose order estimates are gated against the baseline (the final-time error of several
 #: references sits at round-off on some grids, so its slope is not a stable statistic)
 GATED_NORMS = ("sup", "l2")
@@ -172,7 +204,8 @@ def _compare_records(base: Report, cur: Report, out: list[Change]) -> None:
         elif b.status == PASSED and c.status == SKIPPED:
             out.append(Change("status", key, f"passed → skipped: {c.message}", True))
         elif b.status in (PASSED, XFAIL) and c.status == UNDECIDED:
-            out.append(Change("status", key, f"{b.status} → undecided: {c.message}", True))
+            noise = is_noise_undecided(c)   # the machine, not the code: a change (see Timing above)
+            out.append(Change("status", key, f"{b.status} → undecided: {c.message}", not noise))
         elif b.status != c.status:
             out.append(Change("status", key, f"{b.status} → {c.status}", False))
         be, ce = b.details.get("error"), c.details.get("error")
@@ -183,10 +216,7 @@ def _compare_records(base: Report, cur: Report, out: list[Change]) -> None:
             if ce > ERROR_GROWTH * be and ce > ERROR_IGNORE_BELOW:
                 out.append(Change("error", key, f"error grew from {be:.3g} to {ce:.3g} "
                                   f"(> {ERROR_GROWTH}x)", True))
-        bt, ct = b.details.get("timing_ratio"), c.details.get("timing_ratio")
-        if isinstance(bt, (int, float)) and isinstance(ct, (int, float)) and ct > TIMING_GROWTH * bt:
-            out.append(Change("timing", key, f"same-job timing ratio grew from {bt:.3g} to {ct:.3g} "
-                              f"(> {TIMING_GROWTH}x)", True))
+        _compare_timing_ratio(key, b, c, out)
     for key, c in now.items():
         if key not in before:
             out.append(Change("new", key, f"new record ({c.status})", False))
@@ -263,9 +293,56 @@ def _compare_studies(base: Report, cur: Report, out: list[Change]) -> None:
                                       f"{ce:.3g} (> {ERROR_GROWTH}x)", True))
 
 
+def _number(x: Any) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+
+def _compare_timing_ratio(key: str, b: Any, c: Any, out: list[Change]) -> None:
+    """A record's same-job timing ratio: a regression when the lower end of its interval (the ratio itself
+    when it has none) exceeds ``TIMING_GROWTH`` x the baseline's ratio (module docstring, *Timing*)."""
+    bt, ct = b.details.get("timing_ratio"), c.details.get("timing_ratio")
+    if not (_number(bt) and _number(ct)) or not ct > TIMING_GROWTH * bt:
+        return
+    iv = c.details.get("timing_interval")
+    low = iv[0] if isinstance(iv, (list, tuple)) and len(iv) == 2 and _number(iv[0]) else ct
+    if low > TIMING_GROWTH * bt:
+        bound = f" (its interval's lower end {low:.3g})" if low != ct else ""
+        out.append(Change("timing", key, f"same-job timing ratio grew from {bt:.3g} to {ct:.3g}{bound} "
+                          f"(> {TIMING_GROWTH}x with confidence)", True))
+    else:
+        out.append(Change("timing", key, f"same-job timing ratio {ct:.3g} is above {TIMING_GROWTH}x the baseline's "
+                          f"{bt:.3g}, but its interval reaches down to {low:.3g}: growth not judged (timing noise)",
+                          False))
+
+
+def _calibrations(meta: dict[str, Any]) -> list[float]:
+    """The run's calibrations (``meta.calibrations``, else ``[meta.calibration]``), the positive numbers only."""
+    cals = meta.get("calibrations")
+    if not isinstance(cals, list) or not cals:
+        cals = [meta.get("calibration")]
+    return [float(c) for c in cals if _number(c) and math.isfinite(c) and c > 0]
+
+
+def _stage_unjudged(cur_cals: list[float], stage: dict[str, Any]) -> str | None:
+    """Why a stage time of this run cannot support a regression (module docstring, *Timing*), or ``None``."""
+    why = []
+    drift = max(cur_cals) / min(cur_cals)
+    if drift > CALIBRATION_DRIFT:
+        why.append(f"the calibrations at the run's start and end differ by {drift:.2f}x (> {CALIBRATION_DRIFT}x)")
+    waiting, foreign = stage.get("cpu_waiting"), stage.get("foreign_cpu")
+    signs = [(x > limit, text.format(x)) for x, limit, text in (
+        (waiting, BUSY_WAITING, "some task waited for a CPU {:.0%} of the stage's time"),
+        (foreign, BUSY_FOREIGN, "processes outside the run used {:.0%} of the machine's CPU"))
+        if _number(x)]
+    if signs and all(busy for busy, _ in signs):
+        why.append("the machine was busy: " + " and ".join(text for _, text in signs))
+    return "; ".join(why) or None
+
+
 def _compare_timings(base: Report, cur: Report, out: list[Change]) -> None:
-    bcal, ccal = base.meta.get("calibration"), cur.meta.get("calibration")
-    if not (isinstance(bcal, (int, float)) and isinstance(ccal, (int, float)) and bcal > 0 and ccal > 0):
+    """Stage durations in calibration units against the baseline's (module docstring, *Timing*)."""
+    bcals, ccals = _calibrations(base.meta), _calibrations(cur.meta)
+    if not (bcals and ccals):
         return
     bex, cex = base.meta.get("executor") or "serial", cur.meta.get("executor") or "serial"
     if bex != cex:   # a stage's wall time depends on how many workers ran its units: not comparable
@@ -277,11 +354,24 @@ def _compare_timings(base: Report, cur: Report, out: list[Change]) -> None:
         b = before.get(s.get("name"))
         if not b or min(b.get("duration", 0), s.get("duration", 0)) < TIMING_MIN_SECONDS:
             continue
-        rb, rc = b["duration"] / bcal, s["duration"] / ccal
+        # the stage's units at the run's slower calibration (the growth a regression needs) and at its faster
+        # one (the most growth the run's drift allows)
+        rb, rc, rc_most = b["duration"] / min(bcals), s["duration"] / max(ccals), s["duration"] / min(ccals)
+        if rc_most <= TIMING_GROWTH * rb:
+            continue
+        why = _stage_unjudged(ccals, s)
         if rc > TIMING_GROWTH * rb:
-            out.append(Change("timing", f"stage {s['name']}",
-                              f"{rc:.1f}x the calibration workload, baseline {rb:.1f}x (> {TIMING_GROWTH}x "
-                              f"growth; {s['duration']:.2f} s now)", True))
+            what = (f"{rc:.1f}x the calibration workload, baseline {rb:.1f}x (> {TIMING_GROWTH}x growth; "
+                    f"{s['duration']:.2f} s now)")
+        elif why is None:   # judged: within TIMING_GROWTH in the units a regression is stated in
+            continue
+        else:
+            what = (f"{rc:.1f}x-{rc_most:.1f}x the calibration workload (the run's two calibrations), baseline "
+                    f"{rb:.1f}x (up to {rc_most / rb:.1f}x growth; {s['duration']:.2f} s now)")
+        if why is None:
+            out.append(Change("timing", f"stage {s['name']}", what, True))
+        else:
+            out.append(Change("timing", f"stage {s['name']}", f"{what}: not judged ({why})", False))
 
 
 def compare(baseline: Report, current: Report) -> Comparison:
@@ -308,4 +398,4 @@ def gate(baseline: str | Path | Report, results: str | Path | Report) -> Compari
 
 __all__ = ["Change", "Comparison", "compare", "gate", "check_baseline", "check_runs_compatible",
            "IncompatibleBaseline", "IncompatibleResults", "LISTED_REGRESSIONS", "ORDER_DROP_FLOOR", "ERROR_GROWTH",
-           "TIMING_GROWTH", "TIMING_MIN_SECONDS"]
+           "TIMING_GROWTH", "TIMING_MIN_SECONDS", "CALIBRATION_DRIFT"]

@@ -22,6 +22,18 @@ from .errors import UnknownProfile
 PROFILES = ("dev", "ci", "thorough")
 
 
+#: what :func:`verimono.calibration.calibrate` read on the machine where the budgets below were set (a 2-core EPYC
+#: under KVM): there, a budget of U calibration units is U x 0.0776 s
+REFERENCE_CALIBRATION_S = 0.0776
+
+#: time budget of each stage of ``verimono run`` at the ``ci`` profile, in calibration units (stage seconds /
+#: ``calibrate()``): about twice the measured ratios (convergence 6.3, operator_laws 151, trajectory_laws 24,
+#: assumptions 100, section7 7.8, siconos 44, performance 93 — measured there), with a floor for the sub-second
+#: stages; they add up to 870 units, 68 s there.  A profile scales them by its ``stage_budget_scale``.
+STAGE_BUDGETS = {"convergence": 20.0, "operator_laws": 300.0, "trajectory_laws": 50.0, "assumptions": 200.0,
+                 "section7": 20.0, "siconos": 90.0, "performance": 190.0}
+
+
 @dataclasses.dataclass(frozen=True)
 class Profile:
     """Effort of one profile.
@@ -30,10 +42,13 @@ class Profile:
     examples per operator law in ``verimono run`` (which runs every law on many operators, so fewer);
     ``generated_subjects``: operators and problems drawn from ``verimono.strategies`` per run;
     ``derandomize``: fixed seeds (0 unless ``--seed``), so every job produces the same records;
-    ``unit_timeout``: seconds one unit (one law on one operator, one check of one stepper) may take before
-    it is stopped and recorded as failed (:mod:`verimono.timeouts`; ``--timeout`` overrides).  The slowest
-    catalog unit takes about 5 s here (a law at n = 10^6, ci profile, loaded 2-core machine), so the
-    defaults stop only what does not finish.
+    ``unit_budget``: *calibration units* (multiples of :func:`verimono.calibration.calibrate`, about 0.06-0.08 s
+    on a 2-core EPYC) one unit (one law on one operator, one check of one stepper) may take before it is
+    stopped (:mod:`verimono.timeouts`, which states it in seconds; ``--timeout S`` overrides it in seconds): a
+    law stopped after samples that all held is undecided, anything else stopped is failed.  In units, a slower
+    or busier machine — whose calibration reads longer — gets proportionally more seconds.  The slowest
+    catalog unit takes about 5 s (65 units) on a loaded 2-core machine (a law at n = 10^6, ``ci``), so the
+    defaults (62, 124 and 621 s where the calibration reads 0.0776 s) stop only what does not finish.  ``stage_budget_scale``: the factor on :data:`STAGE_BUDGETS` (stated for ``ci``).
     """
 
     name: str
@@ -41,16 +56,23 @@ class Profile:
     law_examples: int
     generated_subjects: int
     derandomize: bool
-    unit_timeout: float = 120.0
+    unit_budget: float = 1600.0
+    stage_budget_scale: float = 1.0
+
+    def stage_budget_units(self, stage: str) -> float | None:
+        """The calibration units stage ``stage`` may take at this profile (``None``: no budget stated)."""
+        units = STAGE_BUDGETS.get(stage)
+        return None if units is None else units * self.stage_budget_scale
 
 
 _EFFORT = {
     "dev": Profile("dev", max_examples=25, law_examples=10, generated_subjects=3, derandomize=False,
-                   unit_timeout=60.0),
+                   unit_budget=800.0),
     "ci": Profile("ci", max_examples=50, law_examples=20, generated_subjects=6, derandomize=True,
-                  unit_timeout=120.0),
+                  unit_budget=1600.0),
+    # ten times ci's law examples (and subjects five times): its stages get ten times ci's budgets
     "thorough": Profile("thorough", max_examples=500, law_examples=200, generated_subjects=30,
-                        derandomize=False, unit_timeout=600.0),
+                        derandomize=False, unit_budget=8000.0, stage_budget_scale=10.0),
 }
 
 
@@ -104,5 +126,5 @@ def load_hypothesis_profile(name: str | None = None) -> str:
     return name
 
 
-__all__ = ["PROFILES", "Profile", "UnknownProfile", "get_profile", "active_profile",
+__all__ = ["PROFILES", "Profile", "REFERENCE_CALIBRATION_S", "STAGE_BUDGETS", "UnknownProfile", "get_profile", "active_profile",
            "register_hypothesis_profiles", "load_hypothesis_profile"]

@@ -5,7 +5,7 @@ Layout (schema ``verimono.results``, version ``SCHEMA_VERSION`` = ``MAJOR.MINOR`
 
     {
       "schema": "verimono.results",
-      "schema_version": "1.1",
+      "schema_version": "1.2",
       "created": "2025-01-01T12:00:00+00:00",          # UTC, when the document was first written
       "summary": {"passed": 12, "failed": 0, "skipped": 0, "xfail": 0},   # derived, for humans
       "meta": {                                        # free-form facts about the run; keys verimono writes:
@@ -38,7 +38,8 @@ record's study, read back as a :class:`ConvergenceStudy`), ``stage`` and ``refer
 Non-finite floats are written as the strings ``"inf"``, ``"-inf"``, ``"nan"`` (strict JSON has no such
 numbers) and read back as floats where the field is numeric; ``null`` in a numeric list (errors, slopes)
 reads as ``nan``.  Compatibility: a reader accepts the same MAJOR version and any MINOR (minor versions only
-add optional keys; 1.1 added ``environment.blas`` and the optional solvers' versions); anything else, and
+add optional keys; 1.1 added ``environment.blas`` and the optional solvers' versions, 1.2 a study's
+``floors`` and ``solve_tol``); anything else, and
 any malformed field, is a :class:`SchemaError`, which the gate turns into exit status 2.  Writing and
 reading whole reports: :mod:`verimono.results` (``Report.save``, ``load``).
 """
@@ -57,7 +58,7 @@ from .environment import environment
 from .errors import SchemaError
 
 SCHEMA_NAME = "verimono.results"
-SCHEMA_VERSION = "1.1"
+SCHEMA_VERSION = "1.2"
 _NON_FINITE = ("nan", "inf", "-inf", "+inf", "infinity", "-infinity")
 #: the fields of a result record
 RECORD_FIELDS = frozenset({"check", "subject", "status", "worst", "bound", "counterexample", "message", "seed",
@@ -129,6 +130,10 @@ def study_from_dict(data: Any, i: int | str = 0) -> ConvergenceStudy:
         raise SchemaError(f"{where}: expected must be null or an order object, got {exp!r:.80}")
     d["floor"] = _number(data["floor"], f"{where}: floor", allow_null=False)
     d["timings"] = _numbers(data["timings"], f"{where}: timings")
+    if data.get("floors") is not None:
+        d["floors"] = _numbers(data["floors"], f"{where}: floors", n)
+    if data.get("solve_tol") is not None:
+        d["solve_tol"] = _number(data["solve_tol"], f"{where}: solve_tol", allow_null=False)
     try:
         return ConvergenceStudy.from_dict(d)
     except (TypeError, KeyError, ValueError) as exc:

@@ -14,7 +14,12 @@ A stepper law is one decorated evaluator (:func:`stepper_law`), of one of two fo
 
 The laws are stated per initial point: a batch problem is checked through its first row.  Requirements
 (what the stepper claims, what the problem states) are judged before the stepper runs; every exception
-is judged by the core's one policy (:func:`verimono.checks.core.classify`).
+is judged by the core's one policy (:func:`verimono.checks.core.classify`).  Under a unit's time budget
+(:func:`verimono.timeouts.run_unit`: ``check_stepper`` and the stepper stages run every law in one) a
+per-partition law states its progress partition by partition: stopped by the budget after partitions that
+all held, its record is *undecided* (time budget, ``k`` partitions), not a failure of the stepper; stopped
+before any partition returned, or after one that failed, it is failed.  A law of the stepper as a whole
+(:func:`run_once`: one evaluation, no partial evidence) stopped by the budget is failed.
 """
 
 from __future__ import annotations
@@ -26,6 +31,8 @@ import numpy as np
 from ..claims import claim_of
 from ..grids import graded_grid, random_grid, uniform_grid, validate_grid
 from ..problem import Problem
+from ..results import PASSED
+from ..timeouts import note_progress
 from .core import Outcome, law, run, stepper_subject
 from .search import valid_seed
 from .subjects import require_problem, require_stepper
@@ -119,6 +126,11 @@ def _prefix_failure(decl: Any, stepper: Callable, p: Problem, grid: np.ndarray, 
     return again if again.failed else None
 
 
+def _held(out: Outcome) -> bool:
+    """Whether one partition's outcome is evidence that the law holds (decided, within its bound)."""
+    return not (out.failed or out.inconclusive) and out.status in (None, PASSED)
+
+
 def run_on_grids(decl: Any, stepper: Callable, problem: Problem, *, grids: Any = None, seed: int = 0,
                  **kw: Any) -> Any:
     """A per-partition law on every partition of the battery: the worst outcome, a failure shrunk to the
@@ -134,7 +146,11 @@ def run_on_grids(decl: Any, stepper: Callable, problem: Problem, *, grids: Any =
     kw = {"seed": seed, **kw}
 
     def evaluate() -> Outcome:
-        outcomes = {g: decl.evaluate(stepper, p, t, **kw) for g, t in parts.items()}
+        outcomes: dict[str, Outcome] = {}
+        for g, t in parts.items():
+            outcomes[g] = decl.evaluate(stepper, p, t, **kw)
+            # out of budget now, a law whose partitions all held is undecided, not failed (verimono.timeouts)
+            note_progress(len(outcomes), all(_held(o) for o in outcomes.values()), "partitions")
         gname = max(outcomes, key=lambda g: outcomes[g].worst)
         out = outcomes[gname]
         out.details = {"worst_by_grid": {g: o.worst for g, o in outcomes.items()}, **out.details}

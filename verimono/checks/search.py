@@ -21,8 +21,10 @@ the operator lacks stops the search (skipped), a limit of verimono's own solvers
 inconclusive (counted in ``details["harness_limited"]``), anything else fails the sample.  Inconclusive
 samples are counted and never pass: a record whose every sample was inconclusive is skipped, undecided
 when verimono's own solvers decided none.  The unit's time budget (:mod:`verimono.timeouts`) bounds the
-whole search: a search that runs out of time after samples that all held is undecided (time budget);
-an operator whose first call never returns fails.
+whole search (in calibration units: a slower or busier machine gets more seconds): a search that runs out
+of time after samples that all held is undecided (time budget, ``k`` samples); an operator call that never
+returns fails — the first one, or one that ran :data:`verimono.timeouts.HANG_MULTIPLE` x longer than every
+sample before it.
 """
 
 from __future__ import annotations
@@ -42,7 +44,8 @@ from .._reproducible import no_local_constants
 from ..errors import InvalidCheckArgument, UnitTimeout
 from ..profiles import UnknownProfile, active_profile, get_profile
 from ..results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
-from ..timeouts import current_budget, time_limit
+from ..timeouts import (HANG_MULTIPLE, TIME_BUDGET_REASON, current_budget, never_returned, note_progress,
+                        time_limit)
 from .core import REGISTRY, Law, Outcome, classify, law, run, subject_name
 from .samples import NUMPY_DIM, Sample, law_samples
 from .sweep import law_draws, shrink, sweep_count, sweep_samples
@@ -161,20 +164,28 @@ class _Search:
     inconclusive: int = 0
     inconclusive_what: str = ""
     harness_limited: int = 0
+    #: when the sample being evaluated now started (``None`` between samples), and the slowest that returned
+    in_flight: float | None = None
+    slowest: float = 0.0
+    violated: bool = False
 
     def evaluate(self, s: Sample, climb: bool = False) -> None:
         """Evaluate one sample; :class:`_Violation` when it breaks the law (``climb``: inside hypothesis,
         whose ``target`` then climbs toward large ratios)."""
+        start = self.in_flight = time.perf_counter()   # left set when the unit's budget interrupts the sample
         try:
             out = evaluate_sample(self.decl, self.op, s)
         except NotImplementedError as exc:
+            self.in_flight = None
             self.unsupported = str(exc) or type(exc).__name__
             return
+        self.in_flight, self.slowest = None, max(self.slowest, time.perf_counter() - start)
         self.runs += 1
         if out.inconclusive:
             self.inconclusive += 1
             self.inconclusive_what = out.what
             self.harness_limited += HARNESS_LIMIT in out.info
+            self.note()
             return
         r = out.ratio
         if self.worst is None or not r <= self.worst.ratio:
@@ -182,8 +193,14 @@ class _Search:
         if climb:
             hypothesis.target(min(r, TARGET_CAP) if r == r else TARGET_CAP, label=self.decl.name)
         if not r <= BOUND:
-            self.failure, self.failing = out, s
+            self.failure, self.failing, self.violated = out, s, True
+            self.note()
             raise _Violation(self.decl.name)
+        self.note()
+
+    def note(self) -> None:
+        """The progress so far, for an outer unit whose budget may stop the search (verimono.timeouts)."""
+        note_progress(self.runs, not self.violated and self.inconclusive < self.runs)
 
     def fails(self, s: Sample) -> bool:
         return not evaluate_sample(self.decl, self.op, s).ratio <= BOUND
@@ -235,6 +252,7 @@ def _search(decl: Law, op: Any, seed: int, examples: int, horizon: float) -> tup
         pass
     except UnitTimeout as exc:
         how["timed_out"] = str(exc)
+        how["in_flight"] = None if state.in_flight is None else time.perf_counter() - state.in_flight
     except hypothesis.errors.Flaky as exc:  # a failure that did not reproduce on replay
         how["flaky"] = f" (not reproducible on replay: {type(exc).__name__}; the operator is not deterministic)"
     except (hypothesis.errors.HypothesisException, MemoryError, RecursionError) as exc:
@@ -281,7 +299,15 @@ def _verdict(state: _Search, how: dict, base: dict, details: dict, cex_extra: di
     runs = state.runs
     if how["timed_out"] and state.failure is None:
         details.update(timeout=True)
+        in_flight = how.get("in_flight")
+        if never_returned(in_flight, state.slowest) and runs:    # the sample in flight: a call that does not return
+            details.update(in_flight=in_flight, slowest=state.slowest)
+            return CheckResult(status=FAILED, details=details, **base,
+                               message=f"timed out: {how['timed_out']}; the sample in flight ran {in_flight:.1f} s, "
+                                       f"more than {HANG_MULTIPLE:g}x the slowest of the {runs} samples before it "
+                                       f"({state.slowest:.3g} s): a call that does not return")
         if runs and state.inconclusive < runs:
+            details["undecided_reason"] = TIME_BUDGET_REASON
             return CheckResult(status=UNDECIDED, details=details, **base,
                                message=f"time budget exhausted after {runs} samples, all of which held "
                                        f"({how['timed_out']}): too few samples for a verdict")

@@ -129,7 +129,8 @@ def run_stages(names: Iterable[str] | None, profile: Profile, context: RunContex
             rep = stage.fn(profile, context)
             if not isinstance(rep, Report):
                 raise TypeError(f"stage {n} returned {type(rep).__name__}, expected a verimono.Report")
-            status, message = ("failed" if not rep.ok else "passed"), rep.summary()
+            status = "failed" if rep.failures else ("undecided" if not rep.ok else "passed")
+            message = rep.summary()
         except Exception as exc:  # noqa: BLE001 - a crash is a failure of the run, recorded, never swallowed
             rep, status, message = _stage_failure(n, exc, time.perf_counter() - start)
         duration = time.perf_counter() - start

@@ -1,0 +1,192 @@
+"""Planted slowdowns against the speed verdicts of the ``performance`` stage (wall-clock: the benchmark tier).
+
+Each test times real code with :mod:`verimono.performance`'s records at the stage's ``ci`` sizes (9 interleaved
+rounds, up to 27 when the interval straddles the target) and checks the verdict the record gives:
+
+* a planted 3x slowdown — of the DiodeBridge ``simulate`` kernel (2.7x the floor loop idle → ~8x against a
+  5x target) and of the per-step loop ``solve`` (1.2-1.3x the bare loop → ~3.6x against 1.5x) — is **never
+  passed**.  On a quiet machine it is **failed**; under load it may be ``undecided``, but only with the noise
+  evidence to show for it (reason ``"timing noise"``, a wide spread of the rounds);
+* the correct code is never failed (passed, or undecided with the noise evidence);
+* the old gross regressions (a 20x stepper, a kernel that sleeps, a lost vectorisation) still fail.
+
+Run them idle and under ``../shared/tools/stress -n 2 -- python -m pytest -m timing tests/benchmarks/test_bench_planted.py``.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from verimono import performance, timing
+from verimono.results import FAILED, PASSED, UNDECIDED
+from verimono.stepping import solve
+
+#: wall-clock: the ``timing`` tier (``pytest -m timing``, on a quiet machine), never in the default test run
+pytestmark = [pytest.mark.benchmark, pytest.mark.timing]
+
+CI = performance.SIZES["ci"]
+#: the evidence of a quiet measurement: the per-round ratios' interquartile range within 10% of their median
+#: (a 3x slowdown then sits far outside any interval the rule draws)
+QUIET_SPREAD = 0.10
+
+
+def caught(rec) -> None:
+    """A planted slowdown: never passed; failed when its rounds were quiet; undecided only with noise shown."""
+    d = rec.details
+    assert d["identical"], rec.message
+    assert rec.status in (FAILED, UNDECIDED), f"a planted 3x slowdown passed: {rec}"
+    if rec.status == UNDECIDED:
+        assert d["undecided_reason"] == timing.NOISE_REASON and d["noise"]["spread"] > QUIET_SPREAD, rec.message
+    if d["spread"] <= QUIET_SPREAD:
+        assert rec.status == FAILED, f"quiet rounds (spread {d['spread']:.1%}) but not failed: {rec}"
+
+
+def not_failed(rec) -> None:
+    """Correct code: never failed on timing; undecided only with noise shown."""
+    d = rec.details
+    assert rec.status in (PASSED, UNDECIDED), f"correct code failed its performance record: {rec}"
+    if rec.status == UNDECIDED:
+        assert d["undecided_reason"] == timing.NOISE_REASON and d["noise"]["spread"] > QUIET_SPREAD, rec.message
+
+
+def simulate_kernel_3x(monkeypatch):
+    """The LCS kernel path of ``simulate`` (box relation, uniform grid) doing its work three times."""
+    from verimono.lcs.system import LinearRelationSystem
+
+    kernel = LinearRelationSystem._simulate_kernel
+
+    def thrice(self, *args, **kw):
+        kernel(self, *args, **kw)
+        kernel(self, *args, **kw)
+        return kernel(self, *args, **kw)
+
+    monkeypatch.setattr(LinearRelationSystem, "_simulate_kernel", thrice)
+
+
+def solve_3x(problem, t):
+    """The per-step loop three times: every step costs three."""
+    solve(problem, t)
+    solve(problem, t)
+    return solve(problem, t)
+
+
+def test_a_3x_slower_lcs_kernel_fails_its_record(monkeypatch):
+    pytest.importorskip("verimono.lcs")
+    simulate_kernel_3x(monkeypatch)
+    caught(performance.check_lcs_step(steps=CI.lcs_steps, rounds=CI.lcs_rounds, max_rounds=CI.max_rounds))
+
+
+@pytest.mark.parametrize("kind, n", [("t|x|", 1), ("box", 3), ("ball", 10)])
+def test_a_3x_slower_per_step_loop_fails_its_record(kind, n):
+    caught(performance.check_per_step(kind, n, steps=CI.per_step_steps, rounds=CI.per_step_rounds,
+                                      max_rounds=CI.max_rounds, stepper=solve_3x))
+
+
+def test_the_correct_lcs_kernel_is_not_failed():
+    pytest.importorskip("verimono.lcs")
+    not_failed(performance.check_lcs_step(steps=CI.lcs_steps, rounds=CI.lcs_rounds, max_rounds=CI.max_rounds))
+
+
+@pytest.mark.parametrize("kind, n", [("t|x|", 1), ("box", 3), ("ball", 10)])
+def test_the_correct_per_step_loop_is_not_failed(kind, n):
+    not_failed(performance.check_per_step(kind, n, steps=CI.per_step_steps, rounds=CI.per_step_rounds,
+                                          max_rounds=CI.max_rounds))
+
+
+# -- gross regressions ---------------------------------------------------------------------------------------
+
+
+def slow_solve(problem, t):
+    """``solve`` doing 20 times the work: a per-step regression the records must catch."""
+    for _ in range(19):
+        solve(problem, t)
+    return solve(problem, t)
+
+
+def test_a_slowed_stepper_fails_the_per_step_record():
+    rec = performance.check_per_step("box", 3, steps=2000, rounds=9, stepper=slow_solve)
+    assert rec.status == FAILED and rec.details["identical"]
+    assert rec.details["interval"][0] > 5 * performance.PER_STEP_TARGET and rec.worst > 1
+    assert "target ≤ 1.5x" in rec.message and "missed with confidence" in rec.message
+
+
+def test_a_slowed_operator_kernel_fails_the_per_step_record(monkeypatch):
+    """A kernel that *sleeps* 20 µs a step: the own-time clock counts what the code waits on itself (only the
+    wait for a CPU is taken out), so a regression that blocks is not hidden."""
+    if timing.CLOCK != "own":
+        pytest.skip("the CPU-time fallback clock does not count sleeping (schedstat unavailable)")
+    import verimono.stepping as stepping
+
+    kernel = stepping.resolvent_kernel
+
+    def sleepy(op, x0):
+        step = kernel(op, x0)
+
+        def slow(x, lam, t):
+            time.sleep(2e-5)
+            return step(x, lam, t)
+        return slow
+
+    monkeypatch.setattr(stepping, "resolvent_kernel", sleepy)
+    rec = performance.check_per_step("t|x|", 1, steps=1000, rounds=9)
+    assert rec.status == FAILED and rec.details["identical"], rec
+
+
+def test_a_lost_vectorisation_fails_the_ensemble_record():
+    def row_by_row(problem, t):  # the batch solved one member at a time: right values, no speed-up
+        if problem.x0.ndim == 1:
+            return solve(problem, t)
+        import verimono as vm
+
+        return np.stack([solve(vm.Problem(problem.operator, x, problem.T, initial_jump=problem.initial_jump), t).x
+                         for x in problem.x0], axis=1)
+
+    op, kw = performance.ensemble_case("box")
+    rec = performance.check_ensemble(op, "box", batch=100, steps=5, rounds=9, problem_kw=kw, stepper=row_by_row)
+    assert rec.status == FAILED and rec.details["identical"]
+    assert rec.details["ratio"] < 3 and rec.details["timing_ratio"] > 1 / 3
+
+
+# -- the gate on stage times --------------------------------------------------------------------------------
+
+
+def test_a_3x_slower_stage_is_a_gate_regression_unless_the_machine_was_busy(monkeypatch):
+    """Three real runs of a stage doing a fixed amount of work (the calibration workload, about 1 s): the
+    baseline, the same again, and three times the work.  The same work never regresses, busy machine or not;
+    3x the work regresses — or, when the run shows a busy machine, is reported as "not judged" with that
+    evidence; on a quiet machine (foreign CPU at most 10% in both runs) it must regress."""
+    from verimono.runs import execute
+    from verimono.gate import compare
+    from verimono.results import CheckResult, Report
+    from verimono.stages import STAGES, RunContext, Stage
+
+    work = {"repeats": 17}
+
+    def stage(profile, context):
+        for _ in range(work["repeats"]):
+            timing.workload()
+        return Report([CheckResult("work", "fixed", PASSED)])
+
+    monkeypatch.setitem(STAGES, "bench_work", Stage("bench_work", stage, "a fixed amount of work"))
+
+    def run():
+        return execute(command="run", profile_name="ci", stages=["bench_work"], context=RunContext())
+
+    base, same = run(), run()
+    work["repeats"] *= 3
+    slow = run()
+    info = lambda rep: rep.meta["stages"][0]  # noqa: E731
+    assert compare(base, same).ok, [str(c) for c in compare(base, same).changes]
+    comp = compare(base, slow)
+    timing_changes = [c for c in comp.changes if c.kind == "timing"]
+    assert len(timing_changes) == 1, [str(c) for c in comp.changes]
+    change = timing_changes[0]
+    quiet = all(isinstance(info(r).get("foreign_cpu"), float) and info(r)["foreign_cpu"] <= timing.BUSY_FOREIGN
+                for r in (base, slow))
+    if change.regression:
+        assert change.key == "stage bench_work"
+    else:
+        assert "not judged" in change.message and not quiet, (change, info(base), info(slow))
