@@ -47,3 +47,16 @@ def alpha_min_max_slip(M):
     """``1/λ_max`` of the symmetric part instead of ``1/λ_min`` for the constant of Proposition p:lcp2 v."""
     lam = np.linalg.eigvalsh(0.5 * (np.asarray(M) + np.asarray(M).T))
     return 1.0 / float(lam[-1]) if lam[0] > 0 else None
+
+
+def hoffman_sigma_max(Q, R=None):
+    """``1/σ_max`` of the whole row stack instead of the max of ``1/σ_min`` over independent row sets (the
+    angle between the rows ignored)."""
+    A = np.atleast_2d(Q) if R is None else np.vstack([np.atleast_2d(R), np.atleast_2d(Q)])
+    return 1.0 / float(np.linalg.svd(A, compute_uv=False)[0])
+
+
+def hoffman_without_equalities(Q, R=None):
+    """The Hoffman constant of the inequalities alone (the equality rows forgotten)."""
+    from verimono.lcs.hoffman import hoffman_constant
+    return hoffman_constant(Q)

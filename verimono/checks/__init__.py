@@ -12,7 +12,7 @@ system and estimator laws, each with its paper label and requirements) and makes
 * problems — the assumptions of Theorem ``thm:main`` (:mod:`.assumptions`, :func:`check_assumptions`);
 * linear relation systems — the hypotheses of Section 7 (:mod:`.section7`) and the paper's Example
   (:mod:`.example`);
-* estimators — the pseudo-distance (:mod:`.pseudo_distance`).
+* estimators — the pseudo-distance (:mod:`.pseudo_distance`) and Hoffman's constant (:mod:`.hoffman`).
 
 The names below load their module on first use, so ``import verimono.checks.core`` (the run's stage registry
 does) does not load hypothesis and every law; ``verimono.checks.REGISTRY`` and ``verimono.checks.laws_of``

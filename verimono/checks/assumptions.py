@@ -48,12 +48,13 @@ import numpy as np
 from ..errors import OutsideDomain
 from ..operators import resolvent_rows
 from ..problem import Problem
-from ..results import FAILED, PASSED, SKIPPED, XFAIL, XFAIL_DECLARED, CheckResult, Report
+from ..results import FAILED, PASSED, SKIPPED, UNDECIDED, XFAIL, XFAIL_DECLARED, CheckResult, Report
 from .search import valid_seed
 from .core import Outcome, law, laws_of, run, subject_name
 from .subjects import require_problem
 from ..tolerances import GROWTH_FLAG, RTOL, STALL_RATIO, STALL_WINDOW, quotient_tolerance, tolerance
-from .jumps import find_jumps, jump_time
+from .jumps import JUMP_GRID, base_grid, find_jumps, jump_time
+from .over_time import Sup, sup_over_time
 
 EVIDENCE = "evidence from samples, not a proof"
 #: (A2): right limits t + δ_k, δ_k = (T - t) A2_RATIO^k for k = 0, ..., A2_LEVELS (down to 1.5e-5 (T - t))
@@ -68,6 +69,9 @@ A2_SETTLED = 0.9
 A2_TAIL_SAFETY = 2.0
 #: (A2): step sizes λ (relative to T) of the sampled resolvents (the points p already span two scales)
 A2_LAMBDAS = (1e-1,)
+#: (A2): what a jump whose side cannot be decided is recorded as (see :func:`check_assumption_A2`)
+UNDECIDED_SIDE = ("undecided: neither end of the bracket has the shorter decimal; the right-limit test fails at "
+                  "a and passes at b for every jump between adjacent floats, whichever side it is on")
 #: step sizes λ (relative to T) used to reach points of dom F(t,·) ever closer to its boundary
 LAMBDAS = (1.0, 1e-1, 1e-2, 1e-3)
 
@@ -200,12 +204,17 @@ def _right_limit(S: _Samples, t: float, lam: float, P: np.ndarray | None = None)
 def check_assumption_A2(S: _Samples) -> Outcome:
     """(A2): outer semicontinuity from the right of ``t ↦ graph F(t,·)``: a settled right limit
     ``lim J_λ(t+δ) p`` equals ``J_λ(t) p`` at the sampled times and at every jump of ``t ↦ J_λ(t) p`` found
-    between them (module docstring)."""
-    """Right limits at the sampled times, then at every jump of ``t ↦ J_λ(t) p`` found between them
-    (:func:`verimono.checks.jumps.find_jumps`): a jump bracketed by adjacent floats ``a < b`` happens at
-    :func:`~verimono.checks.jumps.jump_time`; if that is ``a`` (``J_λ(a) p`` is the left value, the right
-    limit the other one) the right-limit test there fails, if ``b`` the jump is right-continuous and (A2)
-    holds there; neither (no shorter decimal) is counted as undecided."""
+    between them (:func:`verimono.checks.jumps.find_jumps`).
+
+    A jump bracketed by adjacent floats ``a < b`` happens at :func:`~verimono.checks.jumps.jump_time`: if that
+    is ``a`` (``J_λ(a) p`` is the left value, the right limit the other one) the right-limit test there
+    fails, if ``b`` the jump is right-continuous and (A2) holds there.  When neither end has the shorter
+    decimal the jump is **undecided**, never passed: the right-limit test fails at ``a`` and passes at ``b``
+    for *every* jump so bracketed (no float lies between them, so ``J_λ(a + δ) p`` is the right value for
+    every ``δ > 0`` and ``J_λ(a) p`` the left one), so testing both ends tells nothing; and the two readings
+    — switch right after ``a`` ((A2) fails: ``c = 1`` for ``t ≤ τ``) or at ``b`` ((A2) holds: ``c = 1`` for
+    ``t < τ``) — are the same function of floats, which is all verimono can evaluate.  The record is then
+    ``undecided`` (unless another test failed), with the brackets."""
     T = S.T
     worst, counter, sequences, unsettled = 0.0, None, 0, 0
     for t in S.times[:-1]:
@@ -216,12 +225,13 @@ def check_assumption_A2(S: _Samples) -> Outcome:
                 worst, counter = w, c
     lam = A2_LAMBDAS[0] * T
     jumps, searched = find_jumps(lambda t: resolvent_rows(S.op, S.points, lam, t), T)
-    found = []
+    found, undecided = [], []
     for j in jumps:
         tj = jump_time(j)
         entry = {"bracket": [j.a, j.b], "size": j.size, "t": tj}
         if tj is None:
-            entry["side"] = "undecided (no shorter decimal at either end of the bracket)"
+            entry["side"] = UNDECIDED_SIDE
+            undecided.append(entry)
         elif tj >= T:
             entry["side"] = "at T (no right limit)"
         else:
@@ -230,10 +240,19 @@ def check_assumption_A2(S: _Samples) -> Outcome:
             if w > worst:
                 worst, counter = w, dict(c, found_by="jump search", jump=j.size, bracket=[j.a, j.b])
         found.append(entry)
+    details = {"evidence": EVIDENCE, "sequences": sequences, "unsettled": unsettled, "jumps": found,
+               "jump_search": searched, "undecided_jumps": len(undecided)}
+    if undecided and not worst > 1.0:
+        u = undecided[0]
+        return Outcome(None, status=UNDECIDED, details=details,
+                       message=f"{len(undecided)} jump(s) of t ↦ J_λ(t) p found whose side cannot be decided: the first "
+                               f"between the adjacent floats {u['bracket'][0]!r} and {u['bracket'][1]!r} (size "
+                               f"{u['size']:.3g}); (A2) fails there if the switch is right after the first and holds "
+                               "if it is at the second, and in floating point both are the same function (the "
+                               "right-limit test fails at the first end and passes at the second for every jump so "
+                               f"bracketed) — undecided, never a pass; no other test failed ({EVIDENCE})")
     return _sampled(
-        "assumption_A2", worst, counter,
-        {"evidence": EVIDENCE, "sequences": sequences, "unsettled": unsettled, "jumps": found,
-         "jump_search": searched},
+        "assumption_A2", worst, counter, details,
         lambda c: (f"J_λ(t+δ) p → {np.array2string(c['limit'], precision=4)} as δ ↓ 0 but J_λ(t) p = "
                    f"{np.array2string(c['resolvent_at_t'], precision=4)} (gap {c['gap']:.3g}, tail ≤ "
                    f"{c['tail']:.3g}; t = {c['t']!r}, λ = {c['lam']:.3g}"
@@ -282,18 +301,54 @@ def check_assumption_A3(S: _Samples) -> Outcome:
     worst, counter = 0.0, None
     for a in range(n):
         for b in range(a + 1, n):
-            rhs = phi[b] - phi[a]
-            r = D[a, b] / (max(rhs, 0.0) + tolerance(D[a, b], phi[a], phi[b]))
-            if rhs < -tolerance(phi[a], phi[b]):
-                r = max(r, 2.0)        # a decreasing φ is not allowed by (A3)
+            r = _phi_ratio(D[a, b], phi[a], phi[b])
             if r > worst:
                 worst, counter = r, {"s": ts[a], "t": ts[b], "z": arg[(a, b)], "dist": D[a, b], "phi_s": phi[a],
                                      "phi_t": phi[b]}
     details["phi_stated"] = phi
+    sup, c = _phi_sup(S)
+    details["sup_search"] = sup.as_dict()
+    if sup.value > worst:
+        worst, counter = sup.value, c
     return _sampled("assumption_A3", worst, counter, details,
                     lambda c: f"dist(z, dom F(t)) = {c['dist']:.4g} > φ(t) - φ(s) = {c['phi_t'] - c['phi_s']:.4g} "
-                              f"for z in dom F(s), s = {c['s']:.4g}, t = {c['t']:.4g}: the stated φ is contradicted",
-                    f"stated φ bounds every sampled domain motion ({EVIDENCE})")
+                              f"for z in dom F(s), s = {c['s']!r}, t = {c['t']!r}"
+                              + (" (found by the search over time)" if c.get("found_by") else "")
+                              + ": the stated φ is contradicted",
+                    f"stated φ bounds every sampled domain motion: at {n} sample times, and on windows of length "
+                    f"T/{JUMP_GRID} searched over time ({sup.evaluations} windows; largest ratio {sup.value:.3g} at "
+                    f"s = {sup.t:.4g}) ({EVIDENCE})")
+
+
+def _phi_ratio(dist: float, phi_s: float, phi_t: float) -> float:
+    """``dist / (φ(t) − φ(s) + tol)``; at least 2 when ``φ`` decreases (not allowed by (A3))."""
+    rhs = phi_t - phi_s
+    r = dist / (max(rhs, 0.0) + tolerance(dist, phi_s, phi_t))
+    if rhs < -tolerance(phi_s, phi_t):
+        r = max(r, 2.0)
+    return float(r)
+
+
+def _phi_sup(S: _Samples) -> tuple[Sup, dict]:
+    """The stated φ against the domain motion on every window ``[s, s + w]``, ``w = T/JUMP_GRID``, searched
+    over ``s`` (:func:`verimono.checks.over_time.sup_over_time`; families: the sample points)."""
+    op, P, T, phi = S.op, S.points, S.T, S.problem.phi
+    w = T / JUMP_GRID
+
+    def one(i: int, s: float) -> tuple[float, dict]:
+        t = min(s + w, T)
+        z = np.asarray(op.project_domain(P[i], s), dtype=float)
+        q = np.asarray(op.project_domain(z, t), dtype=float)
+        d = float(np.linalg.norm(z - q))
+        ps, pt = float(phi(s)), float(phi(t))
+        return _phi_ratio(d, ps, pt), {"s": s, "t": t, "z": z, "dist": d, "phi_s": ps, "phi_t": pt}
+
+    def values(s: float, which):
+        return np.array([one(i, s)[0] for i in (range(len(P)) if which is None else which)])
+
+    sup = sup_over_time(values, 0.0, T - w, grid=base_grid(T)[:-1])
+    _, c = one(sup.family, sup.t)
+    return sup, dict(c, found_by="search over time")
 
 
 def _excess(S: _Samples, a: float, b: float) -> tuple[float, np.ndarray]:
@@ -366,14 +421,100 @@ def check_assumption_LG(S: _Samples) -> Outcome:
     details = {"evidence": EVIDENCE, "times": S.times, "sigma_hat": sig_hat, "sup_ratio_by_lambda": by_lam,
                "growth": growth, "F0": how, "stated": sigma is not None}
     if sigma is not None:
+        sup, c = _sigma_sup(S)
+        details["sup_search"] = sup.as_dict()
+        if sup.value > worst:
+            worst, counter = sup.value, c
         return _sampled("assumption_LG", worst, counter, details,
-                        lambda c: f"|F^0(t,z)| = {c['F0_norm']:.4g} > σ(t)(1 + |z|) at t = {c['t']:.4g}: the stated "
-                                  "σ is contradicted",
-                        f"stated σ bounds every sample ({EVIDENCE})")
+                        lambda c: f"|F^0(t,z)| = {c['F0_norm']:.4g} > σ(t)(1 + |z|) = "
+                                  f"{c['sigma_t'] * (1 + np.linalg.norm(c['z'])):.4g} at t = {c['t']!r}"
+                                  + (" (found by the search over time)" if c.get("found_by") else "")
+                                  + ": the stated σ is contradicted",
+                        f"stated σ bounds every sample, at {len(S.times)} sample times and searched over time "
+                        f"({sup.evaluations} times; largest ratio {sup.value:.3g} at t = {sup.t:.4g}) ({EVIDENCE})")
     return _growth(growth, {"sup_ratio_by_lambda": by_lam}, details,
                    f"sup |F^0(t,z)|/(1+|z|) grows {growth:.3g}-fold as z approaches the boundary of dom F: evidence "
                    "that (LG) fails",
                    f"estimated σ̂ ≤ {float(np.max(sig_hat)):.4g} ({EVIDENCE}; F^0 by {how})")
+
+
+def _sigma_sup(S: _Samples) -> tuple[Sup, dict]:
+    """The stated σ against ``|F^0(t, z)|/(1 + |z|)`` searched over ``t`` (families: the sampled ``z =
+    J_λ(t) p``, one per point ``p`` and step ``λ``)."""
+    op, P, sigma, lams = S.op, S.points, S.problem.sigma, S.lambdas
+    mu = 1e-6 * S.T
+
+    def ratio(z: np.ndarray, t: float) -> tuple[float, dict | None]:
+        val, _ = _f0_norm(op, z, t, mu)
+        if val is None:
+            return -np.inf, None
+        sig = float(sigma(t))
+        rhs = sig * (1.0 + float(np.linalg.norm(z)))
+        return val / (rhs + tolerance(rhs, val)), {"t": t, "z": z, "F0_norm": val, "sigma_t": sig}
+
+    def values(t: float, which):
+        if which is None:
+            return np.array([ratio(z, t)[0] for lam in lams for z in resolvent_rows(op, P, lam, t)])
+        out = []
+        for f in which:
+            li, pi = divmod(int(f), len(P))
+            out.append(ratio(resolvent_rows(op, P[pi:pi + 1], lams[li], t)[0], t)[0])
+        return np.array(out)
+
+    sup = sup_over_time(values, 0.0, S.T)
+    li, pi = divmod(sup.family, len(P))
+    _, c = ratio(resolvent_rows(op, P[pi:pi + 1], lams[li], sup.t)[0], sup.t)
+    return sup, dict(c or {"t": sup.t, "z": P[pi], "F0_norm": np.nan, "sigma_t": np.nan}, lam=lams[li],
+                     found_by="search over time")
+
+
+def _theta_sup(S: _Samples, key: str) -> tuple[Sup, dict]:
+    """The stated θ against the Yosida increment of ``key`` ((YB) or (YB')) searched over ``s ∈ [0, T − λ]``
+    (families: one per step ``λ`` and point ``p``, ``z = J_{T/10}(s) p ∈ dom F(s)``)."""
+    op, P, theta, T = S.op, S.points, S.problem.theta, S.T
+    lams = S.lambdas[1:]
+    nP = len(P)
+
+    def increments(s: float, lam: float, z: np.ndarray, f0: float | None) -> tuple[float, dict]:
+        y_next = float(np.linalg.norm(op.yosida(z, lam, s + lam)))
+        d = y_next - f0 if key == "YB" else y_next - float(np.linalg.norm(op.yosida(z, lam, s)))
+        rhs = float(theta(s + lam)) - float(theta(s))
+        q = d / (max(rhs, 0.0) + quotient_tolerance(lam, z)) if d > 0 else 0.0
+        return q, {"form": key, "s": s, "lambda": lam, "z": z, "lhs": d, "rhs": rhs}
+
+    def f0_of(z: np.ndarray, s: float) -> float | None:
+        if key != "YB":
+            return None
+        v = _min_norm(op, z, s)
+        return None if v is None else float(np.linalg.norm(v))
+
+    def one(f: int, s: float) -> tuple[float, dict | None]:
+        li, pi = divmod(int(f), nP)
+        lam = lams[li]
+        if s + lam > T + 1e-12:
+            return -np.inf, None
+        z = resolvent_rows(op, P[pi:pi + 1], 0.1 * T, s)[0]
+        f0 = f0_of(z, s)
+        if key == "YB" and f0 is None:
+            return -np.inf, None
+        return increments(s, lam, z, f0)
+
+    def values(s: float, which):
+        if which is not None:
+            return np.array([one(f, s)[0] for f in which])
+        Z = resolvent_rows(op, P, 0.1 * T, s)
+        F0 = [f0_of(z, s) for z in Z]
+        out = []
+        for lam in lams:
+            for z, f0 in zip(Z, F0):
+                ok = s + lam <= T + 1e-12 and not (key == "YB" and f0 is None)
+                out.append(increments(s, lam, z, f0)[0] if ok else -np.inf)
+        return np.array(out)
+
+    sup = sup_over_time(values, 0.0, T - min(lams), bounds=lambda f: (0.0, T - lams[f // nP]))
+    _, c = one(sup.family, sup.t)
+    return sup, dict(c or {"form": key, "s": sup.t, "lambda": lams[sup.family // nP], "z": P[sup.family % nP],
+                           "lhs": np.nan, "rhs": np.nan}, found_by="search over time")
 
 
 @law("assumption_YB", "(YB)/(YB')", subject="problem", driver=run_assumption)
@@ -420,6 +561,10 @@ def check_assumption_YB(S: _Samples) -> Outcome:
     details = {"evidence": EVIDENCE, "rate_by_lambda": rates, "theta_hat_slope": rho, "growth": growth,
                "form": key, "stated": theta is not None}
     if theta is not None:
+        sup, c = _theta_sup(S, key)
+        details["sup_search"] = sup.as_dict()
+        if sup.value > worst[key]:
+            worst[key], counter[key] = sup.value, c
         # (YB) is the assumption; (YB') is stronger (|Y_λ(s, z)| ≤ |F^0(s, z)|) and only implies it.  With
         # F^0 the stated θ is judged on (YB) itself; without it a sampled (YB') holds is evidence for (YB),
         # while a (YB') violation says nothing about (YB): no verdict then
@@ -431,9 +576,12 @@ def check_assumption_YB(S: _Samples) -> Outcome:
                                    "which needs |F^0(s, z)|: the operator has no min_norm")
         return _sampled("assumption_YB", worst[key], counter[key], details,
                         lambda c: f"{c['form']}: |Y_λ(s+λ,z)| exceeds θ(s+λ) - θ(s) + ... by "
-                                  f"{c['lhs'] - c['rhs']:.3g} at s = {c['s']:.4g}, λ = {c['lambda']:.3g}: the stated "
-                                  "θ is contradicted",
-                        f"stated θ bounds every sampled Yosida increment ({key}; {EVIDENCE})")
+                                  f"{c['lhs'] - c['rhs']:.3g} at s = {c['s']!r}, λ = {c['lambda']:.3g}"
+                                  + (" (found by the search over time)" if c.get("found_by") else "")
+                                  + ": the stated θ is contradicted",
+                        f"stated θ bounds every sampled Yosida increment, at {len(S.times)} sample times and "
+                        f"searched over s ({sup.evaluations} times; largest ratio {sup.value:.3g} at s = "
+                        f"{sup.t:.4g}) ({key}; {EVIDENCE})")
     return _growth(growth, {"rate_by_lambda": rates}, details,
                    f"the Yosida increment per unit time grows {growth:.3g}-fold as λ shrinks 1000-fold (like 1/λ: a "
                    f"moving domain): evidence that ({key}) fails",
@@ -451,7 +599,7 @@ def thm_main(problem: Problem, records: dict[str, CheckResult]) -> Outcome:
     the five assumptions.  When exactly one of (LG), (YB) has evidence against it and the other has
     evidence for it, that record becomes an expected failure (``xfail``, saying which alternative holds, the
     declaration in ``details["xfail_declared"]``); this record fails when any remaining assumption record
-    failed."""
+    failed, and is undecided (never passed) when one is undecided and none failed."""
     lg, yb = records.get("assumption_LG"), records.get("assumption_YB")
     for this, other, name in ((lg, yb, "(YB)"), (yb, lg, "(LG)")):
         if this is not None and other is not None and this.status == FAILED and other.status == PASSED:
@@ -460,9 +608,15 @@ def thm_main(problem: Problem, records: dict[str, CheckResult]) -> Outcome:
             this.details = {**this.details,
                             XFAIL_DECLARED: f"thm:main needs (LG) or (YB); {name} has evidence for it"}
     bad = [r.check for r in records.values() if r.status == FAILED]
-    return Outcome(None, status=FAILED if bad else PASSED, details={"evidence": EVIDENCE, "from": sorted(records)},
-                   message=("evidence against " + ", ".join(bad)) if bad else
-                   "no sample contradicts (A1)–(A3) and (LG) or (YB) — evidence, not proof")
+    open_ = [r.check for r in records.values() if r.status == UNDECIDED]
+    if bad:
+        return Outcome(None, status=FAILED, details={"evidence": EVIDENCE, "from": sorted(records)},
+                       message="evidence against " + ", ".join(bad))
+    if open_:     # an undecided assumption is never a pass, nor is a theorem resting on it
+        return Outcome(None, status=UNDECIDED, details={"evidence": EVIDENCE, "from": sorted(records)},
+                       message="undecided: " + ", ".join(open_) + " (no record contradicts the others)")
+    return Outcome(None, status=PASSED, details={"evidence": EVIDENCE, "from": sorted(records)},
+                   message="no sample contradicts (A1)–(A3) and (LG) or (YB) — evidence, not proof")
 
 
 ASSUMPTION_LAWS = ("assumption_A1", "assumption_A2", "assumption_A3", "assumption_LG", "assumption_YB")

@@ -15,11 +15,9 @@ import numpy as np
 from ..problem import Problem
 from ..tolerances import LIMIT_EXTRA_LEVELS, LIMIT_RATIO_FLOOR, LIMIT_TAIL_SAFETY, tolerance
 from .core import Outcome
-from .partitions import limit_grids, run_stepper, stepper_law
+from .partitions import LIMIT_LEVELS, limit_grids, refined_random_grid, run_stepper, stepper_law
 from .trajectory_laws import norms as _norms
 
-#: cells of the three refinement levels (|Δ| shrinks 16-fold)
-LIMIT_LEVELS = (10, 40, 160)
 
 
 def _interp(t: np.ndarray, x: np.ndarray, tau: np.ndarray) -> np.ndarray:
@@ -77,9 +75,7 @@ def check_unique_limit(stepper: Callable, p: Problem, *, levels: Sequence[int] =
             # the random kind as a refinement sequence: the first level's random partition with every
             # cell split in K/K0 equal parts (independent random partitions per level have errors C_m h_m
             # with a random C_m, which no own-trend tail can extrapolate)
-            base = limit_grids(p.T, K0, seed)["random"]
-            sub = np.linspace(0.0, 1.0, K // K0 + 1)[:-1]
-            gs["random"] = np.append((base[:-1, None] + np.diff(base)[:, None] * sub[None, :]).ravel(), p.T)
+            gs["random"] = refined_random_grid(p.T, K0, K, seed)
         sols = {g: run_stepper(stepper, p, t) for g, t in gs.items()}
         scale[0] = max(scale[0], max(float(np.max(np.abs(x))) for x in sols.values()))
         runs.append((gs, sols))

@@ -5,7 +5,8 @@ A stepper law is one decorated evaluator (:func:`stepper_law`), of one of two fo
 
 * ``over_grids=True``: ``check_<law>(stepper, problem, t, **kw) -> Outcome`` judges the stepper's solution on
   one partition ``t``.  The driver (:func:`run_on_grids`) evaluates it on every partition of the battery
-  (:func:`battery_grids`: uniform, random, graded, or those given), keeps the worst, and shrinks a failure to
+  (:func:`battery_grids`: uniform and random, or those given; for the proximal scheme's ``selections`` and
+  ``in_domain`` every partition the battery builds, :func:`every_battery_grid`), keeps the worst, and shrinks a failure to
   the shortest prefix ``[0, t_k]`` of its partition that still fails (re-verified), so the counterexample
   holds the problem, the partition, the initial point and the offending step;
 * otherwise ``check_<law>(stepper, problem, **kw) -> Outcome`` judges the stepper as a whole (a unique
@@ -39,11 +40,18 @@ from .subjects import require_problem, require_stepper
 
 #: cells of the default partitions (fine enough for the lemmas' bounds, fast enough for a battery)
 DEFAULT_CELLS = 40
+#: cells of the refinement levels of ``unique_limit`` (:mod:`verimono.checks.limits`; |Δ| shrinks 16-fold)
+LIMIT_LEVELS = (10, 40, 160)
 #: nonuniformity of the default random partition (cell lengths vary by a factor up to 4)
 RANDOM_SPREAD = 0.6
 #: the law's form for a stepper claiming only ``scheme="any"``, by law name (``in_domain``: a distance to
 #: the domain vanishing at the claimed order, instead of exact membership at every node)
 ANY_SCHEME_FORM: dict[str, Callable[..., Outcome]] = {}
+#: laws judged on every partition the battery builds (:func:`every_battery_grid`), not only the two default
+#: ones: the proximal scheme's step-by-step laws (``selections``, ``in_domain``), whose verdict on a stepper
+#: that deviates on some steps only (a Newton solve stopped at a residual of 1e-4: off on the small steps)
+#: must not depend on which partitions a seed happened to draw
+EVERY_GRID: set[str] = set()
 
 
 def single(problem: Problem) -> Problem:
@@ -74,11 +82,37 @@ def limit_grids(T: float, K: int, seed: int = 0) -> dict[str, np.ndarray]:
             "graded": graded_grid(T, K, 2.0)}
 
 
-def battery_grids(grids: Any, problem: Problem, seed: int) -> dict[str, np.ndarray]:
+def refined_random_grid(T: float, K0: int, K: int, seed: int = 0) -> np.ndarray:
+    """The random partition of ``K0`` cells (:func:`limit_grids`) with every cell split in ``K/K0`` equal
+    parts: the random kind as a refinement sequence (``K`` a multiple of ``K0``)."""
+    base = limit_grids(T, K0, seed)["random"]
+    sub = np.linspace(0.0, 1.0, K // K0 + 1)[:-1]
+    return np.append((base[:-1, None] + np.diff(base)[:, None] * sub[None, :]).ravel(), T)
+
+
+def every_battery_grid(problem: Problem, seed: int = 0) -> dict[str, np.ndarray]:
+    """Every partition the battery builds for ``problem``: :func:`default_grids`, the graded one of as many
+    cells, and the convergence grids of ``unique_limit`` (:func:`limit_grids` at each of
+    ``LIMIT_LEVELS``, the random kind refined from the first level's); duplicates dropped."""
+    T = problem.T
+    out = dict(default_grids(problem, seed))
+    out["graded"] = graded_grid(T, DEFAULT_CELLS, 2.0)
+    K0 = LIMIT_LEVELS[0]
+    for K in LIMIT_LEVELS:
+        gs = limit_grids(T, K, seed)
+        if K % K0 == 0 and K != K0:
+            gs["random"] = refined_random_grid(T, K0, K, seed)
+        for kind, g in gs.items():
+            if not any(len(g) == len(h) and np.array_equal(g, h) for h in out.values()):
+                out[f"{kind} K={K}"] = g
+    return out
+
+
+def battery_grids(grids: Any, problem: Problem, seed: int, *, every: bool = False) -> dict[str, np.ndarray]:
     """The partitions a law is judged on: ``grids`` (a dict or a list of increasing arrays from 0 to ``T``),
-    else :func:`default_grids`."""
+    else :func:`default_grids` (``every=True``: :func:`every_battery_grid`)."""
     if grids is None:
-        return default_grids(problem, seed)
+        return every_battery_grid(problem, seed) if every else default_grids(problem, seed)
     if isinstance(grids, dict):
         return {k: validate_grid(g, problem.T) for k, g in grids.items()}
     return {f"grid{i}": validate_grid(g, problem.T) for i, g in enumerate(grids)}
@@ -109,7 +143,7 @@ def run_on_grids(decl: Any, stepper: Callable, problem: Problem, *, grids: Any =
     any_form = ANY_SCHEME_FORM.get(decl.name)
     if any_form is not None and grids is None and not claim_of(stepper).proximal:
         return run(decl, subject, lambda: any_form(stepper, p, seed=seed), stepper=stepper, problem=p)
-    parts = battery_grids(grids, p, seed)
+    parts = battery_grids(grids, p, seed, every=decl.name in EVERY_GRID)
     kw = {"seed": seed, **kw}
 
     def evaluate() -> Outcome:
@@ -155,14 +189,19 @@ def run_once(decl: Any, stepper: Callable, problem: Problem, **kw: Any) -> Any:
 
 
 def stepper_law(name: str, label: str, *requires: Any, over_grids: bool = True,
-                any_scheme: Callable[..., Outcome] | None = None, battery: bool = True) -> Callable:
+                any_scheme: Callable[..., Outcome] | None = None, battery: bool = True,
+                every_grid: bool = False) -> Callable:
     """Declare a stepper law (module docstring); ``any_scheme`` is its form for a stepper claiming only
-    ``scheme="any"`` (judged once, not per partition)."""
+    ``scheme="any"`` (judged once, not per partition); ``every_grid``: judged on :func:`every_battery_grid`
+    when no partitions are given."""
     if any_scheme is not None:
         ANY_SCHEME_FORM[name] = any_scheme
+    if every_grid:
+        EVERY_GRID.add(name)
     return law(name, label, subject="stepper", driver=run_on_grids if over_grids else run_once, requires=requires,
                battery=battery)
 
 
 __all__ = ["stepper_law", "run_on_grids", "run_once", "run_stepper", "single", "default_grids", "limit_grids",
-           "battery_grids", "DEFAULT_CELLS", "RANDOM_SPREAD", "ANY_SCHEME_FORM"]
+           "battery_grids", "every_battery_grid", "refined_random_grid", "DEFAULT_CELLS", "RANDOM_SPREAD",
+           "ANY_SCHEME_FORM", "EVERY_GRID"]

@@ -196,7 +196,7 @@ def domain_vanishing(stepper: Callable, p: Problem, *, seed: int = 0,
                            f"(order {target:g} claimed; scheme='any')")
 
 
-@stepper_law("in_domain", "e:x k+1 props.1", Member("project_domain"), any_scheme=domain_vanishing)
+@stepper_law("in_domain", "e:x k+1 props.1", Member("project_domain"), any_scheme=domain_vanishing, every_grid=True)
 def check_in_domain(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int = 0) -> Outcome:
     """``x_k ∈ cl dom F(t_k,·)`` for every node (``e:x k+1 props.1``; from ``k = 1`` after a jump).
 
@@ -222,7 +222,7 @@ def check_in_domain(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int =
 
 # -- selections -------------------------------------------------------------------------------------
 
-@stepper_law("selections", "eq:iteration", PROXIMAL_CLAIM)
+@stepper_law("selections", "eq:iteration", PROXIMAL_CLAIM, every_grid=True)
 def check_selections(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int = 0) -> Outcome:
     """``y_{k+1} = (z_k - x_{k+1})/h_{k+1} ∈ F(t_{k+1}, x_{k+1})`` (``eq:iteration``), ``z_k = x_k + h f(x_k)
     + ∫u``: through ``operator.contains`` and through ``J_μ(x_{k+1} + μ y_{k+1}) = x_{k+1}`` at ``μ = h/2``.

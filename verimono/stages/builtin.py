@@ -246,6 +246,7 @@ def section7_stage(profile: Profile, context: RunContext) -> Report:
               Unit("section7", "unbounded pseudo-distance", _record_unit, ("example_pseudo_distance_unbounded",))]
     # def:dis against the exact d_H of catalog sets, and the Picard step of Section 6
     units.append(Unit("section7", "pseudo-distance", _pseudo_distance_unit, (seed,)))
+    units.append(Unit("section7", "Hoffman's bound", _hoffman_unit, (seed,)))      # e:hoffman (e: linear case-comp)
     units += [Unit("section7", f"Picard step on {p.name}", _picard_unit, (stepper, p)) for p in context.catalog()
               if p.f is not None and p.lipschitz is not None]
     units += [Unit("section7", f"hypotheses ({label})", _hypotheses_unit, (label, seed)) for label in _INPUTS]
@@ -266,6 +267,12 @@ def _record_unit(name: str, *args: Any) -> Report:
 
 def _pseudo_distance_unit(seed: int) -> Report:
     return Report([check_pseudo_distance(seed=seed)])
+
+
+def _hoffman_unit(seed: int) -> Report:
+    from ..checks.hoffman import check_hoffman
+
+    return Report([check_hoffman(seed=seed)])
 
 
 def _picard_unit(stepper: Callable, problem: Any) -> Report:
