@@ -352,7 +352,7 @@ def test_function_local_imports_are_for_optional_or_heavy_modules():
 LAYERS = (
     ("foundations", ("verimono.errors", "verimono.tolerances", "verimono._jsonable", "verimono._params",
                      "verimono._rows", "verimono._validate", "verimono._reproducible", "verimono.display", "verimono.environment",
-                     "verimono.atomic", "verimono.profiles", "verimono.naming")),
+                     "verimono.atomic", "verimono.profiles", "verimono.naming", "verimono.arrays")),
     ("numerics", ("verimono.grids", "verimono.problem", "verimono.operators", "verimono._subgradients", "verimono.sets",
                   "verimono.qp", "verimono.prox", "verimono.stepping", "verimono.claims", "verimono.convergence",
                   "verimono.pseudo_distance", "verimono.lcs", "verimono.reference", "verimono.strategies",

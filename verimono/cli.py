@@ -75,7 +75,23 @@ def _context(args: argparse.Namespace, **kw: Any) -> Any:
             problems = [get(name) for name in args.reference]
         except KeyError as exc:
             raise BadTarget(str(exc.args[0])) from None
+    for spec in getattr(args, "problem", None) or []:
+        problems = (problems or []) + _load_problems(spec)
     return RunContext(seed=getattr(args, "seed", None), data_dir=data, problems=problems, **kw)
+
+
+def _load_problems(spec: str) -> list[Any]:
+    """``--problem MODULE:OBJECT``: a :class:`verimono.Problem` (or a list of them), remembered as loaded from
+    ``spec`` so that reproduction lines name it."""
+    from .problem import Problem, with_origin
+
+    obj = load_target(spec)
+    found = list(obj) if isinstance(obj, (list, tuple)) else [obj]
+    if not found or not all(isinstance(p, Problem) for p in found):
+        raise BadTarget(f"--problem {spec}: expected a verimono.Problem (or a list of them), got "
+                        f"{type(obj).__name__} (build one with verimono.Problem(...) or "
+                        "verimono.manufactured_problem(...))")
+    return [with_origin(p, spec) for p in found]
 
 
 def _executor_options(args: argparse.Namespace) -> dict[str, Any]:
@@ -118,11 +134,15 @@ def _changes(baseline: Report | None, report: Report) -> Any:
 
 def order_table(report: Report) -> list[str]:
     """One line per convergence study: reference, expected order, measured sup-norm order with its 95%
-    interval, verdict (``missed`` when the stepper does not reach the expected order)."""
+    interval, verdict (``MISSED`` when the stepper does not reach the expected order, ``FAILED`` when its
+    record failed for another reason: a limit that is not the solution's)."""
+    failed = {(r.details["study"].problem, r.details["study"].stepper) for r in report.results
+              if r.check == "convergence_order" and r.status == "failed" and hasattr(r.details.get("study"), "problem")}
     rows = []
     for s in report.studies:
         exp = "-" if s.expected is None else ("exact" if s.expected.exact else f"{s.expected.value:g}")
-        rows.append((s.problem, exp, str(s.order), "ok" if s.verdict()[0] else "MISSED"))
+        verdict = "MISSED" if not s.verdict()[0] else "FAILED" if (s.problem, s.stepper) in failed else "ok"
+        rows.append((s.problem, exp, str(s.order), verdict))
     if not rows:
         return []
     head = ("reference", "expected", "measured sup-norm order [95%]", "verdict")
@@ -412,6 +432,9 @@ def build_parser() -> argparse.ArgumentParser:
                             "for a bare callable) or 'any' (it only converges with --order)")
     check.add_argument("--order", type=float, default=None,
                        help="the convergence order a --scheme any stepper claims (default 1)")
+    check.add_argument("--problem", action="append", default=None, metavar="MODULE:OBJECT",
+                       help="check a stepper on this Problem (or list of them) too, e.g. one from "
+                            "verimono.manufactured_problem (repeatable; with --reference, both)")
     check.add_argument("--solve-tol", type=float, default=None, metavar="TAU",
                        help="the accuracy of the stepper's inner solve per step (relative to 1 + |x|): errors at "
                             "what it accumulates pass as exact to it")

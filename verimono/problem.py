@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import weakref
 from typing import Any, Callable, Sequence
 
 import numpy as np
@@ -215,4 +216,23 @@ class Problem:
         return f"Problem({self.name!r}, n={self.dim}, T={self.T:g}, order={self.order})"
 
 
-__all__ = ["Problem", "Order"]
+
+#: where a problem was loaded from (``MODULE:OBJECT``), for reproduction lines; weak: it dies with the problem
+_ORIGINS: "weakref.WeakKeyDictionary[Problem, str]" = weakref.WeakKeyDictionary()
+
+
+def with_origin(problem: "Problem", spec: str) -> "Problem":
+    """Remember that ``problem`` was loaded from ``spec`` (``MODULE:OBJECT``); returns ``problem``."""
+    _ORIGINS[problem] = str(spec)
+    return problem
+
+
+def origin_of(problem: Any) -> str | None:
+    """The ``MODULE:OBJECT`` ``problem`` was loaded from (:func:`with_origin`), if any."""
+    try:
+        return _ORIGINS.get(problem)
+    except TypeError:
+        return None
+
+
+__all__ = ["with_origin", "origin_of", "Problem", "Order"]

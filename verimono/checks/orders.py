@@ -6,16 +6,26 @@ turns its verdict into a record: ``worst = expected / (upper end of the interval
 ``bound = 1``, so the stepper passes when its measured order can reach the expected one.  For references
 on which the scheme is exact at the nodes, ``worst = max error / round-off floor``.  The study is kept in
 the record (``details["study"]``).
+
+A problem without an exact solution is measured against a fine-grid solution of the same stepper: that is
+self-convergence, which a scheme converging to a wrong limit (an input or a field dropped) passes.  So the
+limit is checked too (:func:`limit_agreement`): on the study's finest grid the stepper and
+:func:`verimono.solve` — the proximal scheme, whose limit is the solution (Theorem ``thm:main``) — must agree
+within ``LIMIT_FACTOR`` times the sum of their estimated errors there.
 """
 
 from __future__ import annotations
 
 from typing import Any, Callable
 
+import numpy as np
+
 from ..claims import claim_of
-from ..convergence import ORDER_SLACK, convergence_study
-from ..problem import Order, Problem
+from ..convergence import ORDER_SLACK, _timed_run, convergence_study
+from ..grids import uniform_grid, validate_grid
+from ..problem import Order, Problem, origin_of
 from ..results import FAILED, PASSED
+from ..stepping import solve
 from .core import Holds, Outcome, law, subject_name
 from .partitions import run_once
 
@@ -29,6 +39,34 @@ def _expected(stepper: Callable, problem: Problem) -> Order | None:
     if problem.order is None:
         return Order(claim.order, "the claimed order (the problem states no regularity)")
     return problem.order.for_claim(claim.order)
+
+
+#: the stepper's and verimono.solve's solutions on the finest grid may differ by this many times the sum of
+#: their estimated errors there: each estimate is against a solution 8x finer, which underestimates the true
+#: error by at most 1/(1 - 8^-p) (1.5x at the catalog's lowest order 1/2), and error constants vary by up to
+#: 2x between the grids of a study
+LIMIT_FACTOR = 4.0
+
+
+def limit_agreement(stepper: Callable, study: Any, problem: Problem) -> tuple[bool, str, dict]:
+    """Whether ``stepper`` converges to the limit of :func:`verimono.solve` on ``problem`` (see the module
+    docstring): their sup distance on the finest grid of ``study`` against ``LIMIT_FACTOR`` times the sum of
+    their estimated errors there (each from its own study on the same grids), plus both round-off floors."""
+    grids = [validate_grid(s, problem.T) if np.ndim(s) else uniform_grid(problem.T, float(s)) for s in problem.steps]
+    k = int(np.argmin(study.mesh))
+    grid = grids[k]
+    ref = convergence_study(solve, problem, grids)
+    ours, _ = _timed_run(stepper, problem, grid)
+    theirs, _ = _timed_run(solve, problem, grid)
+    e_ours, e_ref = float(study.errors["sup"][k]), float(ref.errors["sup"][k])
+    bound = LIMIT_FACTOR * (e_ours + e_ref) + study.floor + ref.floor
+    gap = float(np.max(np.linalg.norm((ours - theirs).reshape(len(grid), -1), axis=1)))
+    info = {"distance": gap, "bound": bound, "stepper_error": e_ours, "solve_error": e_ref, "steps": len(grid) - 1}
+    if gap <= bound:
+        return True, f"its limit agrees with verimono.solve's (distance {gap:.3g} ≤ {bound:.3g} on K = {len(grid) - 1})", info
+    return False, (f"converges, but not to the solution: on K = {len(grid) - 1} it is {gap:.3g} from verimono.solve "
+                   f"(the proximal scheme, whose limit is the solution), more than {LIMIT_FACTOR:g} x the two "
+                   f"estimated errors {e_ours:.3g} + {e_ref:.3g}: self-convergence alone does not show the limit"), info
 
 
 def _states_order(p: Problem) -> str | None:
@@ -59,10 +97,12 @@ def check_convergence_order(stepper: Callable, problem: Problem, *, executor: An
         worst = 0.0
     else:
         worst = exp.value / (fit.high + ORDER_SLACK) if fit.high == fit.high else float("inf")
-    script = ("from verimono.reference import get\n"
-              "from verimono.checks.orders import check_convergence_order\n"
-              f"print(check_convergence_order(stepper, get({subject_name(problem)!r})))")
-    details = {"study": study, "reproduce_python": script}
+    details = {"study": study, "reproduce_python": reproduction_script(problem)}
+    if ok and problem.exact is None and getattr(stepper, "fn", stepper) is not solve:
+        ok, why, details["limit"] = limit_agreement(stepper, study, problem)
+        msg = f"{msg}; {why}"
+        if not ok:
+            worst = max(worst, details["limit"]["distance"] / details["limit"]["bound"])
     if not claim_of(stepper).proximal:
         details["expected"] = {"order": exp.value, "source": exp.source}
     # the study's verdict decides; the ratio says by how much
@@ -70,4 +110,22 @@ def check_convergence_order(stepper: Callable, problem: Problem, *, executor: An
                    counter={} if ok else {"steps": study.mesh, "errors": study.errors["sup"], "message": msg})
 
 
-__all__ = ["check_convergence_order"]
+def reproduction_script(problem: Problem) -> str:
+    """Python that reruns the order check with ``stepper`` bound: the problem from the reference catalog by
+    name, from the ``MODULE:OBJECT`` it was loaded from (:func:`verimono.problem.origin_of`), or else a line
+    the user completes with their own problem."""
+    from ..reference import catalog
+
+    name = subject_name(problem)
+    lines = ["from verimono.checks.orders import check_convergence_order"]
+    origin = origin_of(problem)
+    if name in {p.name for p in catalog()}:
+        lines += ["from verimono.reference import get", f"problem = get({name!r})"]
+    elif origin:
+        lines += ["from verimono.targets import load_target", f"problem = load_target({origin!r})"]
+    else:
+        lines += [f"problem = ...   # the Problem {name!r} you checked (it is not in verimono's reference catalog)"]
+    return "\n".join(lines + ["print(check_convergence_order(stepper, problem))"])
+
+
+__all__ = ["check_convergence_order", "limit_agreement", "reproduction_script", "LIMIT_FACTOR"]
