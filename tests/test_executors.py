@@ -20,7 +20,8 @@ REF = ["--reference", "moving box", "--reference", "t|x| (n=1)"]
 RUN = ["run", "--profile", "ci", "--stage", "convergence", "--stage", "assumptions", *REF]
 #: what differs between two runs of the same battery: timings (seconds, or when the document was written),
 #: the run id both output files carry, and where the units ran (``meta.executor``)
-TIMING_KEYS = {"duration", "timings", "calibration", "calibrations", "created", "run_id", "executor"}
+TIMING_KEYS = {"duration", "timings", "calibration", "calibrations", "created", "run_id", "executor",
+               "cpu_waiting", "foreign_cpu", "loadavg"}   # how busy the machine was during each stage
 
 STEPPERS = '''
 import multiprocessing, os, signal, time
