@@ -61,12 +61,19 @@ def subgradient_contains(op: Any, x, y, t: float = 0.0, tol: float | None = None
     return True
 
 
+def _unit(n: int, i: int) -> np.ndarray:
+    """``e_i`` in ``R^n`` (without the ``n x n`` identity)."""
+    e = np.zeros(n)
+    e[i] = 1.0
+    return e
+
+
 def contains_points(x: np.ndarray, y: np.ndarray, count: int = CONTAINS_POINTS) -> list[np.ndarray]:
     """The deterministic test points ``z`` of :meth:`ProxOperator.contains` (see there)."""
     n = x.size
     rng = np.random.default_rng(n)
     s0 = 1.0 + float(np.max(np.abs(x), initial=0.0))
-    dirs = [np.eye(n)[i % n] for i in range(min(n, 4))]
+    dirs = [_unit(n, i) for i in range(min(n, 4))]
     ny = float(np.linalg.norm(y))
     if ny > 0:
         dirs.append(y / ny)

@@ -47,7 +47,9 @@ class RatioGate:
             for _ in range(rounds - 1):
                 setup()
                 target()
-        self.benchmark.pedantic(target, setup=setup, rounds=rounds, iterations=1, warmup_rounds=0)
+        # pedantic's setup must return None or (args, kwargs): the baseline's own output is dropped
+        self.benchmark.pedantic(target, setup=lambda: (setup(), None)[1], rounds=rounds, iterations=1,
+                                warmup_rounds=0)
 
     def bound(self, target: float, *, speedup: bool = False) -> float:
         """``target`` when benchmarking; loosened by ``SANITY_FACTOR`` in the un-timed normal test run."""

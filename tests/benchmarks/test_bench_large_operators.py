@@ -1,10 +1,12 @@
-"""Issue 14, item 4: ``check_operator`` on image- and PDE-sized operators.
+"""``check_operator`` on image- and PDE-sized operators.
 
 A correct closed-form operator (``F = ∂((1 + t)|·|)``, block soft thresholding) must pass every law at
 ``n = 2000`` within 10 s and at ``n = 10^6`` within 60 s on the reference machine (2 cores), with the
 ``ci`` profile's 20 examples per law; points are drawn by NumPy above ``NUMPY_DIM`` coordinates.  With
 ``--benchmark-disable`` (the normal test run) the large case uses ``n = 20000`` and the loose sanity bound.
-Measured here, loaded machine: n = 2000 in 4.6 s, n = 10^6 in 35.6 s.
+Measured here, loaded machine: n = 2000 in 4.6 s, n = 10^6 in 35.6 s.  A law that runs out of its time
+budget (in calibration units) after samples that all held is undecided: then the machine could not support
+a verdict, and the test says so as a skip rather than pass or fail.
 """
 
 from __future__ import annotations
@@ -14,6 +16,8 @@ import time
 import pytest
 
 import verimono as vm
+from verimono.checks.operator_battery import LAWS as OPERATOR_LAWS
+from verimono.results import UNDECIDED
 
 
 @pytest.mark.parametrize("n, seconds", [(2000, 10.0), (10 ** 6, 60.0)], ids=["n=2000", "n=1e6"])
@@ -23,5 +27,10 @@ def test_check_operator_on_a_large_correct_operator(gate, n, seconds):
     start = time.perf_counter()
     rep = vm.check_operator(op, seed=0, examples=20)
     elapsed = time.perf_counter() - start
-    assert rep.ok and rep.counts["passed"] == 18, rep.summary()   # every law but prox_minimiser (n <= 4 only)
+    assert rep.counts["failed"] == 0, rep.summary()
+    undecided = [r for r in rep.results if r.status == UNDECIDED]
+    if undecided:
+        pytest.skip("undecided, the machine too slow for the budget: " + "; ".join(r.message for r in undecided))
+    # every law but prox_minimiser (n <= 4 only) passed
+    assert rep.counts["passed"] == len(OPERATOR_LAWS) - 1, rep.summary()
     assert elapsed <= gate.bound(seconds), f"{elapsed:.1f} s at n = {n}"

@@ -56,7 +56,11 @@ def _outside(p, gp, what) -> Outcome:
 
 def _directions(x, p, n, seed_like) -> list[np.ndarray]:
     """Unit directions: the coordinates, ``x - p``, ``p`` and seeded random ones (deterministic in the sample)."""
-    dirs = [np.eye(n)[i] for i in range(min(n, 3))]
+    dirs = []
+    for i in range(min(n, 3)):        # e_i without the n x n identity (3.2 GB at n = 20000)
+        e = np.zeros(n)
+        e[i] = 1.0
+        dirs.append(e)
     for v in (x - p, p):
         nv = _nrm(v)
         if nv > 0:
