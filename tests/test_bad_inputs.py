@@ -254,3 +254,33 @@ def test_examples_zero_is_refused_not_passed():
     with pytest.raises(InvalidCheckArgument):
         vm.check_operator(double, examples=0)
     assert not vm.check_operator(double, examples=5, seed=0).ok
+
+
+# -- typed and validated: grids, sets and shapes that were a bare ValueError, a MemoryError or silence ----------
+
+@pytest.mark.parametrize("build", [
+    lambda g: vm.random_grid(1.0, -3),
+    lambda g: vm.uniform_grid(1.0, 1e-12),                 # 10^12 cells: a MemoryError before
+    lambda g: vm.refine(g, 0),                             # returned the grid's t_K alone before
+    lambda g: vm.refine(g, 2.7),                           # refined by 2 before
+    lambda g: vm.graded_grid(1.0, 0),
+    lambda g: vm.random_grid(1.0, 3, seed=-1),
+    lambda g: vm.uniform_grid("a", steps=2),
+    lambda g: vm.uniform_grid(1.0, steps=True),
+], ids=["negative steps", "1e12 cells", "factor 0", "factor 2.7", "zero cells", "negative seed", "T not a number",
+        "bool steps"])
+def test_bad_grid_arguments_are_invalid_grids(build):
+    from verimono.errors import InvalidGrid
+
+    with pytest.raises(InvalidGrid):
+        build(vm.uniform_grid(1.0, steps=4))
+
+
+def test_a_normal_cone_of_what_is_not_a_set_and_a_fractional_shape_are_invalid_problems():
+    from verimono.errors import InvalidProblem
+
+    with pytest.raises(InvalidProblem, match="NormalCone needs a convex set"):
+        vm.NormalCone(3.0)                                 # an AttributeError before
+    for shape in (3.5, (2, "a"), (2, 0), True):            # 3.5 gave R^3 silently before
+        with pytest.raises(InvalidProblem, match="shape"):
+            vm.operator_from_prox(lambda x, lam, t: x, shape=shape)

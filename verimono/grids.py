@@ -7,6 +7,8 @@ array from ``0`` to ``T`` is accepted by :func:`verimono.solve` after :func:`val
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from .errors import InvalidGrid
@@ -46,31 +48,61 @@ def validate_grid(t_grid, T: float | None = None) -> np.ndarray:
     return t
 
 
-def uniform_grid(T: float, h: float | None = None, *, steps: int | None = None) -> np.ndarray:
-    """Uniform partition of ``[0, T]`` with step ``h`` (which must divide ``T``) or ``steps`` cells."""
+#: at most this many cells in a grid built here (8·10^8 bytes of nodes): more is a mistake (a step size
+#: meant in other units), refused with a clear error instead of a MemoryError or an hour of work
+MAX_CELLS = 10 ** 8
+
+
+def _horizon(T: Any) -> float:
+    try:
+        T = float(T)
+    except (TypeError, ValueError):
+        raise InvalidGrid(f"T must be a positive finite number, got {T!r}") from None
     if not np.isfinite(T) or T <= 0:
         raise InvalidGrid(f"T must be positive and finite, got {T!r}")
+    return T
+
+
+def _cells(steps: Any, what: str = "steps") -> int:
+    """A positive whole number of cells, at most :data:`MAX_CELLS`."""
+    try:
+        K = int(steps)
+    except (TypeError, ValueError, OverflowError):
+        raise InvalidGrid(f"{what} must be a positive integer, got {steps!r}") from None
+    if isinstance(steps, bool) or K < 1 or K != steps:
+        raise InvalidGrid(f"{what} must be a positive integer, got {steps!r}")
+    if K > MAX_CELLS:
+        raise InvalidGrid(f"{what} = {K} exceeds {MAX_CELLS} cells (verimono.grids.MAX_CELLS): is the step in "
+                          "the right units?")
+    return K
+
+
+def uniform_grid(T: float, h: float | None = None, *, steps: int | None = None) -> np.ndarray:
+    """Uniform partition of ``[0, T]`` with step ``h`` (which must divide ``T``) or ``steps`` cells."""
+    T = _horizon(T)
     if (h is None) == (steps is None):
         raise InvalidGrid("give exactly one of h and steps")
     if h is not None:
         if not np.isfinite(h) or h <= 0:
             raise InvalidGrid(f"step size must be positive and finite, got h = {h!r}")
+        if T / h > MAX_CELLS:
+            raise InvalidGrid(f"h = {h!r} gives {T / h:.3g} cells on [0, {T!r}], more than {MAX_CELLS} "
+                              "(verimono.grids.MAX_CELLS): is the step in the right units?")
         K = int(round(T / h))
         if K < 1 or abs(K * h - T) > 1e-9 * T:
             raise InvalidGrid(f"h = {h!r} does not divide T = {T!r} (T/h = {T / h!r}); "
                               "use uniform_grid(T, steps=K) for K equal cells")
     else:
-        K = int(steps)
-        if K < 1 or K != steps:
-            raise InvalidGrid(f"steps must be a positive integer, got {steps!r}")
+        K = _cells(steps)
     return np.linspace(0.0, T, K + 1)
 
 
 def graded_grid(T: float, steps: int, power: float = 2.0) -> np.ndarray:
     """Graded partition ``t_k = T (k/K)^power`` (fine near 0 for ``power > 1``)."""
-    if power <= 0:
-        raise InvalidGrid(f"power must be positive, got {power!r}")
-    s = np.linspace(0.0, 1.0, int(steps) + 1)
+    T, K = _horizon(T), _cells(steps)
+    if not (isinstance(power, (int, float)) and np.isfinite(power) and power > 0):
+        raise InvalidGrid(f"power must be positive and finite, got {power!r}")
+    s = np.linspace(0.0, 1.0, K + 1)
     t = T * s ** power
     t[-1] = T
     return validate_grid(t, T)
@@ -78,10 +110,14 @@ def graded_grid(T: float, steps: int, power: float = 2.0) -> np.ndarray:
 
 def random_grid(T: float, steps: int, *, seed: int = 0, spread: float = 0.5) -> np.ndarray:
     """Random partition with ``steps`` cells whose lengths vary by a factor up to ``(1+spread)/(1-spread)``."""
-    if not 0 <= spread < 1:
+    T, K = _horizon(T), _cells(steps)
+    if not (isinstance(spread, (int, float)) and 0 <= spread < 1):
         raise InvalidGrid(f"spread must lie in [0, 1), got {spread!r}")
-    rng = np.random.default_rng(seed)
-    w = 1.0 + spread * rng.uniform(-1.0, 1.0, int(steps))
+    try:
+        rng = np.random.default_rng(seed)
+    except (TypeError, ValueError) as exc:
+        raise InvalidGrid(f"seed must be a non-negative integer, got {seed!r} ({exc})") from None
+    w = 1.0 + spread * rng.uniform(-1.0, 1.0, K)
     t = np.concatenate([[0.0], np.cumsum(w)]) * (T / w.sum())
     t[-1] = T
     return validate_grid(t, T)
@@ -90,7 +126,10 @@ def random_grid(T: float, steps: int, *, seed: int = 0, spread: float = 0.5) -> 
 def refine(t_grid, factor: int = 2) -> np.ndarray:
     """Split every cell of a partition into ``factor`` equal cells (nested refinement)."""
     t = validate_grid(t_grid)
-    s = np.linspace(0.0, 1.0, int(factor) + 1)[:-1]
+    factor = _cells(factor, "factor")
+    if (len(t) - 1) * factor > MAX_CELLS:
+        raise InvalidGrid(f"refining {len(t) - 1} cells by {factor} exceeds {MAX_CELLS} cells (verimono.grids.MAX_CELLS)")
+    s = np.linspace(0.0, 1.0, factor + 1)[:-1]
     fine = (t[:-1, None] + np.diff(t)[:, None] * s[None, :]).ravel()
     return np.concatenate([fine, t[-1:]])
 

@@ -586,6 +586,9 @@ class NormalCone(Operator):
     """
 
     def __init__(self, S: Any, name: str | None = None) -> None:
+        if not all(callable(getattr(S, m, None)) for m in ("project", "contains")) or not hasattr(S, "dim"):
+            raise InvalidProblem(f"NormalCone needs a convex set (verimono.sets: Ball, Box, HalfSpace, Polyhedron, "
+                                 f"...: dim, project(x, t), contains(x, t)), got {type(S).__name__} {S!r:.60}")
         super().__init__(S.dim, name or f"NormalCone({getattr(S, 'name', type(S).__name__)})")
         self.S = S
         self.static = getattr(S, "static", False)

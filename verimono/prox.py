@@ -80,9 +80,14 @@ class ProxOperator(Operator):
             raise InvalidProblem("give the shape of the points (shape=(n,) or shape=(m, n)) or dim")
         if shape is None:
             shape = (int(dim),)
-        shape = (int(shape),) if np.ndim(shape) == 0 else tuple(int(s) for s in shape)
-        if not shape or any(s < 1 for s in shape):
-            raise InvalidProblem(f"shape must be a tuple of positive integers, got {shape!r}")
+        given = shape
+        try:
+            parts = [shape] if np.ndim(shape) == 0 else list(shape)
+            shape = tuple(int(s) for s in parts)
+        except (TypeError, ValueError, OverflowError):
+            raise InvalidProblem(f"shape must be a positive integer or a tuple of them, got {given!r}") from None
+        if not shape or any(s < 1 for s in shape) or any(isinstance(p, bool) or p != s for p, s in zip(parts, shape)):
+            raise InvalidProblem(f"shape must be a positive integer or a tuple of them, got {given!r}")
         if dim is not None and int(dim) != math.prod(shape):
             raise InvalidProblem(f"dim={dim} does not match shape={shape}")
         super().__init__(math.prod(shape), name or getattr(prox, "__name__", "prox"))
