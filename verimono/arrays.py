@@ -230,6 +230,15 @@ def padded(rows: int) -> int:
     return 1 << max(0, int(rows) - 1).bit_length()
 
 
+def batch_chunks(count: int):
+    """``(lo, rows, pick)`` for the chunks of ``count`` rows: rows ``lo .. lo + rows`` of the batch, and
+    ``pick`` the indices of the chunk padded to :func:`padded` rows by repeating its first row (a batched
+    subject is called once per chunk with ``X[pick]``; its first ``rows`` answers are kept)."""
+    for lo in range(0, count, MAX_BATCH):
+        rows = min(MAX_BATCH, count - lo)
+        yield lo, rows, np.r_[np.arange(lo, lo + rows), np.full(padded(rows) - rows, lo)]
+
+
 def prefetch_key(x: np.ndarray, lam: float, t: float) -> tuple:
     """The key of a prefetched ``J_λ x`` at ``t`` (exact: the bytes of ``x``;
     :func:`verimono.checks.batches.prefetched`)."""
@@ -300,4 +309,4 @@ def kind_of(value: Any) -> ArrayKind | None:
     return array_kind(lib, dtype=dt, device=getattr(value, "device", None) if lib == "torch" else None)
 
 
-__all__ = ["LIBRARIES", "MAX_BATCH", "Boundary", "padded", "prefetch_key", "take_prefetched", "ArrayKind", "array_kind", "kind_of", "library_of", "precision_of", "to_numpy", "as_float64"]
+__all__ = ["LIBRARIES", "MAX_BATCH", "Boundary", "padded", "batch_chunks", "prefetch_key", "take_prefetched", "ArrayKind", "array_kind", "kind_of", "library_of", "precision_of", "to_numpy", "as_float64"]

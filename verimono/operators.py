@@ -28,7 +28,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ._params import as_param
-from .arrays import MAX_BATCH, Boundary, array_kind, as_float64, padded, take_prefetched
+from .arrays import Boundary, array_kind, as_float64, batch_chunks, take_prefetched
 from ._rows import _INF, _TINY, _mx, _norm, _sqrt, dot_rows
 from ._subgradients import checked_value, subgradient_contains
 from ._validate import bad_lam, bad_param, batch_column, check_lam, real_array
@@ -242,9 +242,7 @@ class _FromResolvent(Operator):
         if not self.batched:
             return np.array([self.resolvent(r, lam, t) for r, lam, t in zip(X, lams, ts)]).reshape(X.shape)
         out = np.empty_like(X)
-        for lo in range(0, X.shape[0], MAX_BATCH):
-            rows = min(MAX_BATCH, X.shape[0] - lo)
-            pick = np.r_[np.arange(lo, lo + rows), np.full(padded(rows) - rows, lo)]
+        for lo, rows, pick in batch_chunks(X.shape[0]):
             P = self._out(self._resolvent(self._io.given(X[pick]), self._io.given(lams[pick]), self._io.given(ts[pick])),
                           f"the batched resolvent of {self.name}")
             if P.shape != (pick.size, self.dim):

@@ -32,7 +32,7 @@ import numpy as np
 
 from ._subgradients import (CONTAINS_POINTS, ProxOutputError, checked_value, contains_points,  # noqa: F401 - re-exported
                       subgradient_contains)
-from .arrays import MAX_BATCH, Boundary, array_kind, as_float64, padded, take_prefetched
+from .arrays import Boundary, array_kind, as_float64, batch_chunks, take_prefetched
 from .errors import InvalidProblem
 from .operators import Operator
 
@@ -180,9 +180,7 @@ class ProxOperator(Operator):
         if not self.batched:
             return np.array([self.resolvent(r, lam, t) for r, lam, t in zip(X, lams, ts)]).reshape(X.shape)
         out = np.empty_like(X)
-        for lo in range(0, X.shape[0], MAX_BATCH):
-            rows = min(MAX_BATCH, X.shape[0] - lo)
-            pick = np.r_[np.arange(lo, lo + rows), np.full(padded(rows) - rows, lo)]
+        for lo, rows, pick in batch_chunks(X.shape[0]):
             Xb = self._io.given(X[pick].reshape((pick.size,) + self.shape))
             res = self._call(Xb, self._io.given(lams[pick]), self._io.given(ts[pick]) if self._prox_t else None)
             if self._unwrap is not None:
