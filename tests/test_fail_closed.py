@@ -29,18 +29,9 @@ from verimono.cli import main
 from verimono.gate import compare
 from verimono.results import CheckResult, Report, SchemaError, load
 
+from probe_bad_inputs import CASES, run_probe, sample_report
+
 ONE_REF = ["--stage", "convergence", "--reference", "moving box", "--profile", "ci", "--executor", "serial"]
-
-
-def _report() -> Report:
-    rep = Report([CheckResult("monotone", "Linear", "passed", worst=0.5, bound=1.0),
-                  CheckResult("monotone", "Ball", "passed", worst=0.2, bound=1.0),
-                  CheckResult("siconos_agreement", "DiodeBridge", "passed", worst=0.1, bound=1.0,
-                              details={"error": 1e-9}),
-                  CheckResult("performance_per_step", "solve", "passed", worst=0.7, bound=1.5,
-                              details={"timing_ratio": 1.1})])
-    rep.meta.update({"command": "run", "profile": "ci", "target": None})
-    return rep
 
 
 def _save(path: Path, doc: dict) -> Path:
@@ -61,7 +52,7 @@ def _gate(capsys, base: Path, results: Path) -> tuple[int, str]:
 @pytest.mark.parametrize("where", ["before", "after"])
 def test_a_repeated_record_key_exits_2_naming_it(tmp_path, capsys, role, where):
     """A failed copy inserted *before* the passed original was gated green (the later copy won)."""
-    good = _report().to_dict()
+    good = sample_report().to_dict()
     bad = copy.deepcopy(good)
     failed = dict(bad["results"][0], status="failed", message="ratio 1.3 > 1", worst=1.3)
     bad["results"].insert(0 if where == "before" else len(bad["results"]), failed)
@@ -73,10 +64,10 @@ def test_a_repeated_record_key_exits_2_naming_it(tmp_path, capsys, role, where):
 
 
 def test_compare_refuses_repeated_keys_of_reports_in_memory():
-    cur = _report()
+    cur = sample_report()
     cur.results.insert(0, CheckResult("monotone", "Linear", "failed", worst=1.3, bound=1.0))
     with pytest.raises(SchemaError, match=r"monotone\[Linear\].*more than once"):
-        compare(_report(), cur)
+        compare(sample_report(), cur)
 
 
 @pytest.fixture(scope="module")
@@ -120,28 +111,28 @@ def _set(doc: dict, key: str, field: str, value) -> None:
 def test_a_baseline_with_a_non_finite_figure_is_unusable(tmp_path, capsys, key, field, value):
     """A baseline with NaN worst ratios was accepted (the record read back as failed, so anything 'fixed'
     it); a NaN error or timing ratio compared false against every threshold."""
-    base = _report().to_dict()
+    base = sample_report().to_dict()
     _set(base, key, field, value)
-    code, text = _gate(capsys, _save(tmp_path / "base.json", base), _save(tmp_path / "cur.json", _report().to_dict()))
+    code, text = _gate(capsys, _save(tmp_path / "base.json", base), _save(tmp_path / "cur.json", sample_report().to_dict()))
     assert code == 2 and "unusable" in text and key in text
 
 
 def test_a_baseline_recording_a_genuine_failure_stays_usable(tmp_path, capsys):
     """Not over-strict: a failed record may carry a NaN ratio, and a baseline may record known failures."""
-    rep = _report()
+    rep = sample_report()
     rep.add(CheckResult("known_bad", "op", "failed", worst=float("nan"), bound=1.0, message="diverged"))
     code, _ = _gate(capsys, _save(tmp_path / "base.json", rep.to_dict()), _save(tmp_path / "cur.json", rep.to_dict()))
     assert code == 0
 
 
 def test_a_pass_that_becomes_an_undeclared_xfail_regresses_a_declared_one_does_not():
-    cur = _report()
+    cur = sample_report()
     cur.results[0].status, cur.results[0].message = "xfail", "ratio 1.3 > 1"
-    regs = compare(_report(), cur).regressions
+    regs = compare(sample_report(), cur).regressions
     assert [(c.kind, c.key) for c in regs] == [("status", "monotone[Linear]")]
     assert "without a declaration" in regs[0].message
     cur.results[0].details["xfail_declared"] = "known: the test operator is not monotone"
-    comp = compare(_report(), cur)
+    comp = compare(sample_report(), cur)
     assert comp.ok and any("declared: known" in c.message for c in comp.others)
 
 
@@ -340,9 +331,9 @@ def test_a_full_disk_at_the_end_of_a_run_exits_2_in_one_line_and_keeps_the_resul
 
 
 def test_a_full_disk_for_report_and_baseline_exits_2_in_one_line(tmp_path, monkeypatch, capsys):
-    _report().save(tmp_path / "results.json")
+    sample_report().save(tmp_path / "results.json")
     (tmp_path / "r.html").write_text("old")
-    _report().save(tmp_path / "baseline.json")
+    sample_report().save(tmp_path / "baseline.json")
     before = (tmp_path / "baseline.json").read_text()
     _failing_pair_writes(monkeypatch)
     capsys.readouterr()
@@ -361,8 +352,8 @@ def test_output_files_honour_the_umask(tmp_path, umask, mode):
 
     old = os.umask(umask)
     try:
-        paths = write(_report(), tmp_path / "out")
-        saved = _report().save(tmp_path / "baseline.json")
+        paths = write(sample_report(), tmp_path / "out")
+        saved = sample_report().save(tmp_path / "baseline.json")
     finally:
         os.umask(old)
     for p in (paths["json"], paths["html"], saved):
@@ -371,9 +362,9 @@ def test_output_files_honour_the_umask(tmp_path, umask, mode):
 
 def test_a_replaced_file_keeps_its_own_mode_as_with_open(tmp_path):
     path = tmp_path / "baseline.json"
-    _report().save(path)
+    sample_report().save(path)
     path.chmod(0o664)
-    _report().save(path)
+    sample_report().save(path)
     assert stat.S_IMODE(path.stat().st_mode) == 0o664
 
 
@@ -420,7 +411,7 @@ def _limited(seconds: int = 60):
 @pytest.mark.parametrize("kind", ["/dev/zero", "fifo", "folder"])
 @pytest.mark.parametrize("role", ["--baseline", "--results"])
 def test_reading_a_device_fifo_or_folder_exits_2_without_hanging(tmp_path, kind, role):
-    good = _report().save(tmp_path / "good.json")
+    good = sample_report().save(tmp_path / "good.json")
     if kind == "fifo":
         bad = tmp_path / "fifo.json"
         os.mkfifo(bad)
@@ -434,7 +425,7 @@ def test_reading_a_device_fifo_or_folder_exits_2_without_hanging(tmp_path, kind,
 
 
 def test_a_document_over_the_size_limit_exits_2(tmp_path, capsys, monkeypatch):
-    good = _report().save(tmp_path / "good.json")
+    good = sample_report().save(tmp_path / "good.json")
     monkeypatch.setenv("VERIMONO_MAX_DOCUMENT_MIB", str(512 / (1 << 20)))   # 512 bytes
     code, text = _gate(capsys, good, good)
     assert code == 2 and "larger than the limit" in text and "VERIMONO_MAX_DOCUMENT_MIB" in text
@@ -474,13 +465,7 @@ def test_a_bad_seed_on_the_command_line_is_refused_before_any_work(tmp_path, cap
     assert not (tmp_path / "o").exists()
 
 
-def test_the_issue_25_probe_holds(capsys):
-    """tools/probe_issue25.py: at least 60 new bad inputs, every one typed, bounded and explained."""
-    import importlib.util
-
-    path = Path(__file__).resolve().parent.parent / "tools" / "probe_issue25.py"
-    spec = importlib.util.spec_from_file_location("probe_issue25", path)
-    probe = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(probe)
-    assert len(probe.CASES) >= 60
-    assert probe.run_probe(show=False) == 0, capsys.readouterr().out
+def test_the_bad_input_probe_holds(capsys):
+    """tests/probe_bad_inputs.py: at least 60 new bad inputs, every one typed, bounded and explained."""
+    assert len(CASES) >= 60
+    assert run_probe(show=False) == 0, capsys.readouterr().out

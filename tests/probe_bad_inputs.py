@@ -1,8 +1,10 @@
-"""Reliability probe of issue 25: bad inputs of the issue's kinds, each judged typed, bounded and explained.
+"""Reliability probe: bad inputs of the fail-closed kinds, each judged typed, bounded and explained.
 
-    OPENBLAS_NUM_THREADS=1 python tools/probe_issue25.py [--list]
+    OPENBLAS_NUM_THREADS=1 python tests/probe_bad_inputs.py [--list]
 
-Every case is new (not one of the issue's reproductions verbatim): forged gate documents, run marks,
+``tests/test_fail_closed.py`` runs it and shares its sample gate document (:func:`sample_report`).
+
+Every case is new (not one of the unit tests' reproductions verbatim): forged gate documents, run marks,
 paths that are not documents, time budgets, targets, subjects of the wrong kind, bad seeds and budgets,
 unwritable outputs, subjects that hang.  A case *holds* when
 
@@ -53,7 +55,7 @@ def case(name: str, expected: Any, words: str = "") -> Callable:
 
 # -- documents for the gate ------------------------------------------------------------------------------
 
-def _report() -> Report:
+def sample_report() -> Report:
     rep = Report([CheckResult("monotone", "Linear", "passed", worst=0.5, bound=1.0),
                   CheckResult("monotone", "Ball", "passed", worst=0.2, bound=1.0),
                   CheckResult("siconos_agreement", "DiodeBridge", "passed", worst=0.1, bound=1.0,
@@ -68,7 +70,7 @@ _counter = [0]
 
 
 def _doc(edit: Callable[[dict], Any] | None = None) -> Path:
-    d = _report().to_dict()
+    d = sample_report().to_dict()
     if edit is not None:
         edit(d)
     _counter[0] += 1
