@@ -112,12 +112,11 @@ del _law
 
 # -- census: the laws must apply to most generated problems ------------------------------------------
 
-#: generated problems drawn (derandomized) for the census of skips, per family of :data:`CENSUS_FAMILIES`
+#: generated problems drawn (derandomized) for the census of skips, per family of :data:`FAMILIES`
 CENSUS_EXAMPLES = 20
 #: every family is drawn on its own: hypothesis mixes constants of the modules already imported into its
 #: draws, so one derandomized stream over all families depends on which tests ran before (a whole-suite
 #: run drew no shifted operator in 100 draws where the file alone drew many)
-CENSUS_FAMILIES = FAMILIES
 #: a law skipped on more than this share of generated problems is not tested by its property (every skip
 #: counts as a pass inside @given): skips must be a minority.  Legitimate skips remain: (LG) fails for the
 #: log-barrier and is not explicit for a singular D + Dᵀ; (YB) fails for moving sets, is not stated for a
@@ -151,12 +150,12 @@ def test_laws_apply_to_most_generated_problems():
                     reasons[law][rec.message[:90]] += 1
         draw()
 
-    for family in CENSUS_FAMILIES:
+    for family in FAMILIES:
         census(family)
     assert kinds["LCSOperator"] and kinds["Shifted"] and kinds["NormalCone"], kinds    # every family drawn
     for law in CENSUS_LAWS:
         total = sum(seen[law].values())
-        assert total == CENSUS_EXAMPLES * len(CENSUS_FAMILIES)
+        assert total == CENSUS_EXAMPLES * len(FAMILIES)
         assert seen[law][FAILED] == 0, (law, seen[law])
         share = seen[law][SKIPPED] / total
         assert share <= MAX_SKIP_SHARE, f"{law} skipped on {share:.0%} of generated problems: {dict(reasons[law])}"

@@ -52,7 +52,7 @@ from .claims import SCHEMES, claim_of, with_claim
 from .errors import BadTarget, InvalidCheckArgument, NothingToResume, OutputNotWritable, SchemaError, VerimonoError
 from .profiles import PROFILES, active_profile
 from .progress import Progress
-from .results import SKIPPED, Report
+from .results import FAILED, SKIPPED, Report
 from .runs import (EXIT_FAILED, EXIT_OK, EXIT_UNDECIDED, execute, exit_status, interruptible, merge_resumed)
 from .targets import load_target
 
@@ -137,7 +137,7 @@ def order_table(report: Report) -> list[str]:
     interval, verdict (``MISSED`` when the stepper does not reach the expected order, ``FAILED`` when its
     record failed for another reason: a limit that is not the solution's)."""
     failed = {(r.details["study"].problem, r.details["study"].stepper) for r in report.results
-              if r.check == "convergence_order" and r.status == "failed" and hasattr(r.details.get("study"), "problem")}
+              if r.check == "convergence_order" and r.status == FAILED and hasattr(r.details.get("study"), "problem")}
     rows = []
     for s in report.studies:
         exp = "-" if s.expected is None else ("exact" if s.expected.exact else f"{s.expected.value:g}")

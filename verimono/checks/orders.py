@@ -21,8 +21,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ..claims import claim_of
-from ..convergence import ORDER_SLACK, _timed_run, convergence_study
-from ..grids import uniform_grid, validate_grid
+from ..convergence import ORDER_SLACK, _timed_run, convergence_study, study_grids
 from ..problem import Order, Problem, origin_of
 from ..results import FAILED, PASSED
 from ..stepping import solve
@@ -52,7 +51,7 @@ def limit_agreement(stepper: Callable, study: Any, problem: Problem) -> tuple[bo
     """Whether ``stepper`` converges to the limit of :func:`verimono.solve` on ``problem`` (see the module
     docstring): their sup distance on the finest grid of ``study`` against ``LIMIT_FACTOR`` times the sum of
     their estimated errors there (each from its own study on the same grids), plus both round-off floors."""
-    grids = [validate_grid(s, problem.T) if np.ndim(s) else uniform_grid(problem.T, float(s)) for s in problem.steps]
+    grids = study_grids(problem.T, problem.steps)
     k = int(np.argmin(study.mesh))
     grid = grids[k]
     ref = convergence_study(solve, problem, grids)
