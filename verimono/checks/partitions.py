@@ -28,7 +28,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..arrays import as_float64
+from ..arrays import as_float64, precision_of
 from ..claims import claim_of
 from ..grids import graded_grid, random_grid, uniform_grid, validate_grid
 from ..problem import Problem
@@ -36,6 +36,7 @@ from ..results import PASSED
 from ..timeouts import note_progress
 from .core import Outcome, law, run, stepper_subject
 from .search import valid_seed
+from .shared_runs import remembered
 from .subjects import require_problem, require_stepper
 
 #: cells of the default partitions (fine enough for the lemmas' bounds, fast enough for a battery)
@@ -60,14 +61,21 @@ def single(problem: Problem) -> Problem:
 
 
 def run_stepper(stepper: Callable, problem: Problem, grid: np.ndarray) -> np.ndarray:
-    """``stepper(problem, grid)`` as a float array of shape ``(K+1, n)``, finite (else ``ValueError``)."""
-    x = as_float64(stepper(problem, grid))      # any array library; its precision is observed
+    """``stepper(problem, grid)`` as a float array of shape ``(K+1, n)``, finite (else ``ValueError``); inside
+    :func:`verimono.checks.shared_runs.shared_runs`, run once per (stepper, problem, partition)."""
+    return remembered(stepper, problem, grid, lambda: _validated_run(stepper, problem, grid))
+
+
+def _validated_run(stepper: Callable, problem: Problem, grid: np.ndarray) -> tuple[np.ndarray, str | None]:
+    raw = stepper(problem, grid)
+    precision = precision_of(raw)
+    x = as_float64(raw)      # any array library; its precision is observed
     if x.shape != (len(grid),) + problem.x0.shape:
         raise ValueError(f"stepper {stepper_subject(stepper, problem).split(' on ')[0]} returned shape {x.shape}, "
                          f"expected {(len(grid),) + problem.x0.shape}")
     if not np.all(np.isfinite(x)):
         raise ValueError("the stepper returned non-finite states")
-    return x
+    return x, precision
 
 
 def default_grids(problem: Problem, seed: int = 0, cells: int = DEFAULT_CELLS) -> dict[str, np.ndarray]:

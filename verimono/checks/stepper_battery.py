@@ -23,6 +23,7 @@ from .core import laws_of, stepper_subject
 from .partitions import single
 from .sample_problems import sample_problems
 from .search import valid_seed
+from .shared_runs import shared_runs
 from .subjects import require_problem, require_stepper
 
 #: the law judging the order a stepper reaches on a reference (on the references only)
@@ -116,14 +117,15 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
     if not selected and not orders:
         raise InvalidCheckArgument("check_stepper selected no check (no law, no order): it would verify nothing")
     report = Report()
-    for name, check in stepper_checks(stepper, problems, seed=seed, generated=generated, laws=selected,
-                                      orders=orders, executor=executor):
-        law, _, problem_name = name.partition("[")
-        # a stepper that never returns: a failed record naming the unit, and the battery goes on
-        rec = run_unit(lambda: check(stepper), check=law, subject=stepper_subject(stepper, problem_name[:-1]))
-        report.add(rec)
-        if rec.study is not None:
-            report.studies.append(rec.study)
+    with shared_runs():             # the laws judge the same runs of the stepper: each is made once
+        for name, check in stepper_checks(stepper, problems, seed=seed, generated=generated, laws=selected,
+                                          orders=orders, executor=executor):
+            law, _, problem_name = name.partition("[")
+            # a stepper that never returns: a failed record naming the unit, and the battery goes on
+            rec = run_unit(lambda: check(stepper), check=law, subject=stepper_subject(stepper, problem_name[:-1]))
+            report.add(rec)
+            if rec.study is not None:
+                report.studies.append(rec.study)
     if not len(report):
         raise InvalidCheckArgument("check_stepper selected no check (no law, no order): it would verify nothing")
     return report

@@ -189,14 +189,17 @@ def trajectory_laws_stage(profile: Profile, context: RunContext) -> Report:
 
 def _checks_unit(checks: list[tuple[str, Callable]], subject: Any) -> Report:
     """Every ``check(subject)`` of one battery, in order (``meta["records_per_check"]``: how many each gave)."""
+    from ..checks.shared_runs import shared_runs
+
     report, sizes = Report(), []
-    for name, check in checks:
-        law, _, problem_name = name.partition("[")
-        # each check under the unit time budget: one that does not return is a failed record, the rest go on
-        out = run_unit(lambda: check(subject), check=law, subject=f"{_name(subject)} on {problem_name[:-1]}")
-        before = len(report)
-        report.extend(out) if isinstance(out, Report) else report.add(out)
-        sizes.append(len(report) - before)
+    with shared_runs():             # the laws judge the same runs of the stepper: each is made once
+        for name, check in checks:
+            law, _, problem_name = name.partition("[")
+            # each check under the unit time budget: one that does not return is a failed record, the rest go on
+            out = run_unit(lambda: check(subject), check=law, subject=f"{_name(subject)} on {problem_name[:-1]}")
+            before = len(report)
+            report.extend(out) if isinstance(out, Report) else report.add(out)
+            sizes.append(len(report) - before)
     report.meta["records_per_check"] = sizes
     return report
 
