@@ -25,6 +25,7 @@ from ..timeouts import current_budget, run_unit, time_limit
 from ..checks.core import laws_of
 from ..checks.core import subject_name as _name
 from ..checks.pseudo_distance import check_pseudo_distance
+from ..checks.shared_runs import shared_runs
 from ..checks.siconos import check_siconos_case, check_siconos_lcps
 from .registry import RunContext, register_stage
 
@@ -189,8 +190,6 @@ def trajectory_laws_stage(profile: Profile, context: RunContext) -> Report:
 
 def _checks_unit(checks: list[tuple[str, Callable]], subject: Any) -> Report:
     """Every ``check(subject)`` of one battery, in order (``meta["records_per_check"]``: how many each gave)."""
-    from ..checks.shared_runs import shared_runs
-
     report, sizes = Report(), []
     with shared_runs():             # the laws judge the same runs of the stepper: each is made once
         for name, check in checks:
