@@ -230,13 +230,14 @@ def test_auto_runs_serially_when_its_workers_cannot_start(monkeypatch, capsys):
     """``auto`` is best effort: when no worker can start (a script read from standard input cannot be
     re-imported by a spawned process) it says why and runs the units serially, recording ``serial``;
     an explicit ``process:N`` fails instead.  The reason names the worker's exit status."""
+    import multiprocessing
     import sys as _sys
 
     def exits(self, count):
-        started = []
+        started, ctx = [], multiprocessing.get_context("spawn")
         for _ in range(max(0, count)):
-            parent, child = self._ctx.Pipe(duplex=True)
-            proc = self._ctx.Process(target=_sys.exit, args=(1,))
+            parent, child = ctx.Pipe(duplex=True)
+            proc = ctx.Process(target=_sys.exit, args=(1,))
             proc.start()
             child.close()
             started.append((proc, parent))
@@ -253,3 +254,83 @@ def test_auto_runs_serially_when_its_workers_cannot_start(monkeypatch, capsys):
     assert runner.spec == "serial" and runner.workers == 1
     assert "running the units serially" in capsys.readouterr().err
     runner.close()
+
+
+# -- how workers start, and what a unit carries to them ---------------------------------------------------
+
+def _limits_seen() -> Report:
+    """A unit reporting the unit budget and the calibration of the process it runs in."""
+    from verimono.timeouts import calibration, current_budget
+
+    return Report([CheckResult("limits", "seen", "passed", details={"budget": current_budget(),
+                                                                     "calibration": calibration()})])
+
+
+@pytest.mark.parametrize("method", ["spawn", "fork"])
+def test_a_worker_runs_a_unit_under_the_runs_budget_and_calibration(monkeypatch, method):
+    """``--timeout`` and the run's calibration bound a unit on a worker as in the run's own process: a spawned
+    worker used to measure its own calibration and ignore ``--timeout``."""
+    from verimono.calibration import calibration, set_calibration
+    from verimono.timeouts import budget
+
+    monkeypatch.setenv("VERIMONO_START_METHOD", method)
+    before = calibration()
+    set_calibration(0.123)
+    try:
+        runner = ProcessRunner(1)
+        with budget(7.5):
+            (rep,) = runner.map([Unit("s", "limits", _limits_seen)], None, lambda *a: None)
+        runner.close()
+    finally:
+        set_calibration(before)
+    (rec,) = rep.results
+    assert rec.details == {"budget": 7.5, "calibration": 0.123}
+
+
+def test_workers_are_forked_only_where_that_is_safe(monkeypatch):
+    """Fork (a ready copy of this process) on Linux with no other thread and no library whose threads do not
+    survive a fork; spawn otherwise; ``$VERIMONO_START_METHOD`` decides when set."""
+    import sys
+    import threading
+
+    from verimono.executors import start_method
+
+    monkeypatch.delenv("VERIMONO_START_METHOD", raising=False)
+    monkeypatch.setattr(sys, "platform", "linux")
+    monkeypatch.setattr(threading, "active_count", lambda: 1)
+    for name in ("jax", "torch", "tensorflow", "cupy", "numba"):
+        monkeypatch.delitem(sys.modules, name, raising=False)
+    assert start_method() == "fork"
+    monkeypatch.setitem(sys.modules, "torch", object())
+    assert start_method() == "spawn"
+    monkeypatch.delitem(sys.modules, "torch")
+    monkeypatch.setattr(threading, "active_count", lambda: 2)      # a thread could hold a lock at the fork
+    assert start_method() == "spawn"
+    monkeypatch.setattr(threading, "active_count", lambda: 1)
+    monkeypatch.setattr(sys, "platform", "darwin")
+    assert start_method() == "spawn"
+    monkeypatch.setenv("VERIMONO_START_METHOD", "fork")
+    assert start_method() == "fork"
+    monkeypatch.setenv("VERIMONO_START_METHOD", "forkserver")
+    with pytest.raises(BadExecutor, match="fork or spawn"):
+        start_method()
+
+
+def test_units_start_costliest_first_and_come_back_in_their_order():
+    from verimono.stages.registry import RunContext
+    from verimono.profiles import get_profile
+
+    started: list[str] = []
+
+    class Recording:        # a runner of worker processes, as far as run_units can tell
+        workers = 2
+
+        def map(self, units, profile, progress):
+            started.extend(u.label for u in units)
+            return SerialRunner().map(units, profile, progress)
+
+    ctx = RunContext(executor=Recording())
+    units = [Unit("s", label, _ok, (label,)) for label in "abc"]
+    reports = ctx.run_units(get_profile("ci"), units, costs=[0.1, 3.0, 1.0])
+    assert started == ["b", "c", "a"]
+    assert [r.key for rep in reports for r in rep] == ["law[a]", "law[b]", "law[c]"]

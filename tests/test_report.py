@@ -285,3 +285,27 @@ def test_a_failing_law_reproduces_with_the_reference_the_run_names():
     assert "--reference 'moving box'" in reproduction(failed[0], {"command": "run", "profile": "ci"})
     own = CheckResult("in_domain", "mine", "failed", counterexample={"problem": "moving box"})
     assert "--reference" not in reproduction(own, {"command": "run"})  # nothing said, nothing guessed
+
+
+def test_plots_drawn_ahead_are_the_reports_plots_drawn_once(small_report, monkeypatch):
+    """A run on worker processes draws its plots while it waits (``plots.draw_ahead``): the report then uses
+    them, draws none twice, and is the document it would be without them (apart from the figures' ids)."""
+    from verimono.report import plots
+
+    drawn = []
+    figure = plots.convergence_figure
+    monkeypatch.setattr(plots, "convergence_figure", lambda s, ax=None: drawn.append(s) or figure(s, ax))
+    plots.forget()
+    plain = render(small_report)
+    assert len(drawn) == len(small_report.studies) > 0
+    plots.forget()
+    drawn.clear()
+    plots.draw_ahead(small_report.studies, small_report.trajectories).join()
+    assert len(drawn) == len(small_report.studies)
+    ahead = render(small_report)
+    assert len(drawn) == len(small_report.studies)      # nothing drawn again
+    svg = re.compile(r"<svg .*?</svg>", re.S)
+    assert len(svg.findall(ahead)) == len(svg.findall(plain)) == len(small_report.studies) + len(
+        small_report.trajectories)
+    assert svg.sub("", ahead) == svg.sub("", plain)
+    plots.forget()

@@ -21,9 +21,10 @@
         or stopped by an error) are not that run's, and the gate refuses them (exit 2).  When the pair
         cannot be written (a full disk, an unwritable folder) the previous pair stays, the results are kept
         in the temporary folder, and a one-line message names both paths (exit 2).
-    verimono check MODULE:OBJECT [--profile P] [--out DIR] [--seed N]
+    verimono check MODULE:OBJECT [--profile P] [--out DIR] [--seed N] [run's --timeout, --executor, ...]
         The operator battery on an operator, or the stepper battery on a stepper ``f(problem, t_grid)``;
-        MODULE is a dotted module name or a ``.py`` file (anything else: exit 2).  Its files are marked and
+        MODULE is a dotted module name or a ``.py`` file (anything else: exit 2).  Its units run on every
+        core as ``run``'s do (``--executor serial``: in this process).  Its files are marked and
         written as ``run``'s; after an interrupt, run the same command again (it has no ``--resume``).
     verimono baseline [--out reports/baseline.json] [--from RESULTS] [run options]
         Record the current results (runs the verification, or copies RESULTS) as the gate's baseline.
@@ -406,7 +407,7 @@ def build_parser() -> argparse.ArgumentParser:
                             "before it is stopped and recorded as failed (default: the profile's)")
         p.add_argument("--executor", default=None, metavar="SPEC",
                        help="where the stages' independent units run: serial, auto (every core, at most 4 "
-                            "worker processes; the default of run, $VERIMONO_EXECUTOR overrides), process:N (N "
+                            "worker processes; the default, $VERIMONO_EXECUTOR overrides), process:N (N "
                             "worker processes), or a dask.distributed scheduler address such as tcp://host:8786")
         p.add_argument("--unit-timeout", type=_seconds, default=None, metavar="SECONDS",
                        help="with --executor: a stage unit (a subject's battery) still running after this long "
@@ -425,6 +426,7 @@ def build_parser() -> argparse.ArgumentParser:
     check = sub.add_parser("check", help="run the operator or stepper battery on MODULE:OBJECT")
     check.add_argument("target", metavar="MODULE:OBJECT")
     run_options(check)
+    check.set_defaults(executor=os.environ.get("VERIMONO_EXECUTOR") or "auto")
     check.add_argument("--out", default="reports/check", help="output folder (default reports/check/)")
     check.add_argument("--baseline", default=None, help="show changes against this baseline")
     check.add_argument("--scheme", choices=SCHEMES, default=None,

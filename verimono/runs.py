@@ -19,7 +19,7 @@ from .executors import make_runner
 from .profiles import get_profile, load_hypothesis_profile
 from .progress import Progress
 from .report import write
-from .report.plots import warm_up
+from .report.plots import draw_ahead, warm_up
 from .results import Report
 from .stages import calibrate, run_stages
 from .calibration import set_calibration
@@ -49,7 +49,8 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
     set_calibration(cal)              # the unit of this process's time budgets (verimono.timeouts)
     if hasattr(runner, "prestart"):   # the workers import while this process builds the catalog
         runner.prestart()
-    if getattr(runner, "workers", 1) >= 2:   # this process waits on the workers: draw the report's first
+    waits_on_workers = getattr(runner, "workers", 1) >= 2
+    if waits_on_workers:                     # this process waits on the workers: draw the report's first
         import threading                     # figure meanwhile (matplotlib's import and font cache)
 
         threading.Thread(target=warm_up, name="verimono-report-warm-up", daemon=True).start()
@@ -58,6 +59,8 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
 
     def done(stage, rep, info):
         info.update(probe.lap())      # how busy the machine was during the stage: the gate's evidence
+        if waits_on_workers and (rep.studies or rep.trajectories):
+            draw_ahead(rep.studies, rep.trajectories)   # the report's plots, while the workers run on
         progress.done(stage, rep, info)
         if on_done is not None:
             on_done(stage, rep, info)
@@ -69,8 +72,9 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
     duration = time.perf_counter() - start
     # once more at the end: one calibration (best of 3 x 0.1 s) samples one moment of a shared machine and
     # read 0.08-0.16 s here within an hour; noise only slows a workload down, so the faster of the two ends
-    # (best of 6) is the steadier unit, in the baseline and in the run gated against it alike
-    cals = [cal, calibrate()]
+    # (best of 6) is the steadier unit, in the baseline and in the run gated against it alike; a run without
+    # the performance stage judges no speed, and its one calibration only sizes the time budgets
+    cals = [cal, calibrate()] if stages is None or "performance" in stages else [cal]
     selection = {"stages": stages, "references": None if context.problems is None else
                  [p.name for p in context.problems]}
     report.meta.update({"command": command, "target": target, "profile": profile_name, "seed": context.seed,

@@ -72,6 +72,12 @@ def budget(seconds: float | None) -> Iterator[None]:
         _OVERRIDE.pop()
 
 
+def explicit_budget() -> float | None:
+    """The seconds of the innermost :func:`budget` block (``--timeout``), ``None`` outside one: what a unit
+    shipped to a worker process carries with it (:mod:`verimono.executors`)."""
+    return _OVERRIDE[-1] if _OVERRIDE else None
+
+
 def calibration() -> float:
     """Seconds of the calibration workload in this process (:func:`verimono.calibration.calibration`: measured
     once and cached; :func:`verimono.calibration.set_calibration` supplies one measured elsewhere)."""
@@ -232,5 +238,5 @@ def run_unit(fn: Callable[[], object], *, check: str, subject: str, seconds: flo
         _PROGRESS.pop()
 
 
-__all__ = ["budget", "current_budget", "budget_source", "stage_budget", "calibration", "in_seconds", "time_limit",
+__all__ = ["budget", "explicit_budget", "current_budget", "budget_source", "stage_budget", "calibration", "in_seconds", "time_limit",
            "run_unit", "note_progress", "never_returned", "supported", "TIME_BUDGET_REASON", "HANG_MULTIPLE"]

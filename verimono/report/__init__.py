@@ -12,6 +12,7 @@ from typing import Any
 from ..atomic import clear_in_progress, ensure_writable_dir, keep_elsewhere, replace_all
 from ..errors import OutputNotWritable
 from .html import render
+from .plots import forget
 
 
 def write(report: Any, out_dir: str | Path, *, changes: Any = None, run_id: str | None = None) -> dict[str, Path]:
@@ -33,6 +34,7 @@ def write(report: Any, out_dir: str | Path, *, changes: Any = None, run_id: str 
     try:
         out = ensure_writable_dir(out_dir)
         html = render(report, changes=changes)
+        forget()                                  # the plots drawn ahead for this report
         replace_all({json_path: text, html_path: html})
     except OutputNotWritable as exc:
         try:

@@ -10,6 +10,7 @@ import io
 import itertools
 import math
 import re
+import threading
 from typing import Any
 
 import numpy as np
@@ -37,6 +38,15 @@ def _svg(fig: Any) -> str:
     return text
 
 
+# -- drawn ahead: a run whose units run on worker processes draws its plots while it waits for them ---------
+
+#: ``id(subject) -> (subject, svg)``: plots drawn ahead (:func:`draw_ahead`); the subject is held so its id
+#: cannot be reused while the entry lives (:func:`forget` empties it once a report is written)
+_DRAWN: dict[int, tuple[Any, str]] = {}
+#: one figure drawn at a time, and a plot drawn once: the cache is consulted and filled under it
+_DRAWING = threading.Lock()
+
+
 def _figure(width: float = 4.4, height: float = 3.1) -> Any:
     """A figure on the Agg canvas, outside pyplot (no global state, no GUI backend)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -52,12 +62,13 @@ def warm_up() -> None:
     """Import matplotlib and draw one small figure (font cache, text layout): about 0.6 s that a run on worker
     processes spends in its otherwise idle main process instead of before its report (``verimono run`` calls
     it in a background thread)."""
-    fig = _figure()
-    ax = fig.add_subplot()
-    ax.loglog([1.0, 2.0], [1.0, 2.0], marker="o", label="warm-up")
-    ax.set_title("warm-up", fontsize=10, y=1.0)
-    ax.legend(fontsize=6.5)
-    _svg(fig)
+    with _DRAWING:
+        fig = _figure()
+        ax = fig.add_subplot()
+        ax.loglog([1.0, 2.0], [1.0, 2.0], marker="o", label="warm-up")
+        ax.set_title("warm-up", fontsize=10, y=1.0)
+        ax.legend(fontsize=6.5)
+        _svg(fig)
 
 
 def _decade(v: float, _pos: Any = None) -> str:
@@ -69,9 +80,47 @@ def _num(v: Any) -> float:
     return float(v) if isinstance(v, (int, float, str)) else math.nan
 
 
+def _drawn_once(subject: Any, draw: Any) -> str:
+    with _DRAWING:
+        hit = _DRAWN.get(id(subject))
+        if hit is not None and hit[0] is subject:
+            return hit[1]
+        svg = draw()
+        _DRAWN[id(subject)] = (subject, svg)
+        return svg
+
+
+def draw_ahead(studies: Any = (), samples: Any = ()) -> threading.Thread:
+    """Draw the convergence plots of ``studies`` and the trajectory plots of ``samples`` in a background
+    thread (:func:`convergence_plot` and :func:`trajectory_plot` then return them): what a run whose units
+    run on worker processes does with its otherwise idle main process (``verimono run``/``check`` with
+    ``--executor process:N``, ``auto``).  A plot the report needs before the thread reached it is drawn
+    there, once.  A plot that cannot be drawn ahead is left to the report, which says why."""
+    studies, samples = list(studies), list(samples)
+
+    def draw() -> None:
+        try:
+            for s in studies:
+                convergence_plot(s)
+            for s in samples:
+                trajectory_plot(s)
+        except Exception:  # noqa: BLE001 - the report draws it again and reports the error there
+            pass
+
+    thread = threading.Thread(target=draw, name="verimono-report-plots", daemon=True)
+    thread.start()
+    return thread
+
+
+def forget() -> None:
+    """Drop the plots drawn ahead (after a report is written)."""
+    with _DRAWING:
+        _DRAWN.clear()
+
+
 def convergence_plot(study: Any) -> str:
     """:func:`convergence_figure` as an inline ``<svg>``."""
-    return _svg(convergence_figure(study))
+    return _drawn_once(study, lambda: _svg(convergence_figure(study)))
 
 
 def convergence_figure(study: Any, ax: Any = None) -> Any:
@@ -145,7 +194,7 @@ def convergence_figure(study: Any, ax: Any = None) -> Any:
 
 def trajectory_plot(sample: dict[str, Any]) -> str:
     """:func:`trajectory_figure` as an inline ``<svg>``."""
-    return _svg(trajectory_figure(sample))
+    return _drawn_once(sample, lambda: _svg(trajectory_figure(sample)))
 
 
 def trajectory_figure(sample: dict[str, Any]) -> Any:
@@ -173,4 +222,5 @@ def trajectory_figure(sample: dict[str, Any]) -> Any:
     return fig
 
 
-__all__ = ["convergence_plot", "convergence_figure", "trajectory_plot", "trajectory_figure", "warm_up"]
+__all__ = ["convergence_plot", "convergence_figure", "trajectory_plot", "trajectory_figure", "warm_up", "draw_ahead",
+           "forget"]

@@ -83,8 +83,12 @@ def convergence_stage(profile: Profile, context: RunContext) -> Report:
     """Every analytic reference's convergence study, plus a trajectory sample for the report's plots;
     one unit per reference."""
     stepper = solve if context.stepper is None else context.stepper
-    units = [Unit("convergence", p.name, _convergence_unit, (stepper, p)) for p in context.catalog()]
-    return _merged(context.run_units(profile, units))
+    problems = context.catalog()
+    units = [Unit("convergence", p.name, _convergence_unit, (stepper, p)) for p in problems]
+    reports = context.run_units(profile, units)
+    for p, rep in zip(problems, reports):     # what the stepper costs on each: the later stages' guide
+        context.costs[p.name] = sum(r.duration or 0.0 for r in rep.results)
+    return _merged(reports)
 
 
 def _catalog_operators(context: RunContext) -> list[tuple[str, Any]]:
@@ -177,7 +181,8 @@ def trajectory_laws_stage(profile: Profile, context: RunContext) -> Report:
     units = [Unit("trajectory_laws", subject, _checks_unit, ([checks[k] for k in ks], stepper))
              for subject, ks in groups.items()]
     slots: list[list[CheckResult]] = [[] for _ in checks]
-    for ks, rep in zip(groups.values(), context.run_units(profile, units)):
+    costs = [context.costs.get(subject, 0.0) for subject in groups]     # the costliest problems first
+    for ks, rep in zip(groups.values(), context.run_units(profile, units, costs)):
         sizes = rep.meta.get("records_per_check")
         if sizes is None or len(sizes) != len(ks):  # a unit that did not finish: its one failed record
             slots[ks[0]].extend(rep.results)

@@ -43,7 +43,9 @@ class RunContext:
     the references (``None``: the whole catalog); ``operators`` extra operators to verify (``verimono
     check`` on an operator); ``data_dir`` the data folder (Siconos references) or ``None``;
     ``progress(done, total, label)`` reports progress within a stage; ``executor`` runs the stages'
-    independent units (:mod:`verimono.executors`; serially when ``None``).
+    independent units (:mod:`verimono.executors`; serially when ``None``); ``costs`` holds what an earlier
+    stage measured of a subject (seconds, by problem name), so a later stage can start its costliest units
+    first (:meth:`run_units`).
     """
 
     stepper: Callable | None = None
@@ -53,6 +55,7 @@ class RunContext:
     data_dir: Path | None = None
     progress: Callable[[int, int, str], None] = lambda done, total, label: None
     executor: Any = None
+    costs: dict[str, float] = dataclasses.field(default_factory=dict)
 
     _catalog: list[Any] | None = dataclasses.field(default=None, repr=False)
 
@@ -66,12 +69,23 @@ class RunContext:
             self._catalog = catalog()
         return self._catalog
 
-    def run_units(self, profile: Profile, units: list[Any]) -> list[Report]:
+    def run_units(self, profile: Profile, units: list[Any], costs: list[float] | None = None) -> list[Report]:
         """The reports of ``units`` (:class:`verimono.executors.Unit`), in their order, run on
         ``executor`` (serially here when it is ``None``); a unit that raises, whose worker dies or that
-        times out gives one failed record ``unit[<stage>: <label>]`` and the other units' records stay."""
+        times out gives one failed record ``unit[<stage>: <label>]`` and the other units' records stay.
+
+        ``costs`` (one guess per unit, e.g. from :attr:`costs`): on worker processes the units start
+        costliest first, so that no long unit starts last while the other workers idle; the reports come
+        back in the units' order all the same."""
         runner = self.executor if self.executor is not None else SerialRunner()
-        return runner.map(units, profile.name, self.progress)
+        if costs is None or isinstance(runner, SerialRunner):
+            return runner.map(units, profile.name, self.progress)
+        order = sorted(range(len(units)), key=lambda i: -costs[i])
+        reports = runner.map([units[i] for i in order], profile.name, self.progress)
+        out: list[Report] = [Report()] * len(units)
+        for i, rep in zip(order, reports):
+            out[i] = rep
+        return out
 
     def seed_for(self, profile: Profile) -> int | None:
         """The seed a randomized battery uses: ``seed`` if given, else 0 under a derandomized profile
