@@ -361,9 +361,9 @@ def _cmd_baseline(args: argparse.Namespace) -> int:
 def _baseline_hang(hang: Any) -> None:
     """``verimono baseline``: a call blocked in native code in this process ends it (nothing is written)."""
     from .runs import ISOLATE_ADVICE
-    from .watchdog import disarm, end_process
+    from .watchdog import end_process, ending
 
-    disarm()
+    ending()
     print(f"\nverimono baseline: {hang.call} is blocked in native code ({hang.where or 'where unknown'}): still "
           f"running {hang.elapsed:.1f} s after it started, past its time budget of {hang.budget:g} s; no baseline "
           f"written; {ISOLATE_ADVICE}", file=sys.stderr)

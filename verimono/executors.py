@@ -150,10 +150,10 @@ def _process_worker(conn: Any) -> None:
     lock, state = threading.Lock(), {"busy": False}
 
     def on_hang(hang: watchdog.Hang) -> None:
-        watchdog.disarm()
         with lock:
             if not state["busy"]:     # pragma: no cover - the unit returned meanwhile: nothing to answer
                 return
+            watchdog.ending()
             try:
                 conn.send_bytes(cloudpickle.dumps(("hang", watchdog.hang_report(hang))))
             except Exception:  # noqa: BLE001 - the parent then sees a dead worker, which it reports too

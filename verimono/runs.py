@@ -145,7 +145,7 @@ def interruptible(run: Callable[[Callable], Report], out: Path, *, command: str,
         return partial, done
 
     def on_hang(hang: watchdog.Hang) -> None:
-        watchdog.disarm()
+        watchdog.ending()
         try:
             partial, done = partial_report()
             current = watchdog.hang_report(hang)

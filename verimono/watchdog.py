@@ -21,12 +21,14 @@ install one:
   and the current stage's finished records, with the failed record, to the results file marked incomplete,
   name the call and the file in one line, and exit with status 1.
 
-Either first ends the subject's own child processes (an ``os.system`` command that would outlive the process
-and keep its output pipes open; Linux, through ``/proc``) and cancels the backstop.  The *backstop* is for a
+Either ends the subject's own child processes (an ``os.system`` command that would outlive the process and
+keep its output pipes open; Linux, through ``/proc``) before it exits.  The *backstop* is for a
 native call that blocks while holding the GIL, which stops this thread too: while a handler is installed,
 :mod:`faulthandler` (a C thread that needs no GIL) ends the process with status 1 and the Python tracebacks
 on standard error at ``budget + 2 x grace``, without writing anything (a worker's parent then reports its
-unit as a dead worker; a ``verimono`` command leaves its in-progress mark, which the gate refuses).
+unit as a dead worker; a ``verimono`` command leaves its in-progress mark, which the gate refuses), and a
+handler, which calls :func:`ending` first, gets :data:`ENDING_SECONDS` to write before it does the same.
+The child processes of a call that holds the GIL are not ended (nothing in Python runs to find them).
 
 In a process where no handler is installed — the Python API (``check_stepper``, ``check_operator``) in the
 user's interpreter — the watchdog never ends the process: it prints one warning naming the blocked call and
@@ -279,6 +281,21 @@ def on_hang(handler: Callable[[Hang], None], *, backstop: bool = True) -> Iterat
 
 
 _BACKSTOP_ARMED = False
+#: set by :func:`ending`: the process is being ended, the limits no longer move the backstop
+_ENDING = False
+#: seconds a handler has, from :func:`ending`, to write what finished before the backstop ends the process
+ENDING_SECONDS = 120.0
+
+
+def _backstop_in(seconds: float) -> None:
+    global _BACKSTOP_ARMED
+    import faulthandler
+
+    try:
+        faulthandler.dump_traceback_later(max(seconds, 0.1), exit=True, file=sys.__stderr__ or 2)
+        _BACKSTOP_ARMED = True
+    except (ValueError, RuntimeError, OSError, AttributeError):   # pragma: no cover - no usable stderr
+        pass
 
 
 def _arm_backstop() -> None:
@@ -286,28 +303,23 @@ def _arm_backstop() -> None:
     global _BACKSTOP_ARMED
     import faulthandler
 
-    want = bool(_HANDLERS and _HANDLERS[-1][1] and _LIMITS and not _LIMITS[-1].reported)
-    if want:
+    if _ENDING:
+        return
+    if _HANDLERS and _HANDLERS[-1][1] and _LIMITS and not _LIMITS[-1].reported:
         top = _LIMITS[-1]
-        left = top.start + top.seconds + 2 * grace(top.seconds) - time.monotonic()
-        try:
-            faulthandler.dump_traceback_later(max(left, 0.1), exit=True, file=sys.__stderr__ or 2)
-            _BACKSTOP_ARMED = True
-        except (ValueError, RuntimeError, OSError, AttributeError):   # pragma: no cover - no usable stderr
-            pass
+        _backstop_in(top.start + top.seconds + 2 * grace(top.seconds) - time.monotonic())
     elif _BACKSTOP_ARMED:
         faulthandler.cancel_dump_traceback_later()
         _BACKSTOP_ARMED = False
 
 
-def disarm() -> None:
-    """Cancel the backstop: a handler calls this first, before it writes and exits."""
-    global _BACKSTOP_ARMED
-    import faulthandler
-
-    if _BACKSTOP_ARMED:
-        faulthandler.cancel_dump_traceback_later()
-        _BACKSTOP_ARMED = False
+def ending(seconds: float = ENDING_SECONDS) -> None:
+    """A handler calls this first: the process is being ended, and the backstop now ends it ``seconds``
+    from now should the handler itself get stuck (a write that blocks on what the hung call holds)."""
+    global _ENDING
+    with _COND:
+        _ENDING = True
+        _backstop_in(seconds)
 
 
 def kill_descendants() -> int:
@@ -351,16 +363,16 @@ def end_process(status: int) -> None:
 def _after_fork_in_child() -> None:
     """A forked child (a process pool of a convergence study) runs none of its parent's limits, handlers or
     scopes, and has no watchdog thread or backstop timer of its own yet."""
-    global _COND, _THREAD, _BACKSTOP_ARMED
+    global _COND, _THREAD, _BACKSTOP_ARMED, _ENDING
     _LIMITS.clear()
     _HANDLERS.clear()
     _FRAMES.clear()
-    _COND, _THREAD, _BACKSTOP_ARMED = threading.Condition(), None, False
+    _COND, _THREAD, _BACKSTOP_ARMED, _ENDING = threading.Condition(), None, False, False
 
 
 if hasattr(os, "register_at_fork"):
     os.register_at_fork(after_in_child=_after_fork_in_child)
 
 
-__all__ = ["Hang", "grace", "limit", "on_hang", "scope", "finished", "collected", "hang_report", "disarm",
+__all__ = ["Hang", "grace", "limit", "on_hang", "scope", "finished", "collected", "hang_report", "ending",
            "kill_descendants", "end_process", "GRACE_MIN", "GRACE_FRACTION", "HANG_DETAIL", "UNIT_CHECK"]
