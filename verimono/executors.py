@@ -21,6 +21,10 @@ A unit never takes the run down with it: a unit that raises, whose worker dies, 
 the records of every other unit are kept.  With ``process:N`` the unit a dying worker was running is known
 exactly (each worker runs one unit at a time) and a fresh worker replaces it; on dask a unit that kills
 workers is reported once the scheduler gives up on it (``KilledWorker``, after its ``allowed-failures``).
+A ``process:N`` worker whose unit is blocked in native code past its time budget, which the budget's
+interrupt cannot stop, answers for it before it exits (:mod:`verimono.watchdog`): the records the unit
+finished and a failed record naming the hung call.  The explicit budget of the sending process
+(``--timeout``) applies on the workers too.
 """
 
 from __future__ import annotations
