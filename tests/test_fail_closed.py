@@ -437,17 +437,16 @@ def test_a_document_over_the_size_limit_exits_2(tmp_path, capsys, monkeypatch):
 
 
 @pytest.mark.parametrize("flag, value, reason", [
-    ("--timeout", "inf", "finite budget"),
-    ("--timeout", "nan", "finite number of seconds > 0"),
-    ("--timeout", "-1", "finite number of seconds > 0"),
-    ("--timeout", "0", "finite number of seconds > 0"),
-    ("--unit-timeout", "-1", "finite number of seconds > 0"),
-    ("--unit-timeout", "nan", "finite number of seconds > 0"),
-    ("--unit-timeout", "inf", "finite budget"),
+    ("--timeout", "nan", "number of seconds > 0"),
+    ("--timeout", "-1", "number of seconds > 0"),
+    ("--timeout", "0", "number of seconds > 0"),
+    ("--timeout", "1e999", "overflows to infinity"),
+    ("--unit-timeout", "-1", "number of seconds > 0"),
+    ("--unit-timeout", "nan", "number of seconds > 0"),
 ])
 def test_time_budgets_are_validated_before_any_work(tmp_path, capsys, flag, value, reason):
-    """``--timeout inf`` was refused as "must be > 0, got inf", ``--unit-timeout -1`` failed a correct
-    stepper, ``--unit-timeout nan`` ran with no bound: each is now refused up front, exit 2."""
+    """``--unit-timeout -1`` failed a correct stepper, ``--unit-timeout nan`` ran with no bound: each is
+    now refused up front, exit 2 (``inf`` is no limit: tests/test_native_hang.py)."""
     with pytest.raises(SystemExit) as info:
         main(["run", *ONE_REF, "--out", str(tmp_path / "o"), flag, value])
     err = capsys.readouterr().err

@@ -357,11 +357,11 @@ LAYERS = (
                   "verimono.qp", "verimono.prox", "verimono.stepping", "verimono.claims", "verimono.convergence",
                   "verimono.pseudo_distance", "verimono.lcs", "verimono.reference", "verimono.strategies",
                   "verimono.manufactured", "verimono.data")),
-    ("records", ("verimono.schema", "verimono.results", "verimono.timeouts", "verimono.calibration",
-                 "verimono.timing")),
-    ("checks", ("verimono.checks", "verimono.performance")),
-    ("runs", ("verimono.executors", "verimono.stages", "verimono.runs", "verimono.gate", "verimono.report",
-              "verimono.progress")),
+    ("records", ("verimono.schema", "verimono.results", "verimono.timeouts", "verimono.watchdog",
+                 "verimono.calibration", "verimono.timing")),
+    # the executors need only records and below; a battery runs on them (check_stepper(executor="process:N"))
+    ("checks", ("verimono.checks", "verimono.performance", "verimono.executors")),
+    ("runs", ("verimono.stages", "verimono.runs", "verimono.gate", "verimono.report", "verimono.progress")),
     ("entry points", ("verimono.cli", "verimono.plugin", "verimono.testing", "verimono.targets",
                       "verimono.properties", "verimono")),
 )

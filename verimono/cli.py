@@ -13,9 +13,13 @@
         and completes it (it names the run id it continues; the result records it in ``meta.resumed_from``).
         ``--timeout S``: seconds per unit of work (one law on one operator, one check of one stepper;
         default: the profile's), beyond which the unit is stopped and recorded as failed.  ``--timeout`` and
-        ``--unit-timeout`` must be finite numbers of seconds > 0, checked before any work (exit 2
-        otherwise): ``inf`` is refused, every unit has a bound so that a subject that hangs cannot hang
-        the run — give a large number for a generous budget.
+        ``--unit-timeout`` are numbers of seconds > 0 or ``inf`` (no limit), checked before any work (exit 2
+        otherwise: ``nan``, 0, negatives).  A call blocked in native code (``os.system``, a C extension),
+        which the budget's interrupt cannot stop, is stopped by a process-level limit (``verimono.watchdog``)
+        once the budget and a grace of max(2 s, half the budget) are over: under ``--executor process:N``
+        its worker answers a failed record naming the call and is replaced, and the run goes on; in this
+        process (``--executor serial``) the run ends — the finished stages and a failed record for the call
+        are written marked incomplete, one line names the call, its time and the file — with exit 1.
         Before any work the run marks DIR/results.json in progress (``results.json.in-progress``, with its
         run id) and removes the mark once its pair is written: files beside a mark that stays (a run killed,
         or stopped by an error) are not that run's, and the gate refuses them (exit 2).  When the pair
@@ -42,7 +46,6 @@ Exit status 2 always means "could not decide" (bad usage, unreadable input); it 
 from __future__ import annotations
 
 import argparse
-import math
 import os
 import shlex
 import sys
@@ -167,17 +170,17 @@ def _start(out: Path, command: str, resumes: str | None = None) -> str:
 
 
 def _seconds(text: str) -> float:
-    """``--timeout`` / ``--unit-timeout``: a finite number of seconds > 0 (``inf`` is refused: every unit
-    keeps a bound, so that a subject that hangs cannot hang the run)."""
+    """``--timeout`` / ``--unit-timeout``: a number of seconds > 0, or ``inf`` for no limit (``nan``, 0 and
+    negatives are refused before any work, exit 2)."""
     try:
         seconds = float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a number of seconds > 0, got {text!r}") from None
-    if seconds == math.inf:
-        raise argparse.ArgumentTypeError(f"got {text!r}, but every unit needs a finite budget (so that a subject "
-                                         "that hangs cannot hang the run); give a large number of seconds instead")
-    if not (math.isfinite(seconds) and seconds > 0):
-        raise argparse.ArgumentTypeError(f"must be a finite number of seconds > 0, got {text!r}")
+        raise argparse.ArgumentTypeError(f"must be a number of seconds > 0 (or inf: no limit), got {text!r}") from None
+    if not seconds > 0:          # nan compares false
+        raise argparse.ArgumentTypeError(f"must be a number of seconds > 0 (or inf: no limit), got {text!r}")
+    if seconds == float("inf") and text.strip().lower().lstrip("+") not in ("inf", "infinity"):
+        raise argparse.ArgumentTypeError(f"{text!r} overflows to infinity: write inf for no limit, or a number of "
+                                         "seconds")
     return seconds
 
 
@@ -330,8 +333,12 @@ def _cmd_baseline(args: argparse.Namespace) -> int:
             raise NothingToResume(f"{args.from_results} is an interrupted run (marked incomplete): finish it "
                                   "with `verimono run --resume` before recording it as a baseline")
     else:
-        report = execute(command="run", profile_name=args.profile, stages=args.stage, context=_context(args),
-                         progress=Progress(), **_executor_options(args))
+        from .timeouts import budget
+        from .watchdog import on_hang
+
+        with budget(args.timeout), on_hang(_baseline_hang):
+            report = execute(command="run", profile_name=args.profile, stages=args.stage, context=_context(args),
+                             progress=Progress(), **_executor_options(args))
     report.trajectories = []  # plot samples only: the gate never reads them, and they are half the size
     try:
         path = report.save(args.out)
@@ -350,6 +357,18 @@ def _cmd_baseline(args: argparse.Namespace) -> int:
         print("verimono: warning: the baseline records failing checks; the gate will only catch new ones",
               file=sys.stderr)
     return EXIT_OK
+
+
+def _baseline_hang(hang: Any) -> None:
+    """``verimono baseline``: a call blocked in native code in this process ends it (nothing is written)."""
+    from .runs import ISOLATE_ADVICE
+    from .watchdog import end_process, ending
+
+    ending()
+    print(f"\nverimono baseline: {hang.call} is blocked in native code ({hang.where or 'where unknown'}): still "
+          f"running {hang.elapsed:.1f} s after it started, past its time budget of {hang.budget:g} s; no baseline "
+          f"written; {ISOLATE_ADVICE}", file=sys.stderr)
+    end_process(EXIT_FAILED)
 
 
 def _cmd_gate(args: argparse.Namespace) -> int:
@@ -404,14 +423,14 @@ def build_parser() -> argparse.ArgumentParser:
                        help="use only this analytic reference (repeatable; default: the whole catalog)")
         p.add_argument("--timeout", type=_seconds, default=None, metavar="S",
                        help="seconds per unit of work (one law on one operator, one check of one stepper) "
-                            "before it is stopped and recorded as failed (default: the profile's)")
+                            "before it is stopped and recorded as failed (default: the profile's; inf: no limit)")
         p.add_argument("--executor", default=None, metavar="SPEC",
                        help="where the stages' independent units run: serial, auto (every core, at most 4 "
                             "worker processes; the default, $VERIMONO_EXECUTOR overrides), process:N (N "
                             "worker processes), or a dask.distributed scheduler address such as tcp://host:8786")
         p.add_argument("--unit-timeout", type=_seconds, default=None, metavar="SECONDS",
                        help="with --executor: a stage unit (a subject's battery) still running after this long "
-                            "becomes a failed record")
+                            "becomes a failed record (inf: no limit)")
 
     run = sub.add_parser("run", help="run the whole verification and write the report")
     run_options(run)

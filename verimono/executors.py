@@ -22,6 +22,10 @@ A unit never takes the run down with it: a unit that raises, whose worker dies, 
 the records of every other unit are kept.  With ``process:N`` the unit a dying worker was running is known
 exactly (each worker runs one unit at a time) and a fresh worker replaces it; on dask a unit that kills
 workers is reported once the scheduler gives up on it (``KilledWorker``, after its ``allowed-failures``).
+A ``process:N`` worker whose unit is blocked in native code past its time budget, which the budget's
+interrupt cannot stop, answers for it before it exits (:mod:`verimono.watchdog`): the records the unit
+finished and a failed record naming the hung call.  The explicit budget of the sending process
+(``--timeout``) applies on the workers too.
 """
 
 from __future__ import annotations
@@ -36,14 +40,15 @@ from collections import deque
 from multiprocessing.connection import wait as _wait
 from typing import Any, Callable, Sequence
 
+from . import watchdog
 from .calibration import calibration, set_calibration
 from .errors import BadExecutor
 from .profiles import load_hypothesis_profile
 from .results import FAILED, CheckResult, Report
-from .timeouts import budget, explicit_budget
+from .timeouts import budget, explicit_budget, unlimited
 
 #: the check name of the record that stands for a unit that crashed, died or timed out
-UNIT_CHECK = "unit"
+UNIT_CHECK = watchdog.UNIT_CHECK
 
 
 @dataclasses.dataclass
@@ -81,19 +86,22 @@ def _prepare_worker(profile: str | None) -> None:
 
 
 def run_payload(payload: bytes) -> bytes:
-    """Run one shipped unit: ``payload`` is ``cloudpickle.dumps((profile, fn, args, limits))`` (``limits``: the
-    run's explicit unit budget and calibration, :func:`_limits`); the answer is ``cloudpickle.dumps(("ok",
-    report))`` or ``("error", message, traceback)`` — never an exception, so a unit's own error is told apart
-    from the worker's death."""
+    """Run one shipped unit: ``payload`` is ``cloudpickle.dumps((profile, fn, args, limits, stage, label))``
+    (``limits``: the sending process's explicit unit budget, :func:`verimono.timeouts.explicit_budget`, and its
+    calibration, the unit of the profile's budgets — :func:`_limits` — applied here too, so a worker's budgets
+    are the run's); the answer is ``cloudpickle.dumps(("ok", report))`` or ``("error", message,
+    traceback)`` — never an exception, so a unit's own error is told apart from the worker's death.  (A
+    ``process:N`` worker whose unit blocks in native code answers ``("hang", report)`` instead and exits:
+    :func:`_process_worker`.)"""
     import cloudpickle
 
     start = time.perf_counter()
     try:
-        profile, fn, args, limits = cloudpickle.loads(payload)
+        profile, fn, args, limits, stage, label = cloudpickle.loads(payload)
         _prepare_worker(profile)
         if limits.get("calibration"):
             set_calibration(limits["calibration"])
-        with budget(limits.get("budget")):
+        with watchdog.scope(stage=stage, label=label), budget(limits.get("budget")):
             out = fn(*args)
         if not isinstance(out, Report):
             raise TypeError(f"a unit returned {type(out).__name__}, expected a verimono.Report")
@@ -104,35 +112,77 @@ def run_payload(payload: bytes) -> bytes:
 
 
 def _decode(unit: Unit, answer: bytes) -> Report:
+    return _decode_answer(unit, answer)[0]
+
+
+def _decode_answer(unit: Unit, answer: bytes) -> tuple[Report, bool]:
+    """The report an answer stands for, and whether its worker has ended (a unit blocked in native code:
+    the records it finished and the failed record of the hung call)."""
     import cloudpickle
 
     try:
         out = cloudpickle.loads(answer)
     except Exception as exc:
-        return unit_failure(unit, f"its result could not be read back ({type(exc).__name__}: {exc})")
+        return unit_failure(unit, f"its result could not be read back ({type(exc).__name__}: {exc})"), False
     if out[0] == "ok":
-        return out[1]
-    return unit_failure(unit, f"raised {out[1]}", traceback_text=out[2], duration=out[3])
+        return out[1], False
+    if out[0] == "hang":
+        return out[1], True
+    return unit_failure(unit, f"raised {out[1]}", traceback_text=out[2], duration=out[3]), False
 
 
 #: seconds a new worker process may take to import verimono and say it is ready
 WORKER_START_TIMEOUT = 300.0
 
 
+#: exit status of a worker that ended itself on a unit blocked in native code (after answering for it)
+HANG_EXIT = 3
+
+
 def _process_worker(conn: Any) -> None:
     """Loop of a ``process:N`` worker: say ``ready`` once verimono is imported (so a unit's timeout does
-    not count the worker's start), then receive a payload and answer, until an empty message."""
+    not count the worker's start), then receive a payload and answer, until an empty message.
+
+    A call of the unit blocked in native code past its time budget (:mod:`verimono.watchdog`) cannot be
+    interrupted: the watchdog thread answers for the unit instead — ``("hang", report)``, the records the
+    unit finished and the failed record of the hung call — ends the call's child processes and exits
+    (status :data:`HANG_EXIT`); the parent replaces the worker.  One answer per payload, whichever comes
+    first (``lock``)."""
+    import threading
+
+    import cloudpickle
     import scipy.stats  # noqa: F401  (with numpy and verimono, imported here: what every unit needs)
 
+    # spawn passed the connection as an inheritable descriptor: a child process of the unit's (os.system)
+    # would hold it open, and the parent would not see this worker's end until that child's
+    os.set_inheritable(conn.fileno(), False)
+    lock, state = threading.Lock(), {"busy": False}
+
+    def on_hang(hang: watchdog.Hang) -> None:
+        with lock:
+            if not state["busy"]:     # pragma: no cover - the unit returned meanwhile: nothing to answer
+                return
+            watchdog.ending()
+            try:
+                conn.send_bytes(cloudpickle.dumps(("hang", watchdog.hang_report(hang))))
+            except Exception:  # noqa: BLE001 - the parent then sees a dead worker, which it reports too
+                pass
+            watchdog.end_process(HANG_EXIT)
+
     conn.send_bytes(b"ready")
-    while True:
-        try:
-            payload = conn.recv_bytes()
-        except (EOFError, OSError):
-            return
-        if not payload:
-            return
-        conn.send_bytes(run_payload(payload))
+    with watchdog.on_hang(on_hang):
+        while True:
+            try:
+                payload = conn.recv_bytes()
+            except (EOFError, OSError):
+                return
+            if not payload:
+                return
+            state["busy"] = True
+            answer = run_payload(payload)
+            with lock:
+                state["busy"] = False
+                conn.send_bytes(answer)
 
 
 def _limits() -> dict[str, float | None]:
@@ -145,7 +195,7 @@ def _ship(unit: Unit, profile: str | None) -> bytes:
     import cloudpickle
 
     _register_targets_by_value()
-    return cloudpickle.dumps((profile, unit.fn, unit.args, _limits()))
+    return cloudpickle.dumps((profile, unit.fn, unit.args, _limits(), unit.stage, unit.label))
 
 
 def _register_targets_by_value() -> None:
@@ -222,13 +272,15 @@ class SerialRunner:
             progress(i, len(units), u.label)
             start = time.perf_counter()
             try:
-                rep = u.fn(*u.args)
+                with watchdog.scope(stage=u.stage, label=u.label):   # named should it block in native code
+                    rep = u.fn(*u.args)
                 if not isinstance(rep, Report):
                     raise TypeError(f"a unit returned {type(rep).__name__}, expected a verimono.Report")
             except Exception as exc:
                 rep = unit_failure(u, f"raised {type(exc).__name__}: {exc}",
                                    traceback_text=traceback.format_exc(limit=8),
                                    duration=time.perf_counter() - start)
+            watchdog.finished(rep)
             out.append(rep)
         progress(len(units), len(units), "")
         return out
@@ -361,7 +413,10 @@ class ProcessRunner:
                         self._stop(worker, kill=True)
                         worker = replace(worker)
                     else:
-                        results[i] = _decode(units[i], answer)
+                        results[i], ended = _decode_answer(units[i], answer)
+                        if ended:          # it answered for a unit blocked in native code, and exits
+                            self._stop(worker, kill=False)
+                            worker = replace(worker)
                     done += 1
                     idle.append(worker)
                     progress(done, len(units), units[i].label)
@@ -488,7 +543,9 @@ AUTO_MAX_WORKERS = 4
 def make_runner(spec: Any = None, *, timeout: float | None = None) -> Any:
     """A runner for ``spec``: ``None``/``"serial"``, ``"auto"`` (``process:N`` with ``N`` this machine's cores,
     at most :data:`AUTO_MAX_WORKERS`; serial on one core), ``"process:N"``, a ``scheme://address`` of a dask
-    scheduler, or a ``distributed.Client``; :class:`BadExecutor` for anything else."""
+    scheduler, or a ``distributed.Client``; :class:`BadExecutor` for anything else.  ``timeout``: seconds a
+    unit may run on a worker (``None`` or ``inf``: no limit)."""
+    timeout = None if unlimited(timeout) else timeout
     if spec is None or spec == "serial":
         return SerialRunner()
     if isinstance(spec, str):

@@ -2,8 +2,9 @@
 
 :func:`execute` runs stages with a context and returns the merged, annotated report (the run's facts in
 ``report.meta``: command, profile, seed, selection, executor, calibration, duration, environment);
-:func:`interruptible` turns an interrupt (Ctrl-C, SIGTERM) into a results file of the finished stages
-marked incomplete; :func:`merge_resumed` completes such a run.  The command line
+:func:`interruptible` turns an interrupt (Ctrl-C, SIGTERM) — or a call of the subject blocked in native code
+past its time budget, which no interrupt can stop (:mod:`verimono.watchdog`) — into a results file of the
+finished stages marked incomplete; :func:`merge_resumed` completes such a run.  The command line
 (:mod:`verimono.cli`) is a thin layer over these.
 """
 
@@ -14,6 +15,7 @@ import time
 from pathlib import Path
 from typing import Any, Callable
 
+from . import watchdog
 from .environment import environment
 from .executors import make_runner
 from .profiles import get_profile, load_hypothesis_profile
@@ -100,6 +102,12 @@ def exit_status(report: Report) -> int:
 
 #: exit status of an interrupted run (the shell's convention for SIGINT)
 EXIT_INTERRUPTED = 130
+#: ``details`` key of a record of a stage that did not finish (written with a native hang; a resumed run
+#: runs that stage again, so :func:`merge_resumed` drops them)
+UNFINISHED_STAGE = "unfinished_stage"
+#: what isolates a subject that blocks in native code (printed when a serial run has to end on one)
+ISOLATE_ADVICE = ("`--executor process:N` runs each unit in a worker process, so that such a call ends its worker "
+                  "only (a failed record) and the run goes on")
 
 
 def interruptible(run: Callable[[Callable], Report], out: Path, *, command: str, profile: str,
@@ -108,21 +116,26 @@ def interruptible(run: Callable[[Callable], Report], out: Path, *, command: str,
     """``run(on_done)`` with SIGTERM treated as an interrupt; on an interrupt write the stages finished so
     far (with ``previous``'s, when resuming) to ``out`` marked ``incomplete`` (as the run ``run_id``) and
     return the exit status.  ``advice``: how to go on, printed after the interrupt (default: ``verimono
-    run --resume``, which only ``run`` has)."""
+    run --resume``, which only ``run`` has).
+
+    A call of the subject blocked in native code in this process (the serial executor), which no interrupt
+    reaches, ends the process from :mod:`verimono.watchdog`'s thread once its budget and grace are over:
+    the same file, plus the records the current stage finished (``details["unfinished_stage"]``) and a
+    failed record naming the hung call, one line naming the call, its time, the file and
+    :data:`ISOLATE_ADVICE`, and exit status 1 (:data:`EXIT_FAILED`: a call that does not return is a failure
+    of the subject).  Only here — a command of verimono's — is the process ended on a native hang; the Python
+    API leaves the user's interpreter running (:mod:`verimono.watchdog`)."""
     import signal
 
     finished: list[tuple[Report, dict]] = []
+    stage_scope: list = []
 
     def on_done(stage, rep, info):
         finished.append((rep, info))
+        if stage_scope and stage_scope[0] is not None:
+            stage_scope[0].items.clear()        # the scope keeps only the current stage's finished units
 
-    def term(signum, frame):
-        raise KeyboardInterrupt(f"signal {signum}")
-
-    old = signal.signal(signal.SIGTERM, term) if _main_thread() else None
-    try:
-        return run(on_done)
-    except KeyboardInterrupt:
+    def partial_report() -> tuple[Report, list[str]]:
         partial = previous if previous is not None else Report(meta={"stages": []})
         for rep, info in finished:
             partial.extend(rep)
@@ -133,7 +146,40 @@ def interruptible(run: Callable[[Callable], Report], out: Path, *, command: str,
                              "selection": partial.meta.get("selection") or {"stages": stages, "references": None}})
         if previous is not None and previous.meta.get("run_id"):
             partial.meta["resumed_from"] = previous.meta["run_id"]
+        return partial, done
 
+    def on_hang(hang: watchdog.Hang) -> None:
+        watchdog.ending()
+        try:
+            partial, done = partial_report()
+            current = watchdog.hang_report(hang)
+            for rec in current.results:
+                rec.details[UNFINISHED_STAGE] = True
+            partial.results.extend(current.results)      # their studies stay in each record's details
+            partial.meta["native_hang"] = {"call": hang.call, "budget": hang.budget, "elapsed": hang.elapsed,
+                                           "where": hang.where, "grace": watchdog.grace(hang.budget)}
+            try:
+                where = str(write(partial, out, run_id=run_id)["json"])
+            except Exception as exc:  # noqa: BLE001 - the process ends either way; say what was lost
+                where = f"no file ({type(exc).__name__}: {exc})"
+            print(f"\nverimono: {hang.call} is blocked in native code ({hang.where or 'where unknown'}): still "
+                  f"running {hang.elapsed:.1f} s after it started, past its time budget of {hang.budget:g} s; "
+                  f"ended the run. The {len(done)} finished stage(s) ({', '.join(done) or 'none'}), the "
+                  f"{len(current) - 1} record(s) the current stage finished and a failed record for the hung call "
+                  f"are in {where}, marked incomplete; {ISOLATE_ADVICE}", file=sys.stderr)
+        finally:
+            watchdog.end_process(EXIT_FAILED)
+
+    def term(signum, frame):
+        raise KeyboardInterrupt(f"signal {signum}")
+
+    old = signal.signal(signal.SIGTERM, term) if _main_thread() else None
+    try:
+        with watchdog.scope() as root, watchdog.on_hang(on_hang):
+            stage_scope.append(root)
+            return run(on_done)
+    except KeyboardInterrupt:
+        partial, done = partial_report()
         paths = write(partial, out, run_id=run_id)
         print(f"\nverimono: interrupted; the {len(done)} finished stage(s) ({', '.join(done) or 'none'}) are in "
               f"{paths['json']}, marked incomplete; "
@@ -154,16 +200,18 @@ def merge_resumed(previous: Report, rest: Report) -> Report:
     """The interrupted run's finished stages followed by the resumed ones: one complete report
     (``meta.resumed_from``: the run id of the interrupted run it continues)."""
     merged = Report(meta=dict(rest.meta))
-    merged.extend(previous)
+    finished = Report([r for r in previous.results if not r.details.get(UNFINISHED_STAGE)],
+                      studies=previous.studies, trajectories=previous.trajectories)
+    merged.extend(finished)
     merged.extend(rest)
     merged.meta["stages"] = list(previous.meta.get("stages") or []) + list(rest.meta.get("stages") or [])
     merged.meta["selection"] = previous.meta.get("selection")
     merged.meta["resumed"] = True
     merged.meta["resumed_from"] = previous.meta.get("run_id")
-    for key in ("incomplete", "finished_stages"):
+    for key in ("incomplete", "finished_stages", "native_hang"):
         merged.meta.pop(key, None)
     return merged
 
 
 __all__ = ["execute", "exit_status", "interruptible", "merge_resumed", "EXIT_OK", "EXIT_FAILED", "EXIT_UNDECIDED",
-           "EXIT_INTERRUPTED"]
+           "EXIT_INTERRUPTED", "UNFINISHED_STAGE", "ISOLATE_ADVICE"]

@@ -1,7 +1,8 @@
 """Time budgets for units of work: a resolvent or stepper that never returns must not hang a run.
 
 A *unit* is one law on one operator, or one check of one stepper.  Its budget is, in order: the innermost
-:func:`budget` block, in seconds (``verimono run/check --timeout S`` opens one around the whole run), else
+:func:`budget` block, in seconds (``verimono run/check --timeout S`` opens one around the whole run, and the
+run's worker processes apply it too; ``inf``: no limit), else
 the active profile's ``unit_budget`` (:mod:`verimono.profiles`), stated in *calibration units*: multiples of
 :func:`verimono.calibration.calibrate`, a fixed NumPy-and-Python workload.  In seconds that is ``units x`` the
 calibration measured in this process (:func:`calibration`: measured once, best of 3, about 0.2 s, then
@@ -19,9 +20,16 @@ operator laws' search bounds itself the same way, :mod:`verimono.checks.search`.
 
 The interrupt is raised as an internal ``BaseException`` while it travels through the unit's code, so a
 check's own ``except Exception`` (which turns an operator's error into a failed sample) or hypothesis'
-shrinking cannot swallow or replay it.  Limits: only in the main thread of a POSIX process (elsewhere the
-unit runs unbounded, which the record says), and code blocked inside one long C call is interrupted only
-when it returns to Python.
+shrinking cannot swallow or replay it.  The timer works only in the main thread of a POSIX process
+(elsewhere the unit runs unbounded, which the record says).
+
+A call blocked in native code (``os.system``, a C extension that retries after the signal) runs the
+interrupt only once it returns.  Every armed limit is therefore also watched by :mod:`verimono.watchdog`, a
+process-level limit: a call still inside its limit a grace of ``max(2 s, half the budget)`` after the
+deadline is blocked there, and the process is ended where verimono owns it — a ``process:N`` worker answers
+a failed record naming the call and exits (the run goes on), a serial ``verimono check``/``run`` writes what
+finished, marked incomplete, and exits 1 — while the Python API, in the user's interpreter, warns and waits
+for the call (bounded only with ``check_stepper(..., executor="process:N")``, :mod:`verimono.checks.isolated`).
 """
 
 from __future__ import annotations
@@ -37,6 +45,7 @@ from .errors import InvalidCheckArgument, UnitTimeout
 from . import calibration as _calibration
 from .profiles import Profile, UnknownProfile, active_profile, get_profile
 from .results import FAILED, UNDECIDED, CheckResult
+from . import watchdog
 
 _OVERRIDE: list[float | None] = []
 #: ``details["undecided_reason"]`` of a law stopped by its budget after samples that all held
@@ -51,20 +60,27 @@ class _Expired(BaseException):
 
 
 def _positive(seconds: float | None, what: str = "timeout") -> float | None:
+    """``seconds`` as a float > 0 (``inf``: no limit); ``nan``, 0, negatives and non-numbers are refused."""
     if seconds is None:
         return None
     try:
         s = float(seconds)
     except (TypeError, ValueError):
-        raise InvalidCheckArgument(f"{what} must be a number of seconds > 0, got {seconds!r}") from None
-    if not (s > 0 and math.isfinite(s)):
-        raise InvalidCheckArgument(f"{what} must be a number of seconds > 0, got {seconds!r}")
+        raise InvalidCheckArgument(f"{what} must be a number of seconds > 0 (or inf), got {seconds!r}") from None
+    if not s > 0:     # nan compares false
+        raise InvalidCheckArgument(f"{what} must be a number of seconds > 0 (or inf), got {seconds!r}")
     return s
+
+
+def unlimited(seconds: float | None) -> bool:
+    """Whether a budget of ``seconds`` is no limit at all (``None`` or ``inf``)."""
+    return seconds is None or math.isinf(seconds)
 
 
 @contextmanager
 def budget(seconds: float | None) -> Iterator[None]:
-    """Within the block, every unit's budget is ``seconds`` (``None``: back to the profile default)."""
+    """Within the block, every unit's budget is ``seconds`` (``None``: back to the profile default;
+    ``math.inf``: no limit, as ``--timeout inf``)."""
     _OVERRIDE.append(_positive(seconds))
     try:
         yield
@@ -73,8 +89,8 @@ def budget(seconds: float | None) -> Iterator[None]:
 
 
 def explicit_budget() -> float | None:
-    """The seconds of the innermost :func:`budget` block (``--timeout``), ``None`` outside one: what a unit
-    shipped to a worker process carries with it (:mod:`verimono.executors`)."""
+    """The seconds of the innermost :func:`budget` block, ``None`` outside one (or in a ``budget(None)``): what a
+    worker process must apply to run a unit as this process would (:mod:`verimono.executors`)."""
     return _OVERRIDE[-1] if _OVERRIDE else None
 
 
@@ -138,10 +154,12 @@ def time_limit(seconds: float | None, unit: str) -> Iterator[None]:
     """Run the block for at most ``seconds``; :class:`UnitTimeout` naming ``unit`` when it takes longer.
 
     Nested limits keep the tighter one: an outer limit that expires first still fires (as the outer
-    unit's timeout).  ``seconds=None`` or an unsupported context (:func:`supported`) runs unbounded.
+    unit's timeout).  ``seconds=None``, ``inf`` or an unsupported context (:func:`supported`) runs unbounded.
+    Each armed limit is also watched by :mod:`verimono.watchdog`: a block still running :func:`verimono.
+    watchdog.grace` seconds after the deadline is blocked in native code, where the timer cannot reach it.
     """
     seconds = _positive(seconds)
-    if seconds is None or not supported():
+    if unlimited(seconds) or not supported():
         yield
         return
     start = time.perf_counter()
@@ -157,7 +175,8 @@ def time_limit(seconds: float | None, unit: str) -> Iterator[None]:
     previous = signal.signal(signal.SIGALRM, fire)
     signal.setitimer(signal.ITIMER_REAL, seconds)
     try:
-        yield
+        with watchdog.limit(seconds, unit):
+            yield
     except _Expired as exc:
         if exc.args and exc.args[0] is token:
             elapsed = time.perf_counter() - start
@@ -202,14 +221,23 @@ def run_unit(fn: Callable[[], object], *, check: str, subject: str, seconds: flo
     :class:`verimono.CheckResult` ``check[subject]`` naming the unit and the elapsed time: *undecided*
     (``details["undecided_reason"] == "time budget"``) when the law inside stated, through
     :func:`note_progress`, that everything it evaluated before held; *failed* otherwise — a subject whose
-    first call never returns, or a law that had already seen a violation."""
+    first call never returns, or a law that had already seen a violation.
 
+    A call blocked in native code, which the timer cannot stop, is left to :mod:`verimono.watchdog`; the
+    outcome is passed to :func:`verimono.watchdog.finished`, so that a process ended on such a call later
+    still writes this record."""
+    out = _run_unit(fn, check=check, subject=subject, seconds=seconds)
+    watchdog.finished(out)
+    return out
+
+
+def _run_unit(fn: Callable[[], object], *, check: str, subject: str, seconds: float | None):
     limit = current_budget() if seconds is None else seconds
     start = time.perf_counter()
     progress: dict = {"at": start}
     _PROGRESS.append(progress)
     try:
-        with time_limit(limit, f"{check} on {subject}"):
+        with watchdog.scope(check=check, subject=subject), time_limit(limit, f"{check} on {subject}"):
             return fn()
     except UnitTimeout as exc:
         elapsed = time.perf_counter() - start
@@ -238,5 +266,5 @@ def run_unit(fn: Callable[[], object], *, check: str, subject: str, seconds: flo
         _PROGRESS.pop()
 
 
-__all__ = ["budget", "explicit_budget", "current_budget", "budget_source", "stage_budget", "calibration", "in_seconds", "time_limit",
-           "run_unit", "note_progress", "never_returned", "supported", "TIME_BUDGET_REASON", "HANG_MULTIPLE"]
+__all__ = ["budget", "current_budget", "budget_source", "stage_budget", "calibration", "in_seconds", "time_limit",
+           "run_unit", "note_progress", "never_returned", "supported", "explicit_budget", "unlimited", "TIME_BUDGET_REASON", "HANG_MULTIPLE"]

@@ -9,9 +9,13 @@ from __future__ import annotations
 import functools
 from typing import Any, Callable, Iterator
 
+from .. import watchdog
+from ..errors import InvalidCheckArgument
+from ..executors import Unit
 from ..results import Report
 from . import operator_laws, prox_laws  # noqa: F401 - the laws join the registry on import
 from .core import Law, laws_of, subject_name
+from .isolated import isolating, run_isolated
 from .search import default_examples, fresh_seed, positive_examples, valid_horizon, valid_seed
 from .subjects import require_operator
 
@@ -31,13 +35,20 @@ def operator_checks(op: Any = None, *, seed: int | None = None, examples: int | 
 
 
 def check_operator(op: Any, *, seed: int | None = None, examples: int | None = None,
-                   horizon: float = 1.0) -> Report:
+                   horizon: float = 1.0, executor: str | None = None) -> Report:
     """Run every operator law on ``op`` and return the :class:`verimono.Report` of their records.
 
     ``seed`` makes the search reproducible (one fresh seed is drawn and recorded when ``None``);
     ``examples`` is the effort per law (default: the active profile's ``law_examples``); times are sampled
     in ``[0, horizon]``.  What is not an operator is refused before any law runs
-    (:class:`verimono.InvalidCheckArgument`, naming the wrapper that makes one)."""
+    (:class:`verimono.InvalidCheckArgument`, naming the wrapper that makes one).
+
+    Every call of the resolvent runs under the unit time budget (:mod:`verimono.timeouts`).  A resolvent
+    blocked in native code, which the budget's interrupt cannot stop, is bounded only with
+    ``executor="process:N"``: the battery then runs in a worker process (one: its laws share what the
+    root-cause probe learnt, :mod:`verimono.checks.isolated`), which such a call ends — the records of the
+    laws finished before it and a failed record naming it.  In this process verimono never ends the
+    interpreter on such a call: it warns once and waits for it to return (:mod:`verimono.watchdog`)."""
     require_operator(op)
     seed = fresh_seed() if seed is None else valid_seed(seed)
     if examples is None:
@@ -47,9 +58,21 @@ def check_operator(op: Any, *, seed: int | None = None, examples: int | None = N
     horizon = valid_horizon(horizon)
     report = Report(meta={"subject": subject_name(op), "seed": seed, "examples": examples, "horizon": horizon,
                           **({"profile": profile} if profile else {})})
+    if isolating(executor):
+        (done,) = run_isolated(executor, [Unit("check_operator", subject_name(op), _battery,
+                                               (op, seed, examples, horizon))], op)
+        report.results.extend(done.results)
+        return report
+    if executor not in (None, "serial"):
+        raise InvalidCheckArgument(f"check_operator: executor must be None, 'serial' or 'process:N', got {executor!r}")
     for _, check in operator_checks(op, seed=seed, examples=examples, horizon=horizon):
-        report.add(check(op))
+        watchdog.finished(report.add(check(op)))    # kept should a later law block in native code
     return report
+
+
+def _battery(op: Any, seed: int, examples: int, horizon: float) -> Report:
+    """The battery in a worker process (``check_operator(..., executor="process:N")``)."""
+    return check_operator(op, seed=seed, examples=examples, horizon=horizon)
 
 
 __all__ = ["LAWS", "OPERATOR_CHECKS", "operator_checks", "check_operator"]

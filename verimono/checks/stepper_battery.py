@@ -19,7 +19,9 @@ from ..results import CheckResult, Report
 from ..timeouts import run_unit
 from . import bounds, limits, picard, trajectory_laws  # noqa: F401 - the laws join the registry on import
 from . import orders as _order_law  # noqa: F401 - convergence_order joins the registry on import
+from ..executors import Unit
 from .core import laws_of, stepper_subject
+from .isolated import isolating, run_check, run_isolated
 from .partitions import single
 from .sample_problems import sample_problems
 from .search import valid_seed
@@ -103,6 +105,15 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
     ``laws=False`` keeps the orders only, a list of law names selects laws, ``orders=False`` keeps the laws
     only.  What is not a stepper, a bad seed or an empty selection is refused before anything runs
     (:class:`verimono.InvalidCheckArgument`).
+
+    Every check runs under the unit time budget (:mod:`verimono.timeouts`).  ``executor`` runs the
+    convergence studies' grids (a ``concurrent.futures`` executor, ``"process"`` or ``"serial"``,
+    :func:`verimono.convergence_study`) — except ``executor="process:N"``: then every check runs in one of
+    ``N`` worker processes (:mod:`verimono.checks.isolated`), the only way the Python API bounds a stepper
+    that blocks in native code (``os.system``, a C extension), which the budget's interrupt cannot stop: its
+    worker ends, the check is a failed record naming the call, and the battery goes on.  In this process
+    verimono never ends the interpreter on such a call: it warns once and waits for it to return
+    (:mod:`verimono.watchdog`).
     """
     require_stepper(stepper)
     if problems is not None:
@@ -111,21 +122,30 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
             raise InvalidCheckArgument("check_stepper was given an empty list of problems: it would verify "
                                        "nothing (pass problems=None for the whole catalog)")
         problems = [require_problem(p) for p in problems]
-    stepper = with_claim(stepper, scheme, order)
+    given, stepper = stepper, with_claim(stepper, scheme, order)
     seed = 0 if seed is None else valid_seed(seed)
     selected = () if laws is False else (LAWS if laws is True else _selected(tuple(laws)))
     if not selected and not orders:
         raise InvalidCheckArgument("check_stepper selected no check (no law, no order): it would verify nothing")
     report = Report()
-    with shared_runs():             # the laws judge the same runs of the stepper: each is made once
-        for name, check in stepper_checks(stepper, problems, seed=seed, generated=generated, laws=selected,
-                                          orders=orders, executor=executor):
-            law, _, problem_name = name.partition("[")
+    isolate = isolating(executor)
+    checks = list(stepper_checks(stepper, problems, seed=seed, generated=generated, laws=selected,
+                                 orders=orders, executor=None if isolate else executor))
+    if isolate:   # every check in a worker process: one blocked in native code ends only its worker
+        units = [Unit("check_stepper", name, run_check,
+                      (check, stepper, name.partition("[")[0], stepper_subject(stepper, name.partition("[")[2][:-1])))
+                 for name, check in checks]
+        records = [rec for rep in run_isolated(executor, units, given) for rec in rep.results]
+    else:
+        with shared_runs():         # the laws judge the same runs of the stepper: each is made once
             # a stepper that never returns: a failed record naming the unit, and the battery goes on
-            rec = run_unit(lambda: check(stepper), check=law, subject=stepper_subject(stepper, problem_name[:-1]))
-            report.add(rec)
-            if rec.study is not None:
-                report.studies.append(rec.study)
+            records = [run_unit(lambda: check(stepper), check=name.partition("[")[0],
+                                subject=stepper_subject(stepper, name.partition("[")[2][:-1]))
+                       for name, check in checks]
+    for rec in records:
+        report.add(rec)
+        if rec.study is not None:
+            report.studies.append(rec.study)
     if not len(report):
         raise InvalidCheckArgument("check_stepper selected no check (no law, no order): it would verify nothing")
     return report
