@@ -337,3 +337,20 @@ def test_the_machine_probe_reports_waiting_and_load():
     lap = probe.lap()
     assert set(lap) == {"cpu_waiting", "foreign_cpu", "loadavg"}
     assert lap["cpu_waiting"] is None or 0.0 <= lap["cpu_waiting"] <= 1.0
+
+
+def test_the_timed_records_do_not_wait_for_the_watchdog_thread():
+    """The performance stage waits for verimono's background threads before timing; the watchdog's never ends
+    (it sleeps between deadlines), and waiting for it cost 60 s per stage once a time limit had started it."""
+    import threading
+
+    from verimono import watchdog
+    from verimono.performance import _quiet_process
+    from verimono.timeouts import supported, time_limit
+
+    if not supported():
+        pytest.skip("the watchdog starts with a time limit, which needs the main thread of a POSIX process")
+    with time_limit(30.0, "a unit"):
+        pass
+    assert any(th.name == watchdog.THREAD_NAME for th in threading.enumerate())
+    assert watchdog.THREAD_NAME not in _quiet_process(timeout=0.05)

@@ -30,6 +30,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from . import watchdog
 from .convergence import convergence_study
 from .grids import uniform_grid
 from .operators import NormalCone, NormSubdifferential
@@ -510,10 +511,12 @@ def _quiet_process(timeout: float = 60.0) -> list[str]:
     """Wait (at most ``timeout`` s each) for this process's own background threads (``verimono-*``, e.g. the
     report's matplotlib warm-up that ``verimono run`` starts beside worker processes) before timing: a thread
     holding the GIL makes the timed code wait off the CPU, which the own-time clock rightly counts — measured,
-    it inflated the first record's rounds 3-5x under ``verimono run --stage performance``."""
+    it inflated the first record's rounds 3-5x under ``verimono run --stage performance``.  The watchdog's thread
+    (:data:`verimono.watchdog.THREAD_NAME`) sleeps between deadlines and never ends: it is not waited for."""
     joined = []
     for th in threading.enumerate():
-        if th is not threading.current_thread() and th.name.startswith("verimono-") and th.is_alive():
+        if (th is not threading.current_thread() and th.name.startswith("verimono-") and th.is_alive()
+                and th.name != watchdog.THREAD_NAME):
             th.join(timeout)
             joined.append(th.name)
     return joined

@@ -56,6 +56,9 @@ from .results import FAILED, CheckResult, Report
 #: ``max(GRACE_MIN, GRACE_FRACTION x budget)``
 GRACE_MIN = 2.0
 GRACE_FRACTION = 0.5
+#: the name of the watchdog's thread: it lives as long as its process, asleep on a condition between deadlines
+#: (no CPU, no GIL), so nothing waits for it to end (:func:`verimono.performance._quiet_process`)
+THREAD_NAME = "verimono-watchdog"
 #: the check name of a record that stands for a unit (as :data:`verimono.executors.UNIT_CHECK`)
 UNIT_CHECK = "unit"
 #: ``details`` key of the failed record of a call blocked in native code
@@ -215,7 +218,7 @@ def limit(seconds: float, call: str) -> Iterator[None]:
     with _COND:
         _LIMITS.append(entry)
         if _THREAD is None or not _THREAD.is_alive():
-            _THREAD = threading.Thread(target=_watch, name="verimono-watchdog", daemon=True)
+            _THREAD = threading.Thread(target=_watch, name=THREAD_NAME, daemon=True)
             _THREAD.start()
         _arm_backstop()
         _COND.notify_all()
