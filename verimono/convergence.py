@@ -140,16 +140,24 @@ def fit_order(h: Sequence[float], e: Sequence[float], floor: float | Sequence[fl
     local = (np.diff(le) / np.diff(lh)).tolist() if len(lh) > 1 else []
     if len(lh) < 2:
         return OrderFit(math.nan, math.nan, math.nan, used, dropped, local, True)
-    from scipy import stats  # heavy (≈ 0.9 s here): loaded by the first fit, not by `import verimono`
+    from scipy.special import stdtrit   # the Student-t quantile (scipy.special: already loaded by scipy.linalg)
 
-    res = stats.linregress(lh, le)
-    if len(lh) > 2:
-        half = stats.t.ppf(0.975, len(lh) - 2) * res.stderr
-    else:
-        half = math.nan
+    slope, stderr = least_squares_slope(lh, le)
+    half = float(stdtrit(len(lh) - 2, 0.975)) * stderr if len(lh) > 2 else math.nan
     spread = (max(local) - min(local)) if len(local) > 1 else 0.0
-    return OrderFit(float(res.slope), float(res.slope - half), float(res.slope + half), used, dropped,
-                    local, spread > ASYMPTOTIC_SPREAD)
+    return OrderFit(slope, slope - half, slope + half, used, dropped, local, spread > ASYMPTOTIC_SPREAD)
+
+
+def least_squares_slope(x: np.ndarray, y: np.ndarray) -> tuple[float, float]:
+    """The least-squares slope of ``y`` on ``x`` and its standard error, as ``scipy.stats.linregress`` computes
+    them (its formulas, without importing ``scipy.stats``: 0.6 s, paid again by every worker process).
+    ``x`` must not be constant (a study's meshes are distinct)."""
+    ssxm, ssxym, _, ssym = np.cov(x, y, bias=True).flat
+    r = 0.0 if ssxm == 0.0 or ssym == 0.0 else min(1.0, max(-1.0, ssxym / math.sqrt(ssxm * ssym)))
+    slope = ssxym / ssxm
+    df = len(x) - 2
+    stderr = math.sqrt((1.0 - r * r) * ssym / ssxm / df) if df > 0 else math.nan
+    return float(slope), float(stderr)
 
 
 @dataclasses.dataclass

@@ -151,7 +151,7 @@ def _process_worker(conn: Any) -> None:
     import threading
 
     import cloudpickle
-    import scipy.stats  # noqa: F401  (with numpy and verimono, imported here: what every unit needs)
+    import scipy.linalg  # noqa: F401  (with numpy and verimono, imported here: what every unit needs)
 
     # spawn passed the connection as an inheritable descriptor: a child process of the unit's (os.system)
     # would hold it open, and the parent would not see this worker's end until that child's

@@ -97,11 +97,26 @@ def lcp_scale(M: np.ndarray, q: np.ndarray, z: np.ndarray | None = None) -> floa
     return 1.0 + max(float(np.abs(q).max(initial=0.0)), mz)
 
 
+#: answers of :func:`is_psd` for small matrices, by their bytes: a system's one-step and multiplier problems
+#: ask about the same few matrices at every step (bounded: emptied when it reaches this many)
+_PSD_SEEN: dict[tuple, bool] = {}
+_PSD_SEEN_MAX = 256
+
+
 def is_psd(M: np.ndarray, rtol: float = RTOL) -> bool:
     """``M + Mᵀ ⪰ 0`` up to ``rtol`` relative to ``max |M|`` (``M`` need not be symmetric)."""
     if M.size == 0:
         return True
-    return bool(np.linalg.eigvalsh(M + M.T)[0] >= -rtol * (1.0 + np.abs(M).max()))
+    key = (M.shape, M.dtype.str, M.tobytes(), rtol) if M.size <= 1024 else None
+    seen = _PSD_SEEN.get(key) if key is not None else None
+    if seen is not None:
+        return seen
+    answer = bool(np.linalg.eigvalsh(M + M.T)[0] >= -rtol * (1.0 + np.abs(M).max()))
+    if key is not None:
+        if len(_PSD_SEEN) >= _PSD_SEEN_MAX:
+            _PSD_SEEN.clear()
+        _PSD_SEEN[key] = answer
+    return answer
 
 
 def _verified(M, q, z, scale=None) -> tuple[bool, float, float]:

@@ -23,7 +23,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from .._params import as_param
-from ..errors import InfeasibleStep, InvalidProblem, OutsideDomain, SolverFailure
+from ..errors import InfeasibleStep, InvalidProblem, OutsideDomain, SolverFailure, VerimonoError
 from ..grids import validate_grid
 from ..operators import Operator
 from ..problem import Problem
@@ -441,21 +441,32 @@ class LCSOperator(Operator):
 
     def contains(self, x, y, t=0.0, tol=None):
         """Whether some ``(x', y') ∈ graph H(t,·)`` lies within ``tol`` of ``(x, y)`` in each coordinate (the
-        :meth:`verimono.Operator.contains` contract): first at ``x' = x`` (the multiplier nearest to explaining
-        ``y``), else through the graph point ``(p, x + y − p)``, ``p = J_1(x + y)``, which is ``|x − p|`` from
-        ``(x, y)`` in both coordinates — a point within rounding of a kink of ``H`` (``x = 2e-16`` for the
-        edge ``0`` of the Example's ``dom H``, where ``H(x) = {0}`` but ``H(0) = (−∞, 0]``) is a member there."""
+        :meth:`verimono.Operator.contains` contract), through either witness: the graph point ``(p, x + y − p)``,
+        ``p = J_1(x + y)``, which is ``|x − p|`` from ``(x, y)`` in both coordinates — so a point within rounding
+        of a kink of ``H`` (``x = 2e-16`` for the edge ``0`` of the Example's ``dom H``, where ``H(x) = {0}`` but
+        ``H(0) = (−∞, 0]``) is a member there — tried first, being the cheaper (the resolvent's warm-started
+        kernel); else at ``x' = x``, the multiplier nearest to explaining ``y``."""
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
         s = self.system
         tol = tolerance(s.A @ x, y) if tol is None else tol
+        self._box()         # H(t, x) as a set needs a box relation: NotImplementedError otherwise, as always
+        # either witness proves membership; the graph point through the (warm-started) resolvent is the cheaper
+        # one, so it is tried first, and the multipliers' selection (an LCP and often a QP) only when it fails
+        try:
+            p, failure = self.resolvent(x + y, 1.0, t), None
+            if np.max(np.abs(p - x)) <= tol:
+                return True
+        except VerimonoError as exc:
+            failure = exc
         try:
             lam = self._select(x, t, s.B.T @ s.B, s.B.T @ (s.A @ x + y))
             if np.max(np.abs(-s.A @ x - s.B @ lam - y)) <= tol:
                 return True
         except OutsideDomain:
             pass
-        p = self.resolvent(x + y, 1.0, t)
-        return bool(np.max(np.abs(p - x)) <= tol)
+        if failure is not None:     # neither witness: the resolvent's failure is the answer
+            raise failure
+        return False
 
     def project_domain(self, x, t=0.0):
         x = np.asarray(x, dtype=float)
