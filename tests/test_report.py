@@ -294,7 +294,8 @@ def test_plots_drawn_ahead_are_the_reports_plots_drawn_once(small_report, monkey
 
     drawn = []
     figure = plots.convergence_figure
-    monkeypatch.setattr(plots, "convergence_figure", lambda s, ax=None: drawn.append(s) or figure(s, ax))
+    monkeypatch.setattr(plots, "convergence_figure",
+                        lambda s, ax=None, **kw: drawn.append(s) or figure(s, ax, **kw))
     plots.forget()
     plain = render(small_report)
     assert len(drawn) == len(small_report.studies) > 0
@@ -304,7 +305,7 @@ def test_plots_drawn_ahead_are_the_reports_plots_drawn_once(small_report, monkey
     assert len(drawn) == len(small_report.studies)
     ahead = render(small_report)
     assert len(drawn) == len(small_report.studies)      # nothing drawn again
-    svg = re.compile(r"<svg .*?</svg>", re.S)
+    svg = re.compile(r'<svg role="img" class="plot".*?</svg>', re.S)
     assert len(svg.findall(ahead)) == len(svg.findall(plain)) == len(small_report.studies) + len(
         small_report.trajectories)
     assert svg.sub("", ahead) == svg.sub("", plain)
