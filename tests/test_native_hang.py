@@ -43,10 +43,11 @@ import sys
 import verimono as vm
 
 
-def _inside(module):
+def _inside(module=None, function=None):
+    """Whether a caller is in ``module`` or is the function named ``function``."""
     frame = sys._getframe(1)
     while frame is not None:
-        if frame.f_globals.get("__name__") == module:
+        if frame.f_globals.get("__name__") == module or frame.f_code.co_name == function:
             return True
         frame = frame.f_back
     return False
@@ -58,19 +59,10 @@ def stepper(problem, t_grid):
     return vm.solve(problem, t_grid)
 
 
-def _in_law(name):
-    frame = sys._getframe(1)
-    while frame is not None:
-        if frame.f_code.co_name == name:
-            return True
-        frame = frame.f_back
-    return False
-
-
 def battery_stepper(problem, t_grid):
     # in a battery the laws share the stepper's runs (verimono.checks.shared_runs): in_domain is the first law
     # to run it on the refined partitions, and unique_limit, judging those same runs, never calls it
-    if _in_law("check_in_domain"):
+    if _inside(function="check_in_domain"):
         os.system("sleep {sleep}")
     return vm.solve(problem, t_grid)
 
