@@ -172,7 +172,8 @@ def test_a_resumed_run_drops_the_records_of_the_stage_that_hung():
 
 def _check(tmp_path, *options):
     start = time.perf_counter()
-    proc = subprocess.run([sys.executable, "-m", "verimono.cli", "check", "hanging_stepper:battery_stepper", "--profile", "ci",
+    proc = subprocess.run([sys.executable, "-m", "verimono.cli", "check", "hanging_stepper:battery_stepper",
+                           "--profile", "ci",
                            "--timeout", "1", *REFS, "--out", str(tmp_path / "out"), *options],
                           capture_output=True, text=True, timeout=600, cwd=tmp_path,
                           env={**os.environ, "OPENBLAS_NUM_THREADS": "1"})

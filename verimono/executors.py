@@ -4,9 +4,10 @@ studies) mapped over an executor, their results merged in the units' own order.
 ``verimono run --executor SPEC`` (and ``verimono check``) chooses where units run:
 
 * ``serial`` (the default of the Python API): in this process, one after the other;
-* ``auto`` (the default of ``verimono run`` and ``verimono check``; ``$VERIMONO_EXECUTOR`` overrides): ``process:N`` with ``N`` the
-  machine's cores (at most :data:`AUTO_MAX_WORKERS`), serial on a one-core machine or, saying why, when no
-  worker can start (a script read from standard input cannot be re-imported by a spawned process);
+* ``auto`` (the default of ``verimono run`` and ``verimono check``; ``$VERIMONO_EXECUTOR`` overrides):
+  ``process:N`` with ``N`` the machine's cores (at most :data:`AUTO_MAX_WORKERS`), serial on a one-core
+  machine or, saying why, when no worker can start (a script read from standard input cannot be
+  re-imported by a spawned process);
 * ``process:N``: ``N`` worker processes of this machine (forked where that is safe, else spawned:
   :func:`start_method`);
 * ``tcp://host:port`` (any ``scheme://address``): the workers of a running ``dask.distributed`` scheduler

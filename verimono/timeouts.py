@@ -267,4 +267,5 @@ def _run_unit(fn: Callable[[], object], *, check: str, subject: str, seconds: fl
 
 
 __all__ = ["budget", "current_budget", "budget_source", "stage_budget", "calibration", "in_seconds", "time_limit",
-           "run_unit", "note_progress", "never_returned", "supported", "explicit_budget", "unlimited", "TIME_BUDGET_REASON", "HANG_MULTIPLE"]
+           "run_unit", "note_progress", "never_returned", "supported", "explicit_budget", "unlimited",
+           "TIME_BUDGET_REASON", "HANG_MULTIPLE"]
