@@ -293,12 +293,12 @@ def test_workers_are_forked_only_where_that_is_safe(monkeypatch):
     import sys
     import threading
 
-    from verimono.executors import start_method
+    from verimono.executors import FORK_UNSAFE, start_method
 
     monkeypatch.delenv("VERIMONO_START_METHOD", raising=False)
     monkeypatch.setattr(sys, "platform", "linux")
     monkeypatch.setattr(threading, "active_count", lambda: 1)
-    for name in ("jax", "torch", "tensorflow", "cupy", "numba"):
+    for name in FORK_UNSAFE:         # (dask's distributed, loaded by another test of this module, is one)
         monkeypatch.delitem(sys.modules, name, raising=False)
     assert start_method() == "fork"
     monkeypatch.setitem(sys.modules, "torch", object())
