@@ -23,7 +23,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from .._params import as_param
-from ..errors import InfeasibleStep, InvalidProblem, OutsideDomain, SolverFailure, VerimonoError
+from ..errors import InfeasibleStep, InvalidProblem, OutsideDomain, SolverFailure
 from ..grids import validate_grid
 from ..operators import Operator
 from ..problem import Problem
@@ -456,7 +456,7 @@ class LCSOperator(Operator):
             p, failure = self.resolvent(x + y, 1.0, t), None
             if np.max(np.abs(p - x)) <= tol:
                 return True
-        except VerimonoError as exc:
+        except Exception as exc:  # noqa: BLE001 - raised again below unless the multipliers decide
             failure = exc
         try:
             lam = self._select(x, t, s.B.T @ s.B, s.B.T @ (s.A @ x + y))
