@@ -87,3 +87,48 @@ def test_different_initial_points_and_horizons_are_different_runs():
         a = run_stepper(stepper, p, t)
         b = run_stepper(stepper, p.replace(x0=p.x0 * 0.5), t)
     assert sum(calls.values()) == 2 and not np.array_equal(a, b)
+
+
+def test_a_remembered_value_is_computed_once_and_reports_its_precision_on_every_reuse():
+    from verimono.checks.shared_runs import remembered_value
+    from verimono.tolerances import observe
+
+    calls = []
+
+    def compute():
+        calls.append(1)
+        observe(np.float32)                 # what the operator computed in, seen while computing
+        return (np.arange(3.0),)
+
+    with shared_runs():
+        for _ in range(3):
+            with judged_precision() as seen:
+                (a,) = remembered_value(("k",), (), compute)
+                a[0] = 99.0                 # a copy: the next reuse is not changed
+            assert seen.name == "float32"
+        (b,) = remembered_value(("k",), (), compute)
+    assert len(calls) == 1 and b[0] == 0.0
+    with judged_precision() as seen:        # outside any block: computed every time
+        remembered_value(("k",), (), compute)
+    assert len(calls) == 2 and seen.name == "float32"
+
+
+def test_witnesses_shared_by_in_domain_and_selections_are_computed_once():
+    from verimono.checks.trajectory_laws import check_in_domain
+    from verimono.checks.stepper_battery import CHECKS
+
+    p = _problem("translating ball")
+    resolvents = collections.Counter()
+    op = p.operator
+    original = op.resolvent
+
+    def counted(x, lam, t=0.0):
+        resolvents[(np.asarray(x).tobytes(), float(lam), float(t))] += 1
+        return original(x, lam, t)
+
+    op.resolvent = counted
+    t = uniform_grid(p.T, steps=40)
+    with shared_runs():
+        assert check_in_domain(verimono.solve, p, grids=[t]).status == "passed"
+        assert CHECKS["selections"](verimono.solve, p, grids=[t]).status == "passed"
+    assert resolvents and max(resolvents.values()) == 1

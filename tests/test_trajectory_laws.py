@@ -51,6 +51,21 @@ def test_other_zoo_members_are_caught_too():
         assert any(CHECKS[law](member, q).status == FAILED for q in catalog()[:12] for law in LAWS), member
 
 
+def test_in_domain_takes_resolvent_witnesses_and_measures_the_rest_exactly():
+    """``dist(x_k, dom F) <= |x_k - J(x_k + mu y_k)|`` (a resolvent's value lies in dom F): a correct run is
+    measured exactly at x_0 only, and its bounds are the exact distances up to round-off; a stepper off the
+    domain is measured exactly where its witness is far, so its distance is the projection's."""
+    p = get("translating ball")
+    rec = check_in_domain(solve, p, grids=[uniform_grid(p.T, steps=40)])
+    assert rec.status == PASSED and rec.details["measured_nodes"] == 1
+    assert rec.details["max_distance"] < 1e-12
+    bad = check_in_domain(wrong_time, p, grids=[uniform_grid(p.T, steps=40)])
+    assert bad.status == FAILED and bad.details["measured_nodes"] >= 1
+    cx = bad.counterexample
+    exact = float(np.linalg.norm(np.asarray(cx["projection"]) - np.asarray(cx["x_k"])))
+    assert cx["distance"] == pytest.approx(exact, rel=1e-12)
+
+
 def test_unique_limit_refines_past_meshes_coarser_than_the_problem():
     """A thorough hypothesis run found this false alarm: x' ∈ −∂(2|x|) from x0 = 1/32 dies out at t = 1/64,
     so every partition of mesh 0.1 or 0.025 gives 0 from its first cell on: distances 0, 0, then c·h at

@@ -202,6 +202,21 @@ def tolerance(*scales: float, rtol: float | None = None) -> float:
             m = a
     return rtol * (1.0 + m)
 
+
+def row_tolerances(*rows: np.ndarray, rtol: float | None = None) -> np.ndarray:
+    """:func:`tolerance` of row ``k`` of every array at once: ``rtol * (1 + max_j |rows_j[k]|∞)`` for each ``k``
+    (arrays of shape ``(K, n)``, or ``(K,)`` for scalars per row): what a law computes per step, in one pass."""
+    if rtol is None:
+        rtol = current_rtol()
+    m = None
+    for r in rows:
+        a = np.abs(np.asarray(r, dtype=float))
+        a = a.reshape(a.shape[0], -1).max(axis=1, initial=0.0)
+        m = a if m is None else np.maximum(m, a)
+    if m is None:
+        raise ValueError("row_tolerances needs at least one array")
+    return rtol * (1.0 + m)
+
 #: relative LCP residual below which a back-end's candidate is refined by one active-set (principal
 #: pivot) solve.  The refinement turns a nearly right answer into a round-off-exact one; it is not a
 #: solver, so a candidate further off than this (a back-end reporting "solved" on garbage) is never

@@ -14,6 +14,11 @@ stepper computed in is reported again to the judgement that reuses it (:func:`ve
 a float32 stepper is judged as float32 by every law).  What is kept is bounded
 (:data:`MAX_BYTES`, oldest first out): a large problem is run again rather than held.  A stepper that
 raises or returns what :func:`run_stepper` refuses is not remembered: every law sees it fail.
+
+:func:`remembered_value` does the same for what laws derive from a run and ask for alike — the resolvent
+points ``J_μ(x_{k+1} + μ y_k)`` that ``in_domain`` takes as witnesses of ``dom F`` and ``selections`` judges
+(:func:`verimono.checks.trajectory_laws.resolvent_witnesses`) — with the precision the operator computed
+them in, observed again on every reuse.
 """
 
 from __future__ import annotations
@@ -24,7 +29,7 @@ from typing import Any, Callable, Iterator
 
 import numpy as np
 
-from ..tolerances import observe
+from ..tolerances import judged_precision, observe
 
 #: bytes of states a :func:`shared_runs` block keeps at most (its oldest runs are dropped first)
 MAX_BYTES = 64 * 2**20
@@ -37,6 +42,8 @@ class _Runs:
         self.kept: OrderedDict[tuple, tuple[Any, Any, np.ndarray, str | None]] = OrderedDict()
         self.bytes = 0
         self.hits = 0
+        self.values: OrderedDict[tuple, tuple[Any, tuple, str]] = OrderedDict()
+        self.value_bytes = 0
 
     def get(self, key: tuple) -> np.ndarray | None:
         hit = self.kept.get(key)
@@ -89,4 +96,29 @@ def remembered(stepper: Any, problem: Any, grid: np.ndarray,
     return x
 
 
-__all__ = ["shared_runs", "remembered", "MAX_BYTES"]
+def remembered_value(key: tuple, owners: tuple, compute: Callable[[], tuple[np.ndarray, ...]]) -> tuple[np.ndarray, ...]:
+    """``compute()`` — a tuple of arrays derived from a run — or, inside :func:`shared_runs`, copies of what it
+    returned the first time for the same ``key`` (the precision observed while it ran is observed again).
+    ``owners``: the objects whose ids ``key`` holds, kept alive with the value so no id is reused.  A
+    ``compute`` that raises is not remembered."""
+    if not _ACTIVE:
+        return compute()
+    runs = _ACTIVE[-1]
+    hit = runs.values.get(key)
+    if hit is not None:
+        if hit[2] != "float64":
+            observe(hit[2])
+        return tuple(a.copy() for a in hit[0])
+    with judged_precision() as seen:      # reports what it saw to the judgement in progress as well
+        value = compute()
+    size = sum(a.nbytes for a in value)
+    if size <= MAX_BYTES:
+        runs.values[key] = (tuple(a.copy() for a in value), owners, seen.name)
+        runs.value_bytes += size
+        while runs.value_bytes > MAX_BYTES:
+            _, (old, _, _) = runs.values.popitem(last=False)
+            runs.value_bytes -= sum(a.nbytes for a in old)
+    return value
+
+
+__all__ = ["shared_runs", "remembered", "remembered_value", "MAX_BYTES"]
