@@ -57,6 +57,57 @@ def test_the_calibration_is_measured_once_and_cached(monkeypatch):
         timing.set_calibration(0.0)
 
 
+def _in_fresh_python(code: str) -> str:
+    import subprocess
+    import sys
+
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=120).stdout
+
+
+def test_the_first_calibration_is_measured_in_a_forked_copy_and_its_copy_always_reaped():
+    """The command line starts its first calibration before its imports (:class:`PendingCalibration`): a
+    forked copy measures it (a fresh interpreter: one thread, Linux), answers once, and is reaped — also when
+    the answer is never taken; a copy that cannot answer leaves the measurement to this process."""
+    import sys
+
+    if not sys.platform.startswith("linux"):
+        pytest.skip("the copy is forked on Linux only (elsewhere it is measured in the process: next test)")
+    out = _in_fresh_python(
+        "import os\n"
+        "from verimono.calibration import PendingCalibration, calibrate\n"
+        "p = PendingCalibration()\n"
+        "forked = p._pid is not None\n"
+        "v = p.result()\n"
+        "assert v == p.result()\n"                                   # answered once, kept
+        "here = calibrate()\n"
+        "print(forked, 0.3 < v / here < 3.0)\n"                      # the same workload: the same size
+        "q = PendingCalibration(); pid = q._pid; q.close()\n"         # never taken: ended and reaped
+        "try:\n    os.waitpid(pid, 0); print('unreaped')\nexcept ChildProcessError:\n    print('reaped')\n"
+        "import verimono.calibration as c\n"
+        "parent = os.getpid()\n"
+        "c.calibrate = lambda repeats=3: 0.042 if os.getpid() == parent else 1 / 0\n"
+        "print(PendingCalibration().result())\n")               # the copy failed: measured here
+    assert out.split() == ["True", "True", "reaped", "0.042"]
+
+
+def test_with_another_thread_running_the_first_calibration_is_measured_here(monkeypatch):
+    import threading
+
+    calls = []
+    monkeypatch.setattr(calibration, "calibrate", lambda repeats=3: calls.append(repeats) or 0.05)
+    stop = threading.Event()
+    other = threading.Thread(target=stop.wait)
+    other.start()
+    try:
+        p = calibration.PendingCalibration()
+        assert p._pid is None and calls == []          # no fork while a thread runs: nothing started
+        assert p.result() == 0.05 and p.result() == 0.05 and calls == [3]
+        p.close()
+    finally:
+        stop.set()
+        other.join()
+
+
 def test_a_unit_over_its_scaled_budget_is_stopped_and_says_why(monkeypatch):
     if not timeouts.supported():
         pytest.skip("no SIGALRM here")

@@ -12,6 +12,10 @@ on the own-time clock too.
 from __future__ import annotations
 
 import math
+import os
+import struct
+import sys
+import threading
 import time
 
 import numpy as np
@@ -61,4 +65,71 @@ def set_calibration(seconds: float | None) -> None:
         _CALIBRATION.append(s)
 
 
-__all__ = ["calibrate", "calibration", "set_calibration", "workload"]
+class PendingCalibration:
+    """:func:`calibrate` measured in a forked copy of this process while this one goes on — the command line
+    starts it before its imports (about 0.4 s on one core, while the measurement takes the other) and takes
+    :meth:`result` when its run begins.  Where a fork is not safe (not Linux, or another thread running: a
+    lock held at the fork would stay held in the copy) or fails, :meth:`result` measures here instead."""
+
+    def __init__(self, repeats: int = 3) -> None:
+        self.repeats = repeats
+        self._value: float | None = None
+        self._pid: int | None = None
+        self._fd: int | None = None
+        if not (sys.platform.startswith("linux") and threading.active_count() == 1):
+            return
+        r, w = os.pipe()
+        try:
+            pid = os.fork()
+        except OSError:
+            os.close(r), os.close(w)
+            return
+        if pid == 0:                                     # the copy: measure, answer, and end at once
+            code = 1
+            try:
+                os.close(r)
+                os.write(w, struct.pack("<d", calibrate(repeats)))
+                code = 0
+            finally:
+                os._exit(code)                           # no atexit handlers, no buffers flushed twice
+        os.close(w)
+        self._pid, self._fd = pid, r
+
+    def _collect(self, kill: bool = False) -> float | None:
+        if self._fd is None or self._pid is None:
+            return None
+        fd, pid, self._fd, self._pid = self._fd, self._pid, None, None
+        try:
+            if kill:
+                try:
+                    os.kill(pid, 9)
+                except ProcessLookupError:  # pragma: no cover - it had ended
+                    pass
+                return None
+            data = b""
+            while len(data) < 8:
+                chunk = os.read(fd, 8 - len(data))
+                if not chunk:
+                    break
+                data += chunk
+        finally:
+            os.close(fd)
+            os.waitpid(pid, 0)
+        if len(data) != 8:
+            return None
+        value = struct.unpack("<d", data)[0]
+        return value if value > 0 and math.isfinite(value) else None
+
+    def result(self) -> float:
+        """The seconds measured (waiting for the copy to answer), or measured here if it could not."""
+        if self._value is None:
+            measured = self._collect()
+            self._value = measured if measured is not None else calibrate(self.repeats)
+        return self._value
+
+    def close(self) -> None:
+        """End the copy if its answer was never taken (a command that stopped before its run)."""
+        self._collect(kill=True)
+
+
+__all__ = ["PendingCalibration", "calibrate", "calibration", "set_calibration", "workload"]

@@ -23,8 +23,7 @@ from .progress import Progress
 from .report import write
 from .report.plots import draw_ahead, warm_up
 from .results import Report
-from .stages import calibrate, run_stages
-from .calibration import set_calibration
+from .calibration import PendingCalibration, calibrate, set_calibration
 from .timing import MachineProbe, is_noise_undecided
 
 EXIT_OK, EXIT_FAILED, EXIT_UNDECIDED = 0, 1, 2
@@ -32,12 +31,16 @@ EXIT_OK, EXIT_FAILED, EXIT_UNDECIDED = 0, 1, 2
 
 def execute(*, command: str, profile_name: str, stages: list[str] | None, context: Any, target: str | None = None,
             progress: Progress | None = None, executor: Any = None, unit_timeout: float | None = None,
-            on_done: Callable | None = None) -> Report:
+            on_done: Callable | None = None, calibration: PendingCalibration | None = None) -> Report:
     """Run ``stages`` with ``context`` under a profile and return the merged, fully annotated report.
 
     ``executor`` (``"process:N"``, a dask scheduler address or ``Client``; ``None``: serial) is where the
     stages' independent units run (:mod:`verimono.executors`); ``unit_timeout`` bounds each unit there.
-    ``on_done(stage, report, info)`` is called after each stage (the interrupt handler keeps them)."""
+    ``on_done(stage, report, info)`` is called after each stage (the interrupt handler keeps them).
+    ``calibration``: the run's first calibration, started earlier (the command line starts it before its
+    imports); measured here, before any worker starts, when not given."""
+
+    from .stages import run_stages   # the checks and what they need (scipy): imported once a run begins
 
     profile = get_profile(profile_name)
     load_hypothesis_profile(profile_name)
@@ -47,7 +50,7 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
     if executor is not None and context.executor is None:
         print(f"verimono: units run on {runner.spec}", file=sys.stderr)
     context.executor = context.executor if context.executor is not None else runner
-    cal = calibrate()                 # on a quiet machine, before any worker starts
+    cal = calibration.result() if calibration is not None else calibrate()   # before any worker starts
     set_calibration(cal)              # the unit of this process's time budgets (verimono.timeouts)
     if hasattr(runner, "prestart"):   # the workers import while this process builds the catalog
         runner.prestart()
