@@ -310,3 +310,22 @@ def test_plots_drawn_ahead_are_the_reports_plots_drawn_once(small_report, monkey
         small_report.trajectories)
     assert svg.sub("", ahead) == svg.sub("", plain)
     plots.forget()
+
+
+def test_the_reports_reused_axes_draw_what_a_fresh_figure_draws(small_report):
+    """The report draws every plot of a kind on one reused axes (``plots._reused_axes``): each plot, drawn
+    after the others, is the SVG a new figure gives (apart from the figures' salted ids)."""
+    from verimono.report import plots
+
+    def same(svg: str) -> str:
+        return re.sub(r"\b[mp][0-9a-f]{10}\b", "ID", re.sub(r"vm\d+", "vm", svg))
+
+    kinds = [(plots.convergence_figure, "convergence", small_report.studies),
+             (plots.trajectory_figure, "trajectory", small_report.trajectories)]
+    for figure, kind, subjects in kinds:
+        assert len(subjects) >= 2
+        fresh = [same(plots._svg(figure(s, legend=False))) for s in subjects]
+        for _ in range(2):                      # each plot drawn over every other one
+            reused = [same(plots._svg(figure(s, plots._reused_axes(kind), legend=False))) for s in subjects]
+            assert reused == fresh
+            subjects, fresh = subjects[::-1], fresh[::-1]

@@ -58,6 +58,25 @@ def _figure(width: float = 4.4, height: float = 3.1) -> Any:
     return fig
 
 
+#: the report's axes, one per kind of plot, drawn on again and again under :data:`_DRAWING` (a new figure's axes
+#: and ticks were a third of each plot's time); :func:`_reused_axes` empties them first
+_REUSED: dict[str, Any] = {}
+
+
+def _reused_axes(kind: str) -> Any:
+    """The report's axes for plots of ``kind``, emptied of the previous plot's artists (the figure functions
+    set every scale, limit, locator, label and title they use, so the drawing is the fresh figure's: a test
+    compares them)."""
+    ax = _REUSED.get(kind)
+    if ax is None:
+        ax = _REUSED[kind] = _figure().add_subplot()
+    else:
+        for artist in [*ax.lines, *ax.collections, *ax.texts, *ax.patches, *ax.images]:
+            artist.remove()
+        ax.relim()
+    return ax
+
+
 def warm_up() -> None:
     """Import matplotlib and draw one small figure (font cache, text layout): about 0.6 s that a run on worker
     processes spends in its otherwise idle main process instead of before its report (``verimono run`` calls
@@ -161,7 +180,7 @@ def _plot_html(fig: Any) -> str:
 
 def convergence_plot(study: Any) -> str:
     """:func:`convergence_figure` as an inline ``<svg>`` followed by its legend in HTML."""
-    return _drawn_once(study, lambda: _plot_html(convergence_figure(study, legend=False)))
+    return _drawn_once(study, lambda: _plot_html(convergence_figure(study, _reused_axes("convergence"), legend=False)))
 
 
 def convergence_figure(study: Any, ax: Any = None, *, legend: bool = True) -> Any:
@@ -237,16 +256,18 @@ def convergence_figure(study: Any, ax: Any = None, *, legend: bool = True) -> An
 
 def trajectory_plot(sample: dict[str, Any]) -> str:
     """:func:`trajectory_figure` as an inline ``<svg>`` followed by its legend in HTML."""
-    return _drawn_once(sample, lambda: _plot_html(trajectory_figure(sample, legend=False)))
+    return _drawn_once(sample, lambda: _plot_html(trajectory_figure(sample, _reused_axes("trajectory"), legend=False)))
 
 
-def trajectory_figure(sample: dict[str, Any], *, legend: bool = True) -> Any:
-    """The discrete solution (markers) against the exact one (lines), component by component (≤ 4); the
-    legend drawn in the figure unless ``legend=False`` (the report puts it under the plot, in HTML)."""
+def trajectory_figure(sample: dict[str, Any], ax: Any = None, *, legend: bool = True) -> Any:
+    """The discrete solution (markers) against the exact one (lines), component by component (≤ 4), drawn on
+    ``ax`` (default: a new Agg figure); the legend drawn in the figure unless ``legend=False`` (the report puts
+    it under the plot, in HTML).  Returns the matplotlib ``Figure``."""
     from matplotlib.ticker import MaxNLocator
 
-    fig = _figure()
-    ax = fig.add_subplot()
+    if ax is None:
+        ax = _figure().add_subplot()
+    fig = ax.figure
     t = np.asarray(sample["t"], float)
     x = np.asarray([[_num(v) for v in np.atleast_1d(row)] for row in sample["x"]])
     ncomp = min(x.shape[1], 4)
