@@ -164,3 +164,32 @@ def test_membership_within_rounding_of_the_edge_of_dom_H():
     assert not H.contains(np.array([2.2e-16]), np.array([0.28]), 0.0)       # H(0, 0) = (-∞, 0]
     s = Sample(np.array([-1.25]), np.zeros(1), lam, 1.0, 1.0, 0.0)
     assert check_yosida_in_graph(H, sample=s).status == "passed"
+
+
+def test_a_new_step_size_starts_from_the_last_active_pattern_and_a_wrong_guess_is_never_taken():
+    """The operator's resolvent at a new λ tries the active pattern of the previous step size first (every
+    random partition asks for a new λ per step): verified for the new M, so the answers are the closed
+    form's (paper Example ex: J = max(x + λ max(−v1, 0), −v2)); and a stepper seeded with a wrong pattern
+    still answers right (the pattern fails its sign checks and the full solve decides)."""
+    from reference.lcs_example import closed_form_resolvent, example_system
+
+    from verimono.lcs.relations import _BoxStepper
+
+    op = example_system(lambda t: np.array([-t, 0.0])).operator()
+    lams = 0.01 * (1.0 + np.random.default_rng(0).random(15))     # 15 kept: none forgotten
+    for k, lam in enumerate(lams):
+        t, x = 0.05 * k, np.array([0.3 + 0.01 * k])
+        assert op.resolvent(x, lam, t) == pytest.approx(closed_form_resolvent(x, lam, -t, 0.0), abs=1e-14)
+    solves = sum(sm.step.full_solves for sm in op._mats.values())
+    assert len(op._mats) == 15 and solves <= 2  # the first λ and a change of pattern solved, not all 15
+    rel = Complementarity()
+    M = np.array([[2.0, 1.0], [-1.0, 0.5]])
+    right = rel.stepper(M)
+    wrong = rel.stepper(M)
+    other = rel.stepper(M)
+    other.last = np.array([1, 1], dtype=np.int8).tobytes()     # both strictly inside: wrong for this q
+    wrong.warm_from(other)
+    assert isinstance(wrong, _BoxStepper) and wrong.last == other.last
+    q = np.array([1.0, 2.0])                    # q ≥ 0: z = 0 is the solution
+    assert np.array_equal(wrong(q)[0], right(q)[0]) and np.all(wrong(q)[0] == 0.0)
+    assert wrong.full_solves == 1

@@ -142,6 +142,13 @@ class _BoxStepper:
             return None
         return lam, y
 
+    def warm_from(self, other: object) -> None:
+        """Try ``other``'s last active pattern first (a nearby ``M``, e.g. the same system at another step
+        size): a pattern is a guess that :meth:`_try` verifies for this ``M``, so a wrong one costs one
+        factorisation and falls back to :meth:`BoxRelation.solve`."""
+        if self.last is None and isinstance(other, _BoxStepper) and other.M.shape == self.M.shape:
+            self.last = other.last
+
     def __call__(self, q, scale=None):
         if self.last is not None:
             out = self._try(self.last, q)

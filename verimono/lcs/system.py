@@ -361,6 +361,7 @@ class LCSOperator(Operator):
         self.system = system
         self.static = system.v_constant
         self._mats: dict[float, StepMatrices] = {}
+        self._recent: StepMatrices | None = None
 
     def _sm(self, lam: float) -> StepMatrices:
         sm = self._mats.get(lam)
@@ -368,6 +369,10 @@ class LCSOperator(Operator):
             if len(self._mats) > 16:
                 self._mats.clear()
             sm = self._mats[lam] = self.system.step_matrices(lam, 1.0, None)
+            warm = getattr(sm.step, "warm_from", None)
+            if warm is not None and self._recent is not None:   # a new step size: the last one's pattern first
+                warm(self._recent.step)
+        self._recent = sm
         return sm
 
     def _accepts_batches(self):
