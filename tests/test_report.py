@@ -318,7 +318,7 @@ def test_the_reports_reused_axes_draw_what_a_fresh_figure_draws(small_report):
     from verimono.report import plots
 
     def same(svg: str) -> str:
-        return re.sub(r"\b[mp][0-9a-f]{10}\b", "ID", re.sub(r"vm\d+", "vm", svg))
+        return re.sub(r"\b[mp][0-9a-f]{10}\b", "ID", re.sub(r"vm\d+x\d+", "vm", svg))
 
     kinds = [(plots.convergence_figure, "convergence", small_report.studies),
              (plots.trajectory_figure, "trajectory", small_report.trajectories)]
@@ -329,3 +329,48 @@ def test_the_reports_reused_axes_draw_what_a_fresh_figure_draws(small_report):
             reused = [same(plots._svg(figure(s, plots._reused_axes(kind), legend=False))) for s in subjects]
             assert reused == fresh
             subjects, fresh = subjects[::-1], fresh[::-1]
+
+
+def test_a_drawer_process_draws_the_reports_plots_and_a_dead_one_leaves_them_here(small_report, tmp_path):
+    """The command line's drawer (``plots.drawer_pipe``, forked with the first calibration): the plots asked
+    of it are the ones this process would draw (apart from the figures' ids), each drawn once there; when
+    it dies, the report draws what it owed here."""
+    import pickle
+    import subprocess
+    import sys
+
+    if not sys.platform.startswith("linux"):
+        pytest.skip("the drawer is forked on Linux only")
+    path = tmp_path / "subjects.pickle"
+    path.write_bytes(pickle.dumps((small_report.studies, small_report.trajectories)))
+    code = f"""
+import os, pickle, re, signal
+from verimono.calibration import PendingCalibration
+from verimono.report import plots
+studies, samples = pickle.loads(open({str(path)!r}, "rb").read())
+same = lambda h: re.sub(r"\\b[mp][0-9a-f]{{10}}\\b", "ID", re.sub(r"vm\\d+x\\d+", "vm", h))
+serve_it, connect = plots.drawer_pipe()
+pending = PendingCalibration(then=serve_it)
+assert pending.forked and pending.result() > 0
+connect()
+assert plots.drawing_elsewhere()
+plots.draw_ahead(studies, samples)
+there = [plots.convergence_plot(s) for s in studies] + [plots.trajectory_plot(s) for s in samples]
+assert "matplotlib" not in __import__("sys").modules          # this process drew none of them
+plots.forget()
+plots.disconnect(); pending.close()                            # the drawer ends and is reaped
+here = [plots.convergence_plot(s) for s in studies] + [plots.trajectory_plot(s) for s in samples]
+print(len(there), [same(a) for a in there] == [same(b) for b in here], len({{a for a in there}}) == len(there))
+plots.forget()
+serve_it, connect = plots.drawer_pipe()
+pending = PendingCalibration(then=serve_it)
+pending.result(); connect()
+plots.draw_ahead(studies, samples)
+os.kill(pending._pid, signal.SIGKILL)                          # dies with plots owed
+print(all(same(plots.convergence_plot(s)) == same(h) for s, h in zip(studies, here)))
+plots.disconnect(); pending.close()
+"""
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    n = len(small_report.studies) + len(small_report.trajectories)
+    assert out.stdout.split() == [str(n), "True", "True", "True"]

@@ -17,6 +17,7 @@ import struct
 import sys
 import threading
 import time
+from typing import Callable
 
 import numpy as np
 
@@ -71,11 +72,14 @@ class PendingCalibration:
     :meth:`result` when its run begins.  Where a fork is not safe (not Linux, or another thread running: a
     lock held at the fork would stay held in the copy) or fails, :meth:`result` measures here instead."""
 
-    def __init__(self, repeats: int = 3) -> None:
+    def __init__(self, repeats: int = 3, then: Callable[[], None] | None = None) -> None:
+        """``then``: what the copy does once it has answered (the command line's report drawer,
+        :func:`verimono.report.plots.serve`); the copy then lives on until :meth:`close`."""
         self.repeats = repeats
         self._value: float | None = None
         self._pid: int | None = None
         self._fd: int | None = None
+        self._lives_on = then is not None
         if not (sys.platform.startswith("linux") and threading.active_count() == 1):
             return
         r, w = os.pipe()
@@ -89,6 +93,9 @@ class PendingCalibration:
             try:
                 os.close(r)
                 os.write(w, struct.pack("<d", calibrate(repeats)))
+                os.close(w)
+                if then is not None:
+                    then()
                 code = 0
             finally:
                 os._exit(code)                           # no atexit handlers, no buffers flushed twice
@@ -98,7 +105,8 @@ class PendingCalibration:
     def _collect(self, kill: bool = False) -> float | None:
         if self._fd is None or self._pid is None:
             return None
-        fd, pid, self._fd, self._pid = self._fd, self._pid, None, None
+        fd, pid, self._fd = self._fd, self._pid, None
+        data = b""
         try:
             if kill:
                 try:
@@ -106,7 +114,6 @@ class PendingCalibration:
                 except ProcessLookupError:  # pragma: no cover - it had ended
                     pass
                 return None
-            data = b""
             while len(data) < 8:
                 chunk = os.read(fd, 8 - len(data))
                 if not chunk:
@@ -114,11 +121,22 @@ class PendingCalibration:
                 data += chunk
         finally:
             os.close(fd)
-            os.waitpid(pid, 0)
+            if kill or not self._lives_on or len(data) != 8:   # else it lives on: reaped by close()
+                self._reap()
         if len(data) != 8:
             return None
         value = struct.unpack("<d", data)[0]
         return value if value > 0 and math.isfinite(value) else None
+
+    def _reap(self) -> None:
+        pid, self._pid = self._pid, None
+        if pid is not None:
+            os.waitpid(pid, 0)
+
+    @property
+    def forked(self) -> bool:
+        """Whether a copy was forked (else :meth:`result` measures here, and ``then`` never runs)."""
+        return self._pid is not None
 
     def result(self) -> float:
         """The seconds measured (waiting for the copy to answer), or measured here if it could not."""
@@ -128,8 +146,12 @@ class PendingCalibration:
         return self._value
 
     def close(self) -> None:
-        """End the copy if its answer was never taken (a command that stopped before its run)."""
-        self._collect(kill=True)
+        """End the copy if its answer was never taken (a command that stopped before its run); else wait
+        for a copy that lived on (what ``then`` did ends when its caller lets it: the drawer when its
+        connection closes)."""
+        if self._fd is not None:
+            self._collect(kill=True)
+        self._reap()
 
 
 __all__ = ["PendingCalibration", "calibrate", "calibration", "set_calibration", "workload"]

@@ -493,19 +493,29 @@ BLAS_THREADS = 1
 
 #: the commands that run the verification, whose first calibration :func:`main` starts before its imports
 CALIBRATED_COMMANDS = ("run", "check", "baseline")
+#: the commands whose report's plots are drawn by that copy (``baseline`` writes no report)
+DRAWN_COMMANDS = ("run", "check")
 
 
 def main(argv: list[str] | None = None) -> int:
     from threadpoolctl import threadpool_limits
 
     from .calibration import PendingCalibration
+    from .report import plots
 
     given = list(sys.argv[1:] if argv is None else argv)
     command = next((a for a in given if not a.startswith("-")), None)
     with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
         # the run's first calibration is measured on the other core while this process imports the checks
-        # and reads its target (about 0.4 s; the measurement takes 0.2 s): it is not waited for
-        pending = PendingCalibration() if command in CALIBRATED_COMMANDS and not {"-h", "--help"} & set(given) else None
+        # and reads its target (about 0.4 s; the measurement takes 0.2 s): it is not waited for; the copy
+        # that measures it then imports matplotlib and draws the report's plots as the stages deliver them
+        # (plots.serve), so that this process only runs the stages
+        pending = None
+        if command in CALIBRATED_COMMANDS and not {"-h", "--help"} & set(given):
+            serve_it, connect = plots.drawer_pipe() if command in DRAWN_COMMANDS else (None, None)
+            pending = PendingCalibration(then=serve_it)
+            if pending.forked and connect is not None:
+                connect()
         try:
             args = build_parser().parse_args(argv)
             args.argv = given                          # the command as given (advice after an interrupt)
@@ -517,6 +527,7 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"verimono {args.command}: {exc}", file=sys.stderr)
                 return EXIT_UNDECIDED
         finally:
+            plots.disconnect()                         # the drawer ends, then its process is reaped
             if pending is not None:
                 pending.close()
 

@@ -298,6 +298,9 @@ class ProcessRunner:
         if workers < 1:
             raise BadExecutor(f"process:N needs N >= 1, got {workers}")
         self.workers, self.timeout = int(workers), timeout
+        #: called with each unit's report as it comes back, before the others have (the run sends its plots
+        #: to the drawer from it: :func:`verimono.report.plots.draw_ahead`); an error there is not the unit's
+        self.on_report: Callable[[Report], None] | None = None
         #: ``auto``: when the workers cannot start, say so and run the units serially instead
         self.fallback = fallback
         self._serial: SerialRunner | None = None
@@ -418,6 +421,11 @@ class ProcessRunner:
                         if ended:          # it answered for a unit blocked in native code, and exits
                             self._stop(worker, kill=False)
                             worker = replace(worker)
+                        elif self.on_report is not None:
+                            try:
+                                self.on_report(results[i])
+                            except Exception:  # noqa: BLE001 - a plot asked ahead is drawn by the report instead
+                                pass
                     done += 1
                     idle.append(worker)
                     progress(done, len(units), units[i].label)

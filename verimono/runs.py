@@ -21,7 +21,7 @@ from .executors import make_runner
 from .profiles import get_profile, load_hypothesis_profile
 from .progress import Progress
 from .report import write
-from .report.plots import draw_ahead, warm_up
+from .report.plots import draw_ahead, drawing_elsewhere, warm_up
 from .results import Report
 from .calibration import PendingCalibration, calibrate, set_calibration
 from .timing import MachineProbe, is_noise_undecided
@@ -55,7 +55,10 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
     if hasattr(runner, "prestart"):   # the workers import while this process builds the catalog
         runner.prestart()
     waits_on_workers = getattr(runner, "workers", 1) >= 2
-    if waits_on_workers:                     # this process waits on the workers: draw the report's first
+    if waits_on_workers and drawing_elsewhere() and hasattr(runner, "on_report"):
+        # each unit's plots go to the drawer as the unit comes back (not when its whole stage has)
+        runner.on_report = lambda rep: draw_ahead(rep.studies, rep.trajectories) if rep.studies or rep.trajectories else None
+    elif waits_on_workers:                   # this process waits on the workers: draw the report's first
         import threading                     # figure meanwhile (matplotlib's import and font cache)
 
         threading.Thread(target=warm_up, name="verimono-report-warm-up", daemon=True).start()

@@ -9,9 +9,10 @@ from __future__ import annotations
 import io
 import itertools
 import math
+import os
 import re
 import threading
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -24,7 +25,7 @@ def _svg(fig: Any) -> str:
     import matplotlib
 
     buf = io.StringIO()
-    salt = f"vm{next(_COUNTER)}"
+    salt = f"vm{os.getpid()}x{next(_COUNTER)}"      # unique in a document whichever process drew the plot
     with matplotlib.rc_context({"svg.hashsalt": salt, "svg.fonttype": "none"}):
         fig.savefig(buf, format="svg",
                     metadata={"Creator": None, "Date": None, "Format": None, "Type": None})
@@ -102,6 +103,8 @@ def _num(v: Any) -> float:
 def _drawn_once(subject: Any, draw: Any) -> str:
     with _DRAWING:
         hit = _DRAWN.get(id(subject))
+        if hit is None and _DRAWER is not None:
+            hit = _DRAWER.take(subject)
         if hit is not None and hit[0] is subject:
             return hit[1]
         svg = draw()
@@ -109,13 +112,113 @@ def _drawn_once(subject: Any, draw: Any) -> str:
         return svg
 
 
-def draw_ahead(studies: Any = (), samples: Any = ()) -> threading.Thread:
-    """Draw the convergence plots of ``studies`` and the trajectory plots of ``samples`` in a background
-    thread (:func:`convergence_plot` and :func:`trajectory_plot` then return them): what a run whose units
-    run on worker processes does with its otherwise idle main process (``verimono run``/``check`` with
-    ``--executor process:N``, ``auto``).  A plot the report needs before the thread reached it is drawn
-    there, once.  A plot that cannot be drawn ahead is left to the report, which says why."""
+# -- the drawer: a process of the command line's that draws the plots while the run goes on -------------------
+
+class _Drawer:
+    """This process's end of the drawer (:func:`serve`): plots asked for by :func:`draw_ahead`, taken back
+    by :func:`_drawn_once` when the report needs them.  A drawer that dies or answers nothing leaves its
+    plots to this process (drawn here, as without a drawer)."""
+
+    def __init__(self, conn: Any) -> None:
+        self.conn = conn
+        self.asked: dict[int, Any] = {}       # id(subject) -> subject, asked and not yet answered
+
+    def ask(self, kind: str, subject: Any) -> None:
+        key = id(subject)
+        if key in self.asked or key in _DRAWN:
+            return
+        try:
+            self.conn.send((key, kind, subject))
+        except Exception:  # noqa: BLE001 - a subject that cannot be sent, or a drawer gone: drawn here instead
+            return
+        self.asked[key] = subject
+
+    def take(self, subject: Any) -> tuple[Any, str] | None:
+        """The drawer's plot of ``subject`` (waiting for it when asked), or ``None``."""
+        while id(subject) in self.asked:
+            try:
+                key, html = self.conn.recv()
+            except Exception:  # noqa: BLE001 - the drawer died: what it owes is drawn here
+                self.asked.clear()
+                break
+            drawn = self.asked.pop(key, None)
+            if drawn is not None and html is not None:
+                _DRAWN[key] = (drawn, html)
+        return _DRAWN.get(id(subject))
+
+    def close(self) -> None:
+        try:
+            self.conn.close()
+        except OSError:  # pragma: no cover
+            pass
+
+
+_DRAWER: _Drawer | None = None
+
+
+def drawer_pipe() -> tuple[Callable[[], None], Callable[[], None]]:
+    """``(serve_it, connect)``: before a fork, the two ends of a drawer — ``serve_it()`` runs :func:`serve` in
+    the forked copy (its ``then``: :class:`verimono.calibration.PendingCalibration`), ``connect()`` makes this
+    process's :func:`draw_ahead` send its plots there (call it only when the copy was forked)."""
+    from multiprocessing import Pipe
+
+    here, there = Pipe(duplex=True)
+
+    def serve_it() -> None:
+        here.close()
+        serve(there)
+
+    def connect() -> None:
+        global _DRAWER
+        there.close()
+        _DRAWER = _Drawer(here)
+
+    return serve_it, connect
+
+
+def serve(conn: Any) -> None:
+    """The drawer's loop (in a forked copy of the command line): import matplotlib and draw a first figure,
+    then answer every ``(key, kind, subject)`` with ``(key, html)`` (``None`` where it could not draw it),
+    until the connection closes."""
+    warm_up()
+    draw = {"convergence": convergence_plot, "trajectory": trajectory_plot}
+    while True:
+        try:
+            key, kind, subject = conn.recv()
+        except (EOFError, OSError):
+            return
+        try:
+            html = draw[kind](subject)
+        except Exception:  # noqa: BLE001 - the asking process draws it again and reports the error there
+            html = None
+        forget()
+        conn.send((key, html))
+
+
+def disconnect() -> None:
+    """Close this process's end of the drawer (it then ends)."""
+    global _DRAWER
+    if _DRAWER is not None:
+        _DRAWER.close()
+        _DRAWER = None
+
+
+def draw_ahead(studies: Any = (), samples: Any = ()) -> threading.Thread | None:
+    """Draw the convergence plots of ``studies`` and the trajectory plots of ``samples`` ahead of the report
+    (:func:`convergence_plot` and :func:`trajectory_plot` then return them): what a run whose units run on
+    worker processes does with its waiting (``verimono run``/``check`` with ``--executor process:N``,
+    ``auto``).  With a drawer (:func:`drawer_pipe`) they are sent there and drawn on its core; else they
+    are drawn by a background thread of this process (returned).  A plot the report needs before the
+    drawer or thread reached it is waited for, or drawn there, once.  A plot that cannot be drawn ahead is
+    left to the report, which says why."""
     studies, samples = list(studies), list(samples)
+    if _DRAWER is not None:
+        with _DRAWING:
+            for s in studies:
+                _DRAWER.ask("convergence", s)
+            for s in samples:
+                _DRAWER.ask("trajectory", s)
+        return None
 
     def draw() -> None:
         try:
@@ -132,9 +235,16 @@ def draw_ahead(studies: Any = (), samples: Any = ()) -> threading.Thread:
 
 
 def forget() -> None:
-    """Drop the plots drawn ahead (after a report is written)."""
+    """Drop the plots drawn ahead (after a report is written), and those still asked of the drawer."""
     with _DRAWING:
         _DRAWN.clear()
+        if _DRAWER is not None:
+            _DRAWER.asked.clear()
+
+
+def drawing_elsewhere() -> bool:
+    """Whether :func:`draw_ahead` sends its plots to a drawer process (this process then needs no matplotlib)."""
+    return _DRAWER is not None
 
 
 def _swatch(handle: Any) -> str:
@@ -293,4 +403,4 @@ def trajectory_figure(sample: dict[str, Any], ax: Any = None, *, legend: bool = 
 
 
 __all__ = ["convergence_plot", "convergence_figure", "trajectory_plot", "trajectory_figure", "warm_up", "draw_ahead",
-           "forget"]
+           "forget", "drawer_pipe", "serve", "disconnect", "drawing_elsewhere"]
