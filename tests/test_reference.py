@@ -118,3 +118,20 @@ def test_lipschitz_input_uses_both_terms():
     without_u = vm.Problem(p.operator, p.x0, p.T, f=p.f)
     t = vm.uniform_grid(p.T, steps=300)
     assert np.abs(vm.solve(p, t).x - vm.solve(without_u, t).x).max() > 0.1
+
+
+def test_the_linear_references_exact_solution_is_the_closed_form_of_its_2x2_exponential():
+    """``e^{-Mt} x0`` for the default ``M`` (trace 2s, ``(M - sI)² = -ω² I``) is ``e^{-st}(cos ωt x0 - sin ωt/ω
+    (M - sI) x0)``: the reference's fast form agrees to round-off (6e-16 here; scipy's expm is 3e-14 off)."""
+    import math
+
+    from verimono.reference.linear import M_DEFAULT, linear
+
+    p = linear()
+    s = float(np.trace(M_DEFAULT)) / 2
+    N = M_DEFAULT - s * np.eye(2)
+    w = math.sqrt(-(N @ N)[0, 0])
+    x0 = np.array([1.0, 0.0])
+    for t in np.linspace(0.0, p.T, 401):
+        closed = math.exp(-s * t) * (math.cos(w * t) * x0 - math.sin(w * t) / w * (N @ x0))
+        assert np.max(np.abs(p.exact(t) - closed)) <= 1e-14
