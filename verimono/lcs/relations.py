@@ -108,6 +108,7 @@ class _BoxStepper:
         self.cache: dict[bytes, tuple] = {}
         self.last: bytes | None = None
         self.full_solves = 0
+        self.m_norm = float(np.abs(M).sum(axis=1).max(initial=0.0))
 
     def _entry(self, pat: bytes):
         e = self.cache.get(pat)
@@ -123,22 +124,25 @@ class _BoxStepper:
                     lu = sla.lu_factor(MII)
                 else:
                     lu = False
-            e = (s, I, fixed, self.M[:, I] if I.size else None, lu, self.M @ fixed)
+            e = (I, fixed, lu, self.M @ fixed, self.lo[I], self.hi[I], s == 0, s == 2)
             self.cache[pat] = e
         return e
 
     def _try(self, pat: bytes, q: np.ndarray):
-        s, I, fixed, _, lu, Mfixed = self._entry(pat)
-        if lu is False:
+        """The pattern's solution for ``q`` if it is strictly complementary (margin ``RTOL`` of
+        :func:`verimono.lcs.lcp.lcp_scale`), else ``None``."""
+        I, fixed, lu, Mfixed, loI, hiI, at_lo, at_hi = self._entry(pat)
+        if lu is False or not np.isfinite(q).all():     # non-finite data: the full solve says what is wrong
             return None
         lam = fixed.copy()
         if I.size:
-            lam[I] = sla.lu_solve(lu, -(q[I] + Mfixed[I]))
+            lam[I] = sla.lu_solve(lu, -(q[I] + Mfixed[I]), check_finite=False)
         y = self.M @ lam + q
-        tau = RTOL * lcp_scale(self.M, q, lam)
-        if I.size and (np.any(lam[I] - self.lo[I] <= tau) or np.any(self.hi[I] - lam[I] <= tau)):
+        # lcp_scale(M, q, lam), with ‖M‖∞ computed once
+        tau = RTOL * (1.0 + max(float(np.abs(q).max(initial=0.0)), self.m_norm * float(np.abs(lam).max(initial=0.0))))
+        if I.size and ((lam[I] - loI <= tau).any() or (hiI - lam[I] <= tau).any()):
             return None
-        if np.any(y[s == 0] <= tau) or np.any(y[s == 2] >= -tau):
+        if (y[at_lo] <= tau).any() or (y[at_hi] >= -tau).any():
             return None
         return lam, y
 
