@@ -115,36 +115,36 @@ def _drawn_once(subject: Any, draw: Any) -> str:
 # -- the drawer: a process of the command line's that draws the plots while the run goes on -------------------
 
 class _Drawer:
-    """This process's end of the drawer (:func:`serve`): plots asked for by :func:`draw_ahead`, taken back
-    by :func:`_drawn_once` when the report needs them.  A drawer that dies or answers nothing leaves its
-    plots to this process (drawn here, as without a drawer)."""
+    """This process's end of the drawer (:func:`serve`): plots asked for by :func:`draw_ahead`, fetched by
+    :func:`_drawn_once` when the report needs them.  A drawer that dies or cannot draw a plot leaves it to
+    this process (drawn here, as without a drawer)."""
 
     def __init__(self, conn: Any) -> None:
         self.conn = conn
-        self.asked: dict[int, Any] = {}       # id(subject) -> subject, asked and not yet answered
+        self.asked: dict[int, Any] = {}       # id(subject) -> subject, asked and not yet fetched
 
     def ask(self, kind: str, subject: Any) -> None:
         key = id(subject)
         if key in self.asked or key in _DRAWN:
             return
         try:
-            self.conn.send((key, kind, subject))
+            self.conn.send(("draw", key, kind, subject))
         except Exception:  # noqa: BLE001 - a subject that cannot be sent, or a drawer gone: drawn here instead
             return
         self.asked[key] = subject
 
     def take(self, subject: Any) -> tuple[Any, str] | None:
         """The drawer's plot of ``subject`` (waiting for it when asked), or ``None``."""
-        while id(subject) in self.asked:
-            try:
-                key, html = self.conn.recv()
-            except Exception:  # noqa: BLE001 - the drawer died: what it owes is drawn here
-                self.asked.clear()
-                break
-            drawn = self.asked.pop(key, None)
-            if drawn is not None and html is not None:
-                _DRAWN[key] = (drawn, html)
-        return _DRAWN.get(id(subject))
+        key = id(subject)
+        if self.asked.pop(key, None) is None:
+            return None
+        try:
+            self.conn.send(("send", key))
+            got, html = self.conn.recv()
+        except Exception:  # noqa: BLE001 - the drawer died: what it owes is drawn here
+            self.asked.clear()
+            return None
+        return (subject, html) if got == key and html is not None else None
 
     def close(self) -> None:
         try:
@@ -178,21 +178,39 @@ def drawer_pipe() -> tuple[Callable[[], None], Callable[[], None]]:
 
 def serve(conn: Any) -> None:
     """The drawer's loop (in a forked copy of the command line): import matplotlib and draw a first figure,
-    then answer every ``(key, kind, subject)`` with ``(key, html)`` (``None`` where it could not draw it),
-    until the connection closes."""
+    then draw every ``("draw", key, kind, subject)`` as it comes and keep it, and answer ``("send", key)``
+    with ``(key, html)`` (``None`` where it could not draw it), until the connection closes.  It answers
+    only when asked, so it never waits on the asking process; a thread takes the requests off the
+    connection as they come, so the asking process never waits on it."""
+    import queue
+
+    inbox: queue.SimpleQueue = queue.SimpleQueue()
+
+    def receive() -> None:
+        while True:
+            try:
+                inbox.put(conn.recv())
+            except Exception:  # noqa: BLE001 - closed (or garbled): the loop ends
+                inbox.put(None)
+                return
+
+    threading.Thread(target=receive, name="verimono-drawer-inbox", daemon=True).start()
     warm_up()
     draw = {"convergence": convergence_plot, "trajectory": trajectory_plot}
-    while True:
-        try:
-            key, kind, subject = conn.recv()
-        except (EOFError, OSError):
-            return
-        try:
-            html = draw[kind](subject)
-        except Exception:  # noqa: BLE001 - the asking process draws it again and reports the error there
-            html = None
-        forget()
-        conn.send((key, html))
+    drawn: dict[int, str | None] = {}
+    while (msg := inbox.get()) is not None:
+        if msg[0] == "draw":
+            _, key, kind, subject = msg
+            try:
+                drawn[key] = draw[kind](subject)
+            except Exception:  # noqa: BLE001 - the asking process draws it again and reports the error there
+                drawn[key] = None
+            forget()
+        else:
+            try:
+                conn.send((msg[1], drawn.pop(msg[1], None)))
+            except OSError:
+                return
 
 
 def disconnect() -> None:
