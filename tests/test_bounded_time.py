@@ -71,10 +71,10 @@ def test_no_trajectory_sample_after_a_unit_that_ran_out_of_time():
 
 
 def test_the_trajectory_sample_runs_under_the_budget(monkeypatch):
-    import verimono.checks.orders as orders
+    import verimono.stages.builtin as builtin
     from verimono.stages.builtin import _convergence_unit
 
-    monkeypatch.setattr(orders, "check_convergence_order",
+    monkeypatch.setattr(builtin, "check_convergence_order",
                         lambda stepper, problem: CheckResult("convergence_order", "s", PASSED, worst=0.1, bound=1.0))
     calls: list = []
 

@@ -106,6 +106,34 @@ def test_hypothesis_profiles_follow_the_environment(pytester):
 
 
 
+def test_a_profile_loaded_before_hypothesis_is_imported_is_loaded_when_it_is():
+    """``load_hypothesis_profile`` does not import hypothesis (a stepper's battery never searches): the
+    profile armed last is the one in force the moment hypothesis is imported, however it is imported; an
+    unknown name is refused at once."""
+    import subprocess
+    import sys
+
+    code = """
+import sys
+from verimono.profiles import load_hypothesis_profile, UnknownProfile
+load_hypothesis_profile("thorough"); load_hypothesis_profile("ci")
+print("hypothesis" in sys.modules)
+from hypothesis import strategies                      # a submodule first: the package is imported for it
+from hypothesis import settings
+s = settings.default
+print(s.derandomize, s.database, s.max_examples, type(sys.modules["hypothesis"].__loader__).__name__)
+load_hypothesis_profile("thorough")                   # imported now: loaded at once
+print(settings.default.max_examples)
+try:
+    load_hypothesis_profile("no such profile")
+except UnknownProfile:
+    print("refused")
+"""
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["False", "True", "None", "50", "SourceFileLoader", "500", "refused"]
+
+
 def _baseline_doc(command: str = "pytest") -> dict:
     """A small valid baseline document of one executed record, to be broken by the tests below."""
     from verimono.results import CheckResult, Report
@@ -192,3 +220,23 @@ def test_checks_passed_as_arguments_are_recorded_and_the_sink_takes_records_only
     assert seen == [rec, rec]                                        # the record an exception carries too
     with pytest.raises(TypeError, match="takes a CheckResult or a Report"):
         RecordSink(None).add("passed")
+
+
+def test_a_steppers_battery_never_imports_hypothesis(tmp_path):
+    """The stepper laws draw with NumPy (no search): ``verimono check`` of a stepper does not pay hypothesis'
+    import (the profile is armed for the moment it is imported)."""
+    import subprocess
+    import sys
+
+    (tmp_path / "mystep.py").write_text("import verimono\n\ndef stepper(problem, t):\n"
+                                       "    return verimono.solve(problem, t)\n")
+    code = f"""
+import sys
+from verimono.cli import main
+code = main(["check", {str(tmp_path / 'mystep.py')!r} + ":stepper", "--profile", "ci", "--executor", "serial",
+             "--out", {str(tmp_path / 'out')!r}])
+print(code, "hypothesis" in sys.modules)
+"""
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split()[-2:] == ["0", "False"]

@@ -35,7 +35,7 @@ from ..problem import Problem
 from ..results import PASSED
 from ..timeouts import note_progress
 from .core import Outcome, law, run, stepper_subject
-from .search import valid_seed
+from .arguments import valid_seed
 from .shared_runs import remembered
 from .subjects import require_problem, require_stepper
 

@@ -43,6 +43,7 @@ import numpy as np
 from hypothesis import HealthCheck, Phase, Verbosity, given, settings
 
 from .._reproducible import no_local_constants
+from .arguments import valid_horizon, valid_seed  # noqa: F401 - part of this module's names
 from ..errors import InvalidCheckArgument, UnitTimeout
 from ..profiles import UnknownProfile, active_profile, get_profile
 from ..results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
@@ -96,21 +97,6 @@ def positive_examples(examples: Any) -> int:
     if isinstance(examples, bool) or n != examples or n < 1:
         raise InvalidCheckArgument(f"examples must be a positive integer, got {examples!r}")
     return n
-
-
-def valid_seed(seed: Any) -> int:
-    """``seed`` as a non-negative integer; :class:`InvalidCheckArgument` otherwise."""
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise InvalidCheckArgument(f"seed must be a non-negative integer, got {seed!r}")
-    return int(seed)
-
-
-def valid_horizon(horizon: Any) -> float:
-    """``horizon`` as a finite time ``≥ 0``; :class:`InvalidCheckArgument` otherwise."""
-    if isinstance(horizon, bool) or not isinstance(horizon, (int, float, np.integer, np.floating)) \
-            or not (math.isfinite(horizon) and horizon >= 0):
-        raise InvalidCheckArgument(f"horizon must be a finite time >= 0, got {horizon!r}")
-    return float(horizon)
 
 
 def evaluate_sample(decl: Law, op: Any, s: Sample) -> Outcome:

@@ -24,7 +24,7 @@ from .core import laws_of, stepper_subject
 from .isolated import isolating, run_check, run_isolated
 from .partitions import single
 from .sample_problems import sample_problems
-from .search import valid_seed
+from .arguments import valid_seed
 from .shared_runs import shared_runs
 from .subjects import require_problem, require_stepper
 

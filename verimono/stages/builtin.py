@@ -24,6 +24,8 @@ from ..stepping import solve
 from ..timeouts import current_budget, run_unit, time_limit
 from ..checks.core import laws_of
 from ..checks.core import subject_name as _name
+from ..checks.orders import check_convergence_order
+from ..checks.picard import check_picard
 from ..checks.pseudo_distance import check_pseudo_distance
 from ..checks.shared_runs import shared_runs
 from ..checks.siconos import check_siconos_case, check_siconos_lcps
@@ -53,8 +55,6 @@ def sample_trajectory(stepper: Callable, problem: Any, h: float | None = None) -
 
 def _convergence_unit(stepper: Callable, problem: Any) -> Report:
     """One reference: its convergence-order record and study, and a trajectory sample for the plots."""
-    from ..checks.orders import check_convergence_order
-
     report = Report()
     rec = report.add(run_unit(lambda: check_convergence_order(stepper, problem), check="convergence_order",
                               subject=f"{_name(stepper)} on {problem.name}"))
@@ -283,8 +283,6 @@ def _hoffman_unit(seed: int) -> Report:
 
 
 def _picard_unit(stepper: Callable, problem: Any) -> Report:
-    from ..checks.picard import check_picard
-
     return Report([check_picard(stepper, problem)])
 
 
