@@ -29,6 +29,7 @@ from ..checks.picard import check_picard
 from ..checks.pseudo_distance import check_pseudo_distance
 from ..checks.shared_runs import shared_runs
 from ..checks.siconos import check_siconos_case, check_siconos_lcps
+from ..checks.stepper_battery import stepper_checks
 from .registry import RunContext, register_stage
 
 #: how many points of a trajectory the report keeps for its plot (enough for a smooth curve)
@@ -167,8 +168,6 @@ def _operator_unit(check_operator: Callable, label: str, op: Any, seed: int | No
 def trajectory_laws_stage(profile: Profile, context: RunContext) -> Report:
     """The trajectory laws of the stepper under test on every reference (and, without a user-given
     problem list, on ``profile.generated_subjects`` sampled problems)."""
-    from ..checks.stepper_battery import stepper_checks
-
     stepper = solve if context.stepper is None else context.stepper
     seed = context.seed_for(profile)
     checks = list(stepper_checks(stepper, context.problems, seed=0 if seed is None else seed,
