@@ -352,7 +352,7 @@ same = lambda h: re.sub(r"\\b[mp][0-9a-f]{{10}}\\b", "ID", re.sub(r"vm\\d+x\\d+"
 serve_it, connect = plots.drawer_pipe()
 pending = PendingCalibration(then=serve_it)
 assert pending.forked and pending.result() > 0
-connect()
+connect(True)
 assert plots.drawing_elsewhere()
 plots.draw_ahead(studies, samples)
 there = [plots.convergence_plot(s) for s in studies] + [plots.trajectory_plot(s) for s in samples]
@@ -364,7 +364,7 @@ print(len(there), [same(a) for a in there] == [same(b) for b in here], len({{a f
 plots.forget()
 serve_it, connect = plots.drawer_pipe()
 pending = PendingCalibration(then=serve_it)
-pending.result(); connect()
+pending.result(); connect(True)
 plots.draw_ahead(studies, samples)
 os.kill(pending._pid, signal.SIGKILL)                          # dies with plots owed
 print(all(same(plots.convergence_plot(s)) == same(h) for s, h in zip(studies, here)))

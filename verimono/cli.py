@@ -514,8 +514,8 @@ def main(argv: list[str] | None = None) -> int:
         if command in CALIBRATED_COMMANDS and not {"-h", "--help"} & set(given):
             serve_it, connect = plots.drawer_pipe() if command in DRAWN_COMMANDS else (None, None)
             pending = PendingCalibration(then=serve_it)
-            if pending.forked and connect is not None:
-                connect()
+            if connect is not None:
+                connect(pending.forked)
         try:
             args = build_parser().parse_args(argv)
             args.argv = given                          # the command as given (advice after an interrupt)

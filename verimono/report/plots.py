@@ -156,10 +156,11 @@ class _Drawer:
 _DRAWER: _Drawer | None = None
 
 
-def drawer_pipe() -> tuple[Callable[[], None], Callable[[], None]]:
+def drawer_pipe() -> tuple[Callable[[], None], Callable[[bool], None]]:
     """``(serve_it, connect)``: before a fork, the two ends of a drawer — ``serve_it()`` runs :func:`serve` in
-    the forked copy (its ``then``: :class:`verimono.calibration.PendingCalibration`), ``connect()`` makes this
-    process's :func:`draw_ahead` send its plots there (call it only when the copy was forked)."""
+    the forked copy (its ``then``: :class:`verimono.calibration.PendingCalibration`); ``connect(True)`` makes
+    this process's :func:`draw_ahead` send its plots there once the copy is forked, ``connect(False)`` closes
+    both ends when it was not."""
     from multiprocessing import Pipe
 
     here, there = Pipe(duplex=True)
@@ -168,10 +169,13 @@ def drawer_pipe() -> tuple[Callable[[], None], Callable[[], None]]:
         here.close()
         serve(there)
 
-    def connect() -> None:
+    def connect(forked: bool) -> None:
         global _DRAWER
         there.close()
-        _DRAWER = _Drawer(here)
+        if forked:
+            _DRAWER = _Drawer(here)
+        else:
+            here.close()
 
     return serve_it, connect
 
