@@ -17,13 +17,13 @@ from __future__ import annotations
 from collections import Counter
 
 import numpy as np
-from hypothesis import HealthCheck, Phase, event, given, settings, target
+from hypothesis import HealthCheck, Phase, event, given, reject, settings, target
 from hypothesis import strategies as st
 
 from verimono import Problem, solve
 from verimono import strategies as vs
 from verimono.checks.stepper_battery import CHECKS, LAWS
-from verimono.errors import OutsideDomain, VerimonoError
+from verimono.errors import OutsideDomain, UnverifiedSolution, VerimonoError
 from verimono.results import FAILED, SKIPPED
 from verimono.testing import describe, parametrize_with_checks
 
@@ -47,7 +47,14 @@ def _x0(op, draw):
     """A drawn point mapped into ``dom F(0,·)``: its projection onto ``cl dom F(0,·)``, then — where ``F^0``
     does not exist there (the log-barrier's open domain) — its resolvent ``J_1``, which lies in ``dom F``."""
     x = draw(vs.points(op.dim, scale=3.0), label="x0")
-    x0 = np.asarray(op.project_domain(x, 0.0), dtype=float)
+    try:
+        x0 = np.asarray(op.project_domain(x, 0.0), dtype=float)
+    except UnverifiedSolution as exc:
+        # verimono's own QP could not verify this projection (a shrunk polyhedron: the slab -2^-24 <= x1 <= 0
+        # with x1 = b on top): a limit of the harness, not of a stepper, so no law is judged on this example
+        event("x0 not set up: the projection onto dom F(0) was not verified")
+        reject()
+        raise AssertionError("unreachable") from exc
     try:
         op.min_norm(x0, 0.0)
     except OutsideDomain:
