@@ -356,6 +356,7 @@ connect(True)
 assert plots.drawing_elsewhere()
 plots.draw_ahead(studies, samples)
 there = [plots.convergence_plot(s) for s in studies] + [plots.trajectory_plot(s) for s in samples]
+assert plots.convergence_plot(studies[0]) == there[0]          # shown twice: fetched once, the same plot
 assert "matplotlib" not in __import__("sys").modules          # this process drew none of them
 plots.forget()
 plots.disconnect(); pending.close()                            # the drawer ends and is reaped

@@ -105,6 +105,8 @@ def _drawn_once(subject: Any, draw: Any) -> str:
         hit = _DRAWN.get(id(subject))
         if hit is None and _DRAWER is not None:
             hit = _DRAWER.take(subject)
+            if hit is not None:
+                _DRAWN[id(subject)] = hit        # a plot shown twice is fetched once
         if hit is not None and hit[0] is subject:
             return hit[1]
         svg = draw()
