@@ -58,8 +58,8 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
     if waits_on_workers and drawing_elsewhere() and hasattr(runner, "on_report"):
         # each unit's plots go to the drawer as the unit comes back (not when its whole stage has)
         runner.on_report = lambda rep: draw_ahead(rep.studies, rep.trajectories) if rep.studies or rep.trajectories else None
-    elif waits_on_workers:                   # this process waits on the workers: draw the report's first
-        import threading                     # figure meanwhile (matplotlib's import and font cache)
+    elif waits_on_workers and not drawing_elsewhere():   # this process waits on the workers and draws the
+        import threading                                 # plots itself: matplotlib's import and font cache now
 
         threading.Thread(target=warm_up, name="verimono-report-warm-up", daemon=True).start()
     start = time.perf_counter()
