@@ -332,7 +332,7 @@ def test_the_reports_reused_axes_draw_what_a_fresh_figure_draws(small_report):
 
 
 def test_a_drawer_process_draws_the_reports_plots_and_a_dead_one_leaves_them_here(small_report, tmp_path):
-    """The command line's drawer (``plots.drawer_pipe``, forked with the first calibration): the plots asked
+    """The command line's drawer (``report.drawer``, forked with the first calibration): the plots asked
     of it are the ones this process would draw (apart from the figures' ids), each drawn once there; when
     it dies, the report draws what it owed here."""
     import pickle
@@ -346,10 +346,10 @@ def test_a_drawer_process_draws_the_reports_plots_and_a_dead_one_leaves_them_her
     code = f"""
 import os, pickle, re, signal
 from verimono.calibration import PendingCalibration
-from verimono.report import plots
+from verimono.report import drawer, plots
 studies, samples = pickle.loads(open({str(path)!r}, "rb").read())
 same = lambda h: re.sub(r"\\b[mp][0-9a-f]{{10}}\\b", "ID", re.sub(r"vm\\d+x\\d+", "vm", h))
-serve_it, connect = plots.drawer_pipe()
+serve_it, connect = drawer.drawer_pipe()
 pending = PendingCalibration(then=serve_it)
 assert pending.forked and pending.result() > 0
 connect(True)
@@ -359,17 +359,17 @@ there = [plots.convergence_plot(s) for s in studies] + [plots.trajectory_plot(s)
 assert plots.convergence_plot(studies[0]) == there[0]          # shown twice: fetched once, the same plot
 assert "matplotlib" not in __import__("sys").modules          # this process drew none of them
 plots.forget()
-plots.disconnect(); pending.close()                            # the drawer ends and is reaped
+drawer.disconnect(); pending.close()                            # the drawer ends and is reaped
 here = [plots.convergence_plot(s) for s in studies] + [plots.trajectory_plot(s) for s in samples]
 print(len(there), [same(a) for a in there] == [same(b) for b in here], len({{a for a in there}}) == len(there))
 plots.forget()
-serve_it, connect = plots.drawer_pipe()
+serve_it, connect = drawer.drawer_pipe()
 pending = PendingCalibration(then=serve_it)
 pending.result(); connect(True)
 plots.draw_ahead(studies, samples)
 os.kill(pending._pid, signal.SIGKILL)                          # dies with plots owed
 print(all(same(plots.convergence_plot(s)) == same(h) for s, h in zip(studies, here)))
-plots.disconnect(); pending.close()
+drawer.disconnect(); pending.close()
 """
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr

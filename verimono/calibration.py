@@ -74,7 +74,7 @@ class PendingCalibration:
 
     def __init__(self, repeats: int = 3, then: Callable[[], None] | None = None) -> None:
         """``then``: what the copy does once it has answered (the command line's report drawer,
-        :func:`verimono.report.plots.serve`); the copy then lives on until :meth:`close`."""
+        :func:`verimono.report.drawer.serve`); the copy then lives on until :meth:`close`."""
         self.repeats = repeats
         self._value: float | None = None
         self._pid: int | None = None

@@ -501,7 +501,7 @@ def main(argv: list[str] | None = None) -> int:
     from threadpoolctl import threadpool_limits
 
     from .calibration import PendingCalibration
-    from .report import plots
+    from .report import drawer
 
     given = list(sys.argv[1:] if argv is None else argv)
     command = next((a for a in given if not a.startswith("-")), None)
@@ -509,10 +509,10 @@ def main(argv: list[str] | None = None) -> int:
         # the run's first calibration is measured on the other core while this process imports the checks
         # and reads its target (about 0.4 s; the measurement takes 0.2 s): it is not waited for; the copy
         # that measures it then imports matplotlib and draws the report's plots as the stages deliver them
-        # (plots.serve), so that this process only runs the stages
+        # (report.drawer), so that this process only runs the stages
         pending = None
         if command in CALIBRATED_COMMANDS and not {"-h", "--help"} & set(given):
-            serve_it, connect = plots.drawer_pipe() if command in DRAWN_COMMANDS else (None, None)
+            serve_it, connect = drawer.drawer_pipe() if command in DRAWN_COMMANDS else (None, None)
             pending = PendingCalibration(then=serve_it)
             if connect is not None:
                 connect(pending.forked)
@@ -527,7 +527,7 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"verimono {args.command}: {exc}", file=sys.stderr)
                 return EXIT_UNDECIDED
         finally:
-            plots.disconnect()                         # the drawer ends, then its process is reaped
+            drawer.disconnect()                        # the drawer ends, then its process is reaped
             if pending is not None:
                 pending.close()
 

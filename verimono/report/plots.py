@@ -12,7 +12,7 @@ import math
 import os
 import re
 import threading
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
@@ -114,134 +114,34 @@ def _drawn_once(subject: Any, draw: Any) -> str:
         return svg
 
 
-# -- the drawer: a process of the command line's that draws the plots while the run goes on -------------------
+# -- drawn elsewhere: the command line's drawer process (verimono.report.drawer) ------------------------------
 
-class _Drawer:
-    """This process's end of the drawer (:func:`serve`): plots asked for by :func:`draw_ahead`, fetched by
-    :func:`_drawn_once` when the report needs them.  A drawer that dies or cannot draw a plot leaves it to
-    this process (drawn here, as without a drawer)."""
-
-    def __init__(self, conn: Any) -> None:
-        self.conn = conn
-        self.asked: dict[int, Any] = {}       # id(subject) -> subject, asked and not yet fetched
-
-    def ask(self, kind: str, subject: Any) -> None:
-        key = id(subject)
-        if key in self.asked or key in _DRAWN:
-            return
-        try:
-            self.conn.send(("draw", key, kind, subject))
-        except Exception:  # noqa: BLE001 - a subject that cannot be sent, or a drawer gone: drawn here instead
-            return
-        self.asked[key] = subject
-
-    def take(self, subject: Any) -> tuple[Any, str] | None:
-        """The drawer's plot of ``subject`` (waiting for it when asked), or ``None``."""
-        key = id(subject)
-        if self.asked.pop(key, None) is None:
-            return None
-        try:
-            self.conn.send(("send", key))
-            got, html = self.conn.recv()
-        except Exception:  # noqa: BLE001 - the drawer died: what it owes is drawn here
-            self.asked.clear()
-            return None
-        return (subject, html) if got == key and html is not None else None
-
-    def close(self) -> None:
-        try:
-            self.conn.close()
-        except OSError:  # pragma: no cover
-            pass
+#: the drawer this process sends its plots to (:func:`verimono.report.drawer.drawer_pipe`), or ``None``: an object
+#: with ``ask(kind, subject)``, ``take(subject) -> (subject, html) | None`` and ``forget()``
+_DRAWER: Any = None
 
 
-_DRAWER: _Drawer | None = None
-
-
-def drawer_pipe() -> tuple[Callable[[], None], Callable[[bool], None]]:
-    """``(serve_it, connect)``: before a fork, the two ends of a drawer — ``serve_it()`` runs :func:`serve` in
-    the forked copy (its ``then``: :class:`verimono.calibration.PendingCalibration`); ``connect(True)`` makes
-    this process's :func:`draw_ahead` send its plots there once the copy is forked, ``connect(False)`` closes
-    both ends when it was not."""
-    from multiprocessing import Pipe
-
-    here, there = Pipe(duplex=True)
-
-    def serve_it() -> None:
-        here.close()
-        serve(there)
-
-    def connect(forked: bool) -> None:
-        global _DRAWER
-        there.close()
-        if forked:
-            _DRAWER = _Drawer(here)
-        else:
-            here.close()
-
-    return serve_it, connect
-
-
-def serve(conn: Any) -> None:
-    """The drawer's loop (in a forked copy of the command line): import matplotlib and draw a first figure,
-    then draw every ``("draw", key, kind, subject)`` as it comes and keep it, and answer ``("send", key)``
-    with ``(key, html)`` (``None`` where it could not draw it), until the connection closes.  It answers
-    only when asked, so it never waits on the asking process; a thread takes the requests off the
-    connection as they come, so the asking process never waits on it."""
-    import queue
-
-    inbox: queue.SimpleQueue = queue.SimpleQueue()
-
-    def receive() -> None:
-        while True:
-            try:
-                inbox.put(conn.recv())
-            except Exception:  # noqa: BLE001 - closed (or garbled): the loop ends
-                inbox.put(None)
-                return
-
-    threading.Thread(target=receive, name="verimono-drawer-inbox", daemon=True).start()
-    warm_up()
-    draw = {"convergence": convergence_plot, "trajectory": trajectory_plot}
-    drawn: dict[int, str | None] = {}
-    while (msg := inbox.get()) is not None:
-        if msg[0] == "draw":
-            _, key, kind, subject = msg
-            try:
-                drawn[key] = draw[kind](subject)
-            except Exception:  # noqa: BLE001 - the asking process draws it again and reports the error there
-                drawn[key] = None
-            forget()
-        else:
-            try:
-                conn.send((msg[1], drawn.pop(msg[1], None)))
-            except OSError:
-                return
-
-
-def disconnect() -> None:
-    """Close this process's end of the drawer (it then ends)."""
+def use_drawer(drawer: Any) -> None:
+    """Send :func:`draw_ahead`'s plots to ``drawer`` (``None``: draw them here again)."""
     global _DRAWER
-    if _DRAWER is not None:
-        _DRAWER.close()
-        _DRAWER = None
+    _DRAWER = drawer
 
 
 def draw_ahead(studies: Any = (), samples: Any = ()) -> threading.Thread | None:
     """Draw the convergence plots of ``studies`` and the trajectory plots of ``samples`` ahead of the report
     (:func:`convergence_plot` and :func:`trajectory_plot` then return them): what a run whose units run on
     worker processes does with its waiting (``verimono run``/``check`` with ``--executor process:N``,
-    ``auto``).  With a drawer (:func:`drawer_pipe`) they are sent there and drawn on its core; else they
+    ``auto``).  With a drawer (:mod:`verimono.report.drawer`) they are sent there and drawn on its core; else they
     are drawn by a background thread of this process (returned).  A plot the report needs before the
     drawer or thread reached it is waited for, or drawn there, once.  A plot that cannot be drawn ahead is
     left to the report, which says why."""
     studies, samples = list(studies), list(samples)
     if _DRAWER is not None:
         with _DRAWING:
-            for s in studies:
-                _DRAWER.ask("convergence", s)
-            for s in samples:
-                _DRAWER.ask("trajectory", s)
+            for kind, subjects in (("convergence", studies), ("trajectory", samples)):
+                for s in subjects:
+                    if id(s) not in _DRAWN:
+                        _DRAWER.ask(kind, s)
         return None
 
     def draw() -> None:
@@ -263,7 +163,7 @@ def forget() -> None:
     with _DRAWING:
         _DRAWN.clear()
         if _DRAWER is not None:
-            _DRAWER.asked.clear()
+            _DRAWER.forget()
 
 
 def drawing_elsewhere() -> bool:
@@ -427,4 +327,4 @@ def trajectory_figure(sample: dict[str, Any], ax: Any = None, *, legend: bool = 
 
 
 __all__ = ["convergence_plot", "convergence_figure", "trajectory_plot", "trajectory_figure", "warm_up", "draw_ahead",
-           "forget", "drawer_pipe", "serve", "disconnect", "drawing_elsewhere"]
+           "forget", "use_drawer", "drawing_elsewhere"]
