@@ -49,12 +49,11 @@ def _x0(op, draw):
     x = draw(vs.points(op.dim, scale=3.0), label="x0")
     try:
         x0 = np.asarray(op.project_domain(x, 0.0), dtype=float)
-    except UnverifiedSolution as exc:
+    except UnverifiedSolution:
         # verimono's own QP could not verify this projection (a shrunk polyhedron: the slab -2^-24 <= x1 <= 0
         # with x1 = b on top): a limit of the harness, not of a stepper, so no law is judged on this example
         event("x0 not set up: the projection onto dom F(0) was not verified")
         reject()
-        raise AssertionError("unreachable") from exc
     try:
         op.min_norm(x0, 0.0)
     except OutsideDomain:

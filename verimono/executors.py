@@ -32,6 +32,7 @@ finished and a failed record naming the hung call.  The explicit budget of the s
 from __future__ import annotations
 
 import dataclasses
+import functools
 import multiprocessing
 import os
 import sys
@@ -74,24 +75,23 @@ def unit_failure(unit: Unit, message: str, *, traceback_text: str | None = None,
 
 # -- what runs on a worker ----------------------------------------------------------------------------
 
-#: whether this process has limited BLAS to one thread
-_PREPARED: dict[str, bool] = {"blas": False}
+@functools.cache
+def _one_blas_thread() -> None:
+    """One BLAS thread in this process, as in the ``verimono run`` process (once: threadpoolctl inspects every
+    loaded library, 1.3 ms a call here)."""
+    try:
+        from threadpoolctl import threadpool_limits
+
+        threadpool_limits(limits=1, user_api="blas")
+    except ImportError:  # pragma: no cover - threadpoolctl is a dependency
+        pass
 
 
 def _prepare_worker(profile: str | None) -> None:
-    """The run's hypothesis profile (loaded again for every unit: a unit may load another) and one BLAS
-    thread, as in the ``verimono run`` process (once per process: threadpoolctl inspects every loaded
-    library, 1.3 ms a call here)."""
+    """The run's hypothesis profile (loaded again for every unit: a unit may load another) and one BLAS thread."""
     if profile:
         load_hypothesis_profile(profile)
-    if not _PREPARED["blas"]:
-        try:
-            from threadpoolctl import threadpool_limits
-
-            threadpool_limits(limits=1, user_api="blas")
-        except ImportError:  # pragma: no cover - threadpoolctl is a dependency
-            pass
-        _PREPARED["blas"] = True
+    _one_blas_thread()
 
 
 def run_payload(payload: bytes) -> bytes:

@@ -49,7 +49,7 @@ from ..errors import OutsideDomain
 from ..operators import resolvent_rows
 from ..problem import Problem
 from ..results import FAILED, PASSED, SKIPPED, UNDECIDED, XFAIL, XFAIL_DECLARED, CheckResult, Report
-from .search import valid_seed
+from .arguments import valid_seed
 from .core import Outcome, law, laws_of, run, subject_name
 from .subjects import require_problem
 from ..tolerances import GROWTH_FLAG, RTOL, STALL_RATIO, STALL_WINDOW, quotient_tolerance, tolerance

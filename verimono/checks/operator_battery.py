@@ -16,7 +16,8 @@ from ..results import Report
 from . import operator_laws, prox_laws  # noqa: F401 - the laws join the registry on import
 from .core import Law, laws_of, subject_name
 from .isolated import isolating, run_isolated
-from .search import default_examples, fresh_seed, positive_examples, valid_horizon, valid_seed
+from .arguments import valid_horizon, valid_seed
+from .search import default_examples, fresh_seed, positive_examples
 from .subjects import require_operator
 
 #: the operator laws (:class:`verimono.checks.core.Law`), in the order they run

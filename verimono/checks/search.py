@@ -43,7 +43,7 @@ import numpy as np
 from hypothesis import HealthCheck, Phase, Verbosity, given, settings
 
 from .._reproducible import no_local_constants
-from .arguments import valid_horizon, valid_seed  # noqa: F401 - part of this module's names
+from .arguments import valid_horizon, valid_seed
 from ..errors import InvalidCheckArgument, UnitTimeout
 from ..profiles import UnknownProfile, active_profile, get_profile
 from ..results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult

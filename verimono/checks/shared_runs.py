@@ -38,31 +38,34 @@ _ACTIVE: list["_Runs"] = []
 
 
 class _Runs:
+    """What one :func:`shared_runs` block keeps: ``key -> (owners, arrays, precision)``, at most :data:`MAX_BYTES`
+    of arrays in all, the oldest dropped first."""
+
     def __init__(self) -> None:
-        self.kept: OrderedDict[tuple, tuple[Any, Any, np.ndarray, str | None]] = OrderedDict()
+        self.kept: OrderedDict[tuple, tuple[tuple, tuple[np.ndarray, ...], str | None]] = OrderedDict()
         self.bytes = 0
         self.hits = 0
-        self.values: OrderedDict[tuple, tuple[Any, tuple, str]] = OrderedDict()
-        self.value_bytes = 0
 
-    def get(self, key: tuple) -> np.ndarray | None:
+    def get(self, key: tuple) -> tuple[np.ndarray, ...] | None:
+        """Copies of the arrays kept for ``key`` (their precision observed again), or ``None``."""
         hit = self.kept.get(key)
         if hit is None:
             return None
         self.hits += 1
-        if hit[3] not in (None, "float64"):
-            observe(hit[3])
-        return hit[2].copy()
+        if hit[2] not in (None, "float64"):
+            observe(hit[2])
+        return tuple(a.copy() for a in hit[1])
 
-    def put(self, key: tuple, stepper: Any, problem: Any, x: np.ndarray, precision: str | None) -> None:
-        if x.nbytes > MAX_BYTES:
+    def put(self, key: tuple, owners: tuple, arrays: tuple[np.ndarray, ...], precision: str | None) -> None:
+        size = sum(a.nbytes for a in arrays)
+        if size > MAX_BYTES:
             return
-        # the stepper and problem are held with their states, so the ids in the key cannot be reused
-        self.kept[key] = (stepper, problem, x.copy(), precision)
-        self.bytes += x.nbytes
+        # the owners (stepper, problem) are held with their arrays, so the ids in the key cannot be reused
+        self.kept[key] = (owners, tuple(a.copy() for a in arrays), precision)
+        self.bytes += size
         while self.bytes > MAX_BYTES:
-            _, (_, _, old, _) = self.kept.popitem(last=False)
-            self.bytes -= old.nbytes
+            _, (_, old, _) = self.kept.popitem(last=False)
+            self.bytes -= sum(a.nbytes for a in old)
 
 
 @contextmanager
@@ -89,10 +92,11 @@ def remembered(stepper: Any, problem: Any, grid: np.ndarray,
     if not _ACTIVE:
         return run()[0]
     key = _key(stepper, problem, np.asarray(grid, dtype=float))
-    x = _ACTIVE[-1].get(key)
-    if x is None:
-        x, precision = run()
-        _ACTIVE[-1].put(key, stepper, problem, x, precision)
+    hit = _ACTIVE[-1].get(key)
+    if hit is not None:
+        return hit[0]
+    x, precision = run()
+    _ACTIVE[-1].put(key, (stepper, problem), (x,), precision)
     return x
 
 
@@ -103,21 +107,12 @@ def remembered_value(key: tuple, owners: tuple, compute: Callable[[], tuple[np.n
     ``compute`` that raises is not remembered."""
     if not _ACTIVE:
         return compute()
-    runs = _ACTIVE[-1]
-    hit = runs.values.get(key)
+    hit = _ACTIVE[-1].get(key)
     if hit is not None:
-        if hit[2] != "float64":
-            observe(hit[2])
-        return tuple(a.copy() for a in hit[0])
+        return hit
     with judged_precision() as seen:      # reports what it saw to the judgement in progress as well
         value = compute()
-    size = sum(a.nbytes for a in value)
-    if size <= MAX_BYTES:
-        runs.values[key] = (tuple(a.copy() for a in value), owners, seen.name)
-        runs.value_bytes += size
-        while runs.value_bytes > MAX_BYTES:
-            _, (old, _, _) = runs.values.popitem(last=False)
-            runs.value_bytes -= sum(a.nbytes for a in old)
+    _ACTIVE[-1].put(key, owners, value, seen.name)
     return value
 
 

@@ -252,8 +252,8 @@ def check_selections(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int 
     values, and says first when ``x_{k+1}`` lies outside ``cl dom F(t_{k+1},·)`` — where ``F`` is empty and no
     velocity can be a selection.
 
-    Tolerance: :func:`verimono.tolerances.quotient_tolerance` (a difference quotient divides the
-    round-off of the states by ``h``).
+    Tolerance: that of a difference quotient, :func:`verimono.tolerances.quotient_tolerance` (it divides the
+    round-off of the states by ``h``), computed for every step at once with ``row_tolerances``.
 
     Claim: ``proximal`` — the discrete velocities of the paper's scheme are selections; another scheme's
     (the midpoint rule, the exact solution sampled) are not, and need not be.
@@ -314,6 +314,8 @@ def resolvent_witnesses(stepper: Callable, p: Problem, t: np.ndarray) -> tuple[n
         return y, back
 
     x0 = np.asarray(p.x0)
+    # the states are in the key: a run dropped from the block and made again by a stepper that is not
+    # deterministic gets its own witnesses, never another run's
     key = ("resolvent_witnesses", id(stepper), id(p), float(p.T), x0.tobytes(), t.shape, t.tobytes(), x.tobytes())
     y, back = remembered_value(key, (stepper, p), compute)
     return x, y, back

@@ -67,7 +67,7 @@ _CONNECTED: list[_Drawer] = []
 def drawer_pipe() -> tuple[Callable[[], None], Callable[[bool], None]]:
     """``(serve_it, connect)``: before a fork, the two ends of a drawer — ``serve_it()`` runs :func:`serve` in
     the forked copy (its ``then``: :class:`verimono.calibration.PendingCalibration`); ``connect(True)`` makes
-    this process's :func:`draw_ahead` send its plots there once the copy is forked, ``connect(False)`` closes
+    this process's :func:`verimono.report.plots.draw_ahead` send its plots there once the copy is forked, ``connect(False)`` closes
     both ends when it was not."""
     from multiprocessing import Pipe
 
