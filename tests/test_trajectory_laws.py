@@ -66,6 +66,20 @@ def test_in_domain_takes_resolvent_witnesses_and_measures_the_rest_exactly():
     assert cx["distance"] == pytest.approx(exact, rel=1e-12)
 
 
+def test_witness_steps_are_powers_of_two_below_half_the_step_shared_by_each_octave():
+    """``μ_k`` is the power of two in ``(h_k/4, h_k/2]`` (never the scheme's own step, round-off within the
+    states'), so a partition whose steps span ``r`` octaves needs at most ``r + 1`` distinct resolvent steps."""
+    from verimono.checks.trajectory_laws import witness_steps
+    from verimono.grids import graded_grid, random_grid
+
+    for t in (random_grid(9.4, 160, seed=3), graded_grid(9.4, 160), uniform_grid(1.0, steps=3)):
+        h, mu = np.diff(t), witness_steps(t)
+        assert np.all(h / 4 < mu) and np.all(mu <= h / 2)
+        assert np.all(np.frexp(mu)[0] == 0.5)                      # exactly powers of two
+        octaves = np.log2(h.max() / h.min())
+        assert len(np.unique(mu)) <= np.floor(octaves) + 2
+
+
 def test_unique_limit_refines_past_meshes_coarser_than_the_problem():
     """A thorough hypothesis run found this false alarm: x' ∈ −∂(2|x|) from x0 = 1/32 dies out at t = 1/64,
     so every partition of mesh 0.1 or 0.025 gives 0 from its first cell on: distances 0, 0, then c·h at

