@@ -256,3 +256,25 @@ def test_a_degenerate_candidate_is_accepted_only_when_it_is_least_norm(monkeypat
     kern2 = K.StepKernel(sys, sys.step_matrices(0.2, 1.0), exo_u=False, exo_v=True, v_const=None)
     far2 = kern2.pattern(np.array([1, 1, 1]))
     assert kern2._least_norm_degenerate(far2, kern2.try_row(far2, [0.0], q.tolist(), 1.0)[0], [0.0], 1.0)
+
+
+@pytest.mark.parametrize("n", [1, 2, 4, 9])
+def test_direct_lapack_lu_is_scipys_bit_for_bit(n):
+    """The kernels' LU (LAPACK getrf/getrs without SciPy's per-call wrapper) returns exactly what
+    ``scipy.linalg.lu_factor``/``lu_solve`` return, for one right-hand side and several; a wrong shape is refused."""
+    import scipy.linalg as sla
+
+    from verimono.lcs._lu import lu_factor, lu_solve
+
+    rng = np.random.default_rng(n)
+    A = rng.normal(size=(n, n)) + n * np.eye(n)
+    lu, piv = lu_factor(A)
+    ref = sla.lu_factor(A, check_finite=False)
+    assert np.array_equal(lu, ref[0]) and np.array_equal(piv, ref[1])
+    for b in (rng.normal(size=n), rng.normal(size=(n, 3))):
+        x = lu_solve((lu, piv), b)
+        assert np.array_equal(x, sla.lu_solve(ref, b, check_finite=False))
+        assert np.allclose(A @ x, b, rtol=0, atol=1e-12 * (1 + np.abs(b).max()))
+    assert lu_solve((lu, piv), np.empty((n, 0))).shape == (n, 0)
+    with pytest.raises(ValueError, match="incompatible"):
+        lu_solve((lu, piv), np.ones(n + 1))

@@ -44,10 +44,10 @@ import itertools
 import math
 
 import numpy as np
-import scipy.linalg as sla
 
 from ..errors import BatchStepError, InfeasibleStep, InvalidProblem, SolverFailure, VerimonoError
 from ..tolerances import ACTIVE_SET_COND, QP_RTOL, RTOL
+from ._lu import lu_factor, lu_solve
 from .lcp import lcp_scale
 from .relations import BoxRelation
 
@@ -164,7 +164,7 @@ class StepKernel:
                 return None
             rhs = q[I].copy()
             rhs[:, -1] += Mfixed[I]
-            z[I] = -sla.lu_solve(sla.lu_factor(MII, check_finite=False), rhs, check_finite=False)
+            z[I] = -lu_solve(lu_factor(MII), rhs)
         xn = self._xfree + self.sm.G @ z
         wl = M @ z + q
         wo = self.sys.C @ xn + self.sys.D @ z + self._V

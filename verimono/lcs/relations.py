@@ -16,11 +16,11 @@ least-norm one.
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg as sla
 
 from ..errors import InvalidProblem, NotMonotone, UnverifiedSolution
 from ..operators import Operator
 from ..tolerances import QP_RTOL, RTOL, tolerance
+from ._lu import lu_factor, lu_solve
 from .lcp import LCPResult, lcp_scale, solve_box, solve_lcp
 
 
@@ -121,7 +121,7 @@ class _BoxStepper:
             if I.size:
                 MII = self.M[np.ix_(I, I)]
                 if np.linalg.cond(MII) < 1e12:
-                    lu = sla.lu_factor(MII)
+                    lu = lu_factor(MII)
                 else:
                     lu = False
             e = (I, fixed, lu, self.M @ fixed, self.lo[I], self.hi[I], s == 0, s == 2)
@@ -136,7 +136,7 @@ class _BoxStepper:
             return None
         lam = fixed.copy()
         if I.size:
-            lam[I] = sla.lu_solve(lu, -(q[I] + Mfixed[I]), check_finite=False)
+            lam[I] = lu_solve(lu, -(q[I] + Mfixed[I]))
         y = self.M @ lam + q
         # lcp_scale(M, q, lam), with ‖M‖∞ computed once
         tau = RTOL * (1.0 + max(float(np.abs(q).max(initial=0.0)), self.m_norm * float(np.abs(lam).max(initial=0.0))))
@@ -202,11 +202,11 @@ class OperatorRelation(Relation):
         M, q = np.asarray(M, float), np.asarray(q, float)
         m = q.shape[0]
         gamma = 1.0 / max(np.linalg.norm(M, 2), 1e-12)
-        lu = sla.lu_factor(np.eye(m) + gamma * M)
+        lu = lu_factor(np.eye(m) + gamma * M)
         s = np.zeros(m)
         scale = 1.0 + np.abs(q).max(initial=0.0)
         for _ in range(self.MAX_ITER):
-            zeta = sla.lu_solve(lu, s + gamma * q)
+            zeta = lu_solve(lu, s + gamma * q)
             s = s + self.op.resolvent(2 * zeta - s, gamma) - zeta
             nat = zeta - self.op.resolvent(zeta - gamma * (M @ zeta - q), gamma)
             if np.abs(nat).max() <= QP_RTOL * gamma * scale:

@@ -20,7 +20,6 @@ from __future__ import annotations
 from typing import Any, Callable
 
 import numpy as np
-import scipy.linalg as sla
 
 from .._params import as_param
 from ..errors import InfeasibleStep, InvalidProblem, OutsideDomain, SolverFailure
@@ -30,8 +29,9 @@ from ..problem import Problem
 from ..qp import solve_qp
 from ..stepping import Trajectory
 from ..tolerances import tolerance
-from .lcp import _box_lcp, _feasible, is_psd, proved_solvable, select_over_sol, solve_lcp
+from ._lu import lu_factor, lu_solve
 from .kernel import BatchStepError
+from .lcp import _box_lcp, _feasible, is_psd, proved_solvable, select_over_sol, solve_lcp
 from .relations import BoxRelation, as_relation
 
 
@@ -56,13 +56,13 @@ class StepMatrices:
         self.h, self.theta, self.gamma = h, theta, gamma
         W = np.eye(n) - h * theta * sys.A
         try:
-            self.lu = sla.lu_factor(W, check_finite=False)
+            self.lu = lu_factor(W)
         except (ValueError, np.linalg.LinAlgError):
             raise InvalidProblem(f"I − hθA is singular for h = {h:g}, θ = {theta:g}") from None
         if not np.all(np.isfinite(self.lu[0])) or np.min(np.abs(np.diag(self.lu[0]))) == 0.0:
             raise InvalidProblem(f"I − hθA is singular for h = {h:g}, θ = {theta:g}")
-        self.E = sla.lu_solve(self.lu, np.eye(n) + h * (1.0 - theta) * sys.A)
-        WiB = sla.lu_solve(self.lu, sys.B)
+        self.E = lu_solve(self.lu, np.eye(n) + h * (1.0 - theta) * sys.A)
+        WiB = lu_solve(self.lu, sys.B)
         self.G = h * WiB
         self.M = sys.D + h * gamma * sys.C @ WiB
         self.step = sys.relation.stepper(self.M)
@@ -213,7 +213,7 @@ class LinearRelationSystem:
         parts = []
         if dU is not None:
             flat = dU.reshape(-1, self.n)
-            parts.append(sla.lu_solve(sm.lu, flat.T, check_finite=False).T.reshape(dU.shape))
+            parts.append(lu_solve(sm.lu, flat.T).T.reshape(dU.shape))
         # a nonzero constant v enters as a column of the exogenous terms, like a per-row or varying v: a row of
         # a batch and its single run then do the same multiply-adds (a zero v is folded away: it adds nothing)
         vrow = vc is not None and bool(np.any(vc != 0.0))
@@ -274,7 +274,7 @@ class LinearRelationSystem:
                     xk = X[k, i]
                     xfree = sm.E @ xk
                     if dU is not None:
-                        xfree = xfree + sla.lu_solve(sm.lu, dU[k] if dU.ndim == 2 else dU[k, i])
+                        xfree = xfree + lu_solve(sm.lu, dU[k] if dU.ndim == 2 else dU[k, i])
                     if V is not None:
                         v = V[k] if V.ndim == 2 else V[k, i]
                     else:
