@@ -485,12 +485,6 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-#: BLAS threads for a verification run: every matrix here is small, so extra BLAS threads only contend
-#: for the cores; on the 2-core reference machine, under load, threaded OpenBLAS made the catalog's
-#: convergence studies vary from 0.4 s to 31 s, against a steady 0.4 s single-threaded
-BLAS_THREADS = 1
-
-
 #: the commands that run the verification, whose first calibration :func:`main` starts before its imports
 CALIBRATED_COMMANDS = ("run", "check", "baseline")
 #: the commands whose report's plots are drawn by that copy (``baseline`` writes no report)
@@ -501,6 +495,7 @@ def main(argv: list[str] | None = None) -> int:
     from threadpoolctl import threadpool_limits
 
     from .calibration import PendingCalibration
+    from .executors import BLAS_THREADS
     from .report import drawer
 
     given = list(sys.argv[1:] if argv is None else argv)

@@ -17,7 +17,7 @@ from typing import Any, Callable
 
 from . import watchdog
 from .environment import environment
-from .executors import make_runner
+from .executors import BLAS_THREADS, make_runner
 from .profiles import get_profile, load_hypothesis_profile
 from .progress import Progress
 from .report import write
@@ -39,6 +39,8 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
     ``on_done(stage, report, info)`` is called after each stage (the interrupt handler keeps them).
     ``calibration``: the run's first calibration, started earlier (the command line starts it before its
     imports); measured here, before any worker starts, when not given."""
+
+    from threadpoolctl import threadpool_limits
 
     from .stages import run_stages   # the checks and what they need (scipy): imported once a run begins
 
@@ -74,7 +76,10 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
             on_done(stage, rep, info)
 
     try:
-        report = run_stages(stages, profile, context, on_start=progress.start, on_done=done)
+        # BLAS_THREADS for the BLAS libraries the checks loaded too (SciPy's OpenBLAS is not NumPy's): the command
+        # line limited those loaded when it began, and SciPy's two threads spun 0.5 s of a core in a serial run
+        with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
+            report = run_stages(stages, profile, context, on_start=progress.start, on_done=done)
     finally:
         runner.close()
     duration = time.perf_counter() - start
