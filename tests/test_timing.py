@@ -108,6 +108,23 @@ def test_with_another_thread_running_the_first_calibration_is_measured_here(monk
         other.join()
 
 
+@pytest.mark.parametrize("seconds, agreeing_with, runs, best", [
+    ([0.060, 0.050, 0.055], None, 3, 0.050),        # no earlier calibration: best of 3
+    ([0.062, 0.050, 0.055], 0.060, 1, 0.062),       # the first repeat agrees within 5%: the ends agree
+    ([0.080, 0.058, 0.050], 0.060, 2, 0.058),       # a slow repeat does not, the next one does
+    ([0.080, 0.070, 0.075], 0.060, 3, 0.070),       # none agrees: best of 3, as without one
+    ([0.050, 0.049, 0.030], 0.060, 3, 0.030),       # faster than the start by more than 5%: repeated too
+])
+def test_the_end_calibration_stops_repeating_once_it_agrees_with_the_start(monkeypatch, seconds, agreeing_with,
+                                                                            runs, best):
+    """Repeats of the workload end at the first within AGREEMENT of ``agreeing_with`` (a scripted clock)."""
+    clock, ran = iter(t for s in seconds for t in (0.0, s)), []
+    monkeypatch.setattr(calibration.time, "perf_counter", lambda: next(clock))
+    monkeypatch.setattr(calibration, "workload", lambda: ran.append(1))
+    assert calibration.calibrate(agreeing_with=agreeing_with) == best
+    assert len(ran) == runs
+
+
 def test_a_unit_over_its_scaled_budget_is_stopped_and_says_why(monkeypatch):
     if not timeouts.supported():
         pytest.skip("no SIGALRM here")

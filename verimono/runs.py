@@ -85,9 +85,10 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
     duration = time.perf_counter() - start
     # once more at the end: one calibration (best of 3 x 0.1 s) samples one moment of a shared machine and
     # read 0.08-0.16 s here within an hour; noise only slows a workload down, so the faster of the two ends
-    # (best of 6) is the steadier unit, in the baseline and in the run gated against it alike (and the two
-    # ends' drift tells the gate whether the machine was quiet enough to judge stage times at all)
-    cals = [cal, calibrate()]
+    # is the steadier unit, in the baseline and in the run gated against it alike (and the two ends' drift
+    # tells the gate whether the machine was quiet enough to judge stage times at all: a first repeat that
+    # agrees with the start's is enough to say it was)
+    cals = [cal, calibrate(agreeing_with=cal)]
     selection = {"stages": stages, "references": None if context.problems is None else
                  [p.name for p in context.problems]}
     report.meta.update({"command": command, "target": target, "profile": profile_name, "seed": context.seed,
