@@ -113,12 +113,12 @@ def reproduction_script(problem: Problem) -> str:
     """Python that reruns the order check with ``stepper`` bound: the problem from the reference catalog by
     name, from the ``MODULE:OBJECT`` it was loaded from (:func:`verimono.problem.origin_of`), or else a line
     the user completes with their own problem."""
-    from ..reference import catalog
+    from ..reference import names
 
     name = subject_name(problem)
     lines = ["from verimono.checks.orders import check_convergence_order"]
     origin = origin_of(problem)
-    if name in {p.name for p in catalog()}:
+    if name in names():
         lines += ["from verimono.reference import get", f"problem = get({name!r})"]
     elif origin:
         lines += ["from verimono.targets import load_target", f"problem = load_target({origin!r})"]

@@ -20,7 +20,6 @@ To add a battery::
 from __future__ import annotations
 
 import dataclasses
-import functools
 import os
 import time
 import traceback
@@ -161,12 +160,11 @@ def run_stages(names: Iterable[str] | None, profile: Profile, context: RunContex
     return total
 
 
-@functools.lru_cache(maxsize=1)
 def _reference_names() -> frozenset[str]:
     """Names ``verimono run --reference NAME`` accepts (the reference catalog's)."""
-    from verimono.reference import catalog   # the catalog builds every reference: on first use only
+    from verimono.reference import names   # the catalog builds every reference: on first use only
 
-    return frozenset(p.name for p in catalog())
+    return names()
 
 
 def locate_data(explicit: str | os.PathLike | None = None) -> Path:
