@@ -232,12 +232,13 @@ def check_in_domain(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int =
         ratios[k] = dists[k] / tolerance(x[k], q)
     bad = np.flatnonzero(ratios > 1.0)
     k = int(bad[0]) if bad.size else int(np.argmax(ratios))
-    counter = {"k": k, "t_k": t[k], "x_k": x[k], "distance": dists[k],
-               "projection": p.operator.project_domain(x[k], float(t[k])),
-               "message": f"x_k = {np.array2string(x[k], precision=6)} is at distance {dists[k]:.3g} "
-                          f"from cl dom F(t_k) at k = {k}, t_k = {t[k]:.6g}"}
-    return Outcome(float(np.max(ratios)), k, counter, {"max_distance": float(np.max(dists)),
-                                                       "measured_nodes": int(np.sum(exact))},
+    worst = float(np.max(ratios))
+    counter = {"k": k, "t_k": t[k], "x_k": x[k], "distance": dists[k]}
+    if not worst <= 1.0:     # a failure (a NaN too) shows the projection (a QP for some operators) and says where
+        counter["projection"] = p.operator.project_domain(x[k], float(t[k]))
+        counter["message"] = (f"x_k = {np.array2string(x[k], precision=6)} is at distance {dists[k]:.3g} "
+                              f"from cl dom F(t_k) at k = {k}, t_k = {t[k]:.6g}")
+    return Outcome(worst, k, counter, {"max_distance": float(np.max(dists)), "measured_nodes": int(np.sum(exact))},
                    message="x_k in cl dom F(t_k) at every node")
 
 
@@ -280,6 +281,11 @@ def check_selections(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int 
     bad = np.flatnonzero((ratios > 1.0) | ~member)
     k = int(bad[0]) if bad.size else int(np.argmax(ratios))
     velocity, terms = _velocity(p, t, x, k)
+    details = {"contains_used": contains_available, "misses": int(np.sum(~member)), "velocity": velocity}
+    message = (f"the discrete velocity {velocity} in F(t_(k+1), x_(k+1)) at every step"
+               + ("" if contains_available else " (resolvent characterisation only: no contains)"))
+    if worst <= 1.0:         # held: the counterexample is never shown
+        return Outcome(worst, k + 1, {"k": k + 1}, details, message=message)
     counter = {"k": k + 1, "t_k": t[k + 1], "x_k": x[k], "x_k_plus_1": x[k + 1], "h": h[k], "selection": y[k],
                "velocity": velocity, **terms,
                "contains": bool(member[k]), "resolvent_residual_ratio": ratios[k]}
@@ -293,10 +299,7 @@ def check_selections(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int 
         msg = (f"x_(k+1) = {np.array2string(x[k + 1], precision=6)} lies outside cl dom F(t_(k+1), ·) (distance "
                f"{outside:.3g}) at k+1 = {k + 1}, t = {t[k + 1]:.6g}, where F is empty; so " + msg)
     counter["message"] = msg
-    return Outcome(worst, k + 1, counter, {"contains_used": contains_available, "misses": int(np.sum(~member)),
-                                           "velocity": velocity},
-                   message=f"the discrete velocity {velocity} in F(t_(k+1), x_(k+1)) at every step"
-                           + ("" if contains_available else " (resolvent characterisation only: no contains)"))
+    return Outcome(worst, k + 1, counter, details, message=message)
 
 
 def witness_steps(t: np.ndarray) -> np.ndarray:
