@@ -55,6 +55,19 @@ def test_json_round_trip_is_lossless(small_report, tmp_path):
     assert again.trajectories == json.loads(json.dumps(small_report.trajectories))
 
 
+def test_json_values_convert_non_finite_floats_wherever_they_sit():
+    """Plain JSON from NumPy values: non-finite floats become their repr (strict JSON has no NaN), also inside
+    arrays and lists of floats, which otherwise pass as they are (the trajectories' fast path)."""
+    from verimono.results import to_jsonable
+
+    assert to_jsonable((1.0, 2.5)) == [1.0, 2.5] and to_jsonable([1.0, math.inf]) == [1.0, "inf"]
+    assert to_jsonable([1.0, 2]) == [1.0, 2] and to_jsonable([]) == []
+    assert to_jsonable(np.array([[0.5, 1.0]])) == [[0.5, 1.0]]
+    assert to_jsonable(np.array([math.nan, 1.0])) == ["nan", 1.0]
+    assert to_jsonable(np.array([1, 2])) == [1, 2] and to_jsonable(np.float32(0.25)) == 0.25
+    json.dumps(to_jsonable({"x": np.array([-math.inf]), "y": [math.nan]}), allow_nan=False)
+
+
 def test_document_records_versions_machine_seeds_and_timings(small_report):
     doc = small_report.to_dict()
     assert doc["schema"] == SCHEMA_NAME and doc["schema_version"] == SCHEMA_VERSION

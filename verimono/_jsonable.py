@@ -19,8 +19,12 @@ def to_jsonable(value: Any) -> Any:
     if isinstance(value, dict):
         return {str(k): to_jsonable(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
+        if all(type(v) is float and v - v == 0.0 for v in value):   # finite floats (a trajectory): as they are
+            return list(value)
         return [to_jsonable(v) for v in value]
     if isinstance(value, np.ndarray):
+        if value.dtype.kind == "f" and np.isfinite(value).all():
+            return value.tolist()                                  # nested lists of finite floats
         return to_jsonable(value.tolist())
     if isinstance(value, (np.bool_, bool)):
         return bool(value)
