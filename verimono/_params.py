@@ -41,6 +41,8 @@ class Param:
         if self._fn is None:
             return self._value
         v = self._fn(t)
+        if type(v) is np.ndarray and v.dtype == np.float64:   # the common case, before any message is built
+            return v
         if type(v) is float:
             return np.asarray(v)
         return real_array(v, f"{self.name}({t!r})")
