@@ -68,6 +68,15 @@ def test_generic_operator_relation_matches_relay():
     np.testing.assert_allclose(a.x, b.x, atol=1e-8)
 
 
+def test_operator_relation_refuses_non_finite_one_step_data():
+    """A NaN in the one-step problem is named at once, not iterated on by the splitting to its limit."""
+    rel = OperatorRelation(NormalCone(Box([-1, -1], [1, 1])))
+    assert np.all(np.isfinite(rel.solve(np.eye(2), np.array([0.5, 3.0])).z))
+    for M, q in ((np.eye(2), np.array([np.nan, 1.0])), (np.array([[1.0, np.inf], [0.0, 1.0]]), np.ones(2))):
+        with pytest.raises(InvalidProblem, match="not finite"):
+            rel.solve(M, q)
+
+
 def test_bad_input_and_non_monotone_relations_are_typed():
     with pytest.raises(InvalidProblem, match="B must have n = 2 rows"):
         LinearRelationSystem(np.zeros((2, 2)), np.ones((3, 1)), np.ones((1, 2)), [[0]], Complementarity())

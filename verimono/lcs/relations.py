@@ -200,6 +200,8 @@ class OperatorRelation(Relation):
     def solve(self, M, q, scale=None):
         # ``scale`` is not needed: the splitting's stopping test is already relative to the data
         M, q = np.asarray(M, float), np.asarray(q, float)
+        if not (np.isfinite(M).all() and np.isfinite(q).all()):   # the splitting would iterate on NaN to its limit
+            raise InvalidProblem(f"{self.name}: the one-step problem's data are not finite (M or q)")
         m = q.shape[0]
         gamma = 1.0 / max(np.linalg.norm(M, 2), 1e-12)
         lu = lu_factor(np.eye(m) + gamma * M)

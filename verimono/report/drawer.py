@@ -92,9 +92,8 @@ def serve(conn: Any) -> None:
     """The drawer's loop (in a forked copy of the command line): import matplotlib
     (:func:`verimono.report.plots.warm_up`), then draw every ``("draw", key, kind, subject)`` as it comes and
     keep it, and answer ``("send", key)`` with ``(key, html)`` (``None`` where it could not draw it), until the
-    connection closes.  It answers
-    only when asked, so it never waits on the asking process; a thread takes the requests off the
-    connection as they come, so the asking process never waits on it."""
+    connection closes.  It answers only when asked, so it never waits on the asking process; a thread takes
+    the requests off the connection as they come, so the asking process never waits on it."""
     import queue
 
     inbox: queue.SimpleQueue = queue.SimpleQueue()
