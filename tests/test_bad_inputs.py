@@ -178,6 +178,21 @@ def test_bad_input_raises_a_typed_error(thunk, error, words):
     assert words in str(info.value)
 
 
+def test_moving_box_bounds_meeting_by_round_off_are_a_point_not_an_empty_box():
+    """Bounds equal at t = 1 in exact arithmetic that cross there by round-off (0.1 + 0.2 t exceeds 0.3 by one
+    ulp; the dev profile's hypothesis drew such a box) make a point, the one between them; a crossing beyond
+    the tolerance is still an empty box, named with its t."""
+    box = sets.Box(lambda t: [0.1 + 0.2 * t, -1.0], lambda t: [0.3, 1.0])
+    assert 0.1 + 0.2 * 1.0 > 0.3
+    p = box.project([5.0, 0.5], 1.0)
+    assert p[0] == 0.5 * ((0.1 + 0.2) + 0.3) and p[1] == 0.5
+    assert box.contains(p, 1.0) and not box.contains([5.0, 0.5], 1.0)
+    traj = vm.solve(vm.Problem(vm.NormalCone(box), [0.2, 0.0], 1.0), vm.uniform_grid(1.0, steps=8))
+    assert np.all(np.isfinite(traj.x)) and traj.x[-1, 0] == pytest.approx(0.3, abs=1e-15)
+    with pytest.raises(vm.InvalidProblem, match="box is empty"):
+        sets.Box(lambda t: [0.1 + 0.2 * t], lambda t: [0.3 - 1e-6]).project([0.0], 1.0)
+
+
 def test_at_least_40_kinds_of_bad_input():
     assert len({c[0] for c in CASES}) == len(CASES) >= 40
 

@@ -193,11 +193,20 @@ class Box(ConvexSet):
         return _own(self, Box)
 
     def _bounds_at(self, t):
-        """``(lower(t), upper(t))``, checked ``lower ≤ upper`` (a nonempty box) at this ``t`` when they move."""
+        """``(lower(t), upper(t))``, checked ``lower ≤ upper`` (a nonempty box) at this ``t`` when they move.
+
+        Moving bounds that meet at ``t`` (a set shrinking to a point: ``l0 + t·dl`` and ``u0 + t·du`` equal at
+        ``t = T``) may cross there by round-off; within :func:`verimono.tolerances.tolerance` of their finite
+        size the box is the point between them, and only a larger crossing is an empty box."""
         lo, hi = self._lo(t), self._hi(t)
         if not self.static and not np.all(lo <= hi):
-            raise bad_param(self.name, "lower(t) - upper(t)", np.asarray(lo) - np.asarray(hi), t,
-                            "must be <= 0 (the box is empty)")
+            lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
+            gap = lo - hi
+            finite = np.concatenate([np.ravel(lo[np.isfinite(lo)]), np.ravel(hi[np.isfinite(hi)])])
+            if not np.all(gap <= tolerance(np.abs(finite).max(initial=0.0))):
+                raise bad_param(self.name, "lower(t) - upper(t)", gap, t, "must be <= 0 (the box is empty)")
+            point = 0.5 * (lo + hi)
+            lo, hi = np.where(gap > 0, point, lo), np.where(gap > 0, point, hi)
         return lo, hi
 
     def project(self, x, t=0.0):
