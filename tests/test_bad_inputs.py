@@ -259,11 +259,14 @@ def test_a_passed_record_with_nan_worst_is_failed():
 
 
 def test_examples_zero_is_refused_not_passed():
-    """``check_operator(x ↦ 2x, examples=0)`` reported "9 passed"; with examples it fails."""
-    from verimono.checks import search as ol
+    """``check_operator(x ↦ 2x, examples=0)`` reported "9 passed"; with examples it fails.  (A law by name through
+    ``verimono.checks.run_law``, which registers the operator laws: run alone, this test once met a KeyError.)"""
+    from verimono.checks import run_law
 
-    rec = ol.run_law("monotone", NSUB, seed=0, examples=3)
+    rec = run_law("monotone", NSUB, seed=0, examples=3)
     assert rec.status == "passed" and rec.details["evaluations"] > 0
+    with pytest.raises(InvalidCheckArgument, match="no operator law named 'monotonous'"):
+        run_law("monotonous", NSUB, seed=0, examples=3)
     # the map x -> 2x with examples=0 used to report "9 passed"
     double = vm.operator_from_resolvent(lambda x, lam, t: 2 * np.asarray(x), 2, name="2x")
     with pytest.raises(InvalidCheckArgument):

@@ -52,7 +52,8 @@ def __getattr__(name: str):
         from . import orders as module
     elif home == "samples":
         from . import samples as module
-    elif home == "search":
+    elif home == "search":   # run_law takes a law by name: the operator laws join the registry on import
+        from . import operator_laws  # noqa: F401
         from . import search as module
     elif home == "stepper_battery":
         from . import stepper_battery as module

@@ -375,6 +375,10 @@ def run_law(decl: Law | str, op: Any, *, seed: int | None = None, examples: int 
     is the effort (default: the active profile's, :func:`default_examples`); times are sampled in
     ``[0, horizon]``."""
     if isinstance(decl, str):
+        if decl not in REGISTRY["operator"]:
+            raise InvalidCheckArgument(f"no operator law named {decl!r}; registered: {sorted(REGISTRY['operator'])} "
+                                       "(the laws register when verimono.checks.operator_laws is imported; "
+                                       "verimono.checks.run_law imports it)")
         decl = REGISTRY["operator"][decl]
     horizon = valid_horizon(horizon)
     profile = None
