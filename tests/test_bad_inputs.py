@@ -193,6 +193,21 @@ def test_moving_box_bounds_meeting_by_round_off_are_a_point_not_an_empty_box():
         sets.Box(lambda t: [0.1 + 0.2 * t], lambda t: [0.3 - 1e-6]).project([0.0], 1.0)
 
 
+def test_a_moving_ball_radius_below_zero_by_round_off_is_its_centre_not_an_empty_ball():
+    """0.3 - (0.1 + 0.2 t) is -5.6e-17 at t = 1: the ball shrunk to its centre, in ``project`` and in the solve
+    loop's kernel alike; a radius below 0 beyond the tolerance is still an empty ball."""
+    ball = sets.Ball(lambda t: [1.0, 0.0], lambda t: 0.3 - (0.1 + 0.2 * t))
+    assert 0.3 - (0.1 + 0.2 * 1.0) < 0
+    assert np.array_equal(ball.project([3.0, 4.0], 1.0), [1.0, 0.0])
+    traj = vm.solve(vm.Problem(vm.NormalCone(ball), [1.1, 0.0], 1.0), vm.uniform_grid(1.0, steps=8))
+    assert np.array_equal(traj.x[-1], [1.0, 0.0])
+    with pytest.raises(vm.InvalidProblem, match="the ball is empty"):
+        sets.Ball(lambda t: [1.0, 0.0], lambda t: 1.0 - 1.001 * t).project([0.0, 0.0], 1.0)
+    with pytest.raises(vm.InvalidProblem, match="the ball is empty"):
+        vm.solve(vm.Problem(vm.NormalCone(sets.Ball(lambda t: [1.0, 0.0], lambda t: 1.0 - 1.001 * t)), [1.0, 0.0],
+                            1.0), vm.uniform_grid(1.0, steps=8))
+
+
 def test_at_least_40_kinds_of_bad_input():
     assert len({c[0] for c in CASES}) == len(CASES) >= 40
 

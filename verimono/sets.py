@@ -61,6 +61,14 @@ class ConvexSet:
         return f"{self.name}(dim={self.dim})"
 
 
+def _past_roundoff(excess: np.ndarray, scale: float) -> bool:
+    """Whether a moving parameter is beyond its limit by more than round-off (``excess > 0`` where it is past:
+    a radius below 0, a lower bound above its upper bound), a NaN included.  Parameters that meet their limit
+    at some ``t`` in exact arithmetic (a set shrinking to a point) may cross it there by a few ulps; within
+    :func:`verimono.tolerances.tolerance` of their finite ``scale`` that is the limit itself."""
+    return not np.all(excess <= tolerance(scale))
+
+
 def _all_static(*params) -> bool:
     return all(p.constant for p in params)
 
@@ -104,10 +112,13 @@ class Ball(ConvexSet):
         return _own(self, Ball)
 
     def _radius_at(self, t):
-        """``radius(t)``, checked ``≥ 0`` (a nonempty ball) at this ``t`` when it moves."""
+        """``radius(t)``, checked ``≥ 0`` (a nonempty ball) at this ``t`` when it moves; a radius below 0 by
+        round-off (:func:`_past_roundoff`) is 0, the ball its centre."""
         r = self._r(t)
         if not self._r.constant and not np.all(r >= 0):
-            raise bad_param(self.name, "radius(t)", r, t, "must be >= 0 (the ball is empty)")
+            if _past_roundoff(-r, float(np.max(np.abs(self._c(t)), initial=0.0))):
+                raise bad_param(self.name, "radius(t)", r, t, "must be >= 0 (the ball is empty)")
+            r = np.maximum(r, 0.0)
         return r
 
     def project(self, x, t=0.0):
@@ -151,7 +162,7 @@ class Ball(ConvexSet):
                 return x
             return step
         center = _fast(self._c)
-        rfn = self._r
+        rfn, radius_at = self._r, self._radius_at
 
         def step(x, lam, t):
             if not 0.0 < lam < _INF:
@@ -160,8 +171,8 @@ class Ball(ConvexSet):
             d = x - c
             nrm = _sqrt(d.dot(d))
             r = float(rfn(t))
-            if not r >= 0.0:         # also nan: a radius crossing 0 would divide by zero
-                raise bad_param(name, "radius(t)", r, t, "must be >= 0 (the ball is empty)")
+            if not r >= 0.0:         # also nan: 0 if it is round-off, else the ball is empty
+                r = float(radius_at(t))
             if nrm > r:
                 return c + d * (r / nrm)
             return x
@@ -193,17 +204,14 @@ class Box(ConvexSet):
         return _own(self, Box)
 
     def _bounds_at(self, t):
-        """``(lower(t), upper(t))``, checked ``lower ≤ upper`` (a nonempty box) at this ``t`` when they move.
-
-        Moving bounds that meet at ``t`` (a set shrinking to a point: ``l0 + t·dl`` and ``u0 + t·du`` equal at
-        ``t = T``) may cross there by round-off; within :func:`verimono.tolerances.tolerance` of their finite
-        size the box is the point between them, and only a larger crossing is an empty box."""
+        """``(lower(t), upper(t))``, checked ``lower ≤ upper`` (a nonempty box) at this ``t`` when they move;
+        bounds crossed by round-off (:func:`_past_roundoff`) are the point between them."""
         lo, hi = self._lo(t), self._hi(t)
         if not self.static and not np.all(lo <= hi):
             lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
             gap = lo - hi
             finite = np.concatenate([np.ravel(lo[np.isfinite(lo)]), np.ravel(hi[np.isfinite(hi)])])
-            if not np.all(gap <= tolerance(np.abs(finite).max(initial=0.0))):
+            if _past_roundoff(gap, float(np.abs(finite).max(initial=0.0))):
                 raise bad_param(self.name, "lower(t) - upper(t)", gap, t, "must be <= 0 (the box is empty)")
             point = 0.5 * (lo + hi)
             lo, hi = np.where(gap > 0, point, lo), np.where(gap > 0, point, hi)
