@@ -21,8 +21,8 @@ from verimono import NormalCone, Shifted
 from verimono import strategies as vs
 from verimono.checks.operator_battery import LAWS, operator_checks
 from verimono.checks.samples import law_samples
-from verimono.profiles import active_profile, get_profile
-from verimono.results import FAILED
+from verimono.execution.profiles import active_profile, get_profile
+from verimono.records.results import FAILED
 from verimono.testing import describe, parametrize_with_checks
 
 T = 1.0

@@ -23,8 +23,8 @@ from hypothesis import strategies as st
 from verimono import Problem, solve
 from verimono import strategies as vs
 from verimono.checks.stepper_battery import CHECKS, LAWS
-from verimono.errors import OutsideDomain, UnverifiedSolution, VerimonoError
-from verimono.results import FAILED, SKIPPED
+from verimono.core.errors import OutsideDomain, UnverifiedSolution, VerimonoError
+from verimono.records.results import FAILED, SKIPPED
 from verimono.testing import describe, parametrize_with_checks
 
 #: the battery of solve: 12 references x (1 order + 7 laws) + 4 samples x 7 laws; it may grow, never shrink

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import functools
 
-from verimono.problem import Problem
+from verimono.core.problem import Problem
 
 from . import lcs_example, linear, subdifferential, sweeping
 

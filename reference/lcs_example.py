@@ -31,8 +31,8 @@ import numpy as np
 
 from verimono.lcs.relations import Complementarity
 from verimono.lcs.system import LinearRelationSystem
-from verimono.problem import Order, Problem
-from verimono.pseudo_distance import pseudo_distance_lower_bound
+from verimono.core.problem import Order, Problem
+from verimono.core.pseudo_distance import pseudo_distance_lower_bound
 
 A = np.zeros((1, 1))
 B = np.array([[0.0, 1.0]])

@@ -18,8 +18,8 @@ import math
 import numpy as np
 from scipy.linalg import expm
 
-from verimono.operators import Linear
-from verimono.problem import Order, Problem
+from verimono.core.operators import Linear
+from verimono.core.problem import Order, Problem
 
 M_DEFAULT = np.array([[1.0, 3.0], [-3.0, 0.5]])
 

@@ -19,8 +19,8 @@ import math
 
 import numpy as np
 
-from verimono.operators import LogBarrier, NormSubdifferential
-from verimono.problem import Order, Problem
+from verimono.core.operators import LogBarrier, NormSubdifferential
+from verimono.core.problem import Order, Problem
 
 #: the regularity of t|x|: x is Lipschitz, with a jump of x' at the extinction time
 LIPSCHITZ_KINK = ("x is Lipschitz and x' jumps at the extinction time t* = sqrt(2|x0|) (x in W^{1,inf}, not "

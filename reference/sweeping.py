@@ -26,9 +26,9 @@ import math
 
 import numpy as np
 
-from verimono.operators import NormalCone
-from verimono.problem import Order, Problem
-from verimono.sets import Ball, Box, HalfSpace
+from verimono.core.operators import NormalCone
+from verimono.core.problem import Order, Problem
+from verimono.core.sets import Ball, Box, HalfSpace
 
 TWO_PI = 2.0 * math.pi
 #: regularity of a sweeping solution whose set moves smoothly: Lipschitz, its derivative jumps where the

@@ -35,10 +35,10 @@ import numpy as np
 
 import verimono as vm
 import verimono.testing  # noqa: F401 - vm.testing
-import verimono.timeouts  # noqa: F401 - vm.timeouts
+import verimono.execution.timeouts  # noqa: F401 - vm.timeouts
 from verimono.cli import main
-from verimono.errors import VerimonoError
-from verimono.results import CheckResult, Report
+from verimono.core.errors import VerimonoError
+from verimono.records.results import CheckResult, Report
 
 LIMIT = 60.0
 TMP = Path(tempfile.mkdtemp(prefix="probe25-"))
@@ -278,7 +278,7 @@ def _hanging_operator() -> Report:
 
 def _hanging_stepper() -> Report:
     from verimono.reference import get
-    from verimono.stages.builtin import _convergence_unit
+    from verimono.run.stages.builtin import _convergence_unit
 
     def stepper(problem, t_grid):
         time.sleep(30)

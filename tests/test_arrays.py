@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 import verimono as vm
-from verimono.arrays import as_float64, library_of, precision_of, to_numpy
+from verimono.core.arrays import as_float64, library_of, precision_of, to_numpy
 from verimono.checks import check_operator, run_law
-from verimono.tolerances import judged_precision
+from verimono.core.tolerances import judged_precision
 
 
 def _soft(X, lams):

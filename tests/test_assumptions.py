@@ -11,7 +11,7 @@ from verimono import Linear, Problem, operator_from_resolvent
 from verimono.checks.assumptions import EVIDENCE, check_assumptions
 from verimono.checks.sample_problems import sample_problem
 from verimono.reference import get
-from verimono.results import FAILED, PASSED
+from verimono.records.results import FAILED, PASSED
 
 NAMES = ["assumption_A1", "assumption_A2", "assumption_A3", "assumption_LG", "assumption_YB"]
 
@@ -189,7 +189,7 @@ def test_t_non_auto_YB_claim_is_false_for_a_shifted_operator():
     bounds_yb therefore skips problems with an input, and says why."""
     import verimono as vm
     from verimono.checks.bounds import check_bounds_yb
-    from verimono.operators import Shifted
+    from verimono.core.operators import Shifted
 
     F = vm.NormSubdifferential(1.0, dim=1)
     assert _by(check_assumptions(Problem(F, [0.0], 1.0)))["assumption_YB"].status == PASSED

@@ -15,7 +15,7 @@ import verimono as vm
 from verimono import Linear, Problem
 from verimono.checks.assumptions import UNDECIDED_SIDE, check_assumptions
 from verimono.checks.over_time import sup_over_time
-from verimono.results import FAILED, PASSED, UNDECIDED
+from verimono.records.results import FAILED, PASSED, UNDECIDED
 
 
 def _by(report):

@@ -13,7 +13,7 @@ import pytest
 
 import verimono as vm
 from verimono import errors, sets
-from verimono.operators import resolvent_kernel
+from verimono.core.operators import resolvent_kernel
 
 # resolved by name so that this file also runs (and fails case by case) against a verimono without them
 InvalidCheckArgument = getattr(errors, "InvalidCheckArgument", type("Missing", (Exception,), {}))
@@ -248,14 +248,14 @@ def test_a_stepper_returning_nan_fails_convergence_order_on_every_reference():
 
 
 def test_fit_order_with_a_nan_error_is_not_exact():
-    from verimono.convergence import fit_order
+    from verimono.core.convergence import fit_order
 
     fit = fit_order([0.1, 0.05, 0.025], [1e-3, float("nan"), 2.5e-4], floor=1e-12)
     assert not fit.exact and fit.nonfinite == [1] and fit.slope != fit.slope
 
 
 def test_error_accumulator_keeps_nan():
-    from verimono.convergence import ErrorAccumulator
+    from verimono.core.convergence import ErrorAccumulator
     from verimono.reference import get
 
     p = get("t|x| (n=1)")
@@ -303,14 +303,14 @@ def test_examples_zero_is_refused_not_passed():
 ], ids=["negative steps", "1e12 cells", "factor 0", "factor 2.7", "zero cells", "negative seed", "T not a number",
         "bool steps"])
 def test_bad_grid_arguments_are_invalid_grids(build):
-    from verimono.errors import InvalidGrid
+    from verimono.core.errors import InvalidGrid
 
     with pytest.raises(InvalidGrid):
         build(vm.uniform_grid(1.0, steps=4))
 
 
 def test_a_normal_cone_of_what_is_not_a_set_and_a_fractional_shape_are_invalid_problems():
-    from verimono.errors import InvalidProblem
+    from verimono.core.errors import InvalidProblem
 
     with pytest.raises(InvalidProblem, match="NormalCone needs a convex set"):
         vm.NormalCone(3.0)                                 # an AttributeError before

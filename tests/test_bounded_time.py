@@ -15,8 +15,8 @@ import pytest
 import verimono as vm
 from verimono.checks.search import ROOT_LAW, _SLOW
 from verimono.reference import get
-from verimono.results import PASSED, CheckResult
-from verimono.timeouts import budget, supported
+from verimono.records.results import PASSED, CheckResult
+from verimono.execution.timeouts import budget, supported
 
 pytestmark = pytest.mark.skipif(not supported(), reason="time limits need a POSIX timer in the main thread")
 
@@ -53,7 +53,7 @@ def test_a_fast_resolvent_is_not_remembered_as_slow():
 
 def test_no_trajectory_sample_after_a_unit_that_ran_out_of_time():
     """``sample_trajectory`` ran unbounded after the timed-out unit (89 s for a 3 s budget)."""
-    from verimono.stages.builtin import _convergence_unit
+    from verimono.run.stages.builtin import _convergence_unit
 
     calls: list = []
 
@@ -71,8 +71,8 @@ def test_no_trajectory_sample_after_a_unit_that_ran_out_of_time():
 
 
 def test_the_trajectory_sample_runs_under_the_budget(monkeypatch):
-    import verimono.stages.builtin as builtin
-    from verimono.stages.builtin import _convergence_unit
+    import verimono.run.stages.builtin as builtin
+    from verimono.run.stages.builtin import _convergence_unit
 
     monkeypatch.setattr(builtin, "check_convergence_order",
                         lambda stepper, problem: CheckResult("convergence_order", "s", PASSED, worst=0.1, bound=1.0))

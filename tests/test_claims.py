@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import verimono as vm
-from verimono.claims import ANY, PROXIMAL, Claim, InvalidClaim, Stepper, claim_of, with_claim
+from verimono.core.claims import ANY, PROXIMAL, Claim, InvalidClaim, Stepper, claim_of, with_claim
 from verimono.checks.trajectory_laws import check_in_domain, check_selections
 from verimono.reference import catalog, get
 

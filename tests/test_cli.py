@@ -10,14 +10,14 @@ import textwrap
 import pytest
 
 from verimono.cli import main
-from verimono.results import load
+from verimono.records.results import load
 
 REF = ["--reference", "moving box", "--reference", "t|x| (n=1)"]
 
 BROKEN = '''
 """A stepper that evaluates the moving set at the start of each step instead of its end."""
 import numpy as np
-from verimono.stepping import solve as _solve
+from verimono.core.stepping import solve as _solve
 
 
 def solve(problem, t_grid):
@@ -35,7 +35,7 @@ def solve(problem, t_grid):
 def steppers(tmp_path_factory):
     d = tmp_path_factory.mktemp("steppers")
     (d / "lagged.py").write_text(textwrap.dedent(BROKEN))
-    (d / "good.py").write_text("from verimono.stepping import solve\n")
+    (d / "good.py").write_text("from verimono.core.stepping import solve\n")
     return d
 
 
@@ -141,7 +141,7 @@ def test_check_runs_the_operator_battery_on_an_operator(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("target", ["no_such_module_xyz:thing", "verimono:no_such_thing", "verimono",
-                                    "verimono.sets:Ball"])
+                                    "verimono.core.sets:Ball"])
 def test_bad_targets_exit_2(target, tmp_path, capsys):
     assert main(["check", target, "--out", str(tmp_path)]) == 2
     assert "verimono check:" in capsys.readouterr().err
@@ -170,8 +170,8 @@ def test_report_rerenders_from_results(good_check, tmp_path):
 def test_a_py_target_is_the_file_itself_not_a_module_of_the_same_name(tmp_path):
     """load_target("…/types.py:solve") imported the standard library's types (already in sys.modules), and
     a second lagged.py the first one: the file named is the module loaded."""
-    from verimono.errors import BadTarget
-    from verimono.targets import load_target
+    from verimono.core.errors import BadTarget
+    from verimono.run.targets import load_target
 
     (tmp_path / "types.py").write_text("def solve(problem, t):\n    return 'mine'\n")
     assert load_target(f"{tmp_path}/types.py:solve")(None, None) == "mine"
@@ -208,10 +208,10 @@ class _Stream:
 
 
 def test_progress_on_a_terminal_shows_units_and_the_current_subject(monkeypatch):
-    from verimono.progress import Progress
-    from verimono.runs import execute
+    from verimono.run.progress import Progress
+    from verimono.run.execute import execute
     from verimono.reference import get
-    from verimono.stages import RunContext
+    from verimono.run.stages import RunContext
 
     monkeypatch.delenv("CI", raising=False)
     stream = _Stream(tty=True)
@@ -230,7 +230,7 @@ def test_progress_on_a_terminal_shows_units_and_the_current_subject(monkeypatch)
 
 
 def test_progress_is_quiet_and_line_oriented_off_a_terminal_or_under_ci(monkeypatch):
-    from verimono.progress import Progress
+    from verimono.run.progress import Progress
 
     class Stage:
         name = "operator_laws"

@@ -9,7 +9,7 @@ import pytest
 
 import verimono as vm
 from verimono.checks import check_convergence_order
-from verimono.convergence import ORDER_SLACK, convergence_study, fit_order, grid_errors
+from verimono.core.convergence import ORDER_SLACK, convergence_study, fit_order, grid_errors
 from verimono.reference import catalog, get
 
 
@@ -68,7 +68,7 @@ def test_study_accepts_nonuniform_grids_and_rejects_wrong_shapes():
 
 
 def test_study_round_trips_through_dict():
-    from verimono.convergence import ConvergenceStudy
+    from verimono.core.convergence import ConvergenceStudy
     from verimono.reference import get
 
     s = convergence_study(vm.solve, get("moving box"))
@@ -98,7 +98,7 @@ def test_every_reference_measures_its_expected_order_and_the_half_order_one_neve
 
 
 def test_sampler_is_np_interp_whatever_the_blocks():
-    from verimono.convergence import Sampler
+    from verimono.core.convergence import Sampler
 
     rng = np.random.default_rng(3)
     t = np.sort(np.concatenate([[0.0, 1.0], rng.uniform(0, 1, 300)]))
@@ -120,7 +120,7 @@ def test_fine_grid_study_is_the_interpolated_fine_solution_and_holds_no_trajecto
     the size, where the previous version, holding every trajectory, peaked at 2.5; the rest is the fine
     grid's times and steps (1/10 each at n = 10), the reference values at the grids' nodes and one
     8192-row stream buffer."""
-    from verimono.performance import peak_memory
+    from verimono.run.performance import peak_memory
 
     p = vm.Problem(vm.Linear(np.eye(10) + np.diag(np.ones(9), 1)), np.linspace(1.0, 2.0, 10), 1.0)
     steps = [1 / 4000, 1 / 8000, 1 / 16000]
@@ -209,7 +209,7 @@ def test_no_catalog_reference_stalls_under_solve():
 
 
 def test_solve_floor_accumulates_per_step_and_widens_only_with_a_claim():
-    from verimono.convergence import solve_floor
+    from verimono.core.convergence import solve_floor
 
     assert solve_floor(100, 1e-10, 3.0) == pytest.approx(100 * 1e-10 * 4.0)
     p = get("t|x| (n=1)")
@@ -223,7 +223,7 @@ def test_solve_floor_accumulates_per_step_and_widens_only_with_a_claim():
 
 
 def test_with_claim_keeps_what_is_not_given():
-    from verimono.claims import InvalidClaim, claim_of, with_claim
+    from verimono.core.claims import InvalidClaim, claim_of, with_claim
 
     s = vm.Stepper(vm.solve, scheme="any", order=2, contracts=True)
     c = claim_of(with_claim(s, solve_tol=1e-9))
@@ -238,7 +238,7 @@ def test_the_order_fit_is_scipys_linear_regression_and_student_t_interval():
     importing scipy.stats, 0.6 s in every worker): the same numbers as scipy's, to rounding."""
     from scipy import stats
 
-    from verimono.convergence import fit_order, least_squares_slope
+    from verimono.core.convergence import fit_order, least_squares_slope
 
     rng = np.random.default_rng(7)
     for n in range(3, 10):

@@ -17,7 +17,7 @@ from verimono.checks.operator_battery import LAWS as OPERATOR_LAWS
 from verimono.checks.search import ROOT_LAW
 from verimono.checks.stepper_battery import CHECKS, LAWS as STEPPER_LAWS
 from verimono.reference import get
-from verimono.results import CheckResult
+from verimono.records.results import CheckResult
 
 
 def _declarations() -> dict[int, core.Law]:

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import verimono as vm
-from verimono.sets import Ball, Box, Polyhedron
+from verimono.core.sets import Ball, Box, Polyhedron
 
 
 def ok_problem(**kw):
@@ -117,7 +117,7 @@ def test_resolvent_of_wrong_shape_is_reported():
 
 def test_every_public_exception_class_lives_in_errors():
     """Every public exception class of the package is defined in verimono/errors.py and still importable
-    from where it was before (``verimono.stages.StageUnavailable``, ``verimono.schema.SchemaError``, ...)."""
+    from where it was before (``verimono.run.stages.StageUnavailable``, ``verimono.records.schema.SchemaError``, ...)."""
     import importlib
     import pkgutil
 
@@ -128,10 +128,10 @@ def test_every_public_exception_class_lives_in_errors():
     defined = {(obj.__module__, name) for mod in modules for name, obj in vars(mod).items()
                if isinstance(obj, type) and issubclass(obj, BaseException) and not name.startswith("_")
                and obj.__module__.startswith("verimono")}
-    assert {m for m, _ in defined} == {"verimono.errors"}, sorted(defined)
-    old_homes = {"verimono.stages": ("StageUnavailable", "UnknownStage"), "verimono.cli": ("BadTarget",),
-                 "verimono.profiles": ("UnknownProfile",), "verimono.schema": ("SchemaError",),
-                 "verimono.gate": ("IncompatibleBaseline",), "verimono.lcs.passivity": ("MissingOptionalDependency",)}
+    assert {m for m, _ in defined} == {"verimono.core.errors"}, sorted(defined)
+    old_homes = {"verimono.run.stages": ("StageUnavailable", "UnknownStage"), "verimono.cli": ("BadTarget",),
+                 "verimono.execution.profiles": ("UnknownProfile",), "verimono.records.schema": ("SchemaError",),
+                 "verimono.run.gate": ("IncompatibleBaseline",), "verimono.lcs.passivity": ("MissingOptionalDependency",)}
     for module, names in old_homes.items():
         for name in names:
             assert getattr(importlib.import_module(module), name) is getattr(errors, name)

@@ -13,8 +13,8 @@ import pytest
 
 from verimono.checks.core import REGISTRY
 from verimono.cli import main
-from verimono.executors import BadExecutor, ProcessRunner, SerialRunner, Unit, make_runner
-from verimono.results import CheckResult, Report
+from verimono.execution.executors import BadExecutor, ProcessRunner, SerialRunner, Unit, make_runner
+from verimono.records.results import CheckResult, Report
 
 REF = ["--reference", "moving box", "--reference", "t|x| (n=1)"]
 RUN = ["run", "--profile", "ci", "--stage", "convergence", "--stage", "assumptions", *REF]
@@ -25,7 +25,7 @@ TIMING_KEYS = {"duration", "timings", "calibration", "calibrations", "created", 
 
 STEPPERS = '''
 import multiprocessing, os, signal, time
-from verimono.stepping import solve as _solve
+from verimono.core.stepping import solve as _solve
 
 
 def killer(problem, t_grid):
@@ -171,7 +171,7 @@ def test_a_bad_executor_is_a_usage_error(spec, tmp_path, capsys):
 
 def test_auto_chooses_its_runner_from_the_cores_and_process_n_parses(monkeypatch):
     """The process-free part of the next test (tier ``slow``): which runner a spec makes; none starts a worker."""
-    from verimono.executors import AUTO_MAX_WORKERS
+    from verimono.execution.executors import AUTO_MAX_WORKERS
 
     monkeypatch.setattr(os, "cpu_count", lambda: 1)
     assert isinstance(make_runner("auto"), SerialRunner) and isinstance(make_runner(None), SerialRunner)
@@ -186,7 +186,7 @@ def test_auto_chooses_its_runner_from_the_cores_and_process_n_parses(monkeypatch
 def test_run_uses_every_core_by_default(monkeypatch, tmp_path, capsys):
     """``verimono run`` defaults to ``auto``: process:N with N the cores (at most AUTO_MAX_WORKERS), serial
     on one core; ``$VERIMONO_EXECUTOR`` overrides it.  The records are the serial run's (see above)."""
-    from verimono.executors import AUTO_MAX_WORKERS, ProcessRunner, SerialRunner, make_runner
+    from verimono.execution.executors import AUTO_MAX_WORKERS, ProcessRunner, SerialRunner, make_runner
 
     monkeypatch.setattr(os, "cpu_count", lambda: 1)
     assert isinstance(make_runner("auto"), SerialRunner)
@@ -260,7 +260,7 @@ def test_auto_runs_serially_when_its_workers_cannot_start(monkeypatch, capsys):
 
 def _limits_seen() -> Report:
     """A unit reporting the unit budget and the calibration of the process it runs in."""
-    from verimono.timeouts import calibration, current_budget
+    from verimono.execution.timeouts import calibration, current_budget
 
     return Report([CheckResult("limits", "seen", "passed", details={"budget": current_budget(),
                                                                      "calibration": calibration()})])
@@ -270,8 +270,8 @@ def _limits_seen() -> Report:
 def test_a_worker_runs_a_unit_under_the_runs_budget_and_calibration(monkeypatch, method):
     """``--timeout`` and the run's calibration bound a unit on a worker as in the run's own process: a spawned
     worker used to measure its own calibration and ignore ``--timeout``."""
-    from verimono.calibration import calibration, set_calibration
-    from verimono.timeouts import budget
+    from verimono.execution.calibration import calibration, set_calibration
+    from verimono.execution.timeouts import budget
 
     monkeypatch.setenv("VERIMONO_START_METHOD", method)
     before = calibration()
@@ -293,7 +293,7 @@ def test_workers_are_forked_only_where_that_is_safe(monkeypatch):
     import sys
     import threading
 
-    from verimono.executors import FORK_UNSAFE, start_method
+    from verimono.execution.executors import FORK_UNSAFE, start_method
 
     monkeypatch.delenv("VERIMONO_START_METHOD", raising=False)
     monkeypatch.setattr(sys, "platform", "linux")
@@ -317,8 +317,8 @@ def test_workers_are_forked_only_where_that_is_safe(monkeypatch):
 
 
 def test_units_start_costliest_first_and_come_back_in_their_order():
-    from verimono.stages.registry import RunContext
-    from verimono.profiles import get_profile
+    from verimono.run.stages.registry import RunContext
+    from verimono.execution.profiles import get_profile
 
     started: list[str] = []
 

@@ -26,8 +26,8 @@ import pytest
 
 import verimono as vm
 from verimono.cli import main
-from verimono.gate import compare
-from verimono.results import CheckResult, Report, SchemaError, load
+from verimono.run.gate import compare
+from verimono.records.results import CheckResult, Report, SchemaError, load
 
 from probe_bad_inputs import CASES, run_probe, sample_report
 
@@ -162,8 +162,8 @@ def test_the_committed_baselines_xfails_pass_against_fresh_records():
     """The six xfail records of reports/baseline.json (written before declarations existed) against the
     assumptions stage run now on the same references: no regression."""
     from verimono.reference import get
-    from verimono.runs import execute
-    from verimono.stages import RunContext
+    from verimono.run.execute import execute
+    from verimono.run.stages import RunContext
 
     committed = load(Path(__file__).resolve().parent.parent / "reports" / "baseline.json")
     xfails = [r for r in committed if r.status == "xfail"]
@@ -183,7 +183,7 @@ def test_the_committed_baselines_xfails_pass_against_fresh_records():
 
 KILLER = textwrap.dedent('''
     import os, signal, sys
-    import verimono.stages as stages
+    import verimono.run.stages as stages
     from verimono.cli import main
 
     real = stages.STAGES["convergence"]
@@ -234,8 +234,8 @@ def test_a_killed_run_is_visible_and_its_stale_pair_is_refused(tmp_path, capsys)
 
 
 def test_the_mark_is_written_before_the_work_with_the_run_id_of_the_results(tmp_path, monkeypatch):
-    import verimono.stages as stages
-    from verimono.atomic import in_progress
+    import verimono.run.stages as stages
+    from verimono.records.atomic import in_progress
 
     out, seen = tmp_path / "out", []
     real = stages.STAGES["convergence"]
@@ -251,7 +251,7 @@ def test_the_mark_is_written_before_the_work_with_the_run_id_of_the_results(tmp_
 
 
 def test_resume_names_the_run_it_continues(tmp_path, monkeypatch, capsys):
-    import verimono.stages as stages
+    import verimono.run.stages as stages
 
     out = tmp_path / "out"
     real = stages.STAGES["section7"]
@@ -274,9 +274,9 @@ def test_resume_names_the_run_it_continues(tmp_path, monkeypatch, capsys):
 
 
 def test_the_advice_after_an_interrupted_check_names_a_command_that_exists(tmp_path, monkeypatch, capsys):
-    import verimono.stages as stages
+    import verimono.run.stages as stages
 
-    (tmp_path / "good.py").write_text("from verimono.stepping import solve\n")
+    (tmp_path / "good.py").write_text("from verimono.core.stepping import solve\n")
     real = stages.STAGES["convergence"]
 
     def interrupt(profile, context):
@@ -294,7 +294,7 @@ def test_the_advice_after_an_interrupted_check_names_a_command_that_exists(tmp_p
 
 def _failing_pair_writes(monkeypatch, code: int = errno.ENOSPC) -> None:
     """The pair's temporaries fail as on a full disk (the small in-progress mark still fits)."""
-    import verimono.atomic as atomic
+    import verimono.records.atomic as atomic
 
     real = atomic._temp_for
 
@@ -348,7 +348,7 @@ def test_a_full_disk_for_report_and_baseline_exits_2_in_one_line(tmp_path, monke
 
 @pytest.mark.parametrize("umask, mode", [(0o022, 0o644), (0o027, 0o640), (0o077, 0o600)])
 def test_output_files_honour_the_umask(tmp_path, umask, mode):
-    from verimono.report import write
+    from verimono.records.report import write
 
     old = os.umask(umask)
     try:

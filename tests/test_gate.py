@@ -7,10 +7,10 @@ import copy
 import pytest
 
 from verimono.checks import check_stepper
-from verimono.gate import ERROR_GROWTH, TIMING_GROWTH, IncompatibleBaseline, compare, gate
-from verimono.results import SchemaError
-from verimono.results import CheckResult, Report
-from verimono.stepping import solve
+from verimono.run.gate import ERROR_GROWTH, TIMING_GROWTH, IncompatibleBaseline, compare, gate
+from verimono.records.results import SchemaError
+from verimono.records.results import CheckResult, Report
+from verimono.core.stepping import solve
 
 REFS = ["t|x| (n=1)", "moving box"]
 

@@ -111,7 +111,7 @@ def import_graph(repo: Path = REPO) -> dict[str, set[str]]:
 
 
 def layers(graph: dict[str, set[str]]) -> dict[str, set[str]]:
-    """The graph between the package's layers: each subpackage of ``verimono`` (``verimono.report``,
+    """The graph between the package's layers: each subpackage of ``verimono`` (``verimono.records.report``,
     ``verimono.checks``, ...) collapsed to one node, each top-level module and the package itself one node
     each.  A cycle here (``report`` → ``gate`` → ``report.schema``) is one between layers even when no two
     modules import each other."""
@@ -216,7 +216,7 @@ def test_graph_reader_sees_function_local_and_relative_imports(tmp_path):
 def test_graph_covers_the_mapped_packages():
     graph = import_graph()
     assert {"verimono", "verimono.reference", "verimono.properties", "verimono.checks"} <= set(graph)
-    assert "verimono.reference.sweeping" in graph and "verimono.results" in graph["verimono"]
+    assert "verimono.reference.sweeping" in graph and "verimono.records.results" in graph["verimono"]
 
 
 def test_import_graph_has_no_cycle():
@@ -251,7 +251,7 @@ if __name__ == "__main__":  # pragma: no cover - a listing for whoever is untang
 #: matplotlib, the QP back-ends: together about 1 s of the 1.2-1.5 s the import took) and the layers that
 #: pull them in; each is imported where it is used (the first order fit, the first check, ...)
 NOT_AT_IMPORT = ("scipy.stats", "scipy.optimize", "hypothesis", "matplotlib", "qpsolvers", "proxsuite",
-                 "verimono.checks", "verimono.strategies", "verimono.lcs", "verimono.qp", "verimono.report")
+                 "verimono.checks", "verimono.strategies", "verimono.lcs", "verimono.core.qp", "verimono.records.report")
 
 
 @pytest.mark.slow
@@ -350,20 +350,14 @@ def test_function_local_imports_are_for_optional_or_heavy_modules():
 #: the layers, bottom up: a module imports only from its own layer and the ones below it.  A module belongs to
 #: the first layer one of whose prefixes names it (``verimono.checks`` covers ``verimono.checks.core``, ...)
 LAYERS = (
-    ("foundations", ("verimono.errors", "verimono.tolerances", "verimono._jsonable", "verimono._params",
-                     "verimono._rows", "verimono._validate", "verimono._reproducible", "verimono.display", "verimono.environment",
-                     "verimono.atomic", "verimono.profiles", "verimono.naming", "verimono.arrays")),
-    ("numerics", ("verimono.grids", "verimono.problem", "verimono.operators", "verimono._subgradients", "verimono.sets",
-                  "verimono.qp", "verimono.prox", "verimono.stepping", "verimono.claims", "verimono.convergence",
-                  "verimono.pseudo_distance", "verimono.lcs", "verimono.reference", "verimono.strategies",
-                  "verimono.manufactured", "verimono.data")),
-    ("records", ("verimono.schema", "verimono.results", "verimono.timeouts", "verimono.watchdog",
-                 "verimono.calibration", "verimono.timing")),
-    # the executors need only records and below; a battery runs on them (check_stepper(executor="process:N"))
-    ("checks", ("verimono.checks", "verimono.performance", "verimono.executors")),
-    ("runs", ("verimono.stages", "verimono.runs", "verimono.gate", "verimono.report", "verimono.progress")),
-    ("entry points", ("verimono.cli", "verimono.plugin", "verimono.testing", "verimono.targets",
-                      "verimono.properties", "verimono")),
+    ("core", ("verimono.core",)),
+    ("models", ("verimono.lcs", "verimono.reference", "verimono.strategies", "verimono.data")),
+    ("records", ("verimono.records",)),
+    # what a check runs under (profiles, budgets, the watchdog, workers, calibration): the batteries use it
+    ("execution", ("verimono.execution",)),
+    ("checks", ("verimono.checks",)),
+    ("run", ("verimono.run",)),
+    ("entry points", ("verimono.cli", "verimono.plugin", "verimono.testing", "verimono.properties", "verimono")),
 )
 
 
@@ -386,14 +380,23 @@ def upward_imports(repo: Path = REPO) -> list[str]:
 
 
 def test_the_layer_order_is_seen_failing(tmp_path):
+    """A core module reaching up to the execution machinery or the checks, even inside a function, is found."""
     (tmp_path / "pyproject.toml").write_text('[tool.setuptools.package-dir]\n"verimono" = "pkg"\n')
-    (tmp_path / "pkg").mkdir()
+    for folder in ("core", "execution", "checks"):
+        (tmp_path / "pkg" / folder).mkdir(parents=True)
+        (tmp_path / "pkg" / folder / "__init__.py").write_text("")
     (tmp_path / "pkg" / "__init__.py").write_text("from .cli import main\n")
-    (tmp_path / "pkg" / "errors.py").write_text("def f():\n    from .results import R\n")
-    (tmp_path / "pkg" / "results.py").write_text("from .errors import f\n")
-    (tmp_path / "pkg" / "cli.py").write_text("from .results import R\n")
-    assert upward_imports(tmp_path) == ["verimono.errors (foundations) → verimono.results (records)"]
-    (tmp_path / "pkg" / "newcomer.py").write_text("from .errors import f\n")
+    (tmp_path / "pkg" / "core" / "stepping.py").write_text(
+        "from .errors import E\n\ndef solve():\n    from ..execution.timeouts import budget\n")
+    (tmp_path / "pkg" / "core" / "problem.py").write_text("from ..checks import core\n")
+    (tmp_path / "pkg" / "core" / "errors.py").write_text("class E(Exception):\n    pass\n")
+    (tmp_path / "pkg" / "execution" / "timeouts.py").write_text("from ..core.errors import E\n")
+    (tmp_path / "pkg" / "checks" / "core.py").write_text("from ..execution.timeouts import budget\n")
+    (tmp_path / "pkg" / "cli.py").write_text("from .checks.core import budget\n")
+    assert upward_imports(tmp_path) == [
+        "verimono.core.problem (core) → verimono.checks.core (checks)",
+        "verimono.core.stepping (core) → verimono.execution.timeouts (execution)"]
+    (tmp_path / "pkg" / "newcomer.py").write_text("from .core.errors import E\n")
     with pytest.raises(KeyError, match="verimono.newcomer is in no layer"):
         upward_imports(tmp_path)
 

@@ -10,9 +10,9 @@ import pytest
 from verimono import solve, uniform_grid
 from verimono.checks import example as example_checks
 from verimono.lcs import check_hypotheses
-from verimono.pseudo_distance import pseudo_distance_lower_bound
+from verimono.core.pseudo_distance import pseudo_distance_lower_bound
 from verimono.reference import lcs_example as E
-from verimono.tolerances import RTOL
+from verimono.core.tolerances import RTOL
 
 
 def _enumerated_least_norm_lcp(M, q, tol=1e-12):

@@ -10,7 +10,7 @@ from verimono import InfeasibleStep, InvalidProblem, SolverFailure
 from verimono.lcs import Complementarity, LinearRelationSystem, Relay, solve_lcp
 from verimono.lcs import kernel as K
 from verimono.lcs.siconos_cases import diode_bridge, filippov, relay_oscillator
-from verimono.performance import minimal_lcs
+from verimono.run.performance import minimal_lcs
 
 # A + Aᵀ ⪯ 0, C = Bᵀ, D = RᵀR + skew with rank-1 R: ker(D + Dᵀ) ≠ {0}, so SOL need not be a singleton
 from test_lcs_system import random_passive
@@ -214,7 +214,7 @@ def test_overflow_is_a_typed_error_naming_the_row():
 
 def test_non_uniform_grids_and_operator_relations_batch_row_by_row():
     from verimono import NormalCone
-    from verimono.sets import Box
+    from verimono.core.sets import Box
 
     sysO = LinearRelationSystem(np.zeros((2, 2)), 2 * np.eye(2), np.eye(2), np.zeros((2, 2)),
                                 NormalCone(Box([-1, -1], [1, 1])))

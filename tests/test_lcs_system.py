@@ -8,7 +8,7 @@ import pytest
 from verimono import (InfeasibleStep, InvalidProblem, NormalCone, NotMonotone, operator_from_resolvent, solve,
                       uniform_grid)
 from verimono.lcs import Complementarity, LinearRelationSystem, OperatorRelation, Relay, check_hypotheses
-from verimono.sets import Box
+from verimono.core.sets import Box
 
 
 def random_passive(rng, n=3, m=2):

@@ -1,4 +1,4 @@
-"""Manufactured solutions (:mod:`verimono.manufactured`): the identity ``y* ∈ F(t, x*)``, ``x* = J_{μF}(z)``, the
+"""Manufactured solutions (:mod:`verimono.reference.manufactured`): the identity ``y* ∈ F(t, x*)``, ``x* = J_{μF}(z)``, the
 input and its primitive against independent computations, the kinks against their closed forms, and the
 proximal scheme's order on the three examples — truth, not a self-comparison — with the broken steppers
 it must expose seen failing."""

@@ -1,6 +1,6 @@
 """Issue 25, bounded time in native code: a call of the subject blocked where ``SIGALRM`` cannot reach it
 (``os.system``: glibc's ``system`` retries its ``waitpid`` after the signal) is stopped by the process-level
-limit of :mod:`verimono.watchdog` once its budget and grace are over.
+limit of :mod:`verimono.execution.watchdog` once its budget and grace are over.
 
 Before it, ``verimono check mod:stepper --timeout 3`` on a stepper calling ``os.system("sleep 20")`` took
 141 s for 8 units of 3 s (``--executor serial``: each call ran its full 20 s) and 383 s under ``--executor
@@ -25,8 +25,8 @@ import pytest
 import verimono as vm
 from verimono import watchdog
 from verimono.reference import get
-from verimono.results import FAILED, PASSED, CheckResult, Report, load
-from verimono.timeouts import budget, current_budget, run_unit, supported, time_limit
+from verimono.records.results import FAILED, PASSED, CheckResult, Report, load
+from verimono.execution.timeouts import budget, current_budget, run_unit, supported, time_limit
 
 pytestmark = pytest.mark.skipif(not supported() or not sys.platform.startswith("linux"),
                                 reason="native hangs: a POSIX timer in the main thread, os.system, /proc")
@@ -142,7 +142,7 @@ def test_timeout_inf_means_no_limit(tmp_path, monkeypatch):
     import signal
 
     from verimono.cli import build_parser, main
-    from verimono.executors import make_runner
+    from verimono.execution.executors import make_runner
 
     args = build_parser().parse_args(["run", "--timeout", "inf", "--unit-timeout", "Infinity"])
     assert args.timeout == math.inf and args.unit_timeout == math.inf
@@ -159,7 +159,7 @@ def test_timeout_inf_means_no_limit(tmp_path, monkeypatch):
 
 
 def test_a_resumed_run_drops_the_records_of_the_stage_that_hung():
-    from verimono.runs import UNFINISHED_STAGE, merge_resumed
+    from verimono.run.execute import UNFINISHED_STAGE, merge_resumed
 
     done = CheckResult("a", "x", PASSED)
     partial = CheckResult("b", "y", PASSED, details={UNFINISHED_STAGE: True})

@@ -22,7 +22,7 @@ from verimono.checks.trajectory_laws import check_in_domain, check_selections
 from verimono.lcs import check_hypotheses
 from verimono.reference import catalog
 from verimono.reference import lcs_example as E
-from verimono.results import FAILED, UNDECIDED
+from verimono.records.results import FAILED, UNDECIDED
 
 INPUTS = {"v = (−t, 0)": lambda t: np.array([-t, 0.0]), "v = (sin t, 0)": lambda t: np.array([np.sin(t), 0.0])}
 

@@ -13,7 +13,7 @@ import pytest
 import verimono as vm
 from verimono.checks.orders import check_convergence_order
 from verimono.reference import get
-from verimono.report.notebook import SCOPE, scoped_css
+from verimono.records.report.notebook import SCOPE, scoped_css
 
 from zoo_steppers import drops_input
 

@@ -184,7 +184,7 @@ def test_laws_on_points_closer_than_the_square_root_of_the_smallest_double():
 def test_default_effort_follows_the_profile(monkeypatch):
     """examples=None: the active profile's ``law_examples`` (dev/ci/thorough) is the effort, recorded in the
     record's details and the report's meta; an explicit ``examples`` still wins."""
-    from verimono.profiles import get_profile
+    from verimono.execution.profiles import get_profile
 
     op = operator_from_resolvent(lambda x, lam, t: np.asarray(x) / (1.0 + lam), 1, name="scaled")
     for name in ("dev", "thorough"):

@@ -13,8 +13,8 @@ import pytest
 from scipy.optimize import brentq, minimize
 
 import verimono as vm
-from verimono.sets import Ball, Box, HalfSpace, Polyhedron, Translated
-from verimono.tolerances import tolerance
+from verimono.core.sets import Ball, Box, HalfSpace, Polyhedron, Translated
+from verimono.core.tolerances import tolerance
 
 RNG = np.random.default_rng(20261122)
 MINIMIZER_TOL = 1e-5
@@ -233,7 +233,7 @@ def test_resolvent_rows_batches_only_what_declares_it():
     """resolvent_rows: one vectorized call for a catalog operator (the same bits as row by row), one call per
     row for a user's operator — whose resolvent may treat a (B, n) array as one point — and for a catalog
     subclass that overrides the resolvent."""
-    from verimono.operators import resolvent_rows
+    from verimono.core.operators import resolvent_rows
 
     X = RNG.normal(size=(5, 2))
     calls = []

@@ -10,14 +10,14 @@ import pytest
 
 import verimono as vm
 from verimono.checks.orders import check_convergence_order, reproduction_script
-from verimono.problem import Order, with_origin
+from verimono.core.problem import Order, with_origin
 from verimono.reference import get
 
 PROBLEM_FILE = '''
 import numpy as np
 import verimono as vm
-from verimono.problem import Order
-from verimono.sets import Ball
+from verimono.core.problem import Order
+from verimono.core.sets import Ball
 
 disc = vm.NormalCone(Ball(lambda t: 0.3 * np.array([np.cos(t), np.sin(t)]), 1.0))
 inexact = vm.Problem(disc, np.array([1.2, 0.0]), 2.0, f=lambda x: -0.5 * x, lipschitz=0.5,
@@ -35,7 +35,7 @@ def drops_u(problem, t):
 def user(tmp_path_factory):
     path = tmp_path_factory.mktemp("user") / "user_problem.py"
     path.write_text(textwrap.dedent(PROBLEM_FILE))
-    from verimono.targets import load_target
+    from verimono.run.targets import load_target
 
     return path, load_target(f"{path}:inexact"), load_target(f"{path}:drops_u")
 
@@ -82,7 +82,7 @@ def test_check_takes_a_problem_from_the_command_line(user, tmp_path, capsys):
     code = main(["check", f"{path}:drops_u", "--problem", f"{path}:inexact", "--out", str(out)])
     text = capsys.readouterr().out
     assert code == 1 and "moving disc, no exact solution" in text and "FAILED" in text
-    from verimono.results import load
+    from verimono.records.results import load
 
     rec = next(r for r in load(out / "results.json").results
                if r.check == "convergence_order" and "no exact" in r.subject)

@@ -10,7 +10,7 @@ import pytest
 from verimono import SolverFailure
 from verimono.lcs import is_passive
 from verimono.lcs.passivity import MissingOptionalDependency, kyp_matrix
-from verimono.tolerances import SDP_RTOL
+from verimono.core.tolerances import SDP_RTOL
 
 L, Cc, R = 1e-2, 1e-6, 1e3
 DIODE = (np.array([[0, -1 / Cc], [1 / L, 0]]), np.array([[0, 0, -1 / Cc, 1 / Cc], [0, 0, 0, 0]]),

@@ -11,11 +11,11 @@ import random
 import pytest
 
 from verimono import performance, timing
-from verimono.gate import TIMING_GROWTH, compare
-from verimono.profiles import get_profile
-from verimono.results import FAILED, PASSED, UNDECIDED, Report
-from verimono.stages import STAGES, RunContext
-from verimono.stepping import solve
+from verimono.run.gate import TIMING_GROWTH, compare
+from verimono.execution.profiles import get_profile
+from verimono.records.results import FAILED, PASSED, UNDECIDED, Report
+from verimono.run.stages import STAGES, RunContext
+from verimono.core.stepping import solve
 
 #: small enough for the test run (one look of 6 rounds: the fewest with order-statistics bounds); the memory
 #: study keeps the ci size (below ~75 000 steps its fixed per-block buffers exceed one trajectory, so the
@@ -120,7 +120,7 @@ def test_the_gate_flags_a_doubled_timing_ratio():
 
 
 def test_the_report_shows_the_measured_ratios():
-    from verimono.report.html import render
+    from verimono.records.report.html import render
 
     rep = Report([performance.ratio_record("performance_ensemble", "box B=1000", [0.01, 0.012, 0.011] * 3, [1.0] * 9,
                                            target=performance.ENSEMBLE_TARGET, speedup=True),
@@ -141,7 +141,7 @@ def test_the_memory_record_holds_in_a_fresh_process():
     import subprocess
     import sys
 
-    code = ("import json; from verimono.performance import SIZES, check_memory; "
+    code = ("import json; from verimono.run.performance import SIZES, check_memory; "
             "r = check_memory(steps=SIZES['ci'].memory_steps); print(json.dumps([r.status, r.details['ratio']]))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     status, ratio = json.loads(out.stdout.strip().splitlines()[-1])
@@ -159,7 +159,7 @@ def test_a_study_that_holds_whole_trajectories_fails_the_memory_record():
 def test_on_worker_processes_the_memory_record_runs_beside_the_timed_ones(monkeypatch):
     """With an idle worker the memory record (bytes, not seconds) runs there while the timed records run
     here; the records, their order and the memory verdict are those of the serial stage."""
-    from verimono.executors import ProcessRunner
+    from verimono.execution.executors import ProcessRunner
 
     monkeypatch.setitem(performance.SIZES, "ci", SMALL)
     runner = ProcessRunner(2)
@@ -173,7 +173,7 @@ def test_on_worker_processes_the_memory_record_runs_beside_the_timed_ones(monkey
     assert mem.status == PASSED and mem.details["ratio"] <= performance.MEMORY_TARGET, str(mem)
 
 
-# -- the estimator and the decision rule on synthetic timings (verimono.timing) -------------------------------
+# -- the estimator and the decision rule on synthetic timings (verimono.execution.timing) -------------------------------
 
 
 class Machine:
@@ -345,8 +345,8 @@ def test_the_timed_records_do_not_wait_for_the_watchdog_thread():
     import threading
 
     from verimono import watchdog
-    from verimono.performance import _quiet_process
-    from verimono.timeouts import supported, time_limit
+    from verimono.run.performance import _quiet_process
+    from verimono.execution.timeouts import supported, time_limit
 
     if not supported():
         pytest.skip("the watchdog starts with a time limit, which needs the main thread of a POSIX process")

@@ -11,7 +11,7 @@ import pytest
 import verimono as vm
 from verimono.checks.picard import check_picard
 from verimono.reference import get
-from verimono.results import FAILED, PASSED, SKIPPED
+from verimono.records.results import FAILED, PASSED, SKIPPED
 from zoo_estimators import understated_lipschitz
 
 

@@ -22,7 +22,7 @@ import pytest
 import verimono as vm
 from verimono.checks.orders import check_convergence_order
 from verimono.reference import get
-from verimono.results import CheckResult, emit
+from verimono.records.results import CheckResult, emit
 
 
 def test_order_of_the_scheme(verimono_report):
@@ -115,7 +115,7 @@ def test_a_profile_loaded_before_hypothesis_is_imported_is_loaded_when_it_is():
 
     code = """
 import sys
-from verimono.profiles import load_hypothesis_profile, UnknownProfile
+from verimono.execution.profiles import load_hypothesis_profile, UnknownProfile
 load_hypothesis_profile("thorough"); load_hypothesis_profile("ci")
 print("hypothesis" in sys.modules)
 from hypothesis import strategies                      # a submodule first: the package is imported for it
@@ -136,7 +136,7 @@ except UnknownProfile:
 
 def _baseline_doc(command: str = "pytest") -> dict:
     """A small valid baseline document of one executed record, to be broken by the tests below."""
-    from verimono.results import CheckResult, Report
+    from verimono.records.results import CheckResult, Report
 
     rec = CheckResult("my_law", "my operator", "passed", worst=0.5, bound=1.0)
     return Report([rec], meta={"command": command, "target": None, "profile": "dev", "seed": None}).to_dict()
@@ -175,7 +175,7 @@ def test_a_worker_ships_a_tests_records_and_the_controller_files_them_under_the_
     from types import SimpleNamespace
 
     from verimono.plugin import RecordSink, _Collector
-    from verimono.results import CheckResult
+    from verimono.records.results import CheckResult
 
     rec = CheckResult("my_law", "my operator", "failed", worst=2.0, bound=1.0, message="2 > 1")
     worker = _Collector(None, None, "dev", worker=True)
@@ -202,7 +202,7 @@ def test_a_worker_ships_a_tests_records_and_the_controller_files_them_under_the_
 def test_checks_passed_as_arguments_are_recorded_and_the_sink_takes_records_only():
     import verimono as vm
     from verimono.plugin import RecordSink, _is_verimono_check, _recording
-    from verimono.results import CheckResult
+    from verimono.records.results import CheckResult
 
     assert _is_verimono_check(vm.check_operator) and _is_verimono_check(vm.check_stepper)
     assert not _is_verimono_check(len) and not _is_verimono_check(vm.Problem)

@@ -16,7 +16,7 @@ from zoo_precision import float32, float32_problem, float32_stepper
 from verimono import operator_from_resolvent, solve
 from verimono.checks import OPERATOR_CHECKS, check_operator, check_stepper, run_law
 from verimono.checks.stepper_battery import CHECKS, LAWS as STEPPER_LAWS
-from verimono.profiles import get_profile
+from verimono.execution.profiles import get_profile
 from verimono.reference import catalog as reference_catalog
 from verimono.reference import get
 from verimono.strategies import catalog

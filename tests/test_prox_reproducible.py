@@ -1,5 +1,5 @@
 """Same seed → same records, whatever the user imported.  Hypothesis mixes numeric literals of imported
-"local" modules into generation; verimono's searches switch that off (verimono._reproducible), so a record's
+"local" modules into generation; verimono's searches switch that off (verimono.core._reproducible), so a record's
 seed reproduces it in a fresh process.  Shown in fresh processes with and without an unrelated module of
 many constants, and — so the test is seen able to fail — without the guard the records differ."""
 
@@ -45,7 +45,7 @@ def _records(tmp_path, imported: bool, guarded: bool = True):
 def test_the_guard_empties_the_local_constants_and_restores_them():
     """The in-process part of the tests below (fresh processes, tier ``slow``): within the guard hypothesis'
     pool of local constants is empty, and afterwards it is hypothesis' own again."""
-    from verimono._reproducible import no_local_constants
+    from verimono.core._reproducible import no_local_constants
 
     providers = pytest.importorskip("hypothesis.internal.conjecture.providers")
     before = getattr(providers, "_get_local_constants", None)
@@ -69,7 +69,7 @@ def test_same_seed_same_records_with_and_without_an_unrelated_module(tmp_path):
 
 @pytest.mark.slow
 def test_without_the_guard_the_import_changes_the_samples(tmp_path):
-    from verimono._reproducible import no_local_constants
+    from verimono.core._reproducible import no_local_constants
 
     with no_local_constants() as found:
         if not found:

@@ -8,9 +8,9 @@ import pytest
 
 from verimono import NormalCone, sets
 from verimono.checks.pseudo_distance import check_pseudo_distance, hausdorff_pairs
-from verimono.pseudo_distance import pseudo_distance_lower_bound
-from verimono.results import FAILED, PASSED
-from verimono.tolerances import PSEUDO_DISTANCE_FACTOR
+from verimono.core.pseudo_distance import pseudo_distance_lower_bound
+from verimono.records.results import FAILED, PASSED
+from verimono.core.tolerances import PSEUDO_DISTANCE_FACTOR
 from zoo_estimators import ESTIMATORS
 
 

@@ -1,4 +1,4 @@
-"""The verified QP layer (:mod:`verimono.qp`): no back-end status trusted, the same accuracy at every scale."""
+"""The verified QP layer (:mod:`verimono.core.qp`): no back-end status trusted, the same accuracy at every scale."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ import qpsolvers
 from scipy.optimize import LinearConstraint, minimize
 
 from verimono import InfeasibleStep, SolverFailure
-from verimono.qp import equilibrate, kkt_residual, solve_qp
+from verimono.core.qp import equilibrate, kkt_residual, solve_qp
 
 # the triangle {z1 + z2 <= 1, z >= 0} and a slab cut by an equality, as (G, h, A, b)
 TRIANGLE = (np.array([[1.0, 1.0], [-1.0, 0.0], [0.0, -1.0]]), np.array([1.0, 0.0, 0.0]), None, None)
@@ -53,7 +53,7 @@ def test_a_linear_term_far_larger_than_the_constraints_is_solved_and_returns():
     Example), so the solve runs in a subprocess with a time limit: a regression fails, it does not hang."""
     code = textwrap.dedent("""
         import numpy as np
-        from verimono.qp import solve_qp
+        from verimono.core.qp import solve_qp
         c = 0.7953406842482188
         P, q = np.diag([0.0, 1.0]), np.array([0.0, -c])
         G = np.array([[-1.0, 0.0], [0.0, -1.0], [0.0, -1.0], [1.0, 0.0]])
@@ -142,7 +142,7 @@ def test_a_far_half_space_is_never_dropped_from_the_answer():
     unbounded and no back-end's point verifies; the solve is retried with the row in its units, and the
     answer satisfies it.  (The linear term is then 1e-37 of the data's size, below double precision: any
     feasible z with z₁ = 0 is a minimiser to that precision, which is all a relative check can decide.)"""
-    from verimono.qp import equilibrate
+    from verimono.core.qp import equilibrate
 
     P, q, G, h = np.diag([1.0, 0.0]), np.array([0.0, -1.0]), np.array([[0.0, 1e-37]]), np.array([1.0])
     S = equilibrate(P, q, G, h, None, None)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 
 from verimono.cli import main
-from verimono.gate import LISTED_REGRESSIONS, Change, Comparison
+from verimono.run.gate import LISTED_REGRESSIONS, Change, Comparison
 
 
 def test_regression_lines_list_the_first_ones_then_the_gate_command():

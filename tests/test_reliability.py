@@ -19,10 +19,10 @@ import pytest
 
 import verimono as vm
 from verimono.cli import main
-from verimono.gate import compare, gate
-from verimono.report import html_run_id, write
-from verimono.results import SchemaError, load
-from verimono.results import CheckResult, Report
+from verimono.run.gate import compare, gate
+from verimono.records.report import html_run_id, write
+from verimono.records.results import SchemaError, load
+from verimono.records.results import CheckResult, Report
 
 
 def _report(worst=0.5, tag="a") -> Report:
@@ -38,7 +38,7 @@ def test_enospc_during_a_write_keeps_the_previous_results_intact(tmp_path, monke
     before_json = (tmp_path / "results.json").read_text()
     before_html = (tmp_path / "report.html").read_text()
 
-    import verimono.atomic as atomic
+    import verimono.records.atomic as atomic
 
     real_fdopen = os.fdopen
 
@@ -73,7 +73,7 @@ def test_enospc_during_a_write_keeps_the_previous_results_intact(tmp_path, monke
 def test_baseline_out_is_atomic_too(tmp_path, monkeypatch):
     base = tmp_path / "baseline.json"
     _report(tag="committed").save(base)
-    import verimono.atomic as atomic
+    import verimono.records.atomic as atomic
 
     def full(*a, **k):
         raise OSError(errno.ENOSPC, "No space left on device")
@@ -87,12 +87,12 @@ def test_baseline_out_is_atomic_too(tmp_path, monkeypatch):
 
 def test_interrupt_during_rendering_leaves_a_consistent_pair(tmp_path, monkeypatch):
     write(_report(tag="first"), tmp_path)
-    import verimono.report.html as html
+    import verimono.records.report.html as html
 
     def interrupted(*a, **k):
         raise KeyboardInterrupt
 
-    import verimono.report as report_pkg
+    import verimono.records.report as report_pkg
 
     monkeypatch.setattr(html, "render", interrupted)
     monkeypatch.setattr(report_pkg, "render", interrupted)      # write() renders through its own import
@@ -113,7 +113,7 @@ def test_two_writes_into_one_folder_leave_a_matching_pair(tmp_path):
 
 def test_unwritable_out_is_refused_before_any_stage_runs(tmp_path, capsys, monkeypatch):
     """The clock-free counterpart of the next test (tier ``timing``): the stage is never called."""
-    import verimono.stages as stages
+    import verimono.run.stages as stages
 
     real, calls = stages.STAGES["convergence"], []
 
@@ -142,7 +142,7 @@ def test_unwritable_out_fails_before_any_work(tmp_path, capsys):
 def test_an_interrupted_run_is_marked_incomplete_and_resume_runs_only_the_rest(tmp_path, monkeypatch, capsys):
     """The quick counterpart of the next test (whole stages, tier ``slow``): one reference, and a stand-in for
     the second stage that is interrupted, then completes on ``--resume`` without the first stage running again."""
-    import verimono.stages as stages
+    import verimono.run.stages as stages
 
     out, ran = tmp_path / "out", []
     conv, real = stages.STAGES["convergence"], stages.STAGES["section7"]
@@ -178,7 +178,7 @@ def test_an_interrupted_run_is_marked_incomplete_and_resume_runs_only_the_rest(t
 def test_interrupted_run_is_incomplete_refused_by_the_gate_and_resumed(tmp_path, monkeypatch, capsys):
     """Ctrl-C during the second stage: the first stage's records are kept in a results file marked
     incomplete; the gate exits 2 on it; ``--resume`` runs only the missing stage and completes it."""
-    import verimono.stages as stages
+    import verimono.run.stages as stages
 
     out = tmp_path / "out"
     real = stages.STAGES["section7"]
@@ -257,7 +257,7 @@ def test_passed_now_undecided_regresses():
 
 
 def test_reproduction_commands_quote_the_target():
-    from verimono.report.html import reproduction
+    from verimono.records.report.html import reproduction
 
     rec = CheckResult("monotone", "x", "failed", seed=3, details={"stage": "operator_laws"})
     evil = "mod:obj; touch /tmp/x #"
@@ -280,7 +280,7 @@ def _hanging_resolvent(x, lam, t):
 
 def test_a_hanging_resolvent_becomes_a_failed_record_and_the_run_goes_on():
     from verimono.checks.search import run_law
-    from verimono.timeouts import budget
+    from verimono.execution.timeouts import budget
 
     op = vm.operator_from_resolvent(_hanging_resolvent, 2, name="hangs")
     start = time.perf_counter()
@@ -295,7 +295,7 @@ def test_a_hanging_resolvent_becomes_a_failed_record_and_the_run_goes_on():
 
 def test_a_hanging_stepper_becomes_a_failed_record():
     from verimono.reference import get
-    from verimono.timeouts import budget
+    from verimono.execution.timeouts import budget
 
     def stuck(problem, t_grid):
         while True:
@@ -308,7 +308,7 @@ def test_a_hanging_stepper_becomes_a_failed_record():
 
 
 def test_timeout_must_be_positive():
-    from verimono.timeouts import budget
+    from verimono.execution.timeouts import budget
 
     with pytest.raises(vm.InvalidCheckArgument):
         with budget(0):

@@ -10,11 +10,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from verimono.runs import execute
-from verimono.report.html import SECTIONS, render, reproduction
-from verimono.results import SCHEMA_NAME, SCHEMA_VERSION, SchemaError, environment, load, loads
-from verimono.results import CheckResult, Report
-from verimono.stages import RunContext
+from verimono.run.execute import execute
+from verimono.records.report.html import SECTIONS, render, reproduction
+from verimono.records.results import SCHEMA_NAME, SCHEMA_VERSION, SchemaError, environment, load, loads
+from verimono.records.results import CheckResult, Report
+from verimono.run.stages import RunContext
 
 REFS = ["t|x| (n=1)", "moving box", "static ball, x0 inside"]
 
@@ -58,7 +58,7 @@ def test_json_round_trip_is_lossless(small_report, tmp_path):
 def test_json_values_convert_non_finite_floats_wherever_they_sit():
     """Plain JSON from NumPy values: non-finite floats become their repr (strict JSON has no NaN), also inside
     arrays and lists of floats, which otherwise pass as they are (the trajectories' fast path)."""
-    from verimono.results import to_jsonable
+    from verimono.records.results import to_jsonable
 
     assert to_jsonable((1.0, 2.5)) == [1.0, 2.5] and to_jsonable([1.0, math.inf]) == [1.0, "inf"]
     assert to_jsonable([1.0, 2]) == [1.0, 2] and to_jsonable([]) == []
@@ -116,7 +116,7 @@ EXTERNAL = [
 
 
 def test_html_report_structure_is_complete_and_self_contained(small_report):
-    from verimono.gate import compare
+    from verimono.run.gate import compare
 
     baseline = Report.from_dict(small_report.to_dict())
     baseline.results[0].status = "passed"
@@ -268,7 +268,7 @@ def test_siconos_error_the_gate_checks_is_in_the_laws_table():
 
 
 def test_changes_are_grouped_per_subject():
-    from verimono.gate import Change, Comparison
+    from verimono.run.gate import Change, Comparison
 
     broken = "solve on moving box"
     changes = [Change("status", f"convergence_order[{broken}]", "passed → failed", True),
@@ -303,7 +303,7 @@ def test_a_failing_law_reproduces_with_the_reference_the_run_names():
 def test_plots_drawn_ahead_are_the_reports_plots_drawn_once(small_report, monkeypatch):
     """A run on worker processes draws its plots while it waits (``plots.draw_ahead``): the report then uses
     them, draws none twice, and is the document it would be without them (apart from the figures' ids)."""
-    from verimono.report import plots
+    from verimono.records.report import plots
 
     drawn = []
     figure = plots.convergence_figure
@@ -328,7 +328,7 @@ def test_plots_drawn_ahead_are_the_reports_plots_drawn_once(small_report, monkey
 def test_the_reports_reused_axes_draw_what_a_fresh_figure_draws(small_report):
     """The report draws every plot of a kind on one reused axes (``plots._reused_axes``): each plot, drawn
     after the others, is the SVG a new figure gives (apart from the figures' salted ids)."""
-    from verimono.report import plots
+    from verimono.records.report import plots
 
     def same(svg: str) -> str:
         return re.sub(r"\b[mp][0-9a-f]{10}\b", "ID", re.sub(r"vm\d+x\d+", "vm", svg))
@@ -358,8 +358,8 @@ def test_a_drawer_process_draws_the_reports_plots_and_a_dead_one_leaves_them_her
     path.write_bytes(pickle.dumps((small_report.studies, small_report.trajectories)))
     code = f"""
 import os, pickle, re, signal
-from verimono.calibration import PendingCalibration
-from verimono.report import drawer, plots
+from verimono.execution.calibration import PendingCalibration
+from verimono.records.report import drawer, plots
 studies, samples = pickle.loads(open({str(path)!r}, "rb").read())
 same = lambda h: re.sub(r"\\b[mp][0-9a-f]{{10}}\\b", "ID", re.sub(r"vm\\d+x\\d+", "vm", h))
 serve_it, connect = drawer.drawer_pipe()

@@ -14,7 +14,7 @@ import pytest
 from verimono import Problem
 from verimono.checks.assumptions import check_assumptions
 from verimono.lcs import Complementarity, LinearRelationSystem, check_hypotheses
-from verimono.results import FAILED, PASSED, SKIPPED
+from verimono.records.results import FAILED, PASSED, SKIPPED
 
 
 def _touching(tau, lift=0.0):

@@ -10,9 +10,9 @@ import pytest
 import verimono
 from verimono.checks.partitions import run_stepper
 from verimono.checks.shared_runs import shared_runs
-from verimono.grids import uniform_grid
+from verimono.core.grids import uniform_grid
 from verimono.reference import catalog
-from verimono.tolerances import judged_precision
+from verimono.core.tolerances import judged_precision
 
 
 def _problem(name: str = "static ball, x0 outside (jump)"):
@@ -91,7 +91,7 @@ def test_different_initial_points_and_horizons_are_different_runs():
 
 def test_a_remembered_value_is_computed_once_and_reports_its_precision_on_every_reuse():
     from verimono.checks.shared_runs import remembered_value
-    from verimono.tolerances import observe
+    from verimono.core.tolerances import observe
 
     calls = []
 

@@ -73,7 +73,7 @@ def test_packaged_arrays_equal_the_shared_originals():
 
 
 def test_locate_data_defaults_to_the_packaged_data_and_checks_a_given_folder(tmp_path, monkeypatch):
-    from verimono.stages import StageUnavailable, locate_data
+    from verimono.run.stages import StageUnavailable, locate_data
 
     monkeypatch.delenv("VERIMONO_SHARED", raising=False)
     monkeypatch.chdir(tmp_path)
@@ -103,8 +103,8 @@ def test_siconos_stage_runs_from_a_bare_directory_with_the_baseline_records(tmp_
     """`verimono run --stage siconos` from a folder with no ../shared and no $VERIMONO_SHARED: the 29 records
     of the committed baseline's siconos stage, with their statuses, and no regression against them."""
     from verimono.cli import main
-    from verimono.gate import compare
-    from verimono.results import Report, load
+    from verimono.run.gate import compare
+    from verimono.records.results import Report, load
 
     monkeypatch.delenv("VERIMONO_SHARED", raising=False)
     work = tmp_path / "clone"

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import verimono as vm
-from verimono.sets import Ball, Box
-from verimono.tolerances import tolerance
+from verimono.core.sets import Ball, Box
+from verimono.core.tolerances import tolerance
 
 
 def test_discrete_inclusion_holds_at_every_step():

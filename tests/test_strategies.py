@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from verimono import Operator, validate_grid
 from verimono import strategies as vs
-from verimono.tolerances import tolerance
+from verimono.core.tolerances import tolerance
 
 FAST = settings(max_examples=30, deadline=None, database=None, derandomize=True,
                 suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
@@ -197,7 +197,7 @@ def _stated_functions_hold(stated, w, lam, s, t, nu):
     by λ (quotient_tolerance); hypothesis climbs on each ratio lhs/(rhs + slack)."""
     from hypothesis import target
 
-    from verimono.tolerances import quotient_tolerance
+    from verimono.core.tolerances import quotient_tolerance
 
     op = stated.operator
     w = np.resize(w, op.dim)
@@ -296,7 +296,7 @@ def test_shift_constants_are_needed():
     """Stated.shifted: F = ∇(½x²) shifted by Φ = 2t (u ≡ 2, M = 2): |G^0(1, 0)| = |Φ(1)| = 2 exceeds σ = 1 but not
     σ(1)(1 + M) = 3 (LG); N_[0,1] shifted: dom G(t) = [-2t, 1 - 2t] moves by 2(t - s) = Mt-increments (A3)."""
     from verimono import Linear, NormalCone
-    from verimono.sets import Box
+    from verimono.core.sets import Box
 
     u = vs.ACInput("const", np.array([2.0]), np.zeros(1))
     g = vs.Stated(Linear([[1.0]]), phi=vs.ZERO, sigma=vs.Constant(1.0), theta=vs.ZERO).shifted(u)

@@ -1,5 +1,5 @@
 """Timing that holds on a busy machine, deterministically tested: time budgets in calibration units
-(:mod:`verimono.timeouts`), the gate's noise-aware stage-time rule, and the exit status of a run whose only
+(:mod:`verimono.execution.timeouts`), the gate's noise-aware stage-time rule, and the exit status of a run whose only
 undecided records are speeds the machine was too noisy to judge.  (The estimator and the decision rule:
 ``tests/test_performance.py``; verdicts on real timings: the benchmark tier.)"""
 
@@ -11,9 +11,9 @@ import time
 import pytest
 
 from verimono import calibration, timeouts, timing
-from verimono.gate import CALIBRATION_DRIFT, TIMING_GROWTH, compare
-from verimono.profiles import STAGE_BUDGETS, get_profile
-from verimono.results import PASSED, UNDECIDED, CheckResult, Report
+from verimono.run.gate import CALIBRATION_DRIFT, TIMING_GROWTH, compare
+from verimono.execution.profiles import STAGE_BUDGETS, get_profile
+from verimono.records.results import PASSED, UNDECIDED, CheckResult, Report
 
 
 @pytest.fixture
@@ -74,7 +74,7 @@ def test_the_first_calibration_is_measured_in_a_forked_copy_and_its_copy_always_
         pytest.skip("the copy is forked on Linux only (elsewhere it is measured in the process: next test)")
     out = _in_fresh_python(
         "import os\n"
-        "from verimono.calibration import PendingCalibration, calibrate\n"
+        "from verimono.execution.calibration import PendingCalibration, calibrate\n"
         "p = PendingCalibration()\n"
         "forked = p._pid is not None\n"
         "v = p.result()\n"
@@ -83,7 +83,7 @@ def test_the_first_calibration_is_measured_in_a_forked_copy_and_its_copy_always_
         "print(forked, 0.3 < v / here < 3.0)\n"                      # the same workload: the same size
         "q = PendingCalibration(); pid = q._pid; q.close()\n"         # never taken: ended and reaped
         "try:\n    os.waitpid(pid, 0); print('unreaped')\nexcept ChildProcessError:\n    print('reaped')\n"
-        "import verimono.calibration as c\n"
+        "import verimono.execution.calibration as c\n"
         "parent = os.getpid()\n"
         "c.calibrate = lambda repeats=3: 0.042 if os.getpid() == parent else 1 / 0\n"
         "print(PendingCalibration().result())\n")               # the copy failed: measured here
@@ -251,7 +251,7 @@ def test_a_timing_noise_undecided_record_is_a_change_not_a_regression():
 
 def test_speed_that_could_not_be_judged_does_not_fail_the_run(tmp_path, capsys):
     from verimono.cli import _finish
-    from verimono.runs import EXIT_OK, EXIT_UNDECIDED, exit_status as _exit_status
+    from verimono.run.execute import EXIT_OK, EXIT_UNDECIDED, exit_status as _exit_status
 
     noisy = CheckResult("performance_lcs_step", "DiodeBridge", UNDECIDED, worst=1.1, bound=1.0,
                         details={"undecided_reason": timing.NOISE_REASON})

@@ -14,7 +14,7 @@ from verimono.checks.bounds import LGBounds, YBBounds, check_bounds_lg
 from verimono.checks.stepper_battery import CHECKS, LAWS, reproduce, stepper_checks
 from verimono.checks.trajectory_laws import check_contraction, check_in_domain
 from verimono.reference import catalog, get
-from verimono.results import FAILED, PASSED, SKIPPED
+from verimono.records.results import FAILED, PASSED, SKIPPED
 
 from zoo_steppers import BREAKS, ZOO, amplifier, drops_input, lagged_step, wrong_time
 
@@ -70,7 +70,7 @@ def test_witness_steps_are_powers_of_two_below_half_the_step_shared_by_each_octa
     """``μ_k`` is the power of two in ``(h_k/4, h_k/2]`` (never the scheme's own step, round-off within the
     states'), so a partition whose steps span ``r`` octaves needs at most ``r + 1`` distinct resolvent steps."""
     from verimono.checks.trajectory_laws import witness_steps
-    from verimono.grids import graded_grid, random_grid
+    from verimono.core.grids import graded_grid, random_grid
 
     for t in (random_grid(9.4, 160, seed=3), graded_grid(9.4, 160), uniform_grid(1.0, steps=3)):
         h, mu = np.diff(t), witness_steps(t)

@@ -161,7 +161,7 @@ def test_records_kept_by_a_forked_test_process_fail_the_session(readme_project):
             return True
     '''))
     readme_project.makepyfile(test_mysolver=textwrap.dedent('''
-        from verimono.results import CheckResult, emit
+        from verimono.records.results import CheckResult, emit
 
         def test_law():
             emit(CheckResult("my_law", "my operator", "passed", worst=0.5, bound=1.0))

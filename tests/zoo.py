@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from verimono import L1Subdifferential, Linear, NormalCone, NormSubdifferential, operator_from_resolvent, sets
-from verimono.operators import Operator
+from verimono.core.operators import Operator
 
 #: a monotone, non-symmetric matrix with ‖M‖ = √10: large λ make an explicit step expand
 _M = np.array([[3.0, 1.0], [-1.0, 1.0]])

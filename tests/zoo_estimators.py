@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from verimono.pseudo_distance import graph_points, pseudo_distance_lower_bound
+from verimono.core.pseudo_distance import graph_points, pseudo_distance_lower_bound
 
 
 def twice_too_large(F1, F2, samples, *, lams=(1.0,), t1=0.0, t2=0.0):

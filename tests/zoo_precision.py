@@ -4,7 +4,7 @@
 precision a float32 implementation delivers: a correctly rounded result, plus the rounding of its inputs);
 ``float32_problem(p)`` does so for the operator and the field ``f`` of a problem, and ``float32_stepper(s)``
 returns a stepper's states as float32.  A correct operator stays correct (up to float32 rounding) and a
-broken one keeps its bug, so the judgement at float32 precision (:mod:`verimono.tolerances`) is tested on
+broken one keeps its bug, so the judgement at float32 precision (:mod:`verimono.core.tolerances`) is tested on
 both sides: every correct one passes, every broken one is still caught.
 """
 
@@ -14,7 +14,7 @@ import functools
 
 import numpy as np
 
-from verimono.operators import Operator
+from verimono.core.operators import Operator
 
 F32 = np.float32
 
@@ -57,7 +57,7 @@ class Float32(Operator):
         return self.op.growth(t)
 
     def provides(self, member):
-        from verimono.operators import provides
+        from verimono.core.operators import provides
         return provides(self.op, member)
 
 

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from verimono.errors import OutsideDomain
-from verimono.grids import validate_grid
+from verimono.core.errors import OutsideDomain
+from verimono.core.grids import validate_grid
 
 
 def _scheme(problem, t_grid, *, time=lambda t, k: t[k + 1], step=lambda h, k: h[k], drift_u=True,

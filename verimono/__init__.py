@@ -5,22 +5,69 @@ proximal scheme of Camlibel, Iannelli and Tanwani and checked against the laws a
 Data flow one way: Problem → stepper → Trajectory → checks → results → report / gate.
 """
 
-from .errors import (BadTarget, BatchStepError, IncompatibleBaseline, InfeasibleStep, InvalidCheckArgument,
-                     InvalidClaim, InvalidGrid, InvalidProblem, MissingOptionalDependency, NotMonotone,
-                     OutsideDomain, SchemaError, SolverFailure, StageUnavailable, UnitTimeout, UnknownProfile,
-                     UnknownStage, UnverifiedSolution, VerimonoError)
-from .grids import graded_grid, random_grid, refine, uniform_grid, validate_grid
-from .operators import (L1Subdifferential, Linear, LogBarrier, NormalCone, NormSubdifferential, Operator,
-                        Shifted, operator_from_resolvent)
-from .prox import ProxOperator, ProxOutputError, operator_from_prox
-from .problem import Order, Problem
-from .claims import Claim, Stepper
-from .results import CheckResult, Report
-from .stepping import Trajectory, solve, stream
-from .pseudo_distance import pseudo_distance_lower_bound
-from .convergence import ConvergenceStudy, ErrorAccumulator, convergence_study
-from .manufactured import manufactured_problem
-from . import sets
+import importlib
+
+from .core.errors import (BadTarget, BatchStepError, IncompatibleBaseline, InfeasibleStep, InvalidCheckArgument,
+                          InvalidClaim, InvalidGrid, InvalidProblem, MissingOptionalDependency, NotMonotone,
+                          OutsideDomain, SchemaError, SolverFailure, StageUnavailable, UnitTimeout, UnknownProfile,
+                          UnknownStage, UnverifiedSolution, VerimonoError)
+from .core.grids import graded_grid, random_grid, refine, uniform_grid, validate_grid
+from .core.operators import (L1Subdifferential, Linear, LogBarrier, NormalCone, NormSubdifferential, Operator,
+                             Shifted, operator_from_resolvent)
+from .core.prox import ProxOperator, ProxOutputError, operator_from_prox
+from .core.problem import Order, Problem
+from .core.claims import Claim, Stepper
+from .records.results import CheckResult, Report
+from .core.stepping import Trajectory, solve, stream
+from .core.pseudo_distance import pseudo_distance_lower_bound
+from .core.convergence import ConvergenceStudy, ErrorAccumulator, convergence_study
+from .core import sets
+from .core._moved import install_moved_modules
+
+#: module paths of the flat layout, kept importable (``import verimono.stepping``, ``from verimono.sets import
+#: Ball``): each is the module of its new home, loaded on first use
+MOVED = {
+    "_jsonable": "core._jsonable",
+    "_params": "core._params",
+    "_reproducible": "core._reproducible",
+    "_rows": "core._rows",
+    "_subgradients": "core._subgradients",
+    "_validate": "core._validate",
+    "arrays": "core.arrays",
+    "atomic": "records.atomic",
+    "calibration": "execution.calibration",
+    "claims": "core.claims",
+    "convergence": "core.convergence",
+    "display": "core.display",
+    "environment": "records.environment",
+    "errors": "core.errors",
+    "executors": "execution.executors",
+    "gate": "run.gate",
+    "grids": "core.grids",
+    "manufactured": "reference.manufactured",
+    "naming": "core.naming",
+    "operators": "core.operators",
+    "performance": "run.performance",
+    "problem": "core.problem",
+    "profiles": "execution.profiles",
+    "progress": "run.progress",
+    "prox": "core.prox",
+    "pseudo_distance": "core.pseudo_distance",
+    "qp": "core.qp",
+    "report": "records.report",
+    "results": "records.results",
+    "runs": "run.execute",
+    "schema": "records.schema",
+    "sets": "core.sets",
+    "stages": "run.stages",
+    "stepping": "core.stepping",
+    "targets": "run.targets",
+    "timeouts": "execution.timeouts",
+    "timing": "execution.timing",
+    "tolerances": "core.tolerances",
+    "watchdog": "execution.watchdog",
+}
+install_moved_modules(__name__, MOVED)
 
 
 def __getattr__(name: str):
@@ -31,6 +78,8 @@ def __getattr__(name: str):
 
         value = {"check_operator": check_operator, "check_stepper": check_stepper,
                  "operator_checks": operator_checks}[name]
+    elif name == "manufactured_problem":   # verimono.reference loads the catalog's LCS tools
+        from .reference.manufactured import manufactured_problem as value
     elif name == "check_assumptions":
         from .checks.assumptions import check_assumptions as value
     elif name == "checks":  # `import a.b as c` imports the submodule before reading it: no recursion here
@@ -39,6 +88,8 @@ def __getattr__(name: str):
         import verimono.lcs as value
     elif name == "strategies":
         import verimono.strategies as value
+    elif name in MOVED:   # `vm.stepping`, as the submodule of the flat layout was
+        value = importlib.import_module(f"{__name__}.{MOVED[name]}")
     else:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     globals()[name] = value

@@ -3,7 +3,7 @@
     verimono run [--profile dev|ci|thorough] [--out DIR] [--stage NAME ...] [--seed N] [--data DIR]
                  [--baseline FILE] [--timeout S] [--resume] [--executor serial|process:N|tcp://host:port]
                  [--unit-timeout S]
-        The whole verification (every registered stage, see ``verimono.stages``); writes DIR/results.json
+        The whole verification (every registered stage, see ``verimono.run.stages``); writes DIR/results.json
         and DIR/report.html (DIR defaults to reports/).  Exit 0 when every check holds, 1 when one fails,
         2 when nothing failed but a check was undecided (a limitation of the harness) — except a speed the machine
         was too noisy to judge (a timing record undecided for "timing noise"), which exits 0 and says so.
@@ -15,7 +15,7 @@
         default: the profile's), beyond which the unit is stopped and recorded as failed.  ``--timeout`` and
         ``--unit-timeout`` are numbers of seconds > 0 or ``inf`` (no limit), checked before any work (exit 2
         otherwise: ``nan``, 0, negatives).  A call blocked in native code (``os.system``, a C extension),
-        which the budget's interrupt cannot stop, is stopped by a process-level limit (``verimono.watchdog``)
+        which the budget's interrupt cannot stop, is stopped by a process-level limit (``verimono.execution.watchdog``)
         once the budget and a grace of max(2 s, half the budget) are over: under ``--executor process:N``
         its worker answers a failed record naming the call and is replaced, and the run goes on; in this
         process (``--executor serial``) the run ends — the finished stages and a failed record for the call
@@ -36,7 +36,7 @@
         Exit 1 and print why on a regression; exit 2 when either file is missing, garbled, incompatible,
         repeats a record key, is not a regular file or is larger than the document limit
         (``$VERIMONO_MAX_DOCUMENT_MIB``, default 256), when the baseline holds a non-finite figure, or when
-        the results are those of a run that never completed (see ``verimono.gate``).
+        the results are those of a run that never completed (see ``verimono.run.gate``).
     verimono report [--results reports/results.json] [--out reports/report.html] [--baseline FILE]
         Re-render the HTML report from a results file.
 
@@ -52,20 +52,20 @@ import sys
 from pathlib import Path
 from typing import Any, Callable
 
-from .claims import SCHEMES, claim_of, with_claim
-from .errors import BadTarget, InvalidCheckArgument, NothingToResume, OutputNotWritable, SchemaError, VerimonoError
-from .profiles import PROFILES, active_profile
-from .progress import Progress
-from .results import FAILED, SKIPPED, Report
-from .runs import (EXIT_FAILED, EXIT_OK, EXIT_UNDECIDED, execute, exit_status, interruptible, merge_resumed)
-from .targets import load_target
+from .core.claims import SCHEMES, claim_of, with_claim
+from .core.errors import BadTarget, InvalidCheckArgument, NothingToResume, OutputNotWritable, SchemaError, VerimonoError
+from .execution.profiles import PROFILES, active_profile
+from .run.progress import Progress
+from .records.results import FAILED, SKIPPED, Report
+from .run.execute import (EXIT_FAILED, EXIT_OK, EXIT_UNDECIDED, execute, exit_status, interruptible, merge_resumed)
+from .run.targets import load_target
 
 
 # -- running -----------------------------------------------------------------------------------------
 
 
 def _context(args: argparse.Namespace, **kw: Any) -> Any:
-    from .stages import RunContext, StageUnavailable, locate_data
+    from .run.stages import RunContext, StageUnavailable, locate_data
 
     try:
         data = locate_data(getattr(args, "data", None))
@@ -87,7 +87,7 @@ def _context(args: argparse.Namespace, **kw: Any) -> Any:
 def _load_problems(spec: str) -> list[Any]:
     """``--problem MODULE:OBJECT``: a :class:`verimono.Problem` (or a list of them), remembered as loaded from
     ``spec`` so that reproduction lines name it."""
-    from .problem import Problem, with_origin
+    from .core.problem import Problem, with_origin
 
     obj = load_target(spec)
     found = list(obj) if isinstance(obj, (list, tuple)) else [obj]
@@ -99,7 +99,7 @@ def _load_problems(spec: str) -> list[Any]:
 
 
 def _executor_options(args: argparse.Namespace) -> dict[str, Any]:
-    """What :func:`verimono.runs.execute` takes from the options: the executor, its unit timeout, and the
+    """What :func:`verimono.run.execute.execute` takes from the options: the executor, its unit timeout, and the
     calibration :func:`main` started before its imports."""
     spec = getattr(args, "executor", None)
     return {"executor": None if spec in (None, "serial") else spec, "unit_timeout": getattr(args, "unit_timeout", None),
@@ -108,7 +108,7 @@ def _executor_options(args: argparse.Namespace) -> dict[str, Any]:
 
 def _baseline_for(args: argparse.Namespace) -> Report | None:
     """The baseline to show changes against: ``--baseline`` (must load) or reports/baseline.json if present."""
-    from .results import load
+    from .records.results import load
 
     path = getattr(args, "baseline", None)
     if path:
@@ -129,7 +129,7 @@ def _baseline_for(args: argparse.Namespace) -> Report | None:
 def _changes(baseline: Report | None, report: Report) -> Any:
     if baseline is None:
         return None
-    from .gate import IncompatibleBaseline, check_runs_compatible, compare
+    from .run.gate import IncompatibleBaseline, check_runs_compatible, compare
 
     try:
         check_runs_compatible(baseline, report)
@@ -163,8 +163,8 @@ def _start(out: Path, command: str, resumes: str | None = None) -> str:
     import datetime as dt
     import socket
 
-    from .atomic import mark_in_progress
-    from .report import new_run_id
+    from .records.atomic import mark_in_progress
+    from .records.report import new_run_id
 
     run_id = new_run_id()
     mark_in_progress(out / "results.json", run_id, command=command, pid=os.getpid(), host=socket.gethostname(),
@@ -200,7 +200,7 @@ def _seed(text: str) -> int:
 
 
 def _finish(report: Report, out: Path, baseline: Report | None, run_id: str | None = None) -> int:
-    from .report import write
+    from .records.report import write
 
     changes = _changes(baseline, report)
     paths = write(report, out, changes=changes, run_id=run_id)
@@ -209,7 +209,7 @@ def _finish(report: Report, out: Path, baseline: Report | None, run_id: str | No
     for r in report.failures:
         print(f"  {r}")
     line = f"verimono: {report.summary()}"
-    from .timing import is_noise_undecided
+    from .execution.timing import is_noise_undecided
 
     noisy = [r for r in report.undecided if is_noise_undecided(r)]
     if noisy:
@@ -227,9 +227,9 @@ def _finish(report: Report, out: Path, baseline: Report | None, run_id: str | No
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from .atomic import ensure_writable_dir, in_progress
-    from .results import load
-    from .timeouts import budget
+    from .records.atomic import ensure_writable_dir, in_progress
+    from .records.results import load
+    from .execution.timeouts import budget
 
     out = ensure_writable_dir(args.out)           # before any work: a run must not be lost at the end
     baseline = _baseline_for(args)
@@ -250,7 +250,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
         if previous.meta.get("profile") != args.profile:
             raise NothingToResume(f"the interrupted run used profile {previous.meta.get('profile')!r}, not "
                                   f"{args.profile!r}; resume it with the same options")
-        from .stages import STAGES
+        from .run.stages import STAGES
 
         wanted = (previous.meta.get("selection") or {}).get("stages") or list(STAGES)
         done = set(previous.meta.get("finished_stages") or [])
@@ -291,13 +291,13 @@ def _cmd_check(args: argparse.Namespace) -> int:
         kind = "stepper" + ("" if claim_of(obj).proximal else f" claiming {claim_of(obj).describe()}")
     else:
         raise BadTarget(f"{args.target} is a problem: `verimono check` takes an operator or a stepper")
-    from .atomic import ensure_writable_dir
-    from .timeouts import budget
+    from .records.atomic import ensure_writable_dir
+    from .execution.timeouts import budget
 
     out = ensure_writable_dir(args.out)           # before any work
     baseline = _baseline_for(args)                # a baseline that cannot be read: exit 2 before the work
     if getattr(args, "executor", None) not in (None, "serial"):
-        from .executors import ship_by_value
+        from .execution.executors import ship_by_value
 
         ship_by_value(obj)  # its module need not be importable on the workers
     print(f"verimono: checking {args.target} as a {kind}", file=sys.stderr)
@@ -323,12 +323,12 @@ def _cmd_check(args: argparse.Namespace) -> int:
 
 
 def _cmd_baseline(args: argparse.Namespace) -> int:
-    from .atomic import ensure_writable_file
-    from .results import load
+    from .records.atomic import ensure_writable_file
+    from .records.results import load
 
     ensure_writable_file(args.out)                # before any work
     if args.from_results:
-        from .gate import check_completed
+        from .run.gate import check_completed
 
         check_completed(args.from_results)        # the files of a run that never completed: exit 2
         report = load(args.from_results)
@@ -336,8 +336,8 @@ def _cmd_baseline(args: argparse.Namespace) -> int:
             raise NothingToResume(f"{args.from_results} is an interrupted run (marked incomplete): finish it "
                                   "with `verimono run --resume` before recording it as a baseline")
     else:
-        from .timeouts import budget
-        from .watchdog import on_hang
+        from .execution.timeouts import budget
+        from .execution.watchdog import on_hang
 
         with budget(args.timeout), on_hang(_baseline_hang):
             report = execute(command="run", profile_name=args.profile, stages=args.stage, context=_context(args),
@@ -348,7 +348,7 @@ def _cmd_baseline(args: argparse.Namespace) -> int:
     except OutputNotWritable as exc:
         if args.from_results:                     # its records are in the file it was copied from
             raise
-        from .atomic import keep_elsewhere
+        from .records.atomic import keep_elsewhere
 
         try:
             kept = f"the baseline's records are kept in {keep_elsewhere(report.to_json(), 'verimono-baseline.json')}"
@@ -364,8 +364,8 @@ def _cmd_baseline(args: argparse.Namespace) -> int:
 
 def _baseline_hang(hang: Any) -> None:
     """``verimono baseline``: a call blocked in native code in this process ends it (nothing is written)."""
-    from .runs import ISOLATE_ADVICE
-    from .watchdog import end_process, ending
+    from .run.execute import ISOLATE_ADVICE
+    from .execution.watchdog import end_process, ending
 
     ending()
     print(f"\nverimono baseline: {hang.call} is blocked in native code ({hang.where or 'where unknown'}): still "
@@ -375,7 +375,7 @@ def _baseline_hang(hang: Any) -> None:
 
 
 def _cmd_gate(args: argparse.Namespace) -> int:
-    from .gate import gate
+    from .run.gate import gate
 
     try:
         comparison = gate(args.baseline, args.results)
@@ -395,12 +395,12 @@ def _cmd_gate(args: argparse.Namespace) -> int:
 
 
 def _cmd_report(args: argparse.Namespace) -> int:
-    from .report.html import render
-    from .results import load
+    from .records.report.html import render
+    from .records.results import load
 
     report = load(args.results)
     changes = _changes(load(args.baseline), report) if args.baseline else None
-    from .atomic import ensure_writable_file, write_text
+    from .records.atomic import ensure_writable_file, write_text
 
     out = ensure_writable_file(args.out)
     write_text(out, render(report, changes=changes))
@@ -409,7 +409,7 @@ def _cmd_report(args: argparse.Namespace) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from .stages import STAGES
+    from .run.stages import STAGES
 
     parser = argparse.ArgumentParser(prog="verimono", description=__doc__.split("\n\n")[0],
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -494,9 +494,9 @@ DRAWN_COMMANDS = ("run", "check")
 def main(argv: list[str] | None = None) -> int:
     from threadpoolctl import threadpool_limits
 
-    from .calibration import PendingCalibration
-    from .executors import BLAS_THREADS
-    from .report import drawer
+    from .execution.calibration import PendingCalibration
+    from .execution.executors import BLAS_THREADS
+    from .records.report import drawer
 
     given = list(sys.argv[1:] if argv is None else argv)
     command = next((a for a in given if not a.startswith("-")), None)

@@ -1,10 +1,10 @@
 """pytest plugin of verimono (entry point ``pytest11: verimono = verimono.plugin``).
 
-* Registers the hypothesis profiles ``dev``, ``ci``, ``thorough`` (:mod:`verimono.profiles`) and loads
+* Registers the hypothesis profiles ``dev``, ``ci``, ``thorough`` (:mod:`verimono.execution.profiles`) and loads
   ``$HYPOTHESIS_PROFILE``, else ``ci`` when ``$CI`` is set, else ``dev`` — unless ``--hypothesis-profile``
   was given, which wins.
 * ``--verimono-report DIR`` collects the result records of the session — every record a test hands to
-  the ``verimono_report`` fixture, every record :func:`verimono.results.emit`-ted during a test (as
+  the ``verimono_report`` fixture, every record :func:`verimono.records.results.emit`-ted during a test (as
   ``verimono.testing.parametrize_with_checks`` does), and every record a ``verimono`` check passed in as
   a test argument returns — and writes ``DIR/results.json`` and ``DIR/report.html``, the same report as
   ``verimono run``.
@@ -34,9 +34,9 @@ from typing import Any
 
 import pytest
 
-from .atomic import ensure_writable_dir
-from .errors import OutputNotWritable
-from .results import FAILED, XFAIL, XFAIL_DECLARED, CheckResult, Report, listening
+from .records.atomic import ensure_writable_dir
+from .core.errors import OutputNotWritable
+from .records.results import FAILED, XFAIL, XFAIL_DECLARED, CheckResult, Report, listening
 
 _KEY = pytest.StashKey["_Collector"]()
 
@@ -50,7 +50,7 @@ def pytest_addoption(parser: pytest.Parser) -> None:
 
 
 def _load_profile(config: pytest.Config) -> str | None:
-    from .profiles import load_hypothesis_profile, register_hypothesis_profiles
+    from .execution.profiles import load_hypothesis_profile, register_hypothesis_profiles
 
     register_hypothesis_profiles()
     explicit = config.getoption("hypothesis_profile", default=None)
@@ -74,8 +74,8 @@ def pytest_configure(config: pytest.Config) -> None:
         return
     baseline = None
     if baseline_path:
-        from .gate import check_baseline
-        from .results import SchemaError, load
+        from .run.gate import check_baseline
+        from .records.results import SchemaError, load
 
         try:
             baseline = load(baseline_path)
@@ -175,8 +175,8 @@ class _Collector:
 
     def _receive(self, report: pytest.TestReport) -> None:
         """Records of a test that ran elsewhere (an xdist worker), carried by its call report."""
-        from .results import CheckResult, to_jsonable
-        from .schema import record_fields, study_from_dict
+        from .records.results import CheckResult, to_jsonable
+        from .records.schema import record_fields, study_from_dict
 
         data = json.loads(getattr(report, self.ATTR))
         self.nodeid = report.nodeid
@@ -229,15 +229,15 @@ class _Collector:
     def pytest_sessionfinish(self, session: pytest.Session, exitstatus: int) -> None:
         if self.worker:
             return
-        from .environment import environment
+        from .records.environment import environment
 
         self._in_collection_order()
         if self.hidden and session.exitstatus == pytest.ExitCode.OK:
             session.exitstatus = pytest.ExitCode.TESTS_FAILED
         self.report.meta.update({"duration": time.perf_counter() - self.start, "environment": environment()})
         if self.baseline is not None:
-            from .gate import check_runs_compatible, compare
-            from .results import SchemaError
+            from .run.gate import check_runs_compatible, compare
+            from .records.results import SchemaError
 
             try:
                 check_runs_compatible(self.baseline, self.report)
@@ -249,7 +249,7 @@ class _Collector:
             elif not self.gate_error and not self.comparison.ok and session.exitstatus == pytest.ExitCode.OK:
                 session.exitstatus = pytest.ExitCode.TESTS_FAILED
         if self.out is not None:
-            from .report import write
+            from .records.report import write
 
             self.paths = write(self.report, self.out, changes=self.comparison)
 

@@ -13,7 +13,7 @@ One pytest case per (subject, check), with stable readable ids ``<subject>-<chec
 
 **One source of checks.**  The cases come from the same generators as the plain runners — the protocol
 is a function of the subject yielding ``(name, check)`` pairs with ``check(subject) -> CheckResult``
-(or a :class:`~verimono.results.Report`):
+(or a :class:`~verimono.records.results.Report`):
 
 * operators (anything with ``.resolvent`` and ``.dim``): ``verimono.checks.operator_battery.operator_checks(op)``,
   the generator of :func:`verimono.check_operator`;
@@ -24,7 +24,7 @@ is a function of the subject yielding ``(name, check)`` pairs with ``check(subje
   :func:`verimono.check_stepper` (convergence orders on the references, trajectory laws on the references
   and on seeded sample problems).
 
-**Outcomes.**  ``check(subject)`` hands every record to :func:`verimono.results.emit` (for report plugins),
+**Outcomes.**  ``check(subject)`` hands every record to :func:`verimono.records.results.emit` (for report plugins),
 raises ``AssertionError`` with the record's text when a record failed, and calls ``pytest.skip`` with the
 reason when every record was skipped — pytest counts the skip and ``-rs`` lists why.
 ``expected_failed_checks`` maps a check name (``"selections"``, the full ``"selections[t|x| (n=1)]"``, or a
@@ -32,7 +32,7 @@ case id) to the reason, and turns those cases into **strict** xfails: a check th
 run as ``XPASS(strict)``.  A name that matches no check is an error, and so is a subject yielding no
 checks or a battery smaller than the full registry for its subjects (:func:`registry_size`; ``min_checks``
 may raise that floor): a battery must not shrink silently.  Without ``examples`` the operator laws search
-with the active profile's effort (``dev``/``ci``/``thorough``: :func:`verimono.profiles.get_profile`).
+with the active profile's effort (``dev``/``ci``/``thorough``: :func:`verimono.execution.profiles.get_profile`).
 
 **Counting.**  With this module loaded as a pytest plugin (``-p verimono.testing``, or
 ``from verimono.testing import pytest_configure`` in a ``conftest.py`` as ``properties/conftest.py`` does) the
@@ -53,13 +53,13 @@ import pytest
 from .checks.core import laws_of
 from .checks.core import subject_name as core_subject_name
 from .checks.subjects import kind_of
-from .profiles import active_profile
-from .profiles import load_hypothesis_profile as _load
-from .profiles import register_hypothesis_profiles as _register
-from .results import FAILED, SKIPPED, UNDECIDED, CheckResult, Report, to_jsonable
+from .execution.profiles import active_profile
+from .execution.profiles import load_hypothesis_profile as _load
+from .execution.profiles import register_hypothesis_profiles as _register
+from .records.results import FAILED, SKIPPED, UNDECIDED, CheckResult, Report, to_jsonable
 
 try:  # the listener hook of the results module (present when a report plugin is installed)
-    from .results import emit as _emit
+    from .records.results import emit as _emit
 except ImportError:  # pragma: no cover - older results module
     def _emit(item):
         return item
@@ -69,7 +69,7 @@ except ImportError:  # pragma: no cover - older results module
 
 def register_hypothesis_profiles() -> None:
     """Register the hypothesis profiles ``dev``, ``ci`` (derandomized, no deadline, no database) and
-    ``thorough`` — one definition, in :mod:`verimono.profiles`, shared with ``verimono run``."""
+    ``thorough`` — one definition, in :mod:`verimono.execution.profiles`, shared with ``verimono run``."""
     _register()
 
 

@@ -1,6 +1,6 @@
 """Ratio gates for the performance benchmarks (issue 6).
 
-The measurements are :mod:`verimono.performance`'s — the same functions, baselines and targets as the
+The measurements are :mod:`verimono.run.performance`'s — the same functions, baselines and targets as the
 ``performance`` stage of ``verimono run`` — with pytest-benchmark timing the subject: verimono and its
 bare baseline run interleaved round by round (the baseline in pytest-benchmark's untimed ``setup``,
 verimono as the timed target), and the gate is the median of the per-round ratios, never absolute
@@ -18,8 +18,8 @@ from typing import Any, Callable
 
 import pytest
 
-from verimono.performance import interleave, ratio_record
-from verimono.results import CheckResult
+from verimono.run.performance import interleave, ratio_record
+from verimono.records.results import CheckResult
 
 #: in un-timed runs (--benchmark-disable) the gate is loosened by this factor (a gross-regression alarm)
 SANITY_FACTOR = 3.0
@@ -42,7 +42,7 @@ class RatioGate:
         return self.size(full, small)
 
     def runner(self, setup: Callable[[], Any], target: Callable[[], Any], rounds: int) -> None:
-        """A :data:`verimono.performance.Runner` timing ``target`` with pytest-benchmark."""
+        """A :data:`verimono.run.performance.Runner` timing ``target`` with pytest-benchmark."""
         if not self.enabled:  # pedantic runs its target once when disabled: the other rounds by hand
             for _ in range(rounds - 1):
                 setup()

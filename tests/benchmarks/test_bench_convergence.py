@@ -20,8 +20,8 @@ import numpy as np
 import pytest
 
 import verimono as vm
-from verimono.convergence import convergence_study
-from verimono.performance import check_memory
+from verimono.core.convergence import convergence_study
+from verimono.run.performance import check_memory
 from verimono.reference import get, subdifferential
 
 
@@ -119,7 +119,7 @@ X0 = {"single": [1.0, 2.0, 3.0], "batch": [[1.0, 2.0, 3.0], [-0.5, 0.0, 0.25]]}
 @pytest.mark.parametrize("given", list(INPUTS), ids=list(INPUTS))
 @pytest.mark.parametrize("block", [2, 3, 64, 10_000])
 def test_stream_pieces_are_the_solve_trajectory(block, given, x0):
-    from verimono.stepping import stream
+    from verimono.core.stepping import stream
 
     p = vm.Problem(vm.NormSubdifferential(lambda t: 0.1 + t, dim=3), X0[x0], 1.0,
                    f=lambda x: -0.5 * x, **INPUTS[given])

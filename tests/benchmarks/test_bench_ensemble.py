@@ -3,7 +3,7 @@
 ``solve(problem, t)`` with ``problem.x0`` of shape ``(B, n)`` returns ``(len(t), B, n)`` values that are
 bit-identical to ``B`` separate solves, for every catalog operator and set (checked here, untimed), and for
 ``B = 1000`` runs at least ``ENSEMBLE_TARGET`` × faster than the ``B`` separate ``solve`` calls (timed
-by :func:`verimono.performance.check_ensemble`, which also asserts the identical results; the problems
+by :func:`verimono.run.performance.check_ensemble`, which also asserts the identical results; the problems
 are built outside the timing).  Batches of operators: ``NormSubdifferential(c)`` with ``c`` of shape ``(B,)``,
 ``Ball`` with centers ``(B, n)`` and radii ``(B,)``, ``Box`` with bounds ``(B, n)``.
 """
@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 
 import verimono as vm
-from verimono.performance import check_ensemble
-from verimono.sets import Ball, Box, HalfSpace, Polyhedron, Translated
+from verimono.run.performance import check_ensemble
+from verimono.core.sets import Ball, Box, HalfSpace, Polyhedron, Translated
 
 RNG = np.random.default_rng(6)
 

@@ -17,7 +17,7 @@ import pytest
 
 import verimono as vm
 from verimono.checks.operator_battery import LAWS as OPERATOR_LAWS
-from verimono.results import UNDECIDED
+from verimono.records.results import UNDECIDED
 
 
 @pytest.mark.parametrize("n, seconds", [(2000, 10.0), (10 ** 6, 60.0)], ids=["n=2000", "n=1e6"])

@@ -1,5 +1,5 @@
 """Issue 15, targets 1 and 2: Section 7 systems at compiled-solver speed — DiodeBridge, EulerMoreauOSI(θ = 1/2),
-h = 1e-6, against the floor of a Python step loop (:func:`verimono.performance.floor_loop`: one 2×2
+h = 1e-6, against the floor of a Python step loop (:func:`verimono.run.performance.floor_loop`: one 2×2
 matrix–vector product per step), both measured in the same run.
 
 * one trajectory of 5000 steps (also in the un-timed run: the one-off cost of building the maps of the
@@ -16,7 +16,7 @@ import pytest
 
 pytest.importorskip("verimono.lcs", reason="verimono.lcs (Section 7 systems) is not available")
 
-from verimono.performance import check_lcs_batch, check_lcs_step  # noqa: E402
+from verimono.run.performance import check_lcs_batch, check_lcs_step  # noqa: E402
 
 
 def test_diode_bridge_simulate_vs_floor_loop(gate):

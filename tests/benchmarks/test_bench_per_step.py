@@ -3,14 +3,14 @@
 ``solve`` on t|x| (``c(t) = t``), a box and a ball (``NormalCone``), ``n = 1, 3, 10``, 10^5 steps, within
 ``PER_STEP_TARGET`` × a bare NumPy loop doing the same arithmetic (preallocated output, steps as
 Python floats, the same operations in the same order — hence the same bits, which is asserted).  The
-cases and loops are :mod:`verimono.performance`'s.
+cases and loops are :mod:`verimono.run.performance`'s.
 """
 
 from __future__ import annotations
 
 import pytest
 
-from verimono.performance import PER_STEP_DIMS, PER_STEP_KINDS, check_per_step
+from verimono.run.performance import PER_STEP_DIMS, PER_STEP_KINDS, check_per_step
 
 
 @pytest.mark.parametrize("n", PER_STEP_DIMS)

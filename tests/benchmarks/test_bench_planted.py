@@ -1,6 +1,6 @@
 """Planted slowdowns against the speed verdicts of the ``performance`` stage (wall-clock: the benchmark tier).
 
-Each test times real code with :mod:`verimono.performance`'s records at the stage's ``ci`` sizes (9 interleaved
+Each test times real code with :mod:`verimono.run.performance`'s records at the stage's ``ci`` sizes (9 interleaved
 rounds, up to 27 when the interval straddles the target) and checks the verdict the record gives:
 
 * a planted 3x slowdown — of the DiodeBridge ``simulate`` kernel (2.7x the floor loop idle → ~8x against a
@@ -21,8 +21,8 @@ import numpy as np
 import pytest
 
 from verimono import performance, timing
-from verimono.results import FAILED, PASSED, UNDECIDED
-from verimono.stepping import solve
+from verimono.records.results import FAILED, PASSED, UNDECIDED
+from verimono.core.stepping import solve
 
 #: wall-clock: the ``timing`` tier (``pytest -m timing``, on a quiet machine), never in the default test run
 pytestmark = [pytest.mark.benchmark, pytest.mark.timing]
@@ -118,7 +118,7 @@ def test_a_slowed_operator_kernel_fails_the_per_step_record(monkeypatch):
     wait for a CPU is taken out), so a regression that blocks is not hidden."""
     if timing.CLOCK != "own":
         pytest.skip("the CPU-time fallback clock does not count sleeping (schedstat unavailable)")
-    import verimono.stepping as stepping
+    import verimono.core.stepping as stepping
 
     kernel = stepping.resolvent_kernel
 
@@ -158,10 +158,10 @@ def test_a_3x_slower_stage_is_a_gate_regression_unless_the_machine_was_busy(monk
     baseline, the same again, and three times the work.  The same work never regresses, busy machine or not;
     3x the work regresses — or, when the run shows a busy machine, is reported as "not judged" with that
     evidence; on a quiet machine (foreign CPU at most 10% in both runs) it must regress."""
-    from verimono.runs import execute
-    from verimono.gate import compare
-    from verimono.results import CheckResult, Report
-    from verimono.stages import STAGES, RunContext, Stage
+    from verimono.run.execute import execute
+    from verimono.run.gate import compare
+    from verimono.records.results import CheckResult, Report
+    from verimono.run.stages import STAGES, RunContext, Stage
 
     work = {"repeats": 17}
 

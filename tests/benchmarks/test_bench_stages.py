@@ -2,7 +2,7 @@
 ``pytest properties``.
 
 Each stage runs in-process at the ``ci`` profile (``dev`` in the un-timed normal test run) and is measured
-in *calibration units*: its seconds over :func:`verimono.stages.calibrate` (a fixed NumPy-and-Python
+in *calibration units*: its seconds over :func:`verimono.run.stages.calibrate` (a fixed NumPy-and-Python
 workload) timed in the same process — the unit ``verimono gate`` uses for stage times, so the figure
 transfers between machines.  Each stage has a budget of about twice its measured ratio (the gate's
 ``TIMING_GROWTH``), with a floor for the sub-second stages, and the budgets add up to less than the
@@ -23,11 +23,11 @@ from pathlib import Path
 
 import pytest
 
-from verimono.profiles import REFERENCE_CALIBRATION_S, STAGE_BUDGETS, get_profile
-from verimono.stages import STAGES, RunContext, calibrate
+from verimono.execution.profiles import REFERENCE_CALIBRATION_S, STAGE_BUDGETS, get_profile
+from verimono.run.stages import STAGES, RunContext, calibrate
 
-#: the stage budgets are :data:`verimono.profiles.STAGE_BUDGETS` (calibration units, about 2x the measured
-#: ``ci`` ratios above; ``verimono.timeouts.stage_budget`` states them in this machine's seconds), and
+#: the stage budgets are :data:`verimono.execution.profiles.STAGE_BUDGETS` (calibration units, about 2x the measured
+#: ``ci`` ratios above; ``verimono.execution.timeouts.stage_budget`` states them in this machine's seconds), and
 #: REFERENCE_CALIBRATION_S what calibrate() read on the machine they were measured on; the issue's time to a
 #: verdict there:
 VERDICT_TARGET_S = 120.0

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InvalidCheckArgument
+from ..core.errors import InvalidCheckArgument
 
 
 def valid_seed(seed: Any) -> int:

@@ -45,14 +45,14 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..errors import OutsideDomain
-from ..operators import resolvent_rows
-from ..problem import Problem
-from ..results import FAILED, PASSED, SKIPPED, UNDECIDED, XFAIL, XFAIL_DECLARED, CheckResult, Report
+from ..core.errors import OutsideDomain
+from ..core.operators import resolvent_rows
+from ..core.problem import Problem
+from ..records.results import FAILED, PASSED, SKIPPED, UNDECIDED, XFAIL, XFAIL_DECLARED, CheckResult, Report
 from .arguments import valid_seed
 from .core import Outcome, law, laws_of, run, subject_name
 from .subjects import require_problem
-from ..tolerances import GROWTH_FLAG, RTOL, STALL_RATIO, STALL_WINDOW, quotient_tolerance, tolerance
+from ..core.tolerances import GROWTH_FLAG, RTOL, STALL_RATIO, STALL_WINDOW, quotient_tolerance, tolerance
 from .jumps import JUMP_GRID, base_grid, find_jumps, jump_time
 from .over_time import Sup, sup_over_time
 

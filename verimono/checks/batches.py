@@ -5,7 +5,7 @@ search hands it the points of a whole list of samples in one call instead of one
 Before a phase of the search that knows its samples in advance — the NumPy draws and the scale sweep
 (:mod:`verimono.checks.search`) — :func:`prefetched` evaluates ``J_λ``, ``J_μ``, ``J_ν`` at ``x1`` and ``x2``
 of every sample, at the sample's time, by :meth:`resolvent_batch` (chunks of at most
-:data:`verimono.arrays.MAX_BATCH` rows, padded to a power of two so that a jitted prox compiles for a few
+:data:`verimono.core.arrays.MAX_BATCH` rows, padded to a power of two so that a jitted prox compiles for a few
 shapes only).  The laws then call ``op.resolvent`` as always; a call at a prefetched ``(x, λ, t)`` gets the
 batched value **once** — a second call at the same point evaluates the prox again, so
 ``resolvent_single_valued`` compares the batched value with a single call (a prox whose batched and
@@ -22,7 +22,7 @@ from typing import Any, Iterator, Sequence
 
 import numpy as np
 
-from ..arrays import prefetch_key as key
+from ..core.arrays import prefetch_key as key
 
 
 def batched(op: Any) -> bool:

@@ -22,11 +22,11 @@ from typing import Any, Callable, Iterable
 import numpy as np
 from scipy import integrate
 
-from ..errors import NotApplicable, OutsideDomain
-from ..operators import Operator, provides
-from ..problem import Problem
-from ..stepping import Trajectory
-from ..tolerances import tolerance
+from ..core.errors import NotApplicable, OutsideDomain
+from ..core.operators import Operator, provides
+from ..core.problem import Problem
+from ..core.stepping import Trajectory
+from ..core.tolerances import tolerance
 from .core import PROXIMAL_CLAIM, Holds, Outcome
 from .partitions import run_stepper, single, stepper_law
 from .trajectory_laws import norms

@@ -22,7 +22,7 @@ else, once:
 * **the record** (:func:`record`) of an outcome: passed when its ratio is within its bound, failed with
   the counterexample otherwise, never passed on a non-finite ratio;
 * **the subject's name** (:func:`subject_name`), decided once whatever the status;
-* **the precision** a law judges its subject at (:func:`verimono.tolerances.judged_precision`): the
+* **the precision** a law judges its subject at (:func:`verimono.core.tolerances.judged_precision`): the
   coarsest dtype the subject returned or was given while the law ran, stated in the record
   (``details["dtype"]``, ``details["rtol"]``; a failure's message names a precision other than float64).
 """
@@ -36,12 +36,12 @@ import math
 import time
 from typing import Any, Callable, Iterable
 
-from ..claims import Claim, claim_of
-from ..naming import subject_name
-from ..errors import (InvalidCheckArgument, NotApplicable, StageUnavailable, UnitTimeout, UnverifiedSolution)
-from ..operators import provides
-from ..results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
-from ..tolerances import judged_precision
+from ..core.claims import Claim, claim_of
+from ..core.naming import subject_name
+from ..core.errors import (InvalidCheckArgument, NotApplicable, StageUnavailable, UnitTimeout, UnverifiedSolution)
+from ..core.operators import provides
+from ..records.results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
+from ..core.tolerances import judged_precision
 
 SUBJECTS = ("operator", "stepper", "problem", "system", "estimator")
 

@@ -13,8 +13,8 @@ import numpy as np
 
 from verimono.reference.lcs_example import closed_form_resolvent, example_system, pseudo_distance_demo
 
-from ..results import CheckResult
-from ..tolerances import tolerance
+from ..records.results import CheckResult
+from ..core.tolerances import tolerance
 from .core import Outcome, law, run
 
 SUBJECT = "paper Example ex"

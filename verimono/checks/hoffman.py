@@ -1,7 +1,7 @@
 """Hoffman's bound ``e:hoffman`` as a law of a Hoffman-constant estimator (by default
 :func:`verimono.lcs.hoffman.hoffman_constant`): on sampled polyhedra ``{ζ : Rζ = 0, Qζ ≤ q}`` and points
 ``x`` around them, ``dist(x, 𝓡) ≤ α(|Rx| + |max(0, Qx − q)|)`` with the estimator's ``α``, the distance by
-the KKT-verified projection of :class:`verimono.sets.Polyhedron`.
+the KKT-verified projection of :class:`verimono.core.sets.Polyhedron`.
 
 Polyhedra: a triangle, a box cut by a hyperplane (an equality), the thin wedge ``{0 ≤ ζ_2 ≤ ε ζ_1}``
 (Hoffman's constant ``≈ 1/ε``: a bound that ignores the angle between rows fails there), and
@@ -16,9 +16,9 @@ from typing import Any, Callable
 import numpy as np
 
 from ..lcs.hoffman import hoffman_constant
-from ..results import CheckResult
-from ..sets import Polyhedron
-from ..tolerances import tolerance
+from ..records.results import CheckResult
+from ..core.sets import Polyhedron
+from ..core.tolerances import tolerance
 from .core import Outcome, law, run, subject_name
 
 #: random polyhedra per seed

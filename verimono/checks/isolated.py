@@ -3,8 +3,8 @@
 In the user's interpreter, :func:`verimono.check_stepper` and :func:`verimono.check_operator` stop a call
 that overruns its time budget with ``SIGALRM`` — which cannot reach a call blocked in native code
 (``os.system``, a C extension): verimono never ends the user's interpreter, it warns once
-(:mod:`verimono.watchdog`) and the call goes on until it returns.  With ``executor="process:N"`` the battery
-runs in ``N`` spawned worker processes (:class:`verimono.executors.ProcessRunner`) instead, where such a call
+(:mod:`verimono.execution.watchdog`) and the call goes on until it returns.  With ``executor="process:N"`` the battery
+runs in ``N`` spawned worker processes (:class:`verimono.execution.executors.ProcessRunner`) instead, where such a call
 ends its worker: a failed record naming it, the records finished before it kept, and the battery goes on
 (a script that uses it must guard its entry point with ``if __name__ == "__main__":``, as for any spawned
 process; the subject travels with ``cloudpickle``).
@@ -14,10 +14,10 @@ from __future__ import annotations
 
 from typing import Any, Callable, Sequence
 
-from ..executors import Unit, make_runner, ship_by_value
-from ..profiles import PROFILES, active_profile
-from ..results import Report
-from ..timeouts import run_unit
+from ..execution.executors import Unit, make_runner, ship_by_value
+from ..execution.profiles import PROFILES, active_profile
+from ..records.results import Report
+from ..execution.timeouts import run_unit
 
 
 def isolating(executor: Any) -> bool:
@@ -27,9 +27,9 @@ def isolating(executor: Any) -> bool:
 
 def run_isolated(executor: str, units: Sequence[Unit], subject: Any = None) -> list[Report]:
     """The reports of ``units`` run on ``executor`` (``"process:N"``), in their order; the workers are
-    stopped before it returns.  The explicit time budget of this process (:func:`verimono.timeouts.budget`)
+    stopped before it returns.  The explicit time budget of this process (:func:`verimono.execution.timeouts.budget`)
     applies in the workers too.  ``subject``'s module, when it is the user's, travels by value
-    (:func:`verimono.executors.ship_by_value`: the workers need not import it)."""
+    (:func:`verimono.execution.executors.ship_by_value`: the workers need not import it)."""
     if subject is not None:
         ship_by_value(subject)
     runner = make_runner(executor)

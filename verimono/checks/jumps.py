@@ -11,7 +11,7 @@ the half whose increment is further off the neighbours' trend, until no float li
 ends (or ``JUMP_MAX_LEVELS`` bisections).  On a continuous ``V`` the increment goes to 0 (halving per
 bisection when ``V`` is Lipschitz, by ``2^{-1/2}`` when it is Hölder-½); across a jump of size ``J`` it
 stays ``≥ J``.  A jump is an increment above the rounding floor that *stalled*: still above
-``STALL_RATIO`` times its value ``STALL_WINDOW`` bisections earlier (``verimono.tolerances``; any
+``STALL_RATIO`` times its value ``STALL_WINDOW`` bisections earlier (``verimono.core.tolerances``; any
 Hölder-``p`` ``V`` with ``p > 0.006`` drops below that ratio).  Evidence, not proof: a jump up and back
 inside one cell of the search grid is not seen.
 
@@ -30,7 +30,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..tolerances import STALL_RATIO, STALL_WINDOW, tolerance
+from ..core.tolerances import STALL_RATIO, STALL_WINDOW, tolerance
 
 #: cells of the base grid (where the sup searches of :mod:`verimono.checks.over_time` start: every node there
 #: evaluates every sample, so it is kept coarse)

@@ -12,8 +12,8 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from ..problem import Problem
-from ..tolerances import LIMIT_EXTRA_LEVELS, LIMIT_RATIO_FLOOR, LIMIT_TAIL_SAFETY, tolerance
+from ..core.problem import Problem
+from ..core.tolerances import LIMIT_EXTRA_LEVELS, LIMIT_RATIO_FLOOR, LIMIT_TAIL_SAFETY, tolerance
 from .core import Outcome
 from .partitions import LIMIT_LEVELS, limit_grids, refined_random_grid, run_stepper, stepper_law
 from .trajectory_laws import norms as _norms

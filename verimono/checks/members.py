@@ -1,6 +1,6 @@
 """An operator's members as the laws evaluate them: every returned value checked to be a finite point of
 the input's shape and converted to NumPy float64 for the laws' arithmetic — from any array library, its
-precision reported to the judgement in progress (:func:`verimono.arrays.as_float64`), so that a float32
+precision reported to the judgement in progress (:func:`verimono.core.arrays.as_float64`), so that a float32
 subject is judged at float32 precision — norms computed without underflow, points shortened for
 counterexamples."""
 
@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from ..arrays import as_float64
+from ..core.arrays import as_float64
 from .samples import NUMPY_DIM
 
 

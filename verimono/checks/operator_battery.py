@@ -9,10 +9,10 @@ from __future__ import annotations
 import functools
 from typing import Any, Callable, Iterator
 
-from .. import watchdog
-from ..errors import InvalidCheckArgument
-from ..executors import Unit
-from ..results import Report
+from ..execution import watchdog
+from ..core.errors import InvalidCheckArgument
+from ..execution.executors import Unit
+from ..records.results import Report
 from . import operator_laws, prox_laws  # noqa: F401 - the laws join the registry on import
 from .core import Law, laws_of, subject_name
 from .isolated import isolating, run_isolated
@@ -44,12 +44,12 @@ def check_operator(op: Any, *, seed: int | None = None, examples: int | None = N
     in ``[0, horizon]``.  What is not an operator is refused before any law runs
     (:class:`verimono.InvalidCheckArgument`, naming the wrapper that makes one).
 
-    Every call of the resolvent runs under the unit time budget (:mod:`verimono.timeouts`).  A resolvent
+    Every call of the resolvent runs under the unit time budget (:mod:`verimono.execution.timeouts`).  A resolvent
     blocked in native code, which the budget's interrupt cannot stop, is bounded only with
     ``executor="process:N"``: the battery then runs in a worker process (one: its laws share what the
     root-cause probe learnt, :mod:`verimono.checks.isolated`), which such a call ends — the records of the
     laws finished before it and a failed record naming it.  In this process verimono never ends the
-    interpreter on such a call: it warns once and waits for it to return (:mod:`verimono.watchdog`)."""
+    interpreter on such a call: it warns once and waits for it to return (:mod:`verimono.execution.watchdog`)."""
     require_operator(op)
     seed = fresh_seed() if seed is None else valid_seed(seed)
     if examples is None:

@@ -3,9 +3,9 @@ minimal section, each one decorated evaluator ``check_<law>(op, s) -> Outcome``.
 
 Every law is an inequality ``lhs ≤ rhs`` that holds exactly for a maximal monotone ``F(t,·)``; in
 floating point it is accepted when ``lhs ≤ rhs + slack``, with ``slack`` built from
-:func:`verimono.tolerances.tolerance` of the magnitudes involved (divided by ``λ`` where a Yosida value
+:func:`verimono.core.tolerances.tolerance` of the magnitudes involved (divided by ``λ`` where a Yosida value
 ``(x - J_λ x)/λ`` amplifies the resolvent's error), at the relative tolerance of the precision the operator
-computes in (float64: ``RTOL = 1e-8``; float32: ``2.3e-4``; :data:`verimono.tolerances.RTOL_BY_PRECISION`),
+computes in (float64: ``RTOL = 1e-8``; float32: ``2.3e-4``; :data:`verimono.core.tolerances.RTOL_BY_PRECISION`),
 which the search detects from what the operator returns and records (``details["dtype"]``, ``["rtol"]``).  The recorded ratio of a sample is
 ``lhs / (rhs + slack)`` and every check's bound is 1: ratios near 1 mean "tight" (e.g.
 ``|J_λx - J_λy|² / ⟨J_λx - J_λy, x - y⟩`` for firm nonexpansiveness), and for laws with ``rhs = 0``
@@ -27,8 +27,8 @@ import math
 
 import numpy as np
 
-from ..errors import VerimonoError
-from ..tolerances import LIMIT_FLOOR, STALL_RATIO, STALL_WINDOW, current_eps, repeat_tolerance, tolerance
+from ..core.errors import VerimonoError
+from ..core.tolerances import LIMIT_FLOOR, STALL_RATIO, STALL_WINDOW, current_eps, repeat_tolerance, tolerance
 from .core import Member, Outcome
 from .members import listed, min_norm, norm, point, resolvent
 from .samples import Sample
@@ -60,7 +60,7 @@ def check_resolvent_single_valued(op, s):
     """Proposition prop:maxmon-resolvent-Yosida i–ii:
     ``J_λ`` is defined on all of ``R^n`` and single-valued — two calls on the same ``x``
     return the same finite point of shape ``(n,)`` and leave ``x`` unchanged (ratio: |difference|/tol, the
-    tolerance of repeated calls: :func:`verimono.tolerances.repeat_tolerance`)."""
+    tolerance of repeated calls: :func:`verimono.core.tolerances.repeat_tolerance`)."""
     x = s.x1.copy()
     a = point(op.resolvent(x, s.lam, s.t), s.x1, "resolvent")
     moved = norm(x - s.x1)

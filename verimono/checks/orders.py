@@ -1,7 +1,7 @@
 """The convergence order of a stepper on a problem with its expected order (Theorem ``thm:main`` and each
 reference's stated order).
 
-``check_convergence_order(stepper, problem)`` runs a :func:`verimono.convergence.convergence_study` and
+``check_convergence_order(stepper, problem)`` runs a :func:`verimono.core.convergence.convergence_study` and
 turns its verdict into a record: ``worst = expected / (upper end of the interval + slack)`` and
 ``bound = 1``, so the stepper passes when its measured order can reach the expected one.  For references
 on which the scheme is exact at the nodes, ``worst = max error / round-off floor``.  The study is kept in
@@ -20,11 +20,11 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..claims import claim_of
-from ..convergence import ORDER_SLACK, _timed_run, convergence_study, study_grids
-from ..problem import Order, Problem, origin_of
-from ..results import FAILED, PASSED
-from ..stepping import solve
+from ..core.claims import claim_of
+from ..core.convergence import ORDER_SLACK, _timed_run, convergence_study, study_grids
+from ..core.problem import Order, Problem, origin_of
+from ..records.results import FAILED, PASSED
+from ..core.stepping import solve
 from .core import Holds, Outcome, law, subject_name
 from .partitions import run_once
 
@@ -111,7 +111,7 @@ def check_convergence_order(stepper: Callable, problem: Problem, *, executor: An
 
 def reproduction_script(problem: Problem) -> str:
     """Python that reruns the order check with ``stepper`` bound: the problem from the reference catalog by
-    name, from the ``MODULE:OBJECT`` it was loaded from (:func:`verimono.problem.origin_of`), or else a line
+    name, from the ``MODULE:OBJECT`` it was loaded from (:func:`verimono.core.problem.origin_of`), or else a line
     the user completes with their own problem."""
     from ..reference import names
 
@@ -121,7 +121,7 @@ def reproduction_script(problem: Problem) -> str:
     if name in names():
         lines += ["from verimono.reference import get", f"problem = get({name!r})"]
     elif origin:
-        lines += ["from verimono.targets import load_target", f"problem = load_target({origin!r})"]
+        lines += ["from verimono.run.targets import load_target", f"problem = load_target({origin!r})"]
     else:
         lines += [f"problem = ...   # the Problem {name!r} you checked (it is not in verimono's reference catalog)"]
     return "\n".join(lines + ["print(check_convergence_order(stepper, problem))"])

@@ -31,7 +31,7 @@ from typing import Callable, Sequence
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from ..errors import UnverifiedSolution
+from ..core.errors import UnverifiedSolution
 from .jumps import base_grid
 
 #: worst grid nodes around which the sup is searched locally

@@ -15,7 +15,7 @@ A stepper law is one decorated evaluator (:func:`stepper_law`), of one of two fo
 The laws are stated per initial point: a batch problem is checked through its first row.  Requirements
 (what the stepper claims, what the problem states) are judged before the stepper runs; every exception
 is judged by the core's one policy (:func:`verimono.checks.core.classify`).  Under a unit's time budget
-(:func:`verimono.timeouts.run_unit`: ``check_stepper`` and the stepper stages run every law in one) a
+(:func:`verimono.execution.timeouts.run_unit`: ``check_stepper`` and the stepper stages run every law in one) a
 per-partition law states its progress partition by partition: stopped by the budget after partitions that
 all held, its record is *undecided* (time budget, ``k`` partitions), not a failure of the stepper; stopped
 before any partition returned, or after one that failed, it is failed.  A law of the stepper as a whole
@@ -28,12 +28,12 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..arrays import as_float64, precision_of
-from ..claims import claim_of
-from ..grids import graded_grid, random_grid, uniform_grid, validate_grid
-from ..problem import Problem
-from ..results import PASSED
-from ..timeouts import note_progress
+from ..core.arrays import as_float64, precision_of
+from ..core.claims import claim_of
+from ..core.grids import graded_grid, random_grid, uniform_grid, validate_grid
+from ..core.problem import Problem
+from ..records.results import PASSED
+from ..execution.timeouts import note_progress
 from .core import Outcome, law, run, stepper_subject
 from .arguments import valid_seed
 from .shared_runs import remembered
@@ -158,7 +158,7 @@ def run_on_grids(decl: Any, stepper: Callable, problem: Problem, *, grids: Any =
         outcomes: dict[str, Outcome] = {}
         for g, t in parts.items():
             outcomes[g] = decl.evaluate(stepper, p, t, **kw)
-            # out of budget now, a law whose partitions all held is undecided, not failed (verimono.timeouts)
+            # out of budget now, a law whose partitions all held is undecided, not failed (verimono.execution.timeouts)
             note_progress(len(outcomes), all(_held(o) for o in outcomes.values()), "partitions")
         gname = max(outcomes, key=lambda g: outcomes[g].worst)
         out = outcomes[gname]

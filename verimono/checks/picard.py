@@ -31,10 +31,10 @@ from typing import Callable
 
 import numpy as np
 
-from ..errors import NotApplicable
-from ..grids import uniform_grid, validate_grid
-from ..problem import Problem
-from ..tolerances import tolerance
+from ..core.errors import NotApplicable
+from ..core.grids import uniform_grid, validate_grid
+from ..core.problem import Problem
+from ..core.tolerances import tolerance
 from .core import Outcome
 from .partitions import run_stepper, stepper_law
 

@@ -6,7 +6,7 @@ convex ``Φ(z) = λg(z) + |z - x|²/2``, characterised by the prox inequality
     ⟨x - p, z - p⟩ ≤ λ (g(z) - g(p))   for every z          (⟺ Φ(p) + |z - p|²/2 ≤ Φ(z)),
 
 equivalently ``(x - p)/λ ∈ ∂g(p)`` (the subgradient inequality, tested by the value-based ``contains`` of
-:func:`verimono.prox.subgradient_contains`, through ``yosida_in_graph``).  The resolvent laws hold for the
+:func:`verimono.core.prox.subgradient_contains`, through ``yosida_in_graph``).  The resolvent laws hold for the
 prox of *any* convex function; these laws tie it to the stated ``g`` and catch the exact prox of a wrong
 one (a wrong weight, another norm's formula, a degenerate functional).  The Moreau envelope
 ``e_λ(x) = g(p) + |x - p|²/(2λ)`` is convex and differentiable with the ``1/λ``-Lipschitz gradient
@@ -16,7 +16,7 @@ Each law is a decorated evaluator ``check_<law>(op, s) -> Outcome`` (``s`` a
 :class:`verimono.checks.samples.Sample`) whose ratio is the violation in units of its slack
 (``(lhs - rhs)/slack``), so a negative or small ratio holds; it needs the operator's ``value`` (``g``), and
 is skipped before it runs on an operator that does not state it.  Slacks: ``τ = tolerance(x, p, z)`` per point (the resolvent's accuracy,
-:mod:`verimono.tolerances`), propagated through each side, plus ``tolerance`` of the function values.
+:mod:`verimono.core.tolerances`), propagated through each side, plus ``tolerance`` of the function values.
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ import zlib
 
 import numpy as np
 
-from ..tolerances import current_rtol, tolerance
+from ..core.tolerances import current_rtol, tolerance
 from .core import Member, Outcome
 from .members import norm as _nrm
 from .members import resolvent as _J
@@ -41,7 +41,7 @@ PERTURBATIONS = (1e-4, 1e-2, 1.0)
 
 
 def _tolf(*values: float) -> float:
-    """:func:`verimono.tolerances.tolerance` of scalars, in Python floats (called per perturbation), at the
+    """:func:`verimono.core.tolerances.tolerance` of scalars, in Python floats (called per perturbation), at the
     precision under judgement."""
     return current_rtol() * (1.0 + max(abs(v) for v in values))
 

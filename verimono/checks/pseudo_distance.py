@@ -25,11 +25,11 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .. import sets
-from ..operators import NormalCone
-from ..pseudo_distance import pseudo_distance_lower_bound
-from ..results import CheckResult
-from ..tolerances import PSEUDO_DISTANCE_FACTOR, tolerance
+from ..core import sets
+from ..core.operators import NormalCone
+from ..core.pseudo_distance import pseudo_distance_lower_bound
+from ..records.results import CheckResult
+from ..core.tolerances import PSEUDO_DISTANCE_FACTOR, tolerance
 from .core import Outcome, law, run, subject_name
 
 #: step sizes of the sampled graph points: a large one (y ≈ 0 at boundary points) and a small one
@@ -98,7 +98,7 @@ def run_estimator(decl: Any, estimator: Callable | None = None, *, seed: int = 0
 def check_pseudo_distance(est: Callable, *, seed: int = 0) -> Outcome:
     """``d_H/PSEUDO_DISTANCE_FACTOR ≤ estimator(N_C1, N_C2, samples) ≤ d_H`` on every pair of
     :func:`hausdorff_pairs` (module docstring).  ``estimator(F1, F2, samples, lams=...)`` returns a number or
-    a :class:`~verimono.pseudo_distance.PseudoDistanceBound`."""
+    a :class:`~verimono.core.pseudo_distance.PseudoDistanceBound`."""
     name = subject_name(est)
     rng = np.random.default_rng(seed)
     worst, counter, rows = 0.0, None, []

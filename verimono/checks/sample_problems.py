@@ -23,9 +23,9 @@ import math
 
 import numpy as np
 
-from ..operators import L1Subdifferential, Linear, NormalCone, NormSubdifferential
-from ..problem import Problem
-from ..sets import Ball, Box, HalfSpace
+from ..core.operators import L1Subdifferential, Linear, NormalCone, NormSubdifferential
+from ..core.problem import Problem
+from ..core.sets import Ball, Box, HalfSpace
 
 FAMILIES = ("linear", "norm", "l1", "ball", "box", "halfspace", "input", "lipschitz")
 

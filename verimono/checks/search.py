@@ -20,10 +20,10 @@ A sample's exception is judged by the core's one policy (:func:`verimono.checks.
 the operator lacks stops the search (skipped), a limit of verimono's own solvers makes the sample
 inconclusive (counted in ``details["harness_limited"]``), anything else fails the sample.  Inconclusive
 samples are counted and never pass: a record whose every sample was inconclusive is skipped, undecided
-when verimono's own solvers decided none.  The unit's time budget (:mod:`verimono.timeouts`) bounds the
+when verimono's own solvers decided none.  The unit's time budget (:mod:`verimono.execution.timeouts`) bounds the
 whole search (in calibration units: a slower or busier machine gets more seconds): a search that runs out
 of time after samples that all held is undecided (time budget, ``k`` samples); an operator call that never
-returns fails — the first one, or one that ran :data:`verimono.timeouts.HANG_MULTIPLE` x longer than every
+returns fails — the first one, or one that ran :data:`verimono.execution.timeouts.HANG_MULTIPLE` x longer than every
 sample before it.  The root-cause probe before the search runs under the budget too
 (:func:`bounded_root_cause`): a resolvent that does not return within it is the root cause, probed once per
 operator, so a battery on a hanging operator costs one budget, not one per call.
@@ -42,12 +42,12 @@ import hypothesis.errors
 import numpy as np
 from hypothesis import HealthCheck, Phase, Verbosity, given, settings
 
-from .._reproducible import no_local_constants
+from ..core._reproducible import no_local_constants
 from .arguments import valid_horizon, valid_seed
-from ..errors import InvalidCheckArgument, UnitTimeout
-from ..profiles import UnknownProfile, active_profile, get_profile
-from ..results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
-from ..timeouts import (HANG_MULTIPLE, TIME_BUDGET_REASON, current_budget, never_returned, note_progress,
+from ..core.errors import InvalidCheckArgument, UnitTimeout
+from ..execution.profiles import UnknownProfile, active_profile, get_profile
+from ..records.results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
+from ..execution.timeouts import (HANG_MULTIPLE, TIME_BUDGET_REASON, current_budget, never_returned, note_progress,
                         time_limit)
 from .batches import prefetched
 from .core import REGISTRY, Law, Outcome, classify, law, run, subject_name
@@ -79,7 +79,7 @@ def fresh_seed() -> int:
 
 def default_examples() -> tuple[int, str]:
     """``(examples per law, profile)`` when ``examples`` is not given: the active profile's ``law_examples``
-    (``dev``/``ci``/``thorough``, :func:`verimono.profiles.active_profile`), else ``DEFAULT_EXAMPLES``."""
+    (``dev``/``ci``/``thorough``, :func:`verimono.execution.profiles.active_profile`), else ``DEFAULT_EXAMPLES``."""
     name = active_profile()
     try:
         return get_profile(name).law_examples, name
@@ -212,7 +212,7 @@ class _Search:
         self.note()
 
     def note(self) -> None:
-        """The progress so far, for an outer unit whose budget may stop the search (verimono.timeouts)."""
+        """The progress so far, for an outer unit whose budget may stop the search (verimono.execution.timeouts)."""
         note_progress(self.runs, not self.violated and self.inconclusive < self.runs)
 
     def fails(self, s: Sample) -> bool:

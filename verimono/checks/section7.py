@@ -31,13 +31,13 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InvalidCheckArgument, VerimonoError
+from ..core.errors import InvalidCheckArgument, VerimonoError
 from ..lcs.hypotheses import rel_int_margin, sample_unit_q, shorter_solution
 from ..lcs.lcp import is_psd, lcp_alpha, solve_lcp
 from ..lcs.passivity import is_passive
 from ..lcs.relations import BoxRelation, OperatorRelation
-from ..results import PASSED, SKIPPED, CheckResult, Report
-from ..tolerances import EPS, RTOL, tolerance
+from ..records.results import PASSED, SKIPPED, CheckResult, Report
+from ..core.tolerances import EPS, RTOL, tolerance
 from .core import Outcome, law, laws_of, run, subject_name
 from .jumps import find_jumps
 from .over_time import sup_over_time

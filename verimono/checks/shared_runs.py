@@ -10,7 +10,7 @@ answers a repeated ``(stepper, problem, partition)`` from the first run instead 
 
 Every law still judges the stepper's own output on its own partition; only repeats are answered from the
 first answer (a copy: a law that writes into its array cannot change another's), and the precision the
-stepper computed in is reported again to the judgement that reuses it (:func:`verimono.tolerances.observe`:
+stepper computed in is reported again to the judgement that reuses it (:func:`verimono.core.tolerances.observe`:
 a float32 stepper is judged as float32 by every law).  What is kept is bounded
 (:data:`MAX_BYTES`, oldest first out): a large problem is run again rather than held.  A stepper that
 raises or returns what :func:`run_stepper` refuses is not remembered: every law sees it fail.
@@ -29,7 +29,7 @@ from typing import Any, Callable, Iterator
 
 import numpy as np
 
-from ..tolerances import judged_precision, observe
+from ..core.tolerances import judged_precision, observe
 
 #: bytes of states a :func:`shared_runs` block keeps at most (its oldest runs are dropped first)
 MAX_BYTES = 64 * 2**20

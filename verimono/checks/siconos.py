@@ -16,11 +16,11 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InfeasibleStep
+from ..core.errors import InfeasibleStep
 from ..lcs.lcp import lcp_residual, solve_lcp
 from ..lcs.siconos import PACKAGED_DATA, read_lcp, siconos_root
 from ..lcs.siconos_cases import CASES, INFEASIBLE_LCPS, SICONOS_RTOL, simulate_case, state_error
-from ..results import FAILED, CheckResult, Report
+from ..records.results import FAILED, CheckResult, Report
 from .core import Outcome, law, run
 
 

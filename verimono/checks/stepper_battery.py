@@ -12,14 +12,14 @@ from typing import Any, Callable, Iterable, Iterator, Sequence
 
 import numpy as np
 
-from ..claims import with_claim
-from ..errors import InvalidCheckArgument
-from ..problem import Problem
-from ..results import CheckResult, Report
-from ..timeouts import run_unit
+from ..core.claims import with_claim
+from ..core.errors import InvalidCheckArgument
+from ..core.problem import Problem
+from ..records.results import CheckResult, Report
+from ..execution.timeouts import run_unit
 from . import bounds, limits, picard, trajectory_laws  # noqa: F401 - the laws join the registry on import
 from . import orders as _order_law  # noqa: F401 - convergence_order joins the registry on import
-from ..executors import Unit
+from ..execution.executors import Unit
 from .core import laws_of, stepper_subject
 from .isolated import isolating, run_check, run_isolated
 from .partitions import single
@@ -106,14 +106,14 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
     only.  What is not a stepper, a bad seed or an empty selection is refused before anything runs
     (:class:`verimono.InvalidCheckArgument`).
 
-    Every check runs under the unit time budget (:mod:`verimono.timeouts`).  ``executor`` runs the
+    Every check runs under the unit time budget (:mod:`verimono.execution.timeouts`).  ``executor`` runs the
     convergence studies' grids (a ``concurrent.futures`` executor, ``"process"`` or ``"serial"``,
     :func:`verimono.convergence_study`) — except ``executor="process:N"``: then every check runs in one of
     ``N`` worker processes (:mod:`verimono.checks.isolated`), the only way the Python API bounds a stepper
     that blocks in native code (``os.system``, a C extension), which the budget's interrupt cannot stop: its
     worker ends, the check is a failed record naming the call, and the battery goes on.  In this process
     verimono never ends the interpreter on such a call: it warns once and waits for it to return
-    (:mod:`verimono.watchdog`).
+    (:mod:`verimono.execution.watchdog`).
     """
     require_stepper(stepper)
     if problems is not None:

@@ -11,8 +11,8 @@ from __future__ import annotations
 import inspect
 from typing import Any
 
-from ..errors import InvalidCheckArgument
-from ..problem import Problem
+from ..core.errors import InvalidCheckArgument
+from ..core.problem import Problem
 
 #: second-parameter names that mark a callable as a resolvent or prox ``f(x, lam)``, not a stepper
 #: ``(problem, t_grid)``

@@ -14,7 +14,7 @@ one record whose ``worst`` is the largest observed ``lhs / (rhs + tol)`` (``boun
   F(t_{k+1}, x_{k+1})``, tested with ``operator.contains`` and with the resolvent characterisation
   ``J_μ(x + μy) = x`` at ``μ ≤ h/2`` (a different step than the scheme's: :func:`witness_steps`).
 
-What each binds (:mod:`verimono.claims`): ``selections`` only the proximal scheme; ``contraction`` steppers
+What each binds (:mod:`verimono.core.claims`): ``selections`` only the proximal scheme; ``contraction`` steppers
 claiming it; ``in_domain`` every scheme, in the form its claim allows.
 """
 
@@ -24,13 +24,13 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from ..arrays import as_float64
-from ..claims import claim_of
-from ..errors import NotApplicable, VerimonoError
-from ..grids import uniform_grid
-from ..problem import Problem
-from ..stepping import Trajectory
-from ..tolerances import DOMAIN_ORDER_SLACK, row_tolerances, tolerance
+from ..core.arrays import as_float64
+from ..core.claims import claim_of
+from ..core.errors import NotApplicable, VerimonoError
+from ..core.grids import uniform_grid
+from ..core.problem import Problem
+from ..core.stepping import Trajectory
+from ..core.tolerances import DOMAIN_ORDER_SLACK, row_tolerances, tolerance
 from .core import CONTRACTION_CLAIM, PROXIMAL_CLAIM, Holds, Member, Outcome
 from .partitions import run_stepper, stepper_law
 from .shared_runs import remembered_value
@@ -254,7 +254,7 @@ def check_selections(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int 
     values, and says first when ``x_{k+1}`` lies outside ``cl dom F(t_{k+1},·)`` — where ``F`` is empty and no
     velocity can be a selection.
 
-    Tolerance: that of a difference quotient, :func:`verimono.tolerances.quotient_tolerance` (it divides the
+    Tolerance: that of a difference quotient, :func:`verimono.core.tolerances.quotient_tolerance` (it divides the
     round-off of the states by ``h``), computed for every step at once with ``row_tolerances``.
 
     Claim: ``proximal`` — the discrete velocities of the paper's scheme are selections; another scheme's

@@ -19,7 +19,7 @@ import itertools
 
 import numpy as np
 
-from ..errors import InvalidCheckArgument
+from ..core.errors import InvalidCheckArgument
 
 #: rows of ``[R; −R; Q]`` (after dropping ``−R`` duplicates of nothing) up to which subsets are enumerated
 HOFFMAN_MAX_ROWS = 16

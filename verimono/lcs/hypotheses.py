@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import linprog
 
-from ..tolerances import tolerance
+from ..core.tolerances import tolerance
 from .lcp import is_psd, lcp_residual, sol_polyhedron
 from .relations import BoxRelation
 

@@ -45,8 +45,8 @@ import math
 
 import numpy as np
 
-from ..errors import BatchStepError, InfeasibleStep, InvalidProblem, SolverFailure, VerimonoError
-from ..tolerances import ACTIVE_SET_COND, QP_RTOL, RTOL
+from ..core.errors import BatchStepError, InfeasibleStep, InvalidProblem, SolverFailure, VerimonoError
+from ..core.tolerances import ACTIVE_SET_COND, QP_RTOL, RTOL
 from ._lu import lu_factor, lu_solve
 from .lcp import lcp_scale
 from .relations import BoxRelation

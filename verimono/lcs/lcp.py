@@ -13,7 +13,7 @@ Tiwari, Camlibel, Pang 2009).  It is computed in two phases:
 
        SOL(q, M) = {z ≥ 0 : Mz + q ≥ 0, (M + Mᵀ)(z − z̄) = 0, qᵀ(z − z̄) = 0},
 
-   a polyhedron, so ``z*`` is the projection of 0 onto it, a strictly convex QP (:func:`verimono.qp.solve_qp`).
+   a polyhedron, so ``z*`` is the projection of 0 onto it, a strictly convex QP (:func:`verimono.core.qp.solve_qp`).
    (Proof: for ``z ∈ SOL`` and ``d = z − z̄``, complementarity and feasibility give ``dᵀMd ≤ 0``, so
    ``(M+Mᵀ)d = 0``, hence ``zᵀMz = z̄ᵀMz̄`` and ``qᵀz = −zᵀMz = qᵀz̄``; conversely those equalities make
    ``zᵀ(Mz + q) = z̄ᵀ(Mz̄ + q) = 0``.)  The QP is skipped when ``SOL`` is provably a singleton: every
@@ -38,9 +38,9 @@ from typing import Callable
 import numpy as np
 from scipy.optimize import linprog
 
-from ..errors import InfeasibleStep, InvalidProblem, UnverifiedSolution, VerimonoError
-from ..qp import solve_qp
-from ..tolerances import POLISH_RTOL, QP_RTOL, RTOL
+from ..core.errors import InfeasibleStep, InvalidProblem, UnverifiedSolution, VerimonoError
+from ..core.qp import solve_qp
+from ..core.tolerances import POLISH_RTOL, QP_RTOL, RTOL
 
 #: largest n for which complementary pieces are enumerated (2^n pieces)
 ENUM_MAX = 12
@@ -331,7 +331,7 @@ def select_over_sol(M, q, zbar, P, c, scale: float | None = None) -> np.ndarray:
     """Minimise ``½zᵀPz + cᵀz`` over ``SOL(q, M)`` (PSD ``M``; ``z̄`` any solution), KKT-verified.
 
     ``scale``: the size of the numbers ``q`` was computed from (as in :func:`solve_lcp`), a floor for the
-    units the QP is solved in (:func:`verimono.qp.equilibrate`)."""
+    units the QP is solved in (:func:`verimono.core.qp.equilibrate`)."""
     G, h, A, b = sol_polyhedron(M, q, zbar, scale)
     return solve_qp(P, c, G, h, A if len(A) else None, b if len(A) else None, scale=scale)
 

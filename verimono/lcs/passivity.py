@@ -18,8 +18,8 @@ import dataclasses
 
 import numpy as np
 
-from ..errors import InvalidProblem, MissingOptionalDependency, SolverFailure
-from ..tolerances import RTOL, SDP_RTOL, tolerance
+from ..core.errors import InvalidProblem, MissingOptionalDependency, SolverFailure
+from ..core.tolerances import RTOL, SDP_RTOL, tolerance
 
 
 @dataclasses.dataclass

@@ -17,9 +17,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InvalidProblem, NotMonotone, UnverifiedSolution
-from ..operators import Operator
-from ..tolerances import QP_RTOL, RTOL, tolerance
+from ..core.errors import InvalidProblem, NotMonotone, UnverifiedSolution
+from ..core.operators import Operator
+from ..core.tolerances import QP_RTOL, RTOL, tolerance
 from ._lu import lu_factor, lu_solve
 from .lcp import LCPResult, lcp_scale, solve_box, solve_lcp
 

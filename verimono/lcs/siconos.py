@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InvalidProblem
+from ..core.errors import InvalidProblem
 
 #: the data folder shipped with verimono (holds ``siconos/``): the default of ``verimono run``'s siconos stage
 PACKAGED_DATA = Path(__file__).resolve().parents[1] / "data"

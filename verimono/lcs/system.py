@@ -21,14 +21,14 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .._params import as_param
-from ..errors import InfeasibleStep, InvalidProblem, OutsideDomain, SolverFailure
-from ..grids import validate_grid
-from ..operators import Operator
-from ..problem import Problem
-from ..qp import solve_qp
-from ..stepping import Trajectory
-from ..tolerances import tolerance
+from ..core._params import as_param
+from ..core.errors import InfeasibleStep, InvalidProblem, OutsideDomain, SolverFailure
+from ..core.grids import validate_grid
+from ..core.operators import Operator
+from ..core.problem import Problem
+from ..core.qp import solve_qp
+from ..core.stepping import Trajectory
+from ..core.tolerances import tolerance
 from ._lu import lu_factor, lu_solve
 from .kernel import BatchStepError
 from .lcp import _box_lcp, _feasible, is_psd, proved_solvable, select_over_sol, solve_lcp

@@ -6,7 +6,7 @@ is built around a point it contains, a passive system is solved from a negative 
 Everything shrinks toward the zero/identity/smallest case (dimension 1, zero entries, rank 0, constant in
 time, one grid cell).
 
-Bounds (so that conditioning stays moderate and the tolerances of :mod:`verimono.tolerances` apply):
+Bounds (so that conditioning stays moderate and the tolerances of :mod:`verimono.core.tolerances` apply):
 
 * dimensions ``1 ≤ n ≤ MAX_DIM = 6`` when drawn, ``1 ≤ m ≤ 6`` inputs;
 * points have entries in ``[-POINT_SCALE, POINT_SCALE] = [-10, 10]``;

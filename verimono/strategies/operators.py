@@ -10,8 +10,8 @@ from typing import Any
 import numpy as np
 from hypothesis import strategies as st
 
-from .. import sets as _sets
-from ..operators import (L1Subdifferential, Linear, LogBarrier, NormalCone, NormSubdifferential, Operator,
+from ..core import sets as _sets
+from ..core.operators import (L1Subdifferential, Linear, LogBarrier, NormalCone, NormSubdifferential, Operator,
                          Shifted)
 from .sets import MovingSet, convex_sets, moving_sets
 from .values import (ZERO, ACInput, TimeFunction, Constant, _dim, _fmt, _Grown, _nonneg_time_functions, _NormOf,

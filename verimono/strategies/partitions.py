@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 from hypothesis import strategies as st
 
-from ..grids import validate_grid
+from ..core.grids import validate_grid
 from .values import MAX_CELLS, floats
 
 

@@ -8,7 +8,7 @@ import dataclasses
 import numpy as np
 from hypothesis import strategies as st
 
-from .. import sets as _sets
+from ..core import sets as _sets
 from .values import (SET_SCALE, TimeFunction, _dim, _entry, _fmt, _kinds, _nonneg_time_functions, _vec, floats,
                      time_functions)
 

@@ -1,0 +1,229 @@
+"""Running the verification: the stages of a run under a profile and an executor, interrupts, resuming.
+
+:func:`execute` runs stages with a context and returns the merged, annotated report (the run's facts in
+``report.meta``: command, profile, seed, selection, executor, calibration, duration, environment);
+:func:`interruptible` turns an interrupt (Ctrl-C, SIGTERM) — or a call of the subject blocked in native code
+past its time budget, which no interrupt can stop (:mod:`verimono.execution.watchdog`) — into a results file of the
+finished stages marked incomplete; :func:`merge_resumed` completes such a run.  The command line
+(:mod:`verimono.cli`) is a thin layer over these.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+from typing import Any, Callable
+
+from ..execution import watchdog
+from ..records.environment import environment
+from ..execution.executors import BLAS_THREADS, make_runner
+from ..execution.profiles import get_profile, load_hypothesis_profile
+from .progress import Progress
+from ..records.report import write
+from ..records.report.plots import draw_ahead, drawing_elsewhere, warm_up
+from ..records.results import Report
+from ..execution.calibration import PendingCalibration, calibrate, set_calibration
+from ..execution.timing import MachineProbe, is_noise_undecided
+
+EXIT_OK, EXIT_FAILED, EXIT_UNDECIDED = 0, 1, 2
+
+
+def execute(*, command: str, profile_name: str, stages: list[str] | None, context: Any, target: str | None = None,
+            progress: Progress | None = None, executor: Any = None, unit_timeout: float | None = None,
+            on_done: Callable | None = None, calibration: PendingCalibration | None = None) -> Report:
+    """Run ``stages`` with ``context`` under a profile and return the merged, fully annotated report.
+
+    ``executor`` (``"process:N"``, a dask scheduler address or ``Client``; ``None``: serial) is where the
+    stages' independent units run (:mod:`verimono.execution.executors`); ``unit_timeout`` bounds each unit there.
+    ``on_done(stage, report, info)`` is called after each stage (the interrupt handler keeps them).
+    ``calibration``: the run's first calibration, started earlier (the command line starts it before its
+    imports); measured here, before any worker starts, when not given."""
+
+    from threadpoolctl import threadpool_limits
+
+    from .stages import run_stages   # the checks and what they need (scipy): imported once a run begins
+
+    profile = get_profile(profile_name)
+    load_hypothesis_profile(profile_name)
+    progress = progress or Progress(enabled=False)
+    context.progress = progress.within
+    runner = make_runner(executor, timeout=unit_timeout)
+    if executor is not None and context.executor is None:
+        print(f"verimono: units run on {runner.spec}", file=sys.stderr)
+    context.executor = context.executor if context.executor is not None else runner
+    cal = calibration.result() if calibration is not None else calibrate()   # before any worker starts
+    set_calibration(cal)              # the unit of this process's time budgets (verimono.execution.timeouts)
+    if hasattr(runner, "prestart"):   # the workers import while this process builds the catalog
+        runner.prestart()
+    waits_on_workers = getattr(runner, "workers", 1) >= 2
+    if waits_on_workers and drawing_elsewhere() and hasattr(runner, "on_report"):
+        # each unit's plots go to the drawer as the unit comes back (not when its whole stage has)
+        runner.on_report = lambda rep: draw_ahead(rep.studies, rep.trajectories) if rep.studies or rep.trajectories else None
+    elif waits_on_workers and not drawing_elsewhere():   # this process waits on the workers and draws the
+        import threading                                 # plots itself: matplotlib's import and font cache now
+
+        threading.Thread(target=warm_up, name="verimono-report-warm-up", daemon=True).start()
+    start = time.perf_counter()
+    probe = MachineProbe()
+
+    def done(stage, rep, info):
+        info.update(probe.lap())      # how busy the machine was during the stage: the gate's evidence
+        if waits_on_workers and (rep.studies or rep.trajectories):
+            draw_ahead(rep.studies, rep.trajectories)   # the report's plots, while the workers run on
+        progress.done(stage, rep, info)
+        if on_done is not None:
+            on_done(stage, rep, info)
+
+    try:
+        # BLAS_THREADS for the BLAS libraries the checks loaded too (SciPy's OpenBLAS is not NumPy's): the command
+        # line limited those loaded when it began, and SciPy's two threads spun 0.5 s of a core in a serial run
+        with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
+            report = run_stages(stages, profile, context, on_start=progress.start, on_done=done)
+    finally:
+        runner.close()
+    duration = time.perf_counter() - start
+    # once more at the end: one calibration (best of 3 x 0.1 s) samples one moment of a shared machine and
+    # read 0.08-0.16 s here within an hour; noise only slows a workload down, so the faster of the two ends
+    # is the steadier unit, in the baseline and in the run gated against it alike (and the two ends' drift
+    # tells the gate whether the machine was quiet enough to judge stage times at all: a first repeat that
+    # agrees with the start's is enough to say it was)
+    cals = [cal, calibrate(agreeing_with=cal)]
+    selection = {"stages": stages, "references": None if context.problems is None else
+                 [p.name for p in context.problems]}
+    report.meta.update({"command": command, "target": target, "profile": profile_name, "seed": context.seed,
+                        "selection": selection, "executor": getattr(runner, "spec", type(runner).__name__),
+                        "calibrations": cals,
+                        "calibration": min(cals), "duration": duration,
+                        "data_dir": None if context.data_dir is None else str(context.data_dir),
+                        "environment": environment()})
+    return report
+
+
+def exit_status(report: Report) -> int:
+    """1 when a check failed; else 2 when one was undecided (nothing failed, but not everything was
+    verified: a limitation of the harness is never a pass); else 0.  A timing record undecided because the
+    machine was too noisy to judge a speed (:func:`verimono.execution.timing.is_noise_undecided`) does not count: the
+    machine's load is not the code's defect, and the summary line says that speed was not judged."""
+    if report.failures:
+        return EXIT_FAILED
+    if any(not is_noise_undecided(r) for r in report.undecided) or report.meta.get("incomplete"):
+        return EXIT_UNDECIDED
+    return EXIT_OK
+
+
+#: exit status of an interrupted run (the shell's convention for SIGINT)
+EXIT_INTERRUPTED = 130
+#: ``details`` key of a record of a stage that did not finish (written with a native hang; a resumed run
+#: runs that stage again, so :func:`merge_resumed` drops them)
+UNFINISHED_STAGE = "unfinished_stage"
+#: what isolates a subject that blocks in native code (printed when a serial run has to end on one)
+ISOLATE_ADVICE = ("`--executor process:N` runs each unit in a worker process, so that such a call ends its worker "
+                  "only (a failed record) and the run goes on")
+
+
+def interruptible(run: Callable[[Callable], Report], out: Path, *, command: str, profile: str,
+                   stages: list[str] | None, previous: Report | None = None, run_id: str | None = None,
+                   advice: str | None = None) -> Report | int:
+    """``run(on_done)`` with SIGTERM treated as an interrupt; on an interrupt write the stages finished so
+    far (with ``previous``'s, when resuming) to ``out`` marked ``incomplete`` (as the run ``run_id``) and
+    return the exit status.  ``advice``: how to go on, printed after the interrupt (default: ``verimono
+    run --resume``, which only ``run`` has).
+
+    A call of the subject blocked in native code in this process (the serial executor), which no interrupt
+    reaches, ends the process from :mod:`verimono.execution.watchdog`'s thread once its budget and grace are over:
+    the same file, plus the records the current stage finished (``details["unfinished_stage"]``) and a
+    failed record naming the hung call, one line naming the call, its time, the file and
+    :data:`ISOLATE_ADVICE`, and exit status 1 (:data:`EXIT_FAILED`: a call that does not return is a failure
+    of the subject).  Only here — a command of verimono's — is the process ended on a native hang; the Python
+    API leaves the user's interpreter running (:mod:`verimono.execution.watchdog`)."""
+    import signal
+
+    finished: list[tuple[Report, dict]] = []
+    stage_scope: list = []
+
+    def on_done(stage, rep, info):
+        finished.append((rep, info))
+        if stage_scope and stage_scope[0] is not None:
+            stage_scope[0].items.clear()        # the scope keeps only the current stage's finished units
+
+    def partial_report() -> tuple[Report, list[str]]:
+        partial = previous if previous is not None else Report(meta={"stages": []})
+        for rep, info in finished:
+            partial.extend(rep)
+            partial.meta.setdefault("stages", []).append(info)
+        done = [s["name"] for s in partial.meta.get("stages") or []]
+        partial.meta.update({"command": command, "profile": profile, "incomplete": True,
+                             "finished_stages": done,
+                             "selection": partial.meta.get("selection") or {"stages": stages, "references": None}})
+        if previous is not None and previous.meta.get("run_id"):
+            partial.meta["resumed_from"] = previous.meta["run_id"]
+        return partial, done
+
+    def on_hang(hang: watchdog.Hang) -> None:
+        watchdog.ending()
+        try:
+            partial, done = partial_report()
+            current = watchdog.hang_report(hang)
+            for rec in current.results:
+                rec.details[UNFINISHED_STAGE] = True
+            partial.results.extend(current.results)      # their studies stay in each record's details
+            partial.meta["native_hang"] = {"call": hang.call, "budget": hang.budget, "elapsed": hang.elapsed,
+                                           "where": hang.where, "grace": watchdog.grace(hang.budget)}
+            try:
+                where = str(write(partial, out, run_id=run_id)["json"])
+            except Exception as exc:  # noqa: BLE001 - the process ends either way; say what was lost
+                where = f"no file ({type(exc).__name__}: {exc})"
+            print(f"\nverimono: {hang.call} is blocked in native code ({hang.where or 'where unknown'}): still "
+                  f"running {hang.elapsed:.1f} s after it started, past its time budget of {hang.budget:g} s; "
+                  f"ended the run. The {len(done)} finished stage(s) ({', '.join(done) or 'none'}), the "
+                  f"{len(current) - 1} record(s) the current stage finished and a failed record for the hung call "
+                  f"are in {where}, marked incomplete; {ISOLATE_ADVICE}", file=sys.stderr)
+        finally:
+            watchdog.end_process(EXIT_FAILED)
+
+    def term(signum, frame):
+        raise KeyboardInterrupt(f"signal {signum}")
+
+    old = signal.signal(signal.SIGTERM, term) if _main_thread() else None
+    try:
+        with watchdog.scope() as root, watchdog.on_hang(on_hang):
+            stage_scope.append(root)
+            return run(on_done)
+    except KeyboardInterrupt:
+        partial, done = partial_report()
+        paths = write(partial, out, run_id=run_id)
+        print(f"\nverimono: interrupted; the {len(done)} finished stage(s) ({', '.join(done) or 'none'}) are in "
+              f"{paths['json']}, marked incomplete; "
+              f"{advice or f'continue with `verimono {command} --resume`'}", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    finally:
+        if old is not None:
+            signal.signal(signal.SIGTERM, old)
+
+
+def _main_thread() -> bool:
+    import threading
+
+    return threading.current_thread() is threading.main_thread()
+
+
+def merge_resumed(previous: Report, rest: Report) -> Report:
+    """The interrupted run's finished stages followed by the resumed ones: one complete report
+    (``meta.resumed_from``: the run id of the interrupted run it continues)."""
+    merged = Report(meta=dict(rest.meta))
+    finished = Report([r for r in previous.results if not r.details.get(UNFINISHED_STAGE)],
+                      studies=previous.studies, trajectories=previous.trajectories)
+    merged.extend(finished)
+    merged.extend(rest)
+    merged.meta["stages"] = list(previous.meta.get("stages") or []) + list(rest.meta.get("stages") or [])
+    merged.meta["selection"] = previous.meta.get("selection")
+    merged.meta["resumed"] = True
+    merged.meta["resumed_from"] = previous.meta.get("run_id")
+    for key in ("incomplete", "finished_stages", "native_hang"):
+        merged.meta.pop(key, None)
+    return merged
+
+
+__all__ = ["execute", "exit_status", "interruptible", "merge_resumed", "EXIT_OK", "EXIT_FAILED", "EXIT_UNDECIDED",
+           "EXIT_INTERRUPTED", "UNFINISHED_STAGE", "ISOLATE_ADVICE"]

@@ -1,0 +1,504 @@
+"""Regression gating: compare a run's records with a committed baseline.
+
+``compare(baseline, current)`` lists every :class:`Change`; those with ``regression=True`` make
+``verimono gate`` exit 1.  A regression is
+
+* **status** — a record that passed (or was an expected failure) now fails, or a record that passed is
+  now skipped (a battery that stopped running verifies nothing), or a record that passed is now ``xfail``
+  without a declaration (``details["xfail_declared"]``, set for the xfails of ``expected_failed_checks``
+  and of Theorem ``thm:main``'s (LG)-or-(YB) alternative; a declared one is a change, not a regression);
+* **removed** — a record of the baseline is absent now;
+* **count** — the number of executed (non-skipped) records of a check, or in total, shrinks;
+* **order** — a convergence order estimate falls below its theoretical order (interval's upper end plus
+  ``ORDER_SLACK`` below the expected order), below the baseline's estimate by more than the wider of the
+  two intervals' half-widths and ``ORDER_DROP_FLOOR``, or a study exact at the nodes no longer is;
+* **error** — an error against a reference (each grid of a convergence study; a record's
+  ``details["error"]``, e.g. Siconos agreement) grows by more than ``ERROR_GROWTH``;
+* **non-finite** — an error or order estimate is now ``nan``, ``inf`` or ``null`` where the baseline's
+  was finite (reported as an error / order regression: NaN compares false against every threshold);
+* **non-finite figure** — a record that passes with a ``worst``, ``bound`` or ``details["error"]`` that is
+  ``nan`` or ``inf`` (a NaN ratio satisfies no bound: such a pass was never earned);
+* **undecided** — a record that passed and is now ``undecided`` (it verifies nothing);
+* **study** — a convergence study of the baseline that is absent now while its record remains (the
+  record's order claim is no longer backed by any errors);
+* **incomplete** — results marked ``meta.incomplete`` (an interrupted run) are refused: exit status 2;
+* **timing** — judged only where the measurement supports it (see *Timing* below); stage durations are
+  compared only between runs on the same executor (``meta.executor``: serial, process:N, ...).
+
+*Timing.*  Contention only ever adds time, and it does not add it evenly: a grown number from a busy machine
+is evidence of the machine, not of the code, unless the measurement rules that out.  So:
+
+* a record's same-job ratio (``details["timing_ratio"]``, larger is worse) regresses when it grew by more than
+  ``TIMING_GROWTH`` *with confidence*: the lower end of its interval (``details["timing_interval"]``, the
+  order-statistics bound of the median per-round ratio, :mod:`verimono.execution.timing`) exceeds ``TIMING_GROWTH``
+  times the baseline's ratio.  A record without an interval (the memory record, a deterministic byte count;
+  results from before intervals) compares its ratio itself;
+* a record that passed and is now ``undecided`` because timing noise kept its speed from being judged
+  (``details["undecided_reason"] == "timing noise"``) is a change, not a regression;
+* a stage's duration is stated in calibration units (seconds over the calibration workload of the same job).
+  The run measures that workload at its start and its end (``meta.calibrations``); the stage's units are
+  taken in the *slower* of the two, the baseline's in the *faster* of its own, so that growth is not an
+  artefact of which end was measured.  Growth beyond ``TIMING_GROWTH`` is a regression only when the machine
+  was quiet enough for stage times to mean anything: its two calibrations agree within
+  ``CALIBRATION_DRIFT`` (else the machine's speed changed during the run, and no single unit describes it),
+  and the stage did not run on a busy machine: where the run recorded them (``meta.stages[i]``, by
+  :class:`verimono.execution.timing.MachineProbe`), *busy* means some task waited for a CPU during more than
+  ``BUSY_WAITING`` (10%) of the stage's wall time (Linux PSI, ``cpu_waiting``) *and* processes outside the run
+  used more than ``BUSY_FOREIGN`` (10%) of the machine's CPU capacity (``foreign_cpu``) — contention, and
+  not the run's own (its worker processes importing beside the main one make a quiet run's first stage
+  wait 40%, with 0-5% foreign); with one of the two recorded, that one decides.  Otherwise the growth is
+  reported as a change, "not judged", with the evidence — and so is a growth beyond ``TIMING_GROWTH`` in
+  units taken at the run's *faster* calibration only, when the run cannot be judged (a drifting or busy run
+  may hide a real slowdown in its slower calibration: it is shown, never silently dropped).  A real 3x
+  slowdown on a quiet machine stays caught: 3x in units taken at the slower calibration, whose drift is at
+  most 1.25x, is still above 2x.
+
+Baseline and results must come from the same kind of run (command, target, profile and the selected
+stages and references), be well-formed documents of a readable schema version
+(:mod:`verimono.records.schema` type-checks every field the gate reads), and the baseline must hold at
+least one executed record; otherwise :class:`IncompatibleBaseline` / ``SchemaError`` — the gate fails
+closed with exit status 2.  It fails closed too (the inputs cannot fool it) when
+
+* a document repeats a record key ``check[subject]`` (either copy could be "the" record: a failure
+  would hide behind a pass) — ``SchemaError`` naming the key;
+* a figure the baseline vouches for is not a finite number — a study's error in a gated norm, and, of a
+  record that passed, its ``worst``, ``bound``, ``details["error"]`` or ``details["timing_ratio"]`` (or
+  a pass it claimed with a non-finite worst ratio, ``details["unearned_pass"]``): NaN compares false
+  against every threshold, so such a baseline would let any result pass — :class:`IncompatibleBaseline`;
+* the results (or baseline) file carries the in-progress mark of a run that never completed
+  (:func:`verimono.records.atomic.in_progress`: killed, or stopped by an error, after older files were there) —
+  :class:`IncompatibleResults`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections import Counter
+from pathlib import Path
+from typing import Any
+
+from ..records.atomic import in_progress
+from ..core.convergence import ORDER_SLACK
+from ..core.errors import IncompatibleBaseline, IncompatibleResults, SchemaError
+from ..records.results import FAILED, PASSED, SKIPPED, UNDECIDED, UNEARNED_PASS, XFAIL, XFAIL_DECLARED, Report, load
+from ..execution.timing import BUSY_FOREIGN, BUSY_WAITING, is_noise_undecided
+
+#: smallest drop of a fitted slope that counts as a regression when both intervals are narrower: slopes
+#: are refitted on the same grids, so they reproduce to round-off on one machine and to ~1e-3 across
+#: platforms, while a lost order drops the slope by 0.5 or more
+ORDER_DROP_FLOOR = 0.05
+#: allowed growth of an error against a reference on the same grid: errors are deterministic, so only
+#: round-off (near the floor) or a QP tolerance change moves them, by far less than 1.5x; a stepper
+#: bug that keeps the order (wrong time of evaluation, dropped input) changes the constant by more
+ERROR_GROWTH = 1.5
+#: errors below this absolute size are round-off in every study and are not compared
+ERROR_IGNORE_BELOW = 1e-11
+#: allowed growth of a duration relative to the calibration workload of the same job: on a shared
+#: 2-core runner these ratios vary by up to ~40% between runs (measured); 2x flags real slowdowns such
+#: as a lost vectorisation or a per-step re-validation, which cost 3x and more
+TIMING_GROWTH = 2.0
+#: stages shorter than this (seconds, in both runs) are not timed: start-up noise dominates them
+TIMING_MIN_SECONDS = 0.5
+#: the largest ratio between a run's two calibrations (start, end) for which its stage times are judged:
+#: best-of-3 calibrations agree within ~10% on a quiet machine (0.057/0.057 s here), while load that comes or
+#: goes during a run moves one end by 1.4x and more
+CALIBRATION_DRIFT = 1.25
+#: the norms whose order estimates are gated against the baseline (the final-time error of several
+#: references sits at round-off on some grids, so its slope is not a stable statistic)
+GATED_NORMS = ("sup", "l2")
+#: how many regressions ``verimono run`` and ``verimono check`` list before pointing to ``verimono gate``
+LISTED_REGRESSIONS = 10
+#: run facts that must agree between a baseline and the results it gates (``selection``: the stages and
+#: references chosen with --stage / --reference; a battery that is selected but skipped still regresses)
+COMPATIBLE_KEYS = ("command", "target", "profile", "selection")
+
+
+@dataclasses.dataclass
+class Change:
+    """One difference between baseline and results; ``regression`` ones fail the gate."""
+
+    kind: str
+    key: str
+    message: str
+    regression: bool
+
+    def __str__(self) -> str:
+        tag = "REGRESSION" if self.regression else "change"
+        return f"{tag:10s} {self.kind:8s} {self.key}: {self.message}"
+
+
+@dataclasses.dataclass
+class Comparison:
+    """All changes between a baseline and a run, with what was compared."""
+
+    changes: list[Change]
+    compared: int
+    baseline_meta: dict[str, Any]
+
+    @property
+    def regressions(self) -> list[Change]:
+        return [c for c in self.changes if c.regression]
+
+    @property
+    def others(self) -> list[Change]:
+        return [c for c in self.changes if not c.regression]
+
+    @property
+    def ok(self) -> bool:
+        return not self.regressions
+
+    def summary(self) -> str:
+        n = len(self.regressions)
+        head = (f"{n} regression{'s' if n != 1 else ''}" if n else "no regressions") + \
+            f" ({self.compared} baseline records compared, {len(self.others)} other changes)"
+        return head
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"ok": self.ok, "compared": self.compared, "changes": [dataclasses.asdict(c) for c in self.changes]}
+
+    def regression_lines(self, baseline: str | Path | None = None, results: str | Path | None = None,
+                         limit: int = LISTED_REGRESSIONS) -> list[str]:
+        """The first ``limit`` regressions as ``verimono gate`` prints them, then how many more and the
+        ``verimono gate`` command that lists them all (``baseline``, ``results``: the two documents' paths)."""
+        regs = self.regressions
+        lines = [f"  {c}" for c in regs[:limit]]
+        if len(regs) > limit:
+            lines.append(f"  … and {len(regs) - limit} more; `verimono gate --baseline {baseline or 'BASELINE'} "
+                         f"--results {results or 'RESULTS'}` lists all")
+        return lines
+
+
+def check_unique_keys(report: Report, what: str = "the results") -> None:
+    """Raise ``SchemaError`` naming the key when two records of ``report`` share a key ``check[subject]``:
+    records are matched by key, so a repeated one makes the comparison ambiguous (a failed copy would
+    hide behind a passed one)."""
+    seen: dict[str, int] = {}
+    dupes: list[str] = []
+    for i, r in enumerate(report.results):
+        j = seen.setdefault(r.key, i)
+        if j != i:
+            dupes.append(f"{r.key!r} (records {j} and {i})")
+    if dupes:
+        more = f" and {len(dupes) - 3} more" if len(dupes) > 3 else ""
+        raise SchemaError(f"{what}: the record key {', '.join(dupes[:3])}{more} occurs more than once; each "
+                          "check[subject] must occur once (which copy would the gate compare?)")
+
+
+def _figure_is_finite(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def baseline_nonfinite(baseline: Report) -> list[str]:
+    """Every figure the gate compares against that the baseline holds as a non-finite number (or
+    ``null``, a string): a study's errors in the gated norms; a passed record's ``worst``, ``bound``,
+    ``details["error"]``, ``details["timing_ratio"]``; a pass claimed with a non-finite worst ratio."""
+    bad: list[str] = []
+    for r in baseline.results:
+        if UNEARNED_PASS in r.details:
+            bad.append(f"{r.key}: {r.details[UNEARNED_PASS]}")
+        if r.status != PASSED:
+            continue
+        for name, v in (("worst", r.worst), ("bound", r.bound)):
+            if v is not None and not _figure_is_finite(v):
+                bad.append(f"{r.key}: {name} = {v!r}")
+        for name in ("error", "timing_ratio"):
+            if name in r.details and not _figure_is_finite(r.details[name]):
+                bad.append(f"{r.key}: details[{name!r}] = {r.details[name]!r}")
+    for st in baseline.studies:
+        if not hasattr(st, "errors"):
+            continue
+        for norm in GATED_NORMS:
+            for h, e in zip(st.mesh, st.errors.get(norm, [])):
+                if not _figure_is_finite(e):
+                    bad.append(f"{st.stepper} on {st.problem}: {norm} error at h={h:.3g} = {e!r}")
+    return bad
+
+
+def check_baseline(baseline: Report, what: str = "the baseline") -> None:
+    """Raise :class:`IncompatibleBaseline` unless ``baseline`` is usable: it has executed (non-skipped)
+    records (a baseline without any vouches for nothing, and every run would pass against it), and every
+    figure the gate compares against is finite (:func:`baseline_nonfinite`); ``SchemaError`` when it
+    repeats a record key (:func:`check_unique_keys`)."""
+    if not any(r.status != SKIPPED for r in baseline.results):
+        raise IncompatibleBaseline(f"the baseline has no executed records ({len(baseline.results)} records, "
+                                   "all skipped or none); regenerate it with `verimono baseline`")
+    check_unique_keys(baseline, what)
+    bad = baseline_nonfinite(baseline)
+    if bad:
+        more = f"; and {len(bad) - 3} more" if len(bad) > 3 else ""
+        raise IncompatibleBaseline(f"{what} is unusable: it holds non-finite figures that no result could "
+                                   f"exceed ({'; '.join(bad[:3])}{more}); regenerate it with `verimono baseline`")
+
+
+def check_runs_compatible(baseline: Report, current: Report) -> None:
+    """Raise :class:`IncompatibleBaseline` if the baseline is empty (:func:`check_baseline`) or the two
+    reports are not the same kind of run."""
+    check_baseline(baseline)
+    diffs = [f"{k}: baseline {baseline.meta.get(k)!r}, results {current.meta.get(k)!r}"
+             for k in COMPATIBLE_KEYS if baseline.meta.get(k) != current.meta.get(k)]
+    if diffs:
+        raise IncompatibleBaseline("baseline and results come from different runs (" + "; ".join(diffs) +
+                                   "); regenerate the baseline with the same command and profile")
+
+
+def _fmt(x: Any) -> str:
+    return f"{x:.4g}" if isinstance(x, float) else str(x)
+
+
+def _finite(x: Any) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+
+
+def _why(rec: Any) -> str:
+    if isinstance(rec.worst, (int, float)) and isinstance(rec.bound, (int, float)):
+        rel = "exceeds" if rec.worst > rec.bound else "within"
+        return f"worst {rec.worst:.4g} {rel} bound {rec.bound:.4g}"
+    return "no message"
+
+
+def _compare_records(base: Report, cur: Report, out: list[Change]) -> None:
+    now = {r.key: r for r in cur.results}
+    before = {r.key: r for r in base.results}
+    for key, b in before.items():
+        c = now.get(key)
+        if c is None:
+            out.append(Change("removed", key, f"was {b.status} in the baseline, absent now",
+                              b.status != SKIPPED))
+            continue
+        if b.status in (PASSED, XFAIL) and c.status == FAILED:
+            out.append(Change("status", key, f"{b.status} → failed: {c.message or _why(c)}", True))
+        elif b.status == PASSED and c.status == SKIPPED:
+            out.append(Change("status", key, f"passed → skipped: {c.message}", True))
+        elif b.status == PASSED and c.status == XFAIL:
+            declared = c.details.get(XFAIL_DECLARED)
+            if isinstance(declared, str) and declared.strip():
+                out.append(Change("status", key, f"passed → xfail, declared: {declared}", False))
+            else:
+                out.append(Change("status", key, f"passed → xfail without a declaration (no "
+                                  f"details[{XFAIL_DECLARED!r}]): {c.message}", True))
+        elif b.status in (PASSED, XFAIL) and c.status == UNDECIDED:
+            noise = is_noise_undecided(c)   # the machine, not the code: a change (see Timing above)
+            out.append(Change("status", key, f"{b.status} → undecided: {c.message}", not noise))
+        elif b.status != c.status:
+            out.append(Change("status", key, f"{b.status} → {c.status}", False))
+        be, ce = b.details.get("error"), c.details.get("error")
+        if _finite(be) and c.status != SKIPPED and not _finite(ce):  # a skipped record regresses above
+            out.append(Change("error", key, f"error is now {ce!r}, not a finite number (baseline {be:.3g})",
+                              True))
+        elif _finite(be) and _finite(ce):
+            if ce > ERROR_GROWTH * be and ce > ERROR_IGNORE_BELOW:
+                out.append(Change("error", key, f"error grew from {be:.3g} to {ce:.3g} "
+                                  f"(> {ERROR_GROWTH}x)", True))
+        _compare_timing_ratio(key, b, c, out)
+    for key, c in now.items():
+        if key not in before:
+            out.append(Change("new", key, f"new record ({c.status})", False))
+        if c.status == PASSED:
+            bad = [f"{name} = {v!r}" for name, v in (("worst", c.worst), ("bound", c.bound),
+                                                    ("error", c.details.get("error")))
+                   if v is not None and isinstance(v, (int, float)) and not math.isfinite(v)]
+            if bad:
+                out.append(Change("nonfinite", key, "passed with a non-finite figure (" + ", ".join(bad) +
+                                  "): a nan/inf satisfies no bound", True))
+    executed = lambda rep: Counter(r.check for r in rep.results if r.status != SKIPPED)  # noqa: E731
+    bc, cc = executed(base), executed(cur)
+    for check, n in bc.items():
+        if cc.get(check, 0) < n:
+            out.append(Change("count", check, f"executed records fell from {n} to {cc.get(check, 0)}", True))
+    if sum(cc.values()) < sum(bc.values()):
+        out.append(Change("count", "total", f"executed records fell from {sum(bc.values())} to "
+                          f"{sum(cc.values())}", True))
+
+
+def _compare_studies(base: Report, cur: Report, out: list[Change]) -> None:
+    now = {(s.problem, s.stepper): s for s in cur.studies if hasattr(s, "fits")}
+    for s in cur.studies:
+        if not hasattr(s, "fits"):
+            continue
+        exp, fit = s.expected, s.fits["sup"]
+        if exp is not None and not exp.exact and exp.value is not None and not fit.exact:
+            if not (fit.high + ORDER_SLACK >= exp.value):  # also catches nan intervals
+                out.append(Change("order", f"{s.stepper} on {s.problem}",
+                                  f"sup-norm order {fit} below the theoretical order {exp.value:g}", True))
+    for b in base.studies:
+        if not hasattr(b, "fits"):
+            continue
+        s = now.get((b.problem, b.stepper))
+        if s is None:
+            # a study that vanished while its record stayed: the order claim has lost its evidence
+            # (a vanished record is reported by the record rules)
+            if any(r.check == "convergence_order" and r.subject == f"{b.stepper} on {b.problem}"
+                   and r.status != SKIPPED for r in cur.results):
+                out.append(Change("study", f"{b.stepper} on {b.problem}", "the convergence study of the "
+                                  "baseline is absent from the results while its record remains", True))
+            continue
+        key = f"{b.stepper} on {b.problem}"
+        for norm in GATED_NORMS:
+            bf, cf = b.fits.get(norm), s.fits.get(norm)
+            if bf is None or cf is None:
+                continue
+            if bf.exact and not cf.exact:
+                out.append(Change("order", key, f"{norm}: exact at the nodes in the baseline, now {cf}", True))
+                continue
+            if not (bf.exact or cf.exact) and math.isfinite(bf.slope) and not math.isfinite(cf.slope):
+                out.append(Change("order", key, f"{norm}-norm order is now {cf}, not a finite number "
+                                  f"(baseline {bf})", True))
+                continue
+            if bf.exact or cf.exact or not all(map(math.isfinite, (bf.slope, cf.slope))):
+                continue
+            half = lambda f: (f.high - f.low) / 2 if math.isfinite(f.high - f.low) else 0.0  # noqa: E731
+            allowed = max(half(bf), half(cf), ORDER_DROP_FLOOR)
+            if cf.slope < bf.slope - allowed:
+                out.append(Change("order", key, f"{norm}-norm order fell from {bf} to {cf} "
+                                  f"(more than {allowed:.3g})", True))
+        floor = max(ERROR_IGNORE_BELOW, float(s.floor or 0.0))
+        for norm in GATED_NORMS:
+            for h, be in zip(b.mesh, b.errors[norm], strict=True):  # lengths checked by the schema
+                match = [i for i, hc in enumerate(s.mesh) if math.isclose(hc, h, rel_tol=1e-9)]
+                if not match:
+                    continue
+                ce = s.errors[norm][match[0]]
+                if math.isfinite(be) and not math.isfinite(ce):
+                    out.append(Change("error", key, f"{norm} error at h={h:.3g} is now {ce}, not a finite "
+                                      f"number (baseline {be:.3g})", True))
+                elif ce > ERROR_GROWTH * be and ce > floor:
+                    out.append(Change("error", key, f"{norm} error at h={h:.3g} grew from {be:.3g} to "
+                                      f"{ce:.3g} (> {ERROR_GROWTH}x)", True))
+
+
+def _number(x: Any) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+
+def _compare_timing_ratio(key: str, b: Any, c: Any, out: list[Change]) -> None:
+    """A record's same-job timing ratio: a regression when the lower end of its interval (the ratio itself
+    when it has none) exceeds ``TIMING_GROWTH`` x the baseline's ratio (module docstring, *Timing*)."""
+    bt, ct = b.details.get("timing_ratio"), c.details.get("timing_ratio")
+    if not (_number(bt) and _number(ct)) or not ct > TIMING_GROWTH * bt:
+        return
+    iv = c.details.get("timing_interval")
+    low = iv[0] if isinstance(iv, (list, tuple)) and len(iv) == 2 and _number(iv[0]) else ct
+    if low > TIMING_GROWTH * bt:
+        bound = f" (its interval's lower end {low:.3g})" if low != ct else ""
+        out.append(Change("timing", key, f"same-job timing ratio grew from {bt:.3g} to {ct:.3g}{bound} "
+                          f"(> {TIMING_GROWTH}x with confidence)", True))
+    else:
+        out.append(Change("timing", key, f"same-job timing ratio {ct:.3g} is above {TIMING_GROWTH}x the baseline's "
+                          f"{bt:.3g}, but its interval reaches down to {low:.3g}: growth not judged (timing noise)",
+                          False))
+
+
+def _calibrations(meta: dict[str, Any]) -> list[float]:
+    """The run's calibrations (``meta.calibrations``, else ``[meta.calibration]``), the positive numbers only."""
+    cals = meta.get("calibrations")
+    if not isinstance(cals, list) or not cals:
+        cals = [meta.get("calibration")]
+    return [float(c) for c in cals if _number(c) and math.isfinite(c) and c > 0]
+
+
+def _stage_unjudged(cur_cals: list[float], stage: dict[str, Any]) -> str | None:
+    """Why a stage time of this run cannot support a regression (module docstring, *Timing*), or ``None``."""
+    why = []
+    drift = max(cur_cals) / min(cur_cals)
+    if drift > CALIBRATION_DRIFT:
+        why.append(f"the calibrations at the run's start and end differ by {drift:.2f}x (> {CALIBRATION_DRIFT}x)")
+    waiting, foreign = stage.get("cpu_waiting"), stage.get("foreign_cpu")
+    signs = [(x > limit, text.format(x)) for x, limit, text in (
+        (waiting, BUSY_WAITING, "some task waited for a CPU {:.0%} of the stage's time"),
+        (foreign, BUSY_FOREIGN, "processes outside the run used {:.0%} of the machine's CPU"))
+        if _number(x)]
+    if signs and all(busy for busy, _ in signs):
+        why.append("the machine was busy: " + " and ".join(text for _, text in signs))
+    return "; ".join(why) or None
+
+
+def _compare_timings(base: Report, cur: Report, out: list[Change]) -> None:
+    """Stage durations in calibration units against the baseline's (module docstring, *Timing*)."""
+    bcals, ccals = _calibrations(base.meta), _calibrations(cur.meta)
+    if not (bcals and ccals):
+        return
+    bex, cex = base.meta.get("executor") or "serial", cur.meta.get("executor") or "serial"
+    if bex != cex:   # a stage's wall time depends on how many workers ran its units: not comparable
+        out.append(Change("timing", "stages", f"stage times not compared: the baseline's units ran on {bex}, "
+                                              f"these on {cex}", False))
+        return
+    before = {s["name"]: s for s in base.meta.get("stages") or [] if isinstance(s, dict)}
+    for s in cur.meta.get("stages") or []:
+        b = before.get(s.get("name"))
+        if not b or min(b.get("duration", 0), s.get("duration", 0)) < TIMING_MIN_SECONDS:
+            continue
+        # the stage's units at the run's slower calibration (the growth a regression needs) and at its faster
+        # one (the most growth the run's drift allows)
+        rb, rc, rc_most = b["duration"] / min(bcals), s["duration"] / max(ccals), s["duration"] / min(ccals)
+        if rc_most <= TIMING_GROWTH * rb:
+            continue
+        why = _stage_unjudged(ccals, s)
+        if rc > TIMING_GROWTH * rb:
+            what = (f"{rc:.1f}x the calibration workload, baseline {rb:.1f}x (> {TIMING_GROWTH}x growth; "
+                    f"{s['duration']:.2f} s now)")
+        elif why is None:   # judged: within TIMING_GROWTH in the units a regression is stated in
+            continue
+        else:
+            what = (f"{rc:.1f}x-{rc_most:.1f}x the calibration workload (the run's two calibrations), baseline "
+                    f"{rb:.1f}x (up to {rc_most / rb:.1f}x growth; {s['duration']:.2f} s now)")
+        if why is None:
+            out.append(Change("timing", f"stage {s['name']}", what, True))
+        else:
+            out.append(Change("timing", f"stage {s['name']}", f"{what}: not judged ({why})", False))
+
+
+def compare(baseline: Report, current: Report) -> Comparison:
+    """Every change from ``baseline`` to ``current`` (see the module docstring for what regresses);
+    ``SchemaError`` when either repeats a record key, :class:`IncompatibleBaseline` when the baseline
+    holds a non-finite figure (:func:`check_baseline`'s rules beyond emptiness)."""
+    check_unique_keys(baseline, "the baseline")
+    check_unique_keys(current, "the results")
+    bad = baseline_nonfinite(baseline)
+    if bad:
+        check_baseline(baseline)        # raises, naming the figures
+    changes: list[Change] = []
+    _compare_records(baseline, current, changes)
+    _compare_studies(baseline, current, changes)
+    _compare_timings(baseline, current, changes)
+    return Comparison(changes, len(baseline.results), dict(baseline.meta))
+
+
+def check_completed(path: str | Path, what: str = "results") -> None:
+    """Raise :class:`IncompatibleResults` when ``path`` carries the in-progress mark of a run that has not
+    completed (:func:`verimono.records.atomic.in_progress`): whatever ``path`` holds is not that run's output."""
+    run = in_progress(path)
+    if run is not None:
+        started = f", started {run['started']}" if run.get("started") else ""
+        pid = f", pid {run['pid']}" if run.get("pid") else ""
+        raise IncompatibleResults(
+            f"the {what} {path} are not the output of the last run there: run {run.get('run_id')} "
+            f"(verimono {run.get('command') or '?'}{started}{pid}) marked them in progress and never completed "
+            f"(killed, stopped by an error, or still running; its mark: {run['mark']}); gate the files of a "
+            "run that completed")
+
+
+def gate(baseline: str | Path | Report, results: str | Path | Report) -> Comparison:
+    """Load both documents (fail closed: :class:`SchemaError` / :class:`IncompatibleBaseline` /
+    :class:`IncompatibleResults`, see the module docstring) and compare."""
+    docs = {}
+    for what, doc in (("baseline", baseline), ("results", results)):
+        if not isinstance(doc, Report):
+            check_completed(doc, what)
+        docs[what] = doc if isinstance(doc, Report) else load(doc)
+        rep = docs[what]
+        if rep.meta.get("incomplete"):
+            raise IncompatibleResults(f"the {what} come from an interrupted run (finished stages: "
+                                      f"{', '.join(rep.meta.get('finished_stages') or []) or 'none'}); finish it "
+                                      "with `verimono run --resume` before gating")
+        check_unique_keys(rep, f"the {what}" + ("" if isinstance(doc, Report) else f" {doc}"))
+    base, cur = docs["baseline"], docs["results"]
+    check_baseline(base, "the baseline" + ("" if isinstance(baseline, Report) else f" {baseline}"))
+    check_runs_compatible(base, cur)
+    return compare(base, cur)
+
+
+__all__ = ["Change", "Comparison", "compare", "gate", "check_baseline", "check_runs_compatible",
+           "check_unique_keys", "check_completed", "baseline_nonfinite",
+           "IncompatibleBaseline", "IncompatibleResults", "LISTED_REGRESSIONS", "ORDER_DROP_FLOOR", "ERROR_GROWTH",
+           "TIMING_GROWTH", "TIMING_MIN_SECONDS", "CALIBRATION_DRIFT"]

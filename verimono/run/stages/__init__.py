@@ -1,0 +1,11 @@
+"""The verification run's stages: the registry (:mod:`.registry`) and the stages verimono ships
+(:mod:`.builtin`, registered on import)."""
+
+from . import builtin  # noqa: F401 - the shipped stages join the registry on import
+from .builtin import TRAJECTORY_SAMPLES, sample_trajectory
+from .registry import STAGES, RunContext, Stage, locate_data, register_stage, run_stages
+from ...execution.calibration import calibrate
+from ...core.errors import StageUnavailable, UnknownStage
+
+__all__ = ["STAGES", "Stage", "RunContext", "StageUnavailable", "UnknownStage", "register_stage", "run_stages",
+           "calibrate", "locate_data", "sample_trajectory", "TRAJECTORY_SAMPLES"]

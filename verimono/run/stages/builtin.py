@@ -1,0 +1,342 @@
+"""The stages verimono ships: convergence orders, operator laws, trajectory laws, assumptions, Section 7,
+Siconos agreement and speed — each a list of independent units of work run on the run's executor.
+
+Units travel to worker processes by pickling: each is a module-level function and its arguments, never a
+lambda.  The heavy modules (the checks, hypothesis, the reference catalog) are imported where a stage
+runs, so ``verimono --help`` stays light.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Callable, Iterable
+
+import numpy as np
+
+from .. import performance
+from ...core._jsonable import to_jsonable
+from ...core.errors import StageUnavailable
+from ...execution.executors import Unit
+from ...core.grids import uniform_grid
+from ...execution.profiles import Profile
+from ...records.results import SKIPPED, CheckResult, Report
+from ...core.stepping import solve
+from ...execution.timeouts import current_budget, run_unit, time_limit
+from ...checks.core import laws_of
+from ...checks.core import subject_name as _name
+from ...checks.orders import check_convergence_order
+from ...checks.picard import check_picard
+from ...checks.pseudo_distance import check_pseudo_distance
+from ...checks.shared_runs import shared_runs
+from ...checks.siconos import check_siconos_case, check_siconos_lcps
+from ...checks.stepper_battery import stepper_checks
+from .registry import RunContext, register_stage
+
+#: how many points of a trajectory the report keeps for its plot (enough for a smooth curve)
+TRAJECTORY_SAMPLES = 400
+
+
+def sample_trajectory(stepper: Callable, problem: Any, h: float | None = None) -> dict[str, Any]:
+    """A plot sample: ``stepper`` on a uniform grid of step ``h`` (default: the problem's coarsest
+    recommended step) next to the exact solution, thinned to :data:`TRAJECTORY_SAMPLES` points."""
+    h = h or (max(problem.steps) if problem.steps else problem.T / 50)
+    t = uniform_grid(problem.T, h)
+    x = np.asarray(stepper(problem, t), dtype=float)
+    keep = np.unique(np.linspace(0, len(t) - 1, min(len(t), TRAJECTORY_SAMPLES)).round().astype(int))
+    fine = np.linspace(0.0, problem.T, TRAJECTORY_SAMPLES)
+    exact = None
+    if problem.exact is not None:
+        exact = np.array([np.asarray(problem.exact(s), dtype=float) for s in fine])
+    first = (lambda a: a[:, 0] if a.ndim == 3 else a)  # a batch: plot its first member
+    return to_jsonable({"problem": problem.name, "stepper": _name(stepper), "h": float(h),
+                        "t": t[keep], "x": first(x)[keep],
+                        "t_exact": fine if exact is not None else None,
+                        "exact": first(exact) if exact is not None else None})
+
+
+def _convergence_unit(stepper: Callable, problem: Any) -> Report:
+    """One reference: its convergence-order record and study, and a trajectory sample for the plots."""
+    report = Report()
+    rec = report.add(run_unit(lambda: check_convergence_order(stepper, problem), check="convergence_order",
+                              subject=f"{_name(stepper)} on {problem.name}"))
+    if rec.study is not None:
+        report.studies.append(rec.study)
+    if rec.details.get("timeout") is not None:      # the stepper ran out of time: no unbounded extra call
+        rec.details["trajectory_error"] = "not sampled: the unit ran out of time"
+        return report
+    try:
+        with time_limit(current_budget(), f"the trajectory sample of {rec.subject}"):
+            report.trajectories.append(sample_trajectory(stepper, problem))
+    except Exception as exc:  # noqa: BLE001 - a plot sample: its failure (a UnitTimeout too) is noted, not fatal
+        rec.details["trajectory_error"] = f"{type(exc).__name__}: {exc}"
+    return report
+
+
+def _merged(reports: Iterable[Report]) -> Report:
+    out = Report()
+    for rep in reports:
+        out.extend(rep)
+    return out
+
+
+@register_stage("convergence", "every analytic reference's convergence study against its expected order")
+def convergence_stage(profile: Profile, context: RunContext) -> Report:
+    """Every analytic reference's convergence study, plus a trajectory sample for the report's plots;
+    one unit per reference."""
+    stepper = solve if context.stepper is None else context.stepper
+    problems = context.catalog()
+    units = [Unit("convergence", p.name, _convergence_unit, (stepper, p)) for p in problems]
+    reports = context.run_units(profile, units)
+    for p, rep in zip(problems, reports):     # what the stepper costs on each: the later stages' guide
+        context.costs[p.name] = sum(r.duration or 0.0 for r in rep.results)
+    return _merged(reports)
+
+
+def _catalog_operators(context: RunContext) -> list[tuple[str, Any]]:
+    """Distinct operators of the reference catalog, named by their problem."""
+    seen, out = set(), []
+    for p in context.catalog():
+        key = (type(p.operator).__name__, getattr(p.operator, "name", ""), p.dim)
+        if key not in seen:
+            seen.add(key)
+            out.append((f"{getattr(p.operator, 'name', type(p.operator).__name__)} ({p.name})", p.operator))
+    return out
+
+
+def _generated_operators(profile: Profile, seed: int | None) -> list[tuple[str, Any]]:
+    """``profile.generated_subjects`` operators drawn from ``verimono.strategies.maximal_monotone_operators``
+    in dimensions 1-3 (reproducibly from ``seed``; a fresh draw when ``seed`` is None)."""
+    from hypothesis import HealthCheck, Phase, given, settings
+    from hypothesis import seed as hseed
+
+    from ...strategies.operators import maximal_monotone_operators
+
+    drawn: list[tuple[int, Any]] = []
+    dims = (1, 2, 3)
+    per_dim = max(1, profile.generated_subjects // len(dims))
+    for n in dims:
+        # skip hypothesis' first, simplest example (the zero operator) so the draws exercise real cases
+        @settings(max_examples=per_dim + 1, derandomize=False, database=None, phases=[Phase.generate],
+                  deadline=None, suppress_health_check=list(HealthCheck))
+        @given(maximal_monotone_operators(n))
+        def collect(op):
+            drawn.append((op.dim, op))
+
+        if seed is not None:
+            collect = hseed(seed * 7919 + n)(collect)
+        before = len(drawn)
+        collect()
+        del drawn[before]
+    # the label is the record key the gate compares: it must not depend on what the draw produced (a
+    # different hypothesis release draws different operators from the same seed); the operator's repr
+    # stays in each record's details["operator"]
+    return [(f"generated #{i} (n={n}, seed {seed})", op) for i, (n, op) in enumerate(drawn)]
+
+
+@register_stage("operator_laws", "resolvent and Yosida laws on the catalog operators and generated families")
+def operator_laws_stage(profile: Profile, context: RunContext) -> Report:
+    """``check_operator`` on each catalog operator (or the user's) and on generated families.
+
+    Records are renamed ``subject = <label>`` (the operator's problem or draw) so keys stay unique."""
+    from ...checks.operator_battery import check_operator
+
+    report = Report()
+    if context.operators is not None:
+        subjects = list(context.operators)
+    else:
+        subjects = _catalog_operators(context)
+        try:
+            subjects += _generated_operators(profile, context.seed_for(profile))
+        except StageUnavailable as exc:
+            report.add(CheckResult("stage", "operator_laws: generated families", SKIPPED, message=str(exc)))
+    units = [Unit("operator_laws", label, _operator_unit,
+                  (check_operator, label, op, context.seed_for(profile), profile.law_examples))
+             for label, op in subjects]
+    return report.extend(_merged(context.run_units(profile, units)))
+
+
+def _operator_unit(check_operator: Callable, label: str, op: Any, seed: int | None, examples: Any) -> Report:
+    """One operator's law battery, its records renamed ``subject = label`` (the operator's problem or draw)."""
+    rep = check_operator(op, seed=seed, examples=examples)
+    for r in rep.results:
+        r.details.setdefault("operator", r.subject)
+        r.subject = label
+    return rep
+
+
+@register_stage("trajectory_laws", "contraction, uniqueness of the limit, domain, a-priori bounds, selections")
+def trajectory_laws_stage(profile: Profile, context: RunContext) -> Report:
+    """The trajectory laws of the stepper under test on every reference (and, without a user-given
+    problem list, on ``profile.generated_subjects`` sampled problems)."""
+    stepper = solve if context.stepper is None else context.stepper
+    seed = context.seed_for(profile)
+    checks = list(stepper_checks(stepper, context.problems, seed=0 if seed is None else seed,
+                                     generated=profile.generated_subjects, orders=False))
+    # one unit per subject problem (the battery of checks ``law[problem]`` on it), in first-seen order;
+    # the records are then put back in the order of ``checks``, as a serial loop over them gives
+    groups: dict[str, list[int]] = {}
+    for k, (name, _) in enumerate(checks):
+        groups.setdefault(name.partition("[")[2].rstrip("]") or name, []).append(k)
+    units = [Unit("trajectory_laws", subject, _checks_unit, ([checks[k] for k in ks], stepper))
+             for subject, ks in groups.items()]
+    slots: list[list[CheckResult]] = [[] for _ in checks]
+    costs = [context.costs.get(subject, 0.0) for subject in groups]     # the costliest problems first
+    for ks, rep in zip(groups.values(), context.run_units(profile, units, costs)):
+        sizes = rep.meta.get("records_per_check")
+        if sizes is None or len(sizes) != len(ks):  # a unit that did not finish: its one failed record
+            slots[ks[0]].extend(rep.results)
+            continue
+        it = iter(rep.results)
+        for k, n in zip(ks, sizes):
+            slots[k].extend(next(it) for _ in range(n))
+    return Report([r for slot in slots for r in slot])
+
+
+def _checks_unit(checks: list[tuple[str, Callable]], subject: Any) -> Report:
+    """Every ``check(subject)`` of one battery, in order (``meta["records_per_check"]``: how many each gave)."""
+    report, sizes = Report(), []
+    with shared_runs():             # the laws judge the same runs of the stepper: each is made once
+        for name, check in checks:
+            law, _, problem_name = name.partition("[")
+            # each check under the unit time budget: one that does not return is a failed record, the rest go on
+            out = run_unit(lambda: check(subject), check=law, subject=f"{_name(subject)} on {problem_name[:-1]}")
+            before = len(report)
+            report.extend(out) if isinstance(out, Report) else report.add(out)
+            sizes.append(len(report) - before)
+    report.meta["records_per_check"] = sizes
+    return report
+
+
+@register_stage("assumptions", "sampled evidence for (A1), (A2), (A3), (LG), (YB) on every reference")
+def assumptions_stage(profile: Profile, context: RunContext) -> Report:
+    """``check_assumptions(problem)`` on every reference (evidence, never proof).
+
+    Theorem ``thm:main`` needs (A1)–(A3) and *one of* (LG) or (YB): the composite law
+    :func:`verimono.checks.assumptions.thm_main` states it (an ``xfail`` for the alternative that fails
+    while the other holds, one ``assumptions_thm_main`` record per problem)."""
+    from ...checks.assumptions import check_assumptions
+
+    seed = context.seed_for(profile)
+    units = [Unit("assumptions", p.name, _assumptions_unit, (check_assumptions, p, seed))
+             for p in context.catalog()]
+    return _merged(context.run_units(profile, units))
+
+
+def _assumptions_unit(check_assumptions: Callable, p: Any, seed: int | None) -> Report:
+    """One reference's assumption records, its ``assumptions_thm_main`` record included."""
+    report = Report()
+    rep = run_unit(lambda: check_assumptions(p, seed=0 if seed is None else seed), check="assumptions",
+                   subject=p.name)
+    if isinstance(rep, CheckResult):    # the unit ran out of its time budget: a failed record, go on
+        report.add(rep)
+    else:
+        report.extend(rep)
+    return report
+
+
+@register_stage("section7", "the paper's complementarity example: orders, trajectories, hypotheses")
+def section7_stage(profile: Profile, context: RunContext) -> Report:
+    """The complementarity systems of the paper (``verimono.reference.lcs_example``): convergence order
+    of the stepper under test on each, a trajectory sample, and the evidence for the hypotheses of the
+    Section 7 theorems (``verimono.lcs.check_hypotheses``); one unit per record (or per system)."""
+    from verimono.reference import lcs_example as example
+
+    stepper = solve if context.stepper is None else context.stepper
+    in_catalog = {p.name for p in context.catalog()}  # already studied by the convergence stage
+    problems = [p for p in (example.ramp_problem(), example.sine_problem()) if p.name not in in_catalog]
+    seed = context.seed_for(profile)
+    seed = 0 if seed is None else seed
+    units = [Unit("section7", p.name, _convergence_unit, (stepper, p)) for p in problems]
+    units += [Unit("section7", "closed-form resolvent", _record_unit, ("example_resolvent_closed_form", seed)),
+              Unit("section7", "batched scheme", _record_unit, ("example_batched_scheme", seed)),
+              Unit("section7", "unbounded pseudo-distance", _record_unit, ("example_pseudo_distance_unbounded",))]
+    # def:dis against the exact d_H of catalog sets, and the Picard step of Section 6
+    units.append(Unit("section7", "pseudo-distance", _pseudo_distance_unit, (seed,)))
+    units.append(Unit("section7", "Hoffman's bound", _hoffman_unit, (seed,)))      # e:hoffman (e: linear case-comp)
+    units += [Unit("section7", f"Picard step on {p.name}", _picard_unit, (stepper, p)) for p in context.catalog()
+              if p.f is not None and p.lipschitz is not None]
+    units += [Unit("section7", f"hypotheses ({label})", _hypotheses_unit, (label, seed)) for label in _INPUTS]
+    return _merged(context.run_units(profile, units))
+
+
+#: the Example's inputs whose hypotheses Section 7 checks (a name each: units travel by name, not by lambda)
+_INPUTS = {"v = (−t, 0)": lambda t: np.array([-t, 0.0]), "v = (sin t, 0)": lambda t: np.array([np.sin(t), 0.0])}
+
+
+def _record_unit(name: str, *args: Any) -> Report:
+    """The record of the Example's law ``name`` (:mod:`verimono.checks.example`; ``args``: its seed, if any)."""
+    from ...checks import example  # noqa: F401 - the Example's laws join the registry on import
+
+    check = laws_of("system")[name].public
+    return Report([check(seed=args[0]) if args else check()])
+
+
+def _pseudo_distance_unit(seed: int) -> Report:
+    return Report([check_pseudo_distance(seed=seed)])
+
+
+def _hoffman_unit(seed: int) -> Report:
+    from ...checks.hoffman import check_hoffman
+
+    return Report([check_hoffman(seed=seed)])
+
+
+def _picard_unit(stepper: Callable, problem: Any) -> Report:
+    return Report([check_picard(stepper, problem)])
+
+
+def _hypotheses_unit(label: str, seed: int) -> Report:
+    """The Section 7 hypotheses of the Example with input ``label``, each record's subject naming it."""
+    from verimono.reference import lcs_example
+
+    from ...checks.section7 import check_hypotheses
+
+    rep = check_hypotheses(lcs_example.example_system(_INPUTS[label]), 2.0, seed=seed)
+    for r in rep.results:
+        r.subject = f"{r.subject} ({label})"
+    return rep
+
+
+@register_stage("siconos", "agreement with the Siconos reference trajectories shipped in verimono/data")
+def siconos_stage(profile: Profile, context: RunContext) -> Report:
+    """Agreement with the Siconos reference trajectories (the packaged data, or ``--data DIR``)."""
+    from ...lcs import siconos_cases as cases
+
+    data = Path(context.data_dir) if context.data_dir is not None else cases.PACKAGED_DATA
+    units = [Unit("siconos", name, _siconos_unit, (check_siconos_case, name, data)) for name in cases.CASES]
+    units.append(Unit("siconos", "LCP test files", _siconos_unit, (check_siconos_lcps, data)))
+    return _merged(context.run_units(profile, units))
+
+
+def _siconos_unit(check: Callable, *args: Any) -> Report:
+    """``check(*args)`` (one Siconos trajectory case, or the LCP files) as a report."""
+    out = check(*args)
+    return out if isinstance(out, Report) else Report([out])
+
+
+@register_stage("performance", "verimono against bare baselines, as same-job ratios: per-step overhead, "
+                "ensembles, DiodeBridge, memory")
+def performance_stage(profile: Profile, context: RunContext) -> Report:
+    """The speed targets as records (:mod:`verimono.run.performance`), at the sizes of ``profile``; each
+    record's ``details["timing_ratio"]`` is gated against the baseline by ratio, never by seconds."""
+
+    aside = None
+    if getattr(context.executor, "workers", 1) >= 2:   # a worker is idle: the memory record runs there
+        def aside(steps: int, stepper: Any) -> Callable[[], CheckResult]:
+            import concurrent.futures
+
+            unit = Unit("performance", "memory", _memory_unit, (steps, stepper))
+            pool = concurrent.futures.ThreadPoolExecutor(1)
+            future = pool.submit(context.executor.map, [unit], profile.name, lambda done, total, label: None)
+            pool.shutdown(wait=False)
+            return lambda: future.result()[0].results[0]
+    return performance.performance_report(performance.SIZES[profile.name], stepper=context.stepper, progress=context.progress,
+                                   aside=aside)
+
+
+def _memory_unit(steps: int, stepper: Any) -> Report:
+    """The memory record (:func:`verimono.run.performance.check_memory`) as a unit of work."""
+    return Report([performance.check_memory(steps=steps, stepper=stepper)])
+
+
+__all__ = ["sample_trajectory", "TRAJECTORY_SAMPLES"]

@@ -1,0 +1,187 @@
+"""The verification run as a list of *stages*: a small registry ``name → callable(profile, context) → Report``.
+
+``verimono run`` runs every registered stage in order (or those named with ``--stage``), merges their
+reports and records, per stage, its status, record count and duration in ``report.meta["stages"]``.
+
+A stage never prints and never raises: :func:`run_stages` judges what a stage raised by the checks' one
+exception policy (:func:`verimono.checks.core.classify`) — :class:`verimono.StageUnavailable`, data that
+are absent, is one *skipped* record ``stage[<name>]``, so a missing battery is counted and the gate sees
+the count of checks shrink; anything else, a crash, one *failed* record with its traceback.
+
+To add a battery::
+
+    from verimono.run.stages import register_stage
+
+    @register_stage("my_laws", "what it verifies")
+    def my_laws(profile, context):          # profile: verimono.execution.profiles.Profile; context: RunContext
+        return check_something(context.stepper, seed=context.seed)     # a verimono.Report
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import time
+import traceback
+from pathlib import Path
+from typing import Any, Callable, Iterable
+
+from ...checks.core import classify
+from ...core.errors import StageUnavailable, UnknownStage
+from ...execution.executors import SerialRunner
+from ...lcs.siconos import PACKAGED_DATA, siconos_root
+from ...execution.profiles import Profile
+from ...records.results import FAILED, SKIPPED, CheckResult, Report
+
+
+@dataclasses.dataclass
+class RunContext:
+    """What every stage may use.
+
+    ``stepper`` is the time-stepper under test (``verimono.solve`` for ``verimono run``); ``problems``
+    the references (``None``: the whole catalog); ``operators`` extra operators to verify (``verimono
+    check`` on an operator); ``data_dir`` the data folder (Siconos references) or ``None``;
+    ``progress(done, total, label)`` reports progress within a stage; ``executor`` runs the stages'
+    independent units (:mod:`verimono.execution.executors`; serially when ``None``); ``costs`` holds what an earlier
+    stage measured of a subject (seconds, by problem name), so a later stage can start its costliest units
+    first (:meth:`run_units`).
+    """
+
+    stepper: Callable | None = None
+    problems: list[Any] | None = None
+    operators: list[tuple[str, Any]] | None = None
+    seed: int | None = None
+    data_dir: Path | None = None
+    progress: Callable[[int, int, str], None] = lambda done, total, label: None
+    executor: Any = None
+    costs: dict[str, float] = dataclasses.field(default_factory=dict)
+
+    _catalog: list[Any] | None = dataclasses.field(default=None, repr=False)
+
+    def catalog(self) -> list[Any]:
+        """``problems`` if given, else the reference catalog (built once per run)."""
+        if self.problems is not None:
+            return self.problems
+        if self._catalog is None:
+            from verimono.reference import catalog
+
+            self._catalog = catalog()
+        return self._catalog
+
+    def run_units(self, profile: Profile, units: list[Any], costs: list[float] | None = None) -> list[Report]:
+        """The reports of ``units`` (:class:`verimono.execution.executors.Unit`), in their order, run on
+        ``executor`` (serially here when it is ``None``); a unit that raises, whose worker dies or that
+        times out gives one failed record ``unit[<stage>: <label>]`` and the other units' records stay.
+
+        ``costs`` (one guess per unit, e.g. from :attr:`costs`): on worker processes the units start
+        costliest first, so that no long unit starts last while the other workers idle; the reports come
+        back in the units' order all the same."""
+        runner = self.executor if self.executor is not None else SerialRunner()
+        if costs is None or isinstance(runner, SerialRunner):
+            return runner.map(units, profile.name, self.progress)
+        order = sorted(range(len(units)), key=lambda i: -costs[i])
+        reports = runner.map([units[i] for i in order], profile.name, self.progress)
+        out: list[Report] = [Report()] * len(units)
+        for i, rep in zip(order, reports):
+            out[i] = rep
+        return out
+
+    def seed_for(self, profile: Profile) -> int | None:
+        """The seed a randomized battery uses: ``seed`` if given, else 0 under a derandomized profile
+        (``ci``: the same records in every job), else ``None`` (a fresh seed, recorded in each record)."""
+        if self.seed is not None:
+            return self.seed
+        return 0 if profile.derandomize else None
+
+
+@dataclasses.dataclass(frozen=True)
+class Stage:
+    name: str
+    fn: Callable[[Profile, RunContext], Report]
+    description: str = ""
+
+
+STAGES: dict[str, Stage] = {}
+
+
+def register_stage(name: str, description: str = "") -> Callable:
+    """Decorator registering ``fn(profile, context) -> Report`` as the stage ``name`` (replaces same name)."""
+
+    def deco(fn: Callable[[Profile, RunContext], Report]) -> Callable:
+        STAGES[name] = Stage(name, fn, description or (fn.__doc__ or "").strip().split("\n")[0])
+        return fn
+
+    return deco
+
+
+def _stage_failure(name: str, exc: BaseException, duration: float) -> tuple[Report, str, str]:
+    """The one record of a stage that raised, judged by the checks' exception policy."""
+    status, message = classify(exc)
+    rec = CheckResult("stage", name, status, message=message, duration=duration)
+    if status == FAILED:
+        rec.details["traceback"] = traceback.format_exc(limit=6)
+        return Report([rec]), "error", message
+    return Report([rec]), "skipped" if status == SKIPPED else status, message
+
+
+def run_stages(names: Iterable[str] | None, profile: Profile, context: RunContext,
+               on_start: Callable[[Stage, int, int], None] | None = None,
+               on_done: Callable[[Stage, Report, dict], None] | None = None) -> Report:
+    """Run the stages ``names`` (``None``: all, in registration order) and merge their reports."""
+    names = list(STAGES) if names is None else list(names)
+    for n in names:
+        if n not in STAGES:
+            raise UnknownStage(f"unknown stage {n!r}; registered stages: {', '.join(STAGES)}")
+    total = Report(meta={"stages": []})
+    for i, n in enumerate(names):
+        stage = STAGES[n]
+        if on_start:
+            on_start(stage, i, len(names))
+        start = time.perf_counter()
+        try:
+            rep = stage.fn(profile, context)
+            if not isinstance(rep, Report):
+                raise TypeError(f"stage {n} returned {type(rep).__name__}, expected a verimono.Report")
+            status = "failed" if rep.failures else ("undecided" if not rep.ok else "passed")
+            message = rep.summary()
+        except Exception as exc:  # noqa: BLE001 - a crash is a failure of the run, recorded, never swallowed
+            rep, status, message = _stage_failure(n, exc, time.perf_counter() - start)
+        duration = time.perf_counter() - start
+        info = {"name": n, "status": status, "records": len(rep), "duration": duration, "message": message}
+        for r in rep.results:
+            r.details.setdefault("stage", n)
+            cx = r.counterexample if isinstance(r.counterexample, dict) else {}
+            if isinstance(cx.get("problem"), str) and cx["problem"] in _reference_names():
+                r.details.setdefault("reference", cx["problem"])  # `--reference NAME` reproduces it
+        total.extend(rep)
+        total.meta["stages"].append(info)
+        if on_done:
+            on_done(stage, rep, info)
+    return total
+
+
+def _reference_names() -> frozenset[str]:
+    """Names ``verimono run --reference NAME`` accepts (the reference catalog's)."""
+    from verimono.reference import names   # the catalog builds every reference: on first use only
+
+    return names()
+
+
+def locate_data(explicit: str | os.PathLike | None = None) -> Path:
+    """The data folder of the siconos stage: ``explicit``, else ``$VERIMONO_SHARED`` if it is a folder, else
+    the Siconos data shipped in the package (``verimono/data``); a given folder must hold that layout."""
+    env = os.environ.get("VERIMONO_SHARED")
+    if explicit is not None:
+        path = Path(explicit)
+    elif env and Path(env).is_dir():
+        path = Path(env)
+    else:
+        return PACKAGED_DATA
+    try:
+        siconos_root(path)
+    except FileNotFoundError as exc:
+        raise StageUnavailable(f"data folder {path}: {exc}") from None
+    return path
+
+
+__all__ = ["STAGES", "Stage", "RunContext", "register_stage", "run_stages", "locate_data"]
