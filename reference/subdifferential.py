@@ -81,7 +81,7 @@ def slow_rate(T: float = 1.0) -> Problem:
     (measured: 1.0477·0.9 h^{0.1} at K = 40 … 2560), and the uniform and graded
     (``h_1 = T/K²``) solutions drift *apart* like ``0.9(K^{-0.1} − K^{-0.2})`` until ``K = 2^{10}``.
     ``c(0) = 0`` is a convention (the scheme never evaluates ``F`` at ``t = 0``).  Not in the run's catalog:
-    the test problem of ``unique_limit`` without an assumed rate (``tests/test_trajectory_laws.py``)."""
+    the test problem of ``unique_limit`` without an assumed rate (``tests/checks/test_trajectory_laws.py``)."""
     def exact(t):
         return np.array([2.0 - t ** 0.1])
 

@@ -7,9 +7,14 @@ tests need nothing beside the repository.
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 
 import pytest
+
+# the tests mirror the package's folders (tests/core, tests/checks, ...); the broken subjects they share, the
+# zoo (zoo.py, zoo_steppers.py, ...), stay here, importable from every folder
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 # `verimono run` uses every core by default (`--executor auto`); the many small in-process runs of the
 # tests would each start worker processes (about 1.5 s of spawning and imports apiece), so the tests run

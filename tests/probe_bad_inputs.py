@@ -2,7 +2,7 @@
 
     OPENBLAS_NUM_THREADS=1 python tests/probe_bad_inputs.py [--list]
 
-``tests/test_fail_closed.py`` runs it and shares its sample gate document (:func:`sample_report`).
+``tests/run/test_fail_closed.py`` runs it and shares its sample gate document (:func:`sample_report`).
 
 Every case is new (not one of the unit tests' reproductions verbatim): forged gate documents, run marks,
 paths that are not documents, time budgets, targets, subjects of the wrong kind, bad seeds and budgets,

@@ -11,5 +11,5 @@
 * :mod:`.errors` (every typed error of verimono), :mod:`.naming`, :mod:`.display` and ``_``-helpers.
 
 The core imports nothing else of verimono: the models (``lcs``, ``reference``, ``strategies``), the records, the
-execution machinery, the checks and the run are built on it (``tests/test_layers.py``).
+execution machinery, the checks and the run are built on it (``tests/project/test_layers.py``).
 """

@@ -12,7 +12,7 @@ returning no constants, and its cache of permitted constants by a fresh one, bot
 Hypothesis' *global* constants (a fixed list in its source) still apply: they depend on nothing imported.
 
 On a hypothesis without these internals the context manager does nothing (there is then nothing to turn
-off, or the mechanism moved: ``tests/test_prox_reproducible.py`` detects that by comparing records).
+off, or the mechanism moved: ``tests/core/test_prox_reproducible.py`` detects that by comparing records).
 """
 
 from __future__ import annotations

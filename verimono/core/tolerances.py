@@ -34,7 +34,7 @@ the conditioning of the law's arithmetic, little headroom over its rounding; a l
 sit within 10 times of the ``10^-3``-sized violations of the zoo's stepper that leaves the domain.
 Measured (``docs/prox-libraries.md``): judged at float64's ``RTOL``, correct float32 proxes of jaxopt and
 ProxTorch fail up to 10 laws by 1.2–5.6 times their slack; at float32's they pass, and the float32
-versions of the zoo's broken operators and steppers are all still caught (``tests/test_precision.py``).
+versions of the zoo's broken operators and steppers are all still caught (``tests/core/test_precision.py``).
 
 The precision of a subject is what it computes in, detected from what it returns (the dtype of its outputs)
 and from what it is given (the dtype its declared array library converts inputs to), the coarser deciding:

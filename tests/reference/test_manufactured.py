@@ -185,7 +185,7 @@ def test_primitive_matches_an_independent_quadrature(name, request):
 
 @pytest.mark.parametrize("name", ALL)
 def test_exact_solution_solves_the_inclusion(name, request):
-    """As tests/test_reference.py checks the references: x*' by a central difference (δ = 1e-6), then
+    """As tests/reference/test_reference.py checks the references: x*' by a central difference (δ = 1e-6), then
     f(x*) + u - x*' ∈ F(t, x*); and ∫u over a cell (the pointwise u, Gauss–Kronrod) is the increment of U."""
     p = request.getfixturevalue(name)
     sol = p.exact

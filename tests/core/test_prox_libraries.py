@@ -63,7 +63,7 @@ def _recipes(heading):
     import pathlib
     import re
 
-    doc = (pathlib.Path(__file__).parents[1] / "docs" / "prox-libraries.md").read_text()
+    doc = (pathlib.Path(__file__).parents[2] / "docs" / "prox-libraries.md").read_text()
     section = doc[doc.index(heading):]
     namespace: dict = {}
     exec(re.search(r"```python\n(.*?)```", section, re.S).group(1), namespace)   # noqa: S102 - the doc's recipe

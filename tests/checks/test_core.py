@@ -188,7 +188,7 @@ def test_the_readme_shows_a_law_as_it_is_declared():
     """README "How a check is built": its operator-law excerpt is the code of verimono/checks/operator_laws.py."""
     from pathlib import Path
 
-    root = Path(__file__).resolve().parent.parent
+    root = Path(__file__).resolve().parents[2]
     readme = (root / "README.md").read_text(encoding="utf-8")
     section = readme.split("## How a check is built", 1)[1]
     excerpt = section.split("```py\n", 1)[1].split("```", 1)[0]

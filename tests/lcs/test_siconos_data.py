@@ -16,7 +16,7 @@ from verimono.checks import siconos as siconos_checks
 from verimono.lcs import siconos_cases
 from verimono.lcs.siconos import PACKAGED_DATA, read_lcp, read_ref, ref_path, siconos_root
 
-REPO = Path(__file__).resolve().parent.parent
+REPO = Path(__file__).resolve().parents[2]
 DATA = PACKAGED_DATA / "siconos"
 MANIFEST = json.loads((DATA / "MANIFEST.json").read_text())["files"]
 SICONOS_CHECKS = ("siconos_agreement", "siconos_lcp")

@@ -18,7 +18,7 @@ pytest.importorskip("xdist")  # the test extra installs it; without it there is 
 
 pytest_plugins = ["pytester"]
 
-README = (Path(__file__).resolve().parent.parent / "README.md").read_text()
+README = (Path(__file__).resolve().parents[2] / "README.md").read_text()
 
 
 def _blocks(heading: str) -> list[str]:

@@ -16,7 +16,7 @@ from verimono.strategies import catalog
 ZOO_CASES = [(member, law) for member, laws in zoo.BREAKS.items() for law in laws]
 
 
-#: the value laws are seen failing on the zoo of lawful prox bugs (tests/zoo_prox.py, tests/test_prox.py)
+#: the value laws are seen failing on the zoo of lawful prox bugs (tests/zoo_prox.py, tests/core/test_prox.py)
 VALUE_LAWS = {"prox_inequality", "prox_optimal", "prox_minimiser", "moreau_envelope"}
 
 

@@ -1,7 +1,7 @@
 """Timing that holds on a busy machine, deterministically tested: time budgets in calibration units
 (:mod:`verimono.execution.timeouts`), the gate's noise-aware stage-time rule, and the exit status of a run whose only
 undecided records are speeds the machine was too noisy to judge.  (The estimator and the decision rule:
-``tests/test_performance.py``; verdicts on real timings: the benchmark tier.)"""
+``tests/run/test_performance.py``; verdicts on real timings: the benchmark tier.)"""
 
 from __future__ import annotations
 

@@ -165,7 +165,7 @@ def test_the_committed_baselines_xfails_pass_against_fresh_records():
     from verimono.run.execute import execute
     from verimono.run.stages import RunContext
 
-    committed = load(Path(__file__).resolve().parent.parent / "reports" / "baseline.json")
+    committed = load(Path(__file__).resolve().parents[2] / "reports" / "baseline.json")
     xfails = [r for r in committed if r.status == "xfail"]
     assert len(xfails) == 6
     subjects = sorted({r.subject for r in xfails})
@@ -446,7 +446,7 @@ def test_a_document_over_the_size_limit_exits_2(tmp_path, capsys, monkeypatch):
 ])
 def test_time_budgets_are_validated_before_any_work(tmp_path, capsys, flag, value, reason):
     """``--unit-timeout -1`` failed a correct stepper, ``--unit-timeout nan`` ran with no bound: each is
-    now refused up front, exit 2 (``inf`` is no limit: tests/test_native_hang.py)."""
+    now refused up front, exit 2 (``inf`` is no limit: tests/execution/test_native_hang.py)."""
     with pytest.raises(SystemExit) as info:
         main(["run", *ONE_REF, "--out", str(tmp_path / "o"), flag, value])
     err = capsys.readouterr().err

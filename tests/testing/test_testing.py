@@ -33,7 +33,7 @@ def test_battery(subject, check):
 def _write(pytester, xfail, extra=""):
     import pathlib
 
-    tests = str(pathlib.Path(__file__).parent)
+    tests = str(pathlib.Path(__file__).parents[1])
     pytester.makepyfile(test_battery=STEPPER_FILE.format(tests=tests, xfail=xfail, extra=extra))
 
 
@@ -183,7 +183,7 @@ def test_claims_and_problems_are_subjects_of_the_pytest_battery(pytester):
     the declaration's reason); a Problem gets the assumption evidence, thm_main included."""
     import pathlib
 
-    pytester.makepyfile(test_battery=CLAIMS_FILE.format(tests=str(pathlib.Path(__file__).parent)))
+    pytester.makepyfile(test_battery=CLAIMS_FILE.format(tests=str(pathlib.Path(__file__).parents[1])))
     res = pytester.runpytest_inprocess("-q", "-rs", "-p", "verimono.testing")
     # stepper: orders, unique_limit, in_domain pass; contraction and the 4 proximal-only laws skip.
     # problem: A1, A2, A3, YB, thm_main pass; LG is an expected failure (YB holds), a skip-free pass here
