@@ -14,60 +14,59 @@ system and estimator laws, each with its paper label and requirements) and makes
   (:mod:`.example`);
 * estimators — the pseudo-distance (:mod:`.pseudo_distance`) and Hoffman's constant (:mod:`.hoffman`).
 
-The names below load their module on first use, so ``import verimono.checks.core`` (the run's stage registry
-does) does not load hypothesis and every law; ``verimono.checks.REGISTRY`` and ``verimono.checks.laws_of``
-come with every battery's laws registered.
+**Names come from the registry.**  ``verimono.checks.check_<law>`` is the public check of every registered law
+whose name is an identifier, found in ``REGISTRY`` once every module of this package is imported: a new law
+is its decorated evaluator and nothing else here.  The names below the laws — the batteries, the drivers'
+helpers, the registry itself — are listed in :data:`_HOMES`.  Everything loads on first use, so ``import
+verimono.checks.core`` (the run's stage registry does) loads neither hypothesis nor every law.
 """
 
 from __future__ import annotations
 
-#: public name → the module that defines it
+import importlib
+import pkgutil
+
+#: the public names that are not a law's ``check_<law>``: public name → the module that defines it
 _HOMES = {
-    "REGISTRY": "core", "Outcome": "core", "law": "core", "laws_of": "core",
+    "Outcome": "core", "law": "core", "laws_of": "core",
     "check_assumptions": "assumptions", "problem_checks": "assumptions",
     "LAWS": "operator_battery", "OPERATOR_CHECKS": "operator_battery", "check_operator": "operator_battery",
     "operator_checks": "operator_battery",
-    "check_convergence_order": "orders",
     "Sample": "samples", "law_samples": "samples",
     "BOUND": "search", "DEFAULT_EXAMPLES": "search", "fresh_seed": "search", "run_law": "search",
     "check_stepper": "stepper_battery", "stepper_checks": "stepper_battery",
-    **{f"check_{law}": "operator_laws" for law in (
-        "resolvent_single_valued", "resolvent_nonexpansive", "resolvent_firmly_nonexpansive", "resolvent_in_domain",
-        "resolvent_identity", "resolvent_limit", "monotone", "yosida_lipschitz", "yosida_monotone",
-        "yosida_in_graph", "yosida_nonincreasing", "yosida_bounded_by_min_norm", "yosida_limit",
-        "min_norm_in_graph", "min_norm_least")},
 }
 
 
+def load_every_law() -> dict:
+    """Import every module of this package (each registers its laws on import) and return ``REGISTRY``."""
+    for info in pkgutil.iter_modules(__path__):
+        importlib.import_module(f"{__name__}.{info.name}")
+    from .core import REGISTRY
+
+    return REGISTRY
+
+
+def public_checks() -> dict:
+    """``{"check_<law>": check}`` for every registered law whose name is an identifier."""
+    return {f"check_{name}": decl.public for laws in load_every_law().values()
+            for name, decl in laws.items() if name.isidentifier() and decl.public is not None}
+
+
 def __getattr__(name: str):
-    home = _HOMES.get(name)
-    if home == "core":   # the registry, with every law registered: load the batteries first
-        from . import assumptions, operator_battery, section7, stepper_battery  # noqa: F401
-        from . import core as module
-    elif home == "assumptions":
-        from . import assumptions as module
-    elif home == "operator_battery":
-        from . import operator_battery as module
-    elif home == "orders":
-        from . import orders as module
-    elif home == "samples":
-        from . import samples as module
-    elif home == "search":   # run_law takes a law by name: the operator laws join the registry on import
-        from . import operator_laws  # noqa: F401
-        from . import search as module
-    elif home == "stepper_battery":
-        from . import stepper_battery as module
-    elif home == "operator_laws":
-        from . import operator_laws as module
+    if name == "REGISTRY":
+        value = load_every_law()
+    elif name == "__all__":   # `from verimono.checks import *`
+        return sorted(set(_HOMES) | {"REGISTRY"} | set(public_checks()))
+    elif name in _HOMES:
+        value = getattr(importlib.import_module(f"{__name__}.{_HOMES[name]}"), name)
+    elif name.startswith("check_") and name in (checks := public_checks()):
+        value = checks[name]
     else:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(module, name)
     globals()[name] = value
     return value
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_HOMES))
-
-
-__all__ = sorted(_HOMES)
+    return sorted(set(globals()) | set(_HOMES) | {"REGISTRY"} | set(public_checks()))
