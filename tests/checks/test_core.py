@@ -182,14 +182,3 @@ def test_a_subject_has_one_name_whatever_the_status():
     assert ran.subject == skipped.subject == "My stepper on moving box"
     assert core.subject_name(vm.Stepper(my_stepper, name="S")) == "S"
     assert core.subject_name(my_stepper) == "My stepper" and core.subject_name(lambda: 0) == "<lambda>"
-
-
-def test_the_readme_shows_a_law_as_it_is_declared():
-    """README "How a check is built": its operator-law excerpt is the code of verimono/checks/operator_laws.py."""
-    from pathlib import Path
-
-    root = Path(__file__).resolve().parents[2]
-    readme = (root / "README.md").read_text(encoding="utf-8")
-    section = readme.split("## How a check is built", 1)[1]
-    excerpt = section.split("```py\n", 1)[1].split("```", 1)[0]
-    assert excerpt.strip() and excerpt in (root / "verimono" / "checks" / "operator_laws.py").read_text(encoding="utf-8")

@@ -4,7 +4,6 @@ parallel runner hides make the session fail instead of writing an empty, green r
 
 from __future__ import annotations
 
-import ast
 import json
 import re
 import textwrap
@@ -21,33 +20,21 @@ pytest_plugins = ["pytester"]
 README = (Path(__file__).resolve().parents[2] / "README.md").read_text()
 
 
-def _blocks(heading: str) -> list[str]:
-    match = re.search(rf"^#{{2,4}} {re.escape(heading)}\n(.*?)(?=^#{{2,4}} |\Z)", README, re.S | re.M)
-    assert match, f"README has no section {heading!r}"
-    return re.findall(r"```python\n(.*?)```", match.group(1), re.S)
+def readme_file(name: str) -> str:
+    """The README's file block ``# NAME`` (its first line), verbatim: the reader's ``mysolver.py`` and suite."""
+    found = [b for b in re.findall(r"```python\n(.*?)```", README, re.S) if b.splitlines()[0] == f"# {name}"]
+    assert len(found) == 1, f"README has {len(found)} file blocks # {name}"
+    return found[0]
 
 
 def mysolver_source() -> str:
-    """``mysolver.py`` as the README's walk-through builds it: its imports, ``disc_projection``,
-    ``moving_disc`` and the last (corrected) ``my_stepper``, taken from the README's own code."""
-    keep: dict[str, str] = {}
-    imports: list[str] = []
-    for block in _blocks("Verify your own solver"):
-        for node in ast.parse(block).body:
-            src = ast.get_source_segment(block, node)
-            if isinstance(node, (ast.Import, ast.ImportFrom)):
-                imports.append(src)
-            elif isinstance(node, ast.FunctionDef):
-                keep[node.name] = src
-            elif isinstance(node, ast.Assign) and [getattr(t, "id", None) for t in node.targets] == ["moving_disc"]:
-                keep["moving_disc"] = src
-    assert {"disc_projection", "moving_disc", "my_stepper"} <= keep.keys()
-    return "\n".join(dict.fromkeys(imports)) + "\n\n" + "\n\n".join(keep.values()) + "\n"
+    """``mysolver.py`` of the README's "Three ways in": ``moving_disc`` and ``my_stepper``."""
+    return readme_file("mysolver.py")
 
 
 def suite_source() -> str:
     """The README's pytest suite (section "2. pytest"), verbatim."""
-    (block,) = _blocks("2. pytest")
+    block = readme_file("test_mysolver.py")
     assert "parametrize_with_checks([moving_disc, my_stepper])" in block
     return block
 
