@@ -92,6 +92,22 @@ def record_html(rec: CheckResult) -> str:
                  f"{body}</div>")
 
 
+@register("work_precision_html")
+def work_precision_html(d: dict) -> str:
+    """A work–precision set (its dict): the report's diagram and its verdicts."""
+    from .work_precision import set_html
+
+    return _wrap(set_html(d))
+
+
+@register("work_precision_figure")
+def work_precision_figure(d: dict, ax: Any = None) -> Any:
+    """The report's work–precision diagram as a matplotlib ``Figure``."""
+    from .work_precision import work_precision_figure as figure
+
+    return figure(d, ax)
+
+
 @register("study_figure")
 def study_figure(study: Any, ax: Any = None) -> Any:
     """The report's log-log plot of ``study`` as a matplotlib ``Figure`` (Agg canvas), or drawn on ``ax``."""
