@@ -31,7 +31,7 @@ from ..core.errors import InvalidCheckArgument, NotApplicable
 from ..core.naming import subject_name
 from ..core.problem import Problem
 from ..records.results import FAILED, PASSED, SKIPPED, CheckResult, Report
-from .core import Holds, Outcome, law, laws_of, run
+from .core import Holds, Outcome, law, laws_of, record_of_exception, run
 from .partitions import single
 from . import bounds, trajectory_laws  # noqa: F401 - the laws local to steps join the registry
 
@@ -121,8 +121,6 @@ def own_partition_laws(stepper: Adaptive, problem: Problem, *, controls: Sequenc
         for c in chosen:
             runs[f"own partition ({stepper.control} {c:g})"] = own_run(stepper, p, c)
     except Exception as exc:   # noqa: BLE001 - the stepper failed on a valid input: every law fails with it
-        from .core import record_of_exception
-
         return [record_of_exception(n, subject, exc) for n in laws]
     replay = Stepper(_Replay(runs, p.x0), scheme="proximal", name=subject_name(stepper),
                      solve_tol=stepper.claim.solve_tol)

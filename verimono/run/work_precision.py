@@ -40,7 +40,9 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
+from ..core._jsonable import to_jsonable
 from ..core.adaptive import DEFAULT_TOLERANCES, Adaptive, own_errors, own_run
+from ..core.arrays import as_float64
 from ..core.convergence import exact_on, grid_errors
 from ..core.display import render
 from ..core.errors import InvalidCheckArgument, InvalidProblem
@@ -210,8 +212,6 @@ class WorkPrecisionSet:
         return render("work_precision_figure", self.to_dict(), ax)
 
     def to_dict(self) -> dict[str, Any]:
-        from ..core._jsonable import to_jsonable
-
         return to_jsonable({**dataclasses.asdict(self), "verdicts": self.verdicts()})
 
     @classmethod
@@ -238,8 +238,6 @@ class _Run:
             run = own_run(self.stepper, self.problem, self.control)
             e, scale = own_errors(run, self.problem)
             return e, run.steps, scale
-        from ..core.arrays import as_float64
-
         x = np.asarray(as_float64(self.stepper(self.problem, self.grid)), dtype=float)
         if x.shape != (len(self.grid),) + self.problem.x0.shape:
             raise InvalidProblem(f"stepper {subject_name(self.stepper)} returned shape {x.shape}, expected "
