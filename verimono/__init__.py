@@ -21,6 +21,7 @@ from .records.results import CheckResult, Report
 from .core.stepping import Trajectory, solve, stream
 from .core.pseudo_distance import pseudo_distance_lower_bound
 from .core.convergence import ConvergenceStudy, ErrorAccumulator, convergence_study
+from .core.adaptive import Adaptive, ToleranceStudy, tolerance_study
 from .core import sets
 from .core._moved import install_moved_modules
 
@@ -80,6 +81,16 @@ def __getattr__(name: str):
                  "operator_checks": operator_checks}[name]
     elif name == "manufactured_problem":   # verimono.reference loads the catalog's LCS tools
         from .reference.manufactured import manufactured_problem as value
+    elif name == "solve_adaptive":         # the adaptive proximal scheme (core, light; kept out of the import)
+        from .core.adaptive_proximal import solve_adaptive as value
+    elif name in ("work_precision", "WorkPrecisionSet"):   # timing lives in execution: the run layer
+        from .run import work_precision as _wp
+
+        value = getattr(_wp, name)
+    elif name in ("check_adaptive", "check_tolerance_rate", "check_switching_times"):
+        from .checks import own_steps as _own
+
+        value = getattr(_own, name)
     elif name == "check_assumptions":
         from .checks.assumptions import check_assumptions as value
     elif name == "checks":  # `import a.b as c` imports the submodule before reading it: no recursion here
@@ -115,4 +126,6 @@ __all__ = [
     "CheckResult", "Report", "pseudo_distance_lower_bound", "lcs", "strategies",
     "convergence_study", "ConvergenceStudy", "check_stepper", "check_operator", "operator_checks",
     "check_assumptions", "manufactured_problem",
+    "Adaptive", "ToleranceStudy", "tolerance_study", "solve_adaptive", "work_precision", "WorkPrecisionSet",
+    "check_adaptive", "check_tolerance_rate", "check_switching_times",
 ]

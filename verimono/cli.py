@@ -30,6 +30,14 @@
         MODULE is a dotted module name or a ``.py`` file (anything else: exit 2).  Its units run on every
         core as ``run``'s do (``--executor serial``: in this process).  Its files are marked and
         written as ``run``'s; after an interrupt, run the same command again (it has no ``--resume``).
+    verimono compare MODULE:A MODULE:B ... (--problem MODULE:OBJECT | --reference NAME)... [--out DIR]
+                 [--rounds N] [--norm sup|l2|final]
+        Work–precision of the steppers (fixed-grid ``Stepper``s over the problem's step sizes, ``Adaptive``
+        ones over their tolerances) on each problem (``verimono.run.work_precision``): the records
+        ``work_precision[A vs B on P]`` (CPU time) and ``work_precision_steps[...]`` of the first stepper
+        against each other, and the diagram in DIR/report.html (default reports/compare/).  Exit 0 when A is
+        at least as accurate as every other for the same work, 1 when it is not, 2 when nothing failed but a
+        comparison could not be decided (work ranges that do not overlap; timing noise alone exits 0).
     verimono baseline [--out reports/baseline.json] [--from RESULTS] [run options]
         Record the current results (runs the verification, or copies RESULTS) as the gate's baseline.
     verimono gate --baseline FILE [--results reports/results.json]
@@ -322,6 +330,40 @@ def _cmd_check(args: argparse.Namespace) -> int:
     return _finish(report, out, baseline, run_id)
 
 
+def _cmd_compare(args: argparse.Namespace) -> int:
+    from .core.adaptive import Adaptive
+    from .checks.subjects import kind_of
+    from .records.atomic import ensure_writable_dir
+
+    steppers = []
+    for spec in args.targets:
+        obj = load_target(spec)
+        if not isinstance(obj, Adaptive):
+            try:
+                kind = kind_of(obj)
+            except InvalidCheckArgument as exc:
+                raise BadTarget(f"{spec}: {exc}") from None
+            if kind != "stepper":
+                raise BadTarget(f"{spec} is an {kind}: `verimono compare` takes steppers (a Stepper, a callable "
+                                "stepper(problem, t_grid), or a verimono.Adaptive)")
+        steppers.append(obj)
+    if len(steppers) < 2:
+        raise BadTarget("`verimono compare` needs at least two steppers")
+    problems = _context(args).problems
+    if not problems:
+        raise BadTarget("`verimono compare` needs a problem: --problem MODULE:OBJECT or --reference NAME")
+    out = ensure_writable_dir(args.out)
+    run_id = _start(out, "compare")
+    from .run.work_precision import compare_report
+
+    print(f"verimono: comparing {', '.join(args.targets)} on {len(problems)} problem"
+          f"{'s' if len(problems) != 1 else ''}", file=sys.stderr)
+    report = compare_report(steppers, problems, rounds=args.rounds, max_rounds=max(args.rounds, 3 * args.rounds),
+                            norm=args.norm)
+    report.meta.update({"command": "compare", "target": " ".join(args.targets), "profile": None})
+    return _finish(report, out, None, run_id)
+
+
 def _cmd_baseline(args: argparse.Namespace) -> int:
     from .records.atomic import ensure_writable_file
     from .records.results import load
@@ -463,6 +505,18 @@ def build_parser() -> argparse.ArgumentParser:
                        help="the accuracy of the stepper's inner solve per step (relative to 1 + |x|): errors at "
                             "what it accumulates pass as exact to it")
     check.set_defaults(func=_cmd_check, stage=None)
+
+    comp = sub.add_parser("compare", help="work-precision of several steppers on a problem, with the diagram")
+    comp.add_argument("targets", nargs="+", metavar="MODULE:OBJECT", help="the steppers; the first is judged "
+                      "against each other")
+    comp.add_argument("--problem", action="append", default=None, metavar="MODULE:OBJECT",
+                      help="a Problem with an exact solution (or a list of them); repeatable")
+    comp.add_argument("--reference", action="append", metavar="NAME", help="a reference of the catalog")
+    comp.add_argument("--out", default="reports/compare", help="output folder (default reports/compare/)")
+    comp.add_argument("--rounds", type=int, default=9, help="timed rounds per run (default 9; up to 3x that when "
+                      "the noise cannot decide)")
+    comp.add_argument("--norm", choices=("sup", "l2", "final"), default="sup", help="the error compared")
+    comp.set_defaults(func=_cmd_compare)
 
     base = sub.add_parser("baseline", help="record the current results as the gate's baseline")
     run_options(base)

@@ -1,7 +1,8 @@
 """The HTML report: one self-contained file (inline CSS and SVG, no scripts, no network).
 
 Sections, in order (each a ``<section id=...>``): ``summary`` (counts and stages), ``changes`` (against
-the baseline), ``convergence`` (log-log plots per reference), ``trajectories`` (scheme against exact
+the baseline), ``convergence`` (log-log plots per reference), ``work_precision`` (error against work of
+several steppers, :mod:`.work_precision`), ``trajectories`` (scheme against exact
 solution), ``laws`` (every check with its worst ratio and bound), ``failures`` (counterexample and a
 copy-paste reproduction each), ``timings`` and ``environment``.
 
@@ -24,11 +25,13 @@ from typing import Any
 
 from ..environment import environment
 from ..results import FAILED, PASSED, SKIPPED, STATUSES, UNDECIDED, XFAIL, CheckResult, Report, to_jsonable
+from . import work_precision
 from .plots import convergence_plot, trajectory_plot
 
-SECTIONS = ("summary", "changes", "convergence", "trajectories", "laws", "failures", "performance", "timings",
-            "environment")
+SECTIONS = ("summary", "changes", "convergence", "work_precision", "trajectories", "laws", "failures", "performance",
+            "timings", "environment")
 _TITLES = {"summary": "Summary", "changes": "Changes against the baseline", "convergence": "Convergence orders",
+           "work_precision": "Work–precision",
            "trajectories": "Trajectories against exact solutions", "laws": "Laws and checks",
            "failures": "Failures and how to reproduce them", "performance": "Performance", "timings": "Timings",
            "environment": "Environment"}
@@ -470,7 +473,8 @@ def render(report: Report, *, changes: Any = None, title: str = "verimono report
         report.meta["environment"] = environment()
     bodies = {
         "summary": _summary(report, changes), "changes": _changes(changes),
-        "convergence": _convergence(report), "trajectories": _trajectories(report), "laws": _laws(report),
+        "convergence": _convergence(report), "work_precision": work_precision.section(report),
+        "trajectories": _trajectories(report), "laws": _laws(report),
         "failures": _failures(report), "performance": _performance(report), "timings": _timings(report),
         "environment": _environment(report),
     }

@@ -15,6 +15,7 @@ from ...core.display import register
 from ..results import FAILED, PASSED, CheckResult, Report, to_jsonable
 from . import html
 from .plots import convergence_figure, convergence_plot
+from .work_precision import set_html, work_precision_figure as wp_figure
 
 SCOPE = "vm-nb"
 #: rules the notebook needs on top of the report's: no sticky header rows inside a cell, and headings in
@@ -90,6 +91,18 @@ def record_html(rec: CheckResult) -> str:
     cls = "failure" if rec.status == FAILED else ""
     return _wrap(f'<div class="{cls}" style="padding:6px 10px"><h3 style="margin:2px 0 6px">{html._e(rec.key)}</h3>'
                  f"{body}</div>")
+
+
+@register("work_precision_html")
+def work_precision_html(d: dict) -> str:
+    """A work–precision set (its dict): the report's diagram and its verdicts."""
+    return _wrap(set_html(d))
+
+
+@register("work_precision_figure")
+def work_precision_figure(d: dict, ax: Any = None) -> Any:
+    """The report's work–precision diagram as a matplotlib ``Figure``."""
+    return wp_figure(d, ax)
 
 
 @register("study_figure")
