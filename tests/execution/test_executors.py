@@ -161,6 +161,33 @@ def test_a_unit_that_raises_is_one_failed_record_in_place():
     assert seen[0] == (0, 3, "a") and seen[-1] == (3, 3, "")
 
 
+def _unverified(name):
+    from verimono.core.errors import UnverifiedSolution
+
+    raise UnverifiedSolution(f"{name}: the LCP back-ends gave no verified answer")
+
+
+@pytest.mark.parametrize("where", ["serial", "worker"])
+def test_a_unit_is_judged_by_the_one_exception_policy(where):
+    """What a unit raised means what it means in a law (:func:`verimono.checks.core.classify`): a limit of
+    verimono's own solvers is undecided, never a failure of the subject; another exception is failed.  A unit
+    turned every exception into *failed* before.  ``worker``: the code a worker process runs on a shipped
+    unit, in this process."""
+    from verimono.execution.executors import _decode_answer, _ship, run_payload
+
+    units = [Unit("s", "a", _unverified, ("a",)), Unit("s", "b", _boom, ("b",)), Unit("s", "c", _ok, ("c",))]
+    if where == "serial":
+        reports = SerialRunner().map(units, None, lambda *a: None)
+    else:
+        reports = [_decode_answer(u, run_payload(_ship(u, None)))[0] for u in units]
+    (a,), (b,), (c,) = (rep.results for rep in reports)
+    assert (a.key, a.status) == ("unit[s: a]", "undecided") and "no verified answer" in a.message, a
+    assert a.details["exception"] == "UnverifiedSolution"
+    assert (b.key, b.status) == ("unit[s: b]", "failed") and "ZeroDivisionError: b divided by zero" in b.message
+    assert "traceback" in b.details
+    assert (c.key, c.status) == ("law[c]", "passed")
+
+
 @pytest.mark.parametrize("spec", ["process:two", "threads", "process:0"])
 def test_a_bad_executor_is_a_usage_error(spec, tmp_path, capsys):
     with pytest.raises(BadExecutor):

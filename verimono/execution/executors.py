@@ -18,9 +18,11 @@ target loaded from a file travel by value).  Each worker loads the run's hypothe
 to one thread, as ``verimono run`` does, so a unit's records do not depend on where it ran: under a
 derandomized profile the merged report equals the serial run's apart from timings.
 
-A unit never takes the run down with it: a unit that raises, whose worker dies, or that runs longer than
-``timeout`` seconds becomes one *failed* record ``unit[<stage>: <label>]`` naming it (:func:`unit_failure`);
-the records of every other unit are kept.  With ``process:N`` the unit a dying worker was running is known
+A unit never takes the run down with it: a unit that raises becomes one record ``unit[<stage>: <label>]``
+judged by the one exception policy (:func:`verimono.records.verdicts.classify`: a limit of verimono's own
+solvers is undecided, anything else the subject raised is failed), one whose worker dies or that runs longer
+than ``timeout`` seconds one *failed* record naming it (:func:`unit_failure`); the records of every other
+unit are kept.  With ``process:N`` the unit a dying worker was running is known
 exactly (each worker runs one unit at a time) and a fresh worker replaces it; on dask a unit that kills
 workers is reported once the scheduler gives up on it (``KilledWorker``, after its ``allowed-failures``).
 A ``process:N`` worker whose unit is blocked in native code past its time budget, which the budget's
@@ -46,7 +48,8 @@ from . import watchdog
 from .calibration import calibration, set_calibration
 from ..core.errors import BadExecutor
 from .profiles import load_hypothesis_profile
-from ..records.results import FAILED, CheckResult, Report
+from ..records.results import FAILED, Report
+from ..records.verdicts import classify, new_record
 from .timeouts import budget, explicit_budget, unlimited
 
 #: the check name of the record that stands for a unit that crashed, died or timed out
@@ -64,13 +67,39 @@ class Unit:
     args: tuple = ()
 
 
+def unit_record(unit: Unit, status: str, message: str, *, exception: str | None = None,
+                traceback_text: str | None = None, duration: float | None = None) -> Report:
+    """The report of a unit that did not finish: one record ``unit[<stage>: <label>]`` with ``status``."""
+    details: dict[str, Any] = {}
+    if exception:
+        details["exception"] = exception
+    if traceback_text:
+        details["traceback"] = traceback_text
+    return Report([new_record(UNIT_CHECK, f"{unit.stage}: {unit.label}", status, message=message,
+                              duration=duration, details=details)])
+
+
 def unit_failure(unit: Unit, message: str, *, traceback_text: str | None = None,
                  duration: float | None = None) -> Report:
-    """The report of a unit that did not finish: one failed record ``unit[<stage>: <label>]``."""
-    rec = CheckResult(UNIT_CHECK, f"{unit.stage}: {unit.label}", FAILED, message=message, duration=duration)
-    if traceback_text:
-        rec.details["traceback"] = traceback_text
-    return Report([rec])
+    """The report of a unit that did not finish for a reason of its own — its worker died, it ran past the
+    executor's timeout: one failed record ``unit[<stage>: <label>]``."""
+    return unit_record(unit, FAILED, message, traceback_text=traceback_text, duration=duration)
+
+
+def raised(exc: BaseException) -> tuple[str, str]:
+    """``(status, message)`` of a unit that raised ``exc``: the one exception policy
+    (:func:`verimono.records.verdicts.classify`) — a limit of verimono's own solvers is undecided in a unit as
+    in a law, a failure of the subject is ``raised <type>: <message>``."""
+    status, message = classify(exc)
+    return status, ("raised " + message if status == FAILED else message)
+
+
+def unit_raised(unit: Unit, exc: BaseException, *, traceback_text: str | None = None,
+                duration: float | None = None) -> Report:
+    """The report of a unit that raised ``exc`` (:func:`raised`)."""
+    status, message = raised(exc)
+    return unit_record(unit, status, message, exception=type(exc).__name__, traceback_text=traceback_text,
+                       duration=duration)
 
 
 # -- what runs on a worker ----------------------------------------------------------------------------
@@ -104,8 +133,8 @@ def run_payload(payload: bytes) -> bytes:
     """Run one shipped unit: ``payload`` is ``cloudpickle.dumps((profile, fn, args, limits, stage, label))``
     (``limits``: the sending process's explicit unit budget, :func:`verimono.execution.timeouts.explicit_budget`, and its
     calibration, the unit of the profile's budgets — :func:`_limits` — applied here too, so a worker's budgets
-    are the run's); the answer is ``cloudpickle.dumps(("ok", report))`` or ``("error", message,
-    traceback)`` — never an exception, so a unit's own error is told apart from the worker's death.  (A
+    are the run's); the answer is ``cloudpickle.dumps(("ok", report))`` or ``("error", status, message,
+    exception type, traceback, seconds)`` (the exception judged here, :func:`raised`) — never an exception, so a unit's own error is told apart from the worker's death.  (A
     ``process:N`` worker whose unit blocks in native code answers ``("hang", report)`` instead and exits:
     :func:`_process_worker`.)"""
     import cloudpickle
@@ -122,7 +151,8 @@ def run_payload(payload: bytes) -> bytes:
             raise TypeError(f"a unit returned {type(out).__name__}, expected a verimono.Report")
         return cloudpickle.dumps(("ok", out))
     except Exception as exc:
-        return cloudpickle.dumps(("error", f"{type(exc).__name__}: {exc}", traceback.format_exc(limit=8),
+        status, message = raised(exc)     # judged here, where the exception is
+        return cloudpickle.dumps(("error", status, message, type(exc).__name__, traceback.format_exc(limit=8),
                                   time.perf_counter() - start))
 
 
@@ -143,7 +173,9 @@ def _decode_answer(unit: Unit, answer: bytes) -> tuple[Report, bool]:
         return out[1], False
     if out[0] == "hang":
         return out[1], True
-    return unit_failure(unit, f"raised {out[1]}", traceback_text=out[2], duration=out[3]), False
+    _, status, message, exception, traceback_text, duration = out
+    return unit_record(unit, status, message, exception=exception, traceback_text=traceback_text,
+                       duration=duration), False
 
 
 #: seconds a new worker process may take to import verimono and say it is ready
@@ -292,9 +324,8 @@ class SerialRunner:
                 if not isinstance(rep, Report):
                     raise TypeError(f"a unit returned {type(rep).__name__}, expected a verimono.Report")
             except Exception as exc:
-                rep = unit_failure(u, f"raised {type(exc).__name__}: {exc}",
-                                   traceback_text=traceback.format_exc(limit=8),
-                                   duration=time.perf_counter() - start)
+                rep = unit_raised(u, exc, traceback_text=traceback.format_exc(limit=8),
+                                  duration=time.perf_counter() - start)
             watchdog.finished(rep)
             out.append(rep)
         progress(len(units), len(units), "")
@@ -603,4 +634,4 @@ def make_runner(spec: Any = None, *, timeout: float | None = None) -> Any:
 
 
 __all__ = ["Unit", "UNIT_CHECK", "AUTO_MAX_WORKERS", "ship_by_value", "BadExecutor", "SerialRunner", "ProcessRunner", "DaskRunner", "make_runner",
-           "unit_failure", "run_payload"]
+           "unit_failure", "unit_record", "unit_raised", "raised", "run_payload"]
