@@ -176,12 +176,12 @@ class _Collector:
     def _receive(self, report: pytest.TestReport) -> None:
         """Records of a test that ran elsewhere (an xdist worker), carried by its call report."""
         from .records.results import CheckResult, to_jsonable
-        from .records.schema import record_fields, study_from_dict
+        from .records.schema import study_from_dict
 
         data = json.loads(getattr(report, self.ATTR))
         self.nodeid = report.nodeid
         try:
-            self.add(Report([CheckResult(**record_fields(d, i)) for i, d in enumerate(data["results"])],
+            self.add(Report([CheckResult.from_dict(d) for d in data["results"]],
                             [study_from_dict(s, i) for i, s in enumerate(data["studies"])],
                             trajectories=to_jsonable(data["trajectories"])))
         finally:

@@ -50,7 +50,7 @@ from ..records.results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
 from ..execution.timeouts import (HANG_MULTIPLE, TIME_BUDGET_REASON, current_budget, never_returned, note_progress,
                         time_limit)
 from .batches import prefetched
-from .core import REGISTRY, Law, Outcome, classify, law, run, subject_name
+from .core import REGISTRY, Law, Outcome, classify, law, new_record, run, subject_name
 from .samples import NUMPY_DIM, Sample, law_samples
 from .sweep import law_draws, shrink, sweep_count, sweep_samples
 
@@ -317,23 +317,23 @@ def _verdict(state: _Search, how: dict, base: dict, details: dict, cex_extra: di
         in_flight = how.get("in_flight")
         if never_returned(in_flight, state.slowest) and runs:    # the sample in flight: a call that does not return
             details.update(in_flight=in_flight, slowest=state.slowest)
-            return CheckResult(status=FAILED, details=details, **base,
+            return new_record(status=FAILED, details=details, **base,
                                message=f"timed out: {how['timed_out']}; the sample in flight ran {in_flight:.1f} s, "
                                        f"more than {HANG_MULTIPLE:g}x the slowest of the {runs} samples before it "
                                        f"({state.slowest:.3g} s): a call that does not return")
         if runs and state.inconclusive < runs:
             details["undecided_reason"] = TIME_BUDGET_REASON
-            return CheckResult(status=UNDECIDED, details=details, **base,
+            return new_record(status=UNDECIDED, details=details, **base,
                                message=f"time budget exhausted after {runs} samples, all of which held "
                                        f"({how['timed_out']}): too few samples for a verdict")
-        return CheckResult(status=FAILED, details=details, **base,
+        return new_record(status=FAILED, details=details, **base,
                            message=f"timed out: {how['timed_out']} ({runs} samples evaluated before)")
     if state.failure is None and how["harness"]:
-        return CheckResult(status=UNDECIDED, details=details, **base,
+        return new_record(status=UNDECIDED, details=details, **base,
                            message=f"the harness could not search this operator ({how['harness']}; {runs} samples "
                                    "evaluated before); a limitation of verimono, not a failure of the operator")
     if state.failure is None and state.unsupported is not None:
-        return CheckResult(status=SKIPPED, details=details, **base,
+        return new_record(status=SKIPPED, details=details, **base,
                            message=f"needs a member the operator lacks: {state.unsupported} ({runs} samples "
                                    "evaluated before)")
     if state.failure is not None:
@@ -343,18 +343,18 @@ def _verdict(state: _Search, how: dict, base: dict, details: dict, cex_extra: di
         if state.found_by:
             cex["found_by"] = state.found_by
         worst = out.ratio if state.worst is None else max(state.worst.ratio, out.ratio)
-        return CheckResult(status=FAILED, worst=worst, bound=BOUND, counterexample=cex, details=details, **base,
+        return new_record(status=FAILED, worst=worst, bound=BOUND, counterexample=cex, details=details, **base,
                            message=f"{out.what}: lhs {out.lhs:.6g} > rhs {out.rhs:.6g} + slack {out.slack:.3g} "
                                    f"at {s!r}{how['flaky']}")
     if runs == 0:        # nothing was evaluated: never a pass
-        return CheckResult(status=UNDECIDED, message="no sample was evaluated", details=details, **base)
+        return new_record(status=UNDECIDED, message="no sample was evaluated", details=details, **base)
     if state.harness_limited == runs:
-        return CheckResult(status=UNDECIDED, details=details, **base,
+        return new_record(status=UNDECIDED, details=details, **base,
                            message=f"verimono's own solvers decided none of the {runs} samples (e.g. "
                                    f"{state.inconclusive_what}); a limitation of verimono, not a failure of the "
                                    "operator")
     if state.inconclusive == runs:
-        return CheckResult(status=SKIPPED, details=details, **base,
+        return new_record(status=SKIPPED, details=details, **base,
                            message=f"all {runs} samples inconclusive (e.g. {state.inconclusive_what})")
     if state.worst is not None:
         details["worst_sample"] = state.worst_sample.to_dict()
@@ -363,7 +363,7 @@ def _verdict(state: _Search, how: dict, base: dict, details: dict, cex_extra: di
     counted = f"{runs} samples" + (f" ({state.inconclusive} inconclusive)" if state.inconclusive else "")
     if state.harness_limited:
         counted += f", {state.harness_limited} of them undecided by verimono's own solvers"
-    return CheckResult(status=PASSED, worst=None if state.worst is None else state.worst.ratio, bound=BOUND,
+    return new_record(status=PASSED, worst=None if state.worst is None else state.worst.ratio, bound=BOUND,
                        message=counted + (f"; {how['flaky']}" if how["flaky"] else ""), details=details, **base)
 
 
@@ -401,10 +401,10 @@ def run_law(decl: Law | str, op: Any, *, seed: int | None = None, examples: int 
         if cause is not None:
             why = {**details, "root_cause": cause}
             if decl.name == ROOT_LAW:
-                return CheckResult(status=FAILED, worst=math.inf, bound=BOUND, counterexample={"operator": repr(op)},
+                return new_record(status=FAILED, worst=math.inf, bound=BOUND, counterexample={"operator": repr(op)},
                                    message=f"root cause: {cause}; the other laws are not evaluated", details=why,
                                    **base)
-            return CheckResult(status=SKIPPED, details=why, **base,
+            return new_record(status=SKIPPED, details=why, **base,
                                message=f"not evaluated: {cause} (the root cause is recorded once, as {ROOT_LAW})")
         state, how = _search(decl, op, seed, examples, horizon) if sample is None else _replay(decl, op, sample)
         rec = _verdict(state, how, base, {**details, "evaluations": state.runs, "inconclusive": state.inconclusive,

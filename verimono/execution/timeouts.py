@@ -44,7 +44,8 @@ from typing import Callable, Iterator
 from ..core.errors import InvalidCheckArgument, UnitTimeout
 from . import calibration as _calibration
 from .profiles import Profile, UnknownProfile, active_profile, get_profile
-from ..records.results import FAILED, UNDECIDED, CheckResult
+from ..records.results import FAILED, UNDECIDED
+from ..records.verdicts import new_record
 from . import watchdog
 
 _OVERRIDE: list[float | None] = []
@@ -247,19 +248,19 @@ def _run_unit(fn: Callable[[], object], *, check: str, subject: str, seconds: fl
         evaluated, what = progress.get("evaluated", 0), progress.get("what", "samples")
         what = what[:-1] if evaluated == 1 and what.endswith("s") else what
         if not evaluated:
-            return CheckResult(check, subject, FAILED, message=f"timed out: {exc}", duration=elapsed, details=details)
+            return new_record(check, subject, FAILED, message=f"timed out: {exc}", duration=elapsed, details=details)
         in_flight, slowest = time.perf_counter() - progress["at"], progress["slowest"]
         details.update(evaluated=evaluated, in_flight=in_flight, slowest=slowest)
         if not progress.get("held"):
-            return CheckResult(check, subject, FAILED, message=f"timed out: {exc} (after {evaluated} {what}, not all "
+            return new_record(check, subject, FAILED, message=f"timed out: {exc} (after {evaluated} {what}, not all "
                                                                "of which held)", duration=elapsed, details=details)
         if never_returned(in_flight, slowest):
-            return CheckResult(check, subject, FAILED, duration=elapsed, details=details,
+            return new_record(check, subject, FAILED, duration=elapsed, details=details,
                                message=f"timed out: {exc}; the evaluation in flight ran {in_flight:.1f} s, more than "
                                        f"{HANG_MULTIPLE:g}x the slowest of the {evaluated} {what} before it "
                                        f"({slowest:.3g} s): a call that does not return")
         details["undecided_reason"] = TIME_BUDGET_REASON
-        return CheckResult(check, subject, UNDECIDED, duration=elapsed, details=details,
+        return new_record(check, subject, UNDECIDED, duration=elapsed, details=details,
                            message=f"time budget exhausted after {evaluated} {what}, all of which held ({exc}): "
                                    "too few for a verdict")
     finally:
