@@ -11,6 +11,7 @@ import time
 import pytest
 
 from verimono import calibration, timeouts, timing
+from verimono.execution import config as run_config
 from verimono.run.gate import CALIBRATION_DRIFT, TIMING_GROWTH, compare
 from verimono.execution.profiles import STAGE_BUDGETS, get_profile
 from verimono.records.results import PASSED, UNDECIDED, CheckResult, Report
@@ -28,7 +29,7 @@ def calibrated():
 
 
 def test_unit_budgets_are_calibration_units_times_this_machines_calibration(calibrated, monkeypatch):
-    monkeypatch.setenv("HYPOTHESIS_PROFILE", "ci")
+    monkeypatch.setattr(run_config, "_STACK", [run_config.RunConfig(profile="ci")])   # the run's configuration
     ci = get_profile("ci")
     assert timeouts.current_budget() == pytest.approx(ci.unit_budget * 0.1)
     src = timeouts.budget_source()
@@ -128,7 +129,7 @@ def test_the_end_calibration_stops_repeating_once_it_agrees_with_the_start(monke
 def test_a_unit_over_its_scaled_budget_is_stopped_and_says_why(monkeypatch):
     if not timeouts.supported():
         pytest.skip("no SIGALRM here")
-    monkeypatch.setenv("HYPOTHESIS_PROFILE", "dev")
+    monkeypatch.setattr(run_config, "_STACK", [run_config.RunConfig(profile="dev")])
     timing.set_calibration(1e-4)                   # 800 units x 0.1 ms = 0.08 s
     try:
         def spin():

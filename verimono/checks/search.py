@@ -45,7 +45,7 @@ from hypothesis import HealthCheck, Phase, Verbosity, given, settings
 from ..core._reproducible import no_local_constants
 from .arguments import valid_horizon, valid_seed
 from ..core.errors import InvalidCheckArgument, UnitTimeout
-from ..execution.profiles import UnknownProfile, active_profile, get_profile
+from ..execution.config import current as current_config
 from ..records.results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
 from ..execution.timeouts import (HANG_MULTIPLE, TIME_BUDGET_REASON, current_budget, never_returned, note_progress,
                         time_limit)
@@ -54,7 +54,7 @@ from .core import REGISTRY, Law, Outcome, classify, law, new_record, run, subjec
 from .samples import NUMPY_DIM, Sample, law_samples
 from .sweep import law_draws, shrink, sweep_count, sweep_samples
 
-#: examples per law when ``examples`` is not given and the active hypothesis profile is not one of
+#: examples per law when ``examples`` is not given and the run configuration's profile is not one of
 #: verimono's (a user's own); otherwise the profile's ``law_examples`` governs (:func:`default_examples`)
 DEFAULT_EXAMPLES = 50
 #: every law's ratio ``lhs / (rhs + slack)`` must not exceed this
@@ -78,13 +78,11 @@ def fresh_seed() -> int:
 
 
 def default_examples() -> tuple[int, str]:
-    """``(examples per law, profile)`` when ``examples`` is not given: the active profile's ``law_examples``
-    (``dev``/``ci``/``thorough``, :func:`verimono.execution.profiles.active_profile`), else ``DEFAULT_EXAMPLES``."""
-    name = active_profile()
-    try:
-        return get_profile(name).law_examples, name
-    except UnknownProfile:
-        return DEFAULT_EXAMPLES, name
+    """``(examples per law, profile)`` when ``examples`` is not given: the ``law_examples`` of the run
+    configuration's profile (``dev``/``ci``/``thorough``, :func:`verimono.execution.config.current`), else
+    ``DEFAULT_EXAMPLES`` (a user's own hypothesis profile)."""
+    cfg = current_config()
+    return (DEFAULT_EXAMPLES if cfg.effort is None else cfg.effort.law_examples), cfg.profile
 
 
 def positive_examples(examples: Any) -> int:
@@ -288,7 +286,7 @@ def _search(decl: Law, op: Any, seed: int, examples: int, horizon: float) -> tup
 def _sweep(state: _Search, seed: int, horizon: float) -> int:
     """The scale sweep after a search that found nothing; a violation is shrunk greedily into ``state``.
     Returns the number of sweep samples."""
-    swept = sweep_samples(state.op, seed, horizon, sweep_count(active_profile(), state.decl.name), Sample)
+    swept = sweep_samples(state.op, seed, horizon, sweep_count(current_config().profile, state.decl.name), Sample)
     found = state.first_violation(swept)
     if found is not None:
         state.shrunk_into(found[0], "sweep (shrunk greedily)")

@@ -14,9 +14,11 @@ studies) mapped over an executor, their results merged in the units' own order.
   (``pip install "verimono[dask]"``; verimono must be importable on the workers).
 
 A unit is ``fn(*args) -> Report``, shipped with ``cloudpickle`` (closures, lambdas and a ``verimono check``
-target loaded from a file travel by value).  Each worker loads the run's hypothesis profile and pins BLAS
-to one thread, as ``verimono run`` does, so a unit's records do not depend on where it ran: under a
-derandomized profile the merged report equals the serial run's apart from timings.
+target loaded from a file travel by value), with the run configuration (:mod:`verimono.execution.config`:
+profile, explicit budget, seed) and the run's calibration.  Each worker runs the unit under that
+configuration, loads the run's hypothesis profile and pins BLAS to one thread, as ``verimono run`` does, so a
+unit's records do not depend on where it ran: under a derandomized profile the merged report equals the
+serial run's apart from timings.
 
 A unit never takes the run down with it: a unit that raises becomes one record ``unit[<stage>: <label>]``
 judged by the one exception policy (:func:`verimono.records.verdicts.classify`: a limit of verimono's own
@@ -47,10 +49,12 @@ from typing import Any, Callable, Sequence
 from . import watchdog
 from .calibration import calibration, set_calibration
 from ..core.errors import BadExecutor
+from . import config as _config
+from .config import RunConfig
 from .profiles import load_hypothesis_profile
 from ..records.results import FAILED, Report
 from ..records.verdicts import classify, new_record
-from .timeouts import budget, explicit_budget, unlimited
+from .timeouts import unlimited
 
 #: the check name of the record that stands for a unit that crashed, died or timed out
 UNIT_CHECK = watchdog.UNIT_CHECK
@@ -122,18 +126,28 @@ def _one_blas_thread() -> None:
         pass
 
 
-def _prepare_worker(profile: str | None) -> None:
-    """The run's hypothesis profile (loaded again for every unit: a unit may load another) and one BLAS thread."""
-    if profile:
-        load_hypothesis_profile(profile)
+def config_for(profile: RunConfig | str | None) -> RunConfig:
+    """The run configuration units run under: ``profile`` itself, or the current one
+    (:func:`verimono.execution.config.current`) with the profile named ``profile`` (``None``: as it is)."""
+    if isinstance(profile, RunConfig):
+        return profile
+    cfg = _config.current()
+    return cfg if profile is None or profile == cfg.profile else dataclasses.replace(cfg, profile=profile)
+
+
+def _prepare_worker(cfg: RunConfig) -> None:
+    """The run's hypothesis profile (loaded again for every unit: a unit may load another; a user's own
+    profile is not registered in a fresh worker, so only verimono's) and one BLAS thread."""
+    if cfg.effort is not None:
+        load_hypothesis_profile(cfg.profile)
     _one_blas_thread()
 
 
 def run_payload(payload: bytes) -> bytes:
-    """Run one shipped unit: ``payload`` is ``cloudpickle.dumps((profile, fn, args, limits, stage, label))``
-    (``limits``: the sending process's explicit unit budget, :func:`verimono.execution.timeouts.explicit_budget`, and its
-    calibration, the unit of the profile's budgets — :func:`_limits` — applied here too, so a worker's budgets
-    are the run's); the answer is ``cloudpickle.dumps(("ok", report))`` or ``("error", status, message,
+    """Run one shipped unit: ``payload`` is ``cloudpickle.dumps((config, fn, args, limits, stage, label))``
+    (``config``: the run configuration, :mod:`verimono.execution.config` — profile, explicit budget, seed —
+    under which the unit runs here; ``limits``: the sending process's calibration, the unit of the profile's
+    budgets — :func:`_limits` — applied here too, so a worker's budgets are the run's); the answer is ``cloudpickle.dumps(("ok", report))`` or ``("error", status, message,
     exception type, traceback, seconds)`` (the exception judged here, :func:`raised`) — never an exception, so a unit's own error is told apart from the worker's death.  (A
     ``process:N`` worker whose unit blocks in native code answers ``("hang", report)`` instead and exits:
     :func:`_process_worker`.)"""
@@ -141,11 +155,11 @@ def run_payload(payload: bytes) -> bytes:
 
     start = time.perf_counter()
     try:
-        profile, fn, args, limits, stage, label = cloudpickle.loads(payload)
-        _prepare_worker(profile)
+        cfg, fn, args, limits, stage, label = cloudpickle.loads(payload)
+        _prepare_worker(cfg)
         if limits.get("calibration"):
             set_calibration(limits["calibration"])
-        with watchdog.scope(stage=stage, label=label), budget(limits.get("budget")):
+        with watchdog.scope(stage=stage, label=label), _config.using(cfg):
             out = fn(*args)
         if not isinstance(out, Report):
             raise TypeError(f"a unit returned {type(out).__name__}, expected a verimono.Report")
@@ -233,16 +247,16 @@ def _process_worker(conn: Any) -> None:
 
 
 def _limits() -> dict[str, float | None]:
-    """What bounds a unit wherever it runs: this process's explicit unit budget (``--timeout``) and its
-    calibration (the unit of the profile's budgets), so a worker's budgets are the run's."""
-    return {"budget": explicit_budget(), "calibration": calibration()}
+    """What a worker needs besides the run configuration to bound a unit as this process would: this
+    process's calibration (the unit of the profile's budgets)."""
+    return {"calibration": calibration()}
 
 
-def _ship(unit: Unit, profile: str | None) -> bytes:
+def _ship(unit: Unit, profile: RunConfig | str | None) -> bytes:
     import cloudpickle
 
     _register_targets_by_value()
-    return cloudpickle.dumps((profile, unit.fn, unit.args, _limits(), unit.stage, unit.label))
+    return cloudpickle.dumps((config_for(profile), unit.fn, unit.args, _limits(), unit.stage, unit.label))
 
 
 def _register_targets_by_value() -> None:
@@ -313,7 +327,11 @@ class SerialRunner:
 
     spec = "serial"
 
-    def map(self, units: Sequence[Unit], profile: str | None, progress: Progress) -> list[Report]:
+    def map(self, units: Sequence[Unit], profile: RunConfig | str | None, progress: Progress) -> list[Report]:
+        with _config.using(config_for(profile)):
+            return self._map(units, progress)
+
+    def _map(self, units: Sequence[Unit], progress: Progress) -> list[Report]:
         out = []
         for i, u in enumerate(units):
             progress(i, len(units), u.label)
@@ -410,7 +428,7 @@ class ProcessRunner:
             proc.join()
         conn.close()
 
-    def map(self, units: Sequence[Unit], profile: str | None, progress: Progress) -> list[Report]:
+    def map(self, units: Sequence[Unit], profile: RunConfig | str | None, progress: Progress) -> list[Report]:
         results: list[Report | None] = [None] * len(units)
         pending = deque(range(len(units)))
         busy: dict[Any, tuple[tuple[Any, Any], int, float]] = {}   # conn -> (worker, unit index, start)
@@ -538,7 +556,7 @@ class DaskRunner:
         except Exception:  # pragma: no cover
             return 1
 
-    def map(self, units: Sequence[Unit], profile: str | None, progress: Progress) -> list[Report]:
+    def map(self, units: Sequence[Unit], profile: RunConfig | str | None, progress: Progress) -> list[Report]:
         from distributed import wait as dwait
 
         results: list[Report | None] = [None] * len(units)

@@ -1,9 +1,9 @@
 """Time budgets for units of work: a resolvent or stepper that never returns must not hang a run.
 
-A *unit* is one law on one operator, or one check of one stepper.  Its budget is, in order: the innermost
-:func:`budget` block, in seconds (``verimono run/check --timeout S`` opens one around the whole run, and the
-run's worker processes apply it too; ``inf``: no limit), else
-the active profile's ``unit_budget`` (:mod:`verimono.execution.profiles`), stated in *calibration units*: multiples of
+A *unit* is one law on one operator, or one check of one stepper.  Its budget is the run configuration's
+(:mod:`verimono.execution.config`, chosen at the entry point and shipped to the run's worker processes): its
+explicit seconds (``verimono run/check --timeout S``, or a :func:`budget` block; ``inf``: no limit), else its
+profile's ``unit_budget`` (:mod:`verimono.execution.profiles`), stated in *calibration units*: multiples of
 :func:`verimono.execution.calibration.calibrate`, a fixed NumPy-and-Python workload.  In seconds that is ``units x`` the
 calibration measured in this process (:func:`calibration`: measured once, best of 3, about 0.2 s, then
 cached; ``verimono run`` supplies the one it measures at its start), so a slower or busier machine — where
@@ -43,12 +43,12 @@ from typing import Callable, Iterator
 
 from ..core.errors import InvalidCheckArgument, UnitTimeout
 from . import calibration as _calibration
-from .profiles import Profile, UnknownProfile, active_profile, get_profile
+from . import config as _config
+from .profiles import Profile, get_profile
 from ..records.results import FAILED, UNDECIDED
 from ..records.verdicts import new_record
 from . import watchdog
 
-_OVERRIDE: list[float | None] = []
 #: ``details["undecided_reason"]`` of a law stopped by its budget after samples that all held
 TIME_BUDGET_REASON = "time budget"
 #: a call still running when its unit's budget ran out, after this many times the slowest evaluation of the same
@@ -81,18 +81,16 @@ def unlimited(seconds: float | None) -> bool:
 @contextmanager
 def budget(seconds: float | None) -> Iterator[None]:
     """Within the block, every unit's budget is ``seconds`` (``None``: back to the profile default;
-    ``math.inf``: no limit, as ``--timeout inf``)."""
-    _OVERRIDE.append(_positive(seconds))
-    try:
+    ``math.inf``: no limit, as ``--timeout inf``): the run configuration's ``budget``
+    (:func:`verimono.execution.config.using`)."""
+    with _config.using(budget=_positive(seconds)):
         yield
-    finally:
-        _OVERRIDE.pop()
 
 
 def explicit_budget() -> float | None:
-    """The seconds of the innermost :func:`budget` block, ``None`` outside one (or in a ``budget(None)``): what a
-    worker process must apply to run a unit as this process would (:mod:`verimono.execution.executors`)."""
-    return _OVERRIDE[-1] if _OVERRIDE else None
+    """The explicit seconds per unit of the run configuration (:func:`budget`, ``--timeout``), ``None`` when
+    the profile's budget applies."""
+    return _config.current().budget
 
 
 def calibration() -> float:
@@ -107,18 +105,17 @@ def in_seconds(units: float) -> float:
 
 
 def _profile() -> Profile | None:
-    try:
-        return get_profile(active_profile())
-    except UnknownProfile:
-        return None
+    """The effort of the run configuration's profile (``None``: a user's own hypothesis profile)."""
+    return _config.current().effort
 
 
 def budget_source() -> dict[str, object]:
     """Where the budget of a unit started now comes from: ``{"seconds": S, "source": "explicit"}`` inside a
     :func:`budget` block; else ``{"seconds": S, "source": "profile <name>", "units": U, "calibration": C}``
     with ``S = U x C``; ``{"seconds": None, ...}`` when there is none (an unknown profile)."""
-    if _OVERRIDE and _OVERRIDE[-1] is not None:
-        return {"seconds": _OVERRIDE[-1], "source": "explicit"}
+    explicit = explicit_budget()
+    if explicit is not None:
+        return {"seconds": explicit, "source": "explicit"}
     profile = _profile()
     if profile is None:
         return {"seconds": None, "source": "none"}
@@ -130,8 +127,9 @@ def budget_source() -> dict[str, object]:
 def current_budget() -> float | None:
     """Seconds a unit started now may take: the innermost :func:`budget` (explicit seconds), else the active
     profile's ``unit_budget`` calibration units x :func:`calibration`; ``None`` for an unknown profile."""
-    if _OVERRIDE and _OVERRIDE[-1] is not None:
-        return _OVERRIDE[-1]
+    explicit = explicit_budget()
+    if explicit is not None:
+        return explicit
     profile = _profile()
     return None if profile is None else in_seconds(profile.unit_budget)
 
@@ -140,7 +138,7 @@ def stage_budget(stage: str, profile: str | Profile | None = None) -> float | No
     """Seconds stage ``stage`` may take at ``profile`` (default: the active one): its budget in calibration
     units (:data:`verimono.execution.profiles.STAGE_BUDGETS` x the profile's ``stage_budget_scale``) x
     :func:`calibration`; ``None`` when no budget is stated for it."""
-    p = profile if isinstance(profile, Profile) else get_profile(profile or active_profile())
+    p = profile if isinstance(profile, Profile) else get_profile(profile or _config.current().profile)
     units = p.stage_budget_units(stage)
     return None if units is None else in_seconds(units)
 
