@@ -365,18 +365,23 @@ def test_an_operator_law_out_of_budget_after_samples_that_held_is_undecided():
     op = vm.operator_from_resolvent(slow, 2, name="slow")
     with timeouts.budget(0.4):
         rec = run_law("resolvent_nonexpansive", op, seed=0, examples=500)
+    # undecided whatever the load: what was evaluated held and no call in flight had run long — on a busy machine
+    # the harness may spend the whole budget before the first sample (then no call of the subject was running),
+    # which was recorded as failed before ("0 samples evaluated before"; 2 runs in 3 under `stress`)
     assert rec.status == UNDECIDED and rec.details["undecided_reason"] == "time budget", rec
-    assert "all of which held" in rec.message
+    if rec.details["evaluations"]:
+        assert "all of which held" in rec.message
+    else:
+        assert "before any sample was evaluated" in rec.message
 
-    def hangs_later(x, lam, t):                      # a few samples hold, then a call never returns
-        x = np.asarray(x, dtype=float)
-        while len(seen) >= 20:
-            pass
-        seen.append(1)
-        return x / (1.0 + lam)
+    def hangs_later(x, lam, t):                      # a few samples hold, then a call never returns (it sleeps: the
+        seen.append(1)                               # test takes no CPU from a busy machine)
+        if len(seen) > 20:
+            time.sleep(600)
+        return np.asarray(x, dtype=float) / (1.0 + lam)
 
     seen: list[int] = []
     op = vm.operator_from_resolvent(hangs_later, 2, name="hangs later")
-    with timeouts.budget(1.0):
-        rec = run_law("resolvent_nonexpansive", op, seed=0, examples=500)
+    with timeouts.budget(1.5):                       # in flight > half the budget and 20x any sample, even when busy
+        rec = run_law("resolvent_nonexpansive", op, seed=0, examples=50)
     assert rec.status == "failed" and "does not return" in rec.message and rec.details["evaluations"] >= 2, rec
