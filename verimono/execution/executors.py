@@ -301,11 +301,12 @@ def unpicklable(units: Sequence[Unit], indices: list[int], why: list[str], forke
     failed its stage before, with ``--executor serial`` passing it).  ``forked``: they run in worker
     processes forked for them, else in this process."""
     if indices:
-        where = ("each in a worker process forked for it" if forked else
-                 "in this process, one after the other (forking is not safe here)")
+        one = len(indices) == 1
+        where = (("it runs" if one else "each runs") + " in a worker process forked for it" if forked else
+                 ("it runs" if one else "they run") + " in this process (forking is not safe here)")
         names = ", ".join(units[i].label for i in indices[:3]) + (", ..." if len(indices) > 3 else "")
-        print(f"verimono: {len(indices)} unit(s) of {units[indices[0]].stage} ({names}) cannot be sent to a worker "
-              f"process ({why[0]}): they run {where}", file=sys.stderr)
+        print(f"verimono: {len(indices)} unit{'' if one else 's'} of {units[indices[0]].stage} ({names}) cannot be "
+              f"sent to a worker process ({why[0]}): {where}", file=sys.stderr)
     return list(indices)
 
 
