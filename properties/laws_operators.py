@@ -21,7 +21,8 @@ from verimono import NormalCone, Shifted
 from verimono import strategies as vs
 from verimono.checks.operator_battery import LAWS, operator_checks
 from verimono.checks.samples import law_samples
-from verimono.execution.profiles import active_profile, get_profile
+from verimono.execution.config import current as current_config
+from verimono.execution.profiles import get_profile
 from verimono.records.results import FAILED
 from verimono.testing import describe, parametrize_with_checks
 
@@ -29,7 +30,7 @@ T = 1.0
 #: the catalog: every operator class, static and time-dependent, shifted, normal cones of every set type
 CATALOG = vs.catalog(2) + vs.catalog(3)[:3]
 #: hypothesis examples per law inside each catalog case (the profile's per-law effort)
-LAW_EXAMPLES = max(5, get_profile(active_profile()).law_examples // 2)
+LAW_EXAMPLES = max(5, (current_config().effort or get_profile("dev")).law_examples // 2)
 
 
 @parametrize_with_checks(CATALOG, min_checks=len(CATALOG) * len(LAWS), examples=LAW_EXAMPLES)

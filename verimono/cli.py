@@ -62,7 +62,9 @@ from typing import Any, Callable
 
 from .core.claims import SCHEMES, claim_of, with_claim
 from .core.errors import BadTarget, InvalidCheckArgument, NothingToResume, OutputNotWritable, SchemaError, VerimonoError
-from .execution.profiles import PROFILES, active_profile
+from .execution.config import RunConfig, from_environment
+from .execution.config import using as using_config
+from .execution.profiles import PROFILES
 from .run.progress import Progress
 from .records.results import FAILED, SKIPPED, Report
 from .run.execute import (EXIT_FAILED, EXIT_OK, EXIT_UNDECIDED, execute, exit_status, interruptible, merge_resumed)
@@ -104,6 +106,24 @@ def _load_problems(spec: str) -> list[Any]:
                         f"{type(obj).__name__} (build one with verimono.Problem(...) or "
                         "verimono.manufactured_problem(...))")
     return [with_origin(p, spec) for p in found]
+
+
+def resolve_profile(args: argparse.Namespace) -> None:
+    """``--profile``, or the environment's default when it was left out (:func:`verimono.execution.config.
+    from_environment`; ``dev`` when ``$HYPOTHESIS_PROFILE`` names a profile of the user's own): the one choice
+    of the run, recorded with where it came from (``args.profile_source``)."""
+    if getattr(args, "profile", None) is not None:
+        args.profile_source = "--profile"
+        return
+    default = from_environment()
+    known = default.profile in PROFILES
+    args.profile, args.profile_source = (default.profile, default.source) if known else ("dev", "default")
+
+
+def run_config(args: argparse.Namespace) -> RunConfig:
+    """The run configuration the options choose: profile, explicit budget (``--timeout``), seed, executor."""
+    return RunConfig(profile=args.profile, budget=args.timeout, seed=args.seed, executor=getattr(args, "executor", None),
+                     source=getattr(args, "profile_source", "--profile"))
 
 
 def _executor_options(args: argparse.Namespace) -> dict[str, Any]:
@@ -237,8 +257,6 @@ def _finish(report: Report, out: Path, baseline: Report | None, run_id: str | No
 def _cmd_run(args: argparse.Namespace) -> int:
     from .records.atomic import ensure_writable_dir, in_progress
     from .records.results import load
-    from .execution.timeouts import budget
-
     out = ensure_writable_dir(args.out)           # before any work: a run must not be lost at the end
     baseline = _baseline_for(args)
     previous, stages = None, args.stage
@@ -270,7 +288,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     run_id = _start(out, "run", resumes=None if previous is None else previous.meta.get("run_id"))
 
     def run(on_done):
-        with budget(args.timeout):
+        with using_config(run_config(args)):
             return execute(command="run", profile_name=args.profile, stages=stages, context=ctx,
                            progress=Progress(), on_done=on_done, **_executor_options(args))
 
@@ -300,7 +318,6 @@ def _cmd_check(args: argparse.Namespace) -> int:
     else:
         raise BadTarget(f"{args.target} is a problem: `verimono check` takes an operator or a stepper")
     from .records.atomic import ensure_writable_dir
-    from .execution.timeouts import budget
 
     out = ensure_writable_dir(args.out)           # before any work
     baseline = _baseline_for(args)                # a baseline that cannot be read: exit 2 before the work
@@ -312,7 +329,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
     run_id = _start(out, "check")
 
     def run(on_done):
-        with budget(args.timeout):
+        with using_config(run_config(args)):
             return execute(command="check", profile_name=args.profile, stages=stages, context=ctx,
                            target=args.target, progress=Progress(), on_done=on_done, **_executor_options(args))
 
@@ -378,10 +395,9 @@ def _cmd_baseline(args: argparse.Namespace) -> int:
             raise NothingToResume(f"{args.from_results} is an interrupted run (marked incomplete): finish it "
                                   "with `verimono run --resume` before recording it as a baseline")
     else:
-        from .execution.timeouts import budget
         from .execution.watchdog import on_hang
 
-        with budget(args.timeout), on_hang(_baseline_hang):
+        with using_config(run_config(args)), on_hang(_baseline_hang):
             report = execute(command="run", profile_name=args.profile, stages=args.stage, context=_context(args),
                              progress=Progress(), **_executor_options(args))
     report.trajectories = []  # plot samples only: the gate never reads them, and they are half the size
@@ -458,8 +474,10 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
 
     def run_options(p: argparse.ArgumentParser) -> None:
-        p.add_argument("--profile", choices=PROFILES, default=active_profile() if active_profile() in PROFILES
-                       else "dev", help="effort and hypothesis profile (default: ci when $CI is set, else dev)")
+        p.add_argument("--profile", choices=PROFILES, default=None,
+                       help="effort and hypothesis profile: the examples per law, the scale sweep and the time budget "
+                            "of every unit (default: $HYPOTHESIS_PROFILE when it names one of these, else ci when "
+                            "$CI is set, else dev)")
         p.add_argument("--stage", action="append", choices=list(STAGES), metavar="NAME",
                        help="run only this stage (repeatable); stages: " + ", ".join(STAGES))
         p.add_argument("--seed", type=_seed, default=None, help="seed for the randomized batteries")
@@ -567,6 +585,8 @@ def main(argv: list[str] | None = None) -> int:
                 connect(pending.forked)
         try:
             args = build_parser().parse_args(argv)
+            if hasattr(args, "profile"):
+                resolve_profile(args)
             args.argv = given                          # the command as given (advice after an interrupt)
             args.calibration = pending
             func: Callable[[argparse.Namespace], int] = args.func

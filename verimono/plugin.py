@@ -50,16 +50,25 @@ def pytest_addoption(parser: pytest.Parser) -> None:
 
 
 def _load_profile(config: pytest.Config) -> str | None:
+    """The session's profile — ``--hypothesis-profile`` when given, else the environment's default
+    (:func:`verimono.execution.config.from_environment`) — loaded into hypothesis and installed as the
+    session's run configuration (:func:`verimono.execution.config.install`), which the checks' search and
+    budgets read."""
+    from .execution.config import RunConfig, from_environment, install
     from .execution.profiles import load_hypothesis_profile, register_hypothesis_profiles
 
     register_hypothesis_profiles()
     explicit = config.getoption("hypothesis_profile", default=None)
     if explicit:
+        install(RunConfig(profile=explicit, source="--hypothesis-profile"))
         return explicit
+    default = from_environment()
     try:
-        return load_hypothesis_profile()
+        name = load_hypothesis_profile(default.profile)
     except Exception as exc:  # an unknown $HYPOTHESIS_PROFILE is the user's error: say so
         raise pytest.UsageError(f"verimono: {exc}") from None
+    install(default)
+    return name
 
 
 def pytest_configure(config: pytest.Config) -> None:
@@ -176,12 +185,12 @@ class _Collector:
     def _receive(self, report: pytest.TestReport) -> None:
         """Records of a test that ran elsewhere (an xdist worker), carried by its call report."""
         from .records.results import CheckResult, to_jsonable
-        from .records.schema import record_fields, study_from_dict
+        from .records.schema import study_from_dict
 
         data = json.loads(getattr(report, self.ATTR))
         self.nodeid = report.nodeid
         try:
-            self.add(Report([CheckResult(**record_fields(d, i)) for i, d in enumerate(data["results"])],
+            self.add(Report([CheckResult.from_dict(d) for d in data["results"]],
                             [study_from_dict(s, i) for i, s in enumerate(data["studies"])],
                             trajectories=to_jsonable(data["trajectories"])))
         finally:

@@ -53,7 +53,7 @@ import pytest
 from .checks.core import laws_of
 from .checks.core import subject_name as core_subject_name
 from .checks.subjects import kind_of
-from .execution.profiles import active_profile
+from .execution.config import current as current_config
 from .execution.profiles import load_hypothesis_profile as _load
 from .execution.profiles import register_hypothesis_profiles as _register
 from .records.results import FAILED, SKIPPED, UNDECIDED, CheckResult, Report, to_jsonable
@@ -74,9 +74,10 @@ def register_hypothesis_profiles() -> None:
 
 
 def load_hypothesis_profile(name: str | None = None) -> str:
-    """Register the profiles and load ``name`` (default: ``$HYPOTHESIS_PROFILE``, else ``ci`` when ``$CI``
-    is set, else ``dev``); returns the name loaded."""
-    return _load(name)
+    """Register the profiles and load ``name`` (default: the run configuration's profile,
+    :func:`verimono.execution.config.current` — the pytest plugin's, else ``$HYPOTHESIS_PROFILE``, else ``ci``
+    when ``$CI`` is set, else ``dev``); returns the name loaded."""
+    return _load(name or current_config().profile)
 
 
 # -- subjects and their checks ----------------------------------------------------------------------
@@ -213,7 +214,8 @@ def parametrize_with_checks(subjects: Iterable[Any], expected_failed_checks: Map
     if problems is not None:
         problems = list(problems)
     if seed is None:
-        seed = 0 if active_profile() == "ci" else None
+        effort = current_config().effort    # the run configuration's profile (the plugin's, or the environment's)
+        seed = 0 if effort is not None and effort.derandomize else None
     cases, used, seen_ids = [], set(), Counter()
     all_keys: set[str] = set()
     for subject in subjects:

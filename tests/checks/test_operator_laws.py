@@ -182,21 +182,27 @@ def test_laws_on_points_closer_than_the_square_root_of_the_smallest_double():
 
 
 def test_default_effort_follows_the_profile(monkeypatch):
-    """examples=None: the active profile's ``law_examples`` (dev/ci/thorough) is the effort, recorded in the
-    record's details and the report's meta; an explicit ``examples`` still wins."""
+    """examples=None: the run configuration's profile's ``law_examples`` (dev/ci/thorough) is the effort, and
+    its sweep the sweep, recorded in the record's details and the report's meta; an explicit ``examples``
+    still wins.  The API's ``profile=`` chooses it for one call; the environment does not overrule it."""
+    from verimono.checks.sweep import sweep_count
+    from verimono.execution.config import using
     from verimono.execution.profiles import get_profile
 
     op = operator_from_resolvent(lambda x, lam, t: np.asarray(x) / (1.0 + lam), 1, name="scaled")
+    monkeypatch.setenv("HYPOTHESIS_PROFILE", "ci")
     for name in ("dev", "thorough"):
-        monkeypatch.setenv("HYPOTHESIS_PROFILE", name)
-        r = run_law("resolvent_nonexpansive", op, seed=0)
+        with using(profile=name):
+            r = run_law("resolvent_nonexpansive", op, seed=0)
         assert r.details["examples"] == get_profile(name).law_examples, r.details
+        assert r.details["sweep"] == sweep_count(name, "resolvent_nonexpansive")
         assert r.details["profile"] == name
-    monkeypatch.setenv("HYPOTHESIS_PROFILE", "dev")
-    rep = check_operator(op, seed=0)
+    rep = check_operator(op, seed=0, profile="dev")
     assert rep.meta["examples"] == get_profile("dev").law_examples
     assert all(r.details["examples"] == get_profile("dev").law_examples for r in rep)
     assert run_law("resolvent_nonexpansive", op, seed=0, examples=7).details["examples"] == 7
+    with pytest.raises(vm.UnknownProfile, match="thorough"):
+        check_operator(op, seed=0, profile="fast")
 
 
 def _rejecting(contains_result=False):

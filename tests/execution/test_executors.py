@@ -21,7 +21,8 @@ RUN = ["run", "--profile", "ci", "--stage", "convergence", "--stage", "assumptio
 #: what differs between two runs of the same battery: timings (seconds, or when the document was written),
 #: the run id both output files carry, and where the units ran (``meta.executor``)
 TIMING_KEYS = {"duration", "timings", "calibration", "calibrations", "created", "run_id", "executor",
-               "cpu_waiting", "foreign_cpu", "loadavg"}   # how busy the machine was during each stage
+               "cpu_waiting", "foreign_cpu", "loadavg",   # how busy the machine was during each stage
+               "unit_budget"}                             # the unit budget in seconds: units x the calibration
 
 STEPPERS = '''
 import multiprocessing, os, signal, time
@@ -159,6 +160,33 @@ def test_a_unit_that_raises_is_one_failed_record_in_place():
     assert reports[1][0].status == "failed" and "ZeroDivisionError: b divided by zero" in reports[1][0].message
     assert "traceback" in reports[1][0].details
     assert seen[0] == (0, 3, "a") and seen[-1] == (3, 3, "")
+
+
+def _unverified(name):
+    from verimono.core.errors import UnverifiedSolution
+
+    raise UnverifiedSolution(f"{name}: the LCP back-ends gave no verified answer")
+
+
+@pytest.mark.parametrize("where", ["serial", "worker"])
+def test_a_unit_is_judged_by_the_one_exception_policy(where):
+    """What a unit raised means what it means in a law (:func:`verimono.checks.core.classify`): a limit of
+    verimono's own solvers is undecided, never a failure of the subject; another exception is failed.  A unit
+    turned every exception into *failed* before.  ``worker``: the code a worker process runs on a shipped
+    unit, in this process."""
+    from verimono.execution.executors import _decode_answer, _ship, run_payload
+
+    units = [Unit("s", "a", _unverified, ("a",)), Unit("s", "b", _boom, ("b",)), Unit("s", "c", _ok, ("c",))]
+    if where == "serial":
+        reports = SerialRunner().map(units, None, lambda *a: None)
+    else:
+        reports = [_decode_answer(u, run_payload(_ship(u, None)))[0] for u in units]
+    (a,), (b,), (c,) = (rep.results for rep in reports)
+    assert (a.key, a.status) == ("unit[s: a]", "undecided") and "no verified answer" in a.message, a
+    assert a.details["exception"] == "UnverifiedSolution"
+    assert (b.key, b.status) == ("unit[s: b]", "failed") and "ZeroDivisionError: b divided by zero" in b.message
+    assert "traceback" in b.details
+    assert (c.key, c.status) == ("law[c]", "passed")
 
 
 @pytest.mark.parametrize("spec", ["process:two", "threads", "process:0"])
@@ -334,3 +362,52 @@ def test_units_start_costliest_first_and_come_back_in_their_order():
     reports = ctx.run_units(get_profile("ci"), units, costs=[0.1, 3.0, 1.0])
     assert started == ["b", "c", "a"]
     assert [r.key for rep in reports for r in rep] == ["law[a]", "law[b]", "law[c]"]
+
+
+# -- what cannot be pickled runs where nothing is pickled -------------------------------------------------
+
+LOCKED = '''
+import ctypes, ctypes.util, os, threading
+import numpy as np
+import verimono as vm
+
+LOCK = threading.Lock()                         # a module that cannot be pickled: a lock, and a C library
+LIBM = ctypes.CDLL(ctypes.util.find_library("m"))
+PIDS, SEEN = os.environ["VERIMONO_TEST_PIDS"], set()
+
+
+def shrink(x, lam, t):
+    if os.getpid() not in SEEN:                 # where the battery ran
+        SEEN.add(os.getpid())
+        with open(PIDS, "a") as f:
+            f.write(f"{os.getpid()}\\n")
+    with LOCK:
+        return np.asarray(x, dtype=float) / (1.0 + lam)
+
+
+op = vm.operator_from_resolvent(shrink, 1, name="locked shrink")
+'''
+
+
+@pytest.mark.parametrize("method", ["fork", pytest.param("spawn", marks=pytest.mark.slow)])
+def test_a_subject_that_cannot_be_pickled_runs_where_nothing_is_pickled(method, tmp_path, monkeypatch, capsys):
+    """A module holding a ``threading.Lock`` and a ``ctypes`` library under a worker executor: the stage
+    FAILED before ("cannot pickle '_thread.lock' object") where ``--executor serial`` passes it.  Now the unit
+    runs in a worker forked for it (where forking is safe) or in this process, with one line saying so."""
+    (tmp_path / "locked.py").write_text(textwrap.dedent(LOCKED))
+    pids = tmp_path / "pids"
+    monkeypatch.setenv("VERIMONO_TEST_PIDS", str(pids))
+    monkeypatch.setenv("VERIMONO_START_METHOD", method)
+    code = main(["check", f"{tmp_path / 'locked.py'}:op", "--executor", "process:2", "--profile", "dev",
+                 "--seed", "0", "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    doc = json.loads((tmp_path / "out" / "results.json").read_text())
+    assert code == 0 and not [r for r in doc["results"] if r["status"] == "failed"], doc["results"]
+    assert sum(r["status"] == "passed" for r in doc["results"]) >= 5
+    lines = [ln for ln in err.splitlines() if "cannot be sent to a worker process" in ln]
+    assert len(lines) == 1 and "cannot pickle" in lines[0], err
+    ran_in = {int(p) for p in pids.read_text().split()}
+    if method == "fork":
+        assert "forked for it" in lines[0] and os.getpid() not in ran_in and len(ran_in) == 1
+    else:
+        assert "in this process" in lines[0] and ran_in == {os.getpid()}

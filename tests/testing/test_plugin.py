@@ -240,3 +240,22 @@ print(code, "hypothesis" in sys.modules)
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
     assert out.returncode == 0, out.stderr
     assert out.stdout.split()[-2:] == ["0", "False"]
+
+
+def test_the_plugin_installs_the_sessions_profile_as_the_run_configuration(monkeypatch):
+    """``pytest --hypothesis-profile thorough``: the checks of the session search at thorough's effort (the
+    search read ``$HYPOTHESIS_PROFILE``/``$CI`` before, whatever profile hypothesis had loaded)."""
+    from verimono import plugin
+    from verimono.checks.search import default_examples
+    from verimono.execution import config as run_config
+
+    class Config:
+        def getoption(self, name, default=None):
+            return "thorough" if name == "hypothesis_profile" else default
+
+    monkeypatch.setattr(run_config, "_INSTALLED", [])
+    monkeypatch.setenv("HYPOTHESIS_PROFILE", "dev")
+    assert plugin._load_profile(Config()) == "thorough"
+    cfg = run_config.current()
+    assert (cfg.profile, cfg.source) == ("thorough", "--hypothesis-profile")
+    assert default_examples() == (200, "thorough")

@@ -18,9 +18,12 @@ else, once:
 * **requirements** (:class:`Member`, :class:`Claimed`, :class:`Holds`) are judged before anything runs,
   so a law that does not apply is a skip whose reason comes from the declaration;
 * **the exception policy** (:func:`classify`) maps what an evaluation raised to a status, for a whole
-  record (:func:`run`), for one sample of a search, and for a stage of a run alike;
+  record (:func:`run`), for one sample of a search, for a unit of work and for a stage of a run alike;
 * **the record** (:func:`record`) of an outcome: passed when its ratio is within its bound, failed with
-  the counterexample otherwise, never passed on a non-finite ratio;
+  the counterexample otherwise, never passed on a non-finite ratio — made, as every record of verimono, by
+  the one record builder :func:`new_record`.  The builder and the policy are defined in
+  :mod:`verimono.records.verdicts` (the execution layer below the checks makes records too) and re-exported
+  here;
 * **the subject's name** (:func:`subject_name`), decided once whatever the status;
 * **the precision** a law judges its subject at (:func:`verimono.core.tolerances.judged_precision`): the
   coarsest dtype the subject returned or was given while the law ran, stated in the record
@@ -38,9 +41,10 @@ from typing import Any, Callable, Iterable
 
 from ..core.claims import Claim, claim_of
 from ..core.naming import subject_name
-from ..core.errors import (InvalidCheckArgument, NotApplicable, StageUnavailable, UnitTimeout, UnverifiedSolution)
+from ..core.errors import InvalidCheckArgument, NotApplicable
 from ..core.operators import provides
-from ..records.results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
+from ..records.results import FAILED, PASSED, SKIPPED, CheckResult
+from ..records.verdicts import classify, new_record, record_of_exception
 from ..core.tolerances import judged_precision
 
 SUBJECTS = ("operator", "stepper", "problem", "system", "estimator")
@@ -127,40 +131,8 @@ def stepper_subject(stepper: Any, problem: Any) -> str:
     return f"{subject_name(stepper)} on {problem if isinstance(problem, str) else subject_name(problem)}"
 
 
-# -- the one exception policy -----------------------------------------------------------------------
-
-def classify(exc: BaseException) -> tuple[str, str]:
-    """``(status, message)`` for an exception raised while a law was evaluated — the one policy of every
-    record, every sample of a search and every stage of a run:
-
-    * :class:`NotApplicable` (the law's hypotheses do not hold here) and :class:`StageUnavailable`:
-      skipped, with the reason;
-    * ``NotImplementedError`` (a member the subject lacks, met at run time): skipped;
-    * :class:`UnverifiedSolution` (verimono's own solvers gave no verified answer): undecided — a limit of
-      the harness is never a failure of the subject, and never a pass;
-    * :class:`UnitTimeout`: failed, naming the unit and its budget;
-    * anything else: a failure of the subject (it raised on a valid input), with the exception's type.
-
-    Misuse (:class:`InvalidCheckArgument`) is not classified: it propagates to the caller."""
-    if isinstance(exc, (NotApplicable, StageUnavailable)):
-        return SKIPPED, str(exc)
-    if isinstance(exc, NotImplementedError):
-        return SKIPPED, f"not available: {exc}"
-    if isinstance(exc, UnverifiedSolution):
-        return UNDECIDED, f"verimono's own solvers gave no verified answer: {exc}"
-    if isinstance(exc, UnitTimeout):
-        return FAILED, f"timed out: {exc}"
-    return FAILED, f"{type(exc).__name__}: {exc}"
-
-
-def record_of_exception(check: str, subject: str, exc: BaseException, **kw: Any) -> CheckResult:
-    """The record of a law whose evaluation raised ``exc`` (:func:`classify`)."""
-    status, message = classify(exc)
-    details = dict(kw.pop("details", None) or {})
-    if status != SKIPPED:
-        details.setdefault("exception", type(exc).__name__)
-    return CheckResult(check, subject, status, message=message, details=details, **kw)
-
+# -- the one exception policy and the one record builder ---------------------------------------------
+# (:mod:`verimono.records.verdicts`, below the execution layer, which makes records too: re-exported here)
 
 # -- requirements -----------------------------------------------------------------------------------
 
@@ -300,7 +272,7 @@ def run(decl: Law, subject: str, evaluate: Callable[[], Any], *, operator: Any =
     ctx = Context(operator=op, problem=problem, claim=None if stepper is None else claim_of(stepper))
     why = decl.unmet(ctx)
     if why:
-        rec = CheckResult(decl.name, subject, SKIPPED, message=why, seed=seed)
+        rec = new_record(decl.name, subject, SKIPPED, message=why, seed=seed)
     else:
         with judged_precision() as precision:
             try:
@@ -328,14 +300,14 @@ def record(name: str, subject: str, outcome: Outcome, **kw: Any) -> CheckResult:
     status = outcome.status or (FAILED if outcome.failed else PASSED)
     ratio = {} if outcome.worst is None else {"worst": outcome.worst, "bound": outcome.bound}
     if status != FAILED:
-        return CheckResult(name, subject, status, message=outcome.message, details=details,
-                           **(ratio if status == PASSED else {}), **kw)
+        return new_record(name, subject, status, message=outcome.message, details=details,
+                          **(ratio if status == PASSED else {}), **kw)
     counter = dict(outcome.counter)
     msg = counter.pop("message", "") or outcome.message or f"{name} violated"
-    return CheckResult(name, subject, FAILED, counterexample=counter or None, message=msg, details=details,
-                       **ratio, **kw)
+    return new_record(name, subject, FAILED, counterexample=counter or None, message=msg, details=details,
+                      **ratio, **kw)
 
 
-__all__ = ["Outcome", "Law", "law", "laws_of", "REGISTRY", "run", "record", "record_of_exception", "classify",
+__all__ = ["Outcome", "Law", "law", "laws_of", "REGISTRY", "run", "record", "record_of_exception", "classify", "new_record",
            "Member", "Claimed", "Holds", "Context", "provides", "NotApplicable", "PROXIMAL_CLAIM",
            "CONTRACTION_CLAIM", "SUBJECTS", "subject_name", "stepper_subject", "ratio", "worst_of"]

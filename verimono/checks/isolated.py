@@ -15,7 +15,7 @@ from __future__ import annotations
 from typing import Any, Callable, Sequence
 
 from ..execution.executors import Unit, make_runner, ship_by_value
-from ..execution.profiles import PROFILES, active_profile
+from ..execution.config import current as current_config
 from ..records.results import Report
 from ..execution.timeouts import run_unit
 
@@ -27,15 +27,14 @@ def isolating(executor: Any) -> bool:
 
 def run_isolated(executor: str, units: Sequence[Unit], subject: Any = None) -> list[Report]:
     """The reports of ``units`` run on ``executor`` (``"process:N"``), in their order; the workers are
-    stopped before it returns.  The explicit time budget of this process (:func:`verimono.execution.timeouts.budget`)
-    applies in the workers too.  ``subject``'s module, when it is the user's, travels by value
+    stopped before it returns.  The run configuration of this process (:mod:`verimono.execution.config`: its
+    profile, its explicit time budget) applies in the workers too.  ``subject``'s module, when it is the user's, travels by value
     (:func:`verimono.execution.executors.ship_by_value`: the workers need not import it)."""
     if subject is not None:
         ship_by_value(subject)
     runner = make_runner(executor)
-    profile = active_profile() if active_profile() in PROFILES else None
     try:
-        return runner.map(list(units), profile, _quiet)
+        return runner.map(list(units), current_config(), _quiet)
     finally:
         runner.close()
 

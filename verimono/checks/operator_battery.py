@@ -11,6 +11,7 @@ from typing import Any, Callable, Iterator
 
 from ..execution import watchdog
 from ..core.errors import InvalidCheckArgument
+from ..execution.config import chosen
 from ..execution.executors import Unit
 from ..records.results import Report
 from . import operator_laws, prox_laws  # noqa: F401 - the laws join the registry on import
@@ -36,12 +37,15 @@ def operator_checks(op: Any = None, *, seed: int | None = None, examples: int | 
 
 
 def check_operator(op: Any, *, seed: int | None = None, examples: int | None = None,
-                   horizon: float = 1.0, executor: str | None = None) -> Report:
+                   horizon: float = 1.0, executor: str | None = None, profile: str | None = None) -> Report:
     """Run every operator law on ``op`` and return the :class:`verimono.Report` of their records.
 
     ``seed`` makes the search reproducible (one fresh seed is drawn and recorded when ``None``);
-    ``examples`` is the effort per law (default: the active profile's ``law_examples``); times are sampled
-    in ``[0, horizon]``.  What is not an operator is refused before any law runs
+    ``examples`` is the effort per law (default: the profile's ``law_examples``); times are sampled
+    in ``[0, horizon]``.  ``profile`` (``"dev"``, ``"ci"``, ``"thorough"``) chooses the effort of this call —
+    examples per law, the scale sweep, the time budget of each law — as ``--profile`` does for ``verimono
+    check``; by default the current run configuration's (:mod:`verimono.execution.config`: the pytest
+    plugin's, else ``$HYPOTHESIS_PROFILE``, else ``ci`` when ``$CI`` is set, else ``dev``).  What is not an operator is refused before any law runs
     (:class:`verimono.InvalidCheckArgument`, naming the wrapper that makes one).
 
     Every call of the resolvent runs under the unit time budget (:mod:`verimono.execution.timeouts`).  A resolvent
@@ -50,6 +54,9 @@ def check_operator(op: Any, *, seed: int | None = None, examples: int | None = N
     root-cause probe learnt, :mod:`verimono.checks.isolated`), which such a call ends — the records of the
     laws finished before it and a failed record naming it.  In this process verimono never ends the
     interpreter on such a call: it warns once and waits for it to return (:mod:`verimono.execution.watchdog`)."""
+    if profile is not None:
+        with chosen(profile):
+            return check_operator(op, seed=seed, examples=examples, horizon=horizon, executor=executor)
     require_operator(op)
     seed = fresh_seed() if seed is None else valid_seed(seed)
     if examples is None:

@@ -21,12 +21,17 @@ the operator lacks stops the search (skipped), a limit of verimono's own solvers
 inconclusive (counted in ``details["harness_limited"]``), anything else fails the sample.  Inconclusive
 samples are counted and never pass: a record whose every sample was inconclusive is skipped, undecided
 when verimono's own solvers decided none.  The unit's time budget (:mod:`verimono.execution.timeouts`) bounds the
-whole search (in calibration units: a slower or busier machine gets more seconds): a search that runs out
-of time after samples that all held is undecided (time budget, ``k`` samples); an operator call that never
-returns fails — the first one, or one that ran :data:`verimono.execution.timeouts.HANG_MULTIPLE` x longer than every
-sample before it.  The root-cause probe before the search runs under the budget too
-(:func:`bounded_root_cause`): a resolvent that does not return within it is the root cause, probed once per
-operator, so a battery on a hanging operator costs one budget, not one per call.
+whole search (in calibration units: a slower or busier machine gets more seconds), judged by the one policy
+of a unit out of time (:func:`verimono.records.verdicts.timeout_verdict`): a search that runs out of time
+after samples that all held, or before any sample while no call of the operator was running, is undecided
+(time budget, ``k`` samples); an operator call that never returns fails — one that had run more than half
+the budget and :data:`~verimono.records.verdicts.HANG_MULTIPLE` x longer than every sample before it.  The
+budget's interrupt is raised only in the law's and the operator's code, never inside hypothesis's engine
+(:mod:`verimono.execution.interrupts`; each sample starts at a safe point), and what the engine itself raises
+— it gave up, or failed after an interrupt — is undecided (a limit of the harness), never failed.  The
+root-cause probe before the search runs under the budget too (:func:`bounded_root_cause`): a resolvent that
+does not return within it is the root cause, probed once per operator, so a battery on a hanging operator
+costs one budget, not one per call.
 """
 
 from __future__ import annotations
@@ -45,16 +50,17 @@ from hypothesis import HealthCheck, Phase, Verbosity, given, settings
 from ..core._reproducible import no_local_constants
 from .arguments import valid_horizon, valid_seed
 from ..core.errors import InvalidCheckArgument, UnitTimeout
-from ..execution.profiles import UnknownProfile, active_profile, get_profile
+from ..execution.config import current as current_config
 from ..records.results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
-from ..execution.timeouts import (HANG_MULTIPLE, TIME_BUDGET_REASON, current_budget, never_returned, note_progress,
-                        time_limit)
+from ..execution.timeouts import (checkpoint, current_budget, interrupted, interruptible, note_progress,
+                                  time_limit)
+from ..records.verdicts import timeout_verdict
 from .batches import prefetched
-from .core import REGISTRY, Law, Outcome, classify, law, run, subject_name
+from .core import REGISTRY, Law, Outcome, classify, law, new_record, run, subject_name
 from .samples import NUMPY_DIM, Sample, law_samples
 from .sweep import law_draws, shrink, sweep_count, sweep_samples
 
-#: examples per law when ``examples`` is not given and the active hypothesis profile is not one of
+#: examples per law when ``examples`` is not given and the run configuration's profile is not one of
 #: verimono's (a user's own); otherwise the profile's ``law_examples`` governs (:func:`default_examples`)
 DEFAULT_EXAMPLES = 50
 #: every law's ratio ``lhs / (rhs + slack)`` must not exceed this
@@ -78,13 +84,11 @@ def fresh_seed() -> int:
 
 
 def default_examples() -> tuple[int, str]:
-    """``(examples per law, profile)`` when ``examples`` is not given: the active profile's ``law_examples``
-    (``dev``/``ci``/``thorough``, :func:`verimono.execution.profiles.active_profile`), else ``DEFAULT_EXAMPLES``."""
-    name = active_profile()
-    try:
-        return get_profile(name).law_examples, name
-    except UnknownProfile:
-        return DEFAULT_EXAMPLES, name
+    """``(examples per law, profile)`` when ``examples`` is not given: the ``law_examples`` of the run
+    configuration's profile (``dev``/``ci``/``thorough``, :func:`verimono.execution.config.current`), else
+    ``DEFAULT_EXAMPLES`` (a user's own hypothesis profile)."""
+    cfg = current_config()
+    return (DEFAULT_EXAMPLES if cfg.effort is None else cfg.effort.law_examples), cfg.profile
 
 
 def positive_examples(examples: Any) -> int:
@@ -108,6 +112,8 @@ def evaluate_sample(decl: Law, op: Any, s: Sample) -> Outcome:
     except (InvalidCheckArgument, NotImplementedError):
         raise
     except Exception as exc:  # noqa: BLE001 - the core's policy decides
+        if interrupted():     # raised after the unit's budget interrupted the sample: the timeout's, not the sample's
+            raise
         status, message = classify(exc)
         if status == UNDECIDED:
             return Outcome.inconclusive_sample(message, {HARNESS_LIMIT: str(exc)})
@@ -149,6 +155,8 @@ def bounded_root_cause(op: Any, horizon: float = 1.0) -> str | None:
         with time_limit(current_budget(), f"the root-cause probe of {subject_name(op)}"):
             return root_cause(op, horizon)
     except UnitTimeout as exc:
+        if classify(exc)[0] != FAILED:    # the budget ran out, but not in a call that does not return
+            raise
         cause = f"the resolvent does not return within the time budget at x = 0, λ = 1 ({exc})"
     _SLOW.pop(id(op), None)
     _SLOW[id(op)] = (op, horizon, cause)
@@ -182,9 +190,13 @@ class _Search:
     slowest: float = 0.0
     violated: bool = False
 
+    @interruptible   # the law's and the subject's code: the unit's budget may stop it even under hypothesis
     def evaluate(self, s: Sample, climb: bool = False) -> None:
         """Evaluate one sample; :class:`_Violation` when it breaks the law (``climb``: inside hypothesis,
-        whose ``target`` then climbs toward large ratios)."""
+        whose ``target`` then climbs toward large ratios).  A safe point of the unit's budget first
+        (:func:`verimono.execution.timeouts.checkpoint`): an interrupt that waited for hypothesis's engine
+        to return stops the search here."""
+        checkpoint()
         start = self.in_flight = time.perf_counter()   # left set when the unit's budget interrupts the sample
         try:
             out = evaluate_sample(self.decl, self.op, s)
@@ -266,12 +278,13 @@ def _search(decl: Law, op: Any, seed: int, examples: int, horizon: float) -> tup
     except _Violation:
         pass
     except UnitTimeout as exc:
-        how["timed_out"] = str(exc)
-        how["in_flight"] = None if state.in_flight is None else time.perf_counter() - state.in_flight
+        _timed_out(how, exc, state)
     except hypothesis.errors.Flaky as exc:  # a failure that did not reproduce on replay
         how["flaky"] = f" (not reproducible on replay: {type(exc).__name__}; the operator is not deterministic)"
-    except (hypothesis.errors.HypothesisException, MemoryError, RecursionError) as exc:
-        # the search engine itself gave up (inputs it cannot draw, memory): a limit of the harness
+    except InvalidCheckArgument:
+        raise
+    except Exception as exc:  # noqa: BLE001 - what the search engine raised (a sample's exception never gets here)
+        # the search engine itself gave up (inputs it cannot draw, memory, its own state): a limit of the harness
         how["harness"] = f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"
     stopped = how["timed_out"] or how["harness"]
     if state.failure is None and drawn is not None:      # hypothesis did not meet the draw's violation
@@ -288,7 +301,7 @@ def _search(decl: Law, op: Any, seed: int, examples: int, horizon: float) -> tup
 def _sweep(state: _Search, seed: int, horizon: float) -> int:
     """The scale sweep after a search that found nothing; a violation is shrunk greedily into ``state``.
     Returns the number of sweep samples."""
-    swept = sweep_samples(state.op, seed, horizon, sweep_count(active_profile(), state.decl.name), Sample)
+    swept = sweep_samples(state.op, seed, horizon, sweep_count(current_config().profile, state.decl.name), Sample)
     found = state.first_violation(swept)
     if found is not None:
         state.shrunk_into(found[0], "sweep (shrunk greedily)")
@@ -305,35 +318,38 @@ def _replay(decl: Law, op: Any, sample: Sample | dict) -> tuple[_Search, dict]:
     except _Violation:
         pass
     except UnitTimeout as exc:
-        how["timed_out"] = str(exc)
+        _timed_out(how, exc, state)
     return state, how
+
+
+def _timed_out(how: dict, exc: UnitTimeout, state: _Search) -> None:
+    """What the search knows when its budget stopped it: the limit's text and evidence, and how long the
+    sample in flight had run (``None``: none was, the budget ran out in the harness)."""
+    how["timed_out"] = str(exc)
+    evidence = getattr(exc, "evidence", {})
+    stopped_at = evidence.get("stopped_at") or time.perf_counter()    # the interrupt, not the unwinding after it
+    how["evidence"] = {**evidence, "in_flight": None if state.in_flight is None else stopped_at - state.in_flight}
 
 
 def _verdict(state: _Search, how: dict, base: dict, details: dict, cex_extra: dict) -> CheckResult:
     """The record of a finished search (the statuses of the module docstring)."""
     runs = state.runs
     if how["timed_out"] and state.failure is None:
-        details.update(timeout=True)
-        in_flight = how.get("in_flight")
-        if never_returned(in_flight, state.slowest) and runs:    # the sample in flight: a call that does not return
-            details.update(in_flight=in_flight, slowest=state.slowest)
-            return CheckResult(status=FAILED, details=details, **base,
-                               message=f"timed out: {how['timed_out']}; the sample in flight ran {in_flight:.1f} s, "
-                                       f"more than {HANG_MULTIPLE:g}x the slowest of the {runs} samples before it "
-                                       f"({state.slowest:.3g} s): a call that does not return")
-        if runs and state.inconclusive < runs:
-            details["undecided_reason"] = TIME_BUDGET_REASON
-            return CheckResult(status=UNDECIDED, details=details, **base,
-                               message=f"time budget exhausted after {runs} samples, all of which held "
-                                       f"({how['timed_out']}): too few samples for a verdict")
-        return CheckResult(status=FAILED, details=details, **base,
-                           message=f"timed out: {how['timed_out']} ({runs} samples evaluated before)")
+        # the one policy of a unit out of time: undecided unless a violation was seen or the sample in flight
+        # is a call that does not return (0 samples and none in flight: the harness spent the budget)
+        evidence = how["evidence"]
+        status, message, extra = timeout_verdict(how["timed_out"], **{
+            **evidence, "evaluated": runs, "held": not state.violated, "slowest": state.slowest})
+        details.update(timeout=True, **extra)
+        if evidence.get("harness_error"):
+            details["harness_error"] = evidence["harness_error"]
+        return new_record(status=status, details=details, message=message, **base)
     if state.failure is None and how["harness"]:
-        return CheckResult(status=UNDECIDED, details=details, **base,
+        return new_record(status=UNDECIDED, details=details, **base,
                            message=f"the harness could not search this operator ({how['harness']}; {runs} samples "
                                    "evaluated before); a limitation of verimono, not a failure of the operator")
     if state.failure is None and state.unsupported is not None:
-        return CheckResult(status=SKIPPED, details=details, **base,
+        return new_record(status=SKIPPED, details=details, **base,
                            message=f"needs a member the operator lacks: {state.unsupported} ({runs} samples "
                                    "evaluated before)")
     if state.failure is not None:
@@ -343,18 +359,18 @@ def _verdict(state: _Search, how: dict, base: dict, details: dict, cex_extra: di
         if state.found_by:
             cex["found_by"] = state.found_by
         worst = out.ratio if state.worst is None else max(state.worst.ratio, out.ratio)
-        return CheckResult(status=FAILED, worst=worst, bound=BOUND, counterexample=cex, details=details, **base,
+        return new_record(status=FAILED, worst=worst, bound=BOUND, counterexample=cex, details=details, **base,
                            message=f"{out.what}: lhs {out.lhs:.6g} > rhs {out.rhs:.6g} + slack {out.slack:.3g} "
                                    f"at {s!r}{how['flaky']}")
     if runs == 0:        # nothing was evaluated: never a pass
-        return CheckResult(status=UNDECIDED, message="no sample was evaluated", details=details, **base)
+        return new_record(status=UNDECIDED, message="no sample was evaluated", details=details, **base)
     if state.harness_limited == runs:
-        return CheckResult(status=UNDECIDED, details=details, **base,
+        return new_record(status=UNDECIDED, details=details, **base,
                            message=f"verimono's own solvers decided none of the {runs} samples (e.g. "
                                    f"{state.inconclusive_what}); a limitation of verimono, not a failure of the "
                                    "operator")
     if state.inconclusive == runs:
-        return CheckResult(status=SKIPPED, details=details, **base,
+        return new_record(status=SKIPPED, details=details, **base,
                            message=f"all {runs} samples inconclusive (e.g. {state.inconclusive_what})")
     if state.worst is not None:
         details["worst_sample"] = state.worst_sample.to_dict()
@@ -363,7 +379,7 @@ def _verdict(state: _Search, how: dict, base: dict, details: dict, cex_extra: di
     counted = f"{runs} samples" + (f" ({state.inconclusive} inconclusive)" if state.inconclusive else "")
     if state.harness_limited:
         counted += f", {state.harness_limited} of them undecided by verimono's own solvers"
-    return CheckResult(status=PASSED, worst=None if state.worst is None else state.worst.ratio, bound=BOUND,
+    return new_record(status=PASSED, worst=None if state.worst is None else state.worst.ratio, bound=BOUND,
                        message=counted + (f"; {how['flaky']}" if how["flaky"] else ""), details=details, **base)
 
 
@@ -401,10 +417,10 @@ def run_law(decl: Law | str, op: Any, *, seed: int | None = None, examples: int 
         if cause is not None:
             why = {**details, "root_cause": cause}
             if decl.name == ROOT_LAW:
-                return CheckResult(status=FAILED, worst=math.inf, bound=BOUND, counterexample={"operator": repr(op)},
+                return new_record(status=FAILED, worst=math.inf, bound=BOUND, counterexample={"operator": repr(op)},
                                    message=f"root cause: {cause}; the other laws are not evaluated", details=why,
                                    **base)
-            return CheckResult(status=SKIPPED, details=why, **base,
+            return new_record(status=SKIPPED, details=why, **base,
                                message=f"not evaluated: {cause} (the root cause is recorded once, as {ROOT_LAW})")
         state, how = _search(decl, op, seed, examples, horizon) if sample is None else _replay(decl, op, sample)
         rec = _verdict(state, how, base, {**details, "evaluations": state.runs, "inconclusive": state.inconclusive,

@@ -21,6 +21,7 @@ from ..lcs.lcp import lcp_residual, solve_lcp
 from ..lcs.siconos import PACKAGED_DATA, read_lcp, siconos_root
 from ..lcs.siconos_cases import CASES, INFEASIBLE_LCPS, SICONOS_RTOL, simulate_case, state_error
 from ..records.results import FAILED, CheckResult, Report
+from ..records.verdicts import new_record
 from .core import Outcome, law, run
 
 
@@ -75,11 +76,11 @@ def check_siconos_lcps(data_dir: Path = PACKAGED_DATA) -> Report:
     try:
         root = siconos_root(data_dir)
     except FileNotFoundError as exc:
-        return Report([CheckResult("siconos_lcp", "LCP test files", FAILED, message=str(exc))])
+        return Report([new_record("siconos_lcp", "LCP test files", FAILED, message=str(exc))])
     paths = sorted((root / "lcp").glob("*.dat"))
     if not paths:
-        return Report([CheckResult("siconos_lcp", "LCP test files", FAILED,
-                                   message=f"no LCP test file (lcp/*.dat) in {root}")])
+        return Report([new_record("siconos_lcp", "LCP test files", FAILED,
+                                  message=f"no LCP test file (lcp/*.dat) in {root}")])
     return Report([check_lcp_file(path) for path in paths])
 
 

@@ -19,6 +19,7 @@ from ..records.results import CheckResult, Report
 from ..execution.timeouts import run_unit
 from . import bounds, limits, picard, trajectory_laws  # noqa: F401 - the laws join the registry on import
 from . import orders as _order_law  # noqa: F401 - convergence_order joins the registry on import
+from ..execution.config import chosen
 from ..execution.executors import Unit
 from .core import laws_of, stepper_subject
 from .isolated import isolating, run_check, run_isolated
@@ -92,7 +93,8 @@ def stepper_checks(stepper: Callable | None = None, problems: Iterable[Problem] 
 
 def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, *, scheme: str | None = None,
                   order: float | None = None, seed: int | None = None, executor: Any = None,
-                  laws: bool | Iterable[str] = True, generated: int = 4, orders: bool = True) -> Report:
+                  laws: bool | Iterable[str] = True, generated: int = 4, orders: bool = True,
+                  profile: str | None = None) -> Report:
     """Result records for ``stepper``: convergence orders on the references, then the trajectory laws.
 
     ``scheme``/``order`` state what the stepper claims (:class:`verimono.Stepper`; a bare callable
@@ -113,8 +115,14 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
     that blocks in native code (``os.system``, a C extension), which the budget's interrupt cannot stop: its
     worker ends, the check is a failed record naming the call, and the battery goes on.  In this process
     verimono never ends the interpreter on such a call: it warns once and waits for it to return
-    (:mod:`verimono.execution.watchdog`).
+    (:mod:`verimono.execution.watchdog`).  ``profile`` (``"dev"``, ``"ci"``, ``"thorough"``) chooses the time
+    budget of each check, as ``--profile`` does for ``verimono check``; by default the current run
+    configuration's (:mod:`verimono.execution.config`).
     """
+    if profile is not None:
+        with chosen(profile):
+            return check_stepper(stepper, problems, scheme=scheme, order=order, seed=seed, executor=executor,
+                                 laws=laws, generated=generated, orders=orders)
     require_stepper(stepper)
     if problems is not None:
         problems = list(problems)

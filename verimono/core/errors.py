@@ -118,7 +118,13 @@ class InvalidCheckArgument(VerimonoError, ValueError):
 
 
 class UnitTimeout(VerimonoError, TimeoutError):
-    """A unit of work (one law on one operator, one check of one stepper) exceeded its time budget."""
+    """A unit of work (one law on one operator, one check of one stepper) exceeded its time budget.
+
+    ``evidence`` (a dict, set by the limit that raised it and completed by its unit) is what the budget saw —
+    the budget, the seconds the call in flight had run, how many evaluations finished and whether they all
+    held — from which :func:`verimono.records.verdicts.classify` decides failed or undecided."""
+
+    evidence: dict = {}
 
 
 class OutputNotWritable(VerimonoError, OSError):

@@ -14,25 +14,34 @@ studies) mapped over an executor, their results merged in the units' own order.
   (``pip install "verimono[dask]"``; verimono must be importable on the workers).
 
 A unit is ``fn(*args) -> Report``, shipped with ``cloudpickle`` (closures, lambdas and a ``verimono check``
-target loaded from a file travel by value).  Each worker loads the run's hypothesis profile and pins BLAS
-to one thread, as ``verimono run`` does, so a unit's records do not depend on where it ran: under a
-derandomized profile the merged report equals the serial run's apart from timings.
+target loaded from a file travel by value), with the run configuration (:mod:`verimono.execution.config`:
+profile, explicit budget, seed) and the run's calibration.  Each worker runs the unit under that
+configuration, loads the run's hypothesis profile and pins BLAS to one thread, as ``verimono run`` does, so a
+unit's records do not depend on where it ran: under a derandomized profile the merged report equals the
+serial run's apart from timings.
 
-A unit never takes the run down with it: a unit that raises, whose worker dies, or that runs longer than
-``timeout`` seconds becomes one *failed* record ``unit[<stage>: <label>]`` naming it (:func:`unit_failure`);
-the records of every other unit are kept.  With ``process:N`` the unit a dying worker was running is known
+A unit that cannot be pickled (a module holding a ``threading.Lock``, a ``ctypes`` library) runs in a worker
+process forked for it, where nothing is pickled but its answer, or in this process where forking is not safe
+— one line on standard error says so; it is never a failed record.
+
+A unit never takes the run down with it: a unit that raises becomes one record ``unit[<stage>: <label>]``
+judged by the one exception policy (:func:`verimono.records.verdicts.classify`: a limit of verimono's own
+solvers is undecided, anything else the subject raised is failed), one whose worker dies or that runs longer
+than ``timeout`` seconds one *failed* record naming it (:func:`unit_failure`); the records of every other
+unit are kept.  With ``process:N`` the unit a dying worker was running is known
 exactly (each worker runs one unit at a time) and a fresh worker replaces it; on dask a unit that kills
 workers is reported once the scheduler gives up on it (``KilledWorker``, after its ``allowed-failures``).
 A ``process:N`` worker whose unit is blocked in native code past its time budget, which the budget's
 interrupt cannot stop, answers for it before it exits (:mod:`verimono.execution.watchdog`): the records the unit
 finished and a failed record naming the hung call.  The explicit budget of the sending process
 (``--timeout``) applies on the workers too.
+
+This module holds the runners; a unit and its records are :mod:`verimono.execution.units`, what runs on a
+worker and how units are shipped :mod:`verimono.execution.workers`.
 """
 
 from __future__ import annotations
 
-import dataclasses
-import functools
 import multiprocessing
 import os
 import sys
@@ -42,234 +51,15 @@ from collections import deque
 from multiprocessing.connection import wait as _wait
 from typing import Any, Callable, Sequence
 
+from . import config as _config
 from . import watchdog
-from .calibration import calibration, set_calibration
 from ..core.errors import BadExecutor
-from .profiles import load_hypothesis_profile
-from ..records.results import FAILED, CheckResult, Report
-from .timeouts import budget, explicit_budget, unlimited
-
-#: the check name of the record that stands for a unit that crashed, died or timed out
-UNIT_CHECK = watchdog.UNIT_CHECK
-
-
-@dataclasses.dataclass
-class Unit:
-    """One independent piece of a stage: ``fn(*args) -> Report``; ``label`` names it in progress and in
-    the failed record that stands for it if it cannot finish."""
-
-    stage: str
-    label: str
-    fn: Callable[..., Report]
-    args: tuple = ()
-
-
-def unit_failure(unit: Unit, message: str, *, traceback_text: str | None = None,
-                 duration: float | None = None) -> Report:
-    """The report of a unit that did not finish: one failed record ``unit[<stage>: <label>]``."""
-    rec = CheckResult(UNIT_CHECK, f"{unit.stage}: {unit.label}", FAILED, message=message, duration=duration)
-    if traceback_text:
-        rec.details["traceback"] = traceback_text
-    return Report([rec])
-
-
-# -- what runs on a worker ----------------------------------------------------------------------------
-
-#: BLAS threads for a verification run, in its process and its workers: every matrix here is small, so extra
-#: BLAS threads only contend for the cores; on the 2-core reference machine, under load, threaded OpenBLAS made
-#: the catalog's convergence studies vary from 0.4 s to 31 s, against a steady 0.4 s single-threaded
-BLAS_THREADS = 1
-
-
-@functools.cache
-def _one_blas_thread() -> None:
-    """:data:`BLAS_THREADS` in this process, as in the ``verimono run`` process (once: threadpoolctl inspects
-    every loaded library, 1.3 ms a call here)."""
-    try:
-        from threadpoolctl import threadpool_limits
-
-        threadpool_limits(limits=BLAS_THREADS, user_api="blas")
-    except ImportError:  # pragma: no cover - threadpoolctl is a dependency
-        pass
-
-
-def _prepare_worker(profile: str | None) -> None:
-    """The run's hypothesis profile (loaded again for every unit: a unit may load another) and one BLAS thread."""
-    if profile:
-        load_hypothesis_profile(profile)
-    _one_blas_thread()
-
-
-def run_payload(payload: bytes) -> bytes:
-    """Run one shipped unit: ``payload`` is ``cloudpickle.dumps((profile, fn, args, limits, stage, label))``
-    (``limits``: the sending process's explicit unit budget, :func:`verimono.execution.timeouts.explicit_budget`, and its
-    calibration, the unit of the profile's budgets — :func:`_limits` — applied here too, so a worker's budgets
-    are the run's); the answer is ``cloudpickle.dumps(("ok", report))`` or ``("error", message,
-    traceback)`` — never an exception, so a unit's own error is told apart from the worker's death.  (A
-    ``process:N`` worker whose unit blocks in native code answers ``("hang", report)`` instead and exits:
-    :func:`_process_worker`.)"""
-    import cloudpickle
-
-    start = time.perf_counter()
-    try:
-        profile, fn, args, limits, stage, label = cloudpickle.loads(payload)
-        _prepare_worker(profile)
-        if limits.get("calibration"):
-            set_calibration(limits["calibration"])
-        with watchdog.scope(stage=stage, label=label), budget(limits.get("budget")):
-            out = fn(*args)
-        if not isinstance(out, Report):
-            raise TypeError(f"a unit returned {type(out).__name__}, expected a verimono.Report")
-        return cloudpickle.dumps(("ok", out))
-    except Exception as exc:
-        return cloudpickle.dumps(("error", f"{type(exc).__name__}: {exc}", traceback.format_exc(limit=8),
-                                  time.perf_counter() - start))
-
-
-def _decode(unit: Unit, answer: bytes) -> Report:
-    return _decode_answer(unit, answer)[0]
-
-
-def _decode_answer(unit: Unit, answer: bytes) -> tuple[Report, bool]:
-    """The report an answer stands for, and whether its worker has ended (a unit blocked in native code:
-    the records it finished and the failed record of the hung call)."""
-    import cloudpickle
-
-    try:
-        out = cloudpickle.loads(answer)
-    except Exception as exc:
-        return unit_failure(unit, f"its result could not be read back ({type(exc).__name__}: {exc})"), False
-    if out[0] == "ok":
-        return out[1], False
-    if out[0] == "hang":
-        return out[1], True
-    return unit_failure(unit, f"raised {out[1]}", traceback_text=out[2], duration=out[3]), False
-
-
-#: seconds a new worker process may take to import verimono and say it is ready
-WORKER_START_TIMEOUT = 300.0
-
-
-#: exit status of a worker that ended itself on a unit blocked in native code (after answering for it)
-HANG_EXIT = 3
-
-
-def _process_worker(conn: Any) -> None:
-    """Loop of a ``process:N`` worker: say ``ready`` once verimono is imported (so a unit's timeout does
-    not count the worker's start), then receive a payload and answer, until an empty message.
-
-    A call of the unit blocked in native code past its time budget (:mod:`verimono.execution.watchdog`) cannot be
-    interrupted: the watchdog thread answers for the unit instead — ``("hang", report)``, the records the
-    unit finished and the failed record of the hung call — ends the call's child processes and exits
-    (status :data:`HANG_EXIT`); the parent replaces the worker.  One answer per payload, whichever comes
-    first (``lock``)."""
-    import threading
-
-    import cloudpickle
-    import scipy.linalg  # noqa: F401  (with numpy and verimono, imported here: what every unit needs)
-
-    # spawn passed the connection as an inheritable descriptor: a child process of the unit's (os.system)
-    # would hold it open, and the parent would not see this worker's end until that child's
-    os.set_inheritable(conn.fileno(), False)
-    lock, state = threading.Lock(), {"busy": False}
-
-    def on_hang(hang: watchdog.Hang) -> None:
-        with lock:
-            if not state["busy"]:     # pragma: no cover - the unit returned meanwhile: nothing to answer
-                return
-            watchdog.ending()
-            try:
-                conn.send_bytes(cloudpickle.dumps(("hang", watchdog.hang_report(hang))))
-            except Exception:  # noqa: BLE001 - the parent then sees a dead worker, which it reports too
-                pass
-            watchdog.end_process(HANG_EXIT)
-
-    conn.send_bytes(b"ready")
-    with watchdog.on_hang(on_hang):
-        while True:
-            try:
-                payload = conn.recv_bytes()
-            except (EOFError, OSError):
-                return
-            if not payload:
-                return
-            state["busy"] = True
-            answer = run_payload(payload)
-            with lock:
-                state["busy"] = False
-                conn.send_bytes(answer)
-
-
-def _limits() -> dict[str, float | None]:
-    """What bounds a unit wherever it runs: this process's explicit unit budget (``--timeout``) and its
-    calibration (the unit of the profile's budgets), so a worker's budgets are the run's."""
-    return {"budget": explicit_budget(), "calibration": calibration()}
-
-
-def _ship(unit: Unit, profile: str | None) -> bytes:
-    import cloudpickle
-
-    _register_targets_by_value()
-    return cloudpickle.dumps((profile, unit.fn, unit.args, _limits(), unit.stage, unit.label))
-
-
-def _register_targets_by_value() -> None:
-    """A ``verimono check`` target loaded from a ``.py`` file lives in a module no worker can import:
-    ship that module's functions by value."""
-    import sys
-
-    import cloudpickle
-
-    for name, module in list(sys.modules.items()):
-        if name.startswith("verimono_target_") and module is not None:
-            try:
-                cloudpickle.register_pickle_by_value(module)
-            except ValueError:  # pragma: no cover - already registered
-                pass
-
-
-def ship_by_value(obj: Any) -> None:
-    """Let workers that cannot import ``obj``'s module still run it: a module of the user's (not verimono's,
-    not an installed distribution's) is shipped by value with every unit (``cloudpickle``)."""
-    import sys
-
-    import cloudpickle
-
-    module = sys.modules.get(getattr(obj, "__module__", None) or "")
-    path = getattr(module, "__file__", None) or ""
-    if module is None or module.__name__.split(".")[0] in ("verimono", "__main__") or "-packages" in path:
-        return
-    try:
-        cloudpickle.register_pickle_by_value(module)
-    except ValueError:  # pragma: no cover - a module cloudpickle refuses: it ships by reference
-        pass
-
-
-# -- how workers start ----------------------------------------------------------------------------------
-
-#: modules whose native threads or devices do not survive ``fork`` (their own documentation says so): while
-#: one is loaded, workers are spawned
-FORK_UNSAFE = ("jax", "torch", "tensorflow", "cupy", "numba", "mxnet", "ray", "distributed", "grpc")
-
-
-def start_method() -> str:
-    """How the next worker process starts: ``fork`` — a copy of this process, ready at once, with verimono and
-    the subject already imported — where that is safe: Linux, no other Python thread running (a thread
-    holding a lock at the fork would leave it held in the copy forever) and none of :data:`FORK_UNSAFE`
-    imported; ``spawn`` (a fresh interpreter importing verimono, about 0.8 s on a 2-core machine) otherwise.
-    ``$VERIMONO_START_METHOD`` (``fork`` or ``spawn``) decides instead.  NumPy's OpenBLAS threads are safe:
-    OpenBLAS stops them around a fork (``pthread_atfork``)."""
-    import threading
-
-    chosen = os.environ.get("VERIMONO_START_METHOD", "").strip().lower()
-    if chosen in ("fork", "spawn"):
-        return chosen
-    if chosen:
-        raise BadExecutor(f"$VERIMONO_START_METHOD must be fork or spawn, got {chosen!r}")
-    safe = (sys.platform.startswith("linux") and threading.active_count() == 1
-            and not any(name in sys.modules for name in FORK_UNSAFE))
-    return "fork" if safe else "spawn"
-
+from .config import RunConfig
+from ..records.results import Report
+from .timeouts import unlimited
+from .units import UNIT_CHECK, Unit, config_for, raised, unit_failure, unit_raised, unit_record  # noqa: F401
+from .workers import (BLAS_THREADS, FORK_UNSAFE, HANG_EXIT, WORKER_START_TIMEOUT, _decode, _decode_answer,  # noqa: F401
+                      _limits, _process_worker, _ship, run_payload, ship_by_value, start_method)
 
 # -- runners --------------------------------------------------------------------------------------------
 
@@ -281,7 +71,11 @@ class SerialRunner:
 
     spec = "serial"
 
-    def map(self, units: Sequence[Unit], profile: str | None, progress: Progress) -> list[Report]:
+    def map(self, units: Sequence[Unit], profile: RunConfig | str | None, progress: Progress) -> list[Report]:
+        with _config.using(config_for(profile)):
+            return self._map(units, progress)
+
+    def _map(self, units: Sequence[Unit], progress: Progress) -> list[Report]:
         out = []
         for i, u in enumerate(units):
             progress(i, len(units), u.label)
@@ -292,9 +86,8 @@ class SerialRunner:
                 if not isinstance(rep, Report):
                     raise TypeError(f"a unit returned {type(rep).__name__}, expected a verimono.Report")
             except Exception as exc:
-                rep = unit_failure(u, f"raised {type(exc).__name__}: {exc}",
-                                   traceback_text=traceback.format_exc(limit=8),
-                                   duration=time.perf_counter() - start)
+                rep = unit_raised(u, exc, traceback_text=traceback.format_exc(limit=8),
+                                  duration=time.perf_counter() - start)
             watchdog.finished(rep)
             out.append(rep)
         progress(len(units), len(units), "")
@@ -379,7 +172,7 @@ class ProcessRunner:
             proc.join()
         conn.close()
 
-    def map(self, units: Sequence[Unit], profile: str | None, progress: Progress) -> list[Report]:
+    def map(self, units: Sequence[Unit], profile: RunConfig | str | None, progress: Progress) -> list[Report]:
         results: list[Report | None] = [None] * len(units)
         pending = deque(range(len(units)))
         busy: dict[Any, tuple[tuple[Any, Any], int, float]] = {}   # conn -> (worker, unit index, start)
@@ -397,13 +190,24 @@ class ProcessRunner:
             return self._serial.map(units, profile, progress)
         idle = list(self._pool)
         done = 0
+        cfg = config_for(profile)
+        here: list[int] = []                                        # units that cannot be pickled
+        why: list[str] = []
         progress(0, len(units), "")
 
-        def assign(worker):
-            i = pending.popleft()
-            worker[1].send_bytes(_ship(units[i], profile))
-            busy[worker[1]] = (worker, i, time.monotonic())
-            progress(done, len(units), units[i].label)
+        def assign_all():
+            while pending and idle:
+                i = pending.popleft()
+                try:
+                    payload = _ship(units[i], cfg)
+                except Exception as exc:  # noqa: BLE001 - it cannot travel: run where nothing is pickled
+                    here.append(i)
+                    why.append(f"{type(exc).__name__}: {exc}")
+                    continue
+                worker = idle.pop()
+                worker[1].send_bytes(payload)
+                busy[worker[1]] = (worker, i, time.monotonic())
+                progress(done, len(units), units[i].label)
 
         def replace(worker):
             self._pool.remove(worker)
@@ -413,8 +217,9 @@ class ProcessRunner:
 
         try:
             while pending or busy:
-                while pending and idle:
-                    assign(idle.pop())
+                assign_all()
+                if not busy:
+                    break
                 wait_for = None
                 if self.timeout is not None:
                     now = time.monotonic()
@@ -441,8 +246,7 @@ class ProcessRunner:
                     done += 1
                     idle.append(worker)
                     progress(done, len(units), units[i].label)
-                while pending and idle:   # the next units first: the hook below must not keep a worker waiting
-                    assign(idle.pop())
+                assign_all()              # the next units first: the hook below must not keep a worker waiting
                 for rep in arrived:
                     try:
                         self.on_report(rep)
@@ -459,11 +263,23 @@ class ProcessRunner:
                                                       "stopped)", duration=now - start)
                             done += 1
                             idle.append(replace(worker))
+            for i in unpicklable(units, here, why, forked=start_method() == "fork"):
+                results[i] = self._run_unpicklable(units[i], cfg)
+                done += 1
+                progress(done, len(units), units[i].label)
         except BaseException:
             self.close(kill=True)
             raise
         progress(len(units), len(units), "")
         return [r for r in results]  # type: ignore[misc]
+
+    def _run_unpicklable(self, unit: Unit, cfg: RunConfig) -> Report:
+        """A unit that cannot be pickled: in a worker forked for it (nothing of it is pickled: it is in the
+        forked copy's memory) where forking is safe (:func:`verimono.execution.workers.start_method`), else
+        here, serially (:func:`run_here`)."""
+        if start_method() != "fork":
+            return run_here(unit, cfg)
+        return run_forked(unit, cfg, self.timeout)
 
     def close(self, kill: bool = False) -> None:
         workers = self._pool + self._launched
@@ -476,6 +292,59 @@ class ProcessRunner:
         for w in workers:
             self._stop(w, kill=kill)
         self._pool, self._launched = [], []
+
+
+def unpicklable(units: Sequence[Unit], indices: list[int], why: list[str], forked: bool) -> list[int]:
+    """``indices`` (of ``units`` that could not be pickled, for the reasons ``why``), after one line on standard
+    error saying so and where they run instead — never a failed record: what cannot be pickled is a limit of
+    the executor, not a fault of the subject (a module holding a ``threading.Lock`` or a ``ctypes`` library
+    failed its stage before, with ``--executor serial`` passing it).  ``forked``: they run in worker
+    processes forked for them, else in this process."""
+    if indices:
+        one = len(indices) == 1
+        where = (("it runs" if one else "each runs") + " in a worker process forked for it" if forked else
+                 ("it runs" if one else "they run") + " in this process (forking is not safe here)")
+        names = ", ".join(units[i].label for i in indices[:3]) + (", ..." if len(indices) > 3 else "")
+        print(f"verimono: {len(indices)} unit{'' if one else 's'} of {units[indices[0]].stage} ({names}) cannot be "
+              f"sent to a worker process ({why[0]}): {where}", file=sys.stderr)
+    return list(indices)
+
+
+def run_here(unit: Unit, cfg: RunConfig) -> Report:
+    """``unit`` in this process, as :class:`SerialRunner` runs it (under ``cfg``)."""
+    with _config.using(cfg):
+        return SerialRunner()._map([unit], lambda *a: None)[0]
+
+
+def run_forked(unit: Unit, cfg: RunConfig, timeout: float | None = None) -> Report:
+    """``unit`` in a worker process forked for it (:func:`verimono.execution.workers._process_worker` with
+    the job in its memory): only its answer is pickled.  A worker that dies or overruns ``timeout`` seconds
+    is a failed record, as for any worker."""
+    ctx = multiprocessing.get_context("fork")
+    parent, child = ctx.Pipe(duplex=True)
+    job = (cfg, unit.fn, unit.args, _limits(), unit.stage, unit.label)
+    sys.stdout.flush(), sys.stderr.flush()       # a forked copy must not write this process's buffers again
+    proc = ctx.Process(target=_process_worker, args=(child, job), name="verimono-unit-worker")
+    proc.start()
+    child.close()
+    start = time.monotonic()
+    try:
+        if not parent.poll(WORKER_START_TIMEOUT) or parent.recv_bytes() != b"ready":
+            return unit_failure(unit, f"its forked worker process did not start within {WORKER_START_TIMEOUT:g} s")
+        if not parent.poll(timeout):
+            return unit_failure(unit, f"timed out after {timeout:g} s (worker stopped)", duration=time.monotonic() - start)
+        return _decode_answer(unit, parent.recv_bytes())[0]
+    except (EOFError, OSError):
+        proc.join(timeout=5)
+        code = proc.exitcode
+        how = f"signal {-code}" if code is not None and code < 0 else f"exit status {code}"
+        return unit_failure(unit, f"its worker process died ({how}) while running it", duration=time.monotonic() - start)
+    finally:
+        proc.join(timeout=5)
+        if proc.is_alive():
+            proc.kill()
+            proc.join()
+        parent.close()
 
 
 class DaskRunner:
@@ -507,23 +376,34 @@ class DaskRunner:
         except Exception:  # pragma: no cover
             return 1
 
-    def map(self, units: Sequence[Unit], profile: str | None, progress: Progress) -> list[Report]:
+    def map(self, units: Sequence[Unit], profile: RunConfig | str | None, progress: Progress) -> list[Report]:
         from distributed import wait as dwait
 
         results: list[Report | None] = [None] * len(units)
         pending = deque(range(len(units)))
         flying: dict[Any, tuple[int, float]] = {}
         done = 0
+        cfg = config_for(profile)
+        here: list[int] = []                                        # units that cannot be pickled
+        why: list[str] = []
         progress(0, len(units), "")
         try:
             while pending or flying:
                 slots = self._slots()
                 while pending and len(flying) < slots:
                     i = pending.popleft()
-                    fut = self.client.submit(run_payload, _ship(units[i], profile), pure=False,
+                    try:
+                        payload = _ship(units[i], cfg)
+                    except Exception as exc:  # noqa: BLE001 - it cannot travel: run here, after the others
+                        here.append(i)
+                        why.append(f"{type(exc).__name__}: {exc}")
+                        continue
+                    fut = self.client.submit(run_payload, payload, pure=False,
                                              key=f"verimono-unit-{i}-{os.urandom(4).hex()}")
                     flying[fut] = (i, time.monotonic())
                     progress(done, len(units), units[i].label)
+                if not flying:
+                    break
                 wait_for = 5.0
                 if self.timeout is not None:
                     now = time.monotonic()
@@ -553,6 +433,10 @@ class DaskRunner:
                             results[i] = unit_failure(units[i], f"timed out after {self.timeout:g} s (cancelled)",
                                                       duration=now - start)
                             done += 1
+            for i in unpicklable(units, here, why, forked=False):     # the cluster's workers are elsewhere
+                results[i] = run_here(units[i], cfg)
+                done += 1
+                progress(done, len(units), units[i].label)
         except BaseException:
             for fut in flying:
                 fut.cancel()
@@ -603,4 +487,4 @@ def make_runner(spec: Any = None, *, timeout: float | None = None) -> Any:
 
 
 __all__ = ["Unit", "UNIT_CHECK", "AUTO_MAX_WORKERS", "ship_by_value", "BadExecutor", "SerialRunner", "ProcessRunner", "DaskRunner", "make_runner",
-           "unit_failure", "run_payload"]
+           "unit_failure", "unit_record", "unit_raised", "raised", "run_payload", "run_here", "run_forked"]

@@ -1,27 +1,35 @@
 """Time budgets for units of work: a resolvent or stepper that never returns must not hang a run.
 
-A *unit* is one law on one operator, or one check of one stepper.  Its budget is, in order: the innermost
-:func:`budget` block, in seconds (``verimono run/check --timeout S`` opens one around the whole run, and the
-run's worker processes apply it too; ``inf``: no limit), else
-the active profile's ``unit_budget`` (:mod:`verimono.execution.profiles`), stated in *calibration units*: multiples of
+A *unit* is one law on one operator, or one check of one stepper.  Its budget is the run configuration's
+(:mod:`verimono.execution.config`, chosen at the entry point and shipped to the run's worker processes): its
+explicit seconds (``verimono run/check --timeout S``, or a :func:`budget` block; ``inf``: no limit), else its
+profile's ``unit_budget`` (:mod:`verimono.execution.profiles`), stated in *calibration units*: multiples of
 :func:`verimono.execution.calibration.calibrate`, a fixed NumPy-and-Python workload.  In seconds that is ``units x`` the
 calibration measured in this process (:func:`calibration`: measured once, best of 3, about 0.2 s, then
 cached; ``verimono run`` supplies the one it measures at its start), so a slower or busier machine — where
 the workload, like everything else, takes longer — gets proportionally more time, and a unit is stopped
 for not finishing, not for running on a loaded runner.  Stage budgets (:func:`stage_budget`) are stated the
-same way.  :func:`time_limit` enforces a budget with ``SIGALRM`` (a one-shot real-time timer): the unit's
-code is interrupted where it is — inside a user's Python loop too — and :class:`verimono.UnitTimeout` is
-raised at the ``with`` block, naming the unit and the elapsed time.  :func:`run_unit` turns that into a
-record so the run goes on: *undecided* (time budget, with how many samples were evaluated) when the law
-inside had stated (:func:`note_progress`) that everything it evaluated held — a correct subject on a slow
-machine — and *failed* otherwise: a call that never returns (nothing returned before it, or it ran
-:data:`HANG_MULTIPLE` x longer than any that did), or a law that had seen a violation.  (The
-operator laws' search bounds itself the same way, :mod:`verimono.checks.search`.)
+same way; a budget beyond the platform's timers (:data:`TIMER_LIMIT`, about 73 years) is no limit.
+:func:`time_limit` enforces a budget with ``SIGALRM`` (a one-shot real-time timer): the unit's code is
+interrupted where it is — inside a user's Python loop too — and :class:`verimono.UnitTimeout` is raised at
+the ``with`` block, naming the unit and the elapsed time.  :func:`run_unit` turns that into a record so the
+run goes on, by the one policy of a unit out of time (:func:`verimono.records.verdicts.timeout_verdict`, which
+:func:`verimono.records.verdicts.classify` applies to every ``UnitTimeout``): *undecided* (time budget, with
+how many samples were evaluated) when everything the law inside had evaluated held (:func:`note_progress`)
+and no call in flight had run long — a correct subject on a slow machine — and *failed* when the law had
+seen a violation, or for a call that never returns: one in flight longer than :data:`HANG_MULTIPLE` x any
+that returned before it, half the budget and a tenth of a second.  (The operator laws' search bounds itself
+the same way, :mod:`verimono.checks.search`.)
 
 The interrupt is raised as an internal ``BaseException`` while it travels through the unit's code, so a
 check's own ``except Exception`` (which turns an operator's error into a failed sample) or hypothesis'
-shrinking cannot swallow or replay it.  The timer works only in the main thread of a POSIX process
-(elsewhere the unit runs unbounded, which the record says).
+shrinking cannot swallow or replay it; and it is raised only where that cannot corrupt anything
+(:mod:`verimono.execution.interrupts`): never inside hypothesis's engine, a garbage-collector callback, a
+finalizer or this machinery — there it waits, a few milliseconds at a time, for the unit's own code, or for
+the next :func:`checkpoint`.  Whatever the block raises once interrupted (a library failing in its cleanup)
+is the timeout, never a failure of the subject, and the internal interrupt never leaves the block.  The
+timer works only in the main thread of a POSIX process (elsewhere the unit runs unbounded, which the record
+says).
 
 A call blocked in native code (``os.system``, a C extension that retries after the signal) runs the
 interrupt only once it returns.  Every armed limit is therefore also watched by :mod:`verimono.execution.watchdog`, a
@@ -34,25 +42,26 @@ for the call (bounded only with ``check_stepper(..., executor="process:N")``, :m
 
 from __future__ import annotations
 
-import math
 import signal
+import sys
 import threading
 import time
 from contextlib import contextmanager
-from typing import Callable, Iterator
+from typing import Any, Callable, Iterator
 
 from ..core.errors import InvalidCheckArgument, UnitTimeout
 from . import calibration as _calibration
-from .profiles import Profile, UnknownProfile, active_profile, get_profile
-from ..records.results import FAILED, UNDECIDED, CheckResult
+from . import config as _config
+from .profiles import Profile, get_profile
+from ..records.verdicts import (HANG_FRACTION, HANG_MULTIPLE, TIME_BUDGET_REASON, never_returned,
+                                record_of_exception)
 from . import watchdog
+from .interrupts import DEFER_STEP, interruptible, safe_to_interrupt
 
-_OVERRIDE: list[float | None] = []
-#: ``details["undecided_reason"]`` of a law stopped by its budget after samples that all held
-TIME_BUDGET_REASON = "time budget"
-#: a call still running when its unit's budget ran out, after this many times the slowest evaluation of the same
-#: law that returned, is one that does not return: a failure of the subject, not a law out of time
-HANG_MULTIPLE = 20.0
+#: budgets longer than this (about 73 years) are no limit: the platform's timers refuse longer ones
+#: (``setitimer``, the watchdog's wait and :mod:`faulthandler`'s timer stop near 9.2e9 s, the nanoseconds of a
+#: 64-bit integer), and the watchdog waits for up to twice the budget
+TIMER_LIMIT = threading.TIMEOUT_MAX / 4
 
 
 class _Expired(BaseException):
@@ -73,25 +82,24 @@ def _positive(seconds: float | None, what: str = "timeout") -> float | None:
 
 
 def unlimited(seconds: float | None) -> bool:
-    """Whether a budget of ``seconds`` is no limit at all (``None`` or ``inf``)."""
-    return seconds is None or math.isinf(seconds)
+    """Whether a budget of ``seconds`` is no limit at all: ``None``, ``inf``, or beyond :data:`TIMER_LIMIT`
+    (``--timeout 1e10`` made the timer raise ``OverflowError``, recorded as failures of correct subjects)."""
+    return seconds is None or not seconds <= TIMER_LIMIT
 
 
 @contextmanager
 def budget(seconds: float | None) -> Iterator[None]:
     """Within the block, every unit's budget is ``seconds`` (``None``: back to the profile default;
-    ``math.inf``: no limit, as ``--timeout inf``)."""
-    _OVERRIDE.append(_positive(seconds))
-    try:
+    ``math.inf``: no limit, as ``--timeout inf``): the run configuration's ``budget``
+    (:func:`verimono.execution.config.using`)."""
+    with _config.using(budget=_positive(seconds)):
         yield
-    finally:
-        _OVERRIDE.pop()
 
 
 def explicit_budget() -> float | None:
-    """The seconds of the innermost :func:`budget` block, ``None`` outside one (or in a ``budget(None)``): what a
-    worker process must apply to run a unit as this process would (:mod:`verimono.execution.executors`)."""
-    return _OVERRIDE[-1] if _OVERRIDE else None
+    """The explicit seconds per unit of the run configuration (:func:`budget`, ``--timeout``), ``None`` when
+    the profile's budget applies."""
+    return _config.current().budget
 
 
 def calibration() -> float:
@@ -106,18 +114,17 @@ def in_seconds(units: float) -> float:
 
 
 def _profile() -> Profile | None:
-    try:
-        return get_profile(active_profile())
-    except UnknownProfile:
-        return None
+    """The effort of the run configuration's profile (``None``: a user's own hypothesis profile)."""
+    return _config.current().effort
 
 
 def budget_source() -> dict[str, object]:
     """Where the budget of a unit started now comes from: ``{"seconds": S, "source": "explicit"}`` inside a
     :func:`budget` block; else ``{"seconds": S, "source": "profile <name>", "units": U, "calibration": C}``
     with ``S = U x C``; ``{"seconds": None, ...}`` when there is none (an unknown profile)."""
-    if _OVERRIDE and _OVERRIDE[-1] is not None:
-        return {"seconds": _OVERRIDE[-1], "source": "explicit"}
+    explicit = explicit_budget()
+    if explicit is not None:
+        return {"seconds": explicit, "source": "explicit"}
     profile = _profile()
     if profile is None:
         return {"seconds": None, "source": "none"}
@@ -129,8 +136,9 @@ def budget_source() -> dict[str, object]:
 def current_budget() -> float | None:
     """Seconds a unit started now may take: the innermost :func:`budget` (explicit seconds), else the active
     profile's ``unit_budget`` calibration units x :func:`calibration`; ``None`` for an unknown profile."""
-    if _OVERRIDE and _OVERRIDE[-1] is not None:
-        return _OVERRIDE[-1]
+    explicit = explicit_budget()
+    if explicit is not None:
+        return explicit
     profile = _profile()
     return None if profile is None else in_seconds(profile.unit_budget)
 
@@ -139,7 +147,7 @@ def stage_budget(stage: str, profile: str | Profile | None = None) -> float | No
     """Seconds stage ``stage`` may take at ``profile`` (default: the active one): its budget in calibration
     units (:data:`verimono.execution.profiles.STAGE_BUDGETS` x the profile's ``stage_budget_scale``) x
     :func:`calibration`; ``None`` when no budget is stated for it."""
-    p = profile if isinstance(profile, Profile) else get_profile(profile or active_profile())
+    p = profile if isinstance(profile, Profile) else get_profile(profile or _config.current().profile)
     units = p.stage_budget_units(stage)
     return None if units is None else in_seconds(units)
 
@@ -149,54 +157,121 @@ def supported() -> bool:
     return hasattr(signal, "setitimer") and threading.current_thread() is threading.main_thread()
 
 
+class _Limit:
+    """One armed :func:`time_limit`: its budget, its unit, when it started, the frame that opened it (where
+    :func:`verimono.execution.interrupts.safe_to_interrupt` stops reading the stack), whether its deadline has
+    passed (``due``) and how many times its interrupt was raised into the block (``raised``)."""
+
+    __slots__ = ("seconds", "unit", "start", "boundary", "due", "raised", "closed", "stopped_at")
+
+    def __init__(self, seconds: float, unit: str, boundary: Any) -> None:
+        self.seconds, self.unit, self.boundary = seconds, unit, boundary
+        self.start, self.due, self.raised, self.closed = time.perf_counter(), False, 0, False
+        self.stopped_at: float | None = None
+
+    def expired(self, **evidence: Any) -> UnitTimeout:
+        """The :class:`UnitTimeout` of this limit, with the evidence :func:`verimono.records.verdicts.
+        timeout_verdict` judges (the whole block counted as one call in flight, until its unit says more;
+        ``stopped_at``: the :func:`time.perf_counter` of the interrupt, which is when a call in flight stopped —
+        not when the exception, unwinding through a library's frames, reached the limit)."""
+        elapsed = time.perf_counter() - self.start
+        stopped_at = self.stopped_at if self.stopped_at is not None else time.perf_counter()
+        note = f"; {evidence['harness_error']} after the interrupt" if evidence.get("harness_error") else ""
+        exc = UnitTimeout(f"{self.unit} exceeded its time budget of {self.seconds:g} s (stopped after "
+                          f"{elapsed:.1f} s){note}")
+        exc.evidence = {"budget": self.seconds, "elapsed": elapsed, "in_flight": stopped_at - self.start,
+                        "stopped_at": stopped_at, **evidence}
+        return exc
+
+    def interrupt(self) -> None:
+        """Raise the interrupt into the block (again after :data:`SWALLOWED_STEP`, should the code swallow it)."""
+        self.raised += 1
+        if self.stopped_at is None:
+            self.stopped_at = time.perf_counter()
+        signal.setitimer(signal.ITIMER_REAL, SWALLOWED_STEP)
+        raise _Expired(self)
+
+
+#: the armed limits, innermost last
+_LIMITS: list[_Limit] = []
+#: seconds after an interrupt before it is raised again, should the code have swallowed it (an ``except
+#: BaseException`` of its own); the block's end cancels it
+SWALLOWED_STEP = 0.05
+
+
 @contextmanager
 def time_limit(seconds: float | None, unit: str) -> Iterator[None]:
     """Run the block for at most ``seconds``; :class:`UnitTimeout` naming ``unit`` when it takes longer.
 
     Nested limits keep the tighter one: an outer limit that expires first still fires (as the outer
-    unit's timeout).  ``seconds=None``, ``inf`` or an unsupported context (:func:`supported`) runs unbounded.
-    Each armed limit is also watched by :mod:`verimono.execution.watchdog`: a block still running :func:`verimono.
+    unit's timeout).  ``seconds=None``, ``inf``, a budget beyond the platform's timers (:data:`TIMER_LIMIT`)
+    or an unsupported context (:func:`supported`) runs unbounded.  The interrupt is raised only where that is
+    safe (:mod:`verimono.execution.interrupts`: never inside hypothesis's engine, a gc callback, a finalizer or
+    verimono's own machinery; deferred by :data:`~verimono.execution.interrupts.DEFER_STEP` until the code is
+    the unit's again, or stopped at a :func:`checkpoint`); a block whose deadline passed while the interrupt
+    waited and that finished meanwhile keeps its result.  Whatever the block raises after the interrupt — a
+    library failing in its own cleanup — is this :class:`UnitTimeout` too (``evidence["harness_error"]`` names
+    it), as is a block that returns after swallowing it: the internal interrupt never leaves the block.  Each
+    armed limit is also watched by :mod:`verimono.execution.watchdog`: a block still running :func:`verimono.
     watchdog.grace` seconds after the deadline is blocked in native code, where the timer cannot reach it.
     """
     seconds = _positive(seconds)
     if unlimited(seconds) or not supported():
         yield
         return
-    start = time.perf_counter()
     outer_left, _ = signal.getitimer(signal.ITIMER_REAL)
     if outer_left and outer_left <= seconds:     # the outer unit's budget is the tighter one: leave it alone
         yield
         return
-    token = object()
+    lim = _Limit(seconds, unit, sys._getframe(2))   # 2: past contextlib's __enter__, the `with` statement's frame
 
     def fire(signum, frame):
-        raise _Expired(token)
+        if lim.closed:           # a signal that arrived as the limit closed: nothing to stop, nothing to re-arm
+            return                # (re-armed here, it would fire under the restored handler: SIG_DFL ends the process)
+        lim.due = True
+        if safe_to_interrupt(frame, lim.boundary):
+            lim.interrupt()
+        signal.setitimer(signal.ITIMER_REAL, DEFER_STEP)    # not here: try again in a moment
 
     previous = signal.signal(signal.SIGALRM, fire)
+    _LIMITS.append(lim)
     signal.setitimer(signal.ITIMER_REAL, seconds)
     try:
         with watchdog.limit(seconds, unit):
             yield
-    except _Expired as exc:
-        if exc.args and exc.args[0] is token:
-            elapsed = time.perf_counter() - start
-            raise UnitTimeout(f"{unit} exceeded its time budget of {seconds:g} s (stopped after "
-                              f"{elapsed:.1f} s)") from None
+        if lim.raised:                               # it returned after swallowing the interrupt
+            raise lim.expired(harness_error="a return (the interrupt was swallowed)")
+    except _Expired:                                 # this limit's (or a stale one's: it never leaves a limit)
+        raise lim.expired() from None
+    except (KeyboardInterrupt, SystemExit, GeneratorExit, UnitTimeout):
         raise
+    except BaseException as exc:
+        if not lim.raised:
+            raise
+        # the block raised something else after the interrupt: a library that failed while it was stopped
+        raise lim.expired(harness_error=f"{type(exc).__name__}: {exc}") from None
     finally:
+        lim.closed = True
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, previous)
+        _LIMITS.remove(lim)
         if outer_left:                               # re-arm the outer unit's timer with what it has left
-            left = outer_left - (time.perf_counter() - start)
+            left = outer_left - (time.perf_counter() - lim.start)
             signal.setitimer(signal.ITIMER_REAL, max(left, 1e-3))
 
 
-def never_returned(in_flight: float | None, slowest: float) -> bool:
-    """Whether a call that was still running ``in_flight`` seconds when its unit's budget ran out counts as one
-    that never returns: longer than :data:`HANG_MULTIPLE` x the slowest evaluation of the same law that
-    returned (``slowest`` seconds).  ``None`` (nothing was in flight: the budget ran out between evaluations)
-    is no hang."""
-    return in_flight is not None and in_flight > HANG_MULTIPLE * slowest
+def interrupted() -> bool:
+    """Whether the budget's interrupt has been raised into the code running now (the innermost limit's): an
+    exception met after it — a library failing while it was stopped — is the timeout's, not the subject's."""
+    return bool(_LIMITS) and _LIMITS[-1].raised > 0
+
+
+def checkpoint() -> None:
+    """A safe point: stop here if the innermost limit's deadline has passed while its interrupt waited for
+    the code to leave a place it must not be raised in (:mod:`verimono.execution.interrupts`).  The operator
+    search calls it before each sample."""
+    if _LIMITS and _LIMITS[-1].due:
+        _LIMITS[-1].interrupt()
 
 
 def note_progress(evaluated: int, held: bool, what: str = "samples") -> None:
@@ -204,8 +279,7 @@ def note_progress(evaluated: int, held: bool, what: str = "samples") -> None:
     ``what`` (samples, partitions), every one of which held when ``held``; the next evaluation starts now.
     Should the unit's budget stop it later, the record is *undecided* (time budget, ``evaluated`` ``what``)
     instead of failed — too few for a verdict, none against the subject — unless the evaluation in flight
-    then had run longer than :data:`HANG_MULTIPLE` x the slowest one before it (:func:`never_returned`: a
-    call that does not return fails).  Outside a unit it does nothing."""
+    then counts as a call that does not return (:func:`never_returned`).  Outside a unit it does nothing."""
     if _PROGRESS:
         progress, now = _PROGRESS[-1], time.perf_counter()
         progress.update(evaluated=int(evaluated), held=bool(held), what=what, at=now,
@@ -218,10 +292,12 @@ _PROGRESS: list[dict] = []
 
 def run_unit(fn: Callable[[], object], *, check: str, subject: str, seconds: float | None = None):
     """``fn()`` under the unit budget (``seconds``, else :func:`current_budget`).  A timeout becomes a
-    :class:`verimono.CheckResult` ``check[subject]`` naming the unit and the elapsed time: *undecided*
-    (``details["undecided_reason"] == "time budget"``) when the law inside stated, through
-    :func:`note_progress`, that everything it evaluated before held; *failed* otherwise — a subject whose
-    first call never returns, or a law that had already seen a violation.
+    :class:`verimono.CheckResult` ``check[subject]`` naming the unit and the elapsed time, judged by the one
+    policy of a unit out of time (:func:`verimono.records.verdicts.timeout_verdict`) on what the law inside
+    stated through :func:`note_progress`: *undecided* (``details["undecided_reason"] == "time budget"``)
+    when everything it evaluated held and the evaluation in flight had not run long; *failed* when a
+    violation had been seen or the call in flight counts as one that does not return — a subject whose
+    first call never returns (a unit that states no progress counts as one call).
 
     A call blocked in native code, which the timer cannot stop, is left to :mod:`verimono.execution.watchdog`; the
     outcome is passed to :func:`verimono.execution.watchdog.finished`, so that a process ended on such a call later
@@ -244,28 +320,21 @@ def _run_unit(fn: Callable[[], object], *, check: str, subject: str, seconds: fl
         details: dict[str, object] = {"timeout": limit, "elapsed": elapsed}
         if seconds is None:
             details["budget"] = budget_source()
-        evaluated, what = progress.get("evaluated", 0), progress.get("what", "samples")
-        what = what[:-1] if evaluated == 1 and what.endswith("s") else what
-        if not evaluated:
-            return CheckResult(check, subject, FAILED, message=f"timed out: {exc}", duration=elapsed, details=details)
-        in_flight, slowest = time.perf_counter() - progress["at"], progress["slowest"]
-        details.update(evaluated=evaluated, in_flight=in_flight, slowest=slowest)
-        if not progress.get("held"):
-            return CheckResult(check, subject, FAILED, message=f"timed out: {exc} (after {evaluated} {what}, not all "
-                                                               "of which held)", duration=elapsed, details=details)
-        if never_returned(in_flight, slowest):
-            return CheckResult(check, subject, FAILED, duration=elapsed, details=details,
-                               message=f"timed out: {exc}; the evaluation in flight ran {in_flight:.1f} s, more than "
-                                       f"{HANG_MULTIPLE:g}x the slowest of the {evaluated} {what} before it "
-                                       f"({slowest:.3g} s): a call that does not return")
-        details["undecided_reason"] = TIME_BUDGET_REASON
-        return CheckResult(check, subject, UNDECIDED, duration=elapsed, details=details,
-                           message=f"time budget exhausted after {evaluated} {what}, all of which held ({exc}): "
-                                   "too few for a verdict")
+        exc.evidence = {**getattr(exc, "evidence", {}), "evaluated": progress.get("evaluated", 0),
+                        "held": progress.get("held", True), "what": progress.get("what", "samples"),
+                        "in_flight": _stopped_at(exc) - progress["at"], "slowest": progress.get("slowest", 0.0),
+                        "budget": limit}
+        return record_of_exception(check, subject, exc, details=details, duration=elapsed)
     finally:
         _PROGRESS.pop()
 
 
+def _stopped_at(exc: UnitTimeout) -> float:
+    """When the limit's interrupt stopped the code (now, for a timeout without that evidence)."""
+    return getattr(exc, "evidence", {}).get("stopped_at") or time.perf_counter()
+
+
 __all__ = ["budget", "current_budget", "budget_source", "stage_budget", "calibration", "in_seconds", "time_limit",
-           "run_unit", "note_progress", "never_returned", "supported", "explicit_budget", "unlimited",
-           "TIME_BUDGET_REASON", "HANG_MULTIPLE"]
+           "run_unit", "note_progress", "never_returned", "supported", "explicit_budget", "unlimited", "checkpoint",
+           "interrupted",
+           "interruptible", "TIME_BUDGET_REASON", "HANG_MULTIPLE", "HANG_FRACTION", "TIMER_LIMIT"]

@@ -51,6 +51,7 @@ from contextlib import contextmanager
 from typing import Any, Callable, Iterator
 
 from ..records.results import FAILED, CheckResult, Report
+from ..records.verdicts import new_record
 
 #: the grace after a limit's deadline before its call counts as blocked in native code:
 #: ``max(GRACE_MIN, GRACE_FRACTION x budget)``
@@ -100,7 +101,7 @@ class Hang:
             check, subject = UNIT_CHECK, self.call
         details = {"timeout": self.budget, "elapsed": self.elapsed,
                    HANG_DETAIL: {"call": self.call, "where": self.where, "grace": grace(self.budget)}}
-        return CheckResult(check, subject, FAILED, message=self.message(), duration=self.elapsed, details=details)
+        return new_record(check, subject, FAILED, message=self.message(), duration=self.elapsed, details=details)
 
 
 # -- what the main thread is running ---------------------------------------------------------------------

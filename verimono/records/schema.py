@@ -13,6 +13,8 @@ Layout (schema ``verimono.results``, version ``SCHEMA_VERSION`` = ``MAJOR.MINOR`
         "target": "verimono.stepping:solve" | null,     #   the object a `verimono check` verified
         "profile": "ci",                               #   dev | ci | thorough
         "seed": 0 | null,
+        "config": {"profile", "source", "budget",      #   the run configuration the entry point chose
+                   "seed", "executor", "unit_budget"},  #   (verimono.execution.config) and the unit budget
         "selection": {"stages": [...] | null,          #   the --stage and --reference choices (null: all)
                       "references": [...] | null},
         "stages": [{"name", "status", "records", "duration", "message"}],   # one per stage, in order

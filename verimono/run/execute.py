@@ -18,7 +18,10 @@ from typing import Any, Callable
 from ..execution import watchdog
 from ..records.environment import environment
 from ..execution.executors import BLAS_THREADS, make_runner
+from ..execution.config import RunConfig
+from ..execution.config import using as using_config
 from ..execution.profiles import get_profile, load_hypothesis_profile
+from ..execution.timeouts import budget_source
 from .progress import Progress
 from ..records.report import write
 from ..records.report.plots import draw_ahead, drawing_elsewhere, warm_up
@@ -31,14 +34,18 @@ EXIT_OK, EXIT_FAILED, EXIT_UNDECIDED = 0, 1, 2
 
 def execute(*, command: str, profile_name: str, stages: list[str] | None, context: Any, target: str | None = None,
             progress: Progress | None = None, executor: Any = None, unit_timeout: float | None = None,
-            on_done: Callable | None = None, calibration: PendingCalibration | None = None) -> Report:
+            on_done: Callable | None = None, calibration: PendingCalibration | None = None,
+            config: RunConfig | None = None) -> Report:
     """Run ``stages`` with ``context`` under a profile and return the merged, fully annotated report.
 
     ``executor`` (``"process:N"``, a dask scheduler address or ``Client``; ``None``: serial) is where the
     stages' independent units run (:mod:`verimono.execution.executors`); ``unit_timeout`` bounds each unit there.
     ``on_done(stage, report, info)`` is called after each stage (the interrupt handler keeps them).
     ``calibration``: the run's first calibration, started earlier (the command line starts it before its
-    imports); measured here, before any worker starts, when not given."""
+    imports); measured here, before any worker starts, when not given.  ``config``: the run configuration
+    the entry point chose (:mod:`verimono.execution.config`; default: the current one), which ``profile_name``,
+    the context's seed and ``executor`` complete; everything the stages run — the search, the budgets, the
+    workers — reads it, and ``report.meta["config"]`` records it with the unit budget it gave."""
 
     from threadpoolctl import threadpool_limits
 
@@ -78,7 +85,9 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
     try:
         # BLAS_THREADS for the BLAS libraries the checks loaded too (SciPy's OpenBLAS is not NumPy's): the command
         # line limited those loaded when it began, and SciPy's two threads spun 0.5 s of a core in a serial run
-        with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
+        with threadpool_limits(limits=BLAS_THREADS, user_api="blas"), \
+                using_config(config, profile=profile_name, seed=context.seed, executor=executor) as cfg:
+            unit_budget = budget_source()
             report = run_stages(stages, profile, context, on_start=progress.start, on_done=done)
     finally:
         runner.close()
@@ -95,6 +104,7 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
                         "selection": selection, "executor": getattr(runner, "spec", type(runner).__name__),
                         "calibrations": cals,
                         "calibration": min(cals), "duration": duration,
+                        "config": {**cfg.to_dict(), "unit_budget": unit_budget},
                         "data_dir": None if context.data_dir is None else str(context.data_dir),
                         "environment": environment()})
     return report

@@ -37,6 +37,7 @@ from ..core.operators import NormalCone, NormSubdifferential
 from ..core.problem import Problem
 from ..execution import timing
 from ..records.results import FAILED, PASSED, UNDECIDED, CheckResult, Report
+from ..records.verdicts import new_record
 from ..core.sets import Ball, Box
 from ..core.stepping import solve
 
@@ -317,7 +318,7 @@ def ratio_record(check: str, subject: str, subj_t: list[float], base_t: list[flo
         msg = what + ", " + how + ("" if status == PASSED else "; target missed with confidence")
     if fail is not None:
         status, msg = FAILED, msg + f"; {fail}"
-    return CheckResult(check, subject, status, worst=worst, bound=1.0, message=msg,
+    return new_record(check, subject, status, worst=worst, bound=1.0, message=msg,
                        counterexample=None if status != FAILED else {"case": subject, "ratio": ratio, **(details or {})},
                        details={"timing_ratio": j.timing_ratio, "ratio": ratio, "target": target,
                                 "direction": ">=" if speedup else "<=", "rounds": j.rounds,
@@ -496,7 +497,7 @@ def check_memory(*, steps: int, n: int = 10, stepper: Callable | None = None) ->
     ratio = s_peak / b_peak
     study_ok = bool(study.verdict()[0])
     status = PASSED if ratio <= MEMORY_TARGET else FAILED
-    return CheckResult(
+    return new_record(
         "performance_memory", f"t|x| n={n} {steps} steps", status, worst=ratio / MEMORY_TARGET, bound=1.0,
         message=f"study peak {s_peak / 2**20:.2f} MiB = {ratio:.3f}x one trajectory "
                 f"({b_peak / 2**20:.2f} MiB; target ≤ {MEMORY_TARGET:g}x)",

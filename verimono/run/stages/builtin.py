@@ -20,6 +20,7 @@ from ...execution.executors import Unit
 from ...core.grids import uniform_grid
 from ...execution.profiles import Profile
 from ...records.results import SKIPPED, CheckResult, Report
+from ...records.verdicts import new_record
 from ...core.stepping import solve
 from ...execution.timeouts import current_budget, run_unit, time_limit
 from ...checks.core import laws_of
@@ -148,7 +149,8 @@ def operator_laws_stage(profile: Profile, context: RunContext) -> Report:
         try:
             subjects += _generated_operators(profile, context.seed_for(profile))
         except StageUnavailable as exc:
-            report.add(CheckResult("stage", "operator_laws: generated families", SKIPPED, message=str(exc)))
+            report.add(new_record("stage", "operator_laws: generated families", SKIPPED,
+                                  message=str(exc) or type(exc).__name__))
     units = [Unit("operator_laws", label, _operator_unit,
                   (check_operator, label, op, context.seed_for(profile), profile.law_examples))
              for label, op in subjects]

@@ -31,7 +31,8 @@ from ...core.errors import StageUnavailable, UnknownStage
 from ...execution.executors import SerialRunner
 from ...lcs.siconos import PACKAGED_DATA, siconos_root
 from ...execution.profiles import Profile
-from ...records.results import FAILED, SKIPPED, CheckResult, Report
+from ...records.results import FAILED, SKIPPED, Report
+from ...records.verdicts import new_record
 
 
 @dataclasses.dataclass
@@ -117,7 +118,7 @@ def register_stage(name: str, description: str = "") -> Callable:
 def _stage_failure(name: str, exc: BaseException, duration: float) -> tuple[Report, str, str]:
     """The one record of a stage that raised, judged by the checks' exception policy."""
     status, message = classify(exc)
-    rec = CheckResult("stage", name, status, message=message, duration=duration)
+    rec = new_record("stage", name, status, message=message, duration=duration)
     if status == FAILED:
         rec.details["traceback"] = traceback.format_exc(limit=6)
         return Report([rec]), "error", message
