@@ -31,6 +31,7 @@ from ..core.errors import InvalidCheckArgument, NotApplicable
 from ..core.naming import subject_name
 from ..core.problem import Problem
 from ..records.results import FAILED, PASSED, SKIPPED, CheckResult, Report
+from ..records.verdicts import new_record
 from .core import Holds, Outcome, law, laws_of, record_of_exception, run
 from .partitions import single
 from . import bounds, trajectory_laws  # noqa: F401 - the laws local to steps join the registry
@@ -113,7 +114,7 @@ def own_partition_laws(stepper: Adaptive, problem: Problem, *, controls: Sequenc
     if not stepper.claim.proximal:
         why = ("needs scheme='proximal': a stepper claiming only convergence (scheme='any') is not bound by the "
                "laws of the paper's iterates on its own partition")
-        return [CheckResult(n, subject, SKIPPED, message=why) for n in laws]
+        return [new_record(n, subject, SKIPPED, message=why) for n in laws]
     cs = list(_controls(controls or stepper.tolerances or DEFAULT_TOLERANCES, stepper.control))
     chosen = sorted({max(cs), min(cs)}, reverse=True)
     runs = {}

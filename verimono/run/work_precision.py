@@ -52,6 +52,7 @@ from ..core.problem import Problem
 from ..core.tolerances import roundoff_floor
 from ..execution import timing
 from ..records.results import FAILED, PASSED, UNDECIDED, CheckResult, Report
+from ..records.verdicts import new_record
 
 NORMS = ("sup", "l2", "final")
 #: rounds of the first look (9: the fewest whose order-statistics bounds at 97.5% one-sided leave out one
@@ -187,10 +188,10 @@ class WorkPrecisionSet:
             if v["work"] == "time":
                 details["work_precision"] = self.to_dict()
             worst = v["worst"]
-            out.append(CheckResult("work_precision" if v["work"] == "time" else "work_precision_steps",
-                                   v["subject"], v["status"], worst=worst if math.isfinite(worst) else None,
-                                   bound=1.0 if math.isfinite(worst) else None, message=v["message"],
-                                   details=details))
+            out.append(new_record("work_precision" if v["work"] == "time" else "work_precision_steps",
+                                  v["subject"], v["status"], worst=worst if math.isfinite(worst) else None,
+                                  bound=1.0 if math.isfinite(worst) else None, message=v["message"],
+                                  details=details))
         return out
 
     def __repr__(self) -> str:
