@@ -279,6 +279,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
     from .checks.subjects import kind_of
 
     obj = load_target(args.target)
+    user = obj
     try:
         kind = kind_of(obj)
     except InvalidCheckArgument as exc:
@@ -286,7 +287,10 @@ def _cmd_check(args: argparse.Namespace) -> int:
     if kind == "operator":
         stages, ctx = ["operator_laws"], _context(args, operators=[(args.target, obj)])
     elif kind == "stepper":
-        obj = with_claim(obj, args.scheme, args.order, solve_tol=args.solve_tol)
+        from .execution.timing import TimedStepper
+
+        # its calls are timed apart from the checks around them: the gate judges the subject's own CPU time
+        obj = TimedStepper(with_claim(obj, args.scheme, args.order, solve_tol=args.solve_tol))
         stages, ctx = ["convergence", "trajectory_laws"], _context(args, stepper=obj)
         kind = "stepper" + ("" if claim_of(obj).proximal else f" claiming {claim_of(obj).describe()}")
     else:
@@ -299,7 +303,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
     if getattr(args, "executor", None) not in (None, "serial"):
         from .execution.executors import ship_by_value
 
-        ship_by_value(obj)  # its module need not be importable on the workers
+        ship_by_value(user)  # its module need not be importable on the workers
     print(f"verimono: checking {args.target} as a {kind}", file=sys.stderr)
     run_id = _start(out, "check")
 

@@ -23,7 +23,7 @@ from .progress import Progress
 from ..records.report import write
 from ..records.report.plots import draw_ahead, drawing_elsewhere, warm_up
 from ..records.results import Report
-from ..execution.calibration import PendingCalibration, calibrate, set_calibration
+from ..execution.calibration import PendingCalibration, calibrate_times, cpu_seconds, set_calibration
 from ..execution.timing import MachineProbe, is_noise_undecided
 
 EXIT_OK, EXIT_FAILED, EXIT_UNDECIDED = 0, 1, 2
@@ -52,7 +52,7 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
     if executor is not None and context.executor is None:
         print(f"verimono: units run on {runner.spec}", file=sys.stderr)
     context.executor = context.executor if context.executor is not None else runner
-    cal = calibration.result() if calibration is not None else calibrate()   # before any worker starts
+    cal, cal_cpus = calibration.times() if calibration is not None else calibrate_times()  # before any worker
     set_calibration(cal)              # the unit of this process's time budgets (verimono.execution.timeouts)
     if hasattr(runner, "prestart"):   # the workers import while this process builds the catalog
         runner.prestart()
@@ -88,13 +88,15 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
     # is the steadier unit, in the baseline and in the run gated against it alike (and the two ends' drift
     # tells the gate whether the machine was quiet enough to judge stage times at all: a first repeat that
     # agrees with the start's is enough to say it was)
-    cals = [cal, calibrate(agreeing_with=cal)]
+    end, end_cpus = calibrate_times(agreeing_with=cal)
+    cals = [cal, end]
     selection = {"stages": stages, "references": None if context.problems is None else
                  [p.name for p in context.problems]}
     report.meta.update({"command": command, "target": target, "profile": profile_name, "seed": context.seed,
                         "selection": selection, "executor": getattr(runner, "spec", type(runner).__name__),
                         "calibrations": cals,
                         "calibration": min(cals), "duration": duration,
+                        "calibrations_cpu": [cpu_seconds(cal_cpus), cpu_seconds(end_cpus)],
                         "data_dir": None if context.data_dir is None else str(context.data_dir),
                         "environment": environment()})
     return report

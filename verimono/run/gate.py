@@ -74,6 +74,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import statistics
 from collections import Counter
 from pathlib import Path
 from typing import Any
@@ -82,7 +83,7 @@ from ..records.atomic import in_progress
 from ..core.convergence import ORDER_SLACK
 from ..core.errors import IncompatibleBaseline, IncompatibleResults, SchemaError
 from ..records.results import FAILED, PASSED, SKIPPED, UNDECIDED, UNEARNED_PASS, XFAIL, XFAIL_DECLARED, Report, load
-from ..execution.timing import BUSY_FOREIGN, BUSY_WAITING, is_noise_undecided
+from ..execution.timing import BUSY_FOREIGN, BUSY_WAITING, is_noise_undecided, median_interval
 
 #: smallest drop of a fitted slope that counts as a regression when both intervals are narrower: slopes
 #: are refitted on the same grids, so they reproduce to round-off on one machine and to ~1e-3 across
@@ -98,8 +99,14 @@ ERROR_IGNORE_BELOW = 1e-11
 #: 2-core runner these ratios vary by up to ~40% between runs (measured); 2x flags real slowdowns such
 #: as a lost vectorisation or a per-step re-validation, which cost 3x and more
 TIMING_GROWTH = 2.0
-#: stages shorter than this (seconds, in both runs) are not timed: start-up noise dominates them
+#: stages shorter than this (seconds, in both runs) are not timed by their wall time: start-up noise dominates
 TIMING_MIN_SECONDS = 0.5
+#: CPU figures below this many calibrations (in either run) are not judged: about 0.13 s of CPU idle
+TIMING_MIN_UNITS = 2.0
+#: ... nor below this many CPU seconds (a busy machine's inflated calibration cannot make tiny work count)
+TIMING_MIN_CPU = 0.1
+#: one-sided level of the median interval of a stage's calibration samples (each run's)
+TIMING_ALPHA = 0.025
 #: the largest ratio between a run's two calibrations (start, end) for which its stage times are judged:
 #: best-of-3 calibrations agree within ~10% on a quiet machine (0.057/0.057 s here), while load that comes or
 #: goes during a run moves one end by 1.4x and more
@@ -215,6 +222,23 @@ def baseline_nonfinite(baseline: Report) -> list[str]:
     return bad
 
 
+def baseline_uncalibrated(baseline: Report) -> str | None:
+    """What a baseline with stage times lacks to have them judged, or ``None``: a calibration
+    (``meta.calibration``, the unit of wall times) and, for each stage, its CPU time and the calibration's CPU
+    time measured beside it (``cpu``, ``calibration_cpu``: written since schema 1.3).  A baseline without
+    stages (a pytest session's) times nothing and lacks nothing."""
+    stages = [st for st in baseline.meta.get("stages") or [] if isinstance(st, dict)]
+    if not stages:
+        return None
+    if not _calibrations(baseline.meta):
+        return f"no calibration (meta.calibration = {baseline.meta.get('calibration')!r})"
+    bare = [st.get("name") for st in stages if not (_number(st.get("cpu")) and _slices(st) is not None)]
+    if bare:
+        return (f"no CPU time measured beside its stage{'s' if len(bare) > 1 else ''} {', '.join(map(str, bare))} "
+                f"(stages[].cpu and calibration_cpu; written since schema 1.3)")
+    return None
+
+
 def check_baseline(baseline: Report, what: str = "the baseline") -> None:
     """Raise :class:`IncompatibleBaseline` unless ``baseline`` is usable: it has executed (non-skipped)
     records (a baseline without any vouches for nothing, and every run would pass against it), and every
@@ -224,6 +248,10 @@ def check_baseline(baseline: Report, what: str = "the baseline") -> None:
         raise IncompatibleBaseline(f"the baseline has no executed records ({len(baseline.results)} records, "
                                    "all skipped or none); regenerate it with `verimono baseline`")
     check_unique_keys(baseline, what)
+    uncalibrated = baseline_uncalibrated(baseline)
+    if uncalibrated:
+        raise IncompatibleBaseline(f"{what} has stage times but {uncalibrated}: its stage times could not be "
+                                   "judged, and a slowdown would pass unseen; regenerate it with `verimono baseline`")
     bad = baseline_nonfinite(baseline)
     if bad:
         more = f"; and {len(bad) - 3} more" if len(bad) > 3 else ""
@@ -398,7 +426,8 @@ def _calibrations(meta: dict[str, Any]) -> list[float]:
 
 
 def _stage_unjudged(cur_cals: list[float], stage: dict[str, Any]) -> str | None:
-    """Why a stage time of this run cannot support a regression (module docstring, *Timing*), or ``None``."""
+    """Why a stage's *wall* time in this run cannot support a regression (module docstring, *Timing*), or
+    ``None``: the calibrations at its ends drift, or the machine was busy during the stage."""
     why = []
     drift = max(cur_cals) / min(cur_cals)
     if drift > CALIBRATION_DRIFT:
@@ -413,39 +442,109 @@ def _stage_unjudged(cur_cals: list[float], stage: dict[str, Any]) -> str | None:
     return "; ".join(why) or None
 
 
+def _slices(stage: dict[str, Any]) -> list[float] | None:
+    """The calibration's CPU seconds measured beside the stage's work (``stage["calibration_cpu"]``), or
+    ``None`` when the stage has none (a document from before CPU timing)."""
+    cals = stage.get("calibration_cpu")
+    if not isinstance(cals, list) or not cals:
+        return None
+    xs = [float(c) for c in cals if _number(c) and math.isfinite(c) and c > 0]
+    return xs if len(xs) == len(cals) else None
+
+
+def cpu_units(stage: dict[str, Any], figure: str = "cpu") -> tuple[float, float, float] | None:
+    """``(ratio, low, high)``: the stage's ``figure`` (``"cpu"``, its CPU seconds, or ``"subject_cpu"``,
+    those spent in the subject's calls) over the calibration's CPU seconds measured beside it — the median of
+    its samples — with the bounds that the samples' spread allows (the median's order-statistics interval at
+    one-sided ``TIMING_ALPHA``, :func:`verimono.execution.timing.median_interval`; the samples' range when
+    they are too few for one); ``None`` when the stage lacks either figure."""
+    x, cals = stage.get(figure), _slices(stage)
+    if not (_number(x) and math.isfinite(x) and x >= 0) or cals is None:
+        return None
+    med, lo, hi = median_interval(cals, TIMING_ALPHA)
+    if not (lo > 0 and math.isfinite(hi)):
+        lo, hi = min(cals), max(cals)
+    return x / med, x / hi, x / lo
+
+
+def _cpu_change(what: str, key: str, b: dict[str, Any], s: dict[str, Any], figure: str) -> tuple[str, Change | None]:
+    """The CPU verdict on ``figure`` of stage ``s`` against the baseline's ``b``: ``("regression" | "not
+    judged" | "ok" | "untimed", change)`` (module docstring, *Timing*)."""
+    now, before = cpu_units(s, figure), cpu_units(b, figure)
+    if now is None or before is None:
+        return "untimed", None
+    (rc, rc_lo, rc_hi), (rb, rb_lo, rb_hi) = now, before
+    if min(rc, rb) < TIMING_MIN_UNITS or min(s[figure], b[figure]) < TIMING_MIN_CPU:
+        return "untimed", None
+    growth, least, most = rc / rb, rc_lo / rb_hi, rc_hi / rb_lo
+    if most <= TIMING_GROWTH:
+        return "ok", None
+    cals = _slices(s) or []
+    evidence = (f"{what} {rc:.1f}x the calibration's CPU time (median {statistics.median(cals) * 1e3:.0f} ms of "
+                f"{len(cals)} samples beside it), baseline {rb:.1f}x: {growth:.2f}x growth, between {least:.2f}x "
+                f"and {most:.2f}x with the samples' spread ({s[figure]:.2f} s CPU now, {b[figure]:.2f} s before)")
+    if least > TIMING_GROWTH:
+        return "regression", Change("timing", key, f"{evidence} (> {TIMING_GROWTH}x)", True)
+    return "not judged", Change("timing", key, f"{evidence}: not judged (the calibration's CPU time varied too "
+                                               f"much beside this stage to tell {TIMING_GROWTH}x growth)", False)
+
+
 def _compare_timings(base: Report, cur: Report, out: list[Change]) -> None:
-    """Stage durations in calibration units against the baseline's (module docstring, *Timing*)."""
+    """Stage CPU times, and the subject's part of them, in calibration units against the baseline's; wall
+    times only where the machine was quiet (module docstring, *Timing*)."""
     bcals, ccals = _calibrations(base.meta), _calibrations(cur.meta)
     if not (bcals and ccals):
         return
     bex, cex = base.meta.get("executor") or "serial", cur.meta.get("executor") or "serial"
-    if bex != cex:   # a stage's wall time depends on how many workers ran its units: not comparable
+    if bex != cex:   # a stage's times depend on how many workers ran its units: not comparable
         out.append(Change("timing", "stages", f"stage times not compared: the baseline's units ran on {bex}, "
                                               f"these on {cex}", False))
         return
+    subject = cur.meta.get("target") or "the subject"
     before = {s["name"]: s for s in base.meta.get("stages") or [] if isinstance(s, dict)}
     for s in cur.meta.get("stages") or []:
         b = before.get(s.get("name"))
-        if not b or min(b.get("duration", 0), s.get("duration", 0)) < TIMING_MIN_SECONDS:
+        if not b:
             continue
-        # the stage's units at the run's slower calibration (the growth a regression needs) and at its faster
-        # one (the most growth the run's drift allows)
-        rb, rc, rc_most = b["duration"] / min(bcals), s["duration"] / max(ccals), s["duration"] / min(ccals)
-        if rc_most <= TIMING_GROWTH * rb:
-            continue
-        why = _stage_unjudged(ccals, s)
-        if rc > TIMING_GROWTH * rb:
-            what = (f"{rc:.1f}x the calibration workload, baseline {rb:.1f}x (> {TIMING_GROWTH}x growth; "
-                    f"{s['duration']:.2f} s now)")
-        elif why is None:   # judged: within TIMING_GROWTH in the units a regression is stated in
-            continue
-        else:
-            what = (f"{rc:.1f}x-{rc_most:.1f}x the calibration workload (the run's two calibrations), baseline "
-                    f"{rb:.1f}x (up to {rc_most / rb:.1f}x growth; {s['duration']:.2f} s now)")
-        if why is None:
-            out.append(Change("timing", f"stage {s['name']}", what, True))
-        else:
-            out.append(Change("timing", f"stage {s['name']}", f"{what}: not judged ({why})", False))
+        verdict, change = _cpu_change("CPU time", f"stage {s['name']}", b, s, "cpu")
+        if change is not None:
+            out.append(change)
+        _, subject_change = _cpu_change("CPU time in its calls", f"{subject} in stage {s['name']}", b, s,
+                                        "subject_cpu")
+        if subject_change is not None:
+            out.append(subject_change)
+        if verdict in ("ok", "untimed"):
+            _compare_wall(b, s, bcals, ccals, out, cpu_judged=verdict == "ok")
+
+
+def _compare_wall(b: dict[str, Any], s: dict[str, Any], bcals: list[float], ccals: list[float], out: list[Change],
+                  cpu_judged: bool) -> None:
+    """A stage's wall time in calibration units (taken at the run's slower calibration, the baseline's at its
+    faster): growth beyond ``TIMING_GROWTH`` regresses only on a quiet machine (:func:`_stage_unjudged`) — where
+    its CPU time did not grow, it is time spent off the CPU (sleeping, waiting on I/O or a lock), which CPU time
+    does not see.  On a busy machine, or between drifting calibrations, such growth is listed as not judged
+    with the evidence (``cpu_judged``: the CPU time was judged and did not grow)."""
+    if min(b.get("duration", 0), s.get("duration", 0)) < TIMING_MIN_SECONDS:
+        return
+    rb, rc, rc_most = b["duration"] / min(bcals), s["duration"] / max(ccals), s["duration"] / min(ccals)
+    if rc_most <= TIMING_GROWTH * rb:
+        return
+    why = _stage_unjudged(ccals, s)
+    if why is None and rc <= TIMING_GROWTH * rb:
+        return
+    if rc > TIMING_GROWTH * rb:
+        what = (f"wall time {rc:.1f}x the calibration workload, baseline {rb:.1f}x (> {TIMING_GROWTH}x growth; "
+                f"{s['duration']:.2f} s now)")
+    else:
+        what = (f"wall time {rc:.1f}x-{rc_most:.1f}x the calibration workload (the run's two calibrations), "
+                f"baseline {rb:.1f}x (up to {rc_most / rb:.1f}x growth; {s['duration']:.2f} s now)")
+    cpu = " while its CPU time did not grow" if cpu_judged else ""
+    if why is None:
+        out.append(Change("timing", f"stage {s['name']}", f"{what}{cpu}, on a quiet machine: time spent off the "
+                          "CPU (sleeping, waiting)", True))
+    else:
+        out.append(Change("timing", f"stage {s['name']}", f"{what}{cpu}: time off the CPU not judged ({why})",
+                          False))
 
 
 def compare(baseline: Report, current: Report) -> Comparison:
@@ -454,9 +553,8 @@ def compare(baseline: Report, current: Report) -> Comparison:
     holds a non-finite figure (:func:`check_baseline`'s rules beyond emptiness)."""
     check_unique_keys(baseline, "the baseline")
     check_unique_keys(current, "the results")
-    bad = baseline_nonfinite(baseline)
-    if bad:
-        check_baseline(baseline)        # raises, naming the figures
+    if baseline_nonfinite(baseline) or baseline_uncalibrated(baseline):
+        check_baseline(baseline)        # raises, naming the figures or what is missing
     changes: list[Change] = []
     _compare_records(baseline, current, changes)
     _compare_studies(baseline, current, changes)
@@ -499,6 +597,6 @@ def gate(baseline: str | Path | Report, results: str | Path | Report) -> Compari
 
 
 __all__ = ["Change", "Comparison", "compare", "gate", "check_baseline", "check_runs_compatible",
-           "check_unique_keys", "check_completed", "baseline_nonfinite",
+           "check_unique_keys", "check_completed", "baseline_nonfinite", "baseline_uncalibrated", "cpu_units",
            "IncompatibleBaseline", "IncompatibleResults", "LISTED_REGRESSIONS", "ORDER_DROP_FLOOR", "ERROR_GROWTH",
            "TIMING_GROWTH", "TIMING_MIN_SECONDS", "CALIBRATION_DRIFT"]
