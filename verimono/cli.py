@@ -232,7 +232,6 @@ def _cmd_run(args: argparse.Namespace) -> int:
     from .execution.timeouts import budget
 
     out = ensure_writable_dir(args.out)           # before any work: a run must not be lost at the end
-    baseline = _baseline_for(args)
     previous, stages = None, args.stage
     if args.resume:
         results, killed = out / "results.json", in_progress(out / "results.json")
@@ -258,8 +257,12 @@ def _cmd_run(args: argparse.Namespace) -> int:
         if args.seed is None and previous.meta.get("seed") is not None:
             args.seed = previous.meta["seed"]
 
-    ctx = _context(args)                          # bad references or data: exit 2 before the mark
-    run_id = _start(out, "run", resumes=None if previous is None else previous.meta.get("run_id"))
+    # the mark before anything that takes time (reading the baseline, building the references, importing the
+    # checks): a run killed from here on leaves it, and the gate refuses the files beside it, the previous run's
+    run_id = getattr(args, "run_id", None) if previous is None else None
+    run_id = run_id or _start(out, "run", resumes=None if previous is None else previous.meta.get("run_id"))
+    baseline = _baseline_for(args)
+    ctx = _context(args)                          # bad references or data: exit 2, the mark stays
 
     def run(on_done):
         with budget(args.timeout):
@@ -267,7 +270,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
                            progress=Progress(), on_done=on_done, **_executor_options(args))
 
     report = interruptible(run, out, command="run", profile=args.profile, stages=args.stage, previous=previous,
-                           run_id=run_id)
+                           run_id=run_id, checkpoint=True)
     if isinstance(report, int):
         return report
     if previous is not None:
@@ -277,7 +280,12 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 def _cmd_check(args: argparse.Namespace) -> int:
     from .checks.subjects import kind_of
+    from .records.atomic import ensure_writable_dir
 
+    out = ensure_writable_dir(args.out)           # before any work
+    # the mark before anything that takes time (importing the target and the checks): a check killed from here
+    # on leaves it, and the gate refuses the files beside it, the previous check's
+    run_id = getattr(args, "run_id", None) or _start(out, "check")
     obj = load_target(args.target)
     user = obj
     try:
@@ -295,17 +303,14 @@ def _cmd_check(args: argparse.Namespace) -> int:
         kind = "stepper" + ("" if claim_of(obj).proximal else f" claiming {claim_of(obj).describe()}")
     else:
         raise BadTarget(f"{args.target} is a problem: `verimono check` takes an operator or a stepper")
-    from .records.atomic import ensure_writable_dir
     from .execution.timeouts import budget
 
-    out = ensure_writable_dir(args.out)           # before any work
     baseline = _baseline_for(args)                # a baseline that cannot be read: exit 2 before the work
     if getattr(args, "executor", None) not in (None, "serial"):
         from .execution.executors import ship_by_value
 
         ship_by_value(user)  # its module need not be importable on the workers
     print(f"verimono: checking {args.target} as a {kind}", file=sys.stderr)
-    run_id = _start(out, "check")
 
     def run(on_done):
         with budget(args.timeout):
@@ -334,11 +339,23 @@ def _cmd_baseline(args: argparse.Namespace) -> int:
     if args.from_results:
         from .run.gate import check_completed
 
+        from .core.errors import IncompatibleResults
+        from .records.results import MISSING_RECORDS
+        from .run.gate import check_baseline, check_passes_earned
+
         check_completed(args.from_results)        # the files of a run that never completed: exit 2
         report = load(args.from_results)
         if report.meta.get("incomplete"):
             raise NothingToResume(f"{args.from_results} is an interrupted run (marked incomplete): finish it "
                                   "with `verimono run --resume` before recording it as a baseline")
+        missing = report.meta.get(MISSING_RECORDS) or {}
+        if any(missing.get(k) for k in ("crashed", "hidden")):
+            lost = list(missing.get("crashed") or []) + list(missing.get("hidden") or [])
+            why = "a worker crashed while running" if missing.get("crashed") else "a runner kept the records of"
+            raise IncompatibleResults(f"{args.from_results} is short: {why} {len(lost)} test(s) (e.g. {lost[0]}), "
+                                      "whose records are missing; run the session again before recording a baseline")
+        check_passes_earned(report, str(args.from_results))   # a pass that contradicts its figures: exit 2
+        check_baseline(report, str(args.from_results))        # empty, uncalibrated or non-finite: exit 2
     else:
         from .execution.timeouts import budget
         from .execution.watchdog import on_hang
@@ -495,6 +512,36 @@ CALIBRATED_COMMANDS = ("run", "check", "baseline")
 DRAWN_COMMANDS = ("run", "check")
 
 
+#: the commands whose output folder is marked in progress before the parser (and the stages it lists) is built
+MARKED_COMMANDS = {"run": "reports", "check": "reports/check"}
+
+
+def _early_mark(command: str | None, given: list[str]) -> str | None:
+    """Mark ``--out``/results.json in progress before anything else (the parser imports the stages and the
+    checks: 2-3 s on a loaded machine, during which a killed run would leave the previous run's files
+    unmarked, and the gate would read them as this run's); its run id, or ``None`` — not a marked command,
+    ``--help``, ``--resume`` (the interrupted run's own results are marked incomplete: its mark is read
+    first, then this run's written, :func:`_cmd_run`), or a folder that cannot be written (the command then
+    fails on it with its usual message)."""
+    if command not in MARKED_COMMANDS or {"-h", "--help"} & set(given):
+        return None
+    pre = argparse.ArgumentParser(add_help=False)
+    pre.add_argument("--out", default=MARKED_COMMANDS[command])
+    pre.add_argument("--resume", action="store_true")
+    try:
+        known, _ = pre.parse_known_args(given[given.index(command) + 1:])
+    except SystemExit:           # malformed: the real parser says why
+        return None
+    if known.resume:
+        return None
+    from .records.atomic import ensure_writable_dir
+
+    try:
+        return _start(ensure_writable_dir(known.out), command)
+    except VerimonoError:
+        return None
+
+
 def main(argv: list[str] | None = None) -> int:
     from threadpoolctl import threadpool_limits
 
@@ -516,9 +563,12 @@ def main(argv: list[str] | None = None) -> int:
             if connect is not None:
                 connect(pending.forked)
         try:
+            run_id = _early_mark(command, given)
             args = build_parser().parse_args(argv)
             args.argv = given                          # the command as given (advice after an interrupt)
             args.calibration = pending
+            if run_id is not None:
+                args.run_id = run_id
             func: Callable[[argparse.Namespace], int] = args.func
             try:
                 return func(args)

@@ -123,6 +123,9 @@ def registry_size(subject: Any, *, problems: Iterable | None = None, generated: 
     kind = kind_of(subject)
     if kind in ("operator", "problem"):
         return len(laws_of(kind, battery=True))
+    from .checks.sample_problems import valid_count
+
+    generated = valid_count(generated)
     from .checks.stepper_battery import CHECKS
 
     if problems is not None:

@@ -126,7 +126,7 @@ ISOLATE_ADVICE = ("`--executor process:N` runs each unit in a worker process, so
 
 def interruptible(run: Callable[[Callable], Report], out: Path, *, command: str, profile: str,
                    stages: list[str] | None, previous: Report | None = None, run_id: str | None = None,
-                   advice: str | None = None) -> Report | int:
+                   advice: str | None = None, checkpoint: bool = False) -> Report | int:
     """``run(on_done)`` with SIGTERM treated as an interrupt; on an interrupt write the stages finished so
     far (with ``previous``'s, when resuming) to ``out`` marked ``incomplete`` (as the run ``run_id``) and
     return the exit status.  ``advice``: how to go on, printed after the interrupt (default: ``verimono
@@ -148,12 +148,31 @@ def interruptible(run: Callable[[Callable], Report], out: Path, *, command: str,
         finished.append((rep, info))
         if stage_scope and stage_scope[0] is not None:
             stage_scope[0].items.clear()        # the scope keeps only the current stage's finished units
+        if checkpoint:
+            save_checkpoint()
+
+    def save_checkpoint() -> None:
+        """The stages finished so far, on disk as each finishes (``results.json`` only, marked incomplete, with
+        this run's id; the in-progress mark stays): a run killed with SIGKILL, which no handler sees, leaves
+        them for ``--resume``.  A checkpoint that cannot be written costs the run nothing but that."""
+        from ..records.atomic import write_text
+
+        partial, _ = partial_report()
+        partial.meta["run_id"] = run_id
+        try:
+            write_text(out / "results.json", partial.to_json())
+        except OSError as exc:  # OutputNotWritable too: the final write says it again, with what it keeps
+            print(f"verimono: could not save the finished stages to {out / 'results.json'} "
+                  f"({getattr(exc, 'strerror', None) or exc}); the run goes on", file=sys.stderr)
 
     def partial_report() -> tuple[Report, list[str]]:
-        partial = previous if previous is not None else Report(meta={"stages": []})
+        partial = Report(meta=dict(previous.meta) if previous is not None else {})
+        partial.meta["stages"] = list(previous.meta.get("stages") or []) if previous is not None else []
+        if previous is not None:
+            partial.extend(previous)
         for rep, info in finished:
             partial.extend(rep)
-            partial.meta.setdefault("stages", []).append(info)
+            partial.meta["stages"].append(info)
         done = [s["name"] for s in partial.meta.get("stages") or []]
         partial.meta.update({"command": command, "profile": profile, "incomplete": True,
                              "finished_stages": done,

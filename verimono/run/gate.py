@@ -192,6 +192,19 @@ def check_unique_keys(report: Report, what: str = "the results") -> None:
                           "check[subject] must occur once (which copy would the gate compare?)")
 
 
+def check_passes_earned(report: Report, what: str = "the results") -> None:
+    """Raise ``SchemaError`` naming the records when ``report`` holds a record that *passed* with a worst
+    ratio above its bound (both finite): no check of verimono's writes one (a law passes when ``worst <=
+    bound``), so the document was edited or written by something else, and the gate cannot trust its
+    verdicts — it refuses it (exit 2) rather than compare against it."""
+    bad = [f"{r.key} (worst {r.worst:.4g} > bound {r.bound:.4g})" for r in report.results
+           if r.status == PASSED and _figure_is_finite(r.worst) and _figure_is_finite(r.bound) and r.worst > r.bound]
+    if bad:
+        more = f" and {len(bad) - 3} more" if len(bad) > 3 else ""
+        raise SchemaError(f"{what}: a record passed with its worst ratio above its bound, {', '.join(bad[:3])}"
+                          f"{more}: a pass that contradicts its own figures is invalid")
+
+
 def _figure_is_finite(value: Any) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
 
@@ -553,6 +566,8 @@ def compare(baseline: Report, current: Report) -> Comparison:
     holds a non-finite figure (:func:`check_baseline`'s rules beyond emptiness)."""
     check_unique_keys(baseline, "the baseline")
     check_unique_keys(current, "the results")
+    check_passes_earned(baseline, "the baseline")
+    check_passes_earned(current, "the results")
     if baseline_nonfinite(baseline) or baseline_uncalibrated(baseline):
         check_baseline(baseline)        # raises, naming the figures or what is missing
     changes: list[Change] = []
@@ -590,6 +605,7 @@ def gate(baseline: str | Path | Report, results: str | Path | Report) -> Compari
                                       f"{', '.join(rep.meta.get('finished_stages') or []) or 'none'}); finish it "
                                       "with `verimono run --resume` before gating")
         check_unique_keys(rep, f"the {what}" + ("" if isinstance(doc, Report) else f" {doc}"))
+        check_passes_earned(rep, f"the {what}" + ("" if isinstance(doc, Report) else f" {doc}"))
     base, cur = docs["baseline"], docs["results"]
     check_baseline(base, "the baseline" + ("" if isinstance(baseline, Report) else f" {baseline}"))
     check_runs_compatible(base, cur)
@@ -597,6 +613,6 @@ def gate(baseline: str | Path | Report, results: str | Path | Report) -> Compari
 
 
 __all__ = ["Change", "Comparison", "compare", "gate", "check_baseline", "check_runs_compatible",
-           "check_unique_keys", "check_completed", "baseline_nonfinite", "baseline_uncalibrated", "cpu_units",
+           "check_unique_keys", "check_passes_earned", "check_completed", "baseline_nonfinite", "baseline_uncalibrated", "cpu_units",
            "IncompatibleBaseline", "IncompatibleResults", "LISTED_REGRESSIONS", "ORDER_DROP_FLOOR", "ERROR_GROWTH",
            "TIMING_GROWTH", "TIMING_MIN_SECONDS", "CALIBRATION_DRIFT"]
