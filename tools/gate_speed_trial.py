@@ -10,7 +10,8 @@ Usage (from the repository root, the venv active)::
     python tools/gate_speed_trial.py [--runs 5] [--workdir DIR] [--executor auto]
     ../shared/tools/stress -- python tools/gate_speed_trial.py --runs 5       # on a busy machine
 
-Each ``verimono check`` takes 2 s idle (10-20 s on a loaded 2-core machine).
+Each ``verimono check`` takes 2 s idle (10-20 s on a loaded 2-core machine).  verimono is the one ``python -m
+verimono.cli`` imports: set ``PYTHONPATH`` to a checkout to try that one.
 """
 
 from __future__ import annotations
@@ -38,8 +39,9 @@ def my_stepper(problem, t):
 
 
 def check(work: Path, out: str, repeat: int, executor: str) -> Path:
-    env = dict(os.environ, TRIAL_REPEAT=str(repeat), PYTHONPATH=str(work))
-    proc = subprocess.run(["verimono", "check", "trial_stepper:my_stepper", "--profile", "ci", "--out", out,
+    env = dict(os.environ, TRIAL_REPEAT=str(repeat),
+               PYTHONPATH=os.pathsep.join(p for p in (str(work), os.environ.get("PYTHONPATH", "")) if p))
+    proc = subprocess.run([sys.executable, "-m", "verimono.cli", "check", "trial_stepper:my_stepper", "--profile", "ci", "--out", out,
                            "--executor", executor], cwd=work, env=env, capture_output=True, text=True)
     if proc.returncode != 0:
         sys.exit(f"verimono check exited {proc.returncode}:\n{proc.stdout}\n{proc.stderr}")
@@ -47,7 +49,7 @@ def check(work: Path, out: str, repeat: int, executor: str) -> Path:
 
 
 def gate(work: Path, baseline: Path, results: Path) -> tuple[int, list[str]]:
-    proc = subprocess.run(["verimono", "gate", "--baseline", str(baseline), "--results", str(results), "-v"],
+    proc = subprocess.run([sys.executable, "-m", "verimono.cli", "gate", "--baseline", str(baseline), "--results", str(results), "-v"],
                           cwd=work, capture_output=True, text=True)
     return proc.returncode, [ln.strip() for ln in proc.stdout.splitlines() if "timing" in ln]
 

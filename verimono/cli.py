@@ -12,7 +12,8 @@
         incomplete (the gate refuses it, exit 2) and exits 130; ``--resume`` runs the stages that file lacks
         and completes it (it names the run id it continues; the result records it in ``meta.resumed_from``).
         ``--timeout S``: seconds per unit of work (one law on one operator, one check of one stepper;
-        default: the profile's), beyond which the unit is stopped and recorded as failed.  ``--timeout`` and
+        default: the profile's), beyond which the unit is stopped while the run goes on: undecided when all it
+        evaluated held, failed when a call never returns or a sample was violated.  ``--timeout`` and
         ``--unit-timeout`` are numbers of seconds > 0 or ``inf`` (no limit), checked before any work (exit 2
         otherwise: ``nan``, 0, negatives).  A call blocked in native code (``os.system``, a C extension),
         which the budget's interrupt cannot stop, is stopped by a process-level limit (``verimono.execution.watchdog``)
@@ -79,9 +80,9 @@ def _context(args: argparse.Namespace, **kw: Any) -> Any:
             problems = [get(name) for name in args.reference]
         except KeyError as exc:
             raise BadTarget(str(exc.args[0])) from None
-    for spec in getattr(args, "problem", None) or []:
-        problems = (problems or []) + _load_problems(spec)
-    return RunContext(seed=getattr(args, "seed", None), data_dir=data, problems=problems, **kw)
+    extra = [p for spec in getattr(args, "problem", None) or [] for p in _load_problems(spec)]
+    # --problem adds to the references (the catalog, or those chosen with --reference): it never replaces them
+    return RunContext(seed=getattr(args, "seed", None), data_dir=data, problems=problems, extra_problems=extra, **kw)
 
 
 def _load_problems(spec: str) -> list[Any]:
@@ -293,7 +294,10 @@ def _cmd_check(args: argparse.Namespace) -> int:
     except InvalidCheckArgument as exc:
         raise BadTarget(f"{args.target}: {exc}") from None
     if kind == "operator":
-        stages, ctx = ["operator_laws"], _context(args, operators=[(args.target, obj)])
+        from .core.naming import subject_name
+
+        # the operator's own name, as the API and pytest call it: one record key whatever the entry point
+        stages, ctx = ["operator_laws"], _context(args, operators=[(subject_name(obj), obj)])
     elif kind == "stepper":
         from .execution.timing import TimedStepper
 
@@ -310,7 +314,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
         from .execution.executors import ship_by_value
 
         ship_by_value(user)  # its module need not be importable on the workers
-    print(f"verimono: checking {args.target} as a {kind}", file=sys.stderr)
+    print(f"verimono: checking {args.target} as {'an' if kind[0] in 'aeiou' else 'a'} {kind}", file=sys.stderr)
 
     def run(on_done):
         with budget(args.timeout):
@@ -447,7 +451,9 @@ def build_parser() -> argparse.ArgumentParser:
                        help="use only this analytic reference (repeatable; default: the whole catalog)")
         p.add_argument("--timeout", type=_seconds, default=None, metavar="S",
                        help="seconds per unit of work (one law on one operator, one check of one stepper) "
-                            "before it is stopped and recorded as failed (default: the profile's; inf: no limit)")
+                            "before it is stopped while the run goes on: undecided when all it evaluated held, "
+                            "failed when a call never returns or a sample was violated (default: the profile's; "
+                            "inf: no limit)")
         p.add_argument("--executor", default=None, metavar="SPEC",
                        help="where the stages' independent units run: serial, auto (every core, at most 4 "
                             "worker processes; the default, $VERIMONO_EXECUTOR overrides), process:N (N "

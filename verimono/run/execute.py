@@ -92,6 +92,8 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
     cals = [cal, end]
     selection = {"stages": stages, "references": None if context.problems is None else
                  [p.name for p in context.problems]}
+    if getattr(context, "extra_problems", None):
+        selection["problems"] = [p.name for p in context.extra_problems]
     report.meta.update({"command": command, "target": target, "profile": profile_name, "seed": context.seed,
                         "selection": selection, "executor": getattr(runner, "spec", type(runner).__name__),
                         "calibrations": cals,

@@ -57,20 +57,22 @@ class RunContext:
     progress: Callable[[int, int, str], None] = lambda done, total, label: None
     executor: Any = None
     costs: dict[str, float] = dataclasses.field(default_factory=dict)
+    #: problems checked besides the references (``verimono check --problem``): added to :meth:`catalog`
+    extra_problems: list[Any] = dataclasses.field(default_factory=list)
     #: the CPU and wall seconds of every unit run so far (:func:`timed_unit`), in the order they came back
     unit_times: list[dict[str, Any]] = dataclasses.field(default_factory=list)
 
     _catalog: list[Any] | None = dataclasses.field(default=None, repr=False)
 
     def catalog(self) -> list[Any]:
-        """``problems`` if given, else the reference catalog (built once per run)."""
+        """``problems`` if given, else the reference catalog (built once per run); then ``extra_problems``."""
         if self.problems is not None:
-            return self.problems
+            return list(self.problems) + list(self.extra_problems)
         if self._catalog is None:
             from verimono.reference import catalog
 
             self._catalog = catalog()
-        return self._catalog
+        return self._catalog + list(self.extra_problems)
 
     def run_units(self, profile: Profile, units: list[Any], costs: list[float] | None = None) -> list[Report]:
         """The reports of ``units`` (:class:`verimono.execution.executors.Unit`), in their order, run on
