@@ -22,36 +22,46 @@
 * **study** — a convergence study of the baseline that is absent now while its record remains (the
   record's order claim is no longer backed by any errors);
 * **incomplete** — results marked ``meta.incomplete`` (an interrupted run) are refused: exit status 2;
-* **timing** — judged only where the measurement supports it (see *Timing* below); stage durations are
-  compared only between runs on the same executor (``meta.executor``: serial, process:N, ...).
+* **timing** — a slowdown of 2x or more that the measurement supports (see *Timing* below), busy machine or
+  not; stage times are compared only between runs on the same executor (``meta.executor``: serial,
+  process:N, ...).
 
-*Timing.*  Contention only ever adds time, and it does not add it evenly: a grown number from a busy machine
-is evidence of the machine, not of the code, unless the measurement rules that out.  So:
+*Timing.*  Load on a shared machine inflates wall time without bound and unevenly, so stage times are judged
+by **CPU time** (:mod:`verimono.run.stages.registry`: each unit's CPU time in the process that ran it, with the
+children it reaped, and the part spent in the subject's calls, :class:`verimono.execution.timing.TimedStepper`,
+which ``verimono check`` wraps its stepper in).  A wait for a CPU is no CPU time; what load does to code as it
+runs (caches refilled after every switch, memory bandwidth: 1.5-2.6x here beside other test runs) inflates it,
+and is measured in the same run, beside the work: after each unit, in the same process, slices of the
+calibration workload (:func:`verimono.execution.calibration.slices_after`, ``stages[i]["calibration_cpu"]``).
+So:
 
+* a stage's CPU time (``"cpu"``) and the subject's part of it (``"subject_cpu"``), in units of the **mean** of
+  the stage's calibration samples (:func:`calibration_mean`: the samples fall in two groups on a loaded
+  machine, contended and not, and the mean follows their share as the stage's CPU time does), regress when
+  they grew by more than ``TIMING_GROWTH`` and the **least** growth the two runs' intervals allow (Student's,
+  one-sided ``TIMING_ALPHA`` each) is still above it — whether the machine was busy or not.  Where the
+  samples' spread cannot tell, the growth is listed as a change, "not judged", with the figures;
+* the subject over the whole run too: its CPU time in all stages over all their samples (more samples, a
+  narrower interval than any one stage's): ``"<target> in all stages"``;
+* figures below ``TIMING_MIN_UNITS`` calibrations or ``TIMING_MIN_CPU`` seconds are start-up noise, not judged;
+* a stage's **wall** time in calibration units (the run's ``meta.calibrations``, taken at its slower one,
+  the baseline's at its faster) regresses when it grew beyond ``TIMING_GROWTH`` on a quiet machine only:
+  with its CPU time unchanged that is time spent off the CPU (sleeping, waiting), which CPU time does not
+  see.  On a busy machine — some task waited for a CPU more than ``BUSY_WAITING`` of the stage's time
+  (Linux PSI) and processes outside the run used more than ``BUSY_FOREIGN`` of the machine's CPU — or
+  between calibrations that drift by more than ``CALIBRATION_DRIFT``, such growth is listed as not judged;
 * a record's same-job ratio (``details["timing_ratio"]``, larger is worse) regresses when it grew by more than
   ``TIMING_GROWTH`` *with confidence*: the lower end of its interval (``details["timing_interval"]``, the
   order-statistics bound of the median per-round ratio, :mod:`verimono.execution.timing`) exceeds ``TIMING_GROWTH``
-  times the baseline's ratio.  A record without an interval (the memory record, a deterministic byte count;
-  results from before intervals) compares its ratio itself;
-* a record that passed and is now ``undecided`` because timing noise kept its speed from being judged
-  (``details["undecided_reason"] == "timing noise"``) is a change, not a regression;
-* a stage's duration is stated in calibration units (seconds over the calibration workload of the same job).
-  The run measures that workload at its start and its end (``meta.calibrations``); the stage's units are
-  taken in the *slower* of the two, the baseline's in the *faster* of its own, so that growth is not an
-  artefact of which end was measured.  Growth beyond ``TIMING_GROWTH`` is a regression only when the machine
-  was quiet enough for stage times to mean anything: its two calibrations agree within
-  ``CALIBRATION_DRIFT`` (else the machine's speed changed during the run, and no single unit describes it),
-  and the stage did not run on a busy machine: where the run recorded them (``meta.stages[i]``, by
-  :class:`verimono.execution.timing.MachineProbe`), *busy* means some task waited for a CPU during more than
-  ``BUSY_WAITING`` (10%) of the stage's wall time (Linux PSI, ``cpu_waiting``) *and* processes outside the run
-  used more than ``BUSY_FOREIGN`` (10%) of the machine's CPU capacity (``foreign_cpu``) — contention, and
-  not the run's own (its worker processes importing beside the main one make a quiet run's first stage
-  wait 40%, with 0-5% foreign); with one of the two recorded, that one decides.  Otherwise the growth is
-  reported as a change, "not judged", with the evidence — and so is a growth beyond ``TIMING_GROWTH`` in
-  units taken at the run's *faster* calibration only, when the run cannot be judged (a drifting or busy run
-  may hide a real slowdown in its slower calibration: it is shown, never silently dropped).  A real 3x
-  slowdown on a quiet machine stays caught: 3x in units taken at the slower calibration, whose drift is at
-  most 1.25x, is still above 2x.
+  times the baseline's ratio (a record without an interval compares its ratio itself); one that passed and
+  is now ``undecided`` because timing noise kept its speed from being judged
+  (``details["undecided_reason"] == "timing noise"``) is a change, not a regression.
+
+Measured with ``tools/gate_speed_trial.py`` (a stepper doing its work three times against the same stepper,
+5 runs each, ``verimono check`` on ``process:2``): beside other helpers' runs (load average 9-10 on 2
+cores) and under ``stress -n 2`` with them, every 3x-slower run regressed "in all stages" (least growth
+2.11-2.39x) and no unchanged run did.  A baseline with stage times but no calibration or no CPU figures
+(:func:`baseline_uncalibrated`) is refused — exit 2 — never gated with its timing check turned off.
 
 Baseline and results must come from the same kind of run (command, target, profile and the selected
 stages and references), be well-formed documents of a readable schema version
@@ -65,6 +75,10 @@ closed with exit status 2.  It fails closed too (the inputs cannot fool it) when
   record that passed, its ``worst``, ``bound``, ``details["error"]`` or ``details["timing_ratio"]`` (or
   a pass it claimed with a non-finite worst ratio, ``details["unearned_pass"]``): NaN compares false
   against every threshold, so such a baseline would let any result pass — :class:`IncompatibleBaseline`;
+* a record *passed* with its worst ratio above its bound (:func:`check_passes_earned`: no check of verimono's
+  writes one; a pass that contradicts its own figures cannot be trusted) — ``SchemaError``;
+* the baseline has stage times but no calibration to judge them by (:func:`baseline_uncalibrated`) —
+  :class:`IncompatibleBaseline`;
 * the results (or baseline) file carries the in-progress mark of a run that never completed
   (:func:`verimono.records.atomic.in_progress`: killed, or stopped by an error, after older files were there) —
   :class:`IncompatibleResults`.
