@@ -258,12 +258,15 @@ def _cmd_run(args: argparse.Namespace) -> int:
         if args.seed is None and previous.meta.get("seed") is not None:
             args.seed = previous.meta["seed"]
 
-    # the mark before anything that takes time (reading the baseline, building the references, importing the
-    # checks): a run killed from here on leaves it, and the gate refuses the files beside it, the previous run's
+    # over a previous run's files, the mark before anything that takes time (reading the baseline, building the
+    # references, importing the checks): a run killed from here on leaves it, and the gate refuses those files;
+    # over none, after the options are checked (bad references or data: exit 2, nothing written)
+    resumes = None if previous is None else previous.meta.get("run_id")
     run_id = getattr(args, "run_id", None) if previous is None else None
-    run_id = run_id or _start(out, "run", resumes=None if previous is None else previous.meta.get("run_id"))
+    run_id = run_id or (_start(out, "run", resumes=resumes) if (out / "results.json").exists() else None)
     baseline = _baseline_for(args)
-    ctx = _context(args)                          # bad references or data: exit 2, the mark stays
+    ctx = _context(args)
+    run_id = run_id or _start(out, "run", resumes=resumes)
 
     def run(on_done):
         with budget(args.timeout):
@@ -283,10 +286,9 @@ def _cmd_check(args: argparse.Namespace) -> int:
     from .checks.subjects import kind_of
     from .records.atomic import ensure_writable_dir
 
-    out = ensure_writable_dir(args.out)           # before any work
-    # the mark before anything that takes time (importing the target and the checks): a check killed from here
-    # on leaves it, and the gate refuses the files beside it, the previous check's
-    run_id = getattr(args, "run_id", None) or _start(out, "check")
+    # over a previous check's files, the mark before anything that takes time (importing the target and the
+    # checks): a check killed from here on leaves it, and the gate refuses those files
+    run_id = getattr(args, "run_id", None) or _mark_if_stale(args.out, "check")
     obj = load_target(args.target)
     user = obj
     try:
@@ -309,6 +311,8 @@ def _cmd_check(args: argparse.Namespace) -> int:
         raise BadTarget(f"{args.target} is a problem: `verimono check` takes an operator or a stepper")
     from .execution.timeouts import budget
 
+    out = ensure_writable_dir(args.out)           # before any work
+    run_id = run_id or _start(out, "check")
     baseline = _baseline_for(args)                # a baseline that cannot be read: exit 2 before the work
     if getattr(args, "executor", None) not in (None, "serial"):
         from .execution.executors import ship_by_value
@@ -523,12 +527,12 @@ MARKED_COMMANDS = {"run": "reports", "check": "reports/check"}
 
 
 def _early_mark(command: str | None, given: list[str]) -> str | None:
-    """Mark ``--out``/results.json in progress before anything else (the parser imports the stages and the
-    checks: 2-3 s on a loaded machine, during which a killed run would leave the previous run's files
-    unmarked, and the gate would read them as this run's); its run id, or ``None`` — not a marked command,
-    ``--help``, ``--resume`` (the interrupted run's own results are marked incomplete: its mark is read
-    first, then this run's written, :func:`_cmd_run`), or a folder that cannot be written (the command then
-    fails on it with its usual message)."""
+    """Mark ``--out``/results.json in progress before anything else when a previous run's results are there
+    (the parser imports the stages and the checks: 2-3 s on a loaded machine, during which a killed run would
+    leave those files unmarked, and the gate would read them as this run's); its run id, or ``None`` — not a
+    marked command, ``--help``, ``--resume`` (the interrupted run's own results are marked incomplete: its
+    mark is read first, then this run's written, :func:`_cmd_run`), no results there
+    (:func:`_mark_if_stale`)."""
     if command not in MARKED_COMMANDS or {"-h", "--help"} & set(given):
         return None
     pre = argparse.ArgumentParser(add_help=False)
@@ -540,10 +544,20 @@ def _early_mark(command: str | None, given: list[str]) -> str | None:
         return None
     if known.resume:
         return None
+    return _mark_if_stale(known.out, command)
+
+
+def _mark_if_stale(out: str | os.PathLike, command: str) -> str | None:
+    """Mark ``out``/results.json in progress now, and return the run id, when a results file is there — the
+    files a killed run would leave for the gate to take as its own; ``None`` when there is none (nothing
+    stale: the mark is written after the options and the target are checked, so that bad usage creates
+    nothing) or the folder cannot be written (the command fails on it with its usual message)."""
     from .records.atomic import ensure_writable_dir
 
+    if not (Path(out) / "results.json").exists():
+        return None
     try:
-        return _start(ensure_writable_dir(known.out), command)
+        return _start(ensure_writable_dir(out), command)
     except VerimonoError:
         return None
 

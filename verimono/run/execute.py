@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from ..execution import watchdog
+from ..records.atomic import write_text
 from ..records.environment import environment
 from ..execution.executors import BLAS_THREADS, make_runner
 from ..execution.profiles import get_profile, load_hypothesis_profile
@@ -157,8 +158,6 @@ def interruptible(run: Callable[[Callable], Report], out: Path, *, command: str,
         """The stages finished so far, on disk as each finishes (``results.json`` only, marked incomplete, with
         this run's id; the in-progress mark stays): a run killed with SIGKILL, which no handler sees, leaves
         them for ``--resume``.  A checkpoint that cannot be written costs the run nothing but that."""
-        from ..records.atomic import write_text
-
         partial, _ = partial_report()
         partial.meta["run_id"] = run_id
         try:
