@@ -12,7 +12,8 @@
         incomplete (the gate refuses it, exit 2) and exits 130; ``--resume`` runs the stages that file lacks
         and completes it (it names the run id it continues; the result records it in ``meta.resumed_from``).
         ``--timeout S``: seconds per unit of work (one law on one operator, one check of one stepper;
-        default: the profile's), beyond which the unit is stopped and recorded as failed.  ``--timeout`` and
+        default: the profile's), beyond which the unit is stopped while the run goes on: undecided when all it
+        evaluated held, failed when a call never returns or a sample was violated.  ``--timeout`` and
         ``--unit-timeout`` are numbers of seconds > 0 or ``inf`` (no limit), checked before any work (exit 2
         otherwise: ``nan``, 0, negatives).  A call blocked in native code (``os.system``, a C extension),
         which the budget's interrupt cannot stop, is stopped by a process-level limit (``verimono.execution.watchdog``)
@@ -89,9 +90,9 @@ def _context(args: argparse.Namespace, **kw: Any) -> Any:
             problems = [get(name) for name in args.reference]
         except KeyError as exc:
             raise BadTarget(str(exc.args[0])) from None
-    for spec in getattr(args, "problem", None) or []:
-        problems = (problems or []) + _load_problems(spec)
-    return RunContext(seed=getattr(args, "seed", None), data_dir=data, problems=problems, **kw)
+    extra = [p for spec in getattr(args, "problem", None) or [] for p in _load_problems(spec)]
+    # --problem adds to the references (the catalog, or those chosen with --reference): it never replaces them
+    return RunContext(seed=getattr(args, "seed", None), data_dir=data, problems=problems, extra_problems=extra, **kw)
 
 
 def _load_problems(spec: str) -> list[Any]:
@@ -258,7 +259,6 @@ def _cmd_run(args: argparse.Namespace) -> int:
     from .records.atomic import ensure_writable_dir, in_progress
     from .records.results import load
     out = ensure_writable_dir(args.out)           # before any work: a run must not be lost at the end
-    baseline = _baseline_for(args)
     previous, stages = None, args.stage
     if args.resume:
         results, killed = out / "results.json", in_progress(out / "results.json")
@@ -284,8 +284,15 @@ def _cmd_run(args: argparse.Namespace) -> int:
         if args.seed is None and previous.meta.get("seed") is not None:
             args.seed = previous.meta["seed"]
 
-    ctx = _context(args)                          # bad references or data: exit 2 before the mark
-    run_id = _start(out, "run", resumes=None if previous is None else previous.meta.get("run_id"))
+    # over a previous run's files, the mark before anything that takes time (reading the baseline, building the
+    # references, importing the checks): a run killed from here on leaves it, and the gate refuses those files;
+    # over none, after the options are checked (bad references or data: exit 2, nothing written)
+    resumes = None if previous is None else previous.meta.get("run_id")
+    run_id = getattr(args, "run_id", None) if previous is None else None
+    run_id = run_id or (_start(out, "run", resumes=resumes) if (out / "results.json").exists() else None)
+    baseline = _baseline_for(args)
+    ctx = _context(args)
+    run_id = run_id or _start(out, "run", resumes=resumes)
 
     def run(on_done):
         with using_config(run_config(args)):
@@ -293,7 +300,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
                            progress=Progress(), on_done=on_done, **_executor_options(args))
 
     report = interruptible(run, out, command="run", profile=args.profile, stages=args.stage, previous=previous,
-                           run_id=run_id)
+                           run_id=run_id, checkpoint=True)
     if isinstance(report, int):
         return report
     if previous is not None:
@@ -303,30 +310,39 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 def _cmd_check(args: argparse.Namespace) -> int:
     from .checks.subjects import kind_of
+    from .records.atomic import ensure_writable_dir
 
+    # over a previous check's files, the mark before anything that takes time (importing the target and the
+    # checks): a check killed from here on leaves it, and the gate refuses those files
+    run_id = getattr(args, "run_id", None) or _mark_if_stale(args.out, "check")
     obj = load_target(args.target)
+    user = obj
     try:
         kind = kind_of(obj)
     except InvalidCheckArgument as exc:
         raise BadTarget(f"{args.target}: {exc}") from None
     if kind == "operator":
-        stages, ctx = ["operator_laws"], _context(args, operators=[(args.target, obj)])
+        from .core.naming import subject_name
+
+        # the operator's own name, as the API and pytest call it: one record key whatever the entry point
+        stages, ctx = ["operator_laws"], _context(args, operators=[(subject_name(obj), obj)])
     elif kind == "stepper":
-        obj = with_claim(obj, args.scheme, args.order, solve_tol=args.solve_tol)
+        from .execution.timing import TimedStepper
+
+        # its calls are timed apart from the checks around them: the gate judges the subject's own CPU time
+        obj = TimedStepper(with_claim(obj, args.scheme, args.order, solve_tol=args.solve_tol))
         stages, ctx = ["convergence", "trajectory_laws"], _context(args, stepper=obj)
         kind = "stepper" + ("" if claim_of(obj).proximal else f" claiming {claim_of(obj).describe()}")
     else:
         raise BadTarget(f"{args.target} is a problem: `verimono check` takes an operator or a stepper")
-    from .records.atomic import ensure_writable_dir
-
     out = ensure_writable_dir(args.out)           # before any work
+    run_id = run_id or _start(out, "check")
     baseline = _baseline_for(args)                # a baseline that cannot be read: exit 2 before the work
     if getattr(args, "executor", None) not in (None, "serial"):
         from .execution.executors import ship_by_value
 
-        ship_by_value(obj)  # its module need not be importable on the workers
-    print(f"verimono: checking {args.target} as a {kind}", file=sys.stderr)
-    run_id = _start(out, "check")
+        ship_by_value(user)  # its module need not be importable on the workers
+    print(f"verimono: checking {args.target} as {'an' if kind[0] in 'aeiou' else 'a'} {kind}", file=sys.stderr)
 
     def run(on_done):
         with using_config(run_config(args)):
@@ -389,11 +405,23 @@ def _cmd_baseline(args: argparse.Namespace) -> int:
     if args.from_results:
         from .run.gate import check_completed
 
+        from .core.errors import IncompatibleResults
+        from .records.results import MISSING_RECORDS
+        from .run.gate import check_baseline, check_passes_earned
+
         check_completed(args.from_results)        # the files of a run that never completed: exit 2
         report = load(args.from_results)
         if report.meta.get("incomplete"):
             raise NothingToResume(f"{args.from_results} is an interrupted run (marked incomplete): finish it "
                                   "with `verimono run --resume` before recording it as a baseline")
+        missing = report.meta.get(MISSING_RECORDS) or {}
+        if any(missing.get(k) for k in ("crashed", "hidden")):
+            lost = list(missing.get("crashed") or []) + list(missing.get("hidden") or [])
+            why = "a worker crashed while running" if missing.get("crashed") else "a runner kept the records of"
+            raise IncompatibleResults(f"{args.from_results} is short: {why} {len(lost)} test(s) (e.g. {lost[0]}), "
+                                      "whose records are missing; run the session again before recording a baseline")
+        check_passes_earned(report, str(args.from_results))   # a pass that contradicts its figures: exit 2
+        check_baseline(report, str(args.from_results))        # empty, uncalibrated or non-finite: exit 2
     else:
         from .execution.watchdog import on_hang
 
@@ -486,7 +514,9 @@ def build_parser() -> argparse.ArgumentParser:
                        help="use only this analytic reference (repeatable; default: the whole catalog)")
         p.add_argument("--timeout", type=_seconds, default=None, metavar="S",
                        help="seconds per unit of work (one law on one operator, one check of one stepper) "
-                            "before it is stopped and recorded as failed (default: the profile's; inf: no limit)")
+                            "before it is stopped while the run goes on: undecided when all it evaluated held, "
+                            "failed when a call never returns or a sample was violated (default: the profile's; "
+                            "inf: no limit)")
         p.add_argument("--executor", default=None, metavar="SPEC",
                        help="where the stages' independent units run: serial, auto (every core, at most 4 "
                             "worker processes; the default, $VERIMONO_EXECUTOR overrides), process:N (N "
@@ -563,6 +593,46 @@ CALIBRATED_COMMANDS = ("run", "check", "baseline")
 DRAWN_COMMANDS = ("run", "check")
 
 
+#: the commands whose output folder is marked in progress before the parser (and the stages it lists) is built
+MARKED_COMMANDS = {"run": "reports", "check": "reports/check"}
+
+
+def _early_mark(command: str | None, given: list[str]) -> str | None:
+    """Mark ``--out``/results.json in progress before anything else when a previous run's results are there
+    (the parser imports the stages and the checks: 2-3 s on a loaded machine, during which a killed run would
+    leave those files unmarked, and the gate would read them as this run's); its run id, or ``None`` — not a
+    marked command, ``--help``, ``--resume`` (the interrupted run's own results are marked incomplete: its
+    mark is read first, then this run's written, :func:`_cmd_run`), no results there
+    (:func:`_mark_if_stale`)."""
+    if command not in MARKED_COMMANDS or {"-h", "--help"} & set(given):
+        return None
+    pre = argparse.ArgumentParser(add_help=False)
+    pre.add_argument("--out", default=MARKED_COMMANDS[command])
+    pre.add_argument("--resume", action="store_true")
+    try:
+        known, _ = pre.parse_known_args(given[given.index(command) + 1:])
+    except SystemExit:           # malformed: the real parser says why
+        return None
+    if known.resume:
+        return None
+    return _mark_if_stale(known.out, command)
+
+
+def _mark_if_stale(out: str | os.PathLike, command: str) -> str | None:
+    """Mark ``out``/results.json in progress now, and return the run id, when a results file is there — the
+    files a killed run would leave for the gate to take as its own; ``None`` when there is none (nothing
+    stale: the mark is written after the options and the target are checked, so that bad usage creates
+    nothing) or the folder cannot be written (the command fails on it with its usual message)."""
+    from .records.atomic import ensure_writable_dir
+
+    if not (Path(out) / "results.json").exists():
+        return None
+    try:
+        return _start(ensure_writable_dir(out), command)
+    except VerimonoError:
+        return None
+
+
 def main(argv: list[str] | None = None) -> int:
     from threadpoolctl import threadpool_limits
 
@@ -584,11 +654,14 @@ def main(argv: list[str] | None = None) -> int:
             if connect is not None:
                 connect(pending.forked)
         try:
+            run_id = _early_mark(command, given)
             args = build_parser().parse_args(argv)
             if hasattr(args, "profile"):
                 resolve_profile(args)
             args.argv = given                          # the command as given (advice after an interrupt)
             args.calibration = pending
+            if run_id is not None:
+                args.run_id = run_id
             func: Callable[[argparse.Namespace], int] = args.func
             try:
                 return func(args)

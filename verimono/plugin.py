@@ -36,7 +36,7 @@ import pytest
 
 from .records.atomic import ensure_writable_dir
 from .core.errors import OutputNotWritable
-from .records.results import FAILED, XFAIL, XFAIL_DECLARED, CheckResult, Report, listening
+from .records.results import FAILED, MISSING_RECORDS, XFAIL, XFAIL_DECLARED, CheckResult, Report, listening
 
 _KEY = pytest.StashKey["_Collector"]()
 
@@ -114,6 +114,7 @@ class _Collector:
         self.extras: dict[str, dict[str, list]] = {}   # nodeid -> studies and trajectories of added Reports
         self.order: dict[str, int] = {}                # nodeid -> position in the collection
         self.hidden: list[str] = []                    # call reports whose records could not reach us
+        self.crashed: list[str] = []                   # tests whose xdist worker died while running them
         self.report = Report(meta={"command": "pytest", "target": None, "profile": profile, "seed": None})
         self.nodeid: str | None = None
         self.seen: set[int] = set()
@@ -235,14 +236,23 @@ class _Collector:
                      for x in extra[kind]}
             getattr(self.report, kind).sort(key=lambda x: where.get(id(x), last))
 
+    @pytest.hookimpl(optionalhook=True)
+    def pytest_handlecrashitem(self, crashitem: str, report: Any, sched: Any) -> None:
+        """An xdist worker died while running ``crashitem``: whatever records that test had made died with it."""
+        self.crashed.append(crashitem)
+
     def pytest_sessionfinish(self, session: pytest.Session, exitstatus: int) -> None:
         if self.worker:
             return
         from .records.environment import environment
 
         self._in_collection_order()
-        if self.hidden and session.exitstatus == pytest.ExitCode.OK:
+        if (self.hidden or self.crashed) and session.exitstatus == pytest.ExitCode.OK:
             session.exitstatus = pytest.ExitCode.TESTS_FAILED
+        if self.hidden or self.crashed:
+            # the records of these tests are missing: the results are short, never a baseline (verimono
+            # baseline --from refuses them; the gate shows what they lack against a baseline)
+            self.report.meta[MISSING_RECORDS] = {"crashed": list(self.crashed), "hidden": list(self.hidden)}
         self.report.meta.update({"duration": time.perf_counter() - self.start, "environment": environment()})
         if self.baseline is not None:
             from .run.gate import check_runs_compatible, compare

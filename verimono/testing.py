@@ -51,6 +51,7 @@ from typing import Any, Callable, Iterable, Mapping
 import pytest
 
 from .checks.core import laws_of
+from .checks.sample_problems import valid_count
 from .checks.core import subject_name as core_subject_name
 from .checks.subjects import kind_of
 from .execution.config import current as current_config
@@ -124,6 +125,7 @@ def registry_size(subject: Any, *, problems: Iterable | None = None, generated: 
     kind = kind_of(subject)
     if kind in ("operator", "problem"):
         return len(laws_of(kind, battery=True))
+    generated = valid_count(generated)
     from .checks.stepper_battery import CHECKS
 
     if problems is not None:

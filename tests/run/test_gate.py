@@ -25,7 +25,8 @@ def base() -> Report:
     rep.add(CheckResult("siconos_agreement", "DiodeBridge", "passed", worst=0.1, bound=1.0,
                         details={"error": 1e-9}))
     rep.meta.update({"command": "run", "profile": "ci", "target": None, "calibration": 0.05,
-                     "stages": [{"name": "operator_laws", "duration": 4.0, "status": "passed", "records": 2}]})
+                     "stages": [{"name": "operator_laws", "duration": 4.0, "status": "passed", "records": 2,
+                                 "cpu": 3.6, "calibration_cpu": [0.05] * 8}]})
     return Report.from_dict(rep.to_dict())
 
 
@@ -171,6 +172,9 @@ GARBLED = [
     ("meta.stages entry a string", lambda d: d["meta"].update(stages=["operator_laws"]), "stages"),
     ("stage duration a string", lambda d: d["meta"]["stages"][0].update(duration="4 s"), "stages"),
     ("meta.calibration a string", lambda d: d["meta"].update(calibration="fast"), "calibration"),
+    ("stage cpu a string", lambda d: d["meta"]["stages"][0].update(cpu="3 s"), "cpu"),
+    ("stage cpu negative", lambda d: d["meta"]["stages"][0].update(cpu=-1.0), "cpu"),
+    ("stage calibration_cpu holds a zero", lambda d: d["meta"]["stages"][0]["calibration_cpu"].append(0), "calibration_cpu"),
 ]
 
 

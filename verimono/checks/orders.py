@@ -16,12 +16,14 @@ within ``LIMIT_FACTOR`` times the sum of their estimated errors there.
 
 from __future__ import annotations
 
+import math
 from typing import Any, Callable
 
 import numpy as np
 
 from ..core.claims import claim_of
 from ..core.convergence import ORDER_SLACK, _timed_run, convergence_study, study_grids
+from ..core.grids import uniform_grid
 from ..core.problem import Order, Problem, origin_of
 from ..records.results import FAILED, PASSED
 from ..core.stepping import solve
@@ -86,8 +88,14 @@ def check_convergence_order(stepper: Callable, problem: Problem, *, executor: An
     reference's stated order (exact at the nodes where it is) for the proximal scheme; for a scheme
     claiming only ``scheme="any"`` with order ``p``, ``min(p, problem.order.regularity)``."""
     exp = _expected(stepper, problem)
-    study = convergence_study(stepper, problem if exp is problem.order else problem.replace(order=exp),
-                              problem.steps, executor=executor)
+    try:
+        study = convergence_study(stepper, problem if exp is problem.order else problem.replace(order=exp),
+                                  problem.steps, executor=executor)
+    except NotImplementedError as exc:
+        refused = _refuses_fine_grids(stepper, problem, exc)
+        if refused is None:
+            raise                   # not even the coarsest grid: not available here (skipped, as before)
+        return refused
     ok, msg = study.verdict()
     fit = study.order
     if exp.exact:
@@ -107,6 +115,23 @@ def check_convergence_order(stepper: Callable, problem: Problem, *, executor: An
     # the study's verdict decides; the ratio says by how much
     return Outcome(worst, details=details, message=msg, status=PASSED if ok else FAILED,
                    counter={} if ok else {"steps": study.mesh, "errors": study.errors["sup"], "message": msg})
+
+
+def _refuses_fine_grids(stepper: Callable, problem: Problem, exc: NotImplementedError) -> Outcome | None:
+    """The failed outcome of a stepper that runs the study's coarsest grid but raised ``exc``
+    (NotImplementedError) on a finer one — convergence is a statement about every partition as ``h → 0``, so
+    it cannot be shown, and such a stepper was reported ok (its order record skipped, the stage passed) —
+    or ``None`` when the coarsest grid raises too (the stepper does not run this problem at all)."""
+    h = max(problem.steps)
+    try:
+        stepper(problem, uniform_grid(problem.T, h))
+    except NotImplementedError:
+        return None
+    msg = (f"the stepper runs the coarsest grid (h = {h:g}) but raised NotImplementedError on a finer one of the "
+           f"study (h = {', '.join(f'{s:g}' for s in problem.steps)}): {exc}; convergence is a statement about every "
+           "partition as h → 0, so a stepper that refuses fine grids cannot be shown to converge")
+    return Outcome(math.inf, details={"refused_grids": f"NotImplementedError: {exc}"}, message=msg, status=FAILED,
+                   counter={"steps": list(problem.steps), "message": msg})
 
 
 def reproduction_script(problem: Problem) -> str:

@@ -27,7 +27,7 @@ import zlib
 
 import numpy as np
 
-from ..core.tolerances import current_rtol, tolerance
+from ..core.tolerances import current_eps, current_precision, current_rtol, tolerance
 from .core import Member, Outcome
 from .members import norm as _nrm
 from .members import resolvent as _J
@@ -49,9 +49,21 @@ def _tolf(*values: float) -> float:
 _VALUE = Member("value")
 
 
-def _outside(p, gp, what) -> Outcome:
-    return Outcome.compare(math.inf, 0.0, 1.0, f"{what}: g(p) = {gp} at p = J_λx, so p ∉ dom g",
-                           {"p": p.tolist(), "g(p)": gp})
+def _outside(p, gp, what, x) -> Outcome:
+    """The outcome of a law whose ``p = J_λx`` the user's value function puts outside ``dom g`` (``g(p) = ∞``):
+    a failure (the prox of ``g`` lies in ``dom g``) that says the value function said so, and gives the
+    round-off of ``J`` at that point, ``eps·(1 + |x|)`` with ``eps`` the unit round-off of the precision under
+    judgement — a float32 projection from ``|x| = 1e3`` may leave its set by up to about ``eps·|x| ≈ 1e-4``,
+    which a strict indicator (``inf`` for any point outside) rejects although ``J`` is exact to its precision."""
+    tau = current_eps() * (1.0 + max(_nrm(x), _nrm(p)))
+    prec = current_precision().name
+    return Outcome.compare(math.inf, 0.0, 1.0,
+                           f"{what}: the value function says p = J_λx lies outside dom g (g(p) = {gp}); J's "
+                           f"round-off at this point is about eps·|x| = {tau:.3g} ({prec}, |x| = {_nrm(x):.3g}): a value function "
+                           "that rejects every point outside its set (a strict indicator) also rejects a J that "
+                           "leaves it by round-off; give it that tolerance if J is exact to its precision",
+                           {"p": p.tolist(), "g(p)": gp, "outside_dom_g": "the value function says so",
+                            "resolvent_roundoff": tau, "precision": prec})
 
 
 def _directions(x, p, n, seed_like) -> list[np.ndarray]:
@@ -80,7 +92,7 @@ def _at_prox_point(what):
         def evaluate(op, s):
             p = _J(op, s.x1, s.lam, s.t)
             gp = _g(op, p, s.t)
-            return body(op, s, p, gp) if math.isfinite(gp) else _outside(p, gp, what)
+            return body(op, s, p, gp) if math.isfinite(gp) else _outside(p, gp, what, s.x1)
         return evaluate
     return decorate
 
@@ -199,9 +211,9 @@ def check_moreau_envelope(op, s):
     x1, x2 = s.x1, s.x2
     p1, p2 = _J(op, x1, lam, t), _J(op, x2, lam, t)
     g1, g2 = _g(op, p1, t), _g(op, p2, t)
-    for p, gv in ((p1, g1), (p2, g2)):
+    for x, p, gv in ((x1, p1, g1), (x2, p2, g2)):
         if not math.isfinite(gv):
-            return _outside(p, gv, "Moreau envelope")
+            return _outside(p, gv, "Moreau envelope", x)
     e1 = g1 + float((x1 - p1) @ (x1 - p1)) / (2 * lam)
     e2 = g2 + float((x2 - p2) @ (x2 - p2)) / (2 * lam)
     y1 = (x1 - p1) / lam

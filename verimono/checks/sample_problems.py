@@ -24,6 +24,7 @@ import math
 import numpy as np
 
 from ..core.operators import L1Subdifferential, Linear, NormalCone, NormSubdifferential
+from ..core.errors import InvalidCheckArgument
 from ..core.problem import Problem
 from ..core.sets import Ball, Box, HalfSpace
 
@@ -91,9 +92,21 @@ def sample_problem(seed: int, family: str | None = None) -> Problem:
     raise ValueError(f"unknown family {family!r}; known: {FAMILIES}")
 
 
+def valid_count(count: object, what: str = "generated") -> int:
+    """``count`` as a number of sample problems: an integer ``>= 0`` (0: none), else
+    :class:`verimono.InvalidCheckArgument` — ``generated=-1`` would draw none and say nothing."""
+    import numbers
+
+    if isinstance(count, bool) or not isinstance(count, numbers.Integral) or count < 0:
+        raise InvalidCheckArgument(f"{what} is a number of sample problems, an integer >= 0, got {count!r}")
+    return int(count)
+
+
 def sample_problems(seed: int = 0, count: int = len(FAMILIES)) -> list[Problem]:
-    """``count`` problems cycling through the families, seeds ``seed, seed + 1, ...``."""
+    """``count`` problems cycling through the families, seeds ``seed, seed + 1, ...`` (``count`` an integer
+    ``>= 0``: :func:`valid_count`)."""
+    count = valid_count(count)
     return [sample_problem(seed + i, FAMILIES[(seed + i) % len(FAMILIES)]) for i in range(count)]
 
 
-__all__ = ["FAMILIES", "sample_problem", "sample_problems"]
+__all__ = ["FAMILIES", "sample_problem", "sample_problems", "valid_count"]

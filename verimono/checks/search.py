@@ -47,6 +47,7 @@ import hypothesis.errors
 import numpy as np
 from hypothesis import HealthCheck, Phase, Verbosity, given, settings
 
+from ..core.arrays import library_hint
 from ..core._reproducible import no_local_constants
 from .arguments import valid_horizon, valid_seed
 from ..core.errors import InvalidCheckArgument, UnitTimeout
@@ -133,7 +134,8 @@ def root_cause(op: Any, horizon: float = 1.0) -> str | None:
             except Exception as exc:  # noqa: BLE001 - any exception is the root cause we report
                 if classify(exc)[0] == UNDECIDED:
                     continue
-                return f"the resolvent raises {type(exc).__name__}: {exc} at x = {x[:3].tolist()}..., λ = 1, t = {t:g}"
+                return (f"the resolvent raises {type(exc).__name__}: {exc} at x = {x[:3].tolist()}..., λ = 1, t = {t:g}"
+                        + library_hint(exc, getattr(op, "array", "numpy")))
             if y.shape != x.shape:
                 return f"the resolvent returns shape {y.shape} for a point of shape {x.shape} (λ = 1, t = {t:g})"
     return None

@@ -24,7 +24,7 @@ from ..execution.executors import Unit
 from .core import laws_of, stepper_subject
 from .isolated import isolating, run_check, run_isolated
 from .partitions import single
-from .sample_problems import sample_problems
+from .sample_problems import sample_problems, valid_count
 from .arguments import valid_seed
 from .shared_runs import shared_runs
 from .subjects import require_problem, require_stepper
@@ -77,6 +77,7 @@ def stepper_checks(stepper: Callable | None = None, problems: Iterable[Problem] 
     (the battery does not depend on it); it is accepted for the protocol ``stepper_checks(stepper)``.
     """
     seed = valid_seed(seed)
+    generated = valid_count(generated)
     if problems is None:
         from verimono.reference import catalog   # the catalog builds every reference: on first use only
 
@@ -132,6 +133,7 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
         problems = [require_problem(p) for p in problems]
     given, stepper = stepper, with_claim(stepper, scheme, order)
     seed = 0 if seed is None else valid_seed(seed)
+    generated = valid_count(generated)
     selected = () if laws is False else (LAWS if laws is True else _selected(tuple(laws)))
     if not selected and not orders:
         raise InvalidCheckArgument("check_stepper selected no check (no law, no order): it would verify nothing")

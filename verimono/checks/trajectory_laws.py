@@ -288,12 +288,15 @@ def check_selections(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int 
         return Outcome(worst, k + 1, {"k": k + 1}, details, message=message)
     counter = {"k": k + 1, "t_k": t[k + 1], "x_k": x[k], "x_k_plus_1": x[k + 1], "h": h[k], "selection": y[k],
                "velocity": velocity, **terms,
-               "contains": bool(member[k]), "resolvent_residual_ratio": ratios[k]}
+               "contains": bool(member[k]) if contains_available else None, "resolvent_residual_ratio": ratios[k]}
+    # what each test said: membership only where the operator provides ``contains`` (no "contains: True"
+    # for one that has none: it was never asked)
+    said = (f"contains: {bool(member[k])}, " if contains_available else "the operator has no contains; ")
     outside = _outside_domain(op, x[k + 1], float(t[k + 1])) if bad.size else None
     msg = (f"the discrete velocity y = {velocity} = {np.array2string(y[k], precision=6)} is not in "
            f"F(t_(k+1), x_(k+1)) at k+1 = {k + 1}, t = {t[k + 1]:.6g}"
            + "".join(f", {name} = {np.array2string(v, precision=6)}" for name, v in terms.items())
-           + f" (contains: {bool(member[k])}, |J(x + mu y) - x|/tol = {ratios[k]:.3g})")
+           + f" ({said}|J(x + mu y) - x|/tol = {ratios[k]:.3g})")
     if outside is not None:     # the real cause first: no velocity is a selection outside dom F
         counter["distance_to_domain"] = outside
         msg = (f"x_(k+1) = {np.array2string(x[k + 1], precision=6)} lies outside cl dom F(t_(k+1), ·) (distance "

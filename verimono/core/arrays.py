@@ -254,6 +254,25 @@ def take_prefetched(cache: dict | None, x: Any, lam: float, t: float) -> np.ndar
     return None if hit is None else hit.copy()
 
 
+#: what an error raised by a function of another library's arrays, given NumPy's, says of that library
+_LIBRARY_SIGNS = {"torch": ("Tensor", "torch"), "jax": ("jax", "Array'"), "cupy": ("cupy",)}
+
+
+def library_hint(exc: BaseException, given: str = "numpy") -> str:
+    """A sentence for the message of ``exc``, raised by a user's function that verimono gave ``given``
+    arrays: when its text names another array library (``must be Tensor, not numpy.ndarray``), the option that
+    makes verimono give it that library's arrays (``array="torch"``); else ``""``."""
+    if given != "numpy":
+        return ""
+    text = f"{type(exc).__name__}: {exc}"
+    for lib, signs in _LIBRARY_SIGNS.items():
+        if any(sign in text for sign in signs):
+            return (f"; it was given NumPy arrays and looks like a function of {lib} arrays: wrap it with "
+                    f'array="{lib}" (verimono.operator_from_prox(..., array="{lib}"), or operator_from_resolvent) '
+                    f"so that it is given {lib} arrays")
+    return ""
+
+
 class Boundary:
     """The conversions of one subject at verimono's boundary: its inputs from NumPy to its array type (none
     for NumPy float64), its outputs to NumPy float64 with their precision reported.  ``kind=None``: the

@@ -22,16 +22,86 @@ from typing import Callable
 import numpy as np
 
 
-def workload() -> None:
-    """The calibration workload itself: 20 000 small NumPy steps in a Python loop and one 60 x 60 solve."""
+#: the steps of the calibration workload's loop
+WORKLOAD_STEPS = 20000
+#: the steps of a *slice* (:func:`slice_cpu`): a twentieth of the workload, 3-4 ms of CPU idle, 8 ms busy
+SLICE_STEPS = 1000
+
+
+def workload(steps: int = WORKLOAD_STEPS) -> None:
+    """The calibration workload itself: 20 000 small NumPy steps in a Python loop and one 60 x 60 solve
+    (``steps``: fewer steps, for a slice of it)."""
     x, lo, hi = np.array([0.3, -0.2, 0.9]), -np.ones(3) * 0.5, np.ones(3) * 0.5
-    for k in range(20000):
+    for k in range(steps):
         x = np.clip(x - 1e-3 * np.sin(k * 1e-3) * x, lo, hi)
     np.linalg.solve(np.eye(60) * 4.0 + np.ones((60, 60)), np.ones(60))
 
 
+#: a slice is taken after each unit, and one more per SLICE_EVERY CPU seconds of it, at most MAX_SLICES:
+#: 1.4% of a long unit's CPU time, 3-8 ms after a short one
+SLICE_EVERY = 0.25
+MAX_SLICES = 8
+
+
+def slices_after(cpu_seconds: float) -> list[float]:
+    """:func:`slice_cpu` samples to take after work of ``cpu_seconds``: one, and one more per
+    :data:`SLICE_EVERY` seconds, at most :data:`MAX_SLICES`."""
+    k = 1 + min(int(max(cpu_seconds, 0.0) / SLICE_EVERY), MAX_SLICES - 1)
+    return [slice_cpu() for _ in range(k)]
+
+
+def slice_cpu() -> float:
+    """The CPU time of one slice of the workload, scaled to the whole (x WORKLOAD_STEPS / SLICE_STEPS): a
+    sample of the calibration taken between a run's units, where and when they ran
+    (:func:`verimono.run.stages.registry.timed_unit`).  Load on a shared machine changes within seconds, and
+    with it what the code's CPU time is inflated by (a busy machine switches between more processes, each
+    switch refilling caches: the workload's CPU time read 0.09-0.18 s within a minute here, 0.065 s idle), so a
+    stage's CPU time is stated against samples taken beside its own work, not against one calibration
+    before it."""
+    c0 = time.thread_time()
+    workload(SLICE_STEPS)
+    return (time.thread_time() - c0) * (WORKLOAD_STEPS / SLICE_STEPS)
+
+
 #: how close (relative) a repeat of :func:`calibrate` must come to ``agreeing_with`` to end the repeats early
 AGREEMENT = 0.05
+
+
+def calibrate_times(repeats: int = 3, *, agreeing_with: float | None = None,
+                    agreeing_cpu: float | None = None) -> tuple[float, list[float]]:
+    """``(best wall seconds, CPU seconds of every repeat)`` of :func:`workload`: :func:`calibrate`'s
+    measurement, with the CPU time of the calling thread (:func:`time.thread_time`) of each repeat too.
+
+    The CPU figure is what :mod:`verimono.run.gate` states stage times in: load on the other cores does not
+    add to it (a wait for a CPU is not CPU time), while what load does to the code as it runs (caches,
+    memory bandwidth, a slower clock: up to 2.5x here, the calibration's CPU time 0.17 s against 0.065 s
+    idle beside other test runs) slows the workload and the stages alike.  ``agreeing_with``: as in
+    :func:`calibrate`, on the wall figure; ``agreeing_cpu``: the same on the CPU figure (:func:`cpu_seconds`
+    of the repeats so far within :data:`AGREEMENT` of it) — with both given, both must agree."""
+    best, cpus = float("inf"), []
+    for _ in range(repeats):
+        c0, start = time.thread_time(), time.perf_counter()
+        workload()
+        best = min(best, time.perf_counter() - start)
+        cpus.append(time.thread_time() - c0)
+        agree = [abs(now / then - 1.0) <= AGREEMENT for now, then in ((best, agreeing_with),
+                                                                       (cpu_seconds(cpus), agreeing_cpu))
+                 if then is not None]
+        if agree and all(agree):
+            break
+    return best, cpus
+
+
+def cpu_seconds(cpus: list[float]) -> float:
+    """The CPU figure of a calibration: the median of its repeats' CPU seconds.  Not their minimum, as the
+    wall figure is: a stage's CPU time is a sum over all its work, slowed by whatever the load does to code
+    as it runs (caches, memory bandwidth), so the calibration it is divided by is the workload's typical CPU
+    time under the same load, not its luckiest."""
+    xs = sorted(float(c) for c in cpus)
+    if not xs:
+        raise ValueError("a calibration has at least one repeat")
+    mid = len(xs) // 2
+    return xs[mid] if len(xs) % 2 else 0.5 * (xs[mid - 1] + xs[mid])
 
 
 def calibrate(repeats: int = 3, *, agreeing_with: float | None = None) -> float:
@@ -48,14 +118,7 @@ def calibrate(repeats: int = 3, *, agreeing_with: float | None = None) -> float:
     repeated to remove; a repeat that disagrees is repeated as before.  (0.12 s of a 2-second ``verimono
     check`` on a quiet machine.)
     """
-    best = float("inf")
-    for _ in range(repeats):
-        start = time.perf_counter()
-        workload()
-        best = min(best, time.perf_counter() - start)
-        if agreeing_with is not None and abs(best / agreeing_with - 1.0) <= AGREEMENT:
-            break
-    return best
+    return calibrate_times(repeats, agreeing_with=agreeing_with)[0]
 
 
 _CALIBRATION: list[float] = []
@@ -80,7 +143,7 @@ def set_calibration(seconds: float | None) -> None:
 
 
 class PendingCalibration:
-    """:func:`calibrate` measured in a forked copy of this process while this one goes on — the command line
+    """:func:`calibrate_times` measured in a forked copy of this process while this one goes on — the command line
     starts it before its imports (about 0.4 s on one core, while the measurement takes the other) and takes
     :meth:`result` when its run begins.  Where a fork is not safe (not Linux, or another thread running: a
     lock held at the fork would stay held in the copy) or fails, :meth:`result` measures here instead."""
@@ -89,7 +152,7 @@ class PendingCalibration:
         """``then``: what the copy does once it has answered (the command line's report drawer,
         :func:`verimono.records.report.drawer.serve`); the copy then lives on until :meth:`close`."""
         self.repeats = repeats
-        self._value: float | None = None
+        self._value: tuple[float, list[float]] | None = None
         self._pid: int | None = None
         self._fd: int | None = None
         self._lives_on = then is not None
@@ -105,7 +168,8 @@ class PendingCalibration:
             code = 1
             try:
                 os.close(r)
-                os.write(w, struct.pack("<d", calibrate(repeats)))
+                wall, cpus = calibrate_times(repeats)
+                os.write(w, struct.pack(f"<{1 + repeats}d", wall, *cpus))
                 os.close(w)
                 if then is not None:
                     then()
@@ -115,10 +179,11 @@ class PendingCalibration:
         os.close(w)
         self._pid, self._fd = pid, r
 
-    def _collect(self, kill: bool = False) -> float | None:
+    def _collect(self, kill: bool = False) -> tuple[float, list[float]] | None:
         if self._fd is None or self._pid is None:
             return None
         fd, pid, self._fd = self._fd, self._pid, None
+        size = 8 * (1 + self.repeats)
         data = b""
         try:
             if kill:
@@ -127,19 +192,20 @@ class PendingCalibration:
                 except ProcessLookupError:  # pragma: no cover - it had ended
                     pass
                 return None
-            while len(data) < 8:
-                chunk = os.read(fd, 8 - len(data))
+            while len(data) < size:
+                chunk = os.read(fd, size - len(data))
                 if not chunk:
                     break
                 data += chunk
         finally:
             os.close(fd)
-            if kill or not self._lives_on or len(data) != 8:   # else it lives on: reaped by close()
+            if kill or not self._lives_on or len(data) != size:   # else it lives on: reaped by close()
                 self._reap()
-        if len(data) != 8:
+        if len(data) != size:
             return None
-        value = struct.unpack("<d", data)[0]
-        return value if value > 0 and math.isfinite(value) else None
+        wall, *cpus = struct.unpack(f"<{1 + self.repeats}d", data)
+        ok = all(x > 0 and math.isfinite(x) for x in (wall, *cpus))
+        return (wall, list(cpus)) if ok else None
 
     def _reap(self) -> None:
         pid, self._pid = self._pid, None
@@ -153,9 +219,14 @@ class PendingCalibration:
 
     def result(self) -> float:
         """The seconds measured (waiting for the copy to answer), or measured here if it could not."""
+        return self.times()[0]
+
+    def times(self) -> tuple[float, list[float]]:
+        """:func:`calibrate_times` of the copy (waiting for it to answer), or measured here if it could not:
+        the best wall seconds and the CPU seconds of every repeat."""
         if self._value is None:
             measured = self._collect()
-            self._value = measured if measured is not None else calibrate(self.repeats)
+            self._value = measured if measured is not None else calibrate_times(self.repeats)
         return self._value
 
     def close(self) -> None:
@@ -167,4 +238,4 @@ class PendingCalibration:
         self._reap()
 
 
-__all__ = ["AGREEMENT", "PendingCalibration", "calibrate", "calibration", "set_calibration", "workload"]
+__all__ = ["AGREEMENT", "PendingCalibration", "calibrate", "calibrate_times", "cpu_seconds", "slice_cpu", "slices_after", "SLICE_EVERY", "MAX_SLICES", "WORKLOAD_STEPS", "SLICE_STEPS", "calibration", "set_calibration", "workload"]

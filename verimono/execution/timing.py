@@ -58,8 +58,12 @@ import dataclasses
 import math
 import os
 import statistics
+import threading
 import time
 from typing import Any, Callable, Sequence
+
+from ..core.claims import Stepper, claim_of
+from ..core.naming import subject_name
 
 from .calibration import calibrate, calibration, set_calibration, workload
 
@@ -126,6 +130,63 @@ def timed(fn: Callable[[], Any]) -> tuple[Any, Sample]:
     else:
         waited, own = max(wall - cpu, 0.0), cpu
     return out, Sample(own, wall, cpu, waited)
+
+
+def cpu_now() -> float:
+    """CPU seconds of this process so far, with those of its children it has waited for (a process pool a
+    convergence study forks and closes): :func:`time.process_time` plus :func:`os.times`' children's."""
+    t = os.times()
+    return time.process_time() + t.children_user + t.children_system
+
+
+# -- the subject's own CPU time ----------------------------------------------------------------------------
+
+_SUBJECT_LOCK = threading.Lock()
+_SUBJECT = {"cpu": 0.0, "calls": 0, "active": 0, "since": 0.0}
+
+
+def subject_cpu() -> tuple[float, int]:
+    """``(CPU seconds, calls)`` spent so far in this process inside calls of a :class:`TimedStepper`: the
+    subject's own work, apart from the harness's around it (measured while at least one call is active, so
+    that nested and concurrent calls count once)."""
+    with _SUBJECT_LOCK:
+        extra = cpu_now() - _SUBJECT["since"] if _SUBJECT["active"] else 0.0
+        return _SUBJECT["cpu"] + extra, _SUBJECT["calls"]
+
+
+class TimedStepper(Stepper):
+    """A stepper whose calls add their CPU time to :func:`subject_cpu` — the subject's part of a stage, which
+    the gate judges apart from the harness's (``verimono check`` wraps its target: a stepper made 3x slower
+    grows a stage by only 2x where the checks' own work is half of it).  Its claim, name, ``batched`` and
+    ``fn`` are the stepper's own (``fn`` is the wrapped callable, as a :class:`Stepper`'s)."""
+
+    def __init__(self, stepper: Any) -> None:
+        super().__init__(stepper, name=subject_name(stepper))
+        self.claim = claim_of(stepper)
+        self.batched = bool(getattr(stepper, "batched", False) or getattr(self.fn, "batched", False))
+
+    def __call__(self, problem: Any, t_grid: Any) -> Any:
+        with _SUBJECT_LOCK:
+            if not _SUBJECT["active"]:
+                _SUBJECT["since"] = cpu_now()
+            _SUBJECT["active"] += 1
+            _SUBJECT["calls"] += 1
+        try:
+            return self.fn(problem, t_grid)
+        finally:
+            with _SUBJECT_LOCK:
+                _SUBJECT["active"] -= 1
+                if not _SUBJECT["active"]:
+                    _SUBJECT["cpu"] += cpu_now() - _SUBJECT["since"]
+
+    def __reduce__(self):   # picklable as a Stepper is: by reference to fn
+        return (_rebuild_timed, (self.fn, self.claim, self.__name__, self.batched))
+
+
+def _rebuild_timed(fn: Callable, claim: Any, name: str, batched: bool) -> TimedStepper:
+    s = TimedStepper(Stepper(fn, name=name))
+    s.claim, s.batched = claim, batched
+    return s
 
 
 # -- the estimator and its confidence bound ----------------------------------------------------------------
@@ -365,7 +426,7 @@ class MachineProbe:
         return {"cpu_waiting": waiting, "foreign_cpu": foreign, "loadavg": loadavg()}
 
 
-__all__ = ["ALPHA", "LOOKS", "NOISE_REASON", "BUSY_WAITING", "BUSY_FOREIGN", "CLOCK", "CLOCK_DESCRIPTION", "Sample", "timed",
+__all__ = ["cpu_now", "subject_cpu", "TimedStepper", "ALPHA", "LOOKS", "NOISE_REASON", "BUSY_WAITING", "BUSY_FOREIGN", "CLOCK", "CLOCK_DESCRIPTION", "Sample", "timed",
            "order_rank", "median_interval", "Judgement", "decide", "judge", "is_noise_undecided", "calibrate",
            "calibrate_both",
            "calibration", "set_calibration", "loadavg", "MachineProbe"]

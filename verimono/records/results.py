@@ -45,6 +45,9 @@ STATUSES = (PASSED, FAILED, SKIPPED, XFAIL, UNDECIDED)
 XFAIL_DECLARED = "xfail_declared"
 #: ``details`` key of a record that claimed ``passed`` with a non-finite worst ratio (now ``failed``)
 UNEARNED_PASS = "unearned_pass"
+#: ``meta`` key of a pytest session whose records of some tests are missing (an xdist worker crashed while
+#: running them, or a runner kept them): ``{"crashed": [nodeid, ...], "hidden": [nodeid, ...]}``
+MISSING_RECORDS = "missing_records"
 
 
 def _finite_number(x: Any) -> bool:
@@ -341,7 +344,7 @@ def listening(fn: Callable[[Any], None]) -> Iterator[None]:
         _LISTENERS.remove(fn)
 
 
-__all__ = ["PASSED", "FAILED", "SKIPPED", "XFAIL", "STATUSES", "XFAIL_DECLARED", "UNEARNED_PASS", "CheckResult",
+__all__ = ["PASSED", "FAILED", "SKIPPED", "XFAIL", "STATUSES", "XFAIL_DECLARED", "UNEARNED_PASS", "MISSING_RECORDS", "CheckResult",
            "Report", "to_jsonable", "emit",
            "listening", "SCHEMA_NAME", "SCHEMA_VERSION", "VERSIONED", "OPTIONAL", "SchemaError", "environment",
            "report_to_dict", "report_from_dict", "check_compatible", "loads", "load"]

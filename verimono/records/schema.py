@@ -5,7 +5,7 @@ Layout (schema ``verimono.results``, version ``SCHEMA_VERSION`` = ``MAJOR.MINOR`
 
     {
       "schema": "verimono.results",
-      "schema_version": "1.2",
+      "schema_version": "1.3",
       "created": "2025-01-01T12:00:00+00:00",          # UTC, when the document was first written
       "summary": {"passed": 12, "failed": 0, "skipped": 0, "xfail": 0},   # derived, for humans
       "meta": {                                        # free-form facts about the run; keys verimono writes:
@@ -17,11 +17,17 @@ Layout (schema ``verimono.results``, version ``SCHEMA_VERSION`` = ``MAJOR.MINOR`
                    "seed", "executor", "unit_budget"},  #   (verimono.execution.config) and the unit budget
         "selection": {"stages": [...] | null,          #   the --stage and --reference choices (null: all)
                       "references": [...] | null},
-        "stages": [{"name", "status", "records", "duration", "message"}],   # one per stage, in order
+        "stages": [{"name", "status", "records", "duration", "message",     # one per stage, in order
+                    "cpu",                             #   CPU seconds of the stage's work (all processes)
+                    "calibration_cpu": [0.07, ...],    #   the calibration's CPU seconds, sampled beside it
+                    "subject_cpu", "subject_calls",    #   the part in the subject's calls (verimono check)
+                    "units": [{"label", "cpu", "wall"}],   # each unit's times
+                    "cpu_waiting", "foreign_cpu", "loadavg"}],   # how busy the machine was
         "executor": "serial" | "process:2" | ...,      #   where the stages' units ran (stage times compare
                                                        #   only between runs on the same executor)
         "calibrations": [0.012, 0.013],                #   the workload timed before and after the stages
         "calibration": 0.012,                          #   the faster of the two: the unit of stage times
+        "calibrations_cpu": [0.011, 0.011],            #   their CPU seconds (median of the repeats)
         "duration": 93.5,                              #   seconds of the whole run (or pytest session)
         "data_dir": "/path/to/shared" | null,          #   Siconos reference data used, if any
         "environment": {...},                          #   :func:`verimono.records.environment.environment`
@@ -46,7 +52,8 @@ Non-finite floats are written as the strings ``"inf"``, ``"-inf"``, ``"nan"`` (s
 numbers) and read back as floats where the field is numeric; ``null`` in a numeric list (errors, slopes)
 reads as ``nan``.  Compatibility: a reader accepts the same MAJOR version and any MINOR (minor versions only
 add optional keys; 1.1 added ``environment.blas`` and the optional solvers' versions, 1.2 a study's
-``floors`` and ``solve_tol``); anything else, and
+``floors`` and ``solve_tol``, 1.3 the stages' CPU times: the gate refuses a baseline with stage times
+but without them, :func:`verimono.run.gate.baseline_uncalibrated`); anything else, and
 any malformed field, is a :class:`SchemaError`, which the gate turns into exit status 2.  Writing and
 reading whole reports: :mod:`verimono.records.results` (``Report.save``, ``load``).
 """
@@ -67,7 +74,7 @@ from .environment import environment
 from ..core.errors import SchemaError
 
 SCHEMA_NAME = "verimono.results"
-SCHEMA_VERSION = "1.2"
+SCHEMA_VERSION = "1.3"
 _NON_FINITE = ("nan", "inf", "-inf", "+inf", "infinity", "-infinity")
 #: the fields of a result record
 RECORD_FIELDS = frozenset({"check", "subject", "status", "worst", "bound", "counterexample", "message", "seed",
@@ -200,6 +207,16 @@ def check_meta(meta: dict[str, Any]) -> None:
         if not ok:
             raise SchemaError(f"meta.stages[{k}] must be an object with a name and a duration in seconds, "
                               f"got {st!r:.80}")
+        for key in ("cpu", "subject_cpu"):
+            v = st.get(key)
+            if v is not None and not (isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+                                      and v >= 0):
+                raise SchemaError(f"meta.stages[{k}].{key} must be a number of CPU seconds, got {v!r:.80}")
+        cals = st.get("calibration_cpu")
+        if cals is not None and not (isinstance(cals, list) and cals and all(
+                isinstance(c, (int, float)) and not isinstance(c, bool) and math.isfinite(c) and c > 0 for c in cals)):
+            raise SchemaError(f"meta.stages[{k}].calibration_cpu must be a list of positive CPU seconds, "
+                              f"got {cals!r:.80}")
 
 
 def document(meta: dict[str, Any], counts: dict[str, int], results: list[dict[str, Any]], studies: list[Any],

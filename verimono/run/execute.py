@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from ..execution import watchdog
+from ..records.atomic import write_text
 from ..records.environment import environment
 from ..execution.executors import BLAS_THREADS, make_runner
 from ..execution.config import RunConfig
@@ -26,7 +27,7 @@ from .progress import Progress
 from ..records.report import write
 from ..records.report.plots import draw_ahead, drawing_elsewhere, warm_up
 from ..records.results import Report
-from ..execution.calibration import PendingCalibration, calibrate, set_calibration
+from ..execution.calibration import PendingCalibration, calibrate_times, cpu_seconds, set_calibration
 from ..execution.timing import MachineProbe, is_noise_undecided
 
 EXIT_OK, EXIT_FAILED, EXIT_UNDECIDED = 0, 1, 2
@@ -59,7 +60,7 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
     if executor is not None and context.executor is None:
         print(f"verimono: units run on {runner.spec}", file=sys.stderr)
     context.executor = context.executor if context.executor is not None else runner
-    cal = calibration.result() if calibration is not None else calibrate()   # before any worker starts
+    cal, cal_cpus = calibration.times() if calibration is not None else calibrate_times()  # before any worker
     set_calibration(cal)              # the unit of this process's time budgets (verimono.execution.timeouts)
     if hasattr(runner, "prestart"):   # the workers import while this process builds the catalog
         runner.prestart()
@@ -97,14 +98,18 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
     # is the steadier unit, in the baseline and in the run gated against it alike (and the two ends' drift
     # tells the gate whether the machine was quiet enough to judge stage times at all: a first repeat that
     # agrees with the start's is enough to say it was)
-    cals = [cal, calibrate(agreeing_with=cal)]
+    end, end_cpus = calibrate_times(agreeing_with=cal)
+    cals = [cal, end]
     selection = {"stages": stages, "references": None if context.problems is None else
                  [p.name for p in context.problems]}
+    if getattr(context, "extra_problems", None):
+        selection["problems"] = [p.name for p in context.extra_problems]
     report.meta.update({"command": command, "target": target, "profile": profile_name, "seed": context.seed,
                         "selection": selection, "executor": getattr(runner, "spec", type(runner).__name__),
                         "calibrations": cals,
                         "calibration": min(cals), "duration": duration,
                         "config": {**cfg.to_dict(), "unit_budget": unit_budget},
+                        "calibrations_cpu": [cpu_seconds(cal_cpus), cpu_seconds(end_cpus)],
                         "data_dir": None if context.data_dir is None else str(context.data_dir),
                         "environment": environment()})
     return report
@@ -134,7 +139,7 @@ ISOLATE_ADVICE = ("`--executor process:N` runs each unit in a worker process, so
 
 def interruptible(run: Callable[[Callable], Report], out: Path, *, command: str, profile: str,
                    stages: list[str] | None, previous: Report | None = None, run_id: str | None = None,
-                   advice: str | None = None) -> Report | int:
+                   advice: str | None = None, checkpoint: bool = False) -> Report | int:
     """``run(on_done)`` with SIGTERM treated as an interrupt; on an interrupt write the stages finished so
     far (with ``previous``'s, when resuming) to ``out`` marked ``incomplete`` (as the run ``run_id``) and
     return the exit status.  ``advice``: how to go on, printed after the interrupt (default: ``verimono
@@ -156,12 +161,29 @@ def interruptible(run: Callable[[Callable], Report], out: Path, *, command: str,
         finished.append((rep, info))
         if stage_scope and stage_scope[0] is not None:
             stage_scope[0].items.clear()        # the scope keeps only the current stage's finished units
+        if checkpoint:
+            save_checkpoint()
+
+    def save_checkpoint() -> None:
+        """The stages finished so far, on disk as each finishes (``results.json`` only, marked incomplete, with
+        this run's id; the in-progress mark stays): a run killed with SIGKILL, which no handler sees, leaves
+        them for ``--resume``.  A checkpoint that cannot be written costs the run nothing but that."""
+        partial, _ = partial_report()
+        partial.meta["run_id"] = run_id
+        try:
+            write_text(out / "results.json", partial.to_json())
+        except OSError as exc:  # OutputNotWritable too: the final write says it again, with what it keeps
+            print(f"verimono: could not save the finished stages to {out / 'results.json'} "
+                  f"({getattr(exc, 'strerror', None) or exc}); the run goes on", file=sys.stderr)
 
     def partial_report() -> tuple[Report, list[str]]:
-        partial = previous if previous is not None else Report(meta={"stages": []})
+        partial = Report(meta=dict(previous.meta) if previous is not None else {})
+        partial.meta["stages"] = list(previous.meta.get("stages") or []) if previous is not None else []
+        if previous is not None:
+            partial.extend(previous)
         for rep, info in finished:
             partial.extend(rep)
-            partial.meta.setdefault("stages", []).append(info)
+            partial.meta["stages"].append(info)
         done = [s["name"] for s in partial.meta.get("stages") or []]
         partial.meta.update({"command": command, "profile": profile, "incomplete": True,
                              "finished_stages": done,

@@ -22,36 +22,46 @@
 * **study** — a convergence study of the baseline that is absent now while its record remains (the
   record's order claim is no longer backed by any errors);
 * **incomplete** — results marked ``meta.incomplete`` (an interrupted run) are refused: exit status 2;
-* **timing** — judged only where the measurement supports it (see *Timing* below); stage durations are
-  compared only between runs on the same executor (``meta.executor``: serial, process:N, ...).
+* **timing** — a slowdown of 2x or more that the measurement supports (see *Timing* below), busy machine or
+  not; stage times are compared only between runs on the same executor (``meta.executor``: serial,
+  process:N, ...).
 
-*Timing.*  Contention only ever adds time, and it does not add it evenly: a grown number from a busy machine
-is evidence of the machine, not of the code, unless the measurement rules that out.  So:
+*Timing.*  Load on a shared machine inflates wall time without bound and unevenly, so stage times are judged
+by **CPU time** (:mod:`verimono.run.stages.registry`: each unit's CPU time in the process that ran it, with the
+children it reaped, and the part spent in the subject's calls, :class:`verimono.execution.timing.TimedStepper`,
+which ``verimono check`` wraps its stepper in).  A wait for a CPU is no CPU time; what load does to code as it
+runs (caches refilled after every switch, memory bandwidth: 1.5-2.6x here beside other test runs) inflates it,
+and is measured in the same run, beside the work: after each unit, in the same process, slices of the
+calibration workload (:func:`verimono.execution.calibration.slices_after`, ``stages[i]["calibration_cpu"]``).
+So:
 
+* a stage's CPU time (``"cpu"``) and the subject's part of it (``"subject_cpu"``), in units of the **mean** of
+  the stage's calibration samples (:func:`calibration_mean`: the samples fall in two groups on a loaded
+  machine, contended and not, and the mean follows their share as the stage's CPU time does), regress when
+  they grew by more than ``TIMING_GROWTH`` and the **least** growth the two runs' intervals allow (Student's,
+  one-sided ``TIMING_ALPHA`` each) is still above it — whether the machine was busy or not.  Where the
+  samples' spread cannot tell, the growth is listed as a change, "not judged", with the figures;
+* the subject over the whole run too: its CPU time in all stages over all their samples (more samples, a
+  narrower interval than any one stage's): ``"<target> in all stages"``;
+* figures below ``TIMING_MIN_UNITS`` calibrations or ``TIMING_MIN_CPU`` seconds are start-up noise, not judged;
+* a stage's **wall** time in calibration units (the run's ``meta.calibrations``, taken at its slower one,
+  the baseline's at its faster) regresses when it grew beyond ``TIMING_GROWTH`` on a quiet machine only:
+  with its CPU time unchanged that is time spent off the CPU (sleeping, waiting), which CPU time does not
+  see.  On a busy machine — some task waited for a CPU more than ``BUSY_WAITING`` of the stage's time
+  (Linux PSI) and processes outside the run used more than ``BUSY_FOREIGN`` of the machine's CPU — or
+  between calibrations that drift by more than ``CALIBRATION_DRIFT``, such growth is listed as not judged;
 * a record's same-job ratio (``details["timing_ratio"]``, larger is worse) regresses when it grew by more than
   ``TIMING_GROWTH`` *with confidence*: the lower end of its interval (``details["timing_interval"]``, the
   order-statistics bound of the median per-round ratio, :mod:`verimono.execution.timing`) exceeds ``TIMING_GROWTH``
-  times the baseline's ratio.  A record without an interval (the memory record, a deterministic byte count;
-  results from before intervals) compares its ratio itself;
-* a record that passed and is now ``undecided`` because timing noise kept its speed from being judged
-  (``details["undecided_reason"] == "timing noise"``) is a change, not a regression;
-* a stage's duration is stated in calibration units (seconds over the calibration workload of the same job).
-  The run measures that workload at its start and its end (``meta.calibrations``); the stage's units are
-  taken in the *slower* of the two, the baseline's in the *faster* of its own, so that growth is not an
-  artefact of which end was measured.  Growth beyond ``TIMING_GROWTH`` is a regression only when the machine
-  was quiet enough for stage times to mean anything: its two calibrations agree within
-  ``CALIBRATION_DRIFT`` (else the machine's speed changed during the run, and no single unit describes it),
-  and the stage did not run on a busy machine: where the run recorded them (``meta.stages[i]``, by
-  :class:`verimono.execution.timing.MachineProbe`), *busy* means some task waited for a CPU during more than
-  ``BUSY_WAITING`` (10%) of the stage's wall time (Linux PSI, ``cpu_waiting``) *and* processes outside the run
-  used more than ``BUSY_FOREIGN`` (10%) of the machine's CPU capacity (``foreign_cpu``) — contention, and
-  not the run's own (its worker processes importing beside the main one make a quiet run's first stage
-  wait 40%, with 0-5% foreign); with one of the two recorded, that one decides.  Otherwise the growth is
-  reported as a change, "not judged", with the evidence — and so is a growth beyond ``TIMING_GROWTH`` in
-  units taken at the run's *faster* calibration only, when the run cannot be judged (a drifting or busy run
-  may hide a real slowdown in its slower calibration: it is shown, never silently dropped).  A real 3x
-  slowdown on a quiet machine stays caught: 3x in units taken at the slower calibration, whose drift is at
-  most 1.25x, is still above 2x.
+  times the baseline's ratio (a record without an interval compares its ratio itself); one that passed and
+  is now ``undecided`` because timing noise kept its speed from being judged
+  (``details["undecided_reason"] == "timing noise"``) is a change, not a regression.
+
+Measured with ``tools/gate_speed_trial.py`` (a stepper doing its work three times against the same stepper,
+5 runs each, ``verimono check`` on ``process:2``): beside other helpers' runs (load average 9-10 on 2
+cores) and under ``stress -n 2`` with them, every 3x-slower run regressed "in all stages" (least growth
+2.11-2.39x) and no unchanged run did.  A baseline with stage times but no calibration or no CPU figures
+(:func:`baseline_uncalibrated`) is refused — exit 2 — never gated with its timing check turned off.
 
 Baseline and results must come from the same kind of run (command, target, profile and the selected
 stages and references), be well-formed documents of a readable schema version
@@ -65,6 +75,10 @@ closed with exit status 2.  It fails closed too (the inputs cannot fool it) when
   record that passed, its ``worst``, ``bound``, ``details["error"]`` or ``details["timing_ratio"]`` (or
   a pass it claimed with a non-finite worst ratio, ``details["unearned_pass"]``): NaN compares false
   against every threshold, so such a baseline would let any result pass — :class:`IncompatibleBaseline`;
+* a record *passed* with its worst ratio above its bound (:func:`check_passes_earned`: no check of verimono's
+  writes one; a pass that contradicts its own figures cannot be trusted) — ``SchemaError``;
+* the baseline has stage times but no calibration to judge them by (:func:`baseline_uncalibrated`) —
+  :class:`IncompatibleBaseline`;
 * the results (or baseline) file carries the in-progress mark of a run that never completed
   (:func:`verimono.records.atomic.in_progress`: killed, or stopped by an error, after older files were there) —
   :class:`IncompatibleResults`.
@@ -74,6 +88,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import statistics
 from collections import Counter
 from pathlib import Path
 from typing import Any
@@ -98,8 +113,15 @@ ERROR_IGNORE_BELOW = 1e-11
 #: 2-core runner these ratios vary by up to ~40% between runs (measured); 2x flags real slowdowns such
 #: as a lost vectorisation or a per-step re-validation, which cost 3x and more
 TIMING_GROWTH = 2.0
-#: stages shorter than this (seconds, in both runs) are not timed: start-up noise dominates them
+#: stages shorter than this (seconds, in both runs) are not timed by their wall time: start-up noise dominates
 TIMING_MIN_SECONDS = 0.5
+#: CPU figures below this many calibrations (in either run) are not judged: about 0.13 s of CPU idle
+TIMING_MIN_UNITS = 2.0
+#: ... nor below this many CPU seconds (a busy machine's inflated calibration cannot make tiny work count)
+TIMING_MIN_CPU = 0.1
+#: one-sided level of the interval of the mean of a stage's calibration samples (each run's): the least growth
+#: a regression needs is bounded with both runs' intervals, so a wrong verdict needs both to miss
+TIMING_ALPHA = 0.025
 #: the largest ratio between a run's two calibrations (start, end) for which its stage times are judged:
 #: best-of-3 calibrations agree within ~10% on a quiet machine (0.057/0.057 s here), while load that comes or
 #: goes during a run moves one end by 1.4x and more
@@ -185,6 +207,19 @@ def check_unique_keys(report: Report, what: str = "the results") -> None:
                           "check[subject] must occur once (which copy would the gate compare?)")
 
 
+def check_passes_earned(report: Report, what: str = "the results") -> None:
+    """Raise ``SchemaError`` naming the records when ``report`` holds a record that *passed* with a worst
+    ratio above its bound (both finite): no check of verimono's writes one (a law passes when ``worst <=
+    bound``), so the document was edited or written by something else, and the gate cannot trust its
+    verdicts — it refuses it (exit 2) rather than compare against it."""
+    bad = [f"{r.key} (worst {r.worst:.4g} > bound {r.bound:.4g})" for r in report.results
+           if r.status == PASSED and _figure_is_finite(r.worst) and _figure_is_finite(r.bound) and r.worst > r.bound]
+    if bad:
+        more = f" and {len(bad) - 3} more" if len(bad) > 3 else ""
+        raise SchemaError(f"{what}: a record passed with its worst ratio above its bound, {', '.join(bad[:3])}"
+                          f"{more}: a pass that contradicts its own figures is invalid")
+
+
 def _figure_is_finite(value: Any) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
 
@@ -215,6 +250,23 @@ def baseline_nonfinite(baseline: Report) -> list[str]:
     return bad
 
 
+def baseline_uncalibrated(baseline: Report) -> str | None:
+    """What a baseline with stage times lacks to have them judged, or ``None``: a calibration
+    (``meta.calibration``, the unit of wall times) and, for each stage, its CPU time and the calibration's CPU
+    time measured beside it (``cpu``, ``calibration_cpu``: written since schema 1.3).  A baseline without
+    stages (a pytest session's) times nothing and lacks nothing."""
+    stages = [st for st in baseline.meta.get("stages") or [] if isinstance(st, dict)]
+    if not stages:
+        return None
+    if not _calibrations(baseline.meta):
+        return f"no calibration (meta.calibration = {baseline.meta.get('calibration')!r})"
+    bare = [st.get("name") for st in stages if not (_number(st.get("cpu")) and _slices(st) is not None)]
+    if bare:
+        return (f"no CPU time measured beside its stage{'s' if len(bare) > 1 else ''} {', '.join(map(str, bare))} "
+                f"(stages[].cpu and calibration_cpu; written since schema 1.3)")
+    return None
+
+
 def check_baseline(baseline: Report, what: str = "the baseline") -> None:
     """Raise :class:`IncompatibleBaseline` unless ``baseline`` is usable: it has executed (non-skipped)
     records (a baseline without any vouches for nothing, and every run would pass against it), and every
@@ -224,6 +276,10 @@ def check_baseline(baseline: Report, what: str = "the baseline") -> None:
         raise IncompatibleBaseline(f"the baseline has no executed records ({len(baseline.results)} records, "
                                    "all skipped or none); regenerate it with `verimono baseline`")
     check_unique_keys(baseline, what)
+    uncalibrated = baseline_uncalibrated(baseline)
+    if uncalibrated:
+        raise IncompatibleBaseline(f"{what} has stage times but {uncalibrated}: its stage times could not be "
+                                   "judged, and a slowdown would pass unseen; regenerate it with `verimono baseline`")
     bad = baseline_nonfinite(baseline)
     if bad:
         more = f"; and {len(bad) - 3} more" if len(bad) > 3 else ""
@@ -398,7 +454,8 @@ def _calibrations(meta: dict[str, Any]) -> list[float]:
 
 
 def _stage_unjudged(cur_cals: list[float], stage: dict[str, Any]) -> str | None:
-    """Why a stage time of this run cannot support a regression (module docstring, *Timing*), or ``None``."""
+    """Why a stage's *wall* time in this run cannot support a regression (module docstring, *Timing*), or
+    ``None``: the calibrations at its ends drift, or the machine was busy during the stage."""
     why = []
     drift = max(cur_cals) / min(cur_cals)
     if drift > CALIBRATION_DRIFT:
@@ -413,39 +470,136 @@ def _stage_unjudged(cur_cals: list[float], stage: dict[str, Any]) -> str | None:
     return "; ".join(why) or None
 
 
+def _slices(stage: dict[str, Any]) -> list[float] | None:
+    """The calibration's CPU seconds measured beside the stage's work (``stage["calibration_cpu"]``), or
+    ``None`` when the stage has none (a document from before CPU timing)."""
+    cals = stage.get("calibration_cpu")
+    if not isinstance(cals, list) or not cals:
+        return None
+    xs = [float(c) for c in cals if _number(c) and math.isfinite(c) and c > 0]
+    return xs if len(xs) == len(cals) else None
+
+
+def calibration_mean(samples: list[float], alpha: float = 0.025) -> tuple[float, float, float]:
+    """``(mean, low, high)``: the mean of a stage's calibration samples and its two-sided ``1 - 2 alpha``
+    interval (Student's t quantile by its Cornish-Fisher expansion to the third term: within 0.5% of the
+    table from 5 samples, 3% low for 3); the samples' range when there are fewer than 3.
+
+    The mean, not the median: a stage's CPU time is a sum over its work, inflated on average by what the load
+    does to code as it runs, and the samples, taken after each unit and once more per 0.25 s of it, are
+    spread over the stage's time as its work is.  On a loaded machine they fall in two groups (95 ms
+    uncontended, 170-200 ms contended, here), and their median jumps from one to the other with the share of
+    contended samples, while the mean follows that share: measured beside two CPU spinners, a memory hog and
+    other test runs, the subject's CPU time over the mean read 2.81 and 3.16 for two runs of one stepper
+    (over the median 2.56 and 3.62)."""
+    n = len(samples)
+    mean = statistics.fmean(samples)
+    if n < 3:
+        return mean, min(samples), max(samples)
+    z, v = statistics.NormalDist().inv_cdf(1.0 - alpha), n - 1
+    t = (z + (z ** 3 + z) / (4 * v) + (5 * z ** 5 + 16 * z ** 3 + 3 * z) / (96 * v ** 2)
+         + (3 * z ** 7 + 19 * z ** 5 + 17 * z ** 3 - 15 * z) / (384 * v ** 3))
+    half = t * statistics.stdev(samples) / math.sqrt(n)
+    return mean, max(mean - half, min(samples)), min(mean + half, max(samples))
+
+
+def cpu_units(stage: dict[str, Any], figure: str = "cpu") -> tuple[float, float, float] | None:
+    """``(ratio, low, high)``: the stage's ``figure`` (``"cpu"``, its CPU seconds, or ``"subject_cpu"``,
+    those spent in the subject's calls) over the calibration's CPU seconds measured beside it — the mean of
+    its samples, :func:`calibration_mean` — with the bounds its interval allows; ``None`` when the stage
+    lacks either figure."""
+    x, cals = stage.get(figure), _slices(stage)
+    if not (_number(x) and math.isfinite(x) and x >= 0) or cals is None:
+        return None
+    mean, lo, hi = calibration_mean(cals, TIMING_ALPHA)
+    return x / mean, x / hi, x / lo
+
+
+def _cpu_change(what: str, key: str, b: dict[str, Any], s: dict[str, Any], figure: str) -> tuple[str, Change | None]:
+    """The CPU verdict on ``figure`` of stage ``s`` against the baseline's ``b``: ``("regression" | "not
+    judged" | "ok" | "untimed", change)`` (module docstring, *Timing*)."""
+    now, before = cpu_units(s, figure), cpu_units(b, figure)
+    if now is None or before is None:
+        return "untimed", None
+    (rc, rc_lo, rc_hi), (rb, rb_lo, rb_hi) = now, before
+    if min(rc, rb) < TIMING_MIN_UNITS or min(s[figure], b[figure]) < TIMING_MIN_CPU:
+        return "untimed", None
+    growth, least, most = rc / rb, rc_lo / rb_hi, rc_hi / rb_lo
+    if most <= TIMING_GROWTH:
+        return "ok", None
+    cals = _slices(s) or []
+    evidence = (f"{what} {rc:.1f}x the calibration's CPU time (mean {statistics.fmean(cals) * 1e3:.0f} ms of "
+                f"{len(cals)} samples beside it), baseline {rb:.1f}x: {growth:.2f}x growth, between {least:.2f}x "
+                f"and {most:.2f}x with the samples' spread ({s[figure]:.2f} s CPU now, {b[figure]:.2f} s before)")
+    if least > TIMING_GROWTH:
+        return "regression", Change("timing", key, f"{evidence} (> {TIMING_GROWTH}x)", True)
+    return "not judged", Change("timing", key, f"{evidence}: not judged (the calibration's CPU time varied too "
+                                               f"much beside this stage to tell {TIMING_GROWTH}x growth)", False)
+
+
 def _compare_timings(base: Report, cur: Report, out: list[Change]) -> None:
-    """Stage durations in calibration units against the baseline's (module docstring, *Timing*)."""
+    """Stage CPU times, and the subject's part of them, in calibration units against the baseline's; wall
+    times only where the machine was quiet (module docstring, *Timing*)."""
     bcals, ccals = _calibrations(base.meta), _calibrations(cur.meta)
     if not (bcals and ccals):
         return
     bex, cex = base.meta.get("executor") or "serial", cur.meta.get("executor") or "serial"
-    if bex != cex:   # a stage's wall time depends on how many workers ran its units: not comparable
+    if bex != cex:   # a stage's times depend on how many workers ran its units: not comparable
         out.append(Change("timing", "stages", f"stage times not compared: the baseline's units ran on {bex}, "
                                               f"these on {cex}", False))
         return
+    subject = cur.meta.get("target") or "the subject"
     before = {s["name"]: s for s in base.meta.get("stages") or [] if isinstance(s, dict)}
-    for s in cur.meta.get("stages") or []:
-        b = before.get(s.get("name"))
-        if not b or min(b.get("duration", 0), s.get("duration", 0)) < TIMING_MIN_SECONDS:
-            continue
-        # the stage's units at the run's slower calibration (the growth a regression needs) and at its faster
-        # one (the most growth the run's drift allows)
-        rb, rc, rc_most = b["duration"] / min(bcals), s["duration"] / max(ccals), s["duration"] / min(ccals)
-        if rc_most <= TIMING_GROWTH * rb:
-            continue
-        why = _stage_unjudged(ccals, s)
-        if rc > TIMING_GROWTH * rb:
-            what = (f"{rc:.1f}x the calibration workload, baseline {rb:.1f}x (> {TIMING_GROWTH}x growth; "
-                    f"{s['duration']:.2f} s now)")
-        elif why is None:   # judged: within TIMING_GROWTH in the units a regression is stated in
-            continue
-        else:
-            what = (f"{rc:.1f}x-{rc_most:.1f}x the calibration workload (the run's two calibrations), baseline "
-                    f"{rb:.1f}x (up to {rc_most / rb:.1f}x growth; {s['duration']:.2f} s now)")
-        if why is None:
-            out.append(Change("timing", f"stage {s['name']}", what, True))
-        else:
-            out.append(Change("timing", f"stage {s['name']}", f"{what}: not judged ({why})", False))
+    both = [(before[s["name"]], s) for s in cur.meta.get("stages") or []
+            if isinstance(s, dict) and s.get("name") in before]
+    timed = [(b, s) for b, s in both if cpu_units(b, "subject_cpu") and cpu_units(s, "subject_cpu")]
+    if len(timed) > 1:   # the subject over the whole run: its CPU time in all stages over all their samples
+        pooled = [{"subject_cpu": sum(st["subject_cpu"] for st in side),
+                   "calibration_cpu": [c for st in side for c in _slices(st) or []]} for side in zip(*timed)]
+        _, change = _cpu_change("CPU time in its calls", f"{subject} in all stages", pooled[0], pooled[1],
+                                "subject_cpu")
+        if change is not None:
+            out.append(change)
+    for b, s in both:
+        verdict, change = _cpu_change("CPU time", f"stage {s['name']}", b, s, "cpu")
+        if change is not None:
+            out.append(change)
+        _, subject_change = _cpu_change("CPU time in its calls", f"{subject} in stage {s['name']}", b, s,
+                                        "subject_cpu")
+        if subject_change is not None:
+            out.append(subject_change)
+        if verdict in ("ok", "untimed"):
+            _compare_wall(b, s, bcals, ccals, out, cpu_judged=verdict == "ok")
+
+
+def _compare_wall(b: dict[str, Any], s: dict[str, Any], bcals: list[float], ccals: list[float], out: list[Change],
+                  cpu_judged: bool) -> None:
+    """A stage's wall time in calibration units (taken at the run's slower calibration, the baseline's at its
+    faster): growth beyond ``TIMING_GROWTH`` regresses only on a quiet machine (:func:`_stage_unjudged`) — where
+    its CPU time did not grow, it is time spent off the CPU (sleeping, waiting on I/O or a lock), which CPU time
+    does not see.  On a busy machine, or between drifting calibrations, such growth is listed as not judged
+    with the evidence (``cpu_judged``: the CPU time was judged and did not grow)."""
+    if min(b.get("duration", 0), s.get("duration", 0)) < TIMING_MIN_SECONDS:
+        return
+    rb, rc, rc_most = b["duration"] / min(bcals), s["duration"] / max(ccals), s["duration"] / min(ccals)
+    if rc_most <= TIMING_GROWTH * rb:
+        return
+    why = _stage_unjudged(ccals, s)
+    if why is None and rc <= TIMING_GROWTH * rb:
+        return
+    if rc > TIMING_GROWTH * rb:
+        what = (f"wall time {rc:.1f}x the calibration workload, baseline {rb:.1f}x (> {TIMING_GROWTH}x growth; "
+                f"{s['duration']:.2f} s now)")
+    else:
+        what = (f"wall time {rc:.1f}x-{rc_most:.1f}x the calibration workload (the run's two calibrations), "
+                f"baseline {rb:.1f}x (up to {rc_most / rb:.1f}x growth; {s['duration']:.2f} s now)")
+    cpu = " while its CPU time did not grow" if cpu_judged else ""
+    if why is None:
+        out.append(Change("timing", f"stage {s['name']}", f"{what}{cpu}, on a quiet machine: time spent off the "
+                          "CPU (sleeping, waiting)", True))
+    else:
+        out.append(Change("timing", f"stage {s['name']}", f"{what}{cpu}: time off the CPU not judged ({why})",
+                          False))
 
 
 def compare(baseline: Report, current: Report) -> Comparison:
@@ -454,9 +608,10 @@ def compare(baseline: Report, current: Report) -> Comparison:
     holds a non-finite figure (:func:`check_baseline`'s rules beyond emptiness)."""
     check_unique_keys(baseline, "the baseline")
     check_unique_keys(current, "the results")
-    bad = baseline_nonfinite(baseline)
-    if bad:
-        check_baseline(baseline)        # raises, naming the figures
+    check_passes_earned(baseline, "the baseline")
+    check_passes_earned(current, "the results")
+    if baseline_nonfinite(baseline) or baseline_uncalibrated(baseline):
+        check_baseline(baseline)        # raises, naming the figures or what is missing
     changes: list[Change] = []
     _compare_records(baseline, current, changes)
     _compare_studies(baseline, current, changes)
@@ -492,6 +647,7 @@ def gate(baseline: str | Path | Report, results: str | Path | Report) -> Compari
                                       f"{', '.join(rep.meta.get('finished_stages') or []) or 'none'}); finish it "
                                       "with `verimono run --resume` before gating")
         check_unique_keys(rep, f"the {what}" + ("" if isinstance(doc, Report) else f" {doc}"))
+        check_passes_earned(rep, f"the {what}" + ("" if isinstance(doc, Report) else f" {doc}"))
     base, cur = docs["baseline"], docs["results"]
     check_baseline(base, "the baseline" + ("" if isinstance(baseline, Report) else f" {baseline}"))
     check_runs_compatible(base, cur)
@@ -499,6 +655,6 @@ def gate(baseline: str | Path | Report, results: str | Path | Report) -> Compari
 
 
 __all__ = ["Change", "Comparison", "compare", "gate", "check_baseline", "check_runs_compatible",
-           "check_unique_keys", "check_completed", "baseline_nonfinite",
+           "check_unique_keys", "check_passes_earned", "check_completed", "baseline_nonfinite", "baseline_uncalibrated", "cpu_units", "calibration_mean",
            "IncompatibleBaseline", "IncompatibleResults", "LISTED_REGRESSIONS", "ORDER_DROP_FLOOR", "ERROR_GROWTH",
            "TIMING_GROWTH", "TIMING_MIN_SECONDS", "CALIBRATION_DRIFT"]

@@ -174,6 +174,8 @@ def trajectory_laws_stage(profile: Profile, context: RunContext) -> Report:
     seed = context.seed_for(profile)
     checks = list(stepper_checks(stepper, context.problems, seed=0 if seed is None else seed,
                                      generated=profile.generated_subjects, orders=False))
+    if context.extra_problems:      # --problem: besides the references and the sampled problems
+        checks += stepper_checks(stepper, context.extra_problems, seed=0 if seed is None else seed, orders=False)
     # one unit per subject problem (the battery of checks ``law[problem]`` on it), in first-seen order;
     # the records are then put back in the order of ``checks``, as a serial loop over them gives
     groups: dict[str, list[int]] = {}

@@ -29,6 +29,8 @@ from typing import Any, Callable, Iterable
 from ...checks.core import classify
 from ...core.errors import StageUnavailable, UnknownStage
 from ...execution.executors import SerialRunner
+from ...execution.calibration import slices_after
+from ...execution.timing import cpu_now, subject_cpu
 from ...lcs.siconos import PACKAGED_DATA, siconos_root
 from ...execution.profiles import Profile
 from ...records.results import FAILED, SKIPPED, Report
@@ -56,18 +58,22 @@ class RunContext:
     progress: Callable[[int, int, str], None] = lambda done, total, label: None
     executor: Any = None
     costs: dict[str, float] = dataclasses.field(default_factory=dict)
+    #: problems checked besides the references (``verimono check --problem``): added to :meth:`catalog`
+    extra_problems: list[Any] = dataclasses.field(default_factory=list)
+    #: the CPU and wall seconds of every unit run so far (:func:`timed_unit`), in the order they came back
+    unit_times: list[dict[str, Any]] = dataclasses.field(default_factory=list)
 
     _catalog: list[Any] | None = dataclasses.field(default=None, repr=False)
 
     def catalog(self) -> list[Any]:
-        """``problems`` if given, else the reference catalog (built once per run)."""
+        """``problems`` if given, else the reference catalog (built once per run); then ``extra_problems``."""
         if self.problems is not None:
-            return self.problems
+            return list(self.problems) + list(self.extra_problems)
         if self._catalog is None:
             from verimono.reference import catalog
 
             self._catalog = catalog()
-        return self._catalog
+        return self._catalog + list(self.extra_problems)
 
     def run_units(self, profile: Profile, units: list[Any], costs: list[float] | None = None) -> list[Report]:
         """The reports of ``units`` (:class:`verimono.execution.executors.Unit`), in their order, run on
@@ -78,13 +84,19 @@ class RunContext:
         costliest first, so that no long unit starts last while the other workers idle; the reports come
         back in the units' order all the same."""
         runner = self.executor if self.executor is not None else SerialRunner()
+        timed = [dataclasses.replace(u, fn=timed_unit, args=(u.fn, u.args)) for u in units]
         if costs is None or isinstance(runner, SerialRunner):
-            return runner.map(units, profile.name, self.progress)
-        order = sorted(range(len(units)), key=lambda i: -costs[i])
-        reports = runner.map([units[i] for i in order], profile.name, self.progress)
-        out: list[Report] = [Report()] * len(units)
-        for i, rep in zip(order, reports):
-            out[i] = rep
+            out = runner.map(timed, profile.name, self.progress)
+        else:
+            order = sorted(range(len(units)), key=lambda i: -costs[i])
+            reports = runner.map([timed[i] for i in order], profile.name, self.progress)
+            out = [Report()] * len(units)
+            for i, rep in zip(order, reports):
+                out[i] = rep
+        for u, rep in zip(units, out):
+            t = rep.meta.pop(UNIT_TIME, None)     # absent: a unit that died or timed out (its record says so)
+            if isinstance(t, dict):
+                self.unit_times.append({"stage": u.stage, "label": u.label, **t})
         return out
 
     def seed_for(self, profile: Profile) -> int | None:
@@ -93,6 +105,28 @@ class RunContext:
         if self.seed is not None:
             return self.seed
         return 0 if profile.derandomize else None
+
+
+#: ``Report.meta`` key under which :func:`timed_unit` hands a unit's times back (popped by ``run_units``)
+UNIT_TIME = "unit_time"
+
+
+def timed_unit(fn: Callable[..., Report], args: tuple) -> Report:
+    """``fn(*args)`` with its times in ``meta[UNIT_TIME]``: ``cpu``, the CPU seconds of the process that ran
+    it (:func:`verimono.execution.timing.cpu_now`: a worker process runs one unit at a time, and a subject that computes on
+    threads of its own, XLA's, is counted), ``wall``, and ``pid``, so that the run does not count twice the
+    units that ran in its own process (a serial run: :func:`run_stages` times those itself); and
+    ``calibration_cpu``, slices of the calibration workload measured right after it in the same process
+    (:func:`verimono.execution.calibration.slices_after`), what the stage's CPU time is stated against."""
+    pid, c0, w0, (s0, n0) = os.getpid(), cpu_now(), time.perf_counter(), subject_cpu()
+    rep = fn(*args)
+    if isinstance(rep, Report):
+        s1, n1 = subject_cpu()
+        cpu = cpu_now() - c0
+        rep.meta[UNIT_TIME] = {"cpu": cpu, "wall": time.perf_counter() - w0, "pid": pid,
+                               "subject_cpu": s1 - s0, "subject_calls": n1 - n0,
+                               "calibration_cpu": slices_after(cpu)}
+    return rep
 
 
 @dataclasses.dataclass(frozen=True)
@@ -139,6 +173,11 @@ def run_stages(names: Iterable[str] | None, profile: Profile, context: RunContex
         if on_start:
             on_start(stage, i, len(names))
         start = time.perf_counter()
+        serial = context.executor is None or isinstance(context.executor, SerialRunner)
+        # this process's part: all of it when the units run here; else this thread's (it hands out the units
+        # and merges what comes back; a report warm-up thread of this process is not the stage's)
+        own_cpu = cpu_now if serial else time.thread_time
+        cpu0, (subj0, calls0), n_units = own_cpu(), subject_cpu(), len(context.unit_times)
         try:
             rep = stage.fn(profile, context)
             if not isinstance(rep, Report):
@@ -148,7 +187,23 @@ def run_stages(names: Iterable[str] | None, profile: Profile, context: RunContex
         except Exception as exc:  # noqa: BLE001 - a crash is a failure of the run, recorded, never swallowed
             rep, status, message = _stage_failure(n, exc, time.perf_counter() - start)
         duration = time.perf_counter() - start
-        info = {"name": n, "status": status, "records": len(rep), "duration": duration, "message": message}
+        units = context.unit_times[n_units:]
+        elsewhere = [u for u in units if u.get("pid") != os.getpid()]
+        cpu = own_cpu() - cpu0 + sum(u["cpu"] for u in elsewhere)
+        subj1, calls1 = subject_cpu()
+        subj = subj1 - subj0 + sum(u.get("subject_cpu", 0.0) for u in elsewhere)
+        calls = calls1 - calls0 + sum(u.get("subject_calls", 0) for u in elsewhere)
+        info = {"name": n, "status": status, "records": len(rep), "duration": duration, "cpu": cpu,
+                "message": message}
+        if calls:
+            info.update({"subject_cpu": subj, "subject_calls": calls})
+        slices = [c for u in units for c in u.get("calibration_cpu") or []]
+        if not slices or sum(u["cpu"] for u in units) < 0.5 * cpu:   # the stage's work is mostly not its units'
+            slices += slices_after(cpu)
+        info["calibration_cpu"] = [round(c, 5) for c in slices]
+        if units:
+            info["units"] = [{"label": u["label"], "cpu": round(u["cpu"], 4), "wall": round(u["wall"], 4)}
+                             for u in units]
         for r in rep.results:
             r.details.setdefault("stage", n)
             cx = r.counterexample if isinstance(r.counterexample, dict) else {}
@@ -185,4 +240,4 @@ def locate_data(explicit: str | os.PathLike | None = None) -> Path:
     return path
 
 
-__all__ = ["STAGES", "Stage", "RunContext", "register_stage", "run_stages", "locate_data"]
+__all__ = ["STAGES", "Stage", "RunContext", "register_stage", "run_stages", "locate_data", "timed_unit", "UNIT_TIME"]

@@ -1,0 +1,54 @@
+"""A value law that fails because the user's value function puts ``J_λx`` outside ``dom g`` says so, and gives
+the round-off of ``J`` at that point (issue 33, item 5): a float32 projection onto the unit ball from ``|x|``
+of 900 or 1e3 can land outside it by a few float32 ulps, which a strict indicator (``inf`` for any point
+outside) rejects although the projection is exact to its precision."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import verimono as vm
+from verimono.checks import operator_laws, prox_laws  # noqa: F401 - the laws join the registry on import
+from verimono.checks.search import run_law
+
+
+def ball_projection32(x, lam):
+    """The projection onto the unit ball, computed in float32 (the prox of its indicator, for every λ)."""
+    x = np.asarray(x, dtype=np.float32)
+    n = np.linalg.norm(x)
+    return x if n <= 1 else x / n
+
+
+def strict_indicator(x):
+    return 0.0 if float(np.linalg.norm(np.asarray(x, dtype=np.float64))) <= 1.0 else np.inf
+
+
+def _outside_sample(radius: float, dim: int):
+    """A point of norm ``radius`` whose float32 projection lands outside the unit ball (searched along a few
+    directions: which do depends on round-off)."""
+    rng = np.random.default_rng(int(radius) * 31 + dim)
+    for _ in range(200):
+        d = rng.standard_normal(dim)
+        x = radius * d / np.linalg.norm(d)
+        if strict_indicator(ball_projection32(x, 0.5)) == np.inf:
+            return x
+    pytest.skip(f"no direction found whose float32 projection from |x| = {radius} leaves the ball")
+
+
+@pytest.mark.parametrize("radius, dim", [(900.0, 3), (1e3, 2), (1e3, 5)])
+def test_a_law_failed_by_the_value_function_says_so_and_gives_js_roundoff(radius, dim):
+    op = vm.operator_from_prox(ball_projection32, value=strict_indicator, shape=dim, name="ball32")
+    x = _outside_sample(radius, dim)
+    sample = {"x1": x.tolist(), "x2": (0.5 * x).tolist(), "lam": 0.5, "mu": 0.25, "nu": 1.0, "t": 0.0}
+    rec = run_law("prox_inequality", op, sample=sample)
+    assert rec.status == "failed", rec
+    assert "the value function says p = J_λx lies outside dom g" in rec.message
+    cx = rec.counterexample
+    assert cx["outside_dom_g"] and cx["precision"] == "float32"
+    eps32 = float(np.finfo(np.float32).eps)
+    # the round-off of J at that point: eps32 (1 + |x|)
+    assert cx["resolvent_roundoff"] == pytest.approx(eps32 * (1 + radius), rel=1e-6)
+    # and the projection left the ball by less than that: a round-off, which the strict indicator rejected
+    p = np.asarray(cx["p"])
+    assert 0 < np.linalg.norm(p) - 1.0 <= cx["resolvent_roundoff"]
