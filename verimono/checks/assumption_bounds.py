@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from ..core.errors import UnverifiedSolution
 from ..core.operators import resolvent_rows
 from ..core.tolerances import GROWTH_FLAG, STALL_RATIO, STALL_WINDOW, quotient_tolerance, tolerance
 from ..records.results import FAILED, PASSED, SKIPPED
@@ -266,7 +267,8 @@ def _sigma_sup(S) -> tuple[Sup, dict]:
 
     sup = sup_over_time(values, 0.0, S.T, grid=S.design(), seed=S.seed)
     li, pi = divmod(sup.family, len(P))
-    _, c = _sigma_ratio(S, resolvent_rows(op, P[pi:pi + 1], lams[li], sup.t)[0], sup.t)
+    z = S.rows(P[pi:pi + 1], lams[li], sup.t)[0]
+    _, c = _sigma_ratio(S, z, sup.t) if np.all(np.isfinite(z)) else (None, None)
     return sup, dict(c or {"t": sup.t, "z": P[pi], "F0_norm": np.nan, "sigma_t": np.nan}, lam=lams[li],
                      found_by="search over time")
 
@@ -307,7 +309,10 @@ def _rays(S, t: float):
                  distance=sup.at)
     far = 1.0
     for f in range(len(rays)):
-        a, b = raw(point(f, 1e4 * r)), raw(point(f, 1e7 * r))
+        try:
+            a, b = raw(point(f, 1e4 * r)), raw(point(f, 1e7 * r))
+        except UnverifiedSolution:      # verimono's own solver: no evidence along this ray
+            continue
         if a > 1e-9 and np.isfinite(b):
             far = max(far, b / a)
     return sup, c, far
@@ -381,10 +386,14 @@ def check_assumption_YB(S) -> Outcome:
             s = float(s)
             if s + lam > T + 1e-12:
                 continue
-            Z = resolvent_rows(op, S.points, 0.1 * T, s)  # z ∈ dom F(s)
-            for z in Z:
-                y_next = float(np.linalg.norm(op.yosida(z, lam, s + lam)))
-                y_now = float(np.linalg.norm(op.yosida(z, lam, s)))
+            Z = S.rows(S.points, 0.1 * T, s)  # z ∈ dom F(s)
+            for z in Z[np.all(np.isfinite(Z), axis=1)]:
+                try:
+                    y_next = float(np.linalg.norm(op.yosida(z, lam, s + lam)))
+                    y_now = float(np.linalg.norm(op.yosida(z, lam, s)))
+                except UnverifiedSolution:      # verimono's own solver: no evidence at this point
+                    S.unverified += 1
+                    continue
                 tol = quotient_tolerance(lam, z)
                 cands = {"YB'": y_next - y_now}
                 if has_f0:

@@ -57,13 +57,17 @@ def check_assumption_A1(S) -> Outcome:
     ``(J_λ p, Y_λ p)`` and ``(z, F^0(z))``) at the sample times, and over the pairs of resolvent graph points
     of each ``λ`` searched over ``t`` (:func:`_a1_sup`).  A violation disproves (A1)."""
     worst, counter, pairs = -np.inf, None, 0
+    nn = len(S.near)
     for t in S.times:
-        Z, Y, P = [], [], []
+        Z, Y, P, N = [], [], [], []
         for lam in S.lambdas:
-            z, y, p = S.graph(float(t), lam)
-            Z.append(z), Y.append(y), P.append(np.abs(p).max(axis=1) / lam)
+            J = S.rows(S.points, lam, float(t))
+            keep = np.all(np.isfinite(J), axis=1)       # rows verimono could not verify are no evidence
+            Z.append(J[keep]), Y.append(((S.points - J) / lam)[keep])
+            P.append(np.abs(S.points[keep]).max(axis=1) / lam)
+            N.append(J[:nn][keep[:nn]])
         try:   # minimal sections at the domain points of x0 and the points around it
-            z = np.vstack([zz[: len(S.near)] for zz in Z])
+            z = np.vstack(N)
             f0 = [min_norm_or_none(S.op, zi, float(t)) for zi in z]
             keep = [i for i, v in enumerate(f0) if v is not None]
             Z.append(z[keep]), Y.append(np.array([f0[i] for i in keep]).reshape(-1, S.problem.dim))
@@ -100,10 +104,13 @@ def _a1_sup(S):
     per = len(ia)
 
     def pairs(t: float, li: int, rows: np.ndarray):
-        """The ratios of the pairs of ``rows`` (indices into P) at step ``lams[li]``."""
-        lam = lams[li]
-        z, y, p = S.graph(t, lam, P[rows])
-        return (z, y) + _non_monotone(z, y, np.abs(p).max(axis=1) / lam)
+        """The ratios of the pairs of ``rows`` (indices into P) at step ``lams[li]`` (``-inf`` for a pair with
+        a point whose resolvent verimono could not verify)."""
+        lam, p = lams[li], P[rows]
+        z = S.rows(p, lam, t)
+        y = (p - z) / lam
+        ratio, inner, i, j = _non_monotone(z, y, np.abs(p).max(axis=1) / lam)
+        return z, y, np.where(np.isnan(ratio), -np.inf, ratio), inner, i, j
 
     def values(t: float, which):
         if which is None:
