@@ -142,7 +142,11 @@ def run_assumption(decl: Any, problem: Problem, *, seed: int = 0, points: int = 
     ``x0`` besides the far and kink points, ``times`` times in ``[0, T]``; shared by the laws of a battery)."""
     require_problem(problem)
     samples = samples_for(problem, seed, points, times)
-    return run(decl, subject_name(problem), lambda: decl.evaluate(samples), problem=problem, seed=seed)
+    before = samples.unverified
+    rec = run(decl, subject_name(problem), lambda: decl.evaluate(samples), problem=problem, seed=seed)
+    if samples.unverified > before:      # points skipped: verimono's own solver could not verify them
+        rec.details["unverified_points"] = samples.unverified - before
+    return rec
 
 
 def min_norm_or_none(op, z, t):
