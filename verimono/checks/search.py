@@ -449,6 +449,11 @@ def _verdict(state: _Search, how: dict, base: dict, details: dict, cex_extra: di
     counted = f"{runs} samples" + (f" ({state.inconclusive} inconclusive)" if state.inconclusive else "")
     if state.harness_limited:
         counted += f", {state.harness_limited} of them undecided by verimono's own solvers"
+    read = [c for c in state.coordinates if c.get("read")]
+    if read:        # what the coordinate search resolved: a narrower violation is outside what was searched
+        counted += "; searched " + ", ".join(
+            f"{c['coordinate']} to within a factor {c['resolution']:.3g}" if c["log"] else
+            f"{c['coordinate']} to {c['resolution']:.3g}" for c in read) + " (narrower bands are outside what was searched)"
     return CheckResult(status=PASSED, worst=None if state.worst is None else state.worst.ratio, bound=BOUND,
                        message=counted + (f"; {how['flaky']}" if how["flaky"] else ""), details=details, **base)
 
