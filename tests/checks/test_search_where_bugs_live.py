@@ -95,6 +95,7 @@ def test_v_growing_toward_a_singularity_fails_v_bounded(tau, p):
     assert abs(rec.counterexample["t"] - tau) < 1e-6
 
 
+@pytest.mark.slow
 def test_an_unbounded_v_leaves_LG_not_established():
     v = lambda t: np.array([-1.0 / abs(t - 0.3) if t != 0.3 else -np.inf])      # noqa: E731
     assert "lcs.v_bounded (failed)" in check_hypotheses(_system(v), 1.0).by_check("lcs.LG")[0].message
@@ -107,6 +108,7 @@ def test_a_narrow_spike_of_v_is_bounded(tau, height, width):
     assert rec.status == PASSED and rec.worst == pytest.approx(height, rel=1e-6), rec.message
 
 
+@pytest.mark.slow      # an LP per time: about 600 of them per record
 @pytest.mark.parametrize("tau,width", [(math.e / 7, 1 / 300), (0.7 + math.sqrt(3) / 300, 1 / 250)])
 def test_rel_int_lost_at_one_isolated_time_fails(tau, width):
     # C = D = 0: the margin is v(t), positive except at τ, where it dips linearly to 0 over ±width — between
@@ -142,7 +144,7 @@ def test_few_rows_are_right_in_three_dimensions_and_understate_a_thin_cone_in_fo
     assert hoffman_few_rows(Q4) < 0.2 * hoffman_constant(Q4)
 
 
-@pytest.mark.parametrize("seed", [0, 1, 2])
+@pytest.mark.parametrize("seed", [0, pytest.param(1, marks=pytest.mark.slow), pytest.param(2, marks=pytest.mark.slow)])
 def test_hoffman_understated_on_a_thin_cone_fails(seed):
     rec = check_hoffman(hoffman_few_rows, seed=seed)
     assert rec.status == FAILED and rec.counterexample["polyhedron"].startswith("thin cone (n = "), str(rec)
