@@ -63,7 +63,7 @@ XATOL = 1e-6
 #: golden-section steps of the refinement (``refine=True``): from Brent's ``~1e-8`` to below one ulp
 REFINE_STEPS = 80
 #: the default budget (points of a space per search) when the active profile is not one of verimono's
-DEFAULT_BUDGET = {"time": 512, "coordinate": 27, "points": 150}
+DEFAULT_BUDGET = {"time": 512, "coordinate": 27, "points": 100}
 
 _GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
 
