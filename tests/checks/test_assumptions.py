@@ -61,7 +61,7 @@ def test_graph_jumping_right_after_t_fails_A2(after):
 def test_right_continuous_jump_satisfies_A2():
     # the same jump with c(0.5) = 2: outer semicontinuous *from the right* (the paper's (A2)) — no evidence
     rec = _by(check_assumptions(_scaled_identity(lambda t: 1.0 if t < 0.5 else 2.0)))["assumption_A2"]
-    assert rec.status == PASSED and rec.details["unsettled"] == 0 and rec.details["sequences"] == 6 * 13
+    assert rec.status == PASSED and rec.details["unsettled"] == 0 and rec.details["sequences"] >= 6 * 13
 
 
 def test_understated_phi_sigma_theta_are_contradicted():
@@ -197,6 +197,6 @@ def test_t_non_auto_YB_claim_is_false_for_a_shifted_operator():
     s, lam = 0.3, 1e-4
     assert G.min_norm(np.array([-s]), s)[0] == 0.0 and G.yosida(np.array([-s]), lam, s + lam)[0] == pytest.approx(1.0)
     rec = _by(check_assumptions(Problem(G, [0.0], 1.0), composite=False))["assumption_YB"]
-    assert rec.status == FAILED and rec.details["growth"] >= 100, str(rec)
+    assert rec.status == FAILED and rec.details["growth"] == pytest.approx(100, rel=1e-4), str(rec)   # 1/λ over λ = T/10 … T/1000
     skip = check_bounds_yb(vm.solve, Problem(F, [0.5], 1.0, u=lambda t: np.array([1.0]), theta=lambda t: 0.0))
     assert skip.status == "skipped" and "θ̄ = M_u + θ has the increments of θ" in skip.message, str(skip)

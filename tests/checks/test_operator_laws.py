@@ -342,9 +342,9 @@ def test_a_limit_of_verimonos_own_solvers_is_undecided_never_failed_nor_passed()
     assert rec.status == "failed" and "SolverFailure" in rec.message, str(rec)   # the root cause, as any raise
 
 
-def test_a_law_sees_the_numpy_draws_then_a_short_hypothesis_search_then_the_sweep():
+def test_a_law_sees_the_numpy_draws_then_a_short_hypothesis_search_then_the_sweep_then_the_coordinates():
     """examples NumPy draws, then examples // HYPOTHESIS_SHARE hypothesis examples (at least HYPOTHESIS_MIN),
-    then the scale sweep: every sample counted once in details["evaluations"]."""
+    then the scale sweep, then the coordinate search: every sample counted once in details["evaluations"]."""
     from verimono.checks import search as L
     from verimono.reference import get
 
@@ -352,7 +352,8 @@ def test_a_law_sees_the_numpy_draws_then_a_short_hypothesis_search_then_the_swee
     for examples in (4, 20, 40):
         r = run_law("resolvent_nonexpansive", op, seed=3, examples=examples)
         hyp = max(L.HYPOTHESIS_MIN, examples // L.HYPOTHESIS_SHARE)
-        assert r.status == "passed" and r.details["evaluations"] == examples + hyp + r.details["sweep"], r.details
+        assert r.status == "passed" and r.details["evaluations"] == \
+            examples + hyp + r.details["sweep"] + r.details["coordinate"], r.details
 
 
 def test_a_violation_only_the_draws_meet_is_shrunk_and_replays(monkeypatch):

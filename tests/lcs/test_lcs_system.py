@@ -180,7 +180,7 @@ def test_a_new_step_size_starts_from_the_last_active_pattern_and_a_wrong_guess_i
     random partition asks for a new λ per step): verified for the new M, so the answers are the closed
     form's (paper Example ex: J = max(x + λ max(−v1, 0), −v2)); and a stepper seeded with a wrong pattern
     still answers right (the pattern fails its sign checks and the full solve decides)."""
-    from reference.lcs_example import closed_form_resolvent, example_system
+    from verimono.reference.lcs_example import closed_form_resolvent, example_system
 
     from verimono.lcs.relations import _BoxStepper
 

@@ -9,18 +9,28 @@ search evaluates it, in order, on
    climbs toward violations through :func:`hypothesis.target` on the ratio and shrinks a failing sample —
    with ``examples // HYPOTHESIS_SHARE`` examples when the draws found nothing, with all ``examples`` when
    one broke the law (a draw hypothesis does not meet again is shrunk greedily);
-3. the scale sweep (:mod:`verimono.checks.sweep`), points from ``10^-9`` to ``10^3`` and on the boundary
-   of the domain.
+3. the scale sweep (:mod:`verimono.checks.sweep`), points from ``10^-9`` to ``10^6``, on and just outside
+   the boundary of the domain;
+4. the coordinate search (:mod:`verimono.checks.coordinates`): each coordinate of the worst sample — the
+   step sizes across decades up to ``Λ = 10``, the time, the scale of the points, their offset from the
+   boundary — maximised on its own (:func:`verimono.checks.supremum.maximise`).
+
+Every record says what was searched (``details["searched"]``: the range of ``|x|`` and of the step sizes,
+the largest gap between the sampled times, each coordinate's range and resolution).
 
 Hypothesis's engine costs about 1.7 ms per example here against about 0.02 ms per NumPy draw.  One given
 ``sample=`` (a :class:`~verimono.checks.samples.Sample` or its dict from a counterexample) is evaluated
 alone instead: that is how a failure is replayed and how outer ``@given`` tests drive the laws.
 
 A sample's exception is judged by the core's one policy (:func:`verimono.checks.core.classify`): a member
-the operator lacks stops the search (skipped), a limit of verimono's own solvers makes the sample
-inconclusive (counted in ``details["harness_limited"]``), anything else fails the sample.  Inconclusive
-samples are counted and never pass: a record whose every sample was inconclusive is skipped, undecided
-when verimono's own solvers decided none.  The unit's time budget (:mod:`verimono.execution.timeouts`) bounds the
+the operator lacks stops the search (skipped) — but only when it raises ``NotImplementedError`` at the
+simplest sample too, before any sample was evaluated: a member that evaluates elsewhere and raises here
+raises on part of its domain, and the sample fails —; a limit of verimono's own solvers makes the sample
+inconclusive (counted in ``details["harness_limited"]``), anything else fails the sample, and so does a
+declared batched call that raises (:mod:`verimono.checks.batches`).  Inconclusive samples are counted and
+never pass: a record whose every sample was inconclusive is skipped, undecided when verimono's own solvers
+decided none, and a law passes only with at least :data:`MIN_EVALUATED` samples evaluated to a verdict
+(undecided otherwise, with the counts).  The unit's time budget (:mod:`verimono.execution.timeouts`) bounds the
 whole search (in calibration units: a slower or busier machine gets more seconds), judged by the one policy
 of a unit out of time (:func:`verimono.records.verdicts.timeout_verdict`): a search that runs out of time
 after samples that all held, or before any sample while no call of the operator was running, is undecided
@@ -56,9 +66,11 @@ from ..records.results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
 from ..execution.timeouts import (checkpoint, current_budget, interrupted, interruptible, note_progress,
                                   time_limit)
 from ..records.verdicts import timeout_verdict
-from .batches import prefetched
+from .batches import _BatchFailure, prefetched
+from .coordinates import coordinate_search, searched
 from .core import REGISTRY, Law, Outcome, classify, law, new_record, run, subject_name
 from .samples import NUMPY_DIM, Sample, law_samples
+from .supremum import budget
 from .sweep import law_draws, shrink, sweep_count, sweep_samples
 
 #: examples per law when ``examples`` is not given and the run configuration's profile is not one of
@@ -77,6 +89,14 @@ HYPOTHESIS_MIN = 3
 ROOT_LAW = "resolvent_single_valued"
 #: marks an evaluation that verimono's own numerical machinery could not decide
 HARNESS_LIMIT = "harness_limit"
+#: a law passes only when at least this many samples were evaluated to a verdict (fewer when fewer
+#: ``examples`` were asked for); fewer is undecided, with the counts
+MIN_EVALUATED = 10
+#: laws whose one evaluation is expensive (an independent minimiser per sample) skip the coordinate phase
+COORDINATE_CAP = {"prox_minimiser": 0}
+#: a member raising NotImplementedError at a sample is "not provided" only when it raises at this simple
+#: sample too (x1 = 0, x2 = 10^-2, λ = μ = ν = 1, t = 0); else it raises on part of its domain: a failure
+_SIMPLE = dict(lam=1.0, mu=1.0, nu=1.0, t=0.0)
 
 
 def fresh_seed() -> int:
@@ -191,11 +211,18 @@ class _Search:
     in_flight: float | None = None
     slowest: float = 0.0
     violated: bool = False
+    #: what was evaluated: |x1|, |x2| of every sample, its step sizes and time (details["searched"])
+    xs: list = dataclasses.field(default_factory=list)
+    lams: list = dataclasses.field(default_factory=list)
+    ts: list = dataclasses.field(default_factory=list)
+    coordinates: list = dataclasses.field(default_factory=list)
+    horizon: float = 1.0
 
     @interruptible   # the law's and the subject's code: the unit's budget may stop it even under hypothesis
-    def evaluate(self, s: Sample, climb: bool = False) -> None:
-        """Evaluate one sample; :class:`_Violation` when it breaks the law (``climb``: inside hypothesis,
-        whose ``target`` then climbs toward large ratios).  A safe point of the unit's budget first
+    def evaluate(self, s: Sample, climb: bool = False) -> float | None:
+        """Evaluate one sample and return its ratio (``None`` when inconclusive or not evaluable);
+        :class:`_Violation` when it breaks the law (``climb``: inside hypothesis, whose ``target`` then climbs
+        toward large ratios).  A safe point of the unit's budget first
         (:func:`verimono.execution.timeouts.checkpoint`): an interrupt that waited for hypothesis's engine
         to return stops the search here."""
         checkpoint()
@@ -204,16 +231,20 @@ class _Search:
             out = evaluate_sample(self.decl, self.op, s)
         except NotImplementedError as exc:
             self.in_flight = None
-            self.unsupported = str(exc) or type(exc).__name__
-            return
+            out = self.not_implemented(s, exc)
+            if out is None:
+                return None
         self.in_flight, self.slowest = None, max(self.slowest, time.perf_counter() - start)
         self.runs += 1
+        self.xs += [float(np.max(np.abs(s.x1), initial=0.0)), float(np.max(np.abs(s.x2), initial=0.0))]
+        self.lams += [s.lam, s.mu, s.nu]
+        self.ts.append(s.t)
         if out.inconclusive:
             self.inconclusive += 1
             self.inconclusive_what = out.what
             self.harness_limited += HARNESS_LIMIT in out.info
             self.note()
-            return
+            return None
         r = out.ratio
         if self.worst is None or not r <= self.worst.ratio:
             self.worst, self.worst_sample = out, s
@@ -224,6 +255,23 @@ class _Search:
             self.note()
             raise _Violation(self.decl.name)
         self.note()
+        return r
+
+    def not_implemented(self, s: Sample, exc: NotImplementedError) -> Outcome | None:
+        """A member raised NotImplementedError at ``s``: the operator lacks it (``None``; the search stops,
+        skipped) only when it raises at the simple sample too and no sample was evaluated before; otherwise
+        the operator raises on part of its domain (a resolvent defined only for ``|x| ≤ 5``), and the
+        sample fails."""
+        what = str(exc) or type(exc).__name__
+        if self.runs == 0:
+            simple = Sample(np.zeros(self.op.dim), np.full(self.op.dim, 1e-2), **_SIMPLE)
+            try:
+                evaluate_sample(self.decl, self.op, simple)
+            except NotImplementedError:
+                self.unsupported = what
+                return None
+        return Outcome.compare(math.inf, 0.0, 1.0, f"raised NotImplementedError ({what}) at this sample although "
+                               "it evaluates elsewhere: the operator raises on part of its domain")
 
     def note(self) -> None:
         """The progress so far, for an outer unit whose budget may stop the search (verimono.execution.timeouts)."""
@@ -242,16 +290,21 @@ class _Search:
         """Evaluate ``samples`` in order; the first that breaks the law with its outcome (taken out of the
         state, so that a later phase searches afresh), or ``None``.  A batched operator evaluates their
         points in batched calls first (:func:`verimono.checks.batches.prefetched`)."""
-        with prefetched(self.op, samples):
-            for s in samples:
-                try:
-                    self.evaluate(s)
-                except _Violation:
-                    found = (self.failing, self.failure)
-                    self.failure = self.failing = None
-                    return found
-                if self.unsupported is not None:
-                    break
+        try:
+            with prefetched(self.op, samples):
+                for s in samples:
+                    try:
+                        self.evaluate(s)
+                    except _Violation:
+                        found = (self.failing, self.failure)
+                        self.failure = self.failing = None
+                        return found
+                    if self.unsupported is not None:
+                        break
+        except _BatchFailure as exc:       # a declared batched call that raised: the subject fails
+            self.runs += 1
+            return exc.sample, Outcome.compare(math.inf, 0.0, 1.0, str(exc), {"batch_size": exc.size,
+                                                                              "batch_sizes_tried": exc.sizes})
         return None
 
 
@@ -268,7 +321,8 @@ def _hypothesis_search(state: _Search, seed: int, horizon: float, budget: int) -
 
 def _search(decl: Law, op: Any, seed: int, examples: int, horizon: float) -> tuple[_Search, dict]:
     """The three phases of the search (module docstring) under the unit's time budget."""
-    state, how = _Search(decl, op), {"timed_out": "", "harness": "", "flaky": "", "sweep": 0}
+    state, how = _Search(decl, op, horizon=horizon), {"timed_out": "", "harness": "", "flaky": "", "sweep": 0,
+                                                      "minimum": min(MIN_EVALUATED, examples)}
     drawn = None
     try:
         with no_local_constants(), time_limit(current_budget(), f"{decl.name} on {subject_name(op)}"):
@@ -290,14 +344,38 @@ def _search(decl: Law, op: Any, seed: int, examples: int, horizon: float) -> tup
         how["harness"] = f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"
     stopped = how["timed_out"] or how["harness"]
     if state.failure is None and drawn is not None:      # hypothesis did not meet the draw's violation
-        if stopped:
+        if "batch_size" in drawn[1].info:                 # a batched call that raised: not one sample's doing
+            (state.failing, state.failure), state.found_by = drawn, "a batched call of the NumPy draws"
+        elif stopped:
             (state.failing, state.failure), state.found_by = drawn, "NumPy draws"
         else:
             state.shrunk_into(drawn[0], "NumPy draws (shrunk greedily)")
     # the scale sweep spells out its points: for n > NUMPY_DIM the NumPy recipes cover the scales instead
     if state.failure is None and state.unsupported is None and not stopped and op.dim <= NUMPY_DIM:
         how["sweep"] = _sweep(state, seed, horizon)
+    if state.failure is None and state.unsupported is None and not stopped and state.worst_sample is not None \
+            and COORDINATE_CAP.get(decl.name, 1):
+        _coordinates(state, seed, horizon, how)
     return state, how
+
+
+def _coordinates(state: _Search, seed: int, horizon: float, how: dict) -> None:
+    """The coordinate phase (:mod:`verimono.checks.coordinates`) from the worst sample; a violation is
+    shrunk greedily into ``state``."""
+    def ratio(s: Sample) -> float:
+        r = state.evaluate(s)
+        return -math.inf if r is None else r
+
+    start, before = state.worst_sample, state.runs
+    try:
+        with time_limit(current_budget(), f"{state.decl.name} on {subject_name(state.op)}"):
+            state.coordinates = coordinate_search(ratio, state.op, start, horizon, budget("coordinate"), seed,
+                                                  lambda: state.unsupported is not None)
+    except _Violation:
+        state.shrunk_into(state.failing, "the search over each coordinate of the worst sample (shrunk greedily)")
+    except UnitTimeout as exc:
+        how["timed_out"] = str(exc)
+    how["coordinate"] = state.runs - before
 
 
 def _sweep(state: _Search, seed: int, horizon: float) -> int:
@@ -305,7 +383,9 @@ def _sweep(state: _Search, seed: int, horizon: float) -> int:
     Returns the number of sweep samples."""
     swept = sweep_samples(state.op, seed, horizon, sweep_count(current_config().profile, state.decl.name), Sample)
     found = state.first_violation(swept)
-    if found is not None:
+    if found is not None and "batch_size" in found[1].info:
+        (state.failing, state.failure), state.found_by = found, "a batched call of the sweep"
+    elif found is not None:
         state.shrunk_into(found[0], "sweep (shrunk greedily)")
     return len(swept)
 
@@ -374,6 +454,12 @@ def _verdict(state: _Search, how: dict, base: dict, details: dict, cex_extra: di
     if state.inconclusive == runs:
         return new_record(status=SKIPPED, details=details, **base,
                            message=f"all {runs} samples inconclusive (e.g. {state.inconclusive_what})")
+    decided = runs - state.inconclusive
+    if decided < how.get("minimum", 0):
+        return new_record(status=UNDECIDED, details=details, **base,
+                          message=f"only {decided} of {runs} samples were evaluated to a verdict ({state.inconclusive} "
+                                   f"inconclusive, e.g. {state.inconclusive_what}); a law passes only with at least "
+                                   f"{how['minimum']}")
     if state.worst is not None:
         details["worst_sample"] = state.worst_sample.to_dict()
         details["worst_info"] = {"what": state.worst.what, "lhs": state.worst.lhs, "rhs": state.worst.rhs,
@@ -381,6 +467,11 @@ def _verdict(state: _Search, how: dict, base: dict, details: dict, cex_extra: di
     counted = f"{runs} samples" + (f" ({state.inconclusive} inconclusive)" if state.inconclusive else "")
     if state.harness_limited:
         counted += f", {state.harness_limited} of them undecided by verimono's own solvers"
+    read = [c for c in state.coordinates if c.get("read")]
+    if read:        # what the coordinate search resolved: a narrower violation is outside what was searched
+        counted += "; searched " + ", ".join(
+            f"{c['coordinate']} to within a factor {c['resolution']:.3g}" if c["log"] else
+            f"{c['coordinate']} to {c['resolution']:.3g}" for c in read) + " (narrower bands are outside what was searched)"
     return new_record(status=PASSED, worst=None if state.worst is None else state.worst.ratio, bound=BOUND,
                        message=counted + (f"; {how['flaky']}" if how["flaky"] else ""), details=details, **base)
 
@@ -394,9 +485,9 @@ def run_law(decl: Law | str, op: Any, *, seed: int | None = None, examples: int 
     ``[0, horizon]``."""
     if isinstance(decl, str):
         if decl not in REGISTRY["operator"]:
-            raise InvalidCheckArgument(f"no operator law named {decl!r}; registered: {sorted(REGISTRY['operator'])} "
-                                       "(the laws register when verimono.checks.operator_laws is imported; "
-                                       "verimono.checks.run_law imports it)")
+            from . import operator_laws  # noqa: F401 - the laws register on import
+        if decl not in REGISTRY["operator"]:
+            raise InvalidCheckArgument(f"no operator law named {decl!r}; registered: {sorted(REGISTRY['operator'])}")
         decl = REGISTRY["operator"][decl]
     horizon = valid_horizon(horizon)
     profile = None
@@ -426,7 +517,10 @@ def run_law(decl: Law | str, op: Any, *, seed: int | None = None, examples: int 
                                message=f"not evaluated: {cause} (the root cause is recorded once, as {ROOT_LAW})")
         state, how = _search(decl, op, seed, examples, horizon) if sample is None else _replay(decl, op, sample)
         rec = _verdict(state, how, base, {**details, "evaluations": state.runs, "inconclusive": state.inconclusive,
-                                          "harness_limited": state.harness_limited, "sweep": how["sweep"]},
+                                          "harness_limited": state.harness_limited, "sweep": how["sweep"],
+                                          "coordinate": how.get("coordinate", 0),
+                                          "searched": searched(state.xs, state.lams, state.ts, horizon,
+                                                               state.coordinates)},
                        {"seed": seed, "examples": examples, "horizon": horizon, "operator": repr(op)})
         rec.duration = time.perf_counter() - start
         return rec

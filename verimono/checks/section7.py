@@ -11,7 +11,8 @@ battery.  Records are labelled **evidence, not proof** where they rest on sample
 * ``lcs.rel_int`` (item iii / ``e: linear case-comp`` ii): ``im C ∩ ri(im(𝓜 + D) − v(t)) ≠ ∅`` on sampled
   ``t`` by linear programming (:func:`verimono.lcs.hypotheses.rel_int_margin`), then minimised over ``t``
   (:mod:`verimono.checks.over_time`);
-* ``lcs.v_bounded`` (item iv): sup of ``|v|`` on a sample grid; ``lcs.v_ac`` (``e: linear case-comp`` iii,
+* ``lcs.v_bounded`` (item iv): sup of ``|v|`` searched over ``t`` and zoomed into, growth toward a
+  singularity detected (:mod:`verimono.checks.supremum`); ``lcs.v_ac`` (``e: linear case-comp`` iii,
   ``v ∈ AC``): no jump — the largest increments of ``v`` must vanish when bisected (the search of
   :mod:`verimono.checks.jumps`) — and a settled total variation; a jump fails with its location;
 * ``lcs.least_norm_growth`` (item vi, from Proposition ``p:lcp2`` iv–v for PSD ``D``): the least-norm
@@ -37,10 +38,11 @@ from ..lcs.lcp import is_psd, lcp_alpha, solve_lcp
 from ..lcs.passivity import is_passive
 from ..lcs.relations import BoxRelation, OperatorRelation
 from ..records.results import PASSED, SKIPPED, CheckResult, Report
-from ..core.tolerances import EPS, RTOL, tolerance
+from ..core.tolerances import EPS, RTOL, STALL_WINDOW, tolerance
 from .core import Outcome, law, laws_of, run, subject_name
 from .jumps import find_jumps
 from .over_time import sup_over_time
+from .supremum import Space, maximise, unbounded, zoom
 
 EVIDENCE = "evidence from samples, not a proof"
 #: sample grid of ``v`` on ``[0, T]`` (intervals); the total variation is compared on its last two dyadic
@@ -171,12 +173,15 @@ def check_rel_int(system: Any, T: float, *, samples: int, seed: int) -> Outcome:
     worst_t, least = float(ts[int(np.argmin(margins))]), float(min(margins))
     if not system.v_constant:
         sup = sup_over_time(lambda t, which: np.array([-rel_int_margin(system, float(t))]), 0.0, T, grid=ts,
-                            refine=True)
+                            refine=True, seed=seed)
+        details["searched"] = {"t": sup.searched.as_dict()}
         details["min_search"] = sup.as_dict()
         if -sup.value < least:
             worst_t, least = sup.t, -sup.value
-    how = (f"on {ts.size} sampled t" if system.v_constant else
-           f"on {ts.size} sampled t and minimised over t ({details['min_search']['evaluations']} LPs)")
+    how = (f"on {ts.size} sampled t (v is constant)" if system.v_constant else
+           f"on {ts.size} sampled t and minimised over t ({details['min_search']['evaluations']} LPs, resolution "
+           f"{details['searched']['t']['resolution']:.3g}: a loss on an interval of t narrower than that is outside "
+           "what was searched, at one isolated time only if the margin dips toward it over a wider one)")
     return _verdict(least > tolerance(system.C, system.D),
                     f"im C ∩ ri(im(𝓜 + D) − v(t)) ≠ ∅ {how} by linear programming ({EVIDENCE}); smallest margin "
                     f"{least:.3g} at t = {worst_t!r}", -least, 0.0, details=details,
@@ -192,11 +197,38 @@ def _v_on_grid(system: Any, T: float) -> tuple[np.ndarray, np.ndarray]:
 
 @system_law("lcs.v_bounded", "thm: linear case iv")
 def check_v_bounded(system: Any, T: float, *, samples: int, seed: int) -> Outcome:
-    """Theorem ``thm: linear case`` iv: ``v`` bounded on ``[0, T]`` (the sup of ``|v|`` on a sample grid)."""
-    _, V = _v_on_grid(system, T)
-    finite = bool(np.all(np.isfinite(V)))
-    return _verdict(finite, f"sup |v| = {np.abs(V).max():.4g} on {AC_GRID + 1} samples ({EVIDENCE})",
-                    float(np.abs(V).max()) if finite else None, None, details={"evidence": True})
+    """Theorem ``thm: linear case`` iv: ``v`` bounded on ``[0, T]``.  The sup of ``|v|`` is searched over
+    ``t`` (:func:`verimono.checks.supremum.maximise`: the :data:`AC_GRID` grid, a coverage grid, DIRECT and
+    Brent), then zoomed into (:func:`verimono.checks.supremum.zoom`, down to adjacent floats): a ``|v|`` still
+    growing there (:func:`verimono.checks.supremum.unbounded`: ``v = −1/|t − τ|`` doubles per halving) is
+    unbounded and fails, as does a value that is not finite; a narrow spike settles at its height."""
+    fine, V = _v_on_grid(system, T)
+    if not np.all(np.isfinite(V)):
+        i = int(np.flatnonzero(~np.all(np.isfinite(V.reshape(len(fine), -1)), axis=1))[0])
+        return _verdict(False, f"v is not finite at t = {fine[i]!r} ({EVIDENCE})", details={"evidence": True},
+                        counter={"t": float(fine[i])})
+    def size(t: float) -> float:
+        try:
+            return float(np.max(np.abs(np.asarray(system.v(float(t)), dtype=float)), initial=0.0))
+        except ArithmeticError:     # 1/0 at the singularity itself: |v| is infinite there
+            return math.inf
+    sup = maximise(lambda t, which: np.array([size(t)]), Space("t", 0.0, T), design=fine, seed=seed,
+                   kind="time")
+    z = zoom(size, 0.0, T, sup.at, 2 * sup.searched.resolution)
+    grows = unbounded(z)
+    details = {"evidence": True, "sup_search": sup.as_dict(), "zoom": z.as_dict(),
+               "searched": {"t": sup.searched.as_dict(), "zoom_to": z.widths[-1] if z.widths else None}}
+    top = max(sup.value, z.values[-1] if z.values else sup.value)
+    if grows:
+        msg = (f"|v| grows without bound toward t ≈ {z.at!r}: {z.values[-1]:.4g} on a bracket of width "
+               f"{z.widths[-1]:.2g}, still growing as the bracket halves ({z.values[-1 - STALL_WINDOW]:.4g} "
+               f"{STALL_WINDOW} halvings earlier) — v is not bounded ({EVIDENCE})")
+        return _verdict(False, msg, top, None, details=details,
+                        counter={"t": z.at, "v": z.values[-1], "widths": z.widths[-3:], "values": z.values[-3:]})
+    return _verdict(True, f"sup |v| = {top:.4g} (at t = {z.at:.6g}), searched over t ({sup.searched.points} times, "
+                          f"resolution {sup.searched.resolution:.3g}) and zoomed into down to width "
+                          f"{z.widths[-1] if z.widths else 0:.2g}, where it settles ({EVIDENCE})",
+                    top, None, details=details)
 
 
 @system_law("lcs.v_ac", "e: linear case-comp iii")

@@ -4,12 +4,16 @@ Hypothesis draws points of moderate size and climbs toward large ratios; a bug c
 (a prox that crashes or takes a wrong branch only for ``|x| < 10^-6``, or only on the boundary of its
 domain) is then found at some seeds only.  The sweep evaluates every law, after its search, on
 ``count`` samples drawn from ``numpy.random.default_rng(seed)`` (the record's seed, so the same seed gives
-the same samples): ``x1`` at each scale of :data:`SCALES` in turn (from ``10^-9`` to ``10^6``; every
+the same samples): ``x1`` at each scale of :data:`SCALES` in turn (from ``10^-9`` to ``10^6``, below 1/64 of
+the largest number of the precision the subject is judged at; every
 third one with a single nonzero coordinate, the boundary of orthants, boxes and ℓ1 balls), ``x2`` near
 ``x1`` or at another scale, and every fourth sample replaced by ``J_ν x`` and ``J_ν(J_ν x)`` — points in
-the range of the resolvent, i.e. on the boundary of ``dom F`` for a normal cone.  Step sizes are
-log-uniform in ``[10^-3, 10]`` (``λ = 1`` every fifth sample), times uniform in ``[0, horizon]`` with both
-ends included.
+the range of the resolvent, i.e. on the boundary of ``dom F`` for a normal cone; and every fourth (from the
+first such boundary point on) by a pair of points just *outside* that boundary, ``b + δ(1 + |b|) n`` and
+``b + 1000δ(1 + |b|) n`` with ``b`` the last point ``J_ν x ≠ x`` met, ``n`` the outer normal and ``δ`` from
+:data:`OUTSIDE` (a projection that forgets the points within ``10^-6`` of its set returns the first and
+projects the second: no longer firmly nonexpansive).  Step sizes are log-uniform in ``[10^-3, 10]``
+(``λ = 1`` every fifth sample), times uniform in ``[0, horizon]`` with both ends included.
 
 A sweep sample that breaks the law is shrunk greedily (:func:`shrink`: ``t → 0``, step sizes → 1,
 coordinates → 0, then each coordinate rounded to fewer digits, kept while the law still fails) and
@@ -23,8 +27,12 @@ from typing import Callable
 
 import numpy as np
 
-#: magnitudes of the swept points: tiny (below the rounding scale of a unit problem), unit, huge
-SCALES = (1e-9, 1e-7, 5e-7, 1e-5, 1e-3, 1e-1, 1.0, 3.0, 10.0, 1e2, 1e3)
+from ..core.tolerances import current_largest
+
+#: magnitudes of the swept points: tiny (below the rounding scale of a unit problem), unit, huge, far
+SCALES = (1e-9, 1e-7, 5e-7, 1e-5, 1e-3, 1e-1, 1.0, 3.0, 10.0, 1e2, 1e3, 1e6)
+#: offsets of the points just outside the boundary of the domain, ``b + δ(1 + |b|) n``, relative
+OUTSIDE = (1e-12, 1e-10, 1e-8, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3)
 #: sweep samples per law and profile (``None``: a profile not of verimono's, e.g. a user's own)
 SWEEP_BY_PROFILE = {"dev": 33, "ci": 33, "thorough": 132, None: 33}
 #: laws whose one evaluation is expensive (an independent minimiser) see this many sweep samples at most
@@ -40,9 +48,10 @@ def sweep_samples(op, seed: int, horizon: float, count: int, make: Callable) -> 
     """``count`` samples (built by ``make(x1, x2, lam, mu, nu, t)``) for ``op`` on ``R^n``, seeded by ``seed``."""
     n = int(op.dim)
     rng = np.random.default_rng([int(seed) % (2 ** 63), n, count])
-    out = []
+    cap = current_largest() / 64.0           # a float16 subject cannot be given |x| = 1e6
+    out, boundary = [], None
     for i in range(count):
-        s1 = SCALES[i % len(SCALES)]
+        s1 = min(SCALES[i % len(SCALES)], cap)
         u = rng.uniform(-1.0, 1.0, n)
         if i % 3 == 2:
             u = np.zeros(n)
@@ -51,19 +60,26 @@ def sweep_samples(op, seed: int, horizon: float, count: int, make: Callable) -> 
         if i % 2 == 0:
             x2 = x1 + 1e-2 * s1 * rng.uniform(-1.0, 1.0, n)
         else:
-            x2 = SCALES[rng.integers(len(SCALES))] * rng.uniform(-1.0, 1.0, n)
+            x2 = min(SCALES[rng.integers(len(SCALES))], cap) * rng.uniform(-1.0, 1.0, n)
         lam, mu, nu = (float(10.0 ** rng.uniform(-3.0, 1.0)) for _ in range(3))
         if i % 5 == 0:
             lam = 1.0
         t = float((0.0, float(horizon))[i % 2]) if i % 7 < 2 else float(rng.uniform(0.0, horizon))
-        if i % 4 == 3:   # points in the range of J: J_ν x and J_ν(J_ν x)
+        if i % 4 == 3:   # points in the range of J: J_ν x and J_ν(J_ν x), or just outside the boundary
             try:
                 a = np.asarray(op.resolvent(x1.copy(), nu, t), dtype=float)
                 b = np.asarray(op.resolvent(a.copy(), nu, t), dtype=float)
                 if a.shape == x1.shape and b.shape == x1.shape and np.all(np.isfinite(a)) and np.all(np.isfinite(b)):
+                    d = float(np.linalg.norm(x1 - a))
+                    if d > 0:
+                        boundary = (a, (x1 - a) / d, nu, t)
                     x1, x2 = a, b
             except Exception:   # noqa: BLE001 - the law itself evaluates (and fails) the raw point
                 pass
+        if i % 8 in (5, 7) and boundary is not None:   # b + δ n, b + 1000 δ n: the last boundary point seen
+            a, normal, nu, t = boundary
+            delta = OUTSIDE[(i // 4) % len(OUTSIDE)] * (1.0 + float(np.linalg.norm(a)))
+            x1, x2 = a + delta * normal, a + 1e3 * delta * normal
         out.append(make(x1, x2, lam, mu, nu, t))
     return out
 

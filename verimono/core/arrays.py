@@ -230,13 +230,15 @@ def padded(rows: int) -> int:
     return 1 << max(0, int(rows) - 1).bit_length()
 
 
-def batch_chunks(count: int):
+def batch_chunks(count: int, pad: bool = True):
     """``(lo, rows, pick)`` for the chunks of ``count`` rows: rows ``lo .. lo + rows`` of the batch, and
     ``pick`` the indices of the chunk padded to :func:`padded` rows by repeating its first row (a batched
-    subject is called once per chunk with ``X[pick]``; its first ``rows`` answers are kept)."""
+    subject is called once per chunk with ``X[pick]``; its first ``rows`` answers are kept).  ``pad=False``:
+    the chunk as it is (the checks call a batched subject at every batch size, odd ones included)."""
     for lo in range(0, count, MAX_BATCH):
         rows = min(MAX_BATCH, count - lo)
-        yield lo, rows, np.r_[np.arange(lo, lo + rows), np.full(padded(rows) - rows, lo)]
+        extra = padded(rows) - rows if pad else 0
+        yield lo, rows, np.r_[np.arange(lo, lo + rows), np.full(extra, lo)].astype(int)
 
 
 def prefetch_key(x: np.ndarray, lam: float, t: float) -> tuple:

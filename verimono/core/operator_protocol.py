@@ -185,15 +185,15 @@ class _FromResolvent(Operator):
             return self.resolvent_batch(x, np.full(x.shape[0], lam), np.full(x.shape[0], float(t)))
         return self._out(self._resolvent(self._in(x), lam, t), f"the resolvent of {self.name}")
 
-    def resolvent_batch(self, X, lams, ts):
+    def resolvent_batch(self, X, lams, ts, pad=True):
         """``J_{λ_i}(X_i)`` at ``t_i`` for the rows of ``X`` ``(B, n)``: batched calls of a ``batched``
-        resolvent (chunks padded to powers of two), else one call per row."""
+        resolvent (chunks padded to powers of two; ``pad=False``: as they are), else one call per row."""
         X = as_float64(X)
         lams, ts = np.asarray(lams, dtype=float), np.asarray(ts, dtype=float)
         if not self.batched:
             return np.array([self.resolvent(r, lam, t) for r, lam, t in zip(X, lams, ts)]).reshape(X.shape)
         out = np.empty_like(X)
-        for lo, rows, pick in batch_chunks(X.shape[0]):
+        for lo, rows, pick in batch_chunks(X.shape[0], pad):
             P = self._out(self._resolvent(self._io.given(X[pick]), self._io.given(lams[pick]), self._io.given(ts[pick])),
                           f"the batched resolvent of {self.name}")
             if P.shape != (pick.size, self.dim):

@@ -168,10 +168,11 @@ class ProxOperator(Operator):
         X = self._io.given(self._shaped(x))
         return self._point(self._call(X, lam, t))
 
-    def resolvent_batch(self, X: np.ndarray, lams: np.ndarray, ts: np.ndarray) -> np.ndarray:
+    def resolvent_batch(self, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, pad: bool = True) -> np.ndarray:
         """``J_{λ_i}(X_i)`` at ``t_i`` for the rows of ``X`` ``(B, dim)`` in batched calls of the prox (chunks
         of at most :data:`verimono.core.arrays.MAX_BATCH` rows padded to a power of two, so that a jitted prox
-        compiles for a few shapes); a prox not declared ``batched`` is called row by row."""
+        compiles for a few shapes; ``pad=False``: as they are, which the checks use to meet every batch size); a
+        prox not declared ``batched`` is called row by row."""
         X = as_float64(X)
         lams, ts = np.asarray(lams, dtype=float), np.asarray(ts, dtype=float)
         if X.ndim != 2 or X.shape[1] != self.dim or lams.shape != (X.shape[0],) or ts.shape != (X.shape[0],):
@@ -180,7 +181,7 @@ class ProxOperator(Operator):
         if not self.batched:
             return np.array([self.resolvent(r, lam, t) for r, lam, t in zip(X, lams, ts)]).reshape(X.shape)
         out = np.empty_like(X)
-        for lo, rows, pick in batch_chunks(X.shape[0]):
+        for lo, rows, pick in batch_chunks(X.shape[0], pad):
             Xb = self._io.given(X[pick].reshape((pick.size,) + self.shape))
             res = self._call(Xb, self._io.given(lams[pick]), self._io.given(ts[pick]) if self._prox_t else None)
             if self._unwrap is not None:

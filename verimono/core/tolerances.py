@@ -169,6 +169,17 @@ def observe(dtype: Any) -> None:
             p.observe(name)
 
 
+#: the largest finite number of each precision: points a subject is given stay below it by a margin
+LARGEST_BY_PRECISION = {"float64": 1.7976931348623157e308, "float32": 3.4028235e38, "float16": 65504.0,
+                        "bfloat16": 3.3895314e38}
+
+
+def current_largest() -> float:
+    """The largest finite number of the precision under judgement (float64's outside any)."""
+    p = _JUDGED.get()
+    return LARGEST_BY_PRECISION["float64" if p is None else p.name]
+
+
 def current_precision() -> Precision:
     """The precision under judgement (float64 outside any)."""
     p = _JUDGED.get()

@@ -59,6 +59,11 @@ class Profile:
     derandomize: bool
     unit_budget: float = 1600.0
     stage_budget_scale: float = 1.0
+    #: points of a space one search of :mod:`verimono.checks.supremum` evaluates: ``time`` — a sup over ``t``
+    #: of a problem's hypothesis (its coverage grid holds three quarters of them: ``ci`` resolves windows of
+    #: ``T/384``, ``thorough`` of ``T/6144``); ``coordinate`` — a step size, time or distance of an operator
+    #: law's worst sample; ``points`` — a point search in ``R^n`` (Hoffman's bound)
+    search: dict = dataclasses.field(default_factory=lambda: {"time": 512, "coordinate": 27, "points": 100})
 
     def stage_budget_units(self, stage: str) -> float | None:
         """The calibration units stage ``stage`` may take at this profile (``None``: no budget stated)."""
@@ -68,12 +73,14 @@ class Profile:
 
 _EFFORT = {
     "dev": Profile("dev", max_examples=25, law_examples=10, generated_subjects=3, derandomize=False,
-                   unit_budget=800.0),
+                   unit_budget=800.0, search={"time": 256, "coordinate": 15, "points": 60}),
     "ci": Profile("ci", max_examples=50, law_examples=20, generated_subjects=6, derandomize=True,
-                  unit_budget=1600.0),
-    # ten times ci's law examples (and subjects five times): its stages get ten times ci's budgets
+                  unit_budget=1600.0, search={"time": 512, "coordinate": 27, "points": 100}),
+    # ten times ci's law examples (and subjects five times): its stages get ten times ci's budgets, and its
+    # searches sixteen times ci's points in time (windows of T/6000) and 27 times in a step size
     "thorough": Profile("thorough", max_examples=500, law_examples=200, generated_subjects=30,
-                        derandomize=False, unit_budget=8000.0, stage_budget_scale=10.0),
+                        derandomize=False, unit_budget=8000.0, stage_budget_scale=10.0,
+                        search={"time": 8192, "coordinate": 729, "points": 1500}),
 }
 
 

@@ -1,0 +1,140 @@
+"""The last phase of an operator law's search: each coordinate of the worst sample searched on its own.
+
+An operator law holds for every ``λ, μ, ν > 0``, every ``t`` and every point; the draws, hypothesis and the
+scale sweep (:mod:`verimono.checks.search`) sample them, and a violation confined to a narrow band of one
+coordinate — a resolvent using ``2λ`` only for ``λ ∈ [0.031, 0.036]``, a projection that forgets to project
+points just outside its set — is met there by chance only.  So the search ends here: from the sample with
+the largest ratio, each coordinate is maximised over its whole space with the others held
+(:func:`verimono.checks.supremum.maximise`, ``coordinate`` budget of the profile) — one at a time: a
+violation that needs two coordinates at once (a band of large ``λ`` that shows only at points larger than
+``λ``) is outside this phase:
+
+* ``lam``, and with a budget of at least :data:`MORE_FROM` ``mu``, ``nu`` — step sizes across decades,
+  ``[10^-4, Λ]`` with ``Λ = 10`` (:data:`STEPS`);
+* ``t`` — ``[0, horizon]``;
+* ``scale`` (with a budget of at least :data:`MORE_FROM`; the sweep's points span ``10^-9`` to ``10^6`` at
+  every budget) — the points ``x1, x2`` scaled together so that ``|x1|`` runs over ``[10^-9, 10^6]``: tiny
+  points (the kink ``0`` of every norm) and far ones (``|x| ≫`` the problem's scale);
+* ``offset`` — ``x1`` moved to ``b + s n``, ``b = J_ν x1`` (on the boundary of the domain when ``x1`` is
+  outside it), ``n`` the outer normal ``(x1 − b)/|x1 − b|``, ``s ∈ [10^-12, 10^3](1 + |b|)``, and
+  ``x2 = b + 1000 s n``: a pair just outside the boundary, on one normal.
+
+A coordinate whose ratio is the same to the last bit at every design point (one the law does not read,
+or an identity that holds exactly there) is covered by its design points only (``"read": False`` in the
+record).  Samples of more than ``NUMPY_DIM`` coordinates (recorded by recipe) are searched in
+``lam, mu, nu, t`` only.  What was searched is recorded: :func:`searched` of the whole search.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any, Callable
+
+import numpy as np
+
+from ..core.tolerances import current_largest
+from .samples import Sample
+from .supremum import Searched, Space, maximise
+
+#: the step sizes searched: ``[10^-4, Λ]`` (Λ = 10: the largest step the samples draw)
+STEPS = (1e-4, 10.0)
+#: the range of ``|x1|`` of the scale coordinate
+SCALE = (1e-9, 1e6)
+#: the range of the offset from the boundary, relative to ``1 + |J_ν x1|``
+OFFSET = (1e-12, 1e3)
+#: coordinates searched, in order, each from the worst sample (one at a time: a violation that needs two
+#: of them at once — a band of large λ that shows only at points larger than λ — is outside this phase);
+#: ``mu``, ``nu`` and ``scale`` from a budget of :data:`MORE_FROM` points on (below it the draws, hypothesis and
+#: the sweep — whose points span ``10^-9`` to ``10^6`` — cover them; ``λ``, ``t`` and the boundary come first)
+COORDINATES = ("lam", "t", "offset", "mu", "nu", "scale")
+MORE_FROM = 81
+_MORE = ("mu", "nu", "scale")
+
+def _norm(v: np.ndarray) -> float:
+    m = float(np.max(np.abs(v), initial=0.0))
+    return 0.0 if m == 0.0 or not math.isfinite(m) else m * float(np.linalg.norm(v / m))
+
+
+def _moves(s: Sample, name: str, op: Any, horizon: float) -> tuple[Space, Callable[[float], Sample], list] | None:
+    """The space of coordinate ``name`` of ``s``, the sample at a point of it, and design points (``None``
+    when the coordinate cannot move: a recipe sample's points, ``x1 = 0``, ``x1`` inside the domain)."""
+    if name in ("lam", "mu", "nu"):
+        space = Space(name, *STEPS, log=True)
+        return space, (lambda v: dataclasses.replace(s, **{name: float(v)})), \
+            [10.0 ** k for k in range(-4, 2)] + [getattr(s, name)]
+    if name == "t":
+        space = Space("t", 0.0, float(horizon))
+        return space, (lambda v: dataclasses.replace(s, t=float(v))), [0.0, horizon / 2, float(horizon), s.t]
+    if s.recipe is not None:
+        return None
+    if name == "scale":
+        r = _norm(s.x1)
+        if r == 0.0:
+            return None
+        space = Space("|x1|", SCALE[0], min(SCALE[1], current_largest() / 64.0), log=True)
+        return space, (lambda v: dataclasses.replace(s, x1=s.x1 * (v / r), x2=s.x2 * (v / r))), \
+            [10.0 ** k for k in range(-9, 7, 3)] + [min(max(r, SCALE[0]), SCALE[1])]
+    # offset from the boundary: x1 = b + s n
+    try:
+        b = np.asarray(op.resolvent(s.x1.copy(), s.nu, s.t), dtype=float)
+    except Exception:       # noqa: BLE001 - the laws meet (and judge) the resolvent's exception themselves
+        return None
+    if b.shape != s.x1.shape or not np.all(np.isfinite(b)):
+        return None
+    d = _norm(s.x1 - b)
+    if d == 0.0:
+        return None
+    n, size = (s.x1 - b) / d, 1.0 + _norm(b)
+    hi = min(OFFSET[1] * size, current_largest() / 64e3)      # x2 = b + 1000 s n stays representable
+    if not OFFSET[0] * size < hi:
+        return None
+    space = Space("offset", OFFSET[0] * size, hi, log=True)
+    return space, (lambda v: dataclasses.replace(s, x1=b + v * n, x2=b + 1e3 * v * n)), \
+        [10.0 ** k * size for k in range(-12, 4, 3)]
+
+
+def coordinate_search(evaluate: Callable[[Sample], float], op: Any, start: Sample, horizon: float, points: int,
+                      seed: int, stop: Callable[[], bool]) -> list[dict]:
+    """Each coordinate of ``start`` maximised on its own (module docstring); ``evaluate(sample)`` returns the
+    law's ratio (and raises to end the search, as on a violation); ``stop()`` ends it between coordinates.
+    Returns what each coordinate's search covered."""
+    done = []
+    for name in COORDINATES:
+        if stop():
+            break
+        if name in _MORE and points < MORE_FROM:
+            continue
+        moved = _moves(start, name, op, horizon)
+        if moved is None:
+            continue
+        space, at, design = moved
+        design = [float(min(max(v, space.lo), space.hi)) for v in design]
+        first = [evaluate(at(v)) for v in design]
+        if len(set(first)) <= 1:     # flat to the last bit: a coordinate the law does not read
+            done.append({"coordinate": name, "points": len(design), "read": False,
+                         "range": [space.lo, space.hi], "log": space.log})
+            continue
+        sup = maximise(lambda v, which: np.array([evaluate(at(v))]), space, design=design, points=points,
+                       seed=seed, nodes=1, per_node=1)
+        done.append({"coordinate": name, "read": True, **_brief(sup.searched)})
+    return done
+
+
+def _brief(s: Searched) -> dict:
+    return {"range": [s.space.lo, s.space.hi], "log": s.space.log, "points": s.points, "resolution": s.resolution}
+
+
+def searched(xs: list[float], lams: list[float], ts: list[float], horizon: float, coordinates: list[dict]) -> dict:
+    """What an operator law's search evaluated: the range of ``|x|``, of the step sizes, the largest gap
+    between its times in ``[0, horizon]``, and the coordinate searches."""
+    if not xs:
+        return {"samples": 0}
+    tt = np.unique(np.r_[0.0, np.clip(ts, 0.0, horizon), horizon])
+    return {"samples": len(ts), "x_range": [float(min(xs)), float(max(xs))],
+            "lambda_range": [float(min(lams)), float(max(lams))],
+            "t_resolution": float(np.max(np.diff(tt))) if tt.size > 1 else float(horizon),
+            "coordinates": coordinates}
+
+
+__all__ = ["coordinate_search", "searched", "COORDINATES", "MORE_FROM", "STEPS", "SCALE", "OFFSET"]
