@@ -299,8 +299,8 @@ def _convergence(report: Report) -> str:
         return '<p class="note">No convergence studies in this run.</p>'
     figs, rows = [], []
     for s in studies:
-        ok, msg = s.verdict()
-        status = PASSED if ok else FAILED
+        decision = s.decision()
+        status, msg = decision.status, decision.message
         figs.append(f"<figure>{convergence_plot(s)}<figcaption><b class=\"{status}\">{status.upper()}</b> "
                     f"{_e(s.stepper)} — {_e(msg)}. Reference: {_e(s.reference)}.</figcaption></figure>")
         f = s.fits["sup"]
