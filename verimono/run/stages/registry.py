@@ -55,6 +55,9 @@ class RunContext:
     progress: Callable[[int, int, str], None] = lambda done, total, label: None
     executor: Any = None
     costs: dict[str, float] = dataclasses.field(default_factory=dict)
+    partitions: dict[str, tuple[float, list[int]]] = dataclasses.field(default_factory=dict)
+    #: ``(h_min, h_max)``: every convergence study on uniform grids with steps in that range only
+    step_range: tuple[float, float] | None = None
 
     _catalog: list[Any] | None = dataclasses.field(default=None, repr=False)
 
