@@ -86,15 +86,13 @@ from ..core.errors import InvalidProblem
 from ..core.operators import NormalCone, NormSubdifferential
 from ..core.problem import Order, Problem
 from ..core.sets import Box
+from ._kinks import find_kinks
 
 #: 8-point Gauss–Legendre on [-1, 1]: exact for polynomials of degree 15
 _XI, _W = np.polynomial.legendre.leggauss(8)
 #: 9-point Gauss–Lobatto on [-1, 1] (the ends and the roots of P_8'): exact for degree 15 too
 _XL = np.concatenate([[-1.0], np.sort(np.polynomial.legendre.Legendre.basis(8).deriv().roots().real), [1.0]])
 _WL = 2.0 / (72.0 * np.polynomial.legendre.Legendre.basis(8)(_XL) ** 2)
-#: a run of cells halved at least this often marks a kink candidate (GL8 accepts smooth data of unit size on
-#: the first cells or after a halving or two)
-_KINK_DEPTH = 3
 #: no cell is halved below this fraction of T (a jump of y*, e.g. a jumping weight c(t), stops here)
 _MIN_FRACTION = 2.0 ** -44
 #: at most this many values of x* and U are kept per solution (a study's ∫u and errors meet every grid node
@@ -344,112 +342,10 @@ class ManufacturedSolution:
         ok = ds > 1e-9 * T        # secants over shorter gaps are round-off
         self.lipschitz_x = float(np.max(np.linalg.norm(np.diff(X, axis=0)[ok], axis=1) / ds[ok]))
         self.lipschitz_y = float(np.max(np.linalg.norm(np.diff(Y, axis=0)[ok], axis=1) / ds[ok]))
-        self.kinks, self.input_kinks = self._find_kinks(pieces, given)
-
-    def _find_kinks(self, pieces: list, given: list[float]) -> tuple[tuple[float, ...], tuple[float, ...]]:
-        """``(kinks of x*, kinks of the input only)``.  A kink is where the refinement closed in (a local maximum of the
-        halving depth, at least ``_KINK_DEPTH``), located where one-sided cubics through ``x*`` cross and kept only if
-        the slope of ``x*`` jumps there (:meth:`_locate`); where it does not, the same for ``g = y* - f(x*)``: a kink
-        of the input ``u`` alone (a field only Lipschitz along ``x*``).  Then every cell edge whose one-sided slopes
-        differ (a kink exactly at an edge leaves both cells smooth), located again about the edge.
-
-        Two kinks a short stretch apart (``|z| = μc`` crossed twice in a row) fall in one run of deep cells with a
-        shallower dip between them: each is its own local maximum of depth, located with the cubics kept on its
-        side of the other (they once shared one run, whose cubics straddled both: no crossing was found and the
-        kinks were taken at cell edges, ``4e-6`` off)."""
-        T = self.T
-        candidates = _depth_maxima(pieces)
-        kinks: list[float] = []
-        inputs: list[float] = []
-        for i, (a, b) in enumerate(candidates):
-            lo = 0.5 * (candidates[i - 1][1] + a) if i > 0 else 0.0
-            hi = 0.5 * (b + candidates[i + 1][0]) if i + 1 < len(candidates) else T
-            k = self._locate(a, b, lo, hi)
-            if k is not None:
-                kinks.append(k)
-            elif a <= lo or b >= hi:     # no room to extrapolate from both sides: the refinement's centre
-                kinks.append(0.5 * (a + b))
-            else:
-                k = self._locate(a, b, lo, hi, of=self._integrand)
-                if k is not None:
-                    inputs.append(k)
-        starts = self._starts
-        for j in range(1, len(starts)):
-            t = starts[j]
-            if any(abs(t - k) <= 1e-5 * T for k in kinks + inputs):
-                continue
-            of_x, of_g = self._kink_at_edge(t)
-            if of_x or of_g:
-                right = starts[j + 1] if j + 1 < len(starts) else T
-                w = 0.25 * min(t - starts[j - 1], right - t)
-                k = self._locate(t - 1e-3 * w, t + 1e-3 * w, t - w, t + w, of=None if of_x else self._integrand)
-                (kinks if of_x else inputs).append(t if k is None else k)
-        return tuple(sorted(set(kinks) | set(given))), tuple(sorted(inputs))
+        self.kinks, self.input_kinks = find_kinks(self, pieces, given)
 
     def _integrand(self, t: float) -> np.ndarray:
         return self._g(t)[0]
-
-    def _kink_at_edge(self, t: float) -> tuple[bool, bool]:
-        """Whether the slope of ``x*``, and that of ``g = y* - f(x*)``, jump at ``t``: the one-sided secants over
-        ``ε = 1e-6 T`` differ by more than ``1e-3 (1 + Lip)`` (a smooth function moves them by ``ε |''|``); a jump of
-        ``x*`` itself raises."""
-        e = 1e-6 * self.T
-        (gl, xl, _), (gm, xm, _), (gr, xr, _) = self._g(t - e), self._g(t), self._g(t + e)
-        of_x = bool(np.linalg.norm((xr - xm) - (xm - xl)) / e > 1e-3 * (1.0 + self.lipschitz_x))
-        of_g = bool(np.linalg.norm((gr - gm) - (gm - gl)) / e > 1e-3 * (1.0 + self.lipschitz_x + self.lipschitz_y))
-        if of_x:
-            self._check_continuous(t - 1e-12 * self.T, t + 1e-12 * self.T)
-        return of_x, of_g
-
-    def _locate(self, a: float, b: float, lo: float, hi: float, of: Callable | None = None) -> float | None:
-        """The kink of ``x*`` (or of the function ``of``) in ``[a, b]`` (free of kinks on ``[lo, a]`` and ``[b, hi]``):
-        the crossing of the cubics through it at four points either side, re-centred on it and narrowed until the
-        bracket is ``1e-11 T``; ``None`` when the one-sided slopes agree (a smooth stretch refined for its
-        curvature).
-
-        The slopes are compared once, on a stencil ``1e-4 T`` wide (less where the neighbours leave less room):
-        there a cubic's truncation moves a slope by about ``w³ |x*⁽⁴⁾| ≈ 1e-10`` and rounding by ``eps |x*|/w ≈ 1e-12``.
-        On the refinement's own cells, ``1e-10 T`` wide where a field's kink drove it that deep, rounding alone moved
-        a slope by ``1e-6`` and a smooth ``x*`` looked kinked; on a stencil a tenth of the room wide, truncation did."""
-        T = self.T
-        fn = self._xs if of is None else of
-        lip = self.lipschitz_x if of is None else self.lipschitz_y + self.lipschitz_x
-        c = 0.5 * (a + b)
-        half = min(max(0.5 * (b - a), 1e-4 * T), 0.25 * (c - lo), 0.25 * (hi - c))
-        if half <= 0.0:
-            return None
-        a, b = c - half, c + half
-        k = None
-        for it in range(12):
-            w = 0.5 * (b - a)
-            if a - 3.0 * w < lo or b + 3.0 * w > hi:
-                w = min((a - lo) / 3.0, (hi - b) / 3.0)
-                if w <= 0.0:
-                    return k
-            m = 0.5 * (a + b)
-            sl = np.array([a - j * w for j in range(4)])
-            sr = np.array([b + j * w for j in range(4)])
-            left = np.polyfit((sl - m) / w, np.array([fn(t) for t in sl]), 3)     # (4, n) coefficients
-            right = np.polyfit((sr - m) / w, np.array([fn(t) for t in sr]), 3)
-            delta = right - left
-            j = int(np.argmax(np.abs(delta[-2])))                # the largest jump of slope Δ'(0)
-            roots = np.roots(delta[:, j])
-            roots = roots[np.abs(roots.imag) <= 1e-9 * (1.0 + np.abs(roots.real))].real
-            half = 0.5 * (b - a) / w + 1.0
-            roots = roots[np.abs(roots) <= half]
-            if roots.size == 0:
-                return k
-            r = float(roots[np.argmin(np.abs(roots))])
-            if it == 0:
-                jump = np.array([np.polyval(np.polyder(delta[:, i]), r) for i in range(delta.shape[1])]) / w
-                if np.linalg.norm(jump) <= 1e-6 * (1.0 + lip):
-                    return None
-            k = m + r * w
-            if b - a <= 1e-11 * T:
-                return k
-            eps = max((b - a) / 64.0, 1e-12 * T)
-            a, b = max(k - eps, lo), min(k + eps, hi)
-        return k
 
     def _check_continuous(self, a: float, b: float) -> None:
         xa, xb = self.x(a), self.x(b)
@@ -521,24 +417,6 @@ class ManufacturedSolution:
 
 def _power_of_two_below(d: float) -> float:
     return 2.0 ** math.floor(math.log2(d))
-
-
-def _depth_maxima(pieces: list) -> list[tuple[float, float]]:
-    """The stretches ``(a, b)`` of the adaptive partition where the halving depth (at least ``_KINK_DEPTH``) has a local
-    maximum: consecutive cells of one depth whose neighbours are shallower — where the refinement closed in on a
-    kink (or on a curvature it resolved, which :meth:`ManufacturedSolution._locate` tells apart)."""
-    depth = [p[4] for p in pieces]
-    out, i = [], 0
-    while i < len(pieces):
-        j = i
-        while j + 1 < len(pieces) and depth[j + 1] == depth[i]:
-            j += 1
-        before = depth[i - 1] if i > 0 else -1
-        after = depth[j + 1] if j + 1 < len(pieces) else -1
-        if depth[i] >= _KINK_DEPTH and before < depth[i] and after < depth[i]:
-            out.append((pieces[i][0], pieces[j][1]))
-        i = j + 1
-    return out
 
 
 def _remember(cache: dict, key: float, value: np.ndarray) -> None:
