@@ -147,6 +147,9 @@ def decide(d: StudyData) -> Decision:
         if d.refined == 0 or trailing >= 2:     # no finer grid tried, or the shortfall persisted on a finer one
             return _short_at_the_end(d, h, e, usable, slopes, short, p, what, stall_slope, skipped)
         erratic = True          # it resumed on a finer grid, then fell short again: the fit's interval decides
+    elif finest_short and slopes[-1] < stall_slope and can_refine:
+        # no grid shows the order and the finest stalls: a plateau not yet resolved may resume on finer grids
+        return Decision(UNDECIDED, "the errors stall from the coarsest grid on: a finer grid needed", action="refine")
     paused = bool(short) and not finest_short
     tail = usable[short[-1] + 1:] if paused else usable      # the grids after the last pause
     window = (tail if len(tail) >= 3 else usable)[-WINDOW:]
@@ -173,7 +176,7 @@ def decide(d: StudyData) -> Decision:
                 "alone; judged on all)")
     elif fit.pre_asymptotic:
         note = " (pre-asymptotic: local slopes, coarse to fine: " + ", ".join(f"{s:.2f}" for s in win_slopes) + ")"
-    if fit.reaches(p):
+    if fit.reaches(p) and not (finest_short and not erratic):       # never on a finest refinement falling short
         return Decision(PASSED, f"measured {fit}, {what} {p:g}{note}{skipped}", _ratio(p, fit.high), window, fit)
     if paused and len(tail) < 3 and can_refine:     # the errors resumed after a pause: see them go on
         return Decision(UNDECIDED, "too few grids after the pause: a finer grid needed", action="refine")
@@ -236,7 +239,9 @@ def _exact(d: StudyData, e: np.ndarray, fl: np.ndarray, at_floor: Sequence[int],
 def _measured_below(d, h, e, fit, window, p, what, win_slopes, stall_slope, skipped) -> Decision:
     msg = (f"order {fit.slope:.2f} measured, {p:g} {what} (95% interval {_interval(fit)} on h = {h[window[0]]:.3g} "
            f"... {h[window[-1]]:.3g}){skipped}")
-    decision = Decision(FAILED, msg, _ratio(p, fit.high), window, fit)
+    # a fit reaching p is failed only for its finest refinement falling short: the ratio is that refinement's
+    worst = _ratio(p, max(win_slopes[-1], 0.0)) if fit.reaches(p) else _ratio(p, fit.high)
+    decision = Decision(FAILED, msg, worst, window, fit)
     if win_slopes[-1] < stall_slope:
         return _unstated_floor(d, e, window[-2:], decision)
     return decision
@@ -294,7 +299,7 @@ def _unstated_floor(d: StudyData, e: np.ndarray, where: Sequence[int], decision:
 
 
 def _slope(h, e, a, b) -> float:
-    return float(math.log(e[a] / e[b]) / math.log(h[a] / h[b]))
+    return float(math.log(e[a] / e[b]) / math.log(h[a] / h[b])) if h[a] != h[b] else math.nan
 
 
 def _ratio(p: float, reached: float) -> float:
