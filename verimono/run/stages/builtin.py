@@ -58,7 +58,8 @@ def _convergence_unit(stepper: Callable, problem: Any, step_range: Any = None) -
     """One reference: its convergence-order record and study (in ``step_range`` when given), and a trajectory
     sample for the plots."""
     report = Report()
-    rec = report.add(run_unit(lambda: check_convergence_order(stepper, problem, step_range=step_range),
+    kw = {} if step_range is None else {"step_range": step_range}
+    rec = report.add(run_unit(lambda: check_convergence_order(stepper, problem, **kw),
                               check="convergence_order", subject=f"{_name(stepper)} on {problem.name}"))
     if rec.study is not None:
         report.studies.append(rec.study)
