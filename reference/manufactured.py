@@ -38,10 +38,11 @@ is halved.  ``U(t)`` is the tabulated integral up to the cell holding ``t`` plus
 the rest of it, where ``g`` is smooth.  :attr:`ManufacturedSolution.quadrature_error` sums the cells'
 estimates (``≈ 1e-15`` on the examples, checked against SciPy's adaptive Gauss–Kronrod in the tests): against
 scheme errors ``≥ 1e-6`` it is invisible.  The kinks (:attr:`ManufacturedSolution.kinks`) are located where
-the refinement closed in — at the crossing of cubics through ``x*`` on either side, kept when the slope of
-``x*`` jumps there — and at cell edges whose one-sided slopes differ; a jump of ``x*`` is an error.  The
+the refinement closed in (each local maximum of the halving depth) — at the crossing of cubics through ``x*`` on
+either side, kept when the slope of ``x*`` jumps there — and at cell edges whose one-sided slopes differ; a jump of
+``x*`` is an error.  The
 pointwise ``u(t)`` (for laws that need ``|u|``, and for users) takes ``x*'`` from ``velocity`` when given,
-else from Richardson-extrapolated central differences (error ``O(δ⁶)``, estimated) — one-sided (``O(δ⁴)``),
+else from Richardson-extrapolated central differences (error ``O(δ⁶)``, estimated) — one-sided (``O(δ⁵)``),
 away from the kink, when a kink or an end of ``[0, T]`` lies within the stencil or the central estimate's
 error is large; at a kink ``u`` is the right limit (``u`` is defined a.e.).
 
@@ -59,6 +60,14 @@ with ``h`` the largest step (:meth:`ManufacturedSolution.error_bound`).  It need
 bounded variation along the solution and ``x0 ∈ dom F(0,·)``, the hypotheses of Rulla's order 1 for
 ``∂φ`` with a fixed ``φ`` (SIAM J. Numer. Anal. 33, 1996; ``x0 ∈ D(∂φ)``, BV forcing) — here for any
 time-dependent maximal monotone ``F``.  The order is not more than 1 in general: ``x*'`` jumps at the kinks.
+**Regularity, derived.**  Away from the times where the resolvent switches regime, ``x*`` is as smooth as the path
+and ``t ↦ F(t,·)`` (``smoothness``; C^∞ by default, as :func:`lissajous` is): a ``Linear`` operator, or a set the
+path never leaves, gives a smooth solution, and a scheme claiming order 5 is held to 5 there.  A kink of ``x*``
+caps any scheme's order at 1; a kink of the input only (a field Lipschitz but not smooth along ``x*``) at 2
+(:meth:`ManufacturedSolution.regularity`, in the problem's ``order.regularity``).  The kinks are located to about
+``1e-15 T`` on the examples (tested against the closed forms of the switching times), two kinks a short stretch
+apart included.
+
 An operator evaluated at ``t_k`` instead of ``t_{k+1}`` is the proximal scheme of ``F(t - h, ·)``, an
 ``O(h)`` change of ``F`` when it moves Lipschitz in ``t``: on the order-1 examples it converges with order 1
 as well (the tests show it), so only a problem of higher order — :func:`moving_box`, order 2 — catches it by
@@ -77,15 +86,13 @@ from ..core.errors import InvalidProblem
 from ..core.operators import NormalCone, NormSubdifferential
 from ..core.problem import Order, Problem
 from ..core.sets import Box
+from ._kinks import find_kinks
 
 #: 8-point Gauss–Legendre on [-1, 1]: exact for polynomials of degree 15
 _XI, _W = np.polynomial.legendre.leggauss(8)
 #: 9-point Gauss–Lobatto on [-1, 1] (the ends and the roots of P_8'): exact for degree 15 too
 _XL = np.concatenate([[-1.0], np.sort(np.polynomial.legendre.Legendre.basis(8).deriv().roots().real), [1.0]])
 _WL = 2.0 / (72.0 * np.polynomial.legendre.Legendre.basis(8)(_XL) ** 2)
-#: a run of cells halved at least this often marks a kink candidate (GL8 accepts smooth data of unit size on
-#: the first cells or after a halving or two)
-_KINK_DEPTH = 3
 #: no cell is halved below this fraction of T (a jump of y*, e.g. a jumping weight c(t), stops here)
 _MIN_FRACTION = 2.0 ** -44
 #: at most this many values of x* and U are kept per solution (a study's ∫u and errors meet every grid node
@@ -123,7 +130,7 @@ class ManufacturedSolution:
 
     def __init__(self, operator: Any, path: Callable[[float], Any], mu: float, T: float,
                  f: Callable | None = None, *, velocity: Callable | None = None, kinks: Sequence[float] = (),
-                 cells: int = 64, rtol: float = 1e-13) -> None:
+                 cells: int = 64, rtol: float = 1e-13, smoothness: float = math.inf) -> None:
         if not hasattr(operator, "resolvent") or not hasattr(operator, "dim"):
             raise InvalidProblem(f"operator must be a verimono.Operator, got {operator!r}")
         if not callable(path):
@@ -138,6 +145,12 @@ class ManufacturedSolution:
             if fn is not None and not callable(fn):
                 raise InvalidProblem(f"{what} must be callable, got {fn!r}")
         self.operator, self.path, self.mu, self.T, self.f = operator, path, mu, T, f
+        try:
+            self.smoothness = float(smoothness)
+        except (TypeError, ValueError):
+            raise InvalidProblem(f"smoothness must be a number >= 1 or inf, got {smoothness!r}") from None
+        if not self.smoothness >= 1.0:
+            raise InvalidProblem(f"smoothness must be a number >= 1 or inf, got {smoothness!r}")
         self._velocity = velocity
         self.n = int(operator.dim)
         self._x_cache: dict[float, np.ndarray] = {}
@@ -214,11 +227,13 @@ class ManufacturedSolution:
     def velocity_with_error(self, t: float, delta: float | None = None) -> tuple[np.ndarray, float]:
         """``(x*'(t), error estimate)``: Richardson-extrapolated differences (module docstring), ``(v, 0)``
         from a given formula.  Central ``δ, δ/2, δ/4`` (error ``O(δ⁶)``) unless a kink or an end of ``[0, T]``
-        lies within ``δ``; then one-sided 3-point ``δ, δ/2, δ/4`` (``O(δ⁴)``) away from it."""
+        lies within ``δ``; then one-sided 3-point ``δ, δ/2, δ/4, δ/8`` (``O(δ⁵)``) away from it."""
         t = float(t)
         if self._velocity is not None:
             return np.asarray(self._velocity(t), dtype=float), 0.0
-        d0 = 1e-3 * self.T if delta is None else float(delta)
+        # a power of two: t ± δ/2^j are then exact, so the offsets are the ones the formulas divide by (at t = T = 2π
+        # an offset rounded by an ulp of t put 1.5e-12 into x*', 1.4e-13 after)
+        d0 = 2.0 ** math.floor(math.log2(1e-3 * self.T if delta is None else float(delta)))
         near = 1e-9 * self.T           # a kink this close is at t (kinks are located to about 1e-10 T)
         left = max([0.0] + [k for k in self.kinks if k < t - near])
         right = min([self.T] + [k for k in self.kinks if k > t + near])
@@ -234,9 +249,9 @@ class ManufacturedSolution:
                 return tried[-1]
         # one-sided, away from the obstacle: forward first (the right limit at a kink), then backward
         if right - t > near:
-            tried.append(self._one_sided(t, min(d0, (right - t) / 2.5), +1.0))
+            tried.append(self._one_sided(t, _power_of_two_below(min(d0, (right - t) / 2.5)), +1.0))
         if t - left > near and not (tried and good(tried[-1])):
-            tried.append(self._one_sided(t, min(d0, (t - left) / 2.5), -1.0))
+            tried.append(self._one_sided(t, _power_of_two_below(min(d0, (t - left) / 2.5)), -1.0))
         if not tried:
             raise InvalidProblem(f"no finite-difference stencil fits at t = {t!r}")
         return min(tried, key=lambda r: r[1])
@@ -252,10 +267,11 @@ class ManufacturedSolution:
         def D(s):
             s = sign * s
             return (-3.0 * self._xs(t) + 4.0 * self._xs(t + s) - self._xs(t + 2.0 * s)) / (2.0 * s)
-        D0, D1, D2 = D(d), D(d / 2.0), D(d / 4.0)       # error c2 δ² + c3 δ³ + ...
-        R1 = [(4.0 * D1 - D0) / 3.0, (4.0 * D2 - D1) / 3.0]
-        R2 = (8.0 * R1[1] - R1[0]) / 7.0
-        return R2, float(np.max(np.abs(R2 - R1[1])))
+        D0, D1, D2, D3 = D(d), D(d / 2.0), D(d / 4.0), D(d / 8.0)      # error c2 δ² + c3 δ³ + c4 δ⁴ + ...
+        R1 = [(4.0 * D1 - D0) / 3.0, (4.0 * D2 - D1) / 3.0, (4.0 * D3 - D2) / 3.0]
+        R2 = [(8.0 * R1[1] - R1[0]) / 7.0, (8.0 * R1[2] - R1[1]) / 7.0]
+        R3 = (16.0 * R2[1] - R2[0]) / 15.0                              # O(δ⁵): 3e-13 where O(δ⁴) left 4e-11
+        return R3, float(np.max(np.abs(R3 - R2[1])))
 
     # -- the adaptive table ---------------------------------------------------------------------------
     def _rule(self, a: float, b: float, nodes, weights):
@@ -326,75 +342,10 @@ class ManufacturedSolution:
         ok = ds > 1e-9 * T        # secants over shorter gaps are round-off
         self.lipschitz_x = float(np.max(np.linalg.norm(np.diff(X, axis=0)[ok], axis=1) / ds[ok]))
         self.lipschitz_y = float(np.max(np.linalg.norm(np.diff(Y, axis=0)[ok], axis=1) / ds[ok]))
-        # kink candidates: the runs of deeply halved cells (the refinement closes in on a kink); each is located
-        # where one-sided extrapolations of x* cross, and kept only if the slope of x* jumps there
-        runs, run = [], []
-        for a, b, _, _, depth in pieces + [(T, T, None, 0.0, 0)]:
-            if depth >= _KINK_DEPTH:
-                run.append((a, b))
-            elif run:
-                runs.append((run[0][0], run[-1][1], min(run, key=lambda c: c[1] - c[0])))
-                run = []
-        found = []
-        for i, (a, b, shortest) in enumerate(runs):
-            lo = runs[i - 1][1] if i > 0 else 0.0
-            hi = runs[i + 1][0] if i + 1 < len(runs) else T
-            k = self._locate(a, b, lo, hi)
-            if k is not None:
-                found.append(k)
-            elif a <= lo or b >= hi:     # no room to extrapolate from both sides: the refinement's centre
-                found.append(0.5 * (shortest[0] + shortest[1]))
-        # a kink (or a jump) exactly at a cell edge leaves both cells smooth: every edge away from the kinks found
-        # is looked at, its one-sided slopes compared
-        for t in self._starts[1:]:
-            if all(abs(t - k) > 1e-5 * T for k in found) and self._kink_at_edge(t):
-                found.append(t)
-        self.kinks = tuple(sorted(set(found) | set(given)))
+        self.kinks, self.input_kinks = find_kinks(self, pieces, given)
 
-    def _kink_at_edge(self, t: float) -> bool:
-        """Whether the slope of ``x*`` jumps at ``t``: the one-sided secants over ``ε = 1e-6 T`` differ by more than
-        ``1e-3 (1 + Lip x*)`` (a smooth ``x*`` moves them by ``ε |x*''|``); a jump of ``x*`` itself raises."""
-        e = 1e-6 * self.T
-        xl, xm, xr = self._xs(t - e), self._xs(t), self._xs(t + e)
-        if np.linalg.norm((xr - xm) - (xm - xl)) / e <= 1e-3 * (1.0 + self.lipschitz_x):
-            return False
-        self._check_continuous(t - 1e-12 * self.T, t + 1e-12 * self.T)
-        return True
-
-    def _locate(self, a: float, b: float, lo: float, hi: float) -> float | None:
-        """The kink of ``x*`` in the run ``[a, b]`` (free of kinks on ``[lo, a]`` and ``[b, hi]``): the crossing of
-        the cubics through ``x*`` at four points either side, re-centred on it and narrowed until the bracket is
-        ``1e-11 T``; ``None`` when the one-sided slopes agree (a smooth stretch refined for its curvature)."""
-        T = self.T
-        for _ in range(8):
-            w = 0.5 * (b - a)
-            if a - 3.0 * w < lo or b + 3.0 * w > hi:
-                w = min((a - lo) / 3.0, (hi - b) / 3.0)
-                if w <= 0.0:
-                    return None
-            m = 0.5 * (a + b)
-            sl = np.array([a - k * w for k in range(4)])
-            sr = np.array([b + k * w for k in range(4)])
-            left = np.polyfit((sl - m) / w, np.array([self._xs(t) for t in sl]), 3)     # (4, n) coefficients
-            right = np.polyfit((sr - m) / w, np.array([self._xs(t) for t in sr]), 3)
-            delta = right - left
-            j = int(np.argmax(np.abs(delta[-2])))                # the largest jump of slope Δ'(0)
-            roots = np.roots(delta[:, j])
-            roots = roots[np.abs(roots.imag) <= 1e-9 * (1.0 + np.abs(roots.real))].real
-            half = 0.5 * (b - a) / w + 1.0
-            roots = roots[np.abs(roots) <= half]
-            if roots.size == 0:
-                return None
-            r = float(roots[np.argmin(np.abs(roots))])
-            jump = np.array([np.polyval(np.polyder(delta[:, i]), r) for i in range(self.n)]) / w
-            if np.linalg.norm(jump) <= 1e-6 * (1.0 + self.lipschitz_x):
-                return None
-            k = m + r * w
-            if b - a <= 1e-11 * T:
-                return k
-            eps = max((b - a) / 64.0, 1e-12 * T)
-            a, b = max(k - eps, lo), min(k + eps, hi)
-        return k
+    def _integrand(self, t: float) -> np.ndarray:
+        return self._g(t)[0]
 
     def _check_continuous(self, a: float, b: float) -> None:
         xa, xb = self.x(a), self.x(b)
@@ -414,24 +365,44 @@ class ManufacturedSolution:
         growth = t if L == 0.0 else math.expm1(L * t) / L
         return float(h) * (self.lipschitz_y + L * self.lipschitz_x) * growth / 2.0
 
+    def regularity(self) -> tuple[float, str]:
+        """The highest order the data allow any convergent scheme here, derived from the construction (module
+        docstring): ``x* = J_{μF(t,·)}(z(t))`` is as smooth as the path and ``t ↦ F(t,·)`` (``smoothness``, C^∞ by
+        default) except where the resolvent switches regime — a kink of ``x*``, where ``x*'`` jumps: order 1 at
+        most; where only the input's integrand ``y* - f(x*)`` kinks (a field Lipschitz but not smooth along the
+        solution), ``x*`` is smooth and ``u`` Lipschitz: the cell holding the kink errs by ``O(h²)``, order 2 at
+        most; with neither, the path's and the operator's smoothness."""
+        if self.kinks:
+            return 1.0, (f"x* = J_(mu F(t))(z(t)) is Lipschitz and x*' jumps where the resolvent switches regime "
+                         f"({len(self.kinks)} kinks detected): order 1 at most")
+        if self.input_kinks:
+            return min(2.0, self.smoothness), (
+                f"x* has no kink, but the input u = x*' + y* - f(x*) kinks at {len(self.input_kinks)} times where f is "
+                "not smooth along x*: an O(h^2) error on the cell holding each, order 2 at most")
+        what = "smooth" if self.smoothness == math.inf else f"of order {self.smoothness:g}"
+        return self.smoothness, (f"no kink of x* = J_(mu F(t))(z(t)) or of the input on [0, T] (the resolvent never "
+                                 f"switches regime along the path): the data are as smooth as the path and "
+                                 f"t -> F(t,.), stated {what}")
+
     def order(self, lipschitz: float | None = None) -> Order:
-        """The derived :class:`Order` of the proximal scheme here: 1 (module docstring)."""
+        """The derived :class:`Order` of the proximal scheme here: 1 (module docstring), with the solution's
+        :meth:`regularity`."""
         bound = ""
         if self.f is None or lipschitz is not None:
             bound = f"; here sup error <= {self.error_bound(1.0, lipschitz):.3g} h with the measured constants"
+        reg, why = self.regularity()
         return Order(1.0, "manufactured solution (verimono.reference.manufactured): y* = (z - x*)/mu in F(t, x*) at every t "
                           "and monotonicity of F(t_(k+1),.) give |e_(k+1)| <= (1 + hL)|e_k| + h^2 (Lip y* + L Lip x*)/2"
                           ", order 1 (for a fixed subdifferential: Rulla 1996, x0 in D(dphi), BV forcing)" + bound,
-                     regularity=1.0,
-                     regularity_source=f"x* = J_(mu F(t))(z(t)) is Lipschitz and x*' jumps where the resolvent "
-                                       f"switches regime ({len(self.kinks)} kinks detected): order 1 at most")
+                     regularity=reg, regularity_source=why)
 
     def describe(self) -> str:
         """One paragraph: the construction, the kinks, the quadrature error, the measured constants."""
         ks = ", ".join(f"{k:.6g}" for k in self.kinks[:12]) + (" ..." if len(self.kinks) > 12 else "")
         return (f"manufactured: x* = J_(mu F(t))(z(t)) with z = {getattr(self.path, '__name__', 'path')}, "
                 f"mu = {self.mu:g}; kinks of x* at t = [{ks}]; int u over cells from U (adaptive Gauss-Legendre "
-                f"against Gauss-Lobatto, {self.cells} cells, error estimate {self.quadrature_error:.2g}); measured "
+                f"against Gauss-Lobatto, {self.cells} cells, error estimate {self.quadrature_error:.2g}); regularity "
+                f"{self.regularity()[0]:g}; measured "
                 f"Lip x* = {self.lipschitz_x:.4g}, Lip y* = {self.lipschitz_y:.4g}")
 
     def __getstate__(self) -> dict:
@@ -444,6 +415,10 @@ class ManufacturedSolution:
         return f"ManufacturedSolution({self.operator.name}, mu={self.mu:g}, T={self.T:g}, kinks={len(self.kinks)})"
 
 
+def _power_of_two_below(d: float) -> float:
+    return 2.0 ** math.floor(math.log2(d))
+
+
 def _remember(cache: dict, key: float, value: np.ndarray) -> None:
     if len(cache) >= _CACHE_SIZE:
         cache.clear()
@@ -453,7 +428,7 @@ def _remember(cache: dict, key: float, value: np.ndarray) -> None:
 def manufactured_problem(operator: Any, *, T: float, path: Callable[[float], Any] | None = None, mu: float = 1.0,
                          f: Callable | None = None, lipschitz: float | None = None, name: str | None = None,
                          order: Any = None, steps: Sequence[float] | None = None, velocity: Callable | None = None,
-                         kinks: Sequence[float] = (), **problem_kw: Any) -> Problem:
+                         kinks: Sequence[float] = (), smoothness: float = math.inf, **problem_kw: Any) -> Problem:
     """A :class:`verimono.Problem` whose exact solution is ``x*(t) = J_{μF(t,·)}(z(t))`` (module docstring).
 
     ``operator`` is ``F``; ``path`` is ``z`` (default :func:`lissajous`: a figure eight of amplitude 1.5
@@ -463,7 +438,11 @@ def manufactured_problem(operator: Any, *, T: float, path: Callable[[float], Any
     ``U`` (what the scheme uses: ``∫u`` per cell with no derivative) and ``u`` (pointwise, a.e.), the
     derived order 1 unless ``order`` says otherwise, ``steps`` ``T/50, ..., T/800`` by default, and a
     description in ``notes``.  ``velocity(t) = x*'(t)`` in closed form, when known, replaces the finite
-    differences of ``u``; ``kinks`` (times where ``x*'`` jumps, when known) become cell edges.  Other
+    differences of ``u``; ``kinks`` (times where ``x*'`` jumps, when known) become cell edges.  ``smoothness``: the
+    order of smoothness of the path and of ``t ↦ F(t,·)`` (C^∞ by default, as the default path is); the solution's
+    regularity — what a scheme claiming a higher order is held to — is derived from it and from the kinks found
+    (:meth:`ManufacturedSolution.regularity`: 1 with a kink of ``x*``, 2 with a kink of the input only, else
+    ``smoothness``).  Other
     keywords (``phi``, ``sigma``, ``theta``) go to :class:`verimono.Problem`.  Built eagerly (a few thousand
     resolvents), so a module can hold ``problem = manufactured_problem(...)``.
     """
@@ -474,7 +453,7 @@ def manufactured_problem(operator: Any, *, T: float, path: Callable[[float], Any
     if dim is None:
         raise InvalidProblem(f"operator must be a verimono.Operator, got {operator!r}")
     sol = ManufacturedSolution(operator, lissajous(dim) if path is None else path, mu, T, f, velocity=velocity,
-                               kinks=kinks)
+                               kinks=kinks, smoothness=smoothness)
     return Problem(operator, sol.x0, T, f=f, u=sol.u, U=sol.U, exact=sol,
                    order=sol.order(lipschitz) if order is None else order,
                    name=name or f"manufactured {getattr(operator, 'name', 'F')}", lipschitz=lipschitz,
@@ -485,8 +464,9 @@ def manufactured_problem(operator: Any, *, T: float, path: Callable[[float], Any
 # -- three examples: a moving set, a time-dependent subdifferential, a passive complementarity system ---------
 
 def _field(x: np.ndarray) -> np.ndarray:
-    """``f(x) = -x/2 + 0.3 sin(Px)``, ``P`` the reversal of the coordinates: Lipschitz with ``L = 0.8``."""
-    return -0.5 * x + 0.3 * np.sin(x[::-1])
+    """``f(x) = -x/2 + 0.3 sin(Px)``, ``P`` the reversal of the coordinates: Lipschitz with ``L = 0.8``.  Written for a
+    batch of states ``(B, n)`` too: the coordinates are reversed along the last axis, never the batch's."""
+    return -0.5 * x + 0.3 * np.sin(x[..., ::-1])
 
 
 def moving_box(T: float = 2 * math.pi, mu: float = 1.0, drift: Sequence[float] = (0.3, -0.2)) -> Problem:
@@ -506,14 +486,17 @@ def moving_box(T: float = 2 * math.pi, mu: float = 1.0, drift: Sequence[float] =
     b = np.array(drift, dtype=float)
     box = Box(lambda t: np.array([-1.0 + 0.3 * math.sin(t), -0.8]),
               lambda t: np.array([1.0 + 0.3 * math.sin(t), 0.8 + 0.2 * math.cos(t)]), name="moving box")
-    sol_problem = manufactured_problem(NormalCone(box), T=T, mu=mu, f=lambda x: b, lipschitz=0.0,
+    def drift_field(x):             # constant, with the shape of x: one drift per state of a batch (B, n)
+        return np.broadcast_to(b, np.shape(x)).copy()
+
+    sol_problem = manufactured_problem(NormalCone(box), T=T, mu=mu, f=drift_field, lipschitz=0.0,
                                        name="manufactured moving box", steps=[T / k for k in (101, 202, 404, 808, 1616)])
     sol = sol_problem.exact
     c2 = len(sol.kinks) * sol.lipschitz_y / 2.0
     order = Order(2.0, "manufactured moving box with a constant field: componentwise clamps, exact on cells without "
                        "a switch, Lip y* h^2/2 on a cell with one (derived in verimono.reference.manufactured.moving_box): "
                        f"sup error <= kinks * Lip y* h^2/2 = {c2:.3g} h^2 with the measured constants",
-                  regularity=1.0, regularity_source=sol.order().regularity_source)
+                  regularity=sol.regularity()[0], regularity_source=sol.regularity()[1])
     return sol_problem.replace(order=order)
 
 

@@ -170,14 +170,16 @@ def _changes(baseline: Report | None, report: Report) -> Any:
 
 def order_table(report: Report) -> list[str]:
     """One line per convergence study: reference, expected order, measured sup-norm order with its 95%
-    interval, verdict (``MISSED`` when the stepper does not reach the expected order, ``FAILED`` when its
-    record failed for another reason: a limit that is not the solution's)."""
+    interval, verdict (``MISSED`` when the stepper does not reach the expected order, ``UNDECIDED`` when the study
+    could not decide, ``FAILED`` when its record failed for another reason: a limit that is not the solution's)."""
     failed = {(r.details["study"].problem, r.details["study"].stepper) for r in report.results
               if r.check == "convergence_order" and r.status == FAILED and hasattr(r.details.get("study"), "problem")}
     rows = []
     for s in report.studies:
         exp = "-" if s.expected is None else ("exact" if s.expected.exact else f"{s.expected.value:g}")
-        verdict = "MISSED" if not s.verdict()[0] else "FAILED" if (s.problem, s.stepper) in failed else "ok"
+        status = s.decision().status if hasattr(s, "decision") else ("passed" if s.verdict()[0] else "failed")
+        verdict = {"failed": "MISSED", "undecided": "UNDECIDED"}.get(status, "FAILED" if (s.problem, s.stepper) in failed
+                                                                      else "ok")
         rows.append((s.problem, exp, str(s.order), verdict))
     if not rows:
         return []
@@ -199,6 +201,18 @@ def _start(out: Path, command: str, resumes: str | None = None) -> str:
     mark_in_progress(out / "results.json", run_id, command=command, pid=os.getpid(), host=socket.gethostname(),
                      started=dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"), resumes=resumes)
     return run_id
+
+
+def _step_range(text: str) -> tuple[float, float]:
+    """``--step-range H_MIN:H_MAX``: two positive finite step sizes (either order), checked before any work."""
+    parts = text.replace(",", ":").split(":")
+    try:
+        lo, hi = (float(v) for v in parts)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be two step sizes H_MIN:H_MAX, got {text!r}") from None
+    if not all(0.0 < v < float("inf") for v in (lo, hi)) or lo == hi:
+        raise argparse.ArgumentTypeError(f"must be two distinct positive finite step sizes H_MIN:H_MAX, got {text!r}")
+    return min(lo, hi), max(lo, hi)
 
 
 def _seconds(text: str) -> float:
@@ -331,7 +345,8 @@ def _cmd_check(args: argparse.Namespace) -> int:
 
         # its calls are timed apart from the checks around them: the gate judges the subject's own CPU time
         obj = TimedStepper(with_claim(obj, args.scheme, args.order, solve_tol=args.solve_tol))
-        stages, ctx = ["convergence", "trajectory_laws"], _context(args, stepper=obj)
+        stages, ctx = ["convergence", "trajectory_laws"], _context(args, stepper=obj,
+                                                                    step_range=getattr(args, "step_range", None))
         kind = "stepper" + ("" if claim_of(obj).proximal else f" claiming {claim_of(obj).describe()}")
     else:
         raise BadTarget(f"{args.target} is a problem: `verimono check` takes an operator or a stepper")
@@ -552,6 +567,9 @@ def build_parser() -> argparse.ArgumentParser:
     check.add_argument("--solve-tol", type=float, default=None, metavar="TAU",
                        help="the accuracy of the stepper's inner solve per step (relative to 1 + |x|): errors at "
                             "what it accumulates pass as exact to it")
+    check.add_argument("--step-range", type=_step_range, default=None, metavar="H_MIN:H_MAX",
+                       help="run every convergence study on uniform grids with steps in [H_MIN, H_MAX] only (by "
+                            "default each study chooses its grids for the claimed order: docs/convergence.md)")
     check.set_defaults(func=_cmd_check, stage=None)
 
     comp = sub.add_parser("compare", help="work-precision of several steppers on a problem, with the diagram")

@@ -33,7 +33,8 @@ _HOMES = {
     "LAWS": "operator_battery", "OPERATOR_CHECKS": "operator_battery", "check_operator": "operator_battery",
     "operator_checks": "operator_battery",
     "Sample": "samples", "law_samples": "samples",
-    "BOUND": "search", "DEFAULT_EXAMPLES": "search", "fresh_seed": "search", "run_law": "search",
+    "BOUND": "search", "DEFAULT_EXAMPLES": "search", "fresh_seed": "search",
+    "run_law": "operator_battery",     # search's run_law, from the module that registers the laws it runs
     "check_stepper": "stepper_battery", "stepper_checks": "stepper_battery",
 }
 

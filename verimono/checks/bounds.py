@@ -255,7 +255,8 @@ def _bounded(stepper: Callable, p: Problem, t: np.ndarray, setup: Callable, labe
     return Outcome(float(np.max(ratios)), k, counter, details, message=passed)
 
 
-@stepper_law("bounds_lg", "lem:bndSeq", PROXIMAL_CLAIM, _holds(_lg_requirements))
+@stepper_law("bounds_lg", "lem:bndSeq", PROXIMAL_CLAIM, _holds(_lg_requirements), every_grid=True,
+             study_grids=True)
 def check_bounds_lg(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int = 0) -> Outcome:
     """Lemma ``lem:bndSeq`` (under (A3), (LG)): ``|x_k| ≤ β``, ``|x_k - x_{k-1}| ≤ ψ(t_k) - ψ(t_{k-1})``.
 
@@ -269,7 +270,8 @@ def check_bounds_lg(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int =
                     "|x_k| <= beta and |x_k - x_(k-1)| <= psi(t_k) - psi(t_(k-1)) (lem:bndSeq)")
 
 
-@stepper_law("bounds_yb", "lem:bndSeqYB", PROXIMAL_CLAIM, _holds(_yb_requirements))
+@stepper_law("bounds_yb", "lem:bndSeqYB", PROXIMAL_CLAIM, _holds(_yb_requirements), every_grid=True,
+             study_grids=True)
 def check_bounds_yb(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int = 0) -> Outcome:
     """Lemma ``lem:bndSeqYB`` (under (YB), ``|Δ| < Λ``): ``|x_k| ≤ |x0| + αT`` and
     ``|x_k - x_{k-1}| ≤ α h_k`` with ``α = 2(θ(T) - θ(0)) + |F^0(0, x0)|``.

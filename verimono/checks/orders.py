@@ -1,11 +1,13 @@
 """The convergence order of a stepper on a problem with its expected order (Theorem ``thm:main`` and each
 reference's stated order).
 
-``check_convergence_order(stepper, problem)`` runs a :func:`verimono.core.convergence.convergence_study` and
-turns its verdict into a record: ``worst = expected / (upper end of the interval + slack)`` and
-``bound = 1``, so the stepper passes when its measured order can reach the expected one.  For references
-on which the scheme is exact at the nodes, ``worst = max error / round-off floor``.  The study is kept in
-the record (``details["study"]``).
+``check_convergence_order(stepper, problem)`` runs a :func:`verimono.core.convergence.convergence_study` — which
+chooses its grids for the scheme (coarser for a high-order one, finer when the finest refinement falls short) and
+honours the stepper's claim — and turns its verdict (:mod:`verimono.core.verdicts`) into a record: passed, failed,
+or *undecided* (no asymptotic range above the floor within the study's budget, a floor the user did not state),
+with ``worst = expected / (upper end of the interval + slack)`` and ``bound = 1``.  For references on which the
+scheme is exact at the nodes, ``worst = max error / round-off floor``.  The study is kept in the record
+(``details["study"]``); ``steps`` or ``step_range`` choose the grids for a user who knows better.
 
 A problem without an exact solution is measured against a fine-grid solution of the same stepper: that is
 self-convergence, which a scheme converging to a wrong limit (an input or a field dropped) passes.  So the
@@ -22,24 +24,16 @@ from typing import Any, Callable
 import numpy as np
 
 from ..core.claims import claim_of
-from ..core.convergence import ORDER_SLACK, _timed_run, convergence_study, study_grids
+from ..core.convergence import _timed_run, convergence_study, expected_order, study_grids
+from ..core.errors import InvalidProblem
+from ..core.grid_design import cells_range
 from ..core.grids import uniform_grid
-from ..core.problem import Order, Problem, origin_of
-from ..records.results import FAILED, PASSED
+from ..core.problem import Problem, origin_of
+from ..records.results import FAILED, PASSED, UNDECIDED
 from ..core.stepping import solve
 from .core import Holds, Outcome, law, subject_name
 from .partitions import run_once
-
-
-def _expected(stepper: Callable, problem: Problem) -> Order | None:
-    """The order ``stepper`` must reach on ``problem``: the reference's order for the proximal scheme,
-    ``min(claimed, regularity)`` for a scheme claiming only ``scheme="any"`` (:meth:`Order.for_claim`)."""
-    claim = claim_of(stepper)
-    if claim.proximal:
-        return problem.order
-    if problem.order is None:
-        return Order(claim.order, "the claimed order (the problem states no regularity)")
-    return problem.order.for_claim(claim.order)
+from .shared_runs import note_partitions
 
 
 #: the stepper's and verimono.solve's solutions on the finest grid may differ by this many times the sum of
@@ -53,13 +47,15 @@ def limit_agreement(stepper: Callable, study: Any, problem: Problem) -> tuple[bo
     """Whether ``stepper`` converges to the limit of :func:`verimono.solve` on ``problem`` (see the module
     docstring): their sup distance on the finest grid of ``study`` against ``LIMIT_FACTOR`` times the sum of
     their estimated errors there (each from its own study on the same grids), plus both round-off floors."""
-    grids = study_grids(problem.T, problem.steps)
+    grids = study.grids()                         # coarse to fine, the grids the study chose
+    if any(g is None for g in grids):             # explicit nonuniform grids: those the problem gave
+        grids = sorted(study_grids(problem.T, problem.steps), key=len)
     k = int(np.argmin(study.mesh))
     grid = grids[k]
-    ref = convergence_study(solve, problem, grids)
+    ref = convergence_study(solve, problem, [grids[int(np.argsort(study.mesh)[1])], grid], adapt=False)
     ours, _ = _timed_run(stepper, problem, grid)
     theirs, _ = _timed_run(solve, problem, grid)
-    e_ours, e_ref = float(study.errors["sup"][k]), float(ref.errors["sup"][k])
+    e_ours, e_ref = float(study.errors["sup"][k]), float(ref.errors["sup"][-1])
     bound = LIMIT_FACTOR * (e_ours + e_ref) + study.floor + ref.floor
     gap = float(np.max(np.linalg.norm((ours - theirs).reshape(len(grid), -1), axis=1)))
     info = {"distance": gap, "bound": bound, "stepper_error": e_ours, "solve_error": e_ref, "steps": len(grid) - 1}
@@ -74,36 +70,45 @@ def _states_order(p: Problem) -> str | None:
     return None if p.order is not None and p.steps else "the problem states no expected order or no step sizes"
 
 
-def run_order(decl: Any, stepper: Callable, problem: Problem, steps: Any = None, executor: Any = None) -> Any:
-    """The order law on ``problem`` (``steps``, step sizes or grids, stand in for the problem's own)."""
-    if steps is not None:
-        problem = problem.replace(steps=list(steps))
-    return run_once(decl, stepper, problem, executor=executor)
+def run_order(decl: Any, stepper: Callable, problem: Problem, steps: Any = None, executor: Any = None,
+              step_range: Any = None) -> Any:
+    """The order law on ``problem``: on the grids the study chooses, or exactly on ``steps`` (step sizes or
+    grids), or within ``step_range = (h_min, h_max)``."""
+    kw = {k: v for k, v in (("steps", steps), ("step_range", step_range)) if v is not None}
+    return run_once(decl, stepper, problem, executor=executor, **kw)
 
 
 @law("convergence_order", "thm:main (convergence) and each reference's stated order", subject="stepper",
      driver=run_order, requires=(Holds(_states_order),))
-def check_convergence_order(stepper: Callable, problem: Problem, *, executor: Any = None) -> Outcome:
+def check_convergence_order(stepper: Callable, problem: Problem, *, executor: Any = None, steps: Any = None,
+                            step_range: Any = None) -> Outcome:
     """Whether ``stepper`` reaches the order it must on ``problem`` (one record, study in ``details``): the
     reference's stated order (exact at the nodes where it is) for the proximal scheme; for a scheme
-    claiming only ``scheme="any"`` with order ``p``, ``min(p, problem.order.regularity)``."""
-    exp = _expected(stepper, problem)
+    claiming ``scheme="any"`` with order ``p``, ``min(p, problem.order.regularity)``.
+
+    The study chooses its grids for the scheme from the problem's recommended steps
+    (:mod:`verimono.core.grid_design`); ``steps`` are run exactly as given, ``step_range = (h_min, h_max)``
+    confines it to those steps.  Its verdict (:mod:`verimono.core.verdicts`) may be *undecided*: no asymptotic
+    range above the floor within the budget, a floor the user did not state (the message says what to do)."""
+    exp = expected_order(stepper, problem)
+    if step_range is not None:
+        try:
+            cells_range(problem.T, step_range)
+        except InvalidProblem as exc:       # a range that fits this problem's horizon no study: nothing decided
+            return Outcome(None, message=f"not studied: {exc}", status=UNDECIDED)
     try:
-        study = convergence_study(stepper, problem if exp is problem.order else problem.replace(order=exp),
-                                  problem.steps, executor=executor)
+        study = convergence_study(stepper, problem, steps, step_range=step_range, executor=executor,
+                                  adapt=steps is None and step_range is None)
     except NotImplementedError as exc:
         refused = _refuses_fine_grids(stepper, problem, exc)
         if refused is None:
-            raise                   # not even the coarsest grid: not available here (skipped, as before)
+            raise                   # not even the coarsest grid: not available here (skipped)
         return refused
-    ok, msg = study.verdict()
-    fit = study.order
-    if exp.exact:
-        worst = max(study.errors["sup"]) / study.floor
-    elif fit.exact:
-        worst = 0.0
-    else:
-        worst = exp.value / (fit.high + ORDER_SLACK) if fit.high == fit.high else float("inf")
+    # the study's runs are partitions the battery computed: the step laws judge the stepper on its finest and on
+    # those where its errors fell short
+    note_partitions(stepper, problem, study.step_law_grids())
+    decision = study.decision()
+    ok, msg, worst = decision.ok, decision.message, decision.worst
     details = {"study": study, "reproduce_python": reproduction_script(problem)}
     if ok and problem.exact is None and getattr(stepper, "fn", stepper) is not solve:
         ok, why, details["limit"] = limit_agreement(stepper, study, problem)
@@ -112,8 +117,11 @@ def check_convergence_order(stepper: Callable, problem: Problem, *, executor: An
             worst = max(worst, details["limit"]["distance"] / details["limit"]["bound"])
     if not claim_of(stepper).proximal:
         details["expected"] = {"order": exp.value, "source": exp.source}
+    if study.added:         # the cells of the grids the study chose itself (coarser, finer)
+        details["grids_added"] = [study.steps[i] for i in study.added]
+    status = PASSED if ok else (UNDECIDED if decision.status == UNDECIDED else FAILED)
     # the study's verdict decides; the ratio says by how much
-    return Outcome(worst, details=details, message=msg, status=PASSED if ok else FAILED,
+    return Outcome(worst, details=details, message=msg, status=status,
                    counter={} if ok else {"steps": study.mesh, "errors": study.errors["sup"], "message": msg})
 
 

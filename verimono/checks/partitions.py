@@ -5,8 +5,8 @@ A stepper law is one decorated evaluator (:func:`stepper_law`), of one of two fo
 
 * ``over_grids=True``: ``check_<law>(stepper, problem, t, **kw) -> Outcome`` judges the stepper's solution on
   one partition ``t``.  The driver (:func:`run_on_grids`) evaluates it on every partition of the battery
-  (:func:`battery_grids`: uniform and random, or those given; for the proximal scheme's ``selections`` and
-  ``in_domain`` every partition the battery builds, :func:`every_battery_grid`), keeps the worst, and shrinks a failure to
+  (:func:`battery_grids`: uniform and random, or those given; for the step laws every partition the battery
+  builds, :func:`every_battery_grid`, and its convergence study's), keeps the worst, and shrinks a failure to
   the shortest prefix ``[0, t_k]`` of its partition that still fails (re-verified), so the counterexample
   holds the problem, the partition, the initial point and the offending step;
 * otherwise ``check_<law>(stepper, problem, **kw) -> Outcome`` judges the stepper as a whole (a unique
@@ -36,7 +36,7 @@ from ..records.results import PASSED
 from ..execution.timeouts import note_progress
 from .core import Outcome, law, run, stepper_subject
 from .arguments import valid_seed
-from .shared_runs import remembered
+from .shared_runs import noted_partitions, remembered
 from .subjects import require_problem, require_stepper
 
 #: cells of the default partitions (fine enough for the lemmas' bounds, fast enough for a battery)
@@ -48,11 +48,16 @@ RANDOM_SPREAD = 0.6
 #: the law's form for a stepper claiming only ``scheme="any"``, by law name (``in_domain``: a distance to
 #: the domain vanishing at the claimed order, instead of exact membership at every node)
 ANY_SCHEME_FORM: dict[str, Callable[..., Outcome]] = {}
-#: laws judged on every partition the battery builds (:func:`every_battery_grid`), not only the two default
-#: ones: the proximal scheme's step-by-step laws (``selections``, ``in_domain``), whose verdict on a stepper
-#: that deviates on some steps only (a Newton solve stopped at a residual of 1e-4: off on the small steps)
-#: must not depend on which partitions a seed happened to draw
+#: laws judged on every partition the battery builds (:func:`every_battery_grid`), not only the two default ones:
+#: the step laws on one trajectory (``selections``, ``in_domain``, ``bounds_lg``, ``bounds_yb``), whose verdict on
+#: a stepper that deviates on some steps only (a Newton solve stopped at a residual of 1e-4: off on the small
+#: steps) must not depend on which partitions a seed happened to draw
 EVERY_GRID: set[str] = set()
+#: laws judged on the partitions of the stepper's convergence study as well — its finest grid and those where its
+#: errors fell short (:func:`verimono.checks.shared_runs.note_partitions`): the step laws above and
+#: ``contraction`` (whose pairs of runs from other starts are new runs: on the default partitions and these, not on
+#: every one), so a scheme that changes on steps finer than the battery's partitions is judged there
+STUDY_GRID: set[str] = set()
 
 
 def single(problem: Problem) -> Problem:
@@ -116,11 +121,19 @@ def every_battery_grid(problem: Problem, seed: int = 0) -> dict[str, np.ndarray]
     return out
 
 
-def battery_grids(grids: Any, problem: Problem, seed: int, *, every: bool = False) -> dict[str, np.ndarray]:
+def battery_grids(grids: Any, problem: Problem, seed: int, *, every: bool = False,
+                  stepper: Callable | None = None, study: bool = False) -> dict[str, np.ndarray]:
     """The partitions a law is judged on: ``grids`` (a dict or a list of increasing arrays from 0 to ``T``),
-    else :func:`default_grids` (``every=True``: :func:`every_battery_grid`)."""
+    else :func:`default_grids` (``every=True``: :func:`every_battery_grid`), with ``study=True`` the partitions of
+    ``stepper``'s convergence study on ``problem`` noted in the :func:`verimono.checks.shared_runs.shared_runs`
+    block."""
     if grids is None:
-        return every_battery_grid(problem, seed) if every else default_grids(problem, seed)
+        out = every_battery_grid(problem, seed) if every else default_grids(problem, seed)
+        for g in noted_partitions(stepper, problem) if study and stepper is not None else []:
+            if abs(g[-1] - problem.T) <= 1e-12 * max(1.0, problem.T) and not any(
+                    len(g) == len(h) and np.array_equal(g, h) for h in out.values()):
+                out[f"study K={len(g) - 1}"] = validate_grid(g, problem.T)
+        return out
     if isinstance(grids, dict):
         return {k: validate_grid(g, problem.T) for k, g in grids.items()}
     return {f"grid{i}": validate_grid(g, problem.T) for i, g in enumerate(grids)}
@@ -151,7 +164,8 @@ def run_on_grids(decl: Any, stepper: Callable, problem: Problem, *, grids: Any =
     any_form = ANY_SCHEME_FORM.get(decl.name)
     if any_form is not None and grids is None and not claim_of(stepper).proximal:
         return run(decl, subject, lambda: any_form(stepper, p, seed=seed), stepper=stepper, problem=p)
-    parts = battery_grids(grids, p, seed, every=decl.name in EVERY_GRID)
+    parts = battery_grids(grids, p, seed, every=decl.name in EVERY_GRID, stepper=stepper,
+                          study=decl.name in STUDY_GRID)
     kw = {"seed": seed, **kw}
 
     def evaluate() -> Outcome:
@@ -192,24 +206,26 @@ def run_once(decl: Any, stepper: Callable, problem: Problem, **kw: Any) -> Any:
     rec = run(decl, subject, lambda: decl.evaluate(stepper, p, **kw), stepper=stepper, problem=p)
     if rec.status == "failed" and rec.counterexample is None:      # the stepper raised: what it was given
         rec.counterexample = {"problem": p.name, "T": p.T, "x0": p.x0,
-                              **{k: v for k, v in kw.items() if k in ("levels", "seed", "steps")}}
+                              **{k: v for k, v in kw.items() if k in ("levels", "seed", "steps", "step_range")}}
     return rec
 
 
 def stepper_law(name: str, label: str, *requires: Any, over_grids: bool = True,
                 any_scheme: Callable[..., Outcome] | None = None, battery: bool = True,
-                every_grid: bool = False) -> Callable:
+                every_grid: bool = False, study_grids: bool = False) -> Callable:
     """Declare a stepper law (module docstring); ``any_scheme`` is its form for a stepper claiming only
     ``scheme="any"`` (judged once, not per partition); ``every_grid``: judged on :func:`every_battery_grid`
-    when no partitions are given."""
+    when no partitions are given; ``study_grids``: on the partitions of the stepper's convergence study too."""
     if any_scheme is not None:
         ANY_SCHEME_FORM[name] = any_scheme
     if every_grid:
         EVERY_GRID.add(name)
+    if study_grids:
+        STUDY_GRID.add(name)
     return law(name, label, subject="stepper", driver=run_on_grids if over_grids else run_once, requires=requires,
                battery=battery)
 
 
 __all__ = ["stepper_law", "run_on_grids", "run_once", "run_stepper", "single", "default_grids", "limit_grids",
            "battery_grids", "every_battery_grid", "refined_random_grid", "DEFAULT_CELLS", "RANDOM_SPREAD",
-           "ANY_SCHEME_FORM", "EVERY_GRID"]
+           "ANY_SCHEME_FORM", "EVERY_GRID", "STUDY_GRID"]

@@ -485,9 +485,9 @@ def run_law(decl: Law | str, op: Any, *, seed: int | None = None, examples: int 
     ``[0, horizon]``."""
     if isinstance(decl, str):
         if decl not in REGISTRY["operator"]:
-            from . import operator_laws  # noqa: F401 - the laws register on import
-        if decl not in REGISTRY["operator"]:
-            raise InvalidCheckArgument(f"no operator law named {decl!r}; registered: {sorted(REGISTRY['operator'])}")
+            raise InvalidCheckArgument(f"no operator law named {decl!r}; registered: {sorted(REGISTRY['operator'])} "
+                                       "(the laws register when verimono.checks.operator_laws is imported; "
+                                       "verimono.checks.run_law imports it)")
         decl = REGISTRY["operator"][decl]
     horizon = valid_horizon(horizon)
     profile = None

@@ -2,8 +2,10 @@
 
 A stepper is a function of its problem and partition, and the battery's laws ask for the same ones over and
 over: ``selections`` and ``in_domain`` run on every partition the battery builds (:func:`every_battery_grid`),
-``contraction`` and the a-priori bounds on the two default ones among them, ``unique_limit`` on the
-refinement levels among them.  Inside :func:`shared_runs` (opened by the stepper stages around a problem's
+``contraction`` and the a-priori bounds as well, ``unique_limit`` on the refinement levels among them — and the step
+laws on the partitions of the stepper's convergence study too (:func:`note_partitions`: the study's grids, which
+it chose for the scheme and may have refined, are partitions the battery computed; a stepper that leaves the
+proximal scheme only on steps finer than the battery's own partitions is judged there).  Inside :func:`shared_runs` (opened by the stepper stages around a problem's
 laws and by :func:`verimono.check_stepper` around its battery) :func:`verimono.checks.partitions.run_stepper`
 answers a repeated ``(stepper, problem, partition)`` from the first run instead of running the stepper again
 (measured on the ``ci`` battery of ``verimono.solve``: 881 runs, 367 distinct, 0.69 s of 1.2 s saved).
@@ -39,12 +41,14 @@ _ACTIVE: list["_Runs"] = []
 
 class _Runs:
     """What one :func:`shared_runs` block keeps: ``key -> (owners, arrays, precision)``, at most :data:`MAX_BYTES`
-    of arrays in all, the oldest dropped first."""
+    of arrays in all, the oldest dropped first; and the partitions of each (stepper, problem) the battery's
+    convergence studies ran (:func:`note_partitions`)."""
 
     def __init__(self) -> None:
         self.kept: OrderedDict[tuple, tuple[tuple, tuple[np.ndarray, ...], str | None]] = OrderedDict()
         self.bytes = 0
         self.hits = 0
+        self.partitions: dict[tuple, tuple[Any, list[np.ndarray]]] = {}
 
     def get(self, key: tuple) -> tuple[np.ndarray, ...] | None:
         """Copies of the arrays kept for ``key`` (their precision observed again), or ``None``."""
@@ -100,6 +104,34 @@ def remembered(stepper: Any, problem: Any, grid: np.ndarray,
     return x
 
 
+def _partition_key(stepper: Any, name: str, T: float) -> tuple:
+    return (id(stepper), str(name), float(T))
+
+
+def note_partitions(stepper: Any, problem: Any, grids: Any) -> None:
+    """Inside :func:`shared_runs`: ``stepper`` ran on ``grids`` (partitions of ``[0, problem.T]``) for ``problem`` —
+    a convergence study's grids — so the step laws judge it there too (:func:`noted_partitions`).  ``problem`` is a
+    :class:`verimono.Problem` or its ``(name, T)``."""
+    if not _ACTIVE:
+        return
+    name, T = (problem.name, problem.T) if hasattr(problem, "name") else problem
+    key = _partition_key(stepper, name, T)
+    _, known = _ACTIVE[-1].partitions.get(key, (stepper, []))
+    for g in grids:
+        g = np.asarray(g, dtype=float)
+        if not any(len(g) == len(k) and np.array_equal(g, k) for k in known):
+            known.append(g)
+    _ACTIVE[-1].partitions[key] = (stepper, known)     # the stepper is held: its id cannot be reused
+
+
+def noted_partitions(stepper: Any, problem: Any) -> list[np.ndarray]:
+    """The partitions noted for ``stepper`` on ``problem`` (by name and horizon) in this block, coarse to fine."""
+    if not _ACTIVE:
+        return []
+    _, known = _ACTIVE[-1].partitions.get(_partition_key(stepper, problem.name, problem.T), (None, []))
+    return sorted(known, key=len)
+
+
 def remembered_value(key: tuple, owners: tuple, compute: Callable[[], tuple[np.ndarray, ...]]) -> tuple[np.ndarray, ...]:
     """``compute()`` — a tuple of arrays derived from a run — or, inside :func:`shared_runs`, copies of what it
     returned the first time for the same ``key`` (the precision observed while it ran is observed again).
@@ -116,4 +148,4 @@ def remembered_value(key: tuple, owners: tuple, compute: Callable[[], tuple[np.n
     return value
 
 
-__all__ = ["shared_runs", "remembered", "remembered_value", "MAX_BYTES"]
+__all__ = ["shared_runs", "remembered", "remembered_value", "note_partitions", "noted_partitions", "MAX_BYTES"]

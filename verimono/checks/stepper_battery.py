@@ -69,12 +69,15 @@ def law_checks(problems: Iterable[Problem], laws: Sequence[str] = LAWS, seed: in
 
 def stepper_checks(stepper: Callable | None = None, problems: Iterable[Problem] | None = None, *,
                    seed: int = 0, generated: int = 4, laws: Sequence[str] = LAWS, orders: bool = True,
-                   executor: Any = None) -> Iterator[tuple[str, Callable[[Callable], CheckResult]]]:
+                   executor: Any = None, step_range: Sequence[float] | None = None
+                   ) -> Iterator[tuple[str, Callable[[Callable], CheckResult]]]:
     """The battery of a stepper, as ``(name, check)`` pairs.
 
     ``problems=None``: the reference catalog (convergence orders and laws) plus ``generated`` sampled
     problems (:func:`verimono.checks.sample_problems.sample_problems`, laws only).  ``stepper`` is unused
     (the battery does not depend on it); it is accepted for the protocol ``stepper_checks(stepper)``.
+    ``step_range = (h_min, h_max)`` confines every convergence study to those steps
+    (:func:`verimono.convergence_study`).
     """
     seed = valid_seed(seed)
     generated = valid_count(generated)
@@ -88,14 +91,14 @@ def stepper_checks(stepper: Callable | None = None, problems: Iterable[Problem] 
     if orders:
         order = laws_of("stepper")[ORDER_LAW].check
         for p in refs:
-            yield f"{ORDER_LAW}[{p.name}]", (lambda s, _p=p: order(s, _p, executor=executor))
+            yield f"{ORDER_LAW}[{p.name}]", (lambda s, _p=p: order(s, _p, executor=executor, step_range=step_range))
     yield from law_checks(list(refs) + list(extra), laws, seed)
 
 
 def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, *, scheme: str | None = None,
                   order: float | None = None, seed: int | None = None, executor: Any = None,
                   laws: bool | Iterable[str] = True, generated: int = 4, orders: bool = True,
-                  profile: str | None = None) -> Report:
+                  profile: str | None = None, step_range: Sequence[float] | None = None) -> Report:
     """Result records for ``stepper``: convergence orders on the references, then the trajectory laws.
 
     ``scheme``/``order`` state what the stepper claims (:class:`verimono.Stepper`; a bare callable
@@ -107,7 +110,8 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
     convergence orders (in the order of ``problems``), then one record per (problem, law);
     ``laws=False`` keeps the orders only, a list of law names selects laws, ``orders=False`` keeps the laws
     only.  What is not a stepper, a bad seed or an empty selection is refused before anything runs
-    (:class:`verimono.InvalidCheckArgument`).
+    (:class:`verimono.InvalidCheckArgument`).  The convergence studies choose their grids for the claimed order
+    (:mod:`verimono.core.grid_design`); ``step_range = (h_min, h_max)`` confines them to those step sizes.
 
     Every check runs under the unit time budget (:mod:`verimono.execution.timeouts`).  ``executor`` runs the
     convergence studies' grids (a ``concurrent.futures`` executor, ``"process"`` or ``"serial"``,
@@ -123,7 +127,7 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
     if profile is not None:
         with chosen(profile):
             return check_stepper(stepper, problems, scheme=scheme, order=order, seed=seed, executor=executor,
-                                 laws=laws, generated=generated, orders=orders)
+                                 laws=laws, generated=generated, orders=orders, step_range=step_range)
     require_stepper(stepper)
     if problems is not None:
         problems = list(problems)
@@ -140,7 +144,7 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
     report = Report()
     isolate = isolating(executor)
     checks = list(stepper_checks(stepper, problems, seed=seed, generated=generated, laws=selected,
-                                 orders=orders, executor=None if isolate else executor))
+                                 orders=orders, executor=None if isolate else executor, step_range=step_range))
     if isolate:   # every check in a worker process: one blocked in native code ends only its worker
         units = [Unit("check_stepper", name, run_check,
                       (check, stepper, name.partition("[")[0], stepper_subject(stepper, name.partition("[")[2][:-1])))

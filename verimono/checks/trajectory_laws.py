@@ -117,7 +117,7 @@ def run_starts(stepper: Callable, problem: Problem, starts: Sequence[np.ndarray]
 
 
 @stepper_law("contraction", "uniqueness argument and the Lipschitz theorem (Section 6)", CONTRACTION_CLAIM,
-             Holds(_states_lipschitz))
+             Holds(_states_lipschitz), study_grids=True)
 def check_contraction(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int = 0,
                       x0_primes: Any = None) -> Outcome:
     """Two discrete solutions never move apart faster than ``e^{L t}`` (uniqueness argument, Section 6).
@@ -197,7 +197,8 @@ def domain_vanishing(stepper: Callable, p: Problem, *, seed: int = 0,
                            f"(order {target:g} claimed; scheme='any')")
 
 
-@stepper_law("in_domain", "e:x k+1 props.1", Member("project_domain"), any_scheme=domain_vanishing, every_grid=True)
+@stepper_law("in_domain", "e:x k+1 props.1", Member("project_domain"), any_scheme=domain_vanishing, every_grid=True,
+             study_grids=True)
 def check_in_domain(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int = 0) -> Outcome:
     """``x_k ∈ cl dom F(t_k,·)`` for every node (``e:x k+1 props.1``; from ``k = 1`` after a jump).
 
@@ -244,7 +245,7 @@ def check_in_domain(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int =
 
 # -- selections -------------------------------------------------------------------------------------
 
-@stepper_law("selections", "eq:iteration", PROXIMAL_CLAIM, every_grid=True)
+@stepper_law("selections", "eq:iteration", PROXIMAL_CLAIM, every_grid=True, study_grids=True)
 def check_selections(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int = 0) -> Outcome:
     """``y_{k+1} = (z_k - x_{k+1})/h_{k+1} ∈ F(t_{k+1}, x_{k+1})`` (``eq:iteration``), ``z_k = x_k + h f(x_k)
     + ∫u``: through ``operator.contains`` and through ``J_μ(x_{k+1} + μ y_{k+1}) = x_{k+1}`` at the

@@ -71,7 +71,7 @@ tr.failed td { background:#fff5f5; }
 figure { margin:0; border:1px solid var(--line); border-radius:6px; padding:6px; background:#fff; }
 figure svg { width:100%; height:auto; display:block; }
 figcaption { font-size:12px; color:var(--mute); padding:4px 4px 0; }
-figcaption b.passed { color:var(--ok); } figcaption b.failed { color:var(--bad); }
+figcaption b.passed { color:var(--ok); } figcaption b.failed { color:var(--bad); } figcaption b.undecided { color:#8e24aa; }
 pre { background:#f3f4f7; border:1px solid var(--line); border-radius:6px; padding:8px 10px; overflow-x:auto;
       font: 12px/1.4 ui-monospace, SFMono-Regular, Menlo, Consolas, monospace; white-space:pre; }
 details { margin:6px 0; } summary { cursor:pointer; color:#1f5fbf; }
@@ -302,8 +302,8 @@ def _convergence(report: Report) -> str:
         return '<p class="note">No convergence studies in this run.</p>'
     figs, rows = [], []
     for s in studies:
-        ok, msg = s.verdict()
-        status = PASSED if ok else FAILED
+        decision = s.decision()
+        status, msg = decision.status, decision.message
         figs.append(f"<figure>{convergence_plot(s)}<figcaption><b class=\"{status}\">{status.upper()}</b> "
                     f"{_e(s.stepper)} — {_e(msg)}. Reference: {_e(s.reference)}.</figcaption></figure>")
         f = s.fits["sup"]

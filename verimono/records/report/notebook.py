@@ -12,7 +12,7 @@ import re
 from typing import Any
 
 from ...core.display import register
-from ..results import FAILED, PASSED, CheckResult, Report, to_jsonable
+from ..results import FAILED, CheckResult, Report, to_jsonable
 from . import html
 from .plots import convergence_figure, convergence_plot
 from .work_precision import set_html, work_precision_figure as wp_figure
@@ -124,8 +124,8 @@ def _reproduction(rec: CheckResult, study: Any) -> str:
 
 
 def study_figure_html(study: Any) -> str:
-    ok, msg = study.verdict()
-    status = PASSED if ok else FAILED
+    decision = study.decision()
+    status, msg = decision.status, decision.message
     return (f'<figure style="max-width:560px">{convergence_plot(study)}<figcaption><b class="{status}">'
             f"{status.upper()}</b> {html._e(study.stepper)} — {html._e(msg)}. Reference: "
             f"{html._e(study.reference)}.</figcaption></figure>")

@@ -28,7 +28,7 @@ from ...checks.core import subject_name as _name
 from ...checks.orders import check_convergence_order
 from ...checks.picard import check_picard
 from ...checks.pseudo_distance import check_pseudo_distance
-from ...checks.shared_runs import shared_runs
+from ...checks.shared_runs import note_partitions, shared_runs
 from ...checks.siconos import check_siconos_case, check_siconos_lcps
 from ...checks.stepper_battery import stepper_checks
 from .registry import RunContext, register_stage
@@ -55,11 +55,13 @@ def sample_trajectory(stepper: Callable, problem: Any, h: float | None = None) -
                         "exact": first(exact) if exact is not None else None})
 
 
-def _convergence_unit(stepper: Callable, problem: Any) -> Report:
-    """One reference: its convergence-order record and study, and a trajectory sample for the plots."""
+def _convergence_unit(stepper: Callable, problem: Any, step_range: Any = None) -> Report:
+    """One reference: its convergence-order record and study (in ``step_range`` when given), and a trajectory
+    sample for the plots."""
     report = Report()
-    rec = report.add(run_unit(lambda: check_convergence_order(stepper, problem), check="convergence_order",
-                              subject=f"{_name(stepper)} on {problem.name}"))
+    kw = {} if step_range is None else {"step_range": step_range}
+    rec = report.add(run_unit(lambda: check_convergence_order(stepper, problem, **kw),
+                              check="convergence_order", subject=f"{_name(stepper)} on {problem.name}"))
     if rec.study is not None:
         report.studies.append(rec.study)
     if rec.details.get("timeout") is not None:      # the stepper ran out of time: no unbounded extra call
@@ -86,10 +88,12 @@ def convergence_stage(profile: Profile, context: RunContext) -> Report:
     one unit per reference."""
     stepper = solve if context.stepper is None else context.stepper
     problems = context.catalog()
-    units = [Unit("convergence", p.name, _convergence_unit, (stepper, p)) for p in problems]
+    units = [Unit("convergence", p.name, _convergence_unit, (stepper, p, context.step_range)) for p in problems]
     reports = context.run_units(profile, units)
     for p, rep in zip(problems, reports):     # what the stepper costs on each: the later stages' guide
         context.costs[p.name] = sum(r.duration or 0.0 for r in rep.results)
+        for study in rep.studies:             # the grids the step laws judge too (the study's finest, its shortfalls)
+            context.partitions[p.name] = (float(p.T), [len(g) - 1 for g in study.step_law_grids()])
     return _merged(reports)
 
 
@@ -181,7 +185,9 @@ def trajectory_laws_stage(profile: Profile, context: RunContext) -> Report:
     groups: dict[str, list[int]] = {}
     for k, (name, _) in enumerate(checks):
         groups.setdefault(name.partition("[")[2].rstrip("]") or name, []).append(k)
-    units = [Unit("trajectory_laws", subject, _checks_unit, ([checks[k] for k in ks], stepper))
+    units = [Unit("trajectory_laws", subject, _checks_unit, ([checks[k] for k in ks], stepper,
+                                                             {subject: context.partitions[subject]}
+                                                             if subject in context.partitions else None))
              for subject, ks in groups.items()]
     slots: list[list[CheckResult]] = [[] for _ in checks]
     costs = [context.costs.get(subject, 0.0) for subject in groups]     # the costliest problems first
@@ -196,10 +202,15 @@ def trajectory_laws_stage(profile: Profile, context: RunContext) -> Report:
     return Report([r for slot in slots for r in slot])
 
 
-def _checks_unit(checks: list[tuple[str, Callable]], subject: Any) -> Report:
-    """Every ``check(subject)`` of one battery, in order (``meta["records_per_check"]``: how many each gave)."""
+def _checks_unit(checks: list[tuple[str, Callable]], subject: Any,
+                 partitions: dict[str, tuple[float, list[int]]] | None = None) -> Report:
+    """Every ``check(subject)`` of one battery, in order (``meta["records_per_check"]``: how many each gave);
+    ``partitions``: the grids of the convergence studies (by problem name: ``(T, cell counts)``) the step laws
+    judge the stepper on too."""
     report, sizes = Report(), []
     with shared_runs():             # the laws judge the same runs of the stepper: each is made once
+        for name, (T, cells) in (partitions or {}).items():
+            note_partitions(subject, (name, T), [uniform_grid(T, steps=k) for k in cells])
         for name, check in checks:
             law, _, problem_name = name.partition("[")
             # each check under the unit time budget: one that does not return is a failed record, the rest go on

@@ -62,6 +62,9 @@ class RunContext:
     extra_problems: list[Any] = dataclasses.field(default_factory=list)
     #: the CPU and wall seconds of every unit run so far (:func:`timed_unit`), in the order they came back
     unit_times: list[dict[str, Any]] = dataclasses.field(default_factory=list)
+    partitions: dict[str, tuple[float, list[int]]] = dataclasses.field(default_factory=dict)
+    #: ``(h_min, h_max)``: every convergence study on uniform grids with steps in that range only
+    step_range: tuple[float, float] | None = None
 
     _catalog: list[Any] | None = dataclasses.field(default=None, repr=False)
 
