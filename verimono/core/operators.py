@@ -472,9 +472,11 @@ class LogBarrier(Operator):
 
     @staticmethod
     def _resolve(x, lam, c):
-        # for x < 0, r - x >= -x > 0: the max only silences the discarded x >= 0 entries (no errstate)
+        # the root of y² − x y − λc = 0 that is positive, without cancellation: (x + r)/2 for x ≥ 0, and for
+        # x < 0 its equal 2λc/(r − x) = 2λc/(r + |x|), whose denominator is ≥ r > 0 for every x (the entries
+        # np.where discards never divide by a vanishing r − x)
         r = np.sqrt(x * x + 4.0 * lam * c)
-        return np.where(x >= 0.0, 0.5 * (x + r), 2.0 * lam * c / _mx(r - x, _TINY))
+        return np.where(x >= 0.0, 0.5 * (x + r), 2.0 * lam * c / (r + np.abs(x)))
 
     def _accepts_batches(self):
         return _own(self, LogBarrier)
