@@ -22,7 +22,8 @@ RUN = ["run", "--profile", "ci", "--stage", "convergence", "--stage", "assumptio
 #: the run id both output files carry, and where the units ran (``meta.executor``)
 TIMING_KEYS = {"duration", "timings", "calibration", "calibrations", "created", "run_id", "executor",
                "cpu_waiting", "foreign_cpu", "loadavg",   # how busy the machine was during each stage
-               "unit_budget"}                             # the unit budget in seconds: units x the calibration
+               "unit_budget",                             # the unit budget in seconds: units x the calibration
+               "cpu", "calibration_cpu", "calibrations_cpu", "units"}   # CPU times: the stages', the units', the calibrations'
 
 STEPPERS = '''
 import multiprocessing, os, signal, time

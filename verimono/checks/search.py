@@ -374,7 +374,7 @@ def _coordinates(state: _Search, seed: int, horizon: float, how: dict) -> None:
     except _Violation:
         state.shrunk_into(state.failing, "the search over each coordinate of the worst sample (shrunk greedily)")
     except UnitTimeout as exc:
-        how["timed_out"] = str(exc)
+        _timed_out(how, exc, state)
     how["coordinate"] = state.runs - before
 
 
