@@ -177,7 +177,8 @@ def order_table(report: Report) -> list[str]:
     rows = []
     for s in report.studies:
         exp = "-" if s.expected is None else ("exact" if s.expected.exact else f"{s.expected.value:g}")
-        status = s.decision().status if hasattr(s, "decision") else ("passed" if s.verdict()[0] else "failed")
+        ok = None if hasattr(s, "decision") else s.verdict()[0]
+        status = s.decision().status if hasattr(s, "decision") else {None: "undecided", True: "passed"}.get(ok, "failed")
         verdict = {"failed": "MISSED", "undecided": "UNDECIDED"}.get(status, "FAILED" if (s.problem, s.stepper) in failed
                                                                       else "ok")
         rows.append((s.problem, exp, str(s.order), verdict))
@@ -290,9 +291,9 @@ def _cmd_run(args: argparse.Namespace) -> int:
         if previous.meta.get("profile") != args.profile:
             raise NothingToResume(f"the interrupted run used profile {previous.meta.get('profile')!r}, not "
                                   f"{args.profile!r}; resume it with the same options")
-        from .run.stages import STAGES
+        from .run.stages import default_stages
 
-        wanted = (previous.meta.get("selection") or {}).get("stages") or list(STAGES)
+        wanted = (previous.meta.get("selection") or {}).get("stages") or default_stages()
         done = set(previous.meta.get("finished_stages") or [])
         stages = [n for n in wanted if n not in done]
         if args.seed is None and previous.meta.get("seed") is not None:
@@ -324,6 +325,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 def _cmd_check(args: argparse.Namespace) -> int:
     from .checks.subjects import kind_of
+    from .core.adaptive import Adaptive
     from .records.atomic import ensure_writable_dir
 
     # over a previous check's files, the mark before anything that takes time (importing the target and the
@@ -340,6 +342,11 @@ def _cmd_check(args: argparse.Namespace) -> int:
 
         # the operator's own name, as the API and pytest call it: one record key whatever the entry point
         stages, ctx = ["operator_laws"], _context(args, operators=[(subject_name(obj), obj)])
+    elif isinstance(obj, Adaptive):
+        # a stepper choosing its own steps: its rate in the tolerance and the laws on its own partitions (a grid
+        # stepper's convergence study would call it with a grid it does not take)
+        stages, ctx = ["adaptive"], _context(args, stepper=obj)
+        kind = f"adaptive stepper ({obj.describe()})"
     elif kind == "stepper":
         from .execution.timing import TimedStepper
 
@@ -392,12 +399,13 @@ def _cmd_compare(args: argparse.Namespace) -> int:
             except InvalidCheckArgument as exc:
                 raise BadTarget(f"{spec}: {exc}") from None
             if kind != "stepper":
-                raise BadTarget(f"{spec} is an {kind}: `verimono compare` takes steppers (a Stepper, a callable "
+                raise BadTarget(f"{spec} is {'an' if kind[0] in 'aeiou' else 'a'} {kind}: `verimono compare` takes steppers (a Stepper, a callable "
                                 "stepper(problem, t_grid), or a verimono.Adaptive)")
         steppers.append(obj)
     if len(steppers) < 2:
         raise BadTarget("`verimono compare` needs at least two steppers")
-    problems = _context(args).problems
+    ctx = _context(args)          # --problem adds to --reference (RunContext.extra_problems), as for run and check
+    problems = list(ctx.problems or []) + list(ctx.extra_problems)
     if not problems:
         raise BadTarget("`verimono compare` needs a problem: --problem MODULE:OBJECT or --reference NAME")
     out = ensure_writable_dir(args.out)
@@ -522,7 +530,8 @@ def build_parser() -> argparse.ArgumentParser:
                             "of every unit (default: $HYPOTHESIS_PROFILE when it names one of these, else ci when "
                             "$CI is set, else dev)")
         p.add_argument("--stage", action="append", choices=list(STAGES), metavar="NAME",
-                       help="run only this stage (repeatable); stages: " + ", ".join(STAGES))
+                       help="run only this stage (repeatable); stages: " + ", ".join(
+                           n if s.default else f"{n} (on request)" for n, s in STAGES.items()))
         p.add_argument("--seed", type=_seed, default=None, help="seed for the randomized batteries")
         p.add_argument("--data", default=None, help="Siconos data (DIR/siconos/{refs,lcp}); default: the packaged data")
         p.add_argument("--reference", action="append", metavar="NAME",

@@ -30,7 +30,7 @@ from ..core.claims import Stepper
 from ..core.errors import InvalidCheckArgument, NotApplicable
 from ..core.naming import subject_name
 from ..core.problem import Problem
-from ..records.results import FAILED, PASSED, SKIPPED, CheckResult, Report
+from ..records.results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult, Report
 from ..records.verdicts import new_record
 from .core import Holds, Outcome, law, laws_of, record_of_exception, run
 from .partitions import single
@@ -69,6 +69,8 @@ def check_tolerance_rate(stepper: Adaptive, problem: Problem, *, controls: Seque
     """The tolerance study's verdict (module docstring)."""
     study = tolerance_study(stepper, problem, controls)
     ok, msg = study.verdict()
+    if ok is None:
+        return Outcome(None, details={"tolerance_study": study.to_dict()}, message=msg, status=UNDECIDED)
     fit = study.fits["sup"]
     claim = study.rate if study.control == "tolerance" else study.order
     slack = RATE_SLACK if study.control == "tolerance" else OWN_ORDER_SLACK

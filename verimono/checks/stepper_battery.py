@@ -12,6 +12,7 @@ from typing import Any, Callable, Iterable, Iterator, Sequence
 
 import numpy as np
 
+from ..core.adaptive import Adaptive
 from ..core.claims import with_claim
 from ..core.errors import InvalidCheckArgument
 from ..core.problem import Problem
@@ -123,11 +124,18 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
     (:mod:`verimono.execution.watchdog`).  ``profile`` (``"dev"``, ``"ci"``, ``"thorough"``) chooses the time
     budget of each check, as ``--profile`` does for ``verimono check``; by default the current run
     configuration's (:mod:`verimono.execution.config`).
+
+    A :class:`verimono.Adaptive` stepper (it takes a tolerance, not a grid) gets its own battery,
+    :func:`verimono.check_adaptive`, on ``problems``.
     """
     if profile is not None:
         with chosen(profile):
             return check_stepper(stepper, problems, scheme=scheme, order=order, seed=seed, executor=executor,
                                  laws=laws, generated=generated, orders=orders, step_range=step_range)
+    if isinstance(stepper, Adaptive):    # it chooses its own steps: a grid's study would call it wrongly
+        from .own_steps import check_adaptive
+
+        return check_adaptive(stepper, problems, laws=laws is not False)
     require_stepper(stepper)
     if problems is not None:
         problems = list(problems)

@@ -328,8 +328,9 @@ class ToleranceStudy:
         return (f"its errors stall far above the floor: {e[a]:.3g} -> {e[b]:.3g} as the {self.control} goes "
                 f"{ca:.3g} -> {cb:.3g}, where rate {claim:g} predicts {e[a] * (cb / ca) ** claim:.3g}")
 
-    def verdict(self) -> tuple[bool, str]:
-        """Whether the stepper reaches its claimed rate (and order against the number of steps), with why."""
+    def verdict(self) -> tuple[bool | None, str]:
+        """Whether the stepper reaches its claimed rate (and order against the number of steps), with why;
+        ``None``: undecided (too few errors above the round-off floor to fit a rate)."""
         e = self.errors["sup"]
         bad = [f"{c:.3g}" for c, v in zip(self.controls, e) if not math.isfinite(float(v))]
         if bad:
@@ -345,7 +346,11 @@ class ToleranceStudy:
         claim = self.rate if self.control == "tolerance" else self.order
         if claim is not None:
             if math.isnan(fit.high):
-                return False, f"too few errors above the round-off floor to estimate a rate (slope {fit.slope:.3f})"
+                # two errors or fewer above the floor (a stepper more accurate than its claim): no rate can be
+                # fitted, so none is refuted; tighter tolerances would not help, looser ones would
+                return None, (f"undecided: too few errors above the round-off floor to estimate a rate (slope "
+                              f"{fit.slope:.3f} from {sum(1 for v in e if v > self.floor)} of them; looser "
+                              f"{self.control}s would decide)")
             slack = RATE_SLACK if self.control == "tolerance" else OWN_ORDER_SLACK
             reached = fit.reaches(claim, slack)
             ok &= reached
@@ -367,7 +372,8 @@ class ToleranceStudy:
         for i, c in enumerate(self.controls):
             rows.append(f"  {c:>10.3g}  {self.steps[i]:>6d}  " +
                         "  ".join(f"{float(self.errors[n][i]):>12.3e}" for n in self.errors))
-        return "\n".join([head, *rows, f"  verdict: {'holds' if ok else 'FAILS'} — {msg}"])
+        said = "undecided" if ok is None else ("holds" if ok else "FAILS")
+        return "\n".join([head, *rows, f"  verdict: {said} — {msg}"])
 
     def _repr_html_(self) -> str | None:
         return render("tolerance_study_html", self)

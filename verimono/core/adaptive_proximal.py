@@ -7,12 +7,16 @@ the bounds of ``lem:bndSeq``) hold on it, and the limit is the solution (Theorem
 
 **The error estimate** — step doubling.  From ``x_k`` the controller takes one step of ``h`` (``x_big``) and
 two of ``h/2`` (``x_mid``, ``x_small``); for a solution with bounded ``x''`` the scheme's local error is
-``C h² + O(h³)``, so ``|x_big - x_small| ≈ C h²/2``, the local error of the two half steps.  The step is
-accepted when that is at most ``tol · h · (1 + |x_small|)`` (error per unit step: the local errors then add
-up to at most ``tol · T · (1 + max|x|)`` through the nonexpansive resolvents — global error proportional to
-``tol``, rate 1, and ``N ∝ 1/tol`` steps, order 1 against their number); the two half steps are kept, so the
-partition holds ``t_k``, ``t_k + h/2`` and ``t_k + h`` and every kept state is a proximal iterate on it.
-The next step is ``h · min(MAX_GROWTH, max(MIN_SHRINK, SAFETY · tol h (1 + |x|) / err))``.  Where the
+``C h² + O(h³)``, so ``|x_big - x_small| ≈ C h²/2``, the local error of the two half steps.  No step is
+longer than ``h_max = tol · T`` (:data:`MAX_STEP`: the estimate is blind where one step and two half steps
+agree although both are wrong, and Section 5.1 needs ``|Δ| → 0``), and a step is accepted when its estimate
+is at most ``tol · h_max · (1 + |x_small|)``: where ``x''`` is bounded the steps are ``O(tol)``, ``N ∝ 1/tol``
+and the local errors add up, through the nonexpansive resolvents, to ``O(tol · T (1 + max|x|))`` — rate 1 in
+the tolerance, order 1 against the number of steps; where ``x''`` is not integrable to a bounded step count
+under an error-per-unit-step rule (``x = √(2ct)`` at ``t = 0``: ``h ≤ tol t^{3/2}``) the per-step rule still
+takes ``O(T^{1/4}/tol)`` steps there.  The two half steps are kept, so the partition holds ``t_k``,
+``t_k + h/2`` and ``t_k + h`` and every kept state is a proximal iterate on it.  The next step is
+``h · min(MAX_GROWTH, max(MIN_SHRINK, SAFETY · tol h_max (1 + |x|) / err))``.  Where the
 solution has a kink (an extinction, a switching of the complementarity system) the estimate grows and
 the controller shrinks the steps around it; where it jumps (a discontinuous input, a set that jumps) no
 step satisfies the estimate and steps below ``T · MIN_STEP`` are accepted as they are (counted).
@@ -34,6 +38,11 @@ MAX_GROWTH = 2.0
 MIN_SHRINK = 0.2
 #: steps below ``T · MIN_STEP`` are accepted whatever the estimate (a jump of the solution)
 MIN_STEP = 1e-12
+#: no step longer than ``MAX_STEP · tol · T``: the step-doubling estimate is blind where one step and two half
+#: steps agree although both are wrong (a piecewise-linear input read between its breakpoints, a rate-independent
+#: operator), and convergence needs ``|Δ| → 0`` as ``tol → 0`` (Section 5.1); with it the partition's mesh is
+#: ``O(tol)``, which a rate-1 scheme's global error bound asks anyway
+MAX_STEP = 1.0
 #: the first trial step, as a fraction of ``T``
 FIRST_STEP = 1e-2
 #: at most this many steps (a tolerance meant in other units is refused, not run for an hour)
@@ -70,19 +79,21 @@ def _solve_adaptive(problem: Problem, T: float, tol: float) -> Trajectory:
         raise InvalidProblem(f"tol must be a number in (0, 1), got {tol!r}")
     T = float(T)
     ts, xs = [0.0], [np.array(problem.x0, dtype=float)]
-    t, x, h = 0.0, xs[0], FIRST_STEP * T
+    h_max = MAX_STEP * tol * T
+    t, x, h = 0.0, xs[0], min(FIRST_STEP * T, h_max)
     forced = 0
     while t < T:
         if len(ts) > MAX_STEPS:
             raise InvalidProblem(f"solve_adaptive took more than {MAX_STEPS} steps at tol = {tol:g}: a tolerance "
                                  "this small needs another scheme (the proximal scheme has order 1)")
+        h = min(h, h_max)
         last = h >= T - t
         h = T - t if last else h
         big = _step(problem, x, t, h)
         mid = _step(problem, x, t, h / 2)
         small = _step(problem, mid, t + h / 2, h / 2)
         err = float(np.max(np.abs(big - small)))
-        allowed = tol * h * (1.0 + float(np.max(np.abs(small))))
+        allowed = tol * h_max * (1.0 + float(np.max(np.abs(small))))
         if err <= allowed or h <= MIN_STEP * T:
             forced += err > allowed
             t_mid, t = t + h / 2, (T if last else t + h)

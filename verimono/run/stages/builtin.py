@@ -15,6 +15,8 @@ import numpy as np
 
 from .. import performance
 from ...core._jsonable import to_jsonable
+from ...core.adaptive import Adaptive
+from ...core.adaptive_proximal import solve_adaptive
 from ...core.errors import StageUnavailable
 from ...execution.executors import Unit
 from ...core.grids import uniform_grid
@@ -95,6 +97,24 @@ def convergence_stage(profile: Profile, context: RunContext) -> Report:
         for study in rep.studies:             # the grids the step laws judge too (the study's finest, its shortfalls)
             context.partitions[p.name] = (float(p.T), [len(g) - 1 for g in study.step_law_grids()])
     return _merged(reports)
+
+
+@register_stage("adaptive", "a stepper choosing its own steps (verimono.Adaptive): its rate in the tolerance, the "
+                "laws local to steps on its own partitions, located switching times", default=False)
+def adaptive_stage(profile: Profile, context: RunContext) -> Report:
+    """:func:`verimono.checks.own_steps.check_adaptive` on every reference, one unit per reference: the stepper
+    under test when it is a :class:`verimono.Adaptive` (``verimono check`` chooses this stage for one), else
+    verimono's own :data:`verimono.solve_adaptive`.  Not part of a run that names no stage."""
+    stepper = context.stepper if isinstance(context.stepper, Adaptive) else solve_adaptive
+    problems = context.catalog()
+    units = [Unit("adaptive", p.name, _adaptive_unit, (stepper, p)) for p in problems]
+    return _merged(context.run_units(profile, units))
+
+
+def _adaptive_unit(stepper: Any, problem: Any) -> Report:
+    from ...checks.own_steps import check_adaptive
+
+    return check_adaptive(stepper, [problem])
 
 
 def _catalog_operators(context: RunContext) -> list[tuple[str, Any]]:

@@ -134,19 +134,28 @@ def timed_unit(fn: Callable[..., Report], args: tuple) -> Report:
 
 @dataclasses.dataclass(frozen=True)
 class Stage:
+    """A stage: ``fn(profile, context) -> Report``; ``default``: part of a run that names no stage (a stage on
+    request runs only when named, ``--stage NAME``, or when ``verimono check`` chooses it for its target)."""
     name: str
     fn: Callable[[Profile, RunContext], Report]
     description: str = ""
+    default: bool = True
 
 
 STAGES: dict[str, Stage] = {}
 
 
-def register_stage(name: str, description: str = "") -> Callable:
-    """Decorator registering ``fn(profile, context) -> Report`` as the stage ``name`` (replaces same name)."""
+def default_stages() -> list[str]:
+    """The stages a run that names none runs, in registration order."""
+    return [n for n, s in STAGES.items() if s.default]
+
+
+def register_stage(name: str, description: str = "", *, default: bool = True) -> Callable:
+    """Decorator registering ``fn(profile, context) -> Report`` as the stage ``name`` (replaces same name);
+    ``default=False``: a stage on request (:class:`Stage`)."""
 
     def deco(fn: Callable[[Profile, RunContext], Report]) -> Callable:
-        STAGES[name] = Stage(name, fn, description or (fn.__doc__ or "").strip().split("\n")[0])
+        STAGES[name] = Stage(name, fn, description or (fn.__doc__ or "").strip().split("\n")[0], default)
         return fn
 
     return deco
@@ -165,8 +174,8 @@ def _stage_failure(name: str, exc: BaseException, duration: float) -> tuple[Repo
 def run_stages(names: Iterable[str] | None, profile: Profile, context: RunContext,
                on_start: Callable[[Stage, int, int], None] | None = None,
                on_done: Callable[[Stage, Report, dict], None] | None = None) -> Report:
-    """Run the stages ``names`` (``None``: all, in registration order) and merge their reports."""
-    names = list(STAGES) if names is None else list(names)
+    """Run the stages ``names`` (``None``: the default ones, in registration order) and merge their reports."""
+    names = default_stages() if names is None else list(names)
     for n in names:
         if n not in STAGES:
             raise UnknownStage(f"unknown stage {n!r}; registered stages: {', '.join(STAGES)}")
@@ -243,4 +252,4 @@ def locate_data(explicit: str | os.PathLike | None = None) -> Path:
     return path
 
 
-__all__ = ["STAGES", "Stage", "RunContext", "register_stage", "run_stages", "locate_data", "timed_unit", "UNIT_TIME"]
+__all__ = ["STAGES", "Stage", "default_stages", "RunContext", "register_stage", "run_stages", "locate_data", "timed_unit", "UNIT_TIME"]
