@@ -96,7 +96,7 @@ def test_float32_catalog_operator_passes_at_ci(op):
     _passes(op, 0)
 
 
-@pytest.mark.slow
+@pytest.mark.sweep      # seed 0 is test_float32_catalog_operator_passes_at_ci, in the fast tier
 @pytest.mark.parametrize("op", OPERATORS, ids=lambda op: f"{op.name}/{op.dim}")
 def test_float32_catalog_operator_passes_at_ci_over_seeds_0_to_9(op):
     for seed in range(1, 10):
@@ -114,7 +114,7 @@ def test_float32_solve_passes_on_the_catalog():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("seed", range(10))
+@pytest.mark.parametrize("seed", [0] + [pytest.param(s, marks=pytest.mark.sweep) for s in range(1, 10)])
 def test_float32_solve_passes_over_seeds_0_to_9(seed):
     _solve_passes(seed)
 

@@ -40,7 +40,7 @@ def test_no_false_alarm_on_the_correct_counterpart(member):
     assert check_operator(good, seed=0).ok
 
 
-@pytest.mark.slow
+@pytest.mark.sweep      # seed 0 is test_no_false_alarm_on_the_correct_counterpart, in the fast tier
 @pytest.mark.parametrize("member", list(zoo_prox.LAWFUL))
 def test_no_false_alarm_on_the_correct_counterpart_over_20_seeds(member):
     _, good = zoo_prox.LAWFUL[member]()
