@@ -28,3 +28,16 @@ def siconos_dir() -> Path:
     from verimono.lcs.siconos import PACKAGED_DATA, siconos_root
 
     return siconos_root(PACKAGED_DATA)
+
+
+#: fast-tier tests measured at 2 s or more: marked ``slow`` here (tests/slow_tests.txt says when and how measured)
+_MEASURED_SLOW = {line.split("  #")[0].strip() for line in
+                  (Path(__file__).resolve().parent / "slow_tests.txt").read_text(encoding="utf-8").splitlines()
+                  if line.strip() and not line.startswith("#")}
+
+
+@pytest.hookimpl(tryfirst=True)       # before `-m` deselects: the marker must be there when it looks
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        if item.nodeid in _MEASURED_SLOW:
+            item.add_marker(pytest.mark.slow)
