@@ -28,7 +28,7 @@ import pkgutil
 
 #: the public names that are not a law's ``check_<law>``: public name → the module that defines it
 _HOMES = {
-    "Outcome": "core", "law": "core", "laws_of": "core",
+    "Outcome": "core", "law": "core",
     "check_assumptions": "assumptions", "problem_checks": "assumptions",
     "LAWS": "operator_battery", "OPERATOR_CHECKS": "operator_battery", "check_operator": "operator_battery",
     "operator_checks": "operator_battery",
@@ -48,6 +48,16 @@ def load_every_law() -> dict:
     return REGISTRY
 
 
+def laws_of(kind: str) -> dict:
+    """The registered laws of ``kind`` (``"operator"``, ``"stepper"``, ...), every law module loaded first: the
+    registry of :mod:`.core` alone holds only the laws of the modules imported so far (``laws_of("stepper")``
+    raised KeyError in a fresh process)."""
+    load_every_law()
+    from .core import laws_of as registered
+
+    return registered(kind)
+
+
 def public_checks() -> dict:
     """``{"check_<law>": check}`` for every registered law whose name is an identifier."""
     return {f"check_{name}": decl.public for laws in load_every_law().values()
@@ -58,7 +68,7 @@ def __getattr__(name: str):
     if name == "REGISTRY":
         value = load_every_law()
     elif name == "__all__":   # `from verimono.checks import *`
-        return sorted(set(_HOMES) | {"REGISTRY"} | set(public_checks()))
+        return sorted(set(_HOMES) | {"REGISTRY", "laws_of"} | set(public_checks()))
     elif name in _HOMES:
         value = getattr(importlib.import_module(f"{__name__}.{_HOMES[name]}"), name)
     elif name.startswith("check_") and name in (checks := public_checks()):
@@ -70,4 +80,4 @@ def __getattr__(name: str):
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_HOMES) | {"REGISTRY"} | set(public_checks()))
+    return sorted(set(globals()) | set(_HOMES) | {"REGISTRY", "laws_of"} | set(public_checks()))
