@@ -16,39 +16,33 @@ import numpy as np
 from scipy.integrate import DOP853, RK45
 
 from verimono.core.grids import validate_grid
+from verimono.core.recipes import ode_field
 
 
-def rhs(problem):
-    """``g(t, x) = -F^0(t, x) + f(x) + u(t)`` (the minimal section: ``F(t, x)`` itself where it is single-valued)."""
-    op, f, u = problem.operator, problem.f, problem.u
-
-    def g(t, x):
-        v = -np.asarray(op.min_norm(x, t), dtype=float)
-        if f is not None:
-            v = v + np.asarray(f(x), dtype=float)
-        if u is not None:
-            v = v + np.asarray(u(t), dtype=float)
-        return v
-    return g
+def one_step_per_cell(advance, name):
+    """A stepper taking one step of ``advance(g, t0, t1, x0) -> x1`` per cell of the grid, ``g`` the right-hand
+    side ``-F^0(t, x) + f(x) + u(t)`` (:func:`verimono.core.recipes.ode_field`)."""
+    def step(problem, t_grid):
+        t = validate_grid(t_grid, problem.T)
+        g = ode_field(problem)
+        x = np.empty((len(t),) + problem.x0.shape)
+        x[0] = problem.x0
+        for k in range(len(t) - 1):
+            x[k + 1] = advance(g, t[k], t[k + 1], x[k])
+        return x
+    step.__name__ = name
+    return step
 
 
 def scipy_stepper(cls):
     """SciPy's explicit Runge–Kutta ``cls`` (``RK45``, ``DOP853``), one step per cell of the grid."""
-    def step(problem, t_grid):
-        t = validate_grid(t_grid, problem.T)
-        g = rhs(problem)
-        x = np.empty((len(t),) + problem.x0.shape)
-        x[0] = problem.x0
-        for k in range(len(t) - 1):
-            h = t[k + 1] - t[k]
-            solver = cls(g, t[k], x[k], t[k + 1], first_step=h, max_step=h, rtol=1e3, atol=1e3)
-            solver.step()
-            if solver.t != t[k + 1]:
-                raise RuntimeError(f"{cls.__name__} took a step to {solver.t}, not to {t[k + 1]}")
-            x[k + 1] = solver.y
-        return x
-    step.__name__ = f"scipy {cls.__name__}"
-    return step
+    def advance(g, t0, t1, x0):
+        solver = cls(g, t0, x0, t1, first_step=t1 - t0, max_step=t1 - t0, rtol=1e3, atol=1e3)
+        solver.step()
+        if solver.t != t1:
+            raise RuntimeError(f"{cls.__name__} took a step to {solver.t}, not to {t1}")
+        return solver.y
+    return one_step_per_cell(advance, f"scipy {cls.__name__}")
 
 
 rk45 = scipy_stepper(RK45)
@@ -61,28 +55,15 @@ _A = [[], [0.25], [0.125, 0.125], [0.0, -0.5, 1.0], [3 / 16, 0.0, 0.0, 9 / 16],
 _B = np.array([7.0, 0.0, 32.0, 12.0, 32.0, 7.0]) / 90.0
 
 
-def butcher5(problem, t_grid):
-    """Butcher's explicit six-stage scheme of order 5, one step per cell."""
-    t = validate_grid(t_grid, problem.T)
-    g = rhs(problem)
-    x = np.empty((len(t),) + problem.x0.shape)
-    x[0] = problem.x0
-    for k in range(len(t) - 1):
-        h = t[k + 1] - t[k]
-        stages = []
-        for c, a in zip(_C, _A):
-            y = x[k] + h * sum(aj * kj for aj, kj in zip(a, stages)) if a else x[k]
-            stages.append(g(t[k] + c * h, y))
-        x[k + 1] = x[k] + h * sum(b * s for b, s in zip(_B, stages))
-    return x
+def _butcher5_step(g, t0, t1, x0):
+    h, stages = t1 - t0, []
+    for c, a in zip(_C, _A):
+        y = x0 + h * sum(aj * kj for aj, kj in zip(a, stages)) if a else x0
+        stages.append(g(t0 + c * h, y))
+    return x0 + h * sum(b * s for b, s in zip(_B, stages))
 
 
-def euler(problem, t_grid):
-    """Explicit Euler ``x_{k+1} = x_k + h g(t_k, x_k)``: order 1."""
-    t = validate_grid(t_grid, problem.T)
-    g = rhs(problem)
-    x = np.empty((len(t),) + problem.x0.shape)
-    x[0] = problem.x0
-    for k in range(len(t) - 1):
-        x[k + 1] = x[k] + (t[k + 1] - t[k]) * g(t[k], x[k])
-    return x
+#: Butcher's explicit six-stage scheme of order 5, one step per cell
+butcher5 = one_step_per_cell(_butcher5_step, "butcher5")
+#: explicit Euler ``x_{k+1} = x_k + h g(t_k, x_k)``: order 1
+euler = one_step_per_cell(lambda g, t0, t1, x0: x0 + (t1 - t0) * g(t0, x0), "euler")
