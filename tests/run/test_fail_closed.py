@@ -19,7 +19,6 @@ import stat
 import subprocess
 import sys
 import tempfile
-import textwrap
 from pathlib import Path
 
 import pytest
@@ -30,6 +29,7 @@ from verimono.run.gate import compare
 from verimono.records.results import CheckResult, Report, SchemaError, load
 
 from probe_bad_inputs import CASES, run_probe, sample_report
+from zoo_runs import stage_killer
 
 ONE_REF = ["--stage", "convergence", "--reference", "moving box", "--profile", "ci", "--executor", "serial"]
 
@@ -181,19 +181,7 @@ def test_the_committed_baselines_xfails_pass_against_fresh_records():
 
 # -- 2. a run in progress is visible ---------------------------------------------------------------------
 
-KILLER = textwrap.dedent('''
-    import os, signal, sys
-    import verimono.run.stages as stages
-    from verimono.cli import main
-
-    real = stages.STAGES["convergence"]
-
-    def killed(profile, context):
-        os.kill(os.getpid(), signal.SIGKILL)
-
-    stages.STAGES["convergence"] = stages.Stage("convergence", killed, real.description)
-    sys.exit(main(sys.argv[1:]))
-''')
+KILLER = stage_killer('convergence')
 
 
 def _subprocess_env() -> dict[str, str]:

@@ -19,6 +19,7 @@ from verimono.cli import main
 from verimono.core.errors import InvalidCheckArgument
 from verimono.records.results import MISSING_RECORDS, CheckResult, Report, SchemaError, load
 from verimono.run.gate import compare
+from zoo_runs import stage_killer
 
 pytest_plugins = ["pytester"]
 
@@ -155,19 +156,7 @@ def test_a_check_killed_while_importing_its_target_leaves_the_mark(tmp_path, cap
     assert code == 2 and "never completed" in text
 
 
-STAGE_KILLER = textwrap.dedent('''
-    import os, signal, sys
-    import verimono.run.stages as stages
-    from verimono.cli import main
-
-    real = stages.STAGES["section7"]
-
-    def killed(profile, context):
-        os.kill(os.getpid(), signal.SIGKILL)
-
-    stages.STAGES["section7"] = stages.Stage("section7", killed, real.description)
-    sys.exit(main(sys.argv[1:]))
-''')
+STAGE_KILLER = stage_killer('section7')
 
 
 @pytest.mark.slow
