@@ -158,7 +158,8 @@ class YBBounds:
 
     def __init__(self, x0: np.ndarray, theta: Callable, op: Operator, T: float) -> None:
         try:
-            f0 = float(np.linalg.norm(op.min_norm(x0, 0.0)))
+            with np.errstate(over="ignore"):     # an overflow is the inf handled below
+                f0 = float(np.linalg.norm(op.min_norm(x0, 0.0)))
         except OutsideDomain:
             raise NotApplicable("x0 is not in dom F(0,·) (lem:bndSeqYB needs |F^0(0, x0)|)") from None
         if not np.isfinite(f0):   # x0 within rounding of the boundary: F^0 overflows (c/x at x = 7e-304)
