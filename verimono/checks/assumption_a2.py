@@ -9,10 +9,13 @@ as a wrong limit does.  (The Minty residual of the graph point ``(J_λ(t+δ)p, Y
 
 The right-limit test at ``t`` samples ``δ_k = (T − t) 4^{-k}``, ``k ≤`` :data:`A2_LEVELS`, extrapolates the
 limit from the last differences (geometric tail), and fails when its distance from ``J_λ(t) p`` stays
-above tolerance after subtracting the tail.  A sequence that has not settled there is followed further,
-down to ``δ ≈ 10^{-13} T`` (:data:`A2_DEEP_LEVELS`): one that settles is judged as above; one whose values
-over the last levels are still as far apart as over the first deep ones has **no limit** (failed, with its
-cluster points' spread); one still shrinking but not settled leaves the record **undecided**, never passed.
+above tolerance after subtracting the tail.  A sequence that has not settled there — its tail above the
+tolerance, so that its limit is not pinned down to what is judged — is followed further, down to
+``δ ≈ 10^{-13} T`` (:data:`A2_DEEP_LEVELS`): one that settles is judged as above; one whose values over the
+last levels are still as far apart as over the first deep ones has **no limit** (failed, with its cluster
+points' spread); one still shrinking, or known only to ± a tail above tolerance, leaves the record
+**undecided**, never passed (two differences that shrink by chance once gave an oscillation a tail that
+covered its gap).
 
 Where it runs: the sample times; every jump of ``t ↦ J_λ(t) p`` (:mod:`verimono.checks.jumps`, bisected to
 adjacent floats ``a < b``; the jump time is the end with the shorter decimal — ``t <= 0.45`` switches right
