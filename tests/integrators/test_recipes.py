@@ -67,17 +67,13 @@ PASSING = ["Euler fixed on input", "Heun fixed on linear", "Heun PID on linear",
 PLANTED = ["planted: input late, fixed", "planted: input late, PID", "planted: tolerance ignored, PID"]
 
 
-# the diffrax cases share one module fixture (a 44 s subprocess): one xdist worker runs them all, under
-# `--dist loadgroup` as CI's slow tier runs (each worker set it up once before: 2 x 44 s)
 @pytest.mark.slow
-@pytest.mark.xdist_group("diffrax")
 @pytest.mark.parametrize("case", PASSING)
 def test_diffrax_at_its_advertised_order_or_rate(diffrax_results, case):
     assert diffrax_results[case]["status"] == "passed", diffrax_results[case]
 
 
 @pytest.mark.slow
-@pytest.mark.xdist_group("diffrax")
 @pytest.mark.parametrize("case", PLANTED)
 def test_diffrax_planted_wrapper_bugs_fail(diffrax_results, case):
     assert diffrax_results[case]["status"] == "failed", diffrax_results[case]
