@@ -51,14 +51,30 @@ def test_solve_ivp_wrapper_with_the_input_late_fails():
     assert rec.status == "failed" and "stall" in rec.message
 
 
-@pytest.fixture(scope="module")
-def diffrax_results():
-    if importlib.util.find_spec("diffrax") is None or importlib.util.find_spec("jax") is None:
-        pytest.skip("diffrax and JAX are not installed (pip install 'verimono[integrators]')")
+def _diffrax_cases() -> dict:
     out = subprocess.run([sys.executable, str(HERE / "diffrax_cases.py")], capture_output=True, text=True,
                          timeout=900)
     assert out.returncode == 0, out.stderr[-3000:]
     return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+@pytest.fixture(scope="module")
+def diffrax_results(tmp_path_factory, worker_id):
+    """The diffrax cases (a subprocess of 44 s), run once per session: under pytest-xdist the first worker to
+    ask runs them and the others read its file (pytest-xdist's documented pattern for a fixture run once)."""
+    if importlib.util.find_spec("diffrax") is None or importlib.util.find_spec("jax") is None:
+        pytest.skip("diffrax and JAX are not installed (pip install 'verimono[integrators]')")
+    if worker_id == "master":       # no xdist: this process is the session
+        return _diffrax_cases()
+    import fcntl
+
+    shared = tmp_path_factory.getbasetemp().parent      # this session's directory, common to its workers
+    path = shared / "diffrax_results.json"
+    with open(shared / "diffrax_results.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not path.exists():
+            path.write_text(json.dumps(_diffrax_cases()))
+        return json.loads(path.read_text())
 
 
 PASSING = ["Euler fixed on input", "Heun fixed on linear", "Heun PID on linear", "Tsit5 fixed on input",
