@@ -150,7 +150,6 @@ def right_limit(S, t: float, lam: float, P: np.ndarray | None = None):
                 unsettled += 1
                 continue
             s_first, s_last = _spread(first), _spread(last)
-            tol = tolerance(p, at_t, q[-1])
             if s_last > 4 * tol and s_last >= A2_NO_LIMIT * s_first:
                 ratio = s_last / (4 * tol)
                 if no_limit is None or ratio > no_limit["ratio"]:
@@ -163,7 +162,7 @@ def right_limit(S, t: float, lam: float, P: np.ndarray | None = None):
         if tail > tol and not gap - tail > tol:     # converging, but its limit known only to ± tail > tolerance
             unsettled += 1
             continue
-        ratio = max(gap - tail, 0.0) / tolerance(p, q[-1], at_t)
+        ratio = max(gap - tail, 0.0) / tol
         if ratio > worst:
             worst, counter = ratio, {"t": t, "lam": lam, "p": p, "delta": delta, "limit": q[-1],
                                      "resolvent_at_t": at_t, "gap": gap, "tail": tail}
