@@ -102,6 +102,7 @@ class Linear(_EverywhereDefined):
         # a uniform grid's steps np.diff(linspace) take a handful of values differing in the last bits:
         # keep every factor seen (bounded), not only the last one
         self._inv_cache: dict[float, np.ndarray] = {}
+        self._norm2: float | None = None
 
     def M(self, t: float = 0.0) -> np.ndarray:
         return self._M(t)
@@ -156,8 +157,13 @@ class Linear(_EverywhereDefined):
         return real_array(x) @ (self._M(t) if self.static else self._M_at(t)).T
 
     def growth(self, t=0.0):
-        """``|M(t)x| ≤ ‖M(t)‖₂ |x|``."""
-        return float(np.linalg.norm(self._M(t) if self.static else self._M_at(t), 2))
+        """``|M(t)x| ≤ ‖M(t)‖₂ |x|`` (a constant ``M``'s norm, an SVD, computed once: the bounds ask it at
+        every node of every partition)."""
+        if not self.static:
+            return float(np.linalg.norm(self._M_at(t), 2))
+        if self._norm2 is None:
+            self._norm2 = float(np.linalg.norm(self._M(t), 2))
+        return self._norm2
 
     def contains(self, x, y, t=0.0, tol=None):
         Mx = self.min_norm(x, t)
