@@ -5,6 +5,7 @@ Newton predictor when the residual is below 1e-4 — off on the small steps only
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 import verimono as vm
@@ -32,3 +33,22 @@ def test_a_stepper_off_on_small_steps_fails_selections_at_every_seed(name):
     assert "passed" in seen_default
     # the correct scheme passes on every grid
     assert check_selections(vm.solve, p, seed=0).status == "passed"
+
+
+def test_the_battery_partitions_are_built_once_and_handed_out_as_copies():
+    """The partitions are cached per (T, seed): each call gets its own arrays, so a law (or a stepper) that
+    writes into one cannot change what the next law is judged on; they are the partitions the grid
+    functions build (uniform: ``linspace``; random and graded: :mod:`verimono.core.grids`)."""
+    p = get("t|x| (n=1)")
+    first = every_battery_grid(p, seed=3)
+    assert np.array_equal(first["uniform"], np.linspace(0.0, p.T, 41))
+    assert np.array_equal(first["random"], vm.random_grid(p.T, 40, seed=3, spread=0.6))
+    assert np.array_equal(first["graded K=160"], vm.graded_grid(p.T, 160, 2.0))
+    for g in first.values():
+        g[1:-1] = -1.0                      # a careless writer
+    again = every_battery_grid(p, seed=3)
+    assert set(again) == set(first)
+    assert all(np.all(np.diff(g) > 0) and g[0] == 0.0 and g[-1] == p.T for g in again.values())
+    assert np.array_equal(again["uniform"], np.linspace(0.0, p.T, 41))
+    other = every_battery_grid(p, seed=4)
+    assert not np.array_equal(other["random"], again["random"])   # the seed is part of the key

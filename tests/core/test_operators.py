@@ -78,6 +78,18 @@ def test_linear_time_dependent_and_batched():
             assert np.allclose((np.eye(2) + 0.5 * op.M(t)) @ Ji, xi)
 
 
+def test_linear_growth_is_the_spectral_norm_of_M_at_t():
+    """``|M(t)x| ≤ ‖M(t)‖₂ |x|``: the largest singular value, kept once for a constant ``M`` and read at ``t`` for a
+    moving one (closed forms: a rotation-free shear and ``M(t) = diag(t, 2t)``)."""
+    shear = vm.Linear(np.array([[1.0, 2.0], [-2.0, 0.0]]))
+    sigma = np.sqrt(np.linalg.eigvalsh(np.array([[5.0, 2.0], [2.0, 4.0]]))[-1])   # sqrt(λmax(MᵀM))
+    assert shear.growth() == pytest.approx(sigma, rel=1e-14)
+    assert shear.growth(7.0) == shear.growth(0.0)
+    moving = vm.Linear(lambda t: np.diag([t, 2.0 * t]))
+    assert moving.growth(0.5) == pytest.approx(1.0, rel=1e-14)
+    assert moving.growth(3.0) == pytest.approx(6.0, rel=1e-14)
+
+
 def test_linear_rejects_non_monotone():
     with pytest.raises(vm.NotMonotone, match="positive semidefinite"):
         vm.Linear([[1.0, 0.0], [0.0, -0.5]])
