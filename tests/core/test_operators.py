@@ -289,3 +289,31 @@ def test_catalog_subdifferentials_state_their_function_and_pass_the_value_laws()
 
     failed = {r.check for r in vm.check_operator(Doubled(1.0, dim=3), seed=0).failures}
     assert failed == names
+
+
+def _operators_with_kernels():
+    from verimono.checks.sample_problems import sample_problems
+    from verimono.reference import catalog
+
+    return [(p.name, p) for p in list(catalog()) + list(sample_problems(0, 6))]
+
+
+@pytest.mark.parametrize("name,problem", _operators_with_kernels(), ids=lambda v: v if isinstance(v, str) else "")
+def test_the_resolvent_kernel_returns_exactly_the_resolvent(name, problem):
+    """``resolvent_kernel`` (what ``solve`` steps with and the selections' witnesses are computed with) gives
+    the operator's own ``resolvent`` bit for bit, at points near and far from ``x0``, steps across decades and
+    times over ``[0, T]``; an instance whose ``resolvent`` is replaced gets the replacement."""
+    op, x0 = problem.operator, np.asarray(problem.x0, dtype=float)
+    step = vm.core.operators.resolvent_kernel(op, x0)
+    rng = np.random.default_rng(7)
+    for _ in range(12 if step != op.resolvent else 0):    # no kernel (the complementarity systems): nothing to compare
+        x = x0 + rng.normal(size=x0.shape) * 10.0 ** rng.uniform(-3, 1)
+        lam, t = 10.0 ** rng.uniform(-6, 0), float(rng.uniform(0.0, problem.T))
+        assert np.array_equal(np.asarray(step(x, lam, t), dtype=float), np.asarray(op.resolvent(x, lam, t), dtype=float))
+    calls = []
+    op.resolvent = lambda x, lam, t=0.0: calls.append(lam) or type(op).resolvent(op, x, lam, t)
+    try:
+        vm.core.operators.resolvent_kernel(op, x0)(x0, 0.5, 0.0)
+    finally:
+        del op.resolvent
+    assert calls == [0.5]

@@ -111,8 +111,11 @@ def resolvent_kernel(op: "Operator", x0: np.ndarray) -> Callable:
     """The fastest ``step(x, lam, t) = J_λ x`` of ``op`` for points shaped like ``x0``.
 
     The operator's private kernel when it has one and its :meth:`~Operator.resolvent` is not
-    overridden by a subclass, else the bound :meth:`~Operator.resolvent`.
+    overridden by a subclass or on the object itself (a resolvent wrapped by a test or a user's
+    instrumentation is the one called), else the bound :meth:`~Operator.resolvent`.
     """
+    if "resolvent" in getattr(op, "__dict__", {}):
+        return op.resolvent
     kern = getattr(op, "_kernel", None)
     step = kern(np.asarray(x0, dtype=float)) if kern is not None else None
     return op.resolvent if step is None else step
