@@ -80,7 +80,7 @@ def test_linear_time_dependent_and_batched():
 
 def test_linear_growth_is_the_spectral_norm_of_M_at_t():
     """``|M(t)x| ≤ ‖M(t)‖₂ |x|``: the largest singular value, kept once for a constant ``M`` and read at ``t`` for a
-    moving one (closed forms: a rotation-free shear and ``M(t) = diag(t, 2t)``)."""
+    moving one (closed forms: a nonsymmetric monotone ``M``, ``σ_max = √λ_max(MᵀM)``, and ``M(t) = diag(t, 2t)``)."""
     shear = vm.Linear(np.array([[1.0, 2.0], [-2.0, 0.0]]))
     sigma = np.sqrt(np.linalg.eigvalsh(np.array([[5.0, 2.0], [2.0, 4.0]]))[-1])   # sqrt(λmax(MᵀM))
     assert shear.growth() == pytest.approx(sigma, rel=1e-14)
