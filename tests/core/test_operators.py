@@ -306,10 +306,22 @@ def test_the_resolvent_kernel_returns_exactly_the_resolvent(name, problem):
     op, x0 = problem.operator, np.asarray(problem.x0, dtype=float)
     step = vm.core.operators.resolvent_kernel(op, x0)
     rng = np.random.default_rng(7)
-    for _ in range(12 if step != op.resolvent else 0):    # no kernel (the complementarity systems): nothing to compare
-        x = x0 + rng.normal(size=x0.shape) * 10.0 ** rng.uniform(-3, 1)
-        lam, t = 10.0 ** rng.uniform(-6, 0), float(rng.uniform(0.0, problem.T))
-        assert np.array_equal(np.asarray(step(x, lam, t), dtype=float), np.asarray(op.resolvent(x, lam, t), dtype=float))
+    # where kernels and resolvents part ways: the kink x = 0, far points, the domain's boundary (a far point
+    # projected onto it), steps from 1e-12 to 1e3, the ends of [0, T]; then 300 draws across decades
+    far = x0 + 1e6 * (1.0 + np.abs(x0).max()) * rng.normal(size=x0.shape)
+    edges = [np.zeros_like(x0), x0, far]
+    for t in (0.0, problem.T):
+        try:
+            edges.append(np.asarray(op.project_domain(far, t), dtype=float))
+        except NotImplementedError:
+            pass
+    cases = [(x, lam, t) for x in edges for lam in (1e-12, 1e-6, 1.0, 1e3) for t in (0.0, problem.T)]
+    for _ in range(300):
+        x = x0 + rng.normal(size=x0.shape) * 10.0 ** rng.uniform(-4, 6)
+        cases.append((x, 10.0 ** rng.uniform(-10, 3), float(rng.uniform(0.0, problem.T))))
+    for x, lam, t in cases if step != op.resolvent else []:   # no kernel (the complementarity systems): none
+        assert np.array_equal(np.asarray(step(x, lam, t), dtype=float), np.asarray(op.resolvent(x, lam, t), dtype=float)), \
+            (x, lam, t)
     calls = []
     op.resolvent = lambda x, lam, t=0.0: calls.append(lam) or type(op).resolvent(op, x, lam, t)
     try:
