@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import verimono as vm
-from verimono.checks.partitions import EVERY_GRID, default_grids, every_battery_grid
+from verimono.checks.partitions import EVERY_GRID, default_grids, every_battery_grid, limit_grids
 from verimono.checks.trajectory_laws import check_selections
 from verimono.reference import get
 from zoo_steppers import residual_stop
@@ -52,3 +52,7 @@ def test_the_battery_partitions_are_built_once_and_handed_out_as_copies():
     assert np.array_equal(again["uniform"], np.linspace(0.0, p.T, 41))
     other = every_battery_grid(p, seed=4)
     assert not np.array_equal(other["random"], again["random"])   # the seed is part of the key
+    for build in (lambda: default_grids(p, 3), lambda: limit_grids(p.T, 160, 3)):   # the other cached builders
+        for g in build().values():
+            g[1:-1] = -1.0
+        assert all(np.all(np.diff(g) > 0) for g in build().values())
