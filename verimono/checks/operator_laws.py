@@ -27,10 +27,11 @@ import math
 
 import numpy as np
 
-from ..core.errors import VerimonoError
+from ..core.errors import NotApplicable, OutsideDomain, VerimonoError
 from ..core.tolerances import LIMIT_FLOOR, STALL_RATIO, STALL_WINDOW, current_eps, repeat_tolerance, tolerance
 from .core import Member, Outcome
-from .members import listed, min_norm, norm, point, resolvent
+from .members import (_ROUNDOFF_BOUNDARY, listed, min_norm, norm, outside_by_roundoff_of_dom_g, point, resolvent,
+                      within_roundoff_of_domain)
 from .samples import Sample
 from .search import operator_law
 
@@ -39,12 +40,41 @@ GRADES = tuple(10.0 ** k for k in range(0, 13, 2))
 _MIN_NORM, _CONTAINS, _PROJECT = Member("min_norm"), Member("contains"), Member("project_domain")
 
 
-def _graded_membership(op, x: np.ndarray, y: np.ndarray, t: float, tol: float) -> float:
-    """Smallest tried multiple ``g`` of ``tol`` with ``y ∈ F(t, x)`` up to ``g·tol`` (``inf`` if none)."""
+def _graded_membership(op, x: np.ndarray, y: np.ndarray, t: float, tol: float, scale: float | None = None,
+                       normal: np.ndarray | None = None) -> float:
+    """Smallest tried multiple ``g`` of ``tol`` with ``y ∈ F(t, x)`` up to ``g·tol`` (``inf`` if none; no sample —
+    :class:`NotApplicable` — when ``x`` lies outside the domain by round-off only: of ``dom F`` judged by
+    ``min_norm`` and ``project_domain``, or of ``dom g`` by ``value`` at points within ``eps·(1 + scale)``)."""
     for g in GRADES:
         if op.contains(x.copy(), y.copy(), t, g * tol):
             return g
+    if _outside_by_roundoff(op, x, t):
+        raise NotApplicable(f"y ∈ F(t, x) not decidable at x: {_ROUNDOFF_BOUNDARY}")
+    if getattr(op, "value", None) is not None and scale is not None and _g_infinite(op, x, t) \
+            and outside_by_roundoff_of_dom_g(op, x, t, scale, normal):
+        raise NotApplicable("y ∈ ∂g(t, x) not decidable at x: g(x) = inf there only by round-off (g is finite "
+                            "within a few eps·|x| of x)")
     return math.inf
+
+
+def _g_infinite(op, x: np.ndarray, t: float) -> bool:
+    try:
+        return not math.isfinite(op.value(np.array(x, dtype=float), t))
+    except Exception:      # noqa: BLE001 - the law judges the value function's exceptions elsewhere
+        return False
+
+
+def _outside_by_roundoff(op, x: np.ndarray, t: float) -> bool:
+    """``x ∉ dom F(t,·)`` (its minimal section rejects it) but within round-off of the domain's closure."""
+    if getattr(op, "min_norm", None) is None:
+        return False
+    try:
+        op.min_norm(x.copy(), t)
+    except OutsideDomain:
+        return within_roundoff_of_domain(op, x, t)
+    except Exception:      # noqa: BLE001 - any other answer: x is not shown to be outside
+        return False
+    return False
 
 
 def _domain_pair(op, s: Sample) -> tuple[np.ndarray, np.ndarray, float]:
@@ -181,7 +211,7 @@ def check_yosida_in_graph(op, s):
     a = resolvent(op, s.x1, s.lam, s.t)
     y = (s.x1 - a) / s.lam
     tol = tolerance(s.x1, a, s.lam * y) * (2.0 + 2.0 / s.lam)
-    g = _graded_membership(op, a, y, s.t, tol)
+    g = _graded_membership(op, a, y, s.t, tol, scale=max(norm(s.x1), norm(a)), normal=s.x1 - a)
     return Outcome.compare(g, 0.0, 1.0, "Y_λx ∈ F(t, J_λx) (ratio: tolerance multiple needed)",
                  {"J": listed(a), "Y": listed(y), "tol": tol})
 

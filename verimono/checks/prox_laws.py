@@ -29,6 +29,8 @@ import numpy as np
 
 from ..core.tolerances import current_eps, current_precision, current_rtol, tolerance
 from .core import Member, Outcome
+from ..core.errors import NotApplicable
+from .members import ROUNDOFF_ULPS, outside_by_roundoff_of_dom_g
 from .members import norm as _nrm
 from .members import resolvent as _J
 from .members import value as _g
@@ -49,14 +51,19 @@ def _tolf(*values: float) -> float:
 _VALUE = Member("value")
 
 
-def _outside(p, gp, what, x) -> Outcome:
+def _outside(op, p, gp, what, x, t) -> Outcome:
     """The outcome of a law whose ``p = J_λx`` the user's value function puts outside ``dom g`` (``g(p) = ∞``):
+    no sample (:class:`NotApplicable`: inconclusive) when ``g`` is finite within the round-off of ``J`` at that
+    point (:func:`verimono.checks.members.outside_by_roundoff_of_dom_g`); otherwise
     a failure (the prox of ``g`` lies in ``dom g``) that says the value function said so, and gives the
     round-off of ``J`` at that point, ``eps·(1 + |x|)`` with ``eps`` the unit round-off of the precision under
     judgement — a float32 projection from ``|x| = 1e3`` may leave its set by up to about ``eps·|x| ≈ 1e-4``,
     which a strict indicator (``inf`` for any point outside) rejects although ``J`` is exact to its precision."""
     tau = current_eps() * (1.0 + max(_nrm(x), _nrm(p)))
     prec = current_precision().name
+    if outside_by_roundoff_of_dom_g(op, p, t, max(_nrm(x), _nrm(p)), x - p):
+        raise NotApplicable(f"{what}: g(p) = {gp} at p = J_λx only by round-off (g is finite within "
+                            f"{ROUNDOFF_ULPS[-1]:g} x eps·|x| = {ROUNDOFF_ULPS[-1] * tau:.3g} of p, {prec})")
     return Outcome.compare(math.inf, 0.0, 1.0,
                            f"{what}: the value function says p = J_λx lies outside dom g (g(p) = {gp}); J's "
                            f"round-off at this point is about eps·|x| = {tau:.3g} ({prec}, |x| = {_nrm(x):.3g}): a value function "
@@ -92,7 +99,7 @@ def _at_prox_point(what):
         def evaluate(op, s):
             p = _J(op, s.x1, s.lam, s.t)
             gp = _g(op, p, s.t)
-            return body(op, s, p, gp) if math.isfinite(gp) else _outside(p, gp, what, s.x1)
+            return body(op, s, p, gp) if math.isfinite(gp) else _outside(op, p, gp, what, s.x1, s.t)
         return evaluate
     return decorate
 
@@ -213,7 +220,7 @@ def check_moreau_envelope(op, s):
     g1, g2 = _g(op, p1, t), _g(op, p2, t)
     for x, p, gv in ((x1, p1, g1), (x2, p2, g2)):
         if not math.isfinite(gv):
-            return _outside(p, gv, "Moreau envelope", x)
+            return _outside(op, p, gv, "Moreau envelope", x, t)
     e1 = g1 + float((x1 - p1) @ (x1 - p1)) / (2 * lam)
     e2 = g2 + float((x2 - p2) @ (x2 - p2)) / (2 * lam)
     y1 = (x1 - p1) / lam
