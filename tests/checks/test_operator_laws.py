@@ -361,7 +361,7 @@ def test_a_violation_only_the_draws_meet_is_shrunk_and_replays(monkeypatch):
     the NumPy draws: recorded as theirs, shrunk greedily, and replayed by sample=."""
     from hypothesis import strategies as st
 
-    from verimono.checks import samples, search as L
+    from verimono.checks import coordinates, samples, search as L
 
     harmless = st.just(samples.Sample(np.zeros(2), np.zeros(2), 1.0, 1.0, 1.0, 0.0))
     monkeypatch.setattr(L, "law_samples", lambda n, horizon=1.0: harmless)
@@ -371,7 +371,9 @@ def test_a_violation_only_the_draws_meet_is_shrunk_and_replays(monkeypatch):
     again = run_law("resolvent_nonexpansive", zoo.build("explicit_step"), sample=r.counterexample)
     assert again.status == "failed", str(again)
     monkeypatch.setattr(L, "HYPOTHESIS_MIN", 0)
-    monkeypatch.setattr(L, "law_draws", lambda *a, **k: [])     # without the draws nothing finds it
+    monkeypatch.setattr(L, "law_draws", lambda *a, **k: [])     # without the draws nothing finds it (but the
+    monkeypatch.setattr(coordinates, "COORDINATES",                # direction search, from the pair x1 = x2)
+                        tuple(c for c in coordinates.COORDINATES if c != "direction"))
     assert run_law("resolvent_nonexpansive", zoo.build("explicit_step"), seed=0, examples=20).status == "passed"
 
 

@@ -33,7 +33,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..core.tolerances import current_largest
+from ..core.tolerances import current_largest, current_step_range
+from .directions import direction_search
 from .samples import Sample
 from .supremum import Searched, Space, maximise
 
@@ -47,8 +48,10 @@ OFFSET = (1e-12, 1e3)
 #: of them at once — a band of large λ that shows only at points larger than λ — is outside this phase);
 #: ``mu``, ``nu`` and ``scale`` from a budget of :data:`MORE_FROM` points on (below it the draws, hypothesis and
 #: the sweep — whose points span ``10^-9`` to ``10^6`` — cover them; ``λ``, ``t`` and the boundary come first)
-COORDINATES = ("lam", "t", "offset", "mu", "nu", "scale")
+COORDINATES = ("direction", "lam", "t", "offset", "mu", "nu", "scale")
 MORE_FROM = 81
+#: the decades of the step range (:func:`_decades`) get a design of ``DECADE_SHARE`` times the coordinate budget
+DECADE_SHARE = 2
 _MORE = ("mu", "nu", "scale")
 
 def _norm(v: np.ndarray) -> float:
@@ -60,9 +63,10 @@ def _moves(s: Sample, name: str, op: Any, horizon: float) -> tuple[Space, Callab
     """The space of coordinate ``name`` of ``s``, the sample at a point of it, and design points (``None``
     when the coordinate cannot move: a recipe sample's points, ``x1 = 0``, ``x1`` inside the domain)."""
     if name in ("lam", "mu", "nu"):
-        space = Space(name, *STEPS, log=True)
+        lo, hi = current_step_range()
+        space = Space(name, lo, hi, log=True)
         return space, (lambda v: dataclasses.replace(s, **{name: float(v)})), \
-            [10.0 ** k for k in range(-4, 2)] + [getattr(s, name)]
+            [10.0 ** k for k in range(-4, 2)] + [lo, hi, getattr(s, name)]
     if name == "t":
         space = Space("t", 0.0, float(horizon))
         return space, (lambda v: dataclasses.replace(s, t=float(v))), [0.0, horizon / 2, float(horizon), s.t]
@@ -99,16 +103,33 @@ def coordinate_search(evaluate: Callable[[Sample], float], op: Any, start: Sampl
     """Each coordinate of ``start`` maximised on its own (module docstring); ``evaluate(sample)`` returns the
     law's ratio (and raises to end the search, as on a violation); ``stop()`` ends it between coordinates.
     Returns what each coordinate's search covered."""
-    done = []
+    done, here = [], start
+    best: list = [-math.inf, start]          # the largest ratio the direction search met, and its sample
+
+    def ev(s: Sample) -> float:
+        v = evaluate(s)
+        if v > best[0]:
+            best[:] = [v, s]
+        return v
+
     for name in COORDINATES:
         if stop():
             break
         if name in _MORE and points < MORE_FROM:
             continue
-        moved = _moves(start, name, op, horizon)
+        if name == "direction":        # not one-dimensional: the sphere of directions of x2 - x1
+            got = direction_search(ev, op, start, points, seed)
+            if got is not None:
+                done.append(got)
+            here = best[1]             # the other coordinates from the worst direction (or the worst sample)
+            continue
+        moved = _moves(here, name, op, horizon)
         if moved is None:
             continue
         space, at, design = moved
+        if name in ("lam", "mu", "nu"):
+            done.append(_decades(evaluate, space, at, points, seed, name))
+            space = Space(name, *STEPS, log=True)       # the steps the samples are drawn from, at full density
         design = [float(min(max(v, space.lo), space.hi)) for v in design]
         first = [evaluate(at(v)) for v in design]
         if len(set(first)) <= 1:     # flat to the last bit: a coordinate the law does not read
@@ -119,6 +140,25 @@ def coordinate_search(evaluate: Callable[[Sample], float], op: Any, start: Sampl
                        seed=seed, nodes=1, per_node=1)
         done.append({"coordinate": name, "read": True, **_brief(sup.searched)})
     return done
+
+
+def _decades(evaluate: Callable[[Sample], float], space: Space, at: Callable[[float], Sample], points: int,
+             seed: int, name: str) -> dict:
+    """The step coordinate ``name`` over every decade the precision represents (``space``,
+    :func:`verimono.core.tolerances.current_step_range`): a design of every ``stride``-th decade, ``stride`` the
+    smallest that ``DECADE_SHARE · points`` evaluations pay (ci: every 3rd decade of float64's 160, dev every 6th,
+    thorough every one), then, unless the ratio is the same at every design point (a law that does not read the
+    step: ``"read": False``), the search of :func:`maximise` over the whole range."""
+    lo, hi = math.ceil(math.log10(space.lo)), math.floor(math.log10(space.hi))
+    stride = max(1, math.ceil((hi - lo) / (DECADE_SHARE * max(1, points))))
+    design = [10.0 ** k for k in range(lo, hi + 1, stride)] + [space.hi]
+    first = [evaluate(at(v)) for v in design]
+    if len(set(first)) <= 1:
+        return {"coordinate": f"{name} decades", "read": False, "stride": stride, "points": len(design),
+                "range": [space.lo, space.hi], "log": True}
+    sup = maximise(lambda v, which: np.array([evaluate(at(v))]), space, design=design, points=points,
+                   seed=seed, nodes=1, per_node=1)
+    return {"coordinate": f"{name} decades", "read": True, "stride": stride, **_brief(sup.searched)}
 
 
 def _brief(s: Searched) -> dict:

@@ -471,7 +471,7 @@ def _verdict(state: _Search, how: dict, base: dict, details: dict, cex_extra: di
     if read:        # what the coordinate search resolved: a narrower violation is outside what was searched
         counted += "; searched " + ", ".join(
             f"{c['coordinate']} to within a factor {c['resolution']:.3g}" if c["log"] else
-            f"{c['coordinate']} to {c['resolution']:.3g}" for c in read) + " (narrower bands are outside what was searched)"
+            f"{c['coordinate']} to {c['resolution']:.3g}{' ' + c['unit'] if c.get('unit') else ''}" for c in read) + " (narrower bands are outside what was searched)"
     return new_record(status=PASSED, worst=None if state.worst is None else state.worst.ratio, bound=BOUND,
                        message=counted + (f"; {how['flaky']}" if how["flaky"] else ""), details=details, **base)
 

@@ -13,7 +13,9 @@ first such boundary point on) by a pair of points just *outside* that boundary, 
 ``b + 1000δ(1 + |b|) n`` with ``b`` the last point ``J_ν x ≠ x`` met, ``n`` the outer normal and ``δ`` from
 :data:`OUTSIDE` (a projection that forgets the points within ``10^-6`` of its set returns the first and
 projects the second: no longer firmly nonexpansive).  Step sizes are log-uniform in ``[10^-3, 10]``
-(``λ = 1`` every fifth sample), times uniform in ``[0, horizon]`` with both ends included.
+(``λ = 1`` every fifth sample), times uniform in ``[0, horizon]`` with both ends included.  Every sixth sample
+(from the second) has coordinates of mixed magnitudes ``±10^u``, ``u ∈`` :data:`MIXED` each, with step sizes of
+as many decades: a minimal section wrong only for coordinates in ``(0, 10^-3]`` is met there.
 
 A sweep sample that breaks the law is shrunk greedily (:func:`shrink`: ``t → 0``, step sizes → 1,
 coordinates → 0, then each coordinate rounded to fewer digits, kept while the law still fails) and
@@ -33,6 +35,9 @@ from ..core.tolerances import current_largest
 SCALES = (1e-9, 1e-7, 5e-7, 1e-5, 1e-3, 1e-1, 1.0, 3.0, 10.0, 1e2, 1e3, 1e6)
 #: offsets of the points just outside the boundary of the domain, ``b + δ(1 + |b|) n``, relative
 OUTSIDE = (1e-12, 1e-10, 1e-8, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3)
+#: decades of the mixed-magnitude samples: each coordinate ``±10^u``, and each step ``10^u``, ``u`` uniform here
+#: (a law whose violation needs a coordinate in ``(0, 10^-3]`` at a step below it: the kinks of ``∂|x|₁``)
+MIXED = (-9.0, 2.0)
 #: sweep samples per law and profile (``None``: a profile not of verimono's, e.g. a user's own)
 SWEEP_BY_PROFILE = {"dev": 33, "ci": 33, "thorough": 132, None: 33}
 #: laws whose one evaluation is expensive (an independent minimiser) see this many sweep samples at most
@@ -64,6 +69,11 @@ def sweep_samples(op, seed: int, horizon: float, count: int, make: Callable) -> 
         lam, mu, nu = (float(10.0 ** rng.uniform(-3.0, 1.0)) for _ in range(3))
         if i % 5 == 0:
             lam = 1.0
+        if i % 6 == 1:   # coordinates of mixed magnitudes, with steps of as many decades
+            x1 = rng.choice((-1.0, 1.0), n) * 10.0 ** rng.uniform(*MIXED, n)
+            x1 = np.minimum(np.abs(x1), cap) * np.sign(x1)
+            x2 = x1 + 1e-2 * np.abs(x1) * rng.uniform(-1.0, 1.0, n)
+            lam, mu, nu = (float(10.0 ** rng.uniform(*MIXED)) for _ in range(3))
         t = float((0.0, float(horizon))[i % 2]) if i % 7 < 2 else float(rng.uniform(0.0, horizon))
         if i % 4 == 3:   # points in the range of J: J_ν x and J_ν(J_ν x), or just outside the boundary
             try:

@@ -1,0 +1,146 @@
+"""The direction coordinate of the operator laws over pairs: ``x2 = x1 + r d`` for every ``d`` on the unit
+sphere ``S^{n-1}``.
+
+A law over pairs — monotonicity ``⟨x_a − x_b, y_a − y_b⟩ ≥ 0`` (A1), firm nonexpansiveness
+``|J_λx1 − J_λx2|² ≤ ⟨J_λx1 − J_λx2, x1 − x2⟩``, the ``1/λ``-Lipschitz Yosida approximation (Proposition
+``prop:maxmon-resolvent-Yosida`` ii, iv) — holds for every direction of ``x2 − x1``.  In ``R^12`` the directions
+within 10° of one 2-plane are a fraction ``~10^-8`` of the sphere: random pairs never meet an operator that is
+non-monotone only there.  So, from the worst sample ``(x1, x2)`` of the search (``r = |x2 − x1|``; for a pair
+``x1 = x2``, often the worst of a law ``lhs ≥ 0``, ``r = 10^-2 (1 + |x1|)``), the direction is searched in three
+ways:
+
+1. **the sketch** (:func:`sketch_directions`): the difference map of the resolvent at ``x1``,
+   ``M q_i = (J_λ(x1 + r q_i) − J_λ x1)/r`` on a random orthonormal basis ``q_1 … q_n`` (``n`` calls of the
+   resolvent), is the resolvent's linearisation at scale ``r``.  Each pair law is, to first order, a quadratic
+   form in ``d`` whose worst direction is an extreme eigenvector: of ``sym M`` (monotonicity of ``J`` and of
+   ``I − J``, i.e. of ``F`` and ``Y_λ``), of ``MᵀM`` (nonexpansiveness), of ``MᵀM − sym M`` (firm
+   nonexpansiveness, ``λ``-cocoercivity of ``Y_λ``) and of ``(I − M)ᵀ(I − M)`` (the Lipschitz constant of
+   ``λY_λ``).  Both extreme eigenvectors of each, with both signs, at radius ``r`` and ``r/1000``;
+2. **the sphere**: ``points`` directions drawn uniformly on ``S^{n-1}`` (normalised Gaussians, seeded);
+3. **refinement**: a (1+1) evolution strategy on the sphere from the worst direction found — a random
+   rotation by an angle ``θ`` kept when the ratio grows (``θ`` × 1.5), ``θ`` × 0.8 otherwise — with
+   ``points / 2`` evaluations, down to :data:`FINEST` radians.
+
+A law that does not read the direction (its ratio the same to the last bit at three random directions and the
+sample's own) is covered by those points only (``"read": False``).  The record states what was searched:
+directions drawn, sketched and refined, and the finest angle of the refinement.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any, Callable
+
+import numpy as np
+
+from ..execution.interrupts import interruptible
+from .members import norm
+from .samples import NUMPY_DIM, Sample
+
+#: the refinement's first and finest rotation angles (radians)
+FIRST_ANGLE = 0.3
+FINEST = 1e-4
+#: the radii of the sketch's candidate directions, relative to the worst pair's ``r``
+SKETCH_RADII = (1.0, 1e-3)
+#: the distance of the pair searched when the worst sample is a pair ``x1 = x2``, relative to ``1 + |x1|``
+PAIR_RADIUS = 1e-2
+
+
+def _unit(v: np.ndarray) -> np.ndarray | None:
+    m = norm(v)
+    return None if m == 0.0 or not math.isfinite(m) else v / m
+
+
+@interruptible   # the subject's code: the unit's budget may stop it
+def sketch_directions(op: Any, s: Sample, r: float, rng: np.random.Generator) -> list[np.ndarray]:
+    """Candidate worst directions of the pair laws at ``x1``: extreme eigenvectors of the four matrices of the
+    module docstring, built from ``n`` resolvent calls at ``x1 + r q_i`` (``[]`` when a call raises or returns
+    no finite point: the laws meet that themselves)."""
+    n = s.x1.size
+    q, _ = np.linalg.qr(rng.standard_normal((n, n)))
+    try:
+        j0 = np.asarray(op.resolvent(s.x1.copy(), s.lam, s.t), dtype=float)
+        cols = [np.asarray(op.resolvent(s.x1 + r * q[:, i], s.lam, s.t), dtype=float) for i in range(n)]
+    except Exception:       # noqa: BLE001 - the laws evaluate (and judge) the resolvent's exceptions
+        return []
+    if j0.shape != (n,) or any(c.shape != (n,) for c in cols):
+        return []
+    m = ((np.array(cols) - j0) / r).T @ q.T            # M = D Qᵀ, D's columns the differences along q_i
+    if not np.all(np.isfinite(m)):
+        return []
+    sym, gram, res = 0.5 * (m + m.T), m.T @ m, np.eye(n) - m
+    out = []
+    for a in (sym, gram, gram - sym, res.T @ res):
+        _, v = np.linalg.eigh(0.5 * (a + a.T))
+        out += [v[:, 0], v[:, -1]]
+    return out
+
+
+def direction_search(evaluate: Callable[[Sample], float], op: Any, s: Sample, points: int,
+                     seed: int) -> dict | None:
+    """The direction of ``x2 − x1`` searched from the worst sample ``s`` (module docstring); ``evaluate`` returns
+    the law's ratio (``-inf`` when inconclusive) and raises on a violation, which ends the search.  ``None`` when
+    the direction cannot move (``n = 1``, ``x1 = x2``, a recipe sample)."""
+    n = s.x1.size
+    if s.recipe is not None or n < 2 or n > NUMPY_DIM:
+        return None
+    rng = np.random.default_rng([int(seed) % (2 ** 63), n, 0xD1EC])
+    r = norm(s.x2 - s.x1)
+    if r == 0.0:        # the worst sample of a law "≥ 0" is often the pair x1 = x2 (ratio 0): a nearby pair
+        r = PAIR_RADIUS * (1.0 + norm(s.x1))
+        s = dataclasses.replace(s, x2=s.x1 + r * _unit(rng.standard_normal(n)))
+    if not math.isfinite(r) or r == 0.0:
+        return None
+
+    def at(d: np.ndarray, radius: float = r) -> Sample:
+        return dataclasses.replace(s, x2=s.x1 + radius * d)
+
+    best = [-math.inf, (s.x2 - s.x1) / r, r]
+
+    def ev(d: np.ndarray, radius: float = r) -> float:
+        v = evaluate(at(d, radius))
+        if v > best[0]:
+            best[:] = [v, d, radius]
+        return v
+
+    drawn = [_unit(rng.standard_normal(n)) for _ in range(3)]
+    first = [ev(best[1])] + [ev(d) for d in drawn if d is not None]
+    if len(set(first)) <= 1:
+        return {"coordinate": "direction", "read": False, "points": len(first), "log": False,
+                "range": [0.0, math.pi], "unit": "rad"}
+    count = len(first)
+    sketched = sketch_directions(op, s, r, rng)
+    for d in sketched:
+        for radius in (r * k for k in SKETCH_RADII):
+            for sign in (1.0, -1.0):
+                ev(sign * d, radius)
+                count += 1
+    for _ in range(max(1, int(points))):
+        d = _unit(rng.standard_normal(n))
+        if d is not None:
+            ev(d)
+            count += 1
+    theta, d, radius = FIRST_ANGLE, best[1], best[2]
+    for _ in range(max(1, int(points) // 2)):
+        if theta < FINEST:
+            break
+        g = rng.standard_normal(n)
+        g -= (g @ d) * d
+        g = _unit(g)
+        if g is None:
+            break
+        cand = math.cos(theta) * d + math.sin(theta) * g
+        before = best[0]
+        ev(cand, radius)
+        count += 1
+        if best[0] > before:
+            d, theta = cand, theta * 1.5
+        else:
+            theta *= 0.8
+    return {"coordinate": "direction", "read": True, "points": count, "log": False, "unit": "rad",
+            "range": [0.0, math.pi], "resolution": float(min(theta, FIRST_ANGLE)), "sphere": f"S^{n - 1}",
+            "drawn": int(points), "sketched": len(sketched)}
+
+
+__all__ = ["direction_search", "sketch_directions", "FIRST_ANGLE", "FINEST", "SKETCH_RADII"]
