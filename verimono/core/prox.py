@@ -157,7 +157,7 @@ class ProxOperator(Operator):
 
     # -- the contract ------------------------------------------------------------------------------
     def resolvent(self, x, lam, t=0.0):
-        x = as_float64(x)
+        x = x if given_as_is(x, self._io.name) else as_float64(x)
         if x.ndim == 2:   # a batch of flattened points: one call per row, or one batched call
             if self.batched:
                 return self.resolvent_batch(x, np.full(x.shape[0], float(lam)), np.full(x.shape[0], float(t)))
