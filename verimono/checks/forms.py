@@ -55,6 +55,7 @@ float64 points (:mod:`verimono.checks.batches`); its later calls meet the form.
 
 from __future__ import annotations
 
+import functools
 from typing import Any, Callable, Sequence
 
 import numpy as np
@@ -114,9 +115,15 @@ def forms_for(op: Any) -> tuple[str, ...]:
     return (INTEGER, STRIDED, SLICE, READONLY) + ((DECLARED,) if dt != np.float64 else ())
 
 
-def _garbage(size: int, dt: np.dtype) -> np.ndarray:
+@functools.lru_cache(maxsize=64)
+def _garbage_of(size: int, dt: np.dtype) -> np.ndarray:
     big = np.finfo(dt).max
     return np.resize(np.array([np.nan, big, -big], dtype=dt), size)
+
+
+def _garbage(size: int, dt: np.dtype) -> np.ndarray:
+    """A buffer of ``size`` garbage entries of dtype ``dt`` (NaN, +max, -max in turn): a fresh copy."""
+    return _garbage_of(size, dt).copy()
 
 
 class _Formed:

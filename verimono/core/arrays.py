@@ -283,14 +283,15 @@ def library_hint(exc: BaseException, given: str = "numpy") -> str:
 _AS_GIVEN: contextvars.ContextVar[bool] = contextvars.ContextVar("verimono_as_given", default=False)
 
 
-@contextlib.contextmanager
-def as_given():
-    """Within the block, NumPy subjects are given their inputs as they are (:data:`_AS_GIVEN`)."""
-    token = _AS_GIVEN.set(True)
-    try:
-        yield
-    finally:
-        _AS_GIVEN.reset(token)
+class as_given(contextlib.AbstractContextManager):
+    """Within the block, NumPy subjects are given their inputs as they are (:data:`_AS_GIVEN`); a class, not a
+    generator: it wraps every call of an operator in an input form."""
+
+    def __enter__(self) -> None:
+        self._token = _AS_GIVEN.set(True)
+
+    def __exit__(self, *exc: Any) -> None:
+        _AS_GIVEN.reset(self._token)
 
 
 def given_as_is(x: Any, library: str) -> bool:
