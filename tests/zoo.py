@@ -151,3 +151,114 @@ BREAKS = {name: laws for name, (_, laws) in ZOO.items()}
 
 def build(name: str) -> Operator:
     return ZOO[name][0]()
+
+
+# -- the input's form (verimono.checks.forms): bugs that only arrays other than fresh contiguous float64 meet --
+
+_BALL = sets.Ball([0.0, 0.0], 1.0)
+_BALL_CONE = NormalCone(_BALL)
+
+
+def _on_ball(resolvent, name: str) -> Operator:
+    return operator_from_resolvent(resolvent, 2, min_norm=_BALL_CONE.min_norm, project_domain=_BALL_CONE.project_domain,
+                                   contains=_BALL_CONE.contains, name=name)
+
+
+def truncates_integers() -> Operator:
+    """``N_B`` of the unit ball whose resolvent allocates its output with ``np.empty_like(x)``: an integer
+    ``x`` gets an integer output, the projection ``x/|x|`` truncated toward 0 (``J(3, 0) = (1, 0)`` but
+    ``J(2, 1) = (0, 0)``): ``Y_λx = x/λ`` is then no normal of the ball at ``0``."""
+    def resolvent(x, lam, t):
+        out = np.empty_like(x)
+        out[...] = _BALL.project(np.asarray(x, dtype=float), t)
+        return out
+    return _on_ball(resolvent, "truncates_integers")
+
+
+def reads_parent_buffer() -> Operator:
+    """``N_B`` whose resolvent takes "the underlying array" of a view, ``x.base``, for the point: the first
+    ``n`` entries of the caller's buffer, not ``x`` (the other entries of a strided view, the entries
+    before a slice)."""
+    def resolvent(x, lam, t):
+        data = x if x.base is None else x.base
+        return _BALL.project(np.asarray(data, dtype=float)[:2], t)
+    return _on_ball(resolvent, "reads_parent_buffer")
+
+
+def projects_in_place() -> Operator:
+    """``N_B`` whose resolvent scales ``x`` into the ball in place (``x /= max(1, |x|)``) and returns it:
+    the right value, but the caller's ``x`` is overwritten (and a read-only ``x`` raises)."""
+    def resolvent(x, lam, t):
+        x /= max(1.0, float(np.linalg.norm(x)))
+        return x
+    return _on_ball(resolvent, "projects_in_place")
+
+
+def scratch_on_input() -> Operator:
+    """``N_B`` of the ball centred at ``(1/2, 0)`` whose resolvent uses ``x`` as scratch space (``x -= c``)
+    and restores it bit for bit before returning: the caller's writable ``x`` ends unchanged, but a
+    read-only ``x`` raises ``ValueError``."""
+    c = np.array([0.5, 0.0])
+    ball = sets.Ball(c, 1.0)
+    cone = NormalCone(ball)
+
+    def resolvent(x, lam, t):
+        saved = np.array(x, dtype=float)
+        x -= c.astype(x.dtype)
+        p = _BALL.project(np.asarray(x, dtype=float), t) + c
+        x[...] = saved
+        return p
+    return operator_from_resolvent(resolvent, 2, min_norm=cone.min_norm, project_domain=cone.project_domain,
+                                   contains=cone.contains, name="scratch_on_input")
+
+
+ZOO.update({
+    "truncates_integers": (truncates_integers, ["yosida_in_graph", "resolvent_firmly_nonexpansive"]),
+    "reads_parent_buffer": (reads_parent_buffer, ["resolvent_nonexpansive", "yosida_in_graph"]),
+    "projects_in_place": (projects_in_place, ["resolvent_nonexpansive", "yosida_in_graph"]),
+    "scratch_on_input": (scratch_on_input, ["resolvent_nonexpansive"]),
+})
+BREAKS.update({name: laws for name, (_, laws) in ZOO.items() if name not in BREAKS})
+
+
+def lawful_truncates_integers() -> Operator:
+    def resolvent(x, lam, t):
+        x = np.asarray(x, dtype=float)
+        out = np.empty_like(x)
+        out[...] = _BALL.project(x, t)
+        return out
+    return _on_ball(resolvent, "lawful_truncates_integers")
+
+
+def lawful_reads_parent_buffer() -> Operator:
+    def resolvent(x, lam, t):
+        return _BALL.project(np.asarray(x, dtype=float), t)
+    return _on_ball(resolvent, "lawful_reads_parent_buffer")
+
+
+def lawful_projects_in_place() -> Operator:
+    def resolvent(x, lam, t):
+        x = np.array(x, dtype=float)       # a copy of its own to work on
+        x /= max(1.0, float(np.linalg.norm(x)))
+        return x
+    return _on_ball(resolvent, "lawful_projects_in_place")
+
+
+def lawful_scratch_on_input() -> Operator:
+    c = np.array([0.5, 0.0])
+    cone = NormalCone(sets.Ball(c, 1.0))
+
+    def resolvent(x, lam, t):
+        x = np.array(x, dtype=float)       # scratch space of its own
+        x -= c
+        return _BALL.project(x, t) + c
+    return operator_from_resolvent(resolvent, 2, min_norm=cone.min_norm, project_domain=cone.project_domain,
+                                   contains=cone.contains, name="lawful_scratch_on_input")
+
+
+#: the form bugs' members written correctly (np.asarray(x, dtype=float) / a copy first): every law passes
+FORM_CONTROLS = {"truncates_integers": lawful_truncates_integers, "reads_parent_buffer": lawful_reads_parent_buffer,
+                 "projects_in_place": lawful_projects_in_place, "scratch_on_input": lawful_scratch_on_input}
+#: the members whose bug only an input form meets: behind a boundary that copies its input into a fresh float64
+#: array (tests/zoo_precision.float32) they are lawful operators, as the controls are
+FORM_BUGS = frozenset(FORM_CONTROLS)

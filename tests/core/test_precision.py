@@ -24,7 +24,9 @@ from verimono import tolerances as tol
 
 CI = get_profile("ci").law_examples
 OPERATORS = catalog(2) + catalog(3)[:3]
-ZOO_CASES = [(member, law) for member, laws in zoo.BREAKS.items() for law in laws]
+# the input-form bugs are out of reach behind float32(), which hands the member a fresh float64 copy
+# (their float32 counterpart: tests/checks/test_forms.py)
+ZOO_CASES = [(member, law) for member, laws in zoo.BREAKS.items() for law in laws if member not in zoo.FORM_BUGS]
 
 
 # -- the derivation (tolerances.py) -------------------------------------------------------------------

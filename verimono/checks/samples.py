@@ -16,6 +16,7 @@ import numpy as np
 from hypothesis import strategies as st
 
 from ..strategies.values import points, step_sizes, times
+from .forms import CONTIGUOUS, FORMS, INTEGER, integral
 
 #: above this dimension the points of a sample are drawn by NumPy from a seed (and a kind) that hypothesis
 #: draws and shrinks: hypothesis draws each coordinate through its byte buffer, which cannot hold vectors of
@@ -43,7 +44,8 @@ class Sample:
     """Inputs of one evaluation: points ``x1, x2``, step sizes ``λ = lam, μ = mu, ν = nu`` and time ``t``.
 
     ``recipe`` (large dimensions only) says how NumPy drew the points, so that a sample of a million
-    coordinates is recorded and replayed by a few numbers instead of its coordinates."""
+    coordinates is recorded and replayed by a few numbers instead of its coordinates.  ``form`` is how the
+    points are passed to the operator (:mod:`verimono.checks.forms`; :meth:`in_form` makes one)."""
 
     x1: np.ndarray
     x2: np.ndarray
@@ -52,9 +54,21 @@ class Sample:
     nu: float
     t: float
     recipe: dict[str, Any] | None = dataclasses.field(default=None, compare=False)
+    form: str = CONTIGUOUS
+
+    def in_form(self, form: str) -> "Sample":
+        """This sample with its points passed in ``form`` (:data:`verimono.checks.forms.FORMS`); the
+        ``"integer"`` form rounds the points to integers first, so the law's arithmetic uses the same points."""
+        if form not in FORMS:
+            raise ValueError(f"no input form {form!r}; the forms are {FORMS}")
+        if form == INTEGER:
+            return dataclasses.replace(self, x1=integral(self.x1), x2=integral(self.x2), form=form)
+        return dataclasses.replace(self, form=form)
 
     def to_dict(self) -> dict[str, Any]:
         scalars = {"lam": self.lam, "mu": self.mu, "nu": self.nu, "t": self.t}
+        if self.form != CONTIGUOUS:
+            scalars["form"] = self.form
         if self.recipe is not None:
             return {"recipe": dict(self.recipe), **scalars}
         return {"x1": self.x1.tolist(), "x2": self.x2.tolist(), **scalars}
@@ -62,17 +76,21 @@ class Sample:
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> "Sample":
         if "recipe" in d:
-            return _from_recipe(d["recipe"], float(d["lam"]), float(d["mu"]), float(d["nu"]), float(d["t"]))
-        return cls(np.asarray(d["x1"], dtype=float), np.asarray(d["x2"], dtype=float), float(d["lam"]),
-                   float(d["mu"]), float(d["nu"]), float(d["t"]))
+            s = _from_recipe(d["recipe"], float(d["lam"]), float(d["mu"]), float(d["nu"]), float(d["t"]))
+        else:
+            s = cls(np.asarray(d["x1"], dtype=float), np.asarray(d["x2"], dtype=float), float(d["lam"]),
+                    float(d["mu"]), float(d["nu"]), float(d["t"]))
+        form = d.get("form", CONTIGUOUS)
+        return s if form == CONTIGUOUS else s.in_form(str(form))
 
     def __repr__(self) -> str:
+        tail = "" if self.form == CONTIGUOUS else f", form={self.form!r}"
         if self.recipe is not None:
             return (f"Sample.from_dict({{'recipe': {self.recipe!r}, 'lam': {self.lam!r}, 'mu': {self.mu!r}, "
-                    f"'nu': {self.nu!r}, 't': {self.t!r}}})")
+                    f"'nu': {self.nu!r}, 't': {self.t!r}" + (f", 'form': {self.form!r}" if tail else "") + "})")
         f = lambda a: np.array2string(a, precision=17, separator=", ")  # noqa: E731 - exact replay
         return (f"Sample(x1={f(self.x1)}, x2={f(self.x2)}, lam={self.lam!r}, mu={self.mu!r}, "
-                f"nu={self.nu!r}, t={self.t!r})")
+                f"nu={self.nu!r}, t={self.t!r}{tail})")
 
 
 def _from_recipe(recipe: dict[str, Any], lam: float, mu: float, nu: float, t: float) -> Sample:

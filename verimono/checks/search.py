@@ -13,10 +13,13 @@ search evaluates it, in order, on
    the boundary of the domain;
 4. the coordinate search (:mod:`verimono.checks.coordinates`): each coordinate of the worst sample — the
    step sizes across decades up to ``Λ = 10``, the time, the scale of the points, their offset from the
-   boundary — maximised on its own (:func:`verimono.checks.supremum.maximise`).
+   boundary — maximised on its own (:func:`verimono.checks.supremum.maximise`), and the worst sample in every
+   input form (:mod:`verimono.checks.forms`: integer, strided and offset views into garbage, read-only, the
+   declared dtype — forms the NumPy draws cycle through too), the operator's input unchanged by every call.
 
 Every record says what was searched (``details["searched"]``: the range of ``|x|`` and of the step sizes,
-the largest gap between the sampled times, each coordinate's range and resolution).
+the largest gap between the sampled times, each coordinate's range and resolution, the samples evaluated in
+each input form).
 
 Hypothesis's engine costs about 1.7 ms per example here against about 0.02 ms per NumPy draw.  One given
 ``sample=`` (a :class:`~verimono.checks.samples.Sample` or its dict from a counterexample) is evaluated
@@ -69,6 +72,7 @@ from ..records.verdicts import timeout_verdict
 from .batches import _BatchFailure, prefetched
 from .coordinates import coordinate_search, searched
 from .core import REGISTRY, Law, Outcome, classify, law, new_record, run, subject_name
+from .forms import CONTIGUOUS, cycled, form_note, form_search, forms_for, in_form
 from .samples import NUMPY_DIM, Sample, law_samples
 from .supremum import budget
 from .sweep import law_draws, shrink, sweep_count, sweep_samples
@@ -127,15 +131,17 @@ def positive_examples(examples: Any) -> int:
 def evaluate_sample(decl: Law, op: Any, s: Sample) -> Outcome:
     """``decl.evaluate(op, s)``, an exception judged by the core's policy: a member the operator lacks is
     raised (it stops the search), a limit of verimono's solvers or a hypothesis that does not hold there
-    is an inconclusive sample, anything else a failed one."""
+    is an inconclusive sample, anything else a failed one.  A sample in another input form than contiguous
+    is evaluated on the operator seen through that form (:func:`verimono.checks.forms.in_form`)."""
     try:
-        return decl.evaluate(op, s)
+        return decl.evaluate(op if s.form == CONTIGUOUS else in_form(op, s.form), s)
     except (InvalidCheckArgument, NotImplementedError):
         raise
     except Exception as exc:  # noqa: BLE001 - the core's policy decides
         if interrupted():     # raised after the unit's budget interrupted the sample: the timeout's, not the sample's
             raise
         status, message = classify(exc)
+        message += form_note(s.form)
         if status == UNDECIDED:
             return Outcome.inconclusive_sample(message, {HARNESS_LIMIT: str(exc)})
         if status == SKIPPED:
@@ -217,6 +223,8 @@ class _Search:
     ts: list = dataclasses.field(default_factory=list)
     coordinates: list = dataclasses.field(default_factory=list)
     horizon: float = 1.0
+    #: samples evaluated in each input form (verimono.checks.forms)
+    forms: dict = dataclasses.field(default_factory=dict)
 
     @interruptible   # the law's and the subject's code: the unit's budget may stop it even under hypothesis
     def evaluate(self, s: Sample, climb: bool = False) -> float | None:
@@ -239,6 +247,7 @@ class _Search:
         self.xs += [float(np.max(np.abs(s.x1), initial=0.0)), float(np.max(np.abs(s.x2), initial=0.0))]
         self.lams += [s.lam, s.mu, s.nu]
         self.ts.append(s.t)
+        self.forms[s.form] = self.forms.get(s.form, 0) + 1
         if out.inconclusive:
             self.inconclusive += 1
             self.inconclusive_what = out.what
@@ -327,7 +336,7 @@ def _search(decl: Law, op: Any, seed: int, examples: int, horizon: float) -> tup
     try:
         with no_local_constants(), time_limit(current_budget(), f"{decl.name} on {subject_name(op)}"):
             if op.dim <= NUMPY_DIM:
-                drawn = state.first_violation(law_draws(op.dim, seed, horizon, examples, Sample))
+                drawn = state.first_violation(cycled(law_draws(op.dim, seed, horizon, examples, Sample), forms_for(op)))
             full = drawn is not None or op.dim > NUMPY_DIM
             _hypothesis_search(state, seed, horizon, examples if full else max(HYPOTHESIS_MIN,
                                                                                examples // HYPOTHESIS_SHARE))
@@ -366,11 +375,13 @@ def _coordinates(state: _Search, seed: int, horizon: float, how: dict) -> None:
         r = state.evaluate(s)
         return -math.inf if r is None else r
 
-    start, before = state.worst_sample, state.runs
+    start, before = dataclasses.replace(state.worst_sample, form=CONTIGUOUS), state.runs
     try:
         with time_limit(current_budget(), f"{state.decl.name} on {subject_name(state.op)}"):
+            formed = form_search(ratio, start, forms_for(state.op))      # the input's form, first: a few samples
             state.coordinates = coordinate_search(ratio, state.op, start, horizon, budget("coordinate"), seed,
                                                   lambda: state.unsupported is not None)
+            state.coordinates += [formed] if formed else []
     except _Violation:
         state.shrunk_into(state.failing, "the search over each coordinate of the worst sample (shrunk greedily)")
     except UnitTimeout as exc:
@@ -519,8 +530,8 @@ def run_law(decl: Law | str, op: Any, *, seed: int | None = None, examples: int 
         rec = _verdict(state, how, base, {**details, "evaluations": state.runs, "inconclusive": state.inconclusive,
                                           "harness_limited": state.harness_limited, "sweep": how["sweep"],
                                           "coordinate": how.get("coordinate", 0),
-                                          "searched": searched(state.xs, state.lams, state.ts, horizon,
-                                                               state.coordinates)},
+                                          "searched": {**searched(state.xs, state.lams, state.ts, horizon,
+                                                                  state.coordinates), "forms": dict(state.forms)}},
                        {"seed": seed, "examples": examples, "horizon": horizon, "operator": repr(op)})
         rec.duration = time.perf_counter() - start
         return rec

@@ -19,6 +19,8 @@ dependency of verimono.
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import dataclasses
 import importlib
 import sys
@@ -275,6 +277,29 @@ def library_hint(exc: BaseException, given: str = "numpy") -> str:
     return ""
 
 
+#: while set (:func:`as_given`), a NumPy subject's adapter hands it the NumPy arrays it is called with as they
+#: are — integer dtypes, strided or offset views, read-only arrays — instead of a float64 copy: the input
+#: forms of the operator laws (:mod:`verimono.checks.forms`) reach the user's own function
+_AS_GIVEN: contextvars.ContextVar[bool] = contextvars.ContextVar("verimono_as_given", default=False)
+
+
+class as_given(contextlib.AbstractContextManager):
+    """Within the block, NumPy subjects are given their inputs as they are (:data:`_AS_GIVEN`); a class, not a
+    generator: it wraps every call of an operator in an input form."""
+
+    def __enter__(self) -> None:
+        self._token = _AS_GIVEN.set(True)
+
+    def __exit__(self, *exc: Any) -> None:
+        _AS_GIVEN.reset(self._token)
+
+
+def given_as_is(x: Any, library: str) -> bool:
+    """Whether ``x`` goes to a subject computing with ``library`` as it is: inside :func:`as_given`, a NumPy
+    array of a real (integer or floating) dtype given to a NumPy subject."""
+    return (library == "numpy" and type(x) is np.ndarray and x.dtype.kind in "iuf" and _AS_GIVEN.get())
+
+
 class Boundary:
     """The conversions of one subject at verimono's boundary: its inputs from NumPy to its array type (none
     for NumPy float64), its outputs to NumPy float64 with their precision reported.  ``kind=None``: the
@@ -330,4 +355,4 @@ def kind_of(value: Any) -> ArrayKind | None:
     return array_kind(lib, dtype=dt, device=getattr(value, "device", None) if lib == "torch" else None)
 
 
-__all__ = ["LIBRARIES", "MAX_BATCH", "Boundary", "padded", "batch_chunks", "prefetch_key", "take_prefetched", "ArrayKind", "array_kind", "kind_of", "library_of", "precision_of", "to_numpy", "as_float64"]
+__all__ = ["as_given", "given_as_is", "LIBRARIES", "MAX_BATCH", "Boundary", "padded", "batch_chunks", "prefetch_key", "take_prefetched", "ArrayKind", "array_kind", "kind_of", "library_of", "precision_of", "to_numpy", "as_float64"]

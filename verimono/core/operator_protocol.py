@@ -17,7 +17,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .arrays import Boundary, array_kind, as_float64, batch_chunks, take_prefetched
+from .arrays import Boundary, array_kind, as_float64, batch_chunks, given_as_is, take_prefetched
 from ._subgradients import checked_value, subgradient_contains
 from ._validate import check_lam, real_array
 from .errors import InvalidProblem
@@ -168,8 +168,9 @@ class _FromResolvent(Operator):
             return real_array(value, what)      # the typed error for complex or non-numeric values
 
     def _in(self, x):
-        """A point as the user's members are given it (from any array library, in their array type)."""
-        if not (type(x) is np.ndarray and x.dtype == np.float64):
+        """A point as the user's members are given it (from any array library, in their array type; inside
+        :func:`verimono.core.arrays.as_given`, a NumPy subject's NumPy input as it is)."""
+        if not (type(x) is np.ndarray and x.dtype == np.float64) and not given_as_is(x, self._io.name):
             try:
                 x = as_float64(x)
             except (TypeError, ValueError):

@@ -32,7 +32,7 @@ import numpy as np
 
 from ._subgradients import (CONTAINS_POINTS, ProxOutputError, checked_value, contains_points,  # noqa: F401 - re-exported
                       subgradient_contains)
-from .arrays import Boundary, array_kind, as_float64, batch_chunks, take_prefetched
+from .arrays import Boundary, array_kind, as_float64, batch_chunks, given_as_is, take_prefetched
 from .errors import InvalidProblem
 from .operators import Operator
 
@@ -117,6 +117,8 @@ class ProxOperator(Operator):
 
     # -- the adapter ------------------------------------------------------------------------------
     def _shaped(self, x: np.ndarray) -> np.ndarray:
+        if given_as_is(x, self._io.name) and x.shape == (self.dim,):   # an input form of the laws, as it is
+            return x.reshape(self.shape)
         x = as_float64(x)
         if x.shape != (self.dim,):
             raise InvalidProblem(f"{self.name} acts on R^{self.dim} (arrays of shape {self.shape}, flattened); "
@@ -155,7 +157,7 @@ class ProxOperator(Operator):
 
     # -- the contract ------------------------------------------------------------------------------
     def resolvent(self, x, lam, t=0.0):
-        x = as_float64(x)
+        x = x if given_as_is(x, self._io.name) else as_float64(x)
         if x.ndim == 2:   # a batch of flattened points: one call per row, or one batched call
             if self.batched:
                 return self.resolvent_batch(x, np.full(x.shape[0], float(lam)), np.full(x.shape[0], float(t)))
