@@ -243,6 +243,17 @@ def _seed(text: str) -> int:
     return seed
 
 
+def _rounds(text: str) -> int:
+    """``--rounds``: a whole number of timed rounds >= 1, checked before any work (exit 2)."""
+    try:
+        rounds = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a whole number of rounds >= 1, got {text!r}") from None
+    if rounds < 1:
+        raise argparse.ArgumentTypeError(f"must be a whole number of rounds >= 1, got {text!r}")
+    return rounds
+
+
 def _finish(report: Report, out: Path, baseline: Report | None, run_id: str | None = None) -> int:
     from .records.report import write
 
@@ -588,7 +599,7 @@ def build_parser() -> argparse.ArgumentParser:
                       help="a Problem with an exact solution (or a list of them); repeatable")
     comp.add_argument("--reference", action="append", metavar="NAME", help="a reference of the catalog")
     comp.add_argument("--out", default="reports/compare", help="output folder (default reports/compare/)")
-    comp.add_argument("--rounds", type=int, default=9, help="timed rounds per run (default 9; up to 3x that when "
+    comp.add_argument("--rounds", type=_rounds, default=9, help="timed rounds per run (default 9; up to 3x that when "
                       "the noise cannot decide)")
     comp.add_argument("--norm", choices=("sup", "l2", "final"), default="sup", help="the error compared")
     comp.set_defaults(func=_cmd_compare)
