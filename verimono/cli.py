@@ -1,4 +1,4 @@
-"""Command line of verimono.
+"""Command line of verimono (``verimono --version``: the installed version).
 
     verimono run [--profile dev|ci|thorough] [--out DIR] [--stage NAME ...] [--seed N] [--data DIR]
                  [--baseline FILE] [--timeout S] [--resume] [--executor serial|process:N|tcp://host:port]
@@ -31,7 +31,7 @@
         MODULE is a dotted module name or a ``.py`` file (anything else: exit 2).  Its units run on every
         core as ``run``'s do (``--executor serial``: in this process).  Its files are marked and
         written as ``run``'s; after an interrupt, run the same command again (it has no ``--resume``).
-    verimono compare MODULE:A MODULE:B ... (--problem MODULE:OBJECT | --reference NAME)... [--out DIR]
+    verimono compare MODULE:A MODULE:B ... (--problem MODULE:OBJECT | --reference ID)... [--out DIR]
                  [--rounds N] [--norm sup|l2|final]
         Work–precision of the steppers (fixed-grid ``Stepper``s over the problem's step sizes, ``Adaptive``
         ones over their tolerances) on each problem (``verimono.run.work_precision``): the records
@@ -528,11 +528,25 @@ def _cmd_report(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _version() -> str:
+    """The installed distribution's version (``importlib.metadata``: what pip installed, not a copy of it)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("verimono")
+    except PackageNotFoundError:           # run from a source tree that was never installed
+        from . import __version__
+
+        return f"{__version__} (not installed)"
+
+
 def build_parser() -> argparse.ArgumentParser:
     from .run.stages import STAGES
 
     parser = argparse.ArgumentParser(prog="verimono", description=__doc__.split("\n\n")[0],
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--version", action="version", version=f"verimono {_version()}",
+                        help="print the installed version of verimono and exit")
     sub = parser.add_subparsers(dest="command", required=True)
 
     def run_options(p: argparse.ArgumentParser) -> None:
@@ -545,8 +559,9 @@ def build_parser() -> argparse.ArgumentParser:
                            n if s.default else f"{n} (on request)" for n, s in STAGES.items()))
         p.add_argument("--seed", type=_seed, default=None, help="seed for the randomized batteries")
         p.add_argument("--data", default=None, help="Siconos data (DIR/siconos/{refs,lcp}); default: the packaged data")
-        p.add_argument("--reference", action="append", metavar="NAME",
-                       help="use only this analytic reference (repeatable; default: the whole catalog)")
+        p.add_argument("--reference", action="append", metavar="ID",
+                       help="use only this analytic reference, by its id (tnorm-1, example-ramp, ...) or its display "
+                            "name (repeatable; default: the whole catalog)")
         p.add_argument("--timeout", type=_seconds, default=None, metavar="S",
                        help="seconds per unit of work (one law on one operator, one check of one stepper) "
                             "before it is stopped while the run goes on: undecided when all it evaluated held, "
@@ -597,7 +612,8 @@ def build_parser() -> argparse.ArgumentParser:
                       "against each other")
     comp.add_argument("--problem", action="append", default=None, metavar="MODULE:OBJECT",
                       help="a Problem with an exact solution (or a list of them); repeatable")
-    comp.add_argument("--reference", action="append", metavar="NAME", help="a reference of the catalog")
+    comp.add_argument("--reference", action="append", metavar="ID", help="a reference of the catalog, by its "
+                      "id (tnorm-1, ...) or its display name")
     comp.add_argument("--out", default="reports/compare", help="output folder (default reports/compare/)")
     comp.add_argument("--rounds", type=_rounds, default=9, help="timed rounds per run (default 9; up to 3x that when "
                       "the noise cannot decide)")
