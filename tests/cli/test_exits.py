@@ -36,6 +36,16 @@ def test_every_reference_has_a_stable_ascii_id_and_get_takes_either():
         get("no such reference")
 
 
+def test_the_command_line_resolves_references_by_id():
+    import argparse
+
+    from verimono.cli import _context
+
+    ctx = _context(argparse.Namespace(reference=["tnorm-1", "example-ramp", "moving box"]))
+    assert [p.name for p in ctx.problems] == ["t|x| (n=1)", "Example ex, v = (\u2212t, 0)", "moving box"]
+
+
+@pytest.mark.slow
 def test_run_takes_a_reference_by_its_id(tmp_path, capsys):
     code = main(["run", "--profile", "ci", "--stage", "convergence", "--reference", "tnorm-1",
                  "--reference", "example-ramp", "--executor", "serial", "--out", str(tmp_path)])
