@@ -688,6 +688,15 @@ def _mark_if_stale(out: str | os.PathLike, command: str) -> str | None:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """The command line: the exit status of the command ``argv`` (default ``sys.argv[1:]``).  Its console is
+    guarded (:mod:`verimono.run.console`): a broken pipe or a closed stream ends printing, never the run."""
+    from .run.console import guarded
+
+    with guarded():
+        return _main(argv)
+
+
+def _main(argv: list[str] | None) -> int:
     from threadpoolctl import threadpool_limits
 
     from .execution.calibration import PendingCalibration

@@ -52,3 +52,117 @@ def test_run_takes_a_reference_by_its_id(tmp_path, capsys):
     out = capsys.readouterr().out
     assert code == 0, out
     assert "t|x| (n=1)" in out and "Example ex, v = (\u2212t, 0)" in out
+
+
+# -- 2. output never costs results ------------------------------------------------------------------------------------
+
+class _BrokenPipe:
+    """A console whose reader went away (``| head -c 20`` after 20 bytes)."""
+
+    def __init__(self, after: int = 0):
+        self.left = after
+
+    def write(self, text):
+        if self.left <= 0:
+            raise BrokenPipeError(32, "Broken pipe")
+        self.left -= len(text)
+        return len(text)
+
+    def flush(self):
+        if self.left <= 0:
+            raise BrokenPipeError(32, "Broken pipe")
+
+    def isatty(self):
+        return False
+
+
+@pytest.fixture(scope="module")
+def passing_results(tmp_path_factory):
+    from verimono import check_stepper, solve
+
+    d = tmp_path_factory.mktemp("results")
+    rep = check_stepper(solve, [get("tnorm-1")], laws=False)
+    rep.meta.update({"command": "run", "profile": "ci", "target": None, "calibration": 0.05})
+    rep.save(d / "results.json")
+    return d / "results.json"
+
+
+@pytest.mark.parametrize("stream", ["stdout", "stderr", "both"])
+@pytest.mark.parametrize("after", [0, 20])
+def test_a_broken_console_ends_printing_not_the_command(passing_results, tmp_path, monkeypatch, stream, after):
+    """In-process: ``baseline --from`` then ``gate`` with the console's reader gone; before, BrokenPipeError
+    out of main.  The files are written and the statuses are the verdicts' (0: no regression)."""
+    base = tmp_path / "baseline.json"
+    for name in (("stdout", "stderr") if stream == "both" else (stream,)):
+        monkeypatch.setattr(f"sys.{name}", _BrokenPipe(after))
+    assert main(["baseline", "--from", str(passing_results), "--out", str(base)]) == 0
+    assert base.is_file()
+    assert main(["gate", "--baseline", str(base), "--results", str(passing_results)]) == 0
+    assert main(["report", "--results", str(passing_results), "--out", str(tmp_path / "r.html")]) == 0
+    assert (tmp_path / "r.html").is_file()
+
+
+def test_a_closed_stderr_is_no_stream_at_all(passing_results, tmp_path, monkeypatch):
+    """``2>&-``: Python starts with ``sys.stderr = None``; ``sys.stderr.flush()`` before a fork raised."""
+    monkeypatch.setattr("sys.stderr", None)
+    base = tmp_path / "baseline.json"
+    assert main(["baseline", "--from", str(passing_results), "--out", str(base)]) == 0 and base.is_file()
+
+
+def test_the_console_is_given_back_after_the_command(passing_results, tmp_path):
+    import sys
+
+    found = sys.stdout, sys.stderr
+    main(["gate", "--baseline", str(passing_results), "--results", str(passing_results)])
+    assert (sys.stdout, sys.stderr) == found
+
+
+GOOD = "from verimono.core.stepping import solve\n"
+LAGGED = '''
+import numpy as np
+
+
+def solve(problem, t_grid):          # the moving set evaluated at the start of each step: order lost
+    t = np.asarray(t_grid, dtype=float)
+    x = [np.array(problem.x0, dtype=float)]
+    for k in range(1, len(t)):
+        x.append(np.asarray(problem.operator.resolvent(x[-1], t[k] - t[k - 1], t[k - 1]), dtype=float))
+    return np.array(x)
+'''
+
+
+def _shell(tmp_path, source: str, redirect: str, *extra: str):
+    """``verimono check`` of ``source``'s ``solve`` on two references, its output redirected by ``redirect``
+    (a pipe into ``head -c 20``, a closed stream); the exit status of verimono itself, as a wrapper script sees
+    it (``PIPESTATUS``), and the output folder."""
+    import shlex
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    (tmp_path / "subject.py").write_text(source)
+    out = tmp_path / "out"
+    exe = Path(sys.executable).with_name("verimono")
+    cmd = " ".join(shlex.quote(str(a)) for a in [exe, "check", "subject.py:solve", "--profile", "ci", "--reference",
+                                                 "moving-box", "--reference", "tnorm-1", "--out", out, *extra])
+    script = f"{cmd} {redirect}\necho \"status=${{PIPESTATUS[0]}}\" >&3\n"
+    proc = subprocess.run(["bash", "-c", f"exec 3>&1; {script}"], cwd=tmp_path, capture_output=True, text=True,
+                          timeout=600)
+    status = re.search(r"status=(\d+)", proc.stdout)
+    assert status, proc.stdout + proc.stderr
+    return int(status.group(1)), out
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("source, verdict", [(GOOD, 0), (LAGGED, 1)], ids=["correct", "lagged"])
+@pytest.mark.parametrize("redirect", ["| head -c 20 >/dev/null", "2>&1 | head -c 20 >/dev/null", ">&- 2>&-",
+                                      "2>&- | head -c 1 >/dev/null"],
+                         ids=["stdout into head", "both into head", "both closed", "stderr closed, stdout into head"])
+def test_a_pipe_or_a_closed_stream_never_costs_the_results(tmp_path, source, verdict, redirect):
+    from verimono.records.results import load
+
+    status, out = _shell(tmp_path, source, redirect)
+    assert (out / "results.json").is_file() and (out / "report.html").is_file()
+    assert not (out / "results.json.in-progress").exists()
+    rep = load(out / "results.json")
+    assert status == verdict == (0 if rep.ok else 1), (status, rep.summary())
