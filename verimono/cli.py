@@ -49,7 +49,10 @@
     verimono report [--results reports/results.json] [--out reports/report.html] [--baseline FILE]
         Re-render the HTML report from a results file.
 
-Exit status 2 always means "could not decide" (bad usage, unreadable input); it is never a pass.
+Exit status 2 always means "could not decide" (bad usage, unreadable input); it is never a pass.  Exit 0 only
+when the results were written and passed: what a subject raises — ``sys.exit()`` and ``GeneratorExit`` included —
+is a failed record of it (exit 1); a closed pipe or stream ends the printing, never the run (its results are
+written first and the status is the verdict's: ``verimono.run.console``).  docs/run.md tabulates the statuses.
 """
 
 from __future__ import annotations
@@ -68,6 +71,7 @@ from .execution.config import using as using_config
 from .execution.profiles import PROFILES
 from .run.progress import Progress
 from .records.results import FAILED, SKIPPED, Report
+from .records.verdicts import SUBJECT_EXITS
 from .run.execute import (EXIT_FAILED, EXIT_OK, EXIT_UNDECIDED, execute, exit_status, interruptible, merge_resumed)
 from .run.targets import load_target
 
@@ -730,6 +734,12 @@ def _main(argv: list[str] | None) -> int:
                 return func(args)
             except VerimonoError as exc:
                 print(f"verimono {args.command}: {exc}", file=sys.stderr)
+                return EXIT_UNDECIDED
+            except SUBJECT_EXITS as exc:
+                # a sys.exit() from code the command ran outside any check (every check records its own): never
+                # the command's status — no verdict was reached, and the files (if any) stay marked in progress
+                print(f"verimono {args.command}: ended by {type(exc).__name__}({getattr(exc, 'code', '')!r}) raised "
+                      "outside any check; no verdict", file=sys.stderr)
                 return EXIT_UNDECIDED
         finally:
             drawer.disconnect()                        # the drawer ends, then its process is reaped

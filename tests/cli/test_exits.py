@@ -166,3 +166,141 @@ def test_a_pipe_or_a_closed_stream_never_costs_the_results(tmp_path, source, ver
     assert not (out / "results.json.in-progress").exists()
     rep = load(out / "results.json")
     assert status == verdict == (0 if rep.ok else 1), (status, rep.summary())
+
+
+# -- 1. one exit path: what a subject raises or calls is a failed record of it ------------------------------------------
+
+EXITING = '''
+import os
+import sys
+
+import numpy as np
+
+import verimono as vm
+
+calls = [0]
+
+
+def exits(problem, t_grid):               # a stepper that ends "its" program on the {n}th call
+    calls[0] += 1
+    if calls[0] >= {n}:
+        {how}
+    return vm.solve(problem, t_grid).x
+
+
+def _resolvent(x, lam, t):
+    calls[0] += 1
+    if calls[0] >= {n}:
+        {how}
+    return np.asarray(x, dtype=float) / (1.0 + lam)
+
+
+op = vm.operator_from_resolvent(_resolvent, 2, name="exits")
+'''
+
+
+def _exiting(tmp_path, how: str, n: int = 1) -> str:
+    name = f"exiting_{abs(hash((how, n)))}"
+    (tmp_path / f"{name}.py").write_text(EXITING.format(how=how, n=n))
+    return str(tmp_path / f"{name}.py")
+
+
+_SLOW = pytest.mark.slow
+
+
+@pytest.mark.parametrize("how, n, target", [
+    ("sys.exit(0)", 4, "exits"),               # after some grids of the study ran
+    pytest.param("sys.exit(0)", 1, "exits", marks=_SLOW),
+    pytest.param("sys.exit(3)", 1, "exits", marks=_SLOW),
+    pytest.param("raise SystemExit", 2, "exits", marks=_SLOW),
+    pytest.param("raise GeneratorExit", 1, "exits", marks=_SLOW),
+    pytest.param("sys.exit(0)", 1, "op", marks=_SLOW),                  # a resolvent
+    pytest.param("raise GeneratorExit", 3, "op", marks=_SLOW),
+], ids=["stepper sys.exit(0) 4th call", "stepper sys.exit(0)", "stepper sys.exit(3)", "stepper SystemExit 2nd call",
+        "stepper GeneratorExit", "resolvent sys.exit(0)", "resolvent GeneratorExit 3rd call"])
+def test_a_subject_ending_the_program_is_a_failed_record_and_exit_1(tmp_path, capsys, how, n, target):
+    from verimono.records.results import load
+
+    out = tmp_path / "out"
+    code = main(["check", f"{_exiting(tmp_path, how, n)}:{target}", "--profile", "ci", "--executor", "serial",
+                 "--reference", "tnorm-1", "--out", str(out)])
+    assert code == 1, capsys.readouterr()
+    rep = load(out / "results.json")
+    kind = "GeneratorExit" if "GeneratorExit" in how else "SystemExit"
+    failed = [r for r in rep.results if r.status == "failed"]
+    assert failed and all(kind in r.message for r in failed if "Exit" in r.message), [r.message for r in failed]
+    assert any(kind in r.message for r in failed)
+
+
+@pytest.mark.parametrize("how", ["sys.exit(0)", "raise GeneratorExit"])
+def test_check_stepper_records_a_subject_that_ends_the_program(tmp_path, how):
+    import importlib.util
+
+    import verimono as vm
+
+    spec = importlib.util.spec_from_file_location("exiting_api", _exiting(tmp_path, how))
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    rep = vm.check_stepper(mod.exits, [get("tnorm-1")], laws=["contraction"])
+    assert [r.status for r in rep.results] == ["failed", "failed"]
+    assert all(("SystemExit" if "exit" in how else "GeneratorExit") in r.message for r in rep.results)
+
+
+def test_a_real_interrupt_is_not_taken_for_the_subjects(tmp_path):
+    """KeyboardInterrupt (Ctrl-C, and SIGTERM as the run raises it) still stops the battery: it is the user's."""
+    import importlib.util
+
+    import verimono as vm
+
+    spec = importlib.util.spec_from_file_location("interrupted_api", _exiting(tmp_path, "raise KeyboardInterrupt"))
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    with pytest.raises(KeyboardInterrupt):
+        vm.check_stepper(mod.exits, [get("tnorm-1")], laws=["contraction"])
+
+
+def test_check_operator_records_a_resolvent_that_ends_the_program(tmp_path):
+    import importlib.util
+
+    import verimono as vm
+
+    spec = importlib.util.spec_from_file_location("exiting_op", _exiting(tmp_path, "sys.exit(0)", 5))
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    rep = vm.check_operator(mod.op, examples=4, seed=0)
+    failed = [r for r in rep.results if r.status == "failed"]
+    assert failed and any("SystemExit(0)" in r.message for r in failed), [r.message for r in rep.results]
+    assert not rep.ok
+
+
+@pytest.mark.slow
+def test_os_exit_in_a_worker_is_a_failed_record_and_exit_1(tmp_path):
+    """``os._exit(0)`` cannot be caught in the process that calls it; in a worker process it ends the worker, and
+    the run records the unit as failed (under ``--executor serial`` it ends the run: the in-progress mark stays,
+    and the gate refuses the files, docs/run.md).  In a process of its own, as a user runs it (a pytest process
+    with threads would spawn its workers)."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from verimono.records.results import load
+
+    out = tmp_path / "out"
+    exe = Path(sys.executable).with_name("verimono")
+    proc = subprocess.run([str(exe), "check", f"{_exiting(tmp_path, 'os._exit(0)')}:exits", "--profile", "ci",
+                           "--executor", "process:2", "--reference", "tnorm-1", "--out", str(out)],
+                          capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 1, proc.stderr
+    rep = load(out / "results.json")
+    assert rep.failures and all("worker process died" in r.message for r in rep.failures)
+
+
+@pytest.mark.parametrize("exc", [SystemExit(0), SystemExit(None), GeneratorExit()], ids=["exit(0)", "exit()", "gen"])
+def test_an_exit_raised_outside_any_check_is_no_verdict_not_a_pass(monkeypatch, capsys, exc, passing_results):
+    import verimono.cli as cli
+
+    def ends(args):
+        raise exc
+    monkeypatch.setattr(cli, "_cmd_gate", ends)
+    assert main(["gate", "--baseline", str(passing_results), "--results", str(passing_results)]) == 2
+    assert "no verdict" in capsys.readouterr().err
