@@ -1,4 +1,4 @@
-"""Command line of verimono.
+"""Command line of verimono (``verimono --version``: the installed version).
 
     verimono run [--profile dev|ci|thorough] [--out DIR] [--stage NAME ...] [--seed N] [--data DIR]
                  [--baseline FILE] [--timeout S] [--resume] [--executor serial|process:N|tcp://host:port]
@@ -31,7 +31,7 @@
         MODULE is a dotted module name or a ``.py`` file (anything else: exit 2).  Its units run on every
         core as ``run``'s do (``--executor serial``: in this process).  Its files are marked and
         written as ``run``'s; after an interrupt, run the same command again (it has no ``--resume``).
-    verimono compare MODULE:A MODULE:B ... (--problem MODULE:OBJECT | --reference NAME)... [--out DIR]
+    verimono compare MODULE:A MODULE:B ... (--problem MODULE:OBJECT | --reference ID)... [--out DIR]
                  [--rounds N] [--norm sup|l2|final]
         Work–precision of the steppers (fixed-grid ``Stepper``s over the problem's step sizes, ``Adaptive``
         ones over their tolerances) on each problem (``verimono.run.work_precision``): the records
@@ -49,7 +49,10 @@
     verimono report [--results reports/results.json] [--out reports/report.html] [--baseline FILE]
         Re-render the HTML report from a results file.
 
-Exit status 2 always means "could not decide" (bad usage, unreadable input); it is never a pass.
+Exit status 2 always means "could not decide" (bad usage, unreadable input); it is never a pass.  Exit 0 only
+when the results were written and passed: what a subject raises — ``sys.exit()`` and ``GeneratorExit`` included —
+is a failed record of it (exit 1); a closed pipe or stream ends the printing, never the run (its results are
+written first and the status is the verdict's: ``verimono.run.console``).  docs/run.md tabulates the statuses.
 """
 
 from __future__ import annotations
@@ -68,6 +71,7 @@ from .execution.config import using as using_config
 from .execution.profiles import PROFILES
 from .run.progress import Progress
 from .records.results import FAILED, SKIPPED, Report
+from .records.verdicts import SUBJECT_EXITS
 from .run.execute import (EXIT_FAILED, EXIT_OK, EXIT_UNDECIDED, execute, exit_status, interruptible, merge_resumed)
 from .run.targets import load_target
 
@@ -241,6 +245,17 @@ def _seed(text: str) -> int:
     if seed < 0:
         raise argparse.ArgumentTypeError(f"must be a non-negative integer, got {text!r}")
     return seed
+
+
+def _rounds(text: str) -> int:
+    """``--rounds``: a whole number of timed rounds >= 1, checked before any work (exit 2)."""
+    try:
+        rounds = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a whole number of rounds >= 1, got {text!r}") from None
+    if rounds < 1:
+        raise argparse.ArgumentTypeError(f"must be a whole number of rounds >= 1, got {text!r}")
+    return rounds
 
 
 def _finish(report: Report, out: Path, baseline: Report | None, run_id: str | None = None) -> int:
@@ -517,11 +532,25 @@ def _cmd_report(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _version() -> str:
+    """The installed distribution's version (``importlib.metadata``: what pip installed, not a copy of it)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("verimono")
+    except PackageNotFoundError:           # run from a source tree that was never installed
+        from . import __version__
+
+        return f"{__version__} (not installed)"
+
+
 def build_parser() -> argparse.ArgumentParser:
     from .run.stages import STAGES
 
     parser = argparse.ArgumentParser(prog="verimono", description=__doc__.split("\n\n")[0],
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--version", action="version", version=f"verimono {_version()}",
+                        help="print the installed version of verimono and exit")
     sub = parser.add_subparsers(dest="command", required=True)
 
     def run_options(p: argparse.ArgumentParser) -> None:
@@ -534,8 +563,9 @@ def build_parser() -> argparse.ArgumentParser:
                            n if s.default else f"{n} (on request)" for n, s in STAGES.items()))
         p.add_argument("--seed", type=_seed, default=None, help="seed for the randomized batteries")
         p.add_argument("--data", default=None, help="Siconos data (DIR/siconos/{refs,lcp}); default: the packaged data")
-        p.add_argument("--reference", action="append", metavar="NAME",
-                       help="use only this analytic reference (repeatable; default: the whole catalog)")
+        p.add_argument("--reference", action="append", metavar="ID",
+                       help="use only this analytic reference, by its id (tnorm-1, example-ramp, ...) or its display "
+                            "name (repeatable; default: the whole catalog)")
         p.add_argument("--timeout", type=_seconds, default=None, metavar="S",
                        help="seconds per unit of work (one law on one operator, one check of one stepper) "
                             "before it is stopped while the run goes on: undecided when all it evaluated held, "
@@ -586,9 +616,10 @@ def build_parser() -> argparse.ArgumentParser:
                       "against each other")
     comp.add_argument("--problem", action="append", default=None, metavar="MODULE:OBJECT",
                       help="a Problem with an exact solution (or a list of them); repeatable")
-    comp.add_argument("--reference", action="append", metavar="NAME", help="a reference of the catalog")
+    comp.add_argument("--reference", action="append", metavar="ID", help="a reference of the catalog, by its "
+                      "id (tnorm-1, ...) or its display name")
     comp.add_argument("--out", default="reports/compare", help="output folder (default reports/compare/)")
-    comp.add_argument("--rounds", type=int, default=9, help="timed rounds per run (default 9; up to 3x that when "
+    comp.add_argument("--rounds", type=_rounds, default=9, help="timed rounds per run (default 9; up to 3x that when "
                       "the noise cannot decide)")
     comp.add_argument("--norm", choices=("sup", "l2", "final"), default="sup", help="the error compared")
     comp.set_defaults(func=_cmd_compare)
@@ -661,6 +692,15 @@ def _mark_if_stale(out: str | os.PathLike, command: str) -> str | None:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """The command line: the exit status of the command ``argv`` (default ``sys.argv[1:]``).  Its console is
+    guarded (:mod:`verimono.run.console`): a broken pipe or a closed stream ends printing, never the run."""
+    from .run.console import guarded
+
+    with guarded():
+        return _main(argv)
+
+
+def _main(argv: list[str] | None) -> int:
     from threadpoolctl import threadpool_limits
 
     from .execution.calibration import PendingCalibration
@@ -694,6 +734,12 @@ def main(argv: list[str] | None = None) -> int:
                 return func(args)
             except VerimonoError as exc:
                 print(f"verimono {args.command}: {exc}", file=sys.stderr)
+                return EXIT_UNDECIDED
+            except SUBJECT_EXITS as exc:
+                # a sys.exit() from code the command ran outside any check (every check records its own): never
+                # the command's status — no verdict was reached, and the files (if any) stay marked in progress
+                print(f"verimono {args.command}: ended by {type(exc).__name__}({getattr(exc, 'code', '')!r}) raised "
+                      "outside any check; no verdict", file=sys.stderr)
                 return EXIT_UNDECIDED
         finally:
             drawer.disconnect()                        # the drawer ends, then its process is reaped

@@ -44,7 +44,7 @@ from ..core.naming import subject_name
 from ..core.errors import InvalidCheckArgument, NotApplicable
 from ..core.operators import provides
 from ..records.results import FAILED, PASSED, SKIPPED, CheckResult
-from ..records.verdicts import classify, new_record, record_of_exception
+from ..records.verdicts import SUBJECT_EXITS, classify, new_record, record_of_exception
 from ..core.tolerances import judged_precision
 
 SUBJECTS = ("operator", "stepper", "problem", "system", "estimator")
@@ -280,7 +280,7 @@ def run(decl: Law, subject: str, evaluate: Callable[[], Any], *, operator: Any =
                 rec = out if isinstance(out, CheckResult) else record(decl.name, subject, out, seed=seed)
             except InvalidCheckArgument:
                 raise
-            except Exception as exc:  # noqa: BLE001 - the one policy decides what an exception means
+            except (Exception, *SUBJECT_EXITS) as exc:  # noqa: BLE001 - the one policy decides what it means
                 rec = record_of_exception(decl.name, subject, exc, seed=seed)
         # the precision the subject was judged at, stated in every record it decided (tolerances.py)
         rec.details.update(precision.details())

@@ -225,6 +225,8 @@ class _Search:
     horizon: float = 1.0
     #: samples evaluated in each input form (verimono.checks.forms)
     forms: dict = dataclasses.field(default_factory=dict)
+    #: the last sample seen breaking the law while shrinking, with its outcome
+    seen_failing: tuple | None = None
 
     @interruptible   # the law's and the subject's code: the unit's budget may stop it even under hypothesis
     def evaluate(self, s: Sample, climb: bool = False) -> float | None:
@@ -287,12 +289,25 @@ class _Search:
         note_progress(self.runs, not self.violated and self.inconclusive < self.runs)
 
     def fails(self, s: Sample) -> bool:
-        return not evaluate_sample(self.decl, self.op, s).ratio <= BOUND
+        out = evaluate_sample(self.decl, self.op, s)
+        if not out.ratio <= BOUND:
+            self.seen_failing = (s, out)
+            return True
+        return False
 
-    def shrunk_into(self, failing: Sample, how: str) -> None:
-        """Record the violation at ``failing``, shrunk greedily (:func:`verimono.checks.sweep.shrink`)."""
+    def shrunk_into(self, failing: Sample, outcome: Outcome, how: str) -> None:
+        """Record the violation ``outcome`` seen at ``failing``, shrunk greedily (:func:`verimono.checks.sweep.
+        shrink`).  The record keeps the outcome *seen failing* at the shrunk sample (the last candidate the shrink
+        kept, or ``failing`` itself), never a fresh evaluation there: on an operator whose calls disagree that
+        could hold, and the record would state a violation its own numbers deny."""
+        self.seen_failing = (failing, outcome)
         small, _ = shrink(failing, self.fails, dataclasses.replace)
-        self.failing, self.failure = small, evaluate_sample(self.decl, self.op, small)
+        seen, out = self.seen_failing
+        if seen is not small:       # not expected (the shrink keeps only candidates that failed): evaluate there
+            out = evaluate_sample(self.decl, self.op, small)
+            if out.ratio <= BOUND:
+                small, out = failing, outcome
+        self.failing, self.failure = small, out
         self.found_by = how
 
     def first_violation(self, samples: list[Sample]) -> tuple[Sample, Outcome] | None:
@@ -358,7 +373,7 @@ def _search(decl: Law, op: Any, seed: int, examples: int, horizon: float) -> tup
         elif stopped:
             (state.failing, state.failure), state.found_by = drawn, "NumPy draws"
         else:
-            state.shrunk_into(drawn[0], "NumPy draws (shrunk greedily)")
+            state.shrunk_into(*drawn, "NumPy draws (shrunk greedily)")
     # the scale sweep spells out its points: for n > NUMPY_DIM the NumPy recipes cover the scales instead
     if state.failure is None and state.unsupported is None and not stopped and op.dim <= NUMPY_DIM:
         how["sweep"] = _sweep(state, seed, horizon)
@@ -383,7 +398,7 @@ def _coordinates(state: _Search, seed: int, horizon: float, how: dict) -> None:
                                                   lambda: state.unsupported is not None)
             state.coordinates += [formed] if formed else []
     except _Violation:
-        state.shrunk_into(state.failing, "the search over each coordinate of the worst sample (shrunk greedily)")
+        state.shrunk_into(state.failing, state.failure, "the search over each coordinate of the worst sample (shrunk greedily)")
     except UnitTimeout as exc:
         _timed_out(how, exc, state)
     how["coordinate"] = state.runs - before
@@ -397,7 +412,7 @@ def _sweep(state: _Search, seed: int, horizon: float) -> int:
     if found is not None and "batch_size" in found[1].info:
         (state.failing, state.failure), state.found_by = found, "a batched call of the sweep"
     elif found is not None:
-        state.shrunk_into(found[0], "sweep (shrunk greedily)")
+        state.shrunk_into(*found, "sweep (shrunk greedily)")
     return len(swept)
 
 
@@ -422,6 +437,23 @@ def _timed_out(how: dict, exc: UnitTimeout, state: _Search) -> None:
     evidence = getattr(exc, "evidence", {})
     stopped_at = evidence.get("stopped_at") or time.perf_counter()    # the interrupt, not the unwinding after it
     how["evidence"] = {**evidence, "in_flight": None if state.in_flight is None else stopped_at - state.in_flight}
+
+
+def violation_text(out: Outcome) -> str:
+    """What a violated inequality ``lhs ≤ rhs + slack`` is, true as written: ``"<what>: lhs A > rhs B + slack
+    C"`` with as many digits as make ``A > B + C`` hold for the printed numbers (6 significant digits, more when
+    the sides are closer than that shows; ``lhs inf`` too), or, when the right side is not finite or the left is NaN,
+    the sides and that they are not finite (never a pass, and ``lhs 1 > rhs inf`` would be false)."""
+    lhs, rhs, slack = out.lhs, out.rhs, out.slack
+    if lhs is None or rhs is None or slack is None:
+        return f"{out.what}: ratio {out.ratio:.6g} > {out.bound:g}"
+    if math.isnan(lhs) or not (math.isfinite(rhs) and math.isfinite(slack)):
+        return (f"{out.what}: lhs {lhs:.6g}, rhs {rhs:.6g}, slack {slack:.3g}: a side is not finite (never a pass)")
+    for digits in (6, 9, 12, 17):
+        a, b, c = (f"{v:.{digits}g}" for v in (lhs, rhs, slack))
+        if float(a) > float(b) + float(c):
+            break
+    return f"{out.what}: lhs {a} > rhs {b} + slack {c}"
 
 
 def _verdict(state: _Search, how: dict, base: dict, details: dict, cex_extra: dict) -> CheckResult:
@@ -453,8 +485,7 @@ def _verdict(state: _Search, how: dict, base: dict, details: dict, cex_extra: di
             cex["found_by"] = state.found_by
         worst = out.ratio if state.worst is None else max(state.worst.ratio, out.ratio)
         return new_record(status=FAILED, worst=worst, bound=BOUND, counterexample=cex, details=details, **base,
-                           message=f"{out.what}: lhs {out.lhs:.6g} > rhs {out.rhs:.6g} + slack {out.slack:.3g} "
-                                   f"at {s!r}{how['flaky']}")
+                           message=f"{violation_text(out)} at {s!r}{how['flaky']}")
     if runs == 0:        # nothing was evaluated: never a pass
         return new_record(status=UNDECIDED, message="no sample was evaluated", details=details, **base)
     if state.harness_limited == runs:

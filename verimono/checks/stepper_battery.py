@@ -26,7 +26,7 @@ from .core import laws_of, stepper_subject
 from .isolated import isolating, run_check, run_isolated
 from .partitions import single
 from .sample_problems import sample_problems, valid_count
-from .arguments import valid_seed
+from .arguments import valid_executor, valid_flag, valid_laws, valid_problems, valid_seed, valid_step_range
 from .shared_runs import shared_runs
 from .subjects import require_problem, require_stepper
 
@@ -82,6 +82,10 @@ def stepper_checks(stepper: Callable | None = None, problems: Iterable[Problem] 
     """
     seed = valid_seed(seed)
     generated = valid_count(generated)
+    orders = valid_flag(orders, "orders")
+    step_range = valid_step_range(step_range)
+    executor = valid_executor(executor)
+    problems = valid_problems(problems, "stepper_checks")
     if problems is None:
         from verimono.reference import catalog   # the catalog builds every reference: on first use only
 
@@ -137,16 +141,16 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
 
         return check_adaptive(stepper, problems, laws=laws is not False)
     require_stepper(stepper)
-    if problems is not None:
-        problems = list(problems)
-        if not problems:
-            raise InvalidCheckArgument("check_stepper was given an empty list of problems: it would verify "
-                                       "nothing (pass problems=None for the whole catalog)")
-        problems = [require_problem(p) for p in problems]
+    # every argument before the first call of the stepper: what the harness was given is never charged to it
+    problems = valid_problems(problems)
     given, stepper = stepper, with_claim(stepper, scheme, order)
     seed = 0 if seed is None else valid_seed(seed)
     generated = valid_count(generated)
-    selected = () if laws is False else (LAWS if laws is True else _selected(tuple(laws)))
+    orders = valid_flag(orders, "orders")
+    step_range = valid_step_range(step_range)
+    executor = valid_executor(executor)
+    laws = valid_laws(laws)
+    selected = () if laws is False else (LAWS if laws is True else _selected(laws))
     if not selected and not orders:
         raise InvalidCheckArgument("check_stepper selected no check (no law, no order): it would verify nothing")
     report = Report()

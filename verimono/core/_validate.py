@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import numbers
+
 import numpy as np
 
 from .errors import InvalidProblem
@@ -73,4 +75,39 @@ def batch_column(p: np.ndarray, x: np.ndarray, what: str) -> np.ndarray:
     return p[:, None]
 
 
-__all__ = ["check_lam", "bad_lam", "real_array", "finite_point", "bad_param", "batch_column"]
+def _real(value: object) -> bool:
+    """A real number: a Python or NumPy int or float, not a bool (``True`` is not a step size)."""
+    return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+
+
+def step_range_of(step_range: object, cls: type = InvalidProblem) -> tuple[float, float]:
+    """``step_range = (h_min, h_max)`` (either order) as two finite step sizes ``> 0``, sorted; ``cls``
+    otherwise.  Whether it holds two grids of a problem's ``[0, T]`` depends on ``T``: that is decided per
+    problem (:func:`verimono.core.grid_design.cells_range`)."""
+    try:
+        a, b = step_range  # type: ignore[misc]
+    except (TypeError, ValueError):
+        raise cls(f"step_range must be two step sizes (h_min, h_max), got {step_range!r}") from None
+    if not (_real(a) and _real(b)) or not all(0.0 < float(v) < _INF for v in (a, b)):
+        raise cls(f"step_range must be two positive finite step sizes (h_min, h_max), got {step_range!r}")
+    return min(float(a), float(b)), max(float(a), float(b))
+
+
+def study_executor(executor: object, cls: type = InvalidProblem) -> object:
+    """``executor`` of a convergence study: ``None``, ``"serial"``, ``"process"`` or a ``concurrent.futures``
+    executor (an object with ``submit``); ``cls`` otherwise."""
+    if executor is None or (executor in ("serial", "process") if isinstance(executor, str)
+                            else hasattr(executor, "submit")):
+        return executor
+    raise cls(f"executor must be a concurrent.futures.Executor, 'process', 'serial' or None, got {executor!r}")
+
+
+def refinement_of(value: object, cls: type = InvalidProblem) -> int:
+    """``reference_refinement``: an integer ``>= 2`` (the fine reference grid is that many times finer than the
+    finest grid studied: 1 would measure the finest grid against itself, a fraction would be no refinement)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral) or value < 2:
+        raise cls(f"reference_refinement must be an integer >= 2, got {value!r}")
+    return int(value)
+
+
+__all__ = ["step_range_of", "study_executor", "refinement_of", "check_lam", "bad_lam", "real_array", "finite_point", "bad_param", "batch_column"]

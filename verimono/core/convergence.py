@@ -34,9 +34,10 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from ._jsonable import to_jsonable
-from .claims import claim_of
+from ._validate import refinement_of, step_range_of, study_executor
+from .claims import _solve_tol, claim_of
 from .display import render
-from .errors import InvalidProblem
+from .errors import InvalidClaim, InvalidProblem
 from .grid_design import GridPlan, MIN_GRIDS
 from .naming import subject_name
 from .order_fit import ASYMPTOTIC_SPREAD, ORDER_SLACK, OrderFit, fit_order, least_squares_slope
@@ -239,9 +240,24 @@ def convergence_study(stepper: Callable, problem: Problem, steps: Sequence[Any] 
     ``solve_tol``: the accuracy of the stepper's inner solve, relative to the state's size (default: the
     stepper's own claim, ``Stepper(..., solve_tol=τ)``); it raises each grid's floor by :func:`solve_floor`.
     """
+    # every argument checked before the stepper is called: what the study was given is never charged to it
+    if not callable(stepper) or isinstance(stepper, type):
+        raise InvalidClaim(f"a stepper must be callable as stepper(problem, t_grid), got {stepper!r:.80}")
+    if not isinstance(problem, Problem):
+        raise InvalidProblem(f"a convergence study needs a verimono.Problem, got {type(problem).__name__} "
+                             f"{problem!r:.60}")
+    if steps is not None and (isinstance(steps, (str, bytes)) or not hasattr(steps, "__len__")):
+        raise InvalidProblem(f"steps must be a list of step sizes or grids, got {steps!r:.80}")
+    if step_range is not None:
+        step_range_of(step_range)
+    reference_refinement = refinement_of(reference_refinement)
+    study_executor(executor)
+    if expected is not None and not isinstance(expected, Order):
+        raise InvalidProblem(f"expected must be a verimono.Order (or None: the problem's), got {expected!r}")
+    if adapt is not None and not isinstance(adapt, (bool, np.bool_)):
+        raise InvalidProblem(f"adapt must be True, False or None, got {adapt!r}")
     claim = claim_of(stepper)
-    if solve_tol is None:
-        solve_tol = claim.solve_tol
+    solve_tol = claim.solve_tol if solve_tol is None else _solve_tol(solve_tol)
     exp = expected_order(stepper, problem) if expected is None else expected
     given = problem.steps if steps is None else steps
     if step_range is None and (not given or len(given) < 2):

@@ -37,6 +37,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from .errors import InvalidProblem
+from ._validate import step_range_of
 
 #: a study's verdict rests on at least this many grids above the floor when the budget allows it
 MIN_GRIDS = 4
@@ -92,13 +93,7 @@ def cells_of(grid: np.ndarray, T: float) -> int | None:
 def cells_range(T: float, step_range: Any) -> tuple[int, int]:
     """The cell counts ``(K_lo, K_hi)`` of uniform grids of ``[0, T]`` whose step lies in ``step_range = (h_min,
     h_max)`` (either order); an :class:`InvalidProblem` when no two counts fit."""
-    try:
-        a, b = (float(v) for v in step_range)
-    except (TypeError, ValueError):
-        raise InvalidProblem(f"step_range must be two step sizes (h_min, h_max), got {step_range!r}") from None
-    h_min, h_max = min(a, b), max(a, b)
-    if not (math.isfinite(h_min) and h_min > 0.0 and math.isfinite(h_max)):
-        raise InvalidProblem(f"step_range must be two positive finite step sizes, got {step_range!r}")
+    h_min, h_max = step_range_of(step_range)
     k_lo = max(1, math.ceil(T / h_max * (1.0 - 1e-12)))
     k_hi = math.floor(T / h_min * (1.0 + 1e-12))
     if k_hi < k_lo + 1:

@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import numbers
 import weakref
+from collections.abc import Iterable
 from typing import Any, Callable, Sequence
 
 import numpy as np
@@ -74,6 +76,32 @@ def _finite_array(value: Any, what: str) -> np.ndarray:
     return arr
 
 
+def _lipschitz(value: Any) -> float | None:
+    """``lipschitz`` as a finite number ``>= 0`` (or ``None``: not stated).  A negative or NaN constant would
+    make the laws' bounds (``contraction``'s ``e^{Lh}``, the Gronwall factors) wrong, and a correct stepper
+    fail them for the caller's mistake."""
+    if value is None:
+        return None
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real) \
+            or not (math.isfinite(value) and value >= 0):
+        raise InvalidProblem(f"lipschitz (the Lipschitz constant of f) must be a finite number >= 0, got {value!r}")
+    return float(value)
+
+
+def _steps(steps: Any) -> list[float] | None:
+    """``steps`` as a list of finite positive step sizes (or ``None``)."""
+    if steps is None:
+        return None
+    if isinstance(steps, (str, bytes)) or not isinstance(steps, Iterable):
+        raise InvalidProblem(f"steps must be a list of step sizes, got {steps!r}")
+    out = []
+    for h in steps:
+        if isinstance(h, (bool, np.bool_)) or not isinstance(h, numbers.Real) or not (math.isfinite(h) and h > 0):
+            raise InvalidProblem(f"steps must be finite step sizes > 0, got {h!r} in {steps!r}")
+        out.append(float(h))
+    return out
+
+
 @dataclasses.dataclass(frozen=True, init=False, repr=False, eq=False)
 class Problem:
     """``x' ∈ -F(t, x) + f(x) + u(t)`` on ``[0, T]`` with ``x(0) = x0``.
@@ -141,12 +169,19 @@ class Problem:
             raise InvalidProblem(f"T must be a number, got {T!r}") from None
         if not np.isfinite(T) or T <= 0:
             raise InvalidProblem(f"T must be positive and finite, got T = {T!r}")
-        for what, fn in (("f", f), ("u", u), ("exact", exact), ("U", U)):
+        for what, fn in (("f", f), ("u", u), ("exact", exact), ("U", U), ("phi", phi), ("sigma", sigma),
+                         ("theta", theta)):
             if fn is not None and not callable(fn):
                 raise InvalidProblem(f"{what} must be callable, got {fn!r}")
+        if name is not None and not isinstance(name, str):
+            raise InvalidProblem(f"name must be a string, got {name!r}")
+        if not isinstance(notes, str):
+            raise InvalidProblem(f"notes must be a string, got {notes!r}")
+        if not isinstance(initial_jump, (bool, np.bool_)):
+            raise InvalidProblem(f"initial_jump must be True or False, got {initial_jump!r}")
         fields = dict(operator=operator, x0=x0, T=T, f=f, u=u, exact=exact, order=_as_order(order),
-                      name=name or f"{getattr(operator, 'name', 'F')} problem", U=U, lipschitz=lipschitz,
-                      phi=phi, sigma=sigma, theta=theta, steps=None if steps is None else [float(h) for h in steps],
+                      name=name or f"{getattr(operator, 'name', 'F')} problem", U=U,
+                      lipschitz=_lipschitz(lipschitz), phi=phi, sigma=sigma, theta=theta, steps=_steps(steps),
                       initial_jump=bool(initial_jump), notes=notes)
         for key, value in fields.items():
             object.__setattr__(self, key, value)  # frozen: the one place the fields are set

@@ -54,7 +54,7 @@ from . import calibration as _calibration
 from . import config as _config
 from .profiles import Profile, get_profile
 from ..records.verdicts import (HANG_FRACTION, HANG_MULTIPLE, TIME_BUDGET_REASON, never_returned,
-                                record_of_exception)
+                                SUBJECT_EXITS, record_of_exception)
 from . import watchdog
 from .interrupts import DEFER_STEP, interruptible, safe_to_interrupt
 
@@ -325,6 +325,8 @@ def _run_unit(fn: Callable[[], object], *, check: str, subject: str, seconds: fl
                         "in_flight": _stopped_at(exc) - progress["at"], "slowest": progress.get("slowest", 0.0),
                         "budget": limit}
         return record_of_exception(check, subject, exc, details=details, duration=elapsed)
+    except SUBJECT_EXITS as exc:     # sys.exit() in the subject: its failure, never the end of the run
+        return record_of_exception(check, subject, exc, duration=time.perf_counter() - start)
     finally:
         _PROGRESS.pop()
 

@@ -25,6 +25,7 @@ from ..core.errors import BadExecutor
 from .profiles import load_hypothesis_profile
 from ..records.results import UNDECIDED, Report
 from .units import Unit, config_for, raised, unit_failure, unit_record
+from ..records.verdicts import SUBJECT_EXITS
 
 #: BLAS threads for a verification run, in its process and its workers: every matrix here is small, so extra
 #: BLAS threads only contend for the cores; on the 2-core reference machine, under load, threaded OpenBLAS made
@@ -88,7 +89,7 @@ def run_job(cfg: RunConfig, fn: Any, args: tuple, limits: dict, stage: str, labe
             out = fn(*args)
         if not isinstance(out, Report):
             raise TypeError(f"a unit returned {type(out).__name__}, expected a verimono.Report")
-    except Exception as exc:
+    except (Exception, *SUBJECT_EXITS) as exc:
         status, message = raised(exc)     # judged here, where the exception is
         return cloudpickle.dumps(("error", status, message, type(exc).__name__, traceback.format_exc(limit=8),
                                   time.perf_counter() - start))

@@ -116,6 +116,14 @@ def timeout_verdict(text: str, *, evaluated: int = 0, held: bool = True, in_flig
                        f"evaluated ({text}; {why}): no verdict"), details
 
 
+#: what a subject raises to end the program it runs in (``sys.exit()``, a generator's close): not a status of the
+#: harness's own, but a failure of the subject like any exception it raises — caught where the subject's code
+#: runs (a law, a unit, a stage), so that a subject cannot end ``verimono check`` with a status of its choosing
+#: (``sys.exit(0)`` used to exit 0 with no results).  ``KeyboardInterrupt`` is not among them: Ctrl-C (and
+#: SIGTERM, which the run raises as it) is the user's, and stops the run.
+SUBJECT_EXITS = (SystemExit, GeneratorExit)
+
+
 def classify(exc: BaseException) -> tuple[str, str]:
     """``(status, message)`` for an exception raised while verifying — the one policy of every record,
     every sample of a search, every unit of work and every stage of a run:
@@ -128,6 +136,8 @@ def classify(exc: BaseException) -> tuple[str, str]:
     * :class:`UnitTimeout`: by what the budget saw (:func:`timeout_verdict`, from the evidence the limit
       and the unit attached, ``exc.evidence``): failed when a violation was seen or a call did not return,
       undecided (time budget) otherwise;
+    * ``SystemExit`` and ``GeneratorExit`` (:data:`SUBJECT_EXITS`): a failure of the subject, which would end
+      its caller's program;
     * anything else: a failure of the subject (it raised on a valid input), with the exception's type.
 
     Misuse (:class:`verimono.InvalidCheckArgument`) is not classified: the drivers let it propagate to the
@@ -141,6 +151,11 @@ def classify(exc: BaseException) -> tuple[str, str]:
     if isinstance(exc, UnitTimeout):
         status, message, _ = timeout_verdict(str(exc), **getattr(exc, "evidence", {}))
         return status, message
+    if isinstance(exc, SystemExit):
+        return FAILED, (f"SystemExit({exc.code!r}): the subject called sys.exit() (or raised SystemExit), which "
+                        "would end the program that calls it")
+    if isinstance(exc, GeneratorExit):
+        return FAILED, "GeneratorExit: the subject raised GeneratorExit outside a generator's close"
     return FAILED, f"{type(exc).__name__}: {exc}"
 
 
@@ -161,5 +176,5 @@ def record_of_exception(check: str, subject: str, exc: BaseException, *, prefix:
     return new_record(check, subject, status, message=prefix + message, details=details, **kw)
 
 
-__all__ = ["new_record", "classify", "record_of_exception", "timeout_verdict", "never_returned", "HANG_MULTIPLE",
+__all__ = ["SUBJECT_EXITS", "new_record", "classify", "record_of_exception", "timeout_verdict", "never_returned", "HANG_MULTIPLE",
            "HANG_FRACTION", "HANG_MIN_SECONDS", "TIME_BUDGET_REASON"]

@@ -10,7 +10,9 @@
 * **removed** — a record of the baseline is absent now;
 * **count** — the number of executed (non-skipped) records of a check, or in total, shrinks;
 * **order** — a convergence order estimate falls below its theoretical order (interval's upper end plus
-  ``ORDER_SLACK`` below the expected order), below the baseline's estimate by more than the wider of the
+  ``ORDER_SLACK`` below the expected order) where the baseline's study was not below it (one that was is a
+  change: a baseline recording failing checks lets the gate catch only new ones, as ``verimono baseline``
+  warns), below the baseline's estimate by more than the wider of the
   two intervals' half-widths and ``ORDER_DROP_FLOOR``, or a study exact at the nodes no longer is;
 * **error** — an error against a reference (each grid of a convergence study; a record's
   ``details["error"]``, e.g. Siconos agreement) grows by more than ``ERROR_GROWTH``;
@@ -367,16 +369,27 @@ def _compare_records(base: Report, cur: Report, out: list[Change]) -> None:
                           f"{sum(cc.values())}", True))
 
 
+def _below_theory(s: Any) -> bool:
+    """Whether study ``s``'s sup-norm order lies below its theoretical order (its interval's upper end plus
+    ``ORDER_SLACK``; a NaN interval is below)."""
+    exp, fit = s.expected, s.fits["sup"]
+    return (exp is not None and not exp.exact and exp.value is not None and not fit.exact
+            and not (fit.high + ORDER_SLACK >= exp.value))
+
+
 def _compare_studies(base: Report, cur: Report, out: list[Change]) -> None:
     now = {(s.problem, s.stepper): s for s in cur.studies if hasattr(s, "fits")}
+    then = {(s.problem, s.stepper): s for s in base.studies if hasattr(s, "fits")}
     for s in cur.studies:
-        if not hasattr(s, "fits"):
+        if not hasattr(s, "fits") or not _below_theory(s):
             continue
-        exp, fit = s.expected, s.fits["sup"]
-        if exp is not None and not exp.exact and exp.value is not None and not fit.exact:
-            if not (fit.high + ORDER_SLACK >= exp.value):  # also catches nan intervals
-                out.append(Change("order", f"{s.stepper} on {s.problem}",
-                                  f"sup-norm order {fit} below the theoretical order {exp.value:g}", True))
+        # below theory is a regression when it is new: a baseline recorded below it (`verimono baseline` warns
+        # that the gate then catches only new failures) makes it a change, judged against that baseline below
+        was = then.get((s.problem, s.stepper))
+        known = was is not None and _below_theory(was)
+        out.append(Change("order", f"{s.stepper} on {s.problem}",
+                          f"sup-norm order {s.fits['sup']} below the theoretical order {s.expected.value:g}"
+                          + (f", as in the baseline ({was.fits['sup']})" if known else ""), not known))
     for b in base.studies:
         if not hasattr(b, "fits"):
             continue

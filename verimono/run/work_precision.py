@@ -267,7 +267,21 @@ def work_precision(steppers: Sequence[Any], problem: Problem, *, controls: Any =
     ``problem.steps``) and :class:`verimono.Adaptive` ones (tolerances, default their own); ``controls``: one
     list for all, or a dict ``{stepper name: list}``.  The problem needs an exact solution.  ``rounds`` timed
     rounds, once more up to ``max_rounds`` when a comparison of the first stepper is left to the noise."""
+    if isinstance(steppers, (str, bytes)) or not hasattr(steppers, "__iter__"):
+        raise InvalidCheckArgument(f"work_precision takes a list of steppers, got {type(steppers).__name__}")
     steppers = list(steppers)
+    for s in steppers:
+        if not callable(s) or isinstance(s, type):
+            raise InvalidCheckArgument(f"work_precision: a stepper must be callable, got {s!r:.60}")
+    if not isinstance(problem, Problem):
+        raise InvalidCheckArgument(f"work_precision takes one verimono.Problem, got {type(problem).__name__}")
+    for what, v in (("rounds", rounds), ("max_rounds", max_rounds)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
+            raise InvalidCheckArgument(f"{what} must be a whole number, got {v!r}")
+    if isinstance(alpha, bool) or not isinstance(alpha, (int, float, np.floating)) or not 0.0 < alpha < 1.0:
+        raise InvalidCheckArgument(f"alpha (the tests' level) must be a number in (0, 1), got {alpha!r}")
+    if controls is not None and (isinstance(controls, (str, bytes)) or not hasattr(controls, "__iter__")):
+        raise InvalidCheckArgument(f"controls must be a list (or a dict of lists by stepper name), got {controls!r:.60}")
     if len(steppers) < 2:
         raise InvalidCheckArgument("work_precision compares at least two steppers")
     names = [subject_name(s) for s in steppers]

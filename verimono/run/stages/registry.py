@@ -34,7 +34,7 @@ from ...execution.timing import cpu_now, subject_cpu
 from ...lcs.siconos import PACKAGED_DATA, siconos_root
 from ...execution.profiles import Profile
 from ...records.results import FAILED, SKIPPED, Report
-from ...records.verdicts import new_record
+from ...records.verdicts import SUBJECT_EXITS, new_record
 
 
 @dataclasses.dataclass
@@ -196,7 +196,7 @@ def run_stages(names: Iterable[str] | None, profile: Profile, context: RunContex
                 raise TypeError(f"stage {n} returned {type(rep).__name__}, expected a verimono.Report")
             status = "failed" if rep.failures else ("undecided" if not rep.ok else "passed")
             message = rep.summary()
-        except Exception as exc:  # noqa: BLE001 - a crash is a failure of the run, recorded, never swallowed
+        except (Exception, *SUBJECT_EXITS) as exc:  # noqa: BLE001 - a crash is a failure of the run, recorded
             rep, status, message = _stage_failure(n, exc, time.perf_counter() - start)
         duration = time.perf_counter() - start
         units = context.unit_times[n_units:]
