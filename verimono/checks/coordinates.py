@@ -148,7 +148,8 @@ def _decades(evaluate: Callable[[Sample], float], space: Space, at: Callable[[fl
     :func:`verimono.core.tolerances.current_step_range`): a design of every ``stride``-th decade, ``stride`` the
     smallest that ``DECADE_SHARE · points`` evaluations pay (ci: every 3rd decade of float64's 160, dev every 6th,
     thorough every one), then, unless the ratio is the same at every design point (a law that does not read the
-    step: ``"read": False``), the search of :func:`maximise` over the whole range."""
+    step: ``"read": False``), the local search of :func:`maximise` around the largest design values (the design
+    is the coverage: its stride is the resolution promised)."""
     lo, hi = math.ceil(math.log10(space.lo)), math.floor(math.log10(space.hi))
     stride = max(1, math.ceil((hi - lo) / (DECADE_SHARE * max(1, points))))
     design = [10.0 ** k for k in range(lo, hi + 1, stride)] + [space.hi]
@@ -157,7 +158,7 @@ def _decades(evaluate: Callable[[Sample], float], space: Space, at: Callable[[fl
         return {"coordinate": f"{name} decades", "read": False, "stride": stride, "points": len(design),
                 "range": [space.lo, space.hi], "log": True}
     sup = maximise(lambda v, which: np.array([evaluate(at(v))]), space, design=design, points=points,
-                   seed=seed, nodes=1, per_node=1)
+                   seed=seed, nodes=1, per_node=1, global_search=False)
     return {"coordinate": f"{name} decades", "read": True, "stride": stride, **_brief(sup.searched)}
 
 
