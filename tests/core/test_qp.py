@@ -150,3 +150,17 @@ def test_a_far_half_space_is_never_dropped_from_the_answer():
     assert S.far_violation(np.array([0.0, 2e37])) > 0.9 and S.far_violation(np.array([0.0, 1.0])) == 0.0
     z = solve_qp(P, q, G, h)
     assert G @ z <= h * (1 + 1e-12) and abs(z[0]) <= 1e-12
+
+
+def test_no_point_from_any_back_end_is_infeasible_only_when_certified():
+    """No back-end returning a point is not a proof of infeasibility: a back-end may fail on a feasible QP (the
+    paper Example's H at v ~ 1e-7, where ProxQP and DAQP return nothing).  Infeasibility is reported only on
+    HiGHS' certificate (z₁ = 5 and z₁ ≤ 1); otherwise it is verimono's own limit (UnverifiedSolution: undecided,
+    never charged to the subject).  A back-end that is not installed stands for back-ends that all fail."""
+    from verimono.core.errors import UnverifiedSolution
+
+    G, A = np.array([[1.0, 0.0]]), np.array([[1.0, 0.0]])
+    with pytest.raises(InfeasibleStep):
+        solve_qp(np.eye(2), np.zeros(2), G, [1.0], A, [5.0], backends=("no such back-end",))
+    with pytest.raises(UnverifiedSolution):
+        solve_qp(np.eye(2), np.zeros(2), G, [10.0], A, [5.0], backends=("no such back-end",))

@@ -245,9 +245,9 @@ def solve_qp(P, q, G=None, h=None, A=None, b=None, *, backends=None, scale: floa
     The data are equilibrated first (:func:`equilibrate`; ``scale`` as there) and the KKT check is made in
     those units, i.e. relative to the size of the data at every scale.
 
-    Raises :class:`InfeasibleStep` when the constraints admit no point (every back-end reports
-    infeasibility and none returns a point), :class:`UnverifiedSolution` when candidates exist but none
-    verifies.
+    Raises :class:`InfeasibleStep` when the constraints admit no point (no back-end returns one, and HiGHS'
+    phase one certifies infeasibility), :class:`UnverifiedSolution` when candidates exist but none verifies,
+    or when no back-end returned a point but infeasibility is not certified (a limit of verimono's solvers).
     """
     # writable copies: back-ends such as DAQP reject read-only buffers (constant parameters are read-only)
     P = np.array(P, float); q = np.array(q, float)
@@ -269,5 +269,25 @@ def solve_qp(P, q, G=None, h=None, A=None, b=None, *, backends=None, scale: floa
                 return z
             reasons.append(label + reason)
     if not got_point:
-        raise InfeasibleStep("no back-end found a feasible point: " + "; ".join(reasons))
+        E = attempts[-1][1]            # every row, in unit-normal form: HiGHS' tolerances apply at any scale
+        if _feasible(E.G, E.h, E.A, E.b, P.shape[0]) is False:
+            raise InfeasibleStep("the constraints admit no point (HiGHS' LP certifies it; the back-ends: "
+                                 + "; ".join(reasons) + ")")
+        # a back-end that returns nothing has not shown infeasibility: without HiGHS' certificate of it, the
+        # failure is verimono's own solvers' (a limit of the harness, never charged to the subject)
+        raise UnverifiedSolution("no back-end returned a point although the constraints are not shown infeasible: "
+                                 + "; ".join(reasons))
     raise UnverifiedSolution("no QP back-end produced a verified solution: " + "; ".join(reasons))
+
+
+def _feasible(G, h, A, b, n: int) -> bool | None:
+    """Whether ``{y : Gy ≤ h, Ay = b}`` has a point, by HiGHS' phase one (``scipy.optimize.linprog`` with a zero
+    objective): ``False`` only on its certificate of infeasibility (status 2), ``True`` when it found a point,
+    ``None`` when it could not tell."""
+    from scipy.optimize import linprog
+
+    try:
+        res = linprog(np.zeros(n), A_ub=G, b_ub=h, A_eq=A, b_eq=b, bounds=[(None, None)] * n, method="highs")
+    except Exception:       # noqa: BLE001 - no certificate either way
+        return None
+    return False if res.status == 2 else (True if res.status == 0 else None)
