@@ -37,7 +37,7 @@ from typing import Sequence
 
 import numpy as np
 
-from .order_fit import ORDER_SLACK, OrderFit, fit_order
+from .order_fit import ASYMPTOTIC_SPREAD, ORDER_SLACK, FinestSlopes, OrderFit, finest_slopes, fit_order
 from .problem import Order
 
 PASSED, FAILED, UNDECIDED = "passed", "failed", "undecided"
@@ -163,20 +163,30 @@ def decide(d: StudyData) -> Decision:
                                    f"within the study's budget{skipped}; give a step range where the errors lie above "
                                    f"{max(fl):.2e}", window=window)
     fit = fit_order(h, e, fl, within=window)
+    fine = finest_slopes(h, e, fl, window)
     win_slopes = slopes[len(slopes) - len(window) + 1:]
+    # erratic slopes (up and down, on at least four refinements) after every refinement the study could make
+    noisy = erratic or (fine.erratic and len(win_slopes) >= 4 and not can_refine)
     note = ""
-    if erratic:
+    if erratic or noisy:
         note = (" (erratic local slopes, coarse to fine: " + ", ".join(f"{s:.2f}" for s in win_slopes)
-                + ": the errors fell short, resumed on a finer grid and fell short again; judged on the fit's interval)")
+                + (": the errors fell short, resumed on a finer grid and fell short again" if erratic else "")
+                + "; judged on the fit's interval)")
     elif paused and window[0] == tail[0]:
         note = (f" (pre-asymptotic: the errors paused at {e[tail[0]]:.3g} (h = {h[tail[0]]:.3g}) and resumed; "
                 f"judged on the {len(window)} grids from there)")
     elif paused:
         note = (f" (the errors paused at {e[tail[0]]:.3g} (h = {h[tail[0]]:.3g}) and resumed, on too few grids to fit "
                 "alone; judged on all)")
-    elif fit.pre_asymptotic:
-        note = " (pre-asymptotic: local slopes, coarse to fine: " + ", ".join(f"{s:.2f}" for s in win_slopes) + ")"
-    if fit.reaches(p) and not (finest_short and not erratic):       # never on a finest refinement falling short
+    at_end = _at_the_end(fine)
+    # never on a finest refinement falling short (unless the slopes are erratic)
+    guard = not (finest_short and not erratic)
+    if guard and fine.reaches(p):
+        # the order at the fine end is said where the fit over the window tells another story
+        said = f"; {at_end}" if fit.pre_asymptotic or abs(fit.slope - fine.slope) > ORDER_SLACK else ""
+        return Decision(PASSED, f"measured {fit}, {what} {p:g}{said}{note}{skipped}", _ratio(p, fine.high),
+                        window, fit)
+    if guard and noisy and not fine.below(p) and _fit_holds(fit, p):
         return Decision(PASSED, f"measured {fit}, {what} {p:g}{note}{skipped}", _ratio(p, fit.high), window, fit)
     if paused and len(tail) < 3 and can_refine:     # the errors resumed after a pause: see them go on
         return Decision(UNDECIDED, "too few grids after the pause: a finer grid needed", action="refine")
@@ -184,14 +194,27 @@ def decide(d: StudyData) -> Decision:
         return _exact(d, e, fl, given, grids, skipped)
     if finest_short and not erratic and win_slopes[-1] < stall_slope:
         return _not_falling(d, h, e, usable, slopes, p, what, skipped, fit, window)
-    if win_slopes[-1] + ORDER_SLACK >= p:
-        # the finest refinement reaches p, the coarser ones lag: pre-asymptotic from below
+    if not fine.below(p):
+        # the interval of the finest slope holds p but is wide: the slopes still move (pre-asymptotic), or are noise
         if can_refine:
-            return Decision(UNDECIDED, "pre-asymptotic from below: a finer grid needed", action="refine")
-        return Decision(UNDECIDED, f"measured {fit} on the grids above {at}, {what} {p:g}, but the finest refinement "
-                                   f"falls at order {win_slopes[-1]:.2f}: pre-asymptotic from below, and no finer grid "
-                                   f"lies above the floor ({_tried(d, grids)}){skipped}", window=window, fit=fit)
-    return _measured_below(d, h, e, fit, window, p, what, win_slopes, stall_slope, skipped)
+            return Decision(UNDECIDED, "the finest local slopes still move: a finer grid needed", action="refine")
+        return Decision(UNDECIDED, f"{at_end}, {what} {p:g}: the local slopes still move, and no finer grid lies "
+                                   f"above the floor within the study's budget ({_tried(d, grids)}); the fit over "
+                                   f"h = {h[window[0]]:.3g} ... {h[window[-1]]:.3g} measures {fit}, which averages the "
+                                   f"coarse end with the fine end{note}{skipped}", window=window, fit=fit)
+    return _measured_below(d, h, e, fit, fine, window, p, what, stall_slope, skipped)
+
+
+def _at_the_end(fine: FinestSlopes) -> str:
+    """The order at the fine end, as a numerical analyst reads it off the local slopes."""
+    return (f"order {fine} at the fine end (local slopes, coarse to fine: "
+            + ", ".join(f"{s:.2f}" for s in fine.slopes[-4:]) + f"; the finest on h {fine.h[0]:.3g} -> {fine.h[1]:.3g})")
+
+
+def _fit_holds(fit: OrderFit, p: float) -> bool:
+    """Erratic slopes (noise, not a trend) are averaged by the fit: its interval reaches ``p`` and its slope lies
+    within ``ASYMPTOTIC_SPREAD`` of it (an interval alone, on four or five noisy grids, reaches almost anything)."""
+    return fit.reaches(p) and fit.slope + ORDER_SLACK >= p - ASYMPTOTIC_SPREAD
 
 
 def shortfall_grids(d: StudyData) -> list[int]:
@@ -236,13 +259,14 @@ def _exact(d: StudyData, e: np.ndarray, fl: np.ndarray, at_floor: Sequence[int],
     return Decision(PASSED, f"errors at round-off on {where}: exceeds every order{aside}{skipped}")
 
 
-def _measured_below(d, h, e, fit, window, p, what, win_slopes, stall_slope, skipped) -> Decision:
-    msg = (f"order {fit.slope:.2f} measured, {p:g} {what} (95% interval {_interval(fit)} on h = {h[window[0]]:.3g} "
-           f"... {h[window[-1]]:.3g}){skipped}")
-    # a fit reaching p is failed only for its finest refinement falling short: the ratio is that refinement's
-    worst = _ratio(p, max(win_slopes[-1], 0.0)) if fit.reaches(p) else _ratio(p, fit.high)
-    decision = Decision(FAILED, msg, worst, window, fit)
-    if win_slopes[-1] < stall_slope:
+def _measured_below(d, h, e, fit, fine, window, p, what, stall_slope, skipped) -> Decision:
+    """The finest local slopes sit below the order, their whole interval below it: the order they show is
+    reported (the fit over the window may still "reach" the order, pre-asymptotic from above)."""
+    msg = (f"order {fine.slope:.2f} measured, {p:g} {what} ({_at_the_end(fine)}: its interval "
+           f"[{fine.low:.2f}, {fine.high:.2f}] lies below {p:g}; fit {fit} on h = {h[window[0]]:.3g} ... "
+           f"{h[window[-1]]:.3g}){skipped}")
+    decision = Decision(FAILED, msg, _ratio(p, fine.high), window, fit)
+    if fine.slope < stall_slope:
         return _unstated_floor(d, e, window[-2:], decision)
     return decision
 
