@@ -94,8 +94,10 @@ def test_an_unstated_inner_solve_floor_is_undecided_and_a_real_stall_fails():
     assert stated.status == FAILED and "State the accuracy" not in stated.message
     stall = decide(data([1e-3] * 5, claimed=1.0))
     assert stall.status == FAILED and "stall" in stall.message and "solve_tol" not in stall.message
-    # the level is relative to the solution's scale: 1e-6 errors on a solution of size 1e4 are a solve's level
-    assert decide(data([2e-4] * 5, scale=1e4 * 1e3)).status == UNDECIDED
+    # the level is relative to the solution's scale: 2e-4 errors on a solution of size 1e3 are a solve's level
+    # (2e-7 of it); on one of size 1e7 (2e-11 of it), flat on every grid, they are a floor: exact to it (issue 42)
+    assert decide(data([2e-4] * 5, scale=1e3)).status == UNDECIDED
+    assert decide(data([2e-4] * 5, scale=1e7)).status == PASSED
 
 
 def test_a_non_finite_error_fails_on_a_given_grid_and_is_left_out_on_an_added_one():

@@ -37,7 +37,8 @@ from typing import Sequence
 
 import numpy as np
 
-from .order_fit import ASYMPTOTIC_SPREAD, ORDER_SLACK, FinestSlopes, OrderFit, finest_slopes, fit_order
+from .order_fit import (ASYMPTOTIC_SPREAD, ORDER_SLACK, FinestSlopes, OrderFit, finest_slopes, fit_order,
+                        least_squares_slope)
 from .problem import Order
 
 PASSED, FAILED, UNDECIDED = "passed", "failed", "undecided"
@@ -51,6 +52,14 @@ STALL_MARGIN = 100.0
 #: errors that stop falling at no more than this fraction of the solution's scale, on the grids where they stop,
 #: are an inner solve's floor the user did not state: undecided with that advice, never failed
 SOLVE_LEVEL = 1e-6
+#: errors flat on every grid (spread by at most ``FLAT_SPAN``, not falling at a quarter of the order) at no more
+#: than this fraction of the solution's scale are a floor — an inner solve's tolerance, rounding accumulated
+#: over many steps —, not a discretisation error: the scheme is exact to that floor (a passing verdict).  A
+#: discretisation error that stays put (a wrong limit) is far above it: 1e-8 is 1e4 times round-off in float64
+#: and below what any step of the catalog's studies leaves to a consistent scheme of order 1 or more
+FLOOR_LEVEL = 1e-8
+#: ... flat: the largest error at most this many times the smallest
+FLAT_SPAN = 10.0
 #: a fit rests on at most this many grids, the finest (the asymptotic range is at the fine end)
 WINDOW = 5
 #: below this many grids above the floor the study coarsens, when it may (grid_design.MIN_GRIDS)
@@ -115,6 +124,8 @@ def decide(d: StudyData) -> Decision:
     if exp.exact:
         worst = max((e[i] for i in grids), default=0.0)
         ok = all(e[i] <= fl[i] for i in grids)
+        if not ok and _flat_floor(d, h, e, fl, grids, None) is not None:
+            return _exact_to_detected(d, h, e, fl, grids, _skipped(d, added, e))
         ratio = max((e[i] / fl[i] for i in grids if fl[i] > 0), default=0.0)
         return Decision(PASSED if ok else FAILED,
                         f"errors at {at} (max {worst:.2e} ≤ floor {max(fl):.2e})" if ok else
@@ -125,6 +136,10 @@ def decide(d: StudyData) -> Decision:
     given = [i for i in grids if i not in added]
     exact_on_given = bool(given) and all(e[i] <= fl[i] for i in given)
     usable = _usable_run(grids, e, fl)
+    if usable and _flat_floor(d, h, e, fl, grids, p) is not None:
+        if d.can_coarsen:
+            return Decision(UNDECIDED, "errors flat at a floor: coarser grids needed", action="coarsen")
+        return _exact_to_detected(d, h, e, fl, grids, skipped)
     if not usable:
         if d.can_coarsen:
             return Decision(UNDECIDED, "every error at the floor: coarser grids needed", action="coarsen")
@@ -164,9 +179,16 @@ def decide(d: StudyData) -> Decision:
                                    f"{max(fl):.2e}", window=window)
     fit = fit_order(h, e, fl, within=window)
     fine = finest_slopes(h, e, fl, window)
+    if paused:
+        # after a pause the errors resume at the order, or catch up with it first (a pause and the refinement after
+        # it then merge into one at the order): the reading whose slopes agree best
+        paused_at = {usable[j + 1] for j in short} - {usable[-1]}
+        steady = [i for i in usable if i not in paused_at]
+        if len(steady) >= 3:
+            fine = min(fine, finest_slopes(h, e, fl, steady[-WINDOW:]), key=lambda f: f.spread)
     win_slopes = slopes[len(slopes) - len(window) + 1:]
     # erratic slopes (up and down, on at least four refinements) after every refinement the study could make
-    noisy = erratic or (fine.erratic and len(win_slopes) >= 4 and not can_refine)
+    noisy = len(window) >= 4 and (erratic or (fine.erratic and len(fine.slopes) >= 4 and not can_refine))
     note = ""
     if erratic or noisy:
         note = (" (erratic local slopes, coarse to fine: " + ", ".join(f"{s:.2f}" for s in win_slopes)
@@ -257,6 +279,37 @@ def _exact(d: StudyData, e: np.ndarray, fl: np.ndarray, at_floor: Sequence[int],
         return Decision(PASSED, f"exact to the stated solve tolerance {d.solve_tol:g}: every error at its floor on "
                                 f"{where} (max {max(e[i] for i in at_floor):.2e} ≤ {max(fl):.2e}){aside}{skipped}")
     return Decision(PASSED, f"errors at round-off on {where}: exceeds every order{aside}{skipped}")
+
+
+def _flat_floor(d: StudyData, h: np.ndarray, e: np.ndarray, fl: np.ndarray, grids: Sequence[int],
+                p: float | None) -> float | None:
+    """The level of a floor the errors sit at on every grid (``FLOOR_LEVEL``), or ``None``: at least three grids,
+    every error at most ``FLOOR_LEVEL`` of the solution's scale, spread by at most ``FLAT_SPAN``, and (for an order
+    ``p``) not falling at ``SHORTFALL · min(p, 1)`` (errors at or below their round-off floor count as that floor)."""
+    if len(grids) < 3:
+        return None
+    v = np.array([max(float(e[i]), float(fl[i])) for i in grids])
+    top = float(v.max())
+    if not (0.0 < top <= FLOOR_LEVEL * max(d.scale, 1e-300)) or top > FLAT_SPAN * float(v.min()):
+        return None
+    if p is not None:
+        slope, _ = least_squares_slope(np.log(h[list(grids)]), np.log(v))
+        if slope >= SHORTFALL * min(p, 1.0):
+            return None
+    return top
+
+
+def _exact_to_detected(d: StudyData, h: np.ndarray, e: np.ndarray, fl: np.ndarray, grids: Sequence[int],
+                       skipped: str) -> Decision:
+    """Every error flat at a floor the user did not state (:func:`_flat_floor`): exact to it, said as such."""
+    v = [max(float(e[i]), float(fl[i])) for i in grids]
+    top, low = max(v), min(v)
+    said = ("above the stated solve tolerance's" if d.solve_tol else "a floor nobody stated")
+    return Decision(PASSED, f"exact to the floor: the errors stay flat at {low:.2e} to {top:.2e} (at most "
+                            f"{top / max(d.scale, 1e-300):.1g} of the solution's scale {d.scale:.3g}) on every grid down "
+                            f"to K = {d.steps[grids[0]]} cells, {said} — the level of an inner solve's tolerance or of "
+                            "rounding, not of a discretisation (state it: verimono.Stepper(..., solve_tol=tau), verimono "
+                            f"check --solve-tol tau){skipped}", 0.0)
 
 
 def _measured_below(d, h, e, fit, fine, window, p, what, stall_slope, skipped) -> Decision:
@@ -356,4 +409,4 @@ def _skipped(d: StudyData, added: set, e: np.ndarray) -> str:
 
 
 __all__ = ["Decision", "StudyData", "decide", "shortfall_grids", "PASSED", "FAILED", "UNDECIDED", "SHORTFALL", "STALL_FRACTION",
-           "STALL_MARGIN", "SOLVE_LEVEL", "WINDOW", "MIN_GRIDS"]
+           "STALL_MARGIN", "SOLVE_LEVEL", "FLOOR_LEVEL", "FLAT_SPAN", "WINDOW", "MIN_GRIDS"]
