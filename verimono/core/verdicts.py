@@ -17,14 +17,22 @@ between successive usable grids.
   the stepper fails ("the errors stall at 4.69e-3 over the last 3 refinements"); if the errors resume, the pause
   was pre-asymptotic and the verdict rests on the grids after it; if no finer grid could be tried (fixed grids,
   a step range), it is undecided.  "Reaches" never rests on a finest local slope near 0.
-* **The fit** — on the usable grids after the last shortfall (the finest ``WINDOW`` of them): it passes when its
-  95% interval reaches ``p`` (:meth:`OrderFit.reaches`); else the measured order is reported as such ("order 1.00
-  measured, 5 claimed") — unless its finest local slope does reach ``p`` (pre-asymptotic from below), when the
-  study refines, and without a finer grid above the floor the verdict is undecided.
-* **A floor nobody stated** — errors that stop falling at no more than ``SOLVE_LEVEL`` times the solution's scale
-  are the mark of an inner solve's tolerance, not of a discretisation: without a stated ``solve_tol`` the verdict
-  is *undecided* with the advice to state it (``Stepper(..., solve_tol=τ)``, ``verimono check --solve-tol τ``),
-  never failed; a stall well above that level still fails.
+* **The order at the fine end** — a claimed order is met only when the finest local slopes reach it
+  (:func:`verimono.core.order_fit.finest_slopes`, on the usable grids after the last shortfall, the finest
+  ``WINDOW`` of them): the finest slope the floor cannot move, with an interval of its drift (where the slopes
+  follow a trend, how far they can still move) and its scatter (how far they jump).  Passed when the interval
+  reaches ``p`` (its lower end, or its upper end once the slopes have settled); failed when it lies below ``p``
+  and the two finest slopes lie ``FAIL_MARGIN · min(p, 1)`` below it ("order 2.03 measured, 3 claimed": a scheme
+  of order ``q`` claimed as ``q + 1``); in between the slopes still move — the study refines, and without a finer
+  grid the verdict is undecided.  A fit over the window averages the coarse end with the fine end (local slopes
+  3.50, 2.14, 2.03 fit as 2.46 [1.46, 3.46], which passed a claim of 3): it is reported, and decides only for
+  erratic slopes (noise, on at least four refinements, after every refinement the study could make).
+* **Exact to a floor nobody stated** — errors flat on every grid (``FLAT_SPAN``) at no more than ``FLOOR_LEVEL``
+  of the solution's scale are an inner solve's tolerance or rounding: exact to that floor, a pass said as such.
+* **A floor nobody stated, reached** — errors that stop falling at no more than ``SOLVE_LEVEL`` times the
+  solution's scale (not flat on every grid) are the mark of an inner solve's tolerance, not of a discretisation:
+  without a stated ``solve_tol`` the verdict is *undecided* with the advice to state it (``Stepper(...,
+  solve_tol=τ)``, ``verimono check --solve-tol τ``), never failed; a stall well above that level still fails.
 * A non-finite error on a grid the study was given fails (the stepper diverged); on a grid it added itself it is
   left out (an explicit scheme outside its stability region at ``K = 2``).
 """
@@ -220,8 +228,9 @@ def decide(d: StudyData) -> Decision:
         # the interval of the finest slope holds p but is wide: the slopes still move (pre-asymptotic), or are noise
         if can_refine:
             return Decision(UNDECIDED, "the finest local slopes still move: a finer grid needed", action="refine")
-        return Decision(UNDECIDED, f"{at_end}, {what} {p:g}: the local slopes still move, and no finer grid lies "
-                                   f"above the floor within the study's budget ({_tried(d, grids)}); the fit over "
+        return Decision(UNDECIDED, f"{at_end}, {what} {p:g}: the local slopes still move, and no finer grid could "
+                                   "be tried (fixed grids, the end of the step range or of the study's budget, or the "
+                                   f"floor: {_tried(d, grids)}); the fit over "
                                    f"h = {h[window[0]]:.3g} ... {h[window[-1]]:.3g} measures {fit}, which averages the "
                                    f"coarse end with the fine end{note}{skipped}", window=window, fit=fit)
     return _measured_below(d, h, e, fit, fine, window, p, what, stall_slope, skipped)
@@ -304,7 +313,8 @@ def _exact_to_detected(d: StudyData, h: np.ndarray, e: np.ndarray, fl: np.ndarra
     """Every error flat at a floor the user did not state (:func:`_flat_floor`): exact to it, said as such."""
     v = [max(float(e[i]), float(fl[i])) for i in grids]
     top, low = max(v), min(v)
-    said = ("above the stated solve tolerance's" if d.solve_tol else "a floor nobody stated")
+    said = (f"above the floor its stated solve tolerance {d.solve_tol:g} sets" if d.solve_tol else
+            "a floor nobody stated")
     return Decision(PASSED, f"exact to the floor: the errors stay flat at {low:.2e} to {top:.2e} (at most "
                             f"{top / max(d.scale, 1e-300):.1g} of the solution's scale {d.scale:.3g}) on every grid down "
                             f"to K = {d.steps[grids[0]]} cells, {said} — the level of an inner solve's tolerance or of "
