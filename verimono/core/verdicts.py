@@ -198,11 +198,10 @@ def decide(d: StudyData) -> Decision:
     # erratic slopes (up and down, on at least four refinements) after every refinement the study could make
     noisy = len(window) >= 4 and (erratic or (fine.erratic and len(fine.slopes) >= 4 and not can_refine))
     note = ""
-    if erratic or noisy:
-        note = (" (erratic local slopes, coarse to fine: " + ", ".join(f"{s:.2f}" for s in win_slopes)
-                + (": the errors fell short, resumed on a finer grid and fell short again" if erratic else "")
-                + "; judged on the fit's interval)")
-    elif paused and window[0] == tail[0]:
+    noise = (" (erratic local slopes, coarse to fine: " + ", ".join(f"{s:.2f}" for s in win_slopes)
+             + (": the errors fell short, resumed on a finer grid and fell short again" if erratic else "")
+             + "; judged on the fit's interval)")
+    if paused and window[0] == tail[0]:
         note = (f" (pre-asymptotic: the errors paused at {e[tail[0]]:.3g} (h = {h[tail[0]]:.3g}) and resumed; "
                 f"judged on the {len(window)} grids from there)")
     elif paused:
@@ -217,7 +216,7 @@ def decide(d: StudyData) -> Decision:
         return Decision(PASSED, f"measured {fit}, {what} {p:g}{said}{note}{skipped}", _ratio(p, fine.high),
                         window, fit)
     if guard and noisy and not fine.below(p) and _fit_holds(fit, p):
-        return Decision(PASSED, f"measured {fit}, {what} {p:g}{note}{skipped}", _ratio(p, fit.high), window, fit)
+        return Decision(PASSED, f"measured {fit}, {what} {p:g}{noise}{skipped}", _ratio(p, fit.high), window, fit)
     if paused and len(tail) < 3 and can_refine:     # the errors resumed after a pause: see them go on
         return Decision(UNDECIDED, "too few grids after the pause: a finer grid needed", action="refine")
     if exact_on_given:          # never failed on the coarse grids the study added below exact ones
@@ -232,7 +231,8 @@ def decide(d: StudyData) -> Decision:
                                    "be tried (fixed grids, the end of the step range or of the study's budget, or the "
                                    f"floor: {_tried(d, grids)}); the fit over "
                                    f"h = {h[window[0]]:.3g} ... {h[window[-1]]:.3g} measures {fit}, which averages the "
-                                   f"coarse end with the fine end{note}{skipped}", window=window, fit=fit)
+                                   f"coarse end with the fine end{noise if noisy else note}{skipped}", window=window,
+                                   fit=fit)
     return _measured_below(d, h, e, fit, fine, window, p, what, stall_slope, skipped)
 
 
