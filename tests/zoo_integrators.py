@@ -47,6 +47,40 @@ def heun_on_grid(problem, t_grid, *, bug=None):
     return np.array(out)
 
 
+def explicit_rk_on_grid(problem, t_grid, A, b, c):
+    """The explicit Runge–Kutta scheme of Butcher tableau ``(A, b, c)`` (``A`` strictly lower triangular, as rows),
+    one step per cell, on the single-valued right-hand side as :func:`heun_on_grid`."""
+    rhs = _rhs(problem)
+    x = np.array(problem.x0, dtype=float)
+    out = [x]
+    for k in range(len(t_grid) - 1):
+        t, h = t_grid[k], t_grid[k + 1] - t_grid[k]
+        stages = []
+        for ci, ai in zip(c, A):
+            y = x + h * sum(aij * kj for aij, kj in zip(ai, stages)) if ai else x
+            stages.append(rhs(t + ci * h, y))
+        x = x + h * sum(bi * ki for bi, ki in zip(b, stages))
+        out.append(x)
+    return np.array(out)
+
+
+def bosh3_on_grid(problem, t_grid):
+    """Bogacki–Shampine's three-stage explicit scheme of order 3 (its propagated solution, without the embedded
+    order-2 estimate): P. Bogacki, L. F. Shampine, Appl. Math. Lett. 2 (1989) 321–325."""
+    return explicit_rk_on_grid(problem, t_grid, [[], [0.5], [0.0, 0.75]], [2 / 9, 1 / 3, 4 / 9], [0.0, 0.5, 0.75])
+
+
+def rk4_on_grid(problem, t_grid):
+    """The classical four-stage Runge–Kutta scheme of order 4."""
+    return explicit_rk_on_grid(problem, t_grid, [[], [0.5], [0.0, 0.5], [0.0, 0.0, 1.0]],
+                               [1 / 6, 1 / 3, 1 / 3, 1 / 6], [0.0, 0.5, 0.5, 1.0])
+
+
+def euler_on_grid(problem, t_grid):
+    """Explicit Euler, order 1."""
+    return explicit_rk_on_grid(problem, t_grid, [[]], [1.0], [0.0])
+
+
 heun = vm.Stepper(heun_on_grid, scheme="any", order=2, name="heun")
 heun_stage_half = vm.Stepper(lambda p, t: heun_on_grid(p, t, bug="stage_half"), scheme="any", order=2,
                              name="heun (stage with h/2)")

@@ -4,6 +4,8 @@ seen deciding both ways, independently of any stepper."""
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -94,8 +96,10 @@ def test_an_unstated_inner_solve_floor_is_undecided_and_a_real_stall_fails():
     assert stated.status == FAILED and "State the accuracy" not in stated.message
     stall = decide(data([1e-3] * 5, claimed=1.0))
     assert stall.status == FAILED and "stall" in stall.message and "solve_tol" not in stall.message
-    # the level is relative to the solution's scale: 1e-6 errors on a solution of size 1e4 are a solve's level
-    assert decide(data([2e-4] * 5, scale=1e4 * 1e3)).status == UNDECIDED
+    # the level is relative to the solution's scale: 2e-4 errors on a solution of size 1e3 are a solve's level
+    # (2e-7 of it); on one of size 1e7 (2e-11 of it), flat on every grid, they are a floor: exact to it (issue 42)
+    assert decide(data([2e-4] * 5, scale=1e3)).status == UNDECIDED
+    assert decide(data([2e-4] * 5, scale=1e7)).status == PASSED
 
 
 def test_a_non_finite_error_fails_on_a_given_grid_and_is_left_out_on_an_added_one():
@@ -104,3 +108,73 @@ def test_a_non_finite_error_fails_on_a_given_grid_and_is_left_out_on_an_added_on
     assert decide(data(e, 5.0, ratio=1.5, K0=2)).status == FAILED
     kept = decide(data(e, 5.0, ratio=1.5, K0=2, added=[0]))
     assert kept.status == PASSED, kept.message
+
+
+def _from_slopes(slopes, e0=1e-2, ratio=2.0):
+    """Errors on grids refined by ``ratio`` whose local slopes are ``slopes``, coarse to fine."""
+    e = [e0]
+    for s in slopes:
+        e.append(e[-1] * ratio ** -s)
+    return e
+
+
+def test_the_users_slopes_meet_only_the_order_they_sit_at():
+    """Local slopes 3.50, 2.14, 2.03 (Heun, issue 42): the fit over them is 2.46 with an interval up to 3.46, and it
+    passed a claim of 3.  The finest slopes sit at 2: claimed 3 fails, naming 2.03; claimed 2 passes."""
+    e = _from_slopes([3.50, 2.14, 2.03])
+    three = decide(data(e, 3.0, claimed=3.0))
+    assert three.status == FAILED and "order 2.03 measured, 3 claimed" in three.message, three.message
+    assert three.worst > 1.0 and three.fit.reaches(3.0)          # the fit alone would have passed it
+    assert decide(data(e, 3.0, claimed=3.0, can_refine=True)).status == FAILED     # settled: nothing to refine
+    two = decide(data(e, 2.0, claimed=2.0))
+    assert two.status == PASSED and two.worst <= 1.0, two.message
+
+
+def test_slopes_still_moving_are_refined_then_undecided():
+    """Slopes 4.0, 3.4, 2.9 claimed 3: falling by half an order per refinement, nobody can say where they stop.
+    The study refines; without a finer grid it is undecided.  Refined: settled at 2.95 passes, at 2.0 fails."""
+    e = _from_slopes([4.0, 3.4, 2.9])
+    assert decide(data(e, 3.0, claimed=3.0, can_refine=True)).action == "refine"
+    fixed = decide(data(e, 3.0, claimed=3.0))
+    assert fixed.status == UNDECIDED and "still move" in fixed.message, fixed.message
+    assert decide(data(_from_slopes([4.0, 3.4, 2.9, 2.95]), 3.0, claimed=3.0, refined=1)).status == PASSED
+    assert decide(data(_from_slopes([4.0, 3.4, 2.9, 2.1, 2.02]), 3.0, claimed=3.0, refined=2)).status == FAILED
+
+
+@pytest.mark.parametrize("q", [0.5, 1.0, 2.0, 3.0, 4.0])
+def test_a_claim_one_order_up_never_passes_on_pre_asymptotic_power_laws(q):
+    """Errors ``0.3 h^q (1 + D (h/h_0)^m)`` on 3 to 6 grids refined by 2 or 1.5, the leading term dominant at the
+    finest grid (``|D| (h_n/h_0)^m ≤ 1/2``), fixed grids: claimed ``q + 1`` never passes (43 of these 185 passed
+    before), claimed ``q`` never fails."""
+    seen = {True: set(), False: set()}
+    for ratio, n, D, m in itertools.product([2.0, 1.5], [3, 4, 6], [-0.3, 0.3, 2.0, 20.0], [1, 2]):
+        h = np.array([1.0 / (4 * ratio ** i) for i in range(n)])
+        if abs(D) * (h[-1] / h[0]) ** m > 0.5:
+            continue
+        e = 0.3 * h ** q * (1.0 + D * (h / h[0]) ** m)
+        for claim in (q, q + 1):
+            d = decide(StudyData(h.tolist(), [round(1 / x) for x in h], e.tolist(), [FLOOR] * n, Order(claim, "t"),
+                                 claimed=claim, refined=2))
+            seen[claim == q].add(d.status)
+            assert d.status != (FAILED if claim == q else PASSED), (ratio, n, D, m, claim, d.message)
+    assert PASSED in seen[True] and FAILED in seen[False]
+
+
+def test_errors_flat_at_a_floor_on_every_grid_are_exact_to_it_and_a_constant_error_fails():
+    """The user's case (issue 42): an integrator exact at the nodes up to a Newton solve's floor, errors 7.9e-11 ->
+    3.2e-11 across the grids, failed as "order 0.31 measured".  Flat errors at no more than 1e-8 of the solution's
+    scale are a floor: exact to it.  The same shape at 1e-3 (a wrong limit) fails; the study coarsens first."""
+    user = np.geomspace(7.9e-11, 3.2e-11, 5)
+    d = decide(data(user, 2.0, claimed=2.0))
+    assert d.status == PASSED and "exact to the floor" in d.message and d.worst == 0.0, d.message
+    noise = 1e-10 * (1.0 + 0.3 * np.random.default_rng(42).random(6))
+    assert decide(data(noise, 2.0, claimed=2.0)).status == PASSED
+    assert decide(data(noise, 2.0, claimed=2.0, can_coarsen=True)).action == "coarsen"
+    for wrong in (user * 1e7 / 7.9, noise * 1e7):       # the same shapes at 1e-3
+        bad = decide(data(wrong, 2.0, claimed=2.0))
+        assert bad.status == FAILED, bad.message
+    # at 1e-7 of the scale a flat error is no floor of round-off or of a tight solve: undecided with the advice
+    assert decide(data(noise * 1e3, 2.0, claimed=2.0)).status == UNDECIDED
+    # falling at the order it claims, tiny errors are no floor: a scheme of order 1 claimed 2 at 1e-10 fails
+    tiny = 1e-9 * np.array([1.0 / 2 ** k for k in range(5)])
+    assert decide(data(tiny, 2.0, claimed=2.0)).status == FAILED

@@ -17,14 +17,22 @@ between successive usable grids.
   the stepper fails ("the errors stall at 4.69e-3 over the last 3 refinements"); if the errors resume, the pause
   was pre-asymptotic and the verdict rests on the grids after it; if no finer grid could be tried (fixed grids,
   a step range), it is undecided.  "Reaches" never rests on a finest local slope near 0.
-* **The fit** — on the usable grids after the last shortfall (the finest ``WINDOW`` of them): it passes when its
-  95% interval reaches ``p`` (:meth:`OrderFit.reaches`); else the measured order is reported as such ("order 1.00
-  measured, 5 claimed") — unless its finest local slope does reach ``p`` (pre-asymptotic from below), when the
-  study refines, and without a finer grid above the floor the verdict is undecided.
-* **A floor nobody stated** — errors that stop falling at no more than ``SOLVE_LEVEL`` times the solution's scale
-  are the mark of an inner solve's tolerance, not of a discretisation: without a stated ``solve_tol`` the verdict
-  is *undecided* with the advice to state it (``Stepper(..., solve_tol=τ)``, ``verimono check --solve-tol τ``),
-  never failed; a stall well above that level still fails.
+* **The order at the fine end** — a claimed order is met only when the finest local slopes reach it
+  (:func:`verimono.core.order_fit.finest_slopes`, on the usable grids after the last shortfall, the finest
+  ``WINDOW`` of them): the finest slope the floor cannot move, with an interval of its drift (where the slopes
+  follow a trend, how far they can still move) and its scatter (how far they jump).  Passed when the interval
+  reaches ``p`` (its lower end, or its upper end once the slopes have settled); failed when it lies below ``p``
+  and the two finest slopes lie ``FAIL_MARGIN · min(p, 1)`` below it ("order 2.03 measured, 3 claimed": a scheme
+  of order ``q`` claimed as ``q + 1``); in between the slopes still move — the study refines, and without a finer
+  grid the verdict is undecided.  A fit over the window averages the coarse end with the fine end (local slopes
+  3.50, 2.14, 2.03 fit as 2.46 [1.46, 3.46], which passed a claim of 3): it is reported, and decides only for
+  erratic slopes (noise, on at least four refinements, after every refinement the study could make).
+* **Exact to a floor nobody stated** — errors flat on every grid (``FLAT_SPAN``) at no more than ``FLOOR_LEVEL``
+  of the solution's scale are an inner solve's tolerance or rounding: exact to that floor, a pass said as such.
+* **A floor nobody stated, reached** — errors that stop falling at no more than ``SOLVE_LEVEL`` times the
+  solution's scale (not flat on every grid) are the mark of an inner solve's tolerance, not of a discretisation:
+  without a stated ``solve_tol`` the verdict is *undecided* with the advice to state it (``Stepper(...,
+  solve_tol=τ)``, ``verimono check --solve-tol τ``), never failed; a stall well above that level still fails.
 * A non-finite error on a grid the study was given fails (the stepper diverged); on a grid it added itself it is
   left out (an explicit scheme outside its stability region at ``K = 2``).
 """
@@ -37,7 +45,8 @@ from typing import Sequence
 
 import numpy as np
 
-from .order_fit import ORDER_SLACK, OrderFit, fit_order
+from .order_fit import (ASYMPTOTIC_SPREAD, ORDER_SLACK, FinestSlopes, OrderFit, finest_slopes, fit_order,
+                        least_squares_slope)
 from .problem import Order
 
 PASSED, FAILED, UNDECIDED = "passed", "failed", "undecided"
@@ -51,6 +60,14 @@ STALL_MARGIN = 100.0
 #: errors that stop falling at no more than this fraction of the solution's scale, on the grids where they stop,
 #: are an inner solve's floor the user did not state: undecided with that advice, never failed
 SOLVE_LEVEL = 1e-6
+#: errors flat on every grid (spread by at most ``FLAT_SPAN``, not falling at a quarter of the order) at no more
+#: than this fraction of the solution's scale are a floor — an inner solve's tolerance, rounding accumulated
+#: over many steps —, not a discretisation error: the scheme is exact to that floor (a passing verdict).  A
+#: discretisation error that stays put (a wrong limit) is far above it: 1e-8 is 1e4 times round-off in float64
+#: and below what any step of the catalog's studies leaves to a consistent scheme of order 1 or more
+FLOOR_LEVEL = 1e-8
+#: ... flat: the largest error at most this many times the smallest
+FLAT_SPAN = 10.0
 #: a fit rests on at most this many grids, the finest (the asymptotic range is at the fine end)
 WINDOW = 5
 #: below this many grids above the floor the study coarsens, when it may (grid_design.MIN_GRIDS)
@@ -115,6 +132,8 @@ def decide(d: StudyData) -> Decision:
     if exp.exact:
         worst = max((e[i] for i in grids), default=0.0)
         ok = all(e[i] <= fl[i] for i in grids)
+        if not ok and _flat_floor(d, h, e, fl, grids, None) is not None:
+            return _exact_to_detected(d, h, e, fl, grids, _skipped(d, added, e))
         ratio = max((e[i] / fl[i] for i in grids if fl[i] > 0), default=0.0)
         return Decision(PASSED if ok else FAILED,
                         f"errors at {at} (max {worst:.2e} ≤ floor {max(fl):.2e})" if ok else
@@ -125,6 +144,10 @@ def decide(d: StudyData) -> Decision:
     given = [i for i in grids if i not in added]
     exact_on_given = bool(given) and all(e[i] <= fl[i] for i in given)
     usable = _usable_run(grids, e, fl)
+    if usable and _flat_floor(d, h, e, fl, grids, p) is not None:
+        if d.can_coarsen:
+            return Decision(UNDECIDED, "errors flat at a floor: coarser grids needed", action="coarsen")
+        return _exact_to_detected(d, h, e, fl, grids, skipped)
     if not usable:
         if d.can_coarsen:
             return Decision(UNDECIDED, "every error at the floor: coarser grids needed", action="coarsen")
@@ -163,35 +186,66 @@ def decide(d: StudyData) -> Decision:
                                    f"within the study's budget{skipped}; give a step range where the errors lie above "
                                    f"{max(fl):.2e}", window=window)
     fit = fit_order(h, e, fl, within=window)
+    fine = finest_slopes(h, e, fl, window)
+    if paused:
+        # after a pause the errors resume at the order, or catch up with it first (a pause and the refinement after
+        # it then merge into one at the order): the reading whose slopes agree best
+        paused_at = {usable[j + 1] for j in short} - {usable[-1]}
+        steady = [i for i in usable if i not in paused_at]
+        if len(steady) >= 3:
+            fine = min(fine, finest_slopes(h, e, fl, steady[-WINDOW:]), key=lambda f: f.spread)
     win_slopes = slopes[len(slopes) - len(window) + 1:]
+    # erratic slopes (up and down, on at least four refinements) after every refinement the study could make
+    noisy = len(window) >= 4 and (erratic or (fine.erratic and len(fine.slopes) >= 4 and not can_refine))
     note = ""
-    if erratic:
-        note = (" (erratic local slopes, coarse to fine: " + ", ".join(f"{s:.2f}" for s in win_slopes)
-                + ": the errors fell short, resumed on a finer grid and fell short again; judged on the fit's interval)")
-    elif paused and window[0] == tail[0]:
+    noise = (" (erratic local slopes, coarse to fine: " + ", ".join(f"{s:.2f}" for s in win_slopes)
+             + (": the errors fell short, resumed on a finer grid and fell short again" if erratic else "")
+             + "; judged on the fit's interval)")
+    if paused and window[0] == tail[0]:
         note = (f" (pre-asymptotic: the errors paused at {e[tail[0]]:.3g} (h = {h[tail[0]]:.3g}) and resumed; "
                 f"judged on the {len(window)} grids from there)")
     elif paused:
         note = (f" (the errors paused at {e[tail[0]]:.3g} (h = {h[tail[0]]:.3g}) and resumed, on too few grids to fit "
                 "alone; judged on all)")
-    elif fit.pre_asymptotic:
-        note = " (pre-asymptotic: local slopes, coarse to fine: " + ", ".join(f"{s:.2f}" for s in win_slopes) + ")"
-    if fit.reaches(p) and not (finest_short and not erratic):       # never on a finest refinement falling short
-        return Decision(PASSED, f"measured {fit}, {what} {p:g}{note}{skipped}", _ratio(p, fit.high), window, fit)
+    at_end = _at_the_end(fine)
+    # never on a finest refinement falling short (unless the slopes are erratic)
+    guard = not (finest_short and not erratic)
+    if guard and fine.reaches(p):
+        # the order at the fine end is said where the fit over the window tells another story
+        said = f"; {at_end}" if fit.pre_asymptotic or abs(fit.slope - fine.slope) > ORDER_SLACK else ""
+        return Decision(PASSED, f"measured {fit}, {what} {p:g}{said}{note}{skipped}", _ratio(p, fine.high),
+                        window, fit)
+    if guard and noisy and not fine.below(p) and _fit_holds(fit, p):
+        return Decision(PASSED, f"measured {fit}, {what} {p:g}{noise}{skipped}", _ratio(p, fit.high), window, fit)
     if paused and len(tail) < 3 and can_refine:     # the errors resumed after a pause: see them go on
         return Decision(UNDECIDED, "too few grids after the pause: a finer grid needed", action="refine")
     if exact_on_given:          # never failed on the coarse grids the study added below exact ones
         return _exact(d, e, fl, given, grids, skipped)
     if finest_short and not erratic and win_slopes[-1] < stall_slope:
         return _not_falling(d, h, e, usable, slopes, p, what, skipped, fit, window)
-    if win_slopes[-1] + ORDER_SLACK >= p:
-        # the finest refinement reaches p, the coarser ones lag: pre-asymptotic from below
+    if not fine.below(p):
+        # the interval of the finest slope holds p but is wide: the slopes still move (pre-asymptotic), or are noise
         if can_refine:
-            return Decision(UNDECIDED, "pre-asymptotic from below: a finer grid needed", action="refine")
-        return Decision(UNDECIDED, f"measured {fit} on the grids above {at}, {what} {p:g}, but the finest refinement "
-                                   f"falls at order {win_slopes[-1]:.2f}: pre-asymptotic from below, and no finer grid "
-                                   f"lies above the floor ({_tried(d, grids)}){skipped}", window=window, fit=fit)
-    return _measured_below(d, h, e, fit, window, p, what, win_slopes, stall_slope, skipped)
+            return Decision(UNDECIDED, "the finest local slopes still move: a finer grid needed", action="refine")
+        return Decision(UNDECIDED, f"{at_end}, {what} {p:g}: the local slopes still move, and no finer grid could "
+                                   "be tried (fixed grids, the end of the step range or of the study's budget, or the "
+                                   f"floor: {_tried(d, grids)}); the fit over "
+                                   f"h = {h[window[0]]:.3g} ... {h[window[-1]]:.3g} measures {fit}, which averages the "
+                                   f"coarse end with the fine end{noise if noisy else note}{skipped}", window=window,
+                                   fit=fit)
+    return _measured_below(d, h, e, fit, fine, window, p, what, stall_slope, skipped)
+
+
+def _at_the_end(fine: FinestSlopes) -> str:
+    """The order at the fine end, as a numerical analyst reads it off the local slopes."""
+    return (f"order {fine} at the fine end (local slopes, coarse to fine: "
+            + ", ".join(f"{s:.2f}" for s in fine.slopes[-4:]) + f"; the finest on h {fine.h[0]:.3g} -> {fine.h[1]:.3g})")
+
+
+def _fit_holds(fit: OrderFit, p: float) -> bool:
+    """Erratic slopes (noise, not a trend) are averaged by the fit: its interval reaches ``p`` and its slope lies
+    within ``ASYMPTOTIC_SPREAD`` of it (an interval alone, on four or five noisy grids, reaches almost anything)."""
+    return fit.reaches(p) and fit.slope + ORDER_SLACK >= p - ASYMPTOTIC_SPREAD
 
 
 def shortfall_grids(d: StudyData) -> list[int]:
@@ -236,13 +290,46 @@ def _exact(d: StudyData, e: np.ndarray, fl: np.ndarray, at_floor: Sequence[int],
     return Decision(PASSED, f"errors at round-off on {where}: exceeds every order{aside}{skipped}")
 
 
-def _measured_below(d, h, e, fit, window, p, what, win_slopes, stall_slope, skipped) -> Decision:
-    msg = (f"order {fit.slope:.2f} measured, {p:g} {what} (95% interval {_interval(fit)} on h = {h[window[0]]:.3g} "
-           f"... {h[window[-1]]:.3g}){skipped}")
-    # a fit reaching p is failed only for its finest refinement falling short: the ratio is that refinement's
-    worst = _ratio(p, max(win_slopes[-1], 0.0)) if fit.reaches(p) else _ratio(p, fit.high)
-    decision = Decision(FAILED, msg, worst, window, fit)
-    if win_slopes[-1] < stall_slope:
+def _flat_floor(d: StudyData, h: np.ndarray, e: np.ndarray, fl: np.ndarray, grids: Sequence[int],
+                p: float | None) -> float | None:
+    """The level of a floor the errors sit at on every grid (``FLOOR_LEVEL``), or ``None``: at least three grids,
+    every error at most ``FLOOR_LEVEL`` of the solution's scale, spread by at most ``FLAT_SPAN``, and (for an order
+    ``p``) not falling at ``SHORTFALL · min(p, 1)`` (errors at or below their round-off floor count as that floor)."""
+    if len(grids) < 3:
+        return None
+    v = np.array([max(float(e[i]), float(fl[i])) for i in grids])
+    top = float(v.max())
+    if not (0.0 < top <= FLOOR_LEVEL * max(d.scale, 1e-300)) or top > FLAT_SPAN * float(v.min()):
+        return None
+    if p is not None:
+        slope, _ = least_squares_slope(np.log(h[list(grids)]), np.log(v))
+        if slope >= SHORTFALL * min(p, 1.0):
+            return None
+    return top
+
+
+def _exact_to_detected(d: StudyData, h: np.ndarray, e: np.ndarray, fl: np.ndarray, grids: Sequence[int],
+                       skipped: str) -> Decision:
+    """Every error flat at a floor the user did not state (:func:`_flat_floor`): exact to it, said as such."""
+    v = [max(float(e[i]), float(fl[i])) for i in grids]
+    top, low = max(v), min(v)
+    said = (f"above the floor its stated solve tolerance {d.solve_tol:g} sets" if d.solve_tol else
+            "a floor nobody stated")
+    return Decision(PASSED, f"exact to the floor: the errors stay flat at {low:.2e} to {top:.2e} (at most "
+                            f"{top / max(d.scale, 1e-300):.1g} of the solution's scale {d.scale:.3g}) on every grid down "
+                            f"to K = {d.steps[grids[0]]} cells, {said} — the level of an inner solve's tolerance or of "
+                            "rounding, not of a discretisation (state it: verimono.Stepper(..., solve_tol=tau), verimono "
+                            f"check --solve-tol tau){skipped}", 0.0)
+
+
+def _measured_below(d, h, e, fit, fine, window, p, what, stall_slope, skipped) -> Decision:
+    """The finest local slopes sit below the order, their whole interval below it: the order they show is
+    reported (the fit over the window may still "reach" the order, pre-asymptotic from above)."""
+    msg = (f"order {fine.slope:.2f} measured, {p:g} {what} ({_at_the_end(fine)}: its interval "
+           f"[{fine.low:.2f}, {fine.high:.2f}] lies below {p:g}; fit {fit} on h = {h[window[0]]:.3g} ... "
+           f"{h[window[-1]]:.3g}){skipped}")
+    decision = Decision(FAILED, msg, _ratio(p, fine.high), window, fit)
+    if fine.slope < stall_slope:
         return _unstated_floor(d, e, window[-2:], decision)
     return decision
 
@@ -332,4 +419,4 @@ def _skipped(d: StudyData, added: set, e: np.ndarray) -> str:
 
 
 __all__ = ["Decision", "StudyData", "decide", "shortfall_grids", "PASSED", "FAILED", "UNDECIDED", "SHORTFALL", "STALL_FRACTION",
-           "STALL_MARGIN", "SOLVE_LEVEL", "WINDOW", "MIN_GRIDS"]
+           "STALL_MARGIN", "SOLVE_LEVEL", "FLOOR_LEVEL", "FLAT_SPAN", "WINDOW", "MIN_GRIDS"]
