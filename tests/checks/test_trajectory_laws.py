@@ -382,6 +382,9 @@ def test_trajectory_immutable_fails_on_shared_buffers_mutated_inputs_and_aliases
     rest = get("static ball, x0 inside")                     # at rest: every grid gives the same values
     assert "memory of problem.x0" in check_trajectory_immutable(at_rest_view, rest).message
     assert "memory of" in check_trajectory_immutable(shared_buffer, rest).message   # same values, one buffer
+    one = {"given": uniform_grid(p.T, steps=8)}             # one partition given: run twice on it
+    assert "memory of the array call 1 returned" in check_trajectory_immutable(shared_buffer, p, grids=one).message
+    assert check_trajectory_immutable(solve, p, grids=one).details["calls"] == 2
     grid_view = lambda problem, t: np.asarray(t)[:, None]    # noqa: E731 - the states in the grid's memory
     assert "memory of t_grid" in check_trajectory_immutable(grid_view, p).message
     # the lawful controls: the same steppers returning a fresh array and leaving their inputs alone

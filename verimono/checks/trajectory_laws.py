@@ -484,8 +484,8 @@ def _shares(a: Any, b: np.ndarray) -> bool:
 @stepper_law("trajectory_immutable", "a returned trajectory is the caller's (issue 42)", over_grids=False)
 def check_trajectory_immutable(stepper: Callable, p: Problem, *, seed: int = 0, grids: Any = None) -> Outcome:
     """A trajectory a stepper returned never changes after later calls, and calling it changes nothing it was
-    given.  The stepper runs on two partitions (the battery's default uniform and random ones, or ``grids``), each
-    a fresh copy, on a copy of the problem (a stepper writing into ``problem.x0`` must not change the battery's
+    given.  The stepper runs on two partitions (the battery's default uniform and random ones, or ``grids``; one
+    given partition is run twice), each a fresh copy, on a copy of the problem (a stepper writing into ``problem.x0`` must not change the battery's
     problem).  It fails when
 
     * the array one call returned changed when a later call ran (one output buffer handed out twice), or two
@@ -502,6 +502,8 @@ def check_trajectory_immutable(stepper: Callable, p: Problem, *, seed: int = 0, 
     Claim: every stepper, whatever it claims.
     """
     parts = list(battery_grids(grids, p, seed).values())
+    if len(parts) == 1:     # one partition given: two calls on it (a buffer handed out twice is shared memory)
+        parts = parts * 2
     q = p.replace(x0=np.array(p.x0, dtype=float))          # the stepper's own copy of the problem
     x0 = q.x0.copy()
     returned: list[tuple[int, Any, Any, np.ndarray]] = []   # (call, value, its memory, a copy of its states)
