@@ -41,7 +41,7 @@ from ..core.stepping import Trajectory
 from ..core.tolerances import DOMAIN_ORDER_SLACK, current_precision, row_tolerances, tolerance
 from ..records.results import FAILED, PASSED, UNDECIDED
 from .core import CONTRACTION_CLAIM, PROXIMAL_CLAIM, Holds, Member, Outcome
-from .partitions import battery_grids, run_stepper, stepper_law
+from .partitions import battery_grids, default_grids, run_stepper, stepper_law
 from .shared_runs import remembered_value
 
 #: cells of the refinement levels of the vanishing-distance form of ``in_domain``
@@ -468,6 +468,12 @@ def check_initial_value(stepper: Callable, p: Problem, t: np.ndarray, *, seed: i
 
 # -- trajectory_immutable ---------------------------------------------------------------------------
 
+#: cells of the two partitions ``trajectory_immutable`` runs the stepper on (of one length: a stepper keeping a
+#: buffer per shape hands the same one out twice); what it judges is memory, not accuracy, so few cells do
+#: (40 cost the battery of verimono.solve 2.5 s on the complementarity Example's LCP steps, 8 a fifth of it)
+IMMUTABLE_CELLS = 8
+
+
 def _memory(value: Any) -> Any:
     """What ``value`` holds, as a NumPy array without copying where it can (a view of a NumPy array, a
     ``Trajectory``'s states, a CPU tensor's buffer): the memory a later call could write into."""
@@ -484,8 +490,8 @@ def _shares(a: Any, b: np.ndarray) -> bool:
 @stepper_law("trajectory_immutable", "a returned trajectory is the caller's (issue 42)", over_grids=False)
 def check_trajectory_immutable(stepper: Callable, p: Problem, *, seed: int = 0, grids: Any = None) -> Outcome:
     """A trajectory a stepper returned never changes after later calls, and calling it changes nothing it was
-    given.  The stepper runs on two partitions (the battery's default uniform and random ones, or ``grids``; one
-    given partition is run twice), each a fresh copy, on a copy of the problem (a stepper writing into ``problem.x0`` must not change the battery's
+    given.  The stepper runs on two partitions (uniform and random with ``IMMUTABLE_CELLS`` cells, or ``grids``;
+    one given partition is run twice), each a fresh copy, on a copy of the problem (a stepper writing into ``problem.x0`` must not change the battery's
     problem).  It fails when
 
     * the array one call returned changed when a later call ran (one output buffer handed out twice), or two
@@ -496,12 +502,12 @@ def check_trajectory_immutable(stepper: Callable, p: Problem, *, seed: int = 0, 
 
     Exact: no tolerance — a returned array that changes in any bit has changed.  The laws judging the states
     take their own copy of every run (:func:`verimono.checks.partitions.run_stepper`), so a shared buffer never
-    corrupts their verdicts; this law is where it is named.  Its two runs are its own (40 cells each): the
-    battery's shared runs are copies, which cannot show a later write into the stepper's array.
+    corrupts their verdicts; this law is where it is named.  Its two runs are its own: the
+    battery's shared runs are copies, which cannot show a later write into the stepper's array (8 cells each).
 
     Claim: every stepper, whatever it claims.
     """
-    parts = list(battery_grids(grids, p, seed).values())
+    parts = list((default_grids(p, seed, IMMUTABLE_CELLS) if grids is None else battery_grids(grids, p, seed)).values())
     if len(parts) == 1:     # one partition given: two calls on it (a buffer handed out twice is shared memory)
         parts = parts * 2
     q = p.replace(x0=np.array(p.x0, dtype=float))          # the stepper's own copy of the problem
