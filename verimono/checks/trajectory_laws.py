@@ -240,9 +240,10 @@ def domain_vanishing(stepper: Callable, p: Problem, *, seed: int = 0,
     shown = ", ".join(f"{d:.3g}" for d in D)
     if not fit and D[m] > tol:
         return Outcome(None, details=details, status=UNDECIDED,
-                       message=f"order {target:g} claimed: no level up to K = {levels[-1]} is coarse enough for a fall "
-                               f"(K_m/K_j)^{target:g} of {need:.3g} to the finest, so a distance to cl dom F(t_k) that "
-                               f"does not vanish cannot be told from one that does (distances {shown} for K = {levels})")
+                       message=f"order {target:g} claimed: no level up to K = {levels[-1]} is coarse enough for a "
+                               f"fall (K_m/K_j)^{target:g} of {need:.3g} to the finest, so a distance to cl dom F(t_k) "
+                               f"that does not vanish cannot be told from one that does (distances {shown} for "
+                               f"K = {levels})")
     rhs = DOMAIN_ORDER_SLACK * max((D[j] * (levels[j] / levels[m]) ** target for j in fit), default=0.0)
     return Outcome(D[m] / (rhs + tol),
                    counter={"problem": p.name, "T": p.T, "x0": p.x0, "levels": list(levels), "distances": D,
@@ -470,7 +471,7 @@ def check_initial_value(stepper: Callable, p: Problem, t: np.ndarray, *, seed: i
 
 #: cells of the two partitions ``trajectory_immutable`` runs the stepper on (of one length: a stepper keeping a
 #: buffer per shape hands the same one out twice); what it judges is memory, not accuracy, so few cells do
-#: (40 cost the battery of verimono.solve 2.5 s on the complementarity Example's LCP steps, 8 a fifth of it)
+#: (measured in check_stepper(verimono.solve): 2.5 s with 40 cells on a loaded machine, 0.38 s with 8)
 IMMUTABLE_CELLS = 8
 
 
@@ -490,9 +491,9 @@ def _shares(a: Any, b: np.ndarray) -> bool:
 @stepper_law("trajectory_immutable", "a returned trajectory is the caller's (issue 42)", over_grids=False)
 def check_trajectory_immutable(stepper: Callable, p: Problem, *, seed: int = 0, grids: Any = None) -> Outcome:
     """A trajectory a stepper returned never changes after later calls, and calling it changes nothing it was
-    given.  The stepper runs on two partitions (uniform and random with ``IMMUTABLE_CELLS`` cells, or ``grids``;
-    one given partition is run twice), each a fresh copy, on a copy of the problem (a stepper writing into ``problem.x0`` must not change the battery's
-    problem).  It fails when
+    given.  The stepper runs on two partitions (uniform and random with ``IMMUTABLE_CELLS`` cells, or
+    ``grids``; one given partition is run twice), each a fresh copy, on a copy of the problem (a stepper writing
+    into ``problem.x0`` must not change the battery's problem).  It fails when
 
     * the array one call returned changed when a later call ran (one output buffer handed out twice), or two
       calls returned the same memory (caught even where both calls return the same values, at rest);
@@ -507,7 +508,8 @@ def check_trajectory_immutable(stepper: Callable, p: Problem, *, seed: int = 0, 
 
     Claim: every stepper, whatever it claims.
     """
-    parts = list((default_grids(p, seed, IMMUTABLE_CELLS) if grids is None else battery_grids(grids, p, seed)).values())
+    parts = list((default_grids(p, seed, IMMUTABLE_CELLS) if grids is None
+                  else battery_grids(grids, p, seed)).values())
     if len(parts) == 1:     # one partition given: two calls on it (a buffer handed out twice is shared memory)
         parts = parts * 2
     q = p.replace(x0=np.array(p.x0, dtype=float))          # the stepper's own copy of the problem
@@ -522,18 +524,18 @@ def check_trajectory_immutable(stepper: Callable, p: Problem, *, seed: int = 0, 
         if not np.array_equal(given, grid):
             k = int(np.flatnonzero(given != grid)[0])
             problems.append(f"call {call} changed the t_grid it was given: t_{k} = {grid[k]!r} became {given[k]!r}")
-        if not np.array_equal(q.x0, x0):
-            problems.append(f"call {call} changed problem.x0 it was given: {np.array2string(x0, precision=10)} "
-                            f"became {np.array2string(q.x0, precision=10)}")
-            q = p.replace(x0=np.array(p.x0, dtype=float))
-            x0 = q.x0.copy()
         if _shares(memory, given):
             problems.append(f"call {call} returned its states in the memory of t_grid")
         if _shares(memory, q.x0):
             problems.append(f"call {call} returned its states in the memory of problem.x0")
+        if not np.array_equal(q.x0, x0):
+            problems.append(f"call {call} changed problem.x0 it was given: {np.array2string(x0, precision=10)} "
+                            f"became {np.array2string(q.x0, precision=10)}")
+            q = p.replace(x0=np.array(p.x0, dtype=float))       # the next call starts from x0 again
+            x0 = q.x0.copy()
         for before, old, old_memory, old_states in returned:
             now = np.asarray(as_float64(old), dtype=float)
-            if now.shape != old_states.shape or not np.array_equal(now, old_states):
+            if now.shape != old_states.shape or not np.array_equal(now, old_states, equal_nan=True):
                 change = (f"by up to {float(np.max(np.abs(now - old_states))):.3g}" if now.shape == old_states.shape
                           else f"its shape to {now.shape}")
                 problems.append(f"the array call {before} returned changed when call {call} ran ({change}): one "
