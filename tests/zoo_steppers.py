@@ -153,3 +153,67 @@ def residual_stop(problem, t_grid):
     def post(problem, t, k, z, x):
         return z if float(np.linalg.norm(z - x)) < RESIDUAL_STOP else x
     return _scheme(problem, t_grid, post=post)
+
+
+# -- steppers that break the contract of what a stepper returns (issues 40 and 42) --------------------------------
+
+def scaled_start(problem, t_grid):
+    """Starts from ``1.2 x0`` (an initial point rescaled by a stray factor), and runs the scheme from there."""
+    return _scheme(problem.replace(x0=1.2 * problem.x0), t_grid)
+
+
+def starts_at_zero(problem, t_grid):
+    """Ignores ``x0``: starts at the origin (a state array initialised with zeros and never given ``x0``)."""
+    x = _scheme(problem.replace(x0=np.zeros_like(problem.x0), initial_jump=True), t_grid)
+    return x
+
+
+def projected_start(problem, t_grid):
+    """Returns ``x_0 = proj_{cl dom F(0)}(x0)`` instead of the given ``x0``: the catching-up jump taken at
+    ``t_0`` rather than in the first step (the same states from ``t_1`` on; different only when ``x0`` lies
+    outside the domain, as in ``static ball, x0 outside (jump)``)."""
+    x = _scheme(problem, t_grid)
+    x[0] = problem.operator.project_domain(problem.x0, 0.0)
+    return x
+
+
+_BUFFERS = {}
+
+
+def shared_buffer(problem, t_grid):
+    """Writes its states into one preallocated buffer per shape, kept between calls and returned: the array
+    one call returned is overwritten by the next call of the same shape."""
+    x = _scheme(problem, t_grid)
+    buf = _BUFFERS.setdefault(x.shape, np.empty(x.shape))
+    buf[...] = x
+    return buf
+
+
+def mutates_grid(problem, t_grid):
+    """Uses the caller's grid as scratch: after the run it holds the cells' midpoints (``np.asarray`` does not
+    copy a float array)."""
+    t = np.asarray(t_grid)
+    x = _scheme(problem, t)
+    t[1:] = 0.5 * (t[:-1] + t[1:])
+    return x
+
+
+def mutates_x0(problem, t_grid):
+    """Leaves its final state in ``problem.x0`` (the running state written back into the problem's array): a
+    second run of the same problem starts where the first ended."""
+    x = _scheme(problem, t_grid)
+    problem.x0[...] = x[-1]
+    return x
+
+
+def at_rest_view(problem, t_grid):
+    """Returns ``np.broadcast_to(x0, ...)`` when the solution stays at ``x0`` (a problem at rest): the right
+    values, in the memory of ``problem.x0`` (a later change of ``x0`` changes the returned trajectory)."""
+    x = _scheme(problem, t_grid)
+    if np.all(x == problem.x0):
+        return np.broadcast_to(problem.x0, x.shape)
+    return x
+
+
+BREAKS["initial_value"] = (scaled_start, "t|x| (n=1)", "uniform")
+BREAKS["trajectory_immutable"] = (mutates_grid, "t|x| (n=1)", "uniform/random")   # its float32 wrapper too

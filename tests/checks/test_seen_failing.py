@@ -35,7 +35,7 @@ ZOO_STEPPERS = "checks/test_trajectory_laws.py::test_every_law_fails_on_a_zoo_me
 SEEN_FAILING = {
     **{law: ZOO_OPERATORS for law in REGISTRY["operator"]},
     **{law: ZOO_STEPPERS for law in ("contraction", "in_domain", "selections", "bounds_lg", "bounds_yb",
-                                     "psi_interpolation", "unique_limit")},
+                                     "psi_interpolation", "unique_limit", "initial_value", "trajectory_immutable")},
     "picard_step": "checks/test_picard.py::test_wrong_lipschitz_constant_fails_with_the_counterexample",
     "convergence_order": "checks/test_orders_limit.py::test_a_scheme_converging_to_a_wrong_limit_fails_without_an_exact_solution",
     "assumption_A1": "checks/test_search_over_time.py::test_non_monotone_on_a_narrow_window_fails_A1",

@@ -185,10 +185,11 @@ def test_claims_and_problems_are_subjects_of_the_pytest_battery(pytester):
 
     pytester.makepyfile(test_battery=CLAIMS_FILE.format(tests=str(pathlib.Path(__file__).parents[1])))
     res = pytester.runpytest_inprocess("-q", "-rs", "-p", "verimono.testing")
-    # stepper: orders, unique_limit, in_domain pass; contraction and the 4 proximal-only laws skip.
-    # problem: A1, A2, A3, YB, thm_main pass; LG is an expected failure (YB holds), a skip-free pass here
-    res.assert_outcomes(passed=3 + 6, skipped=5)
+    # stepper: orders, unique_limit, in_domain, initial_value, trajectory_immutable pass; contraction and the 4
+    # proximal-only laws skip.  problem: A1, A2, A3, YB, thm_main pass; LG is an expected failure (YB holds), a
+    # skip-free pass here
+    res.assert_outcomes(passed=5 + 6, skipped=5)
     out = "\n".join(res.outlines)
     assert "needs scheme='proximal'" in out and "contracts=True" in out
     assert "selections[moving half-space]: needs scheme='proximal'" in out
-    assert "9 passed, 0 failed, 5 skipped" in out                  # the battery summary counts them
+    assert "11 passed, 0 failed, 5 skipped" in out                 # the battery summary counts them

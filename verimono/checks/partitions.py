@@ -75,7 +75,10 @@ def run_stepper(stepper: Callable, problem: Problem, grid: np.ndarray) -> np.nda
 def _validated_run(stepper: Callable, problem: Problem, grid: np.ndarray) -> tuple[np.ndarray, str | None]:
     raw = stepper(problem, grid)
     precision = precision_of(raw)
-    x = as_float64(raw)      # any array library; its precision is observed
+    # any array library, its precision observed; always a copy: a law that holds this run while it runs the
+    # stepper again (contraction's other starts) must judge the values returned, not what a stepper handing out
+    # one shared buffer writes into it later (that stepper fails trajectory_immutable)
+    x = np.array(as_float64(raw), dtype=float, copy=True)
     if x.shape != (len(grid),) + problem.x0.shape:
         raise ValueError(f"stepper {stepper_subject(stepper, problem).split(' on ')[0]} returned shape {x.shape}, "
                          f"expected {(len(grid),) + problem.x0.shape}")

@@ -45,7 +45,9 @@ def reproduce(stepper: Callable, problem: Problem, record: CheckResult) -> Check
     if record.check == "unique_limit":
         return law(stepper, problem, levels=cx["levels"], seed=cx["seed"])
     p = single(problem).replace(T=float(cx["T"]))
-    kw: dict[str, Any] = {"grids": [np.asarray(cx["grid"], dtype=float)]}
+    # a law of several calls (trajectory_immutable) states all its partitions, a per-partition law its one
+    grids = cx["grids"] if isinstance(cx.get("grids"), list) else [cx["grid"]]
+    kw: dict[str, Any] = {"grids": [np.asarray(g, dtype=float) for g in grids]}
     if "x0_prime" in cx:
         kw["x0_primes"] = [np.asarray(cx["x0_prime"], dtype=float)]
     return law(stepper, p, **kw)

@@ -14,8 +14,15 @@ one record whose ``worst`` is the largest observed ``lhs / (rhs + tol)`` (``boun
   F(t_{k+1}, x_{k+1})``, tested with ``operator.contains`` and with the resolvent characterisation
   ``J_μ(x + μy) = x`` at ``μ ≤ h/2`` (a different step than the scheme's: :func:`witness_steps`).
 
+* ``initial_value`` — ``x_0 = x0``: the initial condition of ``eq:incGen`` (``x(0) = x0``), which ``eq:iteration``
+  starts from; also when ``x0 ∉ cl dom F(0)`` (``initial_jump``: the scheme jumps in its first step, ``x_0`` is
+  still ``x0``, as :func:`verimono.solve` returns it).
+* ``trajectory_immutable`` — what a stepper returned is its caller's: it never changes when the stepper runs again,
+  and the stepper neither writes into the partition or ``problem.x0`` it was given nor returns their memory.
+
 What each binds (:mod:`verimono.core.claims`): ``selections`` only the proximal scheme; ``contraction`` steppers
-claiming it; ``in_domain`` every scheme, in the form its claim allows.
+claiming it; ``in_domain`` every scheme, in the form its claim allows; ``initial_value`` and
+``trajectory_immutable`` every stepper, whatever it claims.
 """
 
 from __future__ import annotations
@@ -24,20 +31,28 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from ..core.arrays import as_float64
+from ..core.arrays import as_float64, to_numpy
 from ..core.claims import claim_of
 from ..core.errors import NotApplicable, VerimonoError
 from ..core.grids import uniform_grid
 from ..core.operator_protocol import resolvent_kernel
 from ..core.problem import Problem
 from ..core.stepping import Trajectory
-from ..core.tolerances import DOMAIN_ORDER_SLACK, row_tolerances, tolerance
+from ..core.tolerances import DOMAIN_ORDER_SLACK, current_precision, row_tolerances, tolerance
+from ..records.results import FAILED, PASSED, UNDECIDED
 from .core import CONTRACTION_CLAIM, PROXIMAL_CLAIM, Holds, Member, Outcome
-from .partitions import run_stepper, stepper_law
+from .partitions import battery_grids, default_grids, run_stepper, stepper_law
 from .shared_runs import remembered_value
 
 #: cells of the refinement levels of the vanishing-distance form of ``in_domain``
 DOMAIN_LEVELS = (10, 40, 160)
+#: the vanishing-distance form of ``in_domain`` fits its constant only on levels where the claimed order predicts a
+#: fall of at least ``DOMAIN_POWER · DOMAIN_ORDER_SLACK`` to the finest: a distance that does not shrink then fails
+#: by at least this factor (:func:`domain_vanishing`)
+DOMAIN_POWER = 2.0
+#: the finest level (cells) :func:`domain_vanishing` refines to (4-fold steps from ``DOMAIN_LEVELS``) when its
+#: largest coarse distance is on a level too close to the finest for the claimed order
+DOMAIN_MAX_CELLS = 2560
 
 
 def norms(a: np.ndarray) -> np.ndarray:
@@ -173,28 +188,72 @@ def domain_vanishing(stepper: Callable, p: Problem, *, seed: int = 0,
                      levels: Sequence[int] = DOMAIN_LEVELS) -> Outcome:
     """``D(K) = max_k dist(x_k, cl dom F(t_k))`` on uniform partitions with ``K`` cells vanishes at order
     ``p = min(order, the order the problem's regularity allows)``: every convergent scheme has
-    ``dist(x_k, cl dom F(t_k)) ≤ |x_k - x(t_k)| = O(h^p)`` since ``x(t_k) ∈ cl dom F(t_k)``.
+    ``dist(x_k, cl dom F(t_k)) ≤ |x_k - x(t_k)| ≤ C (T/K)^p`` since ``x(t_k) ∈ cl dom F(t_k)``.
 
-    Law: ``D(K_m) ≤ DOMAIN_ORDER_SLACK · max_{j<m} D(K_j) (K_j/K_m)^p + tol`` at the finest level
-    (the constant of ``C h^p`` is not known; the slack absorbs its drift between levels)."""
+    The constant ``C`` is not known.  It is fitted on a coarse level ``K_j``, ``Ĉ = D(K_j) (K_j/T)^p``, and the
+    prediction is checked on the finest ``K_m``:
+
+        ``D(K_m) ≤ S · max_{j ∈ J} D(K_j) (K_j/K_m)^p + tol``,  ``S = DOMAIN_ORDER_SLACK``
+
+    (the slack absorbs the drift of ``C`` between levels).  A distance that does not shrink has ratio
+    ``g_j/S`` there, ``g_j = (K_m/K_j)^p`` the fall the order predicts: the check refutes it only where
+    ``g_j > S``.  So ``J`` holds only the levels with ``g_j ≥ DOMAIN_POWER · S``: a distance that does not shrink
+    fails by at least ``DOMAIN_POWER`` at every claimed order, one shrinking like ``h^p`` passes by ``S``.  (Fitted
+    on ``K_{m-1}`` too, as before, the law could refute nothing at order 1/2: ``g = 4^{1/2} = 2 = S``, and distances
+    0.411, 0.466, 0.460 passed.)  For 1/2 ≤ p < 1 that is the coarsest level of 10, 40, 160; for p ≥ 1 every level,
+    as before.  When the largest coarse distance lies on a level outside ``J`` (a distance that grows before it
+    falls, pre-asymptotically), the levels are refined 4-fold, up to ``DOMAIN_MAX_CELLS`` cells, until it is in
+    ``J``; when ``J`` is still empty there (``p < 1/4``), the record is undecided: no level is coarse enough for the
+    claimed order to predict a fall the slack does not swallow.  Distances within round-off (``tol``, relative to
+    ``max(1, |x0|)``) fit no constant: they are not refined for, and a finest distance within it holds."""
     order = claim_of(stepper).order
     target = p.order.for_claim(order).value if p.order is not None else float(order)
+    levels = [int(K) for K in levels]
+    need = DOMAIN_POWER * DOMAIN_ORDER_SLACK * (1.0 - 1e-12)
+
+    def fitting(m: int) -> list[int]:
+        return [j for j in range(m) if (levels[m] / levels[j]) ** target >= need]
+
     D, where = [], []
-    for K in levels:
+
+    def measure(K: int) -> None:
         t = uniform_grid(p.T, steps=K)
         x, d = domain_distances(stepper, p, t)
         k = int(np.argmax(d))
         D.append(float(d[k]))
         where.append({"K": K, "k": k, "t_k": t[k], "x_k": x[k]})
+
     scale = max(1.0, float(np.max(np.abs(p.x0))))
-    rhs = DOMAIN_ORDER_SLACK * max(D[j] * (levels[j] / levels[-1]) ** target for j in range(len(levels) - 1))
-    return Outcome(D[-1] / (rhs + tolerance(scale)),
+    tol = tolerance(scale)
+    for K in levels:
+        measure(K)
+    # refine while the largest coarse distance (beyond round-off: a constant to fit) is on a level too close to the
+    # finest for the claimed order to predict a fall the slack does not swallow
+    while (max(D[:-1]) > tol and int(np.argmax(D[:-1])) not in fitting(len(D) - 1)
+           and 4 * levels[-1] <= DOMAIN_MAX_CELLS):
+        levels.append(4 * levels[-1])
+        measure(levels[-1])
+    m = len(levels) - 1
+    fit = fitting(m)
+    details = {"levels": list(levels), "distances": D, "order": target, "claim": "any",
+               "fitted_on": [levels[j] for j in fit]}
+    shown = ", ".join(f"{d:.3g}" for d in D)
+    if not fit and D[m] > tol:
+        return Outcome(None, details=details, status=UNDECIDED,
+                       message=f"order {target:g} claimed: no level up to K = {levels[-1]} is coarse enough for a "
+                               f"fall (K_m/K_j)^{target:g} of {need:.3g} to the finest, so a distance to cl dom F(t_k) "
+                               f"that does not vanish cannot be told from one that does (distances {shown} for "
+                               f"K = {levels})")
+    rhs = DOMAIN_ORDER_SLACK * max((D[j] * (levels[j] / levels[m]) ** target for j in fit), default=0.0)
+    return Outcome(D[m] / (rhs + tol),
                    counter={"problem": p.name, "T": p.T, "x0": p.x0, "levels": list(levels), "distances": D,
-                            "order": target, **where[-1],
+                            "order": target, **where[m],
                             "message": f"dist(x_k, cl dom F(t_k)) does not vanish at order {target:g}: "
-                                       f"{', '.join(f'{d:.3g}' for d in D)} for K = {list(levels)}"},
-                   details={"levels": list(levels), "distances": D, "order": target, "claim": "any"},
-                   message=f"dist(x_k, cl dom F(t_k)) {D[0]:.3g} -> {D[-1]:.3g} as K = {levels[0]} -> {levels[-1]} "
+                                       f"{shown} for K = {list(levels)} (at most {rhs:.3g} at K = {levels[m]}: "
+                                       f"{DOMAIN_ORDER_SLACK:g} times the fall the order predicts from K = "
+                                       f"{[levels[j] for j in fit]})"},
+                   details=details,
+                   message=f"dist(x_k, cl dom F(t_k)) {D[0]:.3g} -> {D[m]:.3g} as K = {levels[0]} -> {levels[m]} "
                            f"(order {target:g} claimed; scheme='any')")
 
 
@@ -370,6 +429,129 @@ def _outside_domain(op: Any, x: np.ndarray, t: float) -> float | None:
     return d if d > tolerance(x, q) else None
 
 
-__all__ = ["check_contraction", "check_in_domain", "check_selections", "domain_vanishing", "perturbed_starts",
+# -- initial_value ----------------------------------------------------------------------------------
+
+#: the smallest positive normal number of each precision: the absolute floor of ``initial_value``'s tolerance
+#: (an ``x0`` below it is subnormal or 0 in that precision, with no relative accuracy left)
+SMALLEST_NORMAL = {"float64": float(np.finfo(np.float64).tiny), "float32": float(np.finfo(np.float32).tiny),
+                   "float16": float(np.finfo(np.float16).tiny), "bfloat16": float(np.finfo(np.float32).tiny)}
+
+
+@stepper_law("initial_value", "eq:incGen (x(0) = x0)")
+def check_initial_value(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int = 0) -> Outcome:
+    """``x_0 = x0``: every trajectory starts at the initial point of ``eq:incGen`` (``x(0) = x0``), which
+    ``eq:iteration`` starts from — also when ``x0 ∉ cl dom F(0)`` (``initial_jump``): the catching-up scheme
+    jumps to ``cl dom F`` in its first step, ``x_0`` is still ``x0`` (:func:`verimono.solve` returns it so, and the
+    references' exact solutions have ``x(0) = x0``); a stepper returning the projection as ``x_0`` fails.
+
+    Tolerance: ``|x_0 - x0|_∞ ≤ rtol · |x0|_∞ + tiny``, ``rtol`` the precision the stepper returned its states in
+    (:func:`verimono.core.tolerances.rtol_for`: float32 judged as float32) and ``tiny`` that precision's smallest
+    normal number.  ``x_0`` is a copy of ``x0`` in the subject's precision, off by at most half its ulp: relative to
+    ``|x0|`` itself, not to ``1 + |x0|`` as the states' laws are, so a stepper starting at 0, or at ``1.2 x0``, fails
+    whatever the size of ``x0 ≠ 0``.  Judged on the battery's default partitions (runs the battery makes anyway);
+    a failure shrinks to the one-cell partition ``[0, t_1]``.
+
+    Claim: every stepper, whatever it claims (the solution it approximates starts at ``x0``).
+    """
+    x = run_stepper(stepper, p, t)
+    x0 = np.asarray(p.x0, dtype=float)
+    precision = current_precision()
+    tol = precision.rtol * float(np.max(np.abs(x0))) + SMALLEST_NORMAL[precision.name]
+    d = float(np.max(np.abs(x[0] - x0)))
+    counter = {"k": 0, "t_k": t[0], "x_k": x[0], "distance": d, "tolerance": tol,
+               "message": f"x_0 = {np.array2string(x[0], precision=10)} is not x0 = "
+                          f"{np.array2string(x0, precision=10)}: |x_0 - x0| = {d:.3g} > {tol:.3g} "
+                          f"(rtol {precision.rtol:.2g} times |x0|)"}
+    # k = 1: the shortest failing prefix is the one-cell partition [0, t_1] (a stepper needs a cell to run)
+    return Outcome(d / tol, 1, counter, {"distance": d, "tolerance": tol},
+                   message="x_0 = x0 (within rtol |x0| of the stepper's precision)")
+
+
+# -- trajectory_immutable ---------------------------------------------------------------------------
+
+#: cells of the two partitions ``trajectory_immutable`` runs the stepper on (of one length: a stepper keeping a
+#: buffer per shape hands the same one out twice); what it judges is memory, not accuracy, so few cells do
+#: (measured in check_stepper(verimono.solve): 2.5 s with 40 cells on a loaded machine, 0.38 s with 8)
+IMMUTABLE_CELLS = 8
+
+
+def _memory(value: Any) -> Any:
+    """What ``value`` holds, as a NumPy array without copying where it can (a view of a NumPy array, a
+    ``Trajectory``'s states, a CPU tensor's buffer): the memory a later call could write into."""
+    try:
+        return np.asarray(to_numpy(value))
+    except Exception:  # noqa: BLE001 - a value NumPy cannot view shares no memory NumPy can see
+        return None
+
+
+def _shares(a: Any, b: np.ndarray) -> bool:
+    return isinstance(a, np.ndarray) and np.may_share_memory(a, b) and np.shares_memory(a, b)
+
+
+@stepper_law("trajectory_immutable", "a returned trajectory is the caller's (issue 42)", over_grids=False)
+def check_trajectory_immutable(stepper: Callable, p: Problem, *, seed: int = 0, grids: Any = None) -> Outcome:
+    """A trajectory a stepper returned never changes after later calls, and calling it changes nothing it was
+    given.  The stepper runs on two partitions (uniform and random with ``IMMUTABLE_CELLS`` cells, or
+    ``grids``; one given partition is run twice), each a fresh copy, on a copy of the problem (a stepper writing
+    into ``problem.x0`` must not change the battery's problem).  It fails when
+
+    * the array one call returned changed when a later call ran (one output buffer handed out twice), or two
+      calls returned the same memory (caught even where both calls return the same values, at rest);
+    * a call changed the partition ``t_grid`` or ``problem.x0`` it was given;
+    * what a call returned lies in the memory of ``t_grid`` or ``problem.x0`` (a later change of the caller's
+      array would change it).
+
+    Exact: no tolerance — a returned array that changes in any bit has changed.  The laws judging the states
+    take their own copy of every run (:func:`verimono.checks.partitions.run_stepper`), so a shared buffer never
+    corrupts their verdicts; this law is where it is named.  Its two runs are its own: the
+    battery's shared runs are copies, which cannot show a later write into the stepper's array (8 cells each).
+
+    Claim: every stepper, whatever it claims.
+    """
+    parts = list((default_grids(p, seed, IMMUTABLE_CELLS) if grids is None
+                  else battery_grids(grids, p, seed)).values())
+    if len(parts) == 1:     # one partition given: two calls on it (a buffer handed out twice is shared memory)
+        parts = parts * 2
+    q = p.replace(x0=np.array(p.x0, dtype=float))          # the stepper's own copy of the problem
+    x0 = q.x0.copy()
+    returned: list[tuple[int, Any, Any, np.ndarray]] = []   # (call, value, its memory, a copy of its states)
+    problems: list[str] = []
+    for call, grid in enumerate(parts, start=1):
+        given = np.array(grid, dtype=float)
+        value = stepper(q, given)
+        memory = _memory(value)
+        states = np.array(as_float64(value), dtype=float, copy=True)
+        if not np.array_equal(given, grid):
+            k = int(np.flatnonzero(given != grid)[0])
+            problems.append(f"call {call} changed the t_grid it was given: t_{k} = {grid[k]!r} became {given[k]!r}")
+        if _shares(memory, given):
+            problems.append(f"call {call} returned its states in the memory of t_grid")
+        if _shares(memory, q.x0):
+            problems.append(f"call {call} returned its states in the memory of problem.x0")
+        if not np.array_equal(q.x0, x0):
+            problems.append(f"call {call} changed problem.x0 it was given: {np.array2string(x0, precision=10)} "
+                            f"became {np.array2string(q.x0, precision=10)}")
+            q = p.replace(x0=np.array(p.x0, dtype=float))       # the next call starts from x0 again
+            x0 = q.x0.copy()
+        for before, old, old_memory, old_states in returned:
+            now = np.asarray(as_float64(old), dtype=float)
+            if now.shape != old_states.shape or not np.array_equal(now, old_states, equal_nan=True):
+                change = (f"by up to {float(np.max(np.abs(now - old_states))):.3g}" if now.shape == old_states.shape
+                          else f"its shape to {now.shape}")
+                problems.append(f"the array call {before} returned changed when call {call} ran ({change}): one "
+                                "output buffer handed out twice")
+            elif old_memory is not None and _shares(memory, old_memory):
+                problems.append(f"call {call} returned its states in the memory of the array call {before} returned")
+        returned.append((call, value, memory, states))
+    if problems:
+        counter = {"problem": p.name, "T": p.T, "x0": p.x0, "grids": parts, "findings": problems,
+                   "message": "; ".join(problems)}
+        return Outcome(None, counter=counter, details={"calls": len(parts)}, status=FAILED)
+    return Outcome(None, details={"calls": len(parts)}, status=PASSED,
+                   message=f"{len(parts)} calls: no returned array changed, no input written, no memory shared")
+
+
+__all__ = ["check_contraction", "check_in_domain", "check_selections", "check_initial_value",
+           "check_trajectory_immutable", "domain_vanishing", "perturbed_starts",
            "run_starts", "step_growth", "lipschitz_of", "norms", "domain_distances", "resolvent_witnesses",
            "witness_steps"]

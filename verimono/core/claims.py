@@ -16,6 +16,10 @@ paper bind different schemes differently:
   vanishing at the claimed order (the solution lies in the domain).  Contraction only where claimed
   (``contracts=True``).
 
+Whatever a stepper claims, its trajectory starts at ``x0`` (``x(0) = x0``: the law ``initial_value``) and is its
+caller's: it never changes when the stepper runs again, and the stepper writes into neither the grid nor
+``problem.x0`` it was given (``trajectory_immutable``).
+
 A bare callable claims ``"proximal"``; :func:`verimono.solve` is declared proximal.  Wrap any other
 scheme with :class:`Stepper` to state what it is::
 
