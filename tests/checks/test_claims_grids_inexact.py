@@ -40,7 +40,6 @@ def test_a_uniform_only_stepper_refusing_other_grids_fails_every_step_law_withou
     assert rec.status == "failed" and "uniform grids only" in rec.message
 
 
-@pytest.mark.slow
 def test_the_correct_uniform_only_inexact_catching_up_stepper_passes_the_battery(problem):
     s = uniform_only(zoo.ball_catching_up(1.0, 2.0), inexact=(1.0, 2.0))
     report = vm.check_stepper(s, problems=[problem])
@@ -76,16 +75,19 @@ def test_the_set_taken_at_the_wrong_time_fails_on_a_uniform_only_stepper(problem
 
 
 def test_a_stepper_stopping_short_of_T_fails(problem):
-    """floor(T/h) steps stop one short of T = 2π on every uniform grid the battery hands out (t_K = T exactly):
-    padded with its last state, the last node is not the state at T; unpadded, the trajectory is too short."""
-    t = vm.uniform_grid(problem.T, steps=40)
-    assert math.floor(problem.T / (t[1] - t[0])) == 39 and t[-1] == problem.T
+    """floor(T/h) steps stop one short of T = 2π on the grids of the convergence study (K = 50 ... 800; the
+    battery's uniform partitions are np.linspace(0, T, K + 1), t_K = T exactly): padded with its last state, the
+    last node is not the state at T; unpadded, the trajectory is too short."""
+    t = vm.uniform_grid(problem.T, steps=50)
+    assert math.floor(problem.T / (t[1] - t[0])) == 49 and t[-1] == problem.T
     padded = uniform_only(zoo.ball_catching_up(1.0, 2.0, floor_steps=True), inexact=(1.0, 2.0))
-    rec = check_in_domain(padded, problem)
-    assert rec.status == "failed" and rec.counterexample["k"] == 40, rec
+    rec = check_in_domain(padded, problem, grids=[t])
+    assert rec.status == "failed" and rec.counterexample["k"] == 50, rec
+    assert check_in_domain(uniform_only(zoo.ball_catching_up(1.0, 2.0), inexact=(1.0, 2.0)), problem,
+                           grids=[t]).status == "passed"
     short = uniform_only(lambda p, tg: zoo.ball_catching_up(1.0, 2.0, floor_steps=True)(p, tg)[:-1],
                          inexact=(1.0, 2.0))
-    rec = check_selections(short, problem)
+    rec = check_selections(short, problem, grids=[t])
     assert rec.status == "failed" and "returned shape" in rec.message, rec
 
 
@@ -94,8 +96,11 @@ def test_unique_limit_of_a_uniform_only_stepper_is_judged_on_uniform_refinements
     rec = check_unique_limit(s, problem)
     assert rec.status == "passed", rec
     assert set(rec.details["ratios"]) == {"uniform"} and rec.details["grids"]["claimed"] == "uniform"
-    lagged_limit = uniform_only(lambda p, tg: zoo.ball_catching_up()(p, tg) + 0.3 * (len(tg) % 2), inexact=(1, 2))
-    assert check_unique_limit(lagged_limit, problem).status == "failed"     # odd and even K: no limit
+    # an offset 0.3 (-2)^m on the m-th 4-fold refinement of K = 10 cells: differences that grow, no limit
+    wobbly = uniform_only(lambda p, tg: zoo.ball_catching_up()(p, tg)
+                          + 0.3 * (-2.0) ** round(math.log((len(tg) - 1) / 10, 4)), inexact=(1, 2))
+    rec = check_unique_limit(wobbly, problem)
+    assert rec.status == "failed" and "no limit" in rec.message, rec
 
 
 def test_grids_claim_keeps_the_existing_api():
@@ -114,15 +119,15 @@ def test_a_scheme_violating_its_stated_tolerance_fails(problem):
     claiming what it does (h) passes selections."""
     loose = zoo.ball_catching_up(1.0, 1.0)
     rec = check_selections(uniform_only(loose, inexact=(1.0, 2.0)), problem)
-    assert rec.status == "failed" and "J_{hF(t_(k+1))}(z_k)" in rec.counterexample["message"], rec
+    assert rec.status == "failed" and "exceeds the stated resolvent tolerance" in rec.message, rec
     assert check_selections(uniform_only(loose, inexact=(1.0, 1.0)), problem).status == "passed"
 
 
 def test_the_exact_laws_need_the_stated_tolerance(problem):
-    """Claimed exact, the h² projections fail selections and in_domain; claimed inexact they pass."""
+    """Claimed exact, the h² projections fail selections; claimed inexact they pass.  (in_domain holds either
+    way: the dual iterates overshoot into the ball.)"""
     s = zoo.ball_catching_up(1.0, 2.0)
     assert check_selections(uniform_only(s), problem).status == "failed"
-    assert check_in_domain(uniform_only(s), problem).status == "failed"
     rec = check_selections(uniform_only(s, inexact=(1.0, 2.0)), problem)
     assert rec.status == "passed" and rec.details["inexact"]["max_ratio"] <= 1.0 < 4 * rec.details["inexact"]["max_ratio"]
 
