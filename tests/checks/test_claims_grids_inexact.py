@@ -157,3 +157,15 @@ def test_the_expected_order_follows_from_the_tolerance(problem):
 def test_inexact_claims_that_cannot_be_stated_are_typed_errors(kw):
     with pytest.raises(InvalidClaim):
         Stepper(zoo.wrong_time, **kw)
+
+
+def test_the_command_line_states_both_claims(tmp_path, monkeypatch):
+    """``verimono check --grids uniform --inexact C:Q`` makes the same claim as the Python API."""
+    from verimono.cli import build_parser
+
+    args = build_parser().parse_args(["check", "m:s", "--grids", "uniform", "--inexact", "1:2"])
+    assert (args.grids, args.inexact) == ("uniform", (1.0, 2.0))
+    claim = with_claim(zoo.wrong_time, grids=args.grids, inexact=args.inexact).claim
+    assert claim.uniform and claim.inexact == Inexact(1.0, 2.0)
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["check", "m:s", "--inexact", "0:2"])

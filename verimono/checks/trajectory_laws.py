@@ -299,7 +299,9 @@ def check_selections(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int 
                               "max_ratio": float(np.max(inexact["ratios"])),
                               "max_distance": float(np.max(inexact["distances"]))}
     message = (f"the discrete velocity {velocity} in F(t_(k+1), x_(k+1)) at every step"
-               + ("" if contains_available else " (resolvent characterisation only: no contains)"))
+               + (f" to the stated resolvent tolerance: |x_(k+1) - J_hF(z_k)| <= ε(h) = "
+                  f"{claim_of(stepper).inexact.describe()}" if inexact is not None else
+                  "" if contains_available else " (resolvent characterisation only: no contains)"))
     if worst <= 1.0:         # held: the counterexample is never shown
         return Outcome(worst, k + 1, {"k": k + 1}, details, message=message)
     counter = {"k": k + 1, "t_k": t[k + 1], "x_k": x[k], "x_k_plus_1": x[k + 1], "h": h[k], "selection": y[k],
