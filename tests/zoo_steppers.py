@@ -217,3 +217,60 @@ def at_rest_view(problem, t_grid):
 
 BREAKS["initial_value"] = (scaled_start, "t|x| (n=1)", "uniform")
 BREAKS["trajectory_immutable"] = (mutates_grid, "t|x| (n=1)", "uniform/random")   # its float32 wrapper too
+
+# -- uniform-only catching-up steppers with approximate projections (issue 40) ------------------------------
+# Written the way public sweeping-process codes are: problem-specific (they know the moving set), stepping
+# t_n = n h on uniform grids only (ValueError on any other), projecting by a few iterations of an inner
+# solver stopped at a tolerance eps(h).  Each is a factory ``ball_catching_up(...)`` for the ball B(v t, R) of
+# ``verimono.reference.sweeping.translating_ball``; ``sweeping_2pi()`` is that problem on [0, 2π].
+
+BALL_V, BALL_R = np.array([1.0, 0.5]), 1.0
+
+
+def sweeping_2pi():
+    """The translating ball on ``[0, 2π]`` (its closed form holds for every ``T``): a horizon no step divides
+    in floating point, where a stepper counting ``floor(T/h)`` steps stops one short."""
+    from verimono.reference.sweeping import translating_ball
+
+    T = 2 * np.pi
+    return translating_ball(T=T).replace(name="translating ball on [0, 2π]",
+                                         steps=[T / k for k in (50, 100, 200, 400, 800)])
+
+
+def dual_gradient_ball_projection(z, c, R, eps):
+    """The projection of ``z`` onto ``B(c, R)`` by projected gradient ascent on the dual of
+    ``min ½|x − z|² s.t. ½(|x − c|² − R²) ≤ 0`` (``x(λ) = (z + λc)/(1 + λ)``, step ``1/R²``), stopped as soon
+    as ``x(λ)`` is certified within ``eps`` of the projection (``x(λ)`` and ``P(z)`` lie on the segment from
+    ``c`` to ``z``: their distance is ``||x(λ) − c| − R|``, or 0 inside with ``λ = 0``)."""
+    lam = 0.0
+    for _ in range(200):
+        x = (z + lam * c) / (1.0 + lam)
+        r = float(np.linalg.norm(x - c))
+        if (lam == 0.0 and r <= R) or abs(r - R) <= eps:
+            return x
+        lam = max(0.0, lam + 0.5 * (r * r - R * R) / (R * R))
+    return x
+
+
+def ball_catching_up(C=1.0, q=2.0, *, lag=False, floor_steps=False, v=BALL_V, R=BALL_R):
+    """The catching-up scheme ``x_{n+1} ≈ P_{C(t_{n+1})}(x_n)`` for ``C(t) = B(v t, R)``, on uniform grids only,
+    each projection to ``eps(h) = C h^q``.  ``lag``: the set's centre taken at ``t_n`` instead of ``t_{n+1}``
+    (a planted bug); ``floor_steps``: the step count ``floor(T/h)`` (stops one step short where ``h`` does not
+    divide ``T`` in floating point, and pads with its last state)."""
+    def stepper(problem, t_grid):
+        t = np.asarray(t_grid, dtype=float)
+        K = len(t) - 1
+        h = t[1] - t[0]
+        if not np.allclose(np.diff(t), h, rtol=1e-9, atol=0.0):
+            raise ValueError("this code steps t_n = n h: uniform grids only")
+        eps = C * h ** q
+        n_steps = int(np.floor(t[-1] / h)) if floor_steps else K
+        x = [np.asarray(problem.x0, dtype=float)]
+        for n in range(n_steps):
+            centre = v * ((n if lag else n + 1) * h)
+            x.append(dual_gradient_ball_projection(x[-1], centre, R, eps))
+        x += [x[-1]] * (K - n_steps)
+        return np.array(x)
+    stepper.__name__ = (f"catching_up_eps_{C:g}h^{q:g}" + ("_lagged" if lag else "")
+                        + ("_floor" if floor_steps else ""))
+    return stepper

@@ -208,6 +208,17 @@ def _start(out: Path, command: str, resumes: str | None = None) -> str:
     return run_id
 
 
+def _inexact_arg(text: str) -> tuple[float, float]:
+    """``--inexact C:Q``: ``ε(h) = C h^Q``."""
+    try:
+        C, q = (float(v) for v in text.replace(",", ":").split(":"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected C:Q (eps(h) = C h^Q), got {text!r}") from None
+    if not (0 < C < float("inf") and 0 < q < float("inf")):
+        raise argparse.ArgumentTypeError(f"C and Q must be positive and finite, got {text!r}")
+    return C, q
+
+
 def _step_range(text: str) -> tuple[float, float]:
     """``--step-range H_MIN:H_MAX``: two positive finite step sizes (either order), checked before any work."""
     parts = text.replace(",", ":").split(":")
@@ -366,7 +377,8 @@ def _cmd_check(args: argparse.Namespace) -> int:
         from .execution.timing import TimedStepper
 
         # its calls are timed apart from the checks around them: the gate judges the subject's own CPU time
-        obj = TimedStepper(with_claim(obj, args.scheme, args.order, solve_tol=args.solve_tol))
+        obj = TimedStepper(with_claim(obj, args.scheme, args.order, solve_tol=args.solve_tol,
+                                      grids=getattr(args, "grids", None), inexact=getattr(args, "inexact", None)))
         stages, ctx = ["convergence", "trajectory_laws"], _context(args, stepper=obj,
                                                                     step_range=getattr(args, "step_range", None))
         kind = "stepper" + ("" if claim_of(obj).proximal else f" claiming {claim_of(obj).describe()}")
@@ -606,6 +618,12 @@ def build_parser() -> argparse.ArgumentParser:
     check.add_argument("--solve-tol", type=float, default=None, metavar="TAU",
                        help="the accuracy of the stepper's inner solve per step (relative to 1 + |x|): errors at "
                             "what it accumulates pass as exact to it")
+    check.add_argument("--grids", choices=("any", "uniform"), default=None,
+                       help="the partitions a stepper runs on: 'uniform' judges every law on uniform partitions "
+                            "only (t_n = n T/K), never failing or skipping it for the others (default 'any')")
+    check.add_argument("--inexact", type=_inexact_arg, default=None, metavar="C:Q",
+                       help="the stepper's resolvent is within eps(h) = C h^Q of the exact one: the laws allow it "
+                            "and the expected order is min(p, Q - 1) (docs/checks.md)")
     check.add_argument("--step-range", type=_step_range, default=None, metavar="H_MIN:H_MAX",
                        help="run every convergence study on uniform grids with steps in [H_MIN, H_MAX] only (by "
                             "default each study chooses its grids for the claimed order: docs/convergence.md)")

@@ -15,7 +15,7 @@ import numpy as np
 from ..core.problem import Problem
 from ..core.tolerances import LIMIT_EXTRA_LEVELS, LIMIT_RATIO_FLOOR, LIMIT_TAIL_SAFETY, tolerance
 from .core import Outcome
-from .partitions import LIMIT_LEVELS, limit_grids, refined_random_grid, run_stepper, stepper_law
+from .partitions import LIMIT_LEVELS, claimed_grids, grids_note, limit_grids, refined_random_grid, run_stepper, stepper_law
 from .trajectory_laws import norms as _norms
 
 
@@ -50,6 +50,9 @@ def check_unique_limit(stepper: Callable, p: Problem, *, levels: Sequence[int] =
     give 0 there, the differences are 0, then ``c h``).  Evidence, not proof: a sequence converging at
     rate ``p`` gives ``tail ≈ 4/(4^p − 1)`` times its last difference, so a slow one is judged leniently.
 
+    A stepper claiming ``grids="uniform"`` is judged on the uniform kind alone: the Cauchy criterion, with no
+    second kind to compare (the record says so, ``details["grids"]``).
+
     Claim: any — every convergent scheme has a unique limit (Section 5.4: it is the unique solution).
     """
     levels = list(levels)
@@ -76,6 +79,7 @@ def check_unique_limit(stepper: Callable, p: Problem, *, levels: Sequence[int] =
             # cell split in K/K0 equal parts (independent random partitions per level have errors C_m h_m
             # with a random C_m, which no own-trend tail can extrapolate)
             gs["random"] = refined_random_grid(p.T, K0, K, seed)
+        gs = {k: g for k, g in gs.items() if k in claimed_grids(stepper, gs, p.T)[0]}    # grids="uniform": one kind
         sols = {g: run_stepper(stepper, p, t) for g, t in gs.items()}
         scale[0] = max(scale[0], max(float(np.max(np.abs(x))) for x in sols.values()))
         runs.append((gs, sols))
@@ -110,6 +114,8 @@ def check_unique_limit(stepper: Callable, p: Problem, *, levels: Sequence[int] =
             re = max(r, LIMIT_RATIO_FLOOR)      # a faster fall than order 1 is pre-asymptotic
             tails[k] = LIMIT_TAIL_SAFETY * c[-1] * re / (1.0 - re) if r < 1.0 else np.inf
         D, info = cross(M, since)
+        if len(kinds) == 1:         # one kind (grids="uniform"): the Cauchy criterion alone
+            return D, info, diffs, tails, ratios, -np.inf, tol, any(r >= 1.0 for r in ratios.values())
         a, b = info["pair"] if info else (kinds[0], kinds[1])
         gap = D - tails[a] - tails[b]
         # a distance before the tails' region (first cells of the coarser levels) is not judged, but
@@ -132,7 +138,15 @@ def check_unique_limit(stepper: Callable, p: Problem, *, levels: Sequence[int] =
     not_cauchy = [k for k, r in ratios.items() if r >= 1.0]
     details = {"levels": levels, "distances": distances, "mesh": [p.T / K for K in levels],
                "differences": diffs, "ratios": ratios, "tails": tails, "criterion": "Cauchy with own-trend tail"}
-    pair = info["pair"] if info else list(tails)[:2]
+    if len(tails) == 1:
+        details["grids"], said = grids_note(["random", "graded"])
+        if not not_cauchy:
+            (kind, r), = ratios.items()
+            return Outcome(r, details=details,
+                           message=f"the differences between successive refinements shrink ({kind}: "
+                                   f"{', '.join(f'{c:.3g}' for c in diffs[kind])}, last ratio {r:.3g}; no rate "
+                                   f"assumed){said}")
+    pair = info["pair"] if info else (list(tails) * 2)[:2]
     worst = D / (tails[pair[0]] + tails[pair[1]] + tol) if not not_cauchy else max(ratios.values())
     if gap <= tol and not not_cauchy:
         return Outcome(worst if gap > 0 else min(worst, 1.0), details=details,

@@ -89,8 +89,22 @@ def check_convergence_order(stepper: Callable, problem: Problem, *, executor: An
     The study chooses its grids for the scheme from the problem's recommended steps
     (:mod:`verimono.core.grid_design`); ``steps`` are run exactly as given, ``step_range = (h_min, h_max)``
     confines it to those steps.  Its verdict (:mod:`verimono.core.verdicts`) may be *undecided*: no asymptotic
-    range above the floor within the budget, a floor the user did not state (the message says what to do)."""
+    range above the floor within the budget, a floor the user did not state (the message says what to do).
+
+    A proximal scheme stating an inexact resolvent, ``ε(h) = C h^q``, must reach ``min(p, q − 1)``
+    (:func:`verimono.core.convergence.inexact_order`); with ``q ≤ 1`` its claim allows errors that never vanish
+    and the law fails before the stepper runs: the claim is the subject's, and it contradicts convergence."""
     exp = expected_order(stepper, problem)
+    inexact = claim_of(stepper).inexact
+    if inexact is not None and not exp.value > 0.0:
+        # the claim itself rules convergence out: K = T/h steps may accumulate Σε_k = C T h^(q-1), which does
+        # not vanish for q <= 1 (verimono.core.convergence.inexact_order) — the proximal scheme claims to converge
+        msg = (f"the stated resolvent tolerance ε(h) = {inexact.describe()} (q = {inexact.exponent(problem.T):g}) "
+               f"lets K = T/h steps accumulate Σε_k ~ h^{exp.value:g}, which does not vanish: no convergence follows "
+               "from the claim (the proximal scheme converges, thm:main; its resolvent must be exact to ε(h) = o(h), "
+               "q > 1)")
+        return Outcome(math.inf, details={"expected": {"order": exp.value, "source": exp.source}}, message=msg,
+                       status=FAILED, counter={"inexact": inexact.describe(), "message": msg})
     if step_range is not None:
         try:
             cells_range(problem.T, step_range)
@@ -115,7 +129,7 @@ def check_convergence_order(stepper: Callable, problem: Problem, *, executor: An
         msg = f"{msg}; {why}"
         if not ok:
             worst = max(worst, details["limit"]["distance"] / details["limit"]["bound"])
-    if not claim_of(stepper).proximal:
+    if not claim_of(stepper).proximal or inexact is not None:
         details["expected"] = {"order": exp.value, "source": exp.source}
     if study.added:         # the cells of the grids the study chose itself (coarser, finer)
         details["grids_added"] = [study.steps[i] for i in study.added]

@@ -12,6 +12,12 @@ A stepper law is one decorated evaluator (:func:`stepper_law`), of one of two fo
 * otherwise ``check_<law>(stepper, problem, **kw) -> Outcome`` judges the stepper as a whole (a unique
   limit over refinements, a convergence order): :func:`run_once`.
 
+A stepper claiming ``grids="uniform"`` (:class:`verimono.Stepper`: it steps ``t_n = n T/K`` and refuses any
+other partition) is judged on the uniform partitions of the battery only (:func:`claimed_grids`): every kind
+the battery builds has a uniform partition of the same resolution among them, so no law is failed or skipped
+because the stepper refused the others, and each record says which were left out (``details["grids"]``, the
+message).
+
 The laws are stated per initial point: a batch problem is checked through its first row.  Requirements
 (what the stepper claims, what the problem states) are judged before the stepper runs; every exception
 is judged by the core's one policy (:func:`verimono.checks.core.classify`).  Under a unit's time budget
@@ -31,6 +37,7 @@ import numpy as np
 
 from ..core.arrays import as_float64, precision_of
 from ..core.claims import claim_of
+from ..core.grid_design import cells_of
 from ..core.grids import graded_grid, random_grid, uniform_grid, validate_grid
 from ..core.problem import Problem
 from ..records.results import PASSED
@@ -170,6 +177,31 @@ def battery_grids(grids: Any, problem: Problem, seed: int, *, every: bool = Fals
     return {f"grid{i}": validate_grid(g, problem.T) for i, g in enumerate(grids)}
 
 
+def claimed_grids(stepper: Callable | None, parts: dict[str, np.ndarray], T: float
+                  ) -> tuple[dict[str, np.ndarray], list[str]]:
+    """``(kept, left_out)``: the partitions of ``parts`` the stepper claims to run on — the uniform ones
+    (``np.linspace(0, T, K + 1)``: ``t_K = T`` exactly) for ``grids="uniform"``, all of them otherwise — and
+    the names of the others.  A uniform partition of as many cells replaces each one left out that has no
+    uniform twin among ``parts`` (the same resolution, the kind the stepper runs)."""
+    if stepper is None or not claim_of(stepper).uniform:
+        return parts, []
+    kept = {k: g for k, g in parts.items() if cells_of(g, T) is not None}
+    left = [k for k in parts if k not in kept]
+    for k in left:
+        K = len(parts[k]) - 1
+        if not any(len(g) == K + 1 for g in kept.values()):
+            kept[f"uniform K={K}"] = uniform_grid(T, steps=K)
+    return kept, left
+
+
+def grids_note(left_out: list[str]) -> tuple[dict, str]:
+    """What a record of a ``grids="uniform"`` stepper says of its partitions: ``details["grids"]`` and the
+    message's suffix."""
+    return ({"claimed": "uniform", "left_out": list(left_out)},
+            " — on uniform partitions only (the stepper claims grids='uniform'"
+            + (f"; left out: {', '.join(left_out)})" if left_out else ")"))
+
+
 def _prefix_failure(decl: Any, stepper: Callable, p: Problem, grid: np.ndarray, k: int, kw: dict) -> Outcome | None:
     """The law re-evaluated on the prefix ``[0, t_k]`` of ``grid``, when that still fails."""
     try:
@@ -197,6 +229,9 @@ def run_on_grids(decl: Any, stepper: Callable, problem: Problem, *, grids: Any =
         return run(decl, subject, lambda: any_form(stepper, p, seed=seed), stepper=stepper, problem=p)
     parts = battery_grids(grids, p, seed, every=decl.name in EVERY_GRID, stepper=stepper,
                           study=decl.name in STUDY_GRID)
+    left_out: list[str] | None = None
+    if grids is None and claim_of(stepper).uniform:       # the partitions it runs on (module docstring)
+        parts, left_out = claimed_grids(stepper, parts, p.T)
     kw = {"seed": seed, **kw}
 
     def evaluate() -> Outcome:
@@ -208,6 +243,9 @@ def run_on_grids(decl: Any, stepper: Callable, problem: Problem, *, grids: Any =
         gname = max(outcomes, key=lambda g: outcomes[g].worst)
         out = outcomes[gname]
         out.details = {"worst_by_grid": {g: o.worst for g, o in outcomes.items()}, **out.details}
+        if left_out is not None:
+            out.details["grids"], said = grids_note(left_out)
+            out.message = (out.message or "") + said
         if not out.failed:
             return out
         grid = parts[gname]
@@ -259,4 +297,4 @@ def stepper_law(name: str, label: str, *requires: Any, over_grids: bool = True,
 
 __all__ = ["stepper_law", "run_on_grids", "run_once", "run_stepper", "single", "default_grids", "limit_grids",
            "battery_grids", "every_battery_grid", "refined_random_grid", "DEFAULT_CELLS", "RANDOM_SPREAD",
-           "ANY_SCHEME_FORM", "EVERY_GRID", "STUDY_GRID"]
+           "ANY_SCHEME_FORM", "EVERY_GRID", "STUDY_GRID", "claimed_grids", "grids_note"]

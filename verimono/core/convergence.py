@@ -67,11 +67,37 @@ def expected_order(stepper: Callable, problem: Problem) -> Order | None:
     ``min(claimed, regularity)`` for a scheme claiming ``scheme="any"`` with an order (:meth:`Order.for_claim`),
     the claim alone where the problem states none."""
     claim = claim_of(stepper)
+    if claim.proximal and claim.inexact is not None:
+        return inexact_order(claim.inexact, problem)
     if claim.proximal:
         return problem.order
     if problem.order is None:
         return Order(claim.order, "the claimed order (the problem states no regularity)")
     return problem.order.for_claim(claim.order)
+
+
+def inexact_order(inexact: Any, problem: Problem) -> Order | None:
+    """The order of the proximal scheme whose resolvent is within ``ε(h) = C h^q`` of the exact one
+    (:class:`verimono.core.claims.Inexact`): ``min(p, q − 1)`` with ``p`` the problem's order for the exact
+    scheme (``q − 1`` where it is exact at the nodes).
+
+    Derivation (Rockafellar's criterion (A) accumulated over the steps; /work/shared/literature.md, "Inexact
+    resolvents"): write ``x_{k+1} = J_k(z_k) + e_k``, ``|e_k| ≤ ε(h)``, and ``x̂`` for the exact scheme from
+    the same ``x0``.  The resolvent is nonexpansive (Proposition ``prop:maxmon-resolvent-Yosida`` ii) and the
+    explicit part ``z ↦ z + h f(z)`` grows distances by at most ``1 + hL ≤ e^{hL}``, so
+    ``|x_{k+1} − x̂_{k+1}| ≤ e^{hL}|x_k − x̂_k| + ε(h)`` and ``|x_K − x̂_K| ≤ e^{LT} K ε(h) = e^{LT} C T h^{q−1}``
+    on ``K = T/h`` steps; with ``|x̂_K − x(T)| = O(h^p)`` the error is ``O(h^p + h^{q−1})``.  The bound is
+    attained (a projection stopped ``ε`` short on the same side every step), so nothing better is expected."""
+    q = inexact.exponent(problem.T)
+    src = (f"the resolvent's stated tolerance ε(h) = {inexact.describe()}: K = T/h steps accumulate Σε_k = O(h^(q-1)), "
+           f"q = {q:g} (Rockafellar's criterion (A) summed over the steps; verimono.core.convergence.inexact_order)")
+    base = problem.order
+    if base is None:
+        return Order(q - 1.0, src)
+    if base.exact or base.value is None or q - 1.0 < base.value:
+        return Order(q - 1.0, src + ("" if base.exact else f", below the exact scheme's {base.value:g} ({base.source})"),
+                     regularity=base.regularity, regularity_source=base.regularity_source)
+    return dataclasses.replace(base, source=f"{base.source}; within the stated tolerance's order q - 1 = {q - 1:g}")
 
 
 @dataclasses.dataclass
@@ -263,7 +289,10 @@ def convergence_study(stepper: Callable, problem: Problem, steps: Sequence[Any] 
     if step_range is None and (not given or len(given) < 2):
         raise InvalidProblem("a convergence study needs at least two step sizes or grids (or a step_range)")
     design = problem.order.value if problem.order is not None and not problem.order.exact else 1.0
-    plan = GridPlan(problem.T, study_grids(problem.T, given) if given else [],
+    given_grids = study_grids(problem.T, given) if given else []
+    if claim.uniform:       # it runs on uniform grids only: a given nonuniform grid becomes the uniform one of as many cells
+        given_grids = [np.linspace(0.0, problem.T, len(g)) for g in given_grids]
+    plan = GridPlan(problem.T, given_grids,
                     None if exp is None or exp.exact else exp.value,
                     adaptive=(steps is None) if adapt is None else bool(adapt), step_range=step_range,
                     design_order=design)
@@ -313,7 +342,7 @@ def _assemble(stepper, problem, grids, results, runner, exp, solve_tol, claimed,
     return study
 
 
-__all__ = ["convergence_study", "expected_order", "study_grids", "ConvergenceStudy", "OrderFit", "fit_order",
+__all__ = ["convergence_study", "expected_order", "inexact_order", "study_grids", "ConvergenceStudy", "OrderFit", "fit_order",
            "least_squares_slope", "grid_errors", "exact_on", "solve_floor", "ErrorAccumulator", "Sampler",
            "Decision", "NORMS", "ORDER_SLACK", "ASYMPTOTIC_SPREAD", "STALL_MARGIN", "STALL_FRACTION", "MIN_GRIDS",
            "PARALLEL_MIN_STEPS", "ROUNDOFF_FACTOR", "_timed_run"]
