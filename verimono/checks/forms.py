@@ -61,6 +61,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from ..core.arrays import as_given
+from ..core.errors import InputModified
 
 CONTIGUOUS, INTEGER, STRIDED, SLICE, READONLY, DECLARED = (
     "contiguous", "integer", "strided", "slice", "readonly", "declared_dtype")
@@ -77,10 +78,6 @@ DESCRIBED = {CONTIGUOUS: "a fresh contiguous float64 array",
 SLICE_OFFSET = 3
 #: an integer-valued float64 below this magnitude is exactly an int64 (2^53: every integer below is a float)
 EXACT_INT = 2.0 ** 53
-
-
-class InputModified(Exception):
-    """A member of the subject wrote into the point it was given (or into the buffer around it)."""
 
 
 def integral(x: np.ndarray) -> np.ndarray:

@@ -41,7 +41,7 @@ from ..core.stepping import Trajectory
 from ..core.tolerances import DOMAIN_ORDER_SLACK, current_precision, row_tolerances, tolerance
 from ..records.results import FAILED, PASSED, UNDECIDED
 from .core import CONTRACTION_CLAIM, PROXIMAL_CLAIM, Holds, Member, Outcome
-from .partitions import battery_grids, default_grids, run_stepper, stepper_law
+from .partitions import battery_grids, claimed_grids, default_grids, run_stepper, stepper_law
 from .shared_runs import remembered_value
 
 #: cells of the refinement levels of the vanishing-distance form of ``in_domain``
@@ -542,8 +542,8 @@ def check_trajectory_immutable(stepper: Callable, p: Problem, *, seed: int = 0, 
 
     Claim: every stepper, whatever it claims.
     """
-    parts = list((default_grids(p, seed, IMMUTABLE_CELLS) if grids is None
-                  else battery_grids(grids, p, seed)).values())
+    parts = list(claimed_grids(stepper, default_grids(p, seed, IMMUTABLE_CELLS) if grids is None
+                               else battery_grids(grids, p, seed), p.T)[0].values())    # grids="uniform": its kind
     if len(parts) == 1:     # one partition given: two calls on it (a buffer handed out twice is shared memory)
         parts = parts * 2
     q = p.replace(x0=np.array(p.x0, dtype=float))          # the stepper's own copy of the problem

@@ -112,6 +112,11 @@ class ProxOutputError(VerimonoError, TypeError):
     a list of arrays, a non-scalar value): verimono does not guess which part is the point."""
 
 
+class InputModified(VerimonoError, RuntimeError):
+    """A member of the subject wrote into the point it was given (or into the buffer around it): the caller's
+    array changed (:mod:`verimono.checks.forms`)."""
+
+
 class InvalidCheckArgument(VerimonoError, ValueError):
     """A check was asked to verify nothing: ``examples <= 0``, an empty list of problems, ``T <= 0``, a
     non-positive time budget.  A check that evaluates nothing must not be able to pass."""
@@ -146,6 +151,7 @@ class IncompatibleResults(SchemaError):
 
 
 __all__ = [
+    "InputModified",
     "ProxOutputError",
     "VerimonoError",
     "BatchStepError",
