@@ -432,6 +432,11 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     report = compare_report(steppers, problems, rounds=args.rounds, max_rounds=max(args.rounds, 3 * args.rounds),
                             norm=args.norm)
     report.meta.update({"command": "compare", "target": " ".join(args.targets), "profile": None})
+    # the report's "Reproduce" line: this command as given (compare has no --profile, and its targets and problems
+    # are what it compares), which runs as printed from the same folder
+    again = shlex.join(["verimono", *getattr(args, "argv", ["compare", *args.targets])])
+    for rec in report.results:
+        rec.details.setdefault("reproduce", again)
     return _finish(report, out, None, run_id)
 
 
