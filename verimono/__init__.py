@@ -129,3 +129,7 @@ __all__ = [
     "Adaptive", "ToleranceStudy", "tolerance_study", "solve_adaptive", "work_precision", "WorkPrecisionSet",
     "check_adaptive", "check_tolerance_rate", "check_switching_times",
 ]
+
+# a stepper (or a law) raises it for a problem it does not apply to: a counted skip with the reason, never a failure
+from .core.errors import NotApplicable as NotApplicable  # noqa: E402
+__all__.append("NotApplicable")

@@ -28,7 +28,11 @@
         in the temporary folder, and a one-line message names both paths (exit 2).
     verimono check MODULE:OBJECT [--profile P] [--out DIR] [--seed N] [run's --timeout, --executor, ...]
         The operator battery on an operator, or the stepper battery on a stepper ``f(problem, t_grid)``;
-        MODULE is a dotted module name or a ``.py`` file (anything else: exit 2).  Its units run on every
+        MODULE is a dotted module name or a ``.py`` file (anything else: exit 2).  ``--problem MODULE:OBJECT``
+        adds the user's problems to the references; ``--only`` runs exactly the problems named with
+        ``--problem`` (and ``--reference``): no catalog, no generated problems.  A stepper raising
+        ``verimono.NotApplicable`` on a problem it does not handle (an ODE integrator on a set-valued ``F``) gets
+        counted skips with its reason there, never failures.  Its units run on every
         core as ``run``'s do (``--executor serial``: in this process).  Its files are marked and
         written as ``run``'s; after an interrupt, run the same command again (it has no ``--resume``).
     verimono compare MODULE:A MODULE:B ... (--problem MODULE:OBJECT | --reference ID)... [--out DIR]
@@ -95,7 +99,12 @@ def _context(args: argparse.Namespace, **kw: Any) -> Any:
         except KeyError as exc:
             raise BadTarget(str(exc.args[0])) from None
     extra = [p for spec in getattr(args, "problem", None) or [] for p in _load_problems(spec)]
-    # --problem adds to the references (the catalog, or those chosen with --reference): it never replaces them
+    # --problem adds to the references (the catalog, or those chosen with --reference): it never replaces them,
+    # except under --only: then exactly the problems named (--problem, --reference), no catalog, no generated ones
+    if getattr(args, "only", False):
+        if not extra and not problems:
+            raise BadTarget("--only runs exactly the problems named with --problem (or --reference): name at least one")
+        problems = problems or []
     return RunContext(seed=getattr(args, "seed", None), data_dir=data, problems=problems, extra_problems=extra, **kw)
 
 
@@ -444,6 +453,11 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     report = compare_report(steppers, problems, rounds=args.rounds, max_rounds=max(args.rounds, 3 * args.rounds),
                             norm=args.norm)
     report.meta.update({"command": "compare", "target": " ".join(args.targets), "profile": None})
+    # the report's "Reproduce" line: this command as given (compare has no --profile, and its targets and problems
+    # are what it compares), which runs as printed from the same folder
+    again = shlex.join(["verimono", *getattr(args, "argv", ["compare", *args.targets])])
+    for rec in report.results:
+        rec.details.setdefault("reproduce", again)
     return _finish(report, out, None, run_id)
 
 
@@ -615,6 +629,9 @@ def build_parser() -> argparse.ArgumentParser:
     check.add_argument("--problem", action="append", default=None, metavar="MODULE:OBJECT",
                        help="check a stepper on this Problem (or list of them) too, e.g. one from "
                             "verimono.manufactured_problem (repeatable; with --reference, both)")
+    check.add_argument("--only", action="store_true",
+                       help="run exactly the problems named with --problem (and --reference): not the reference "
+                            "catalog, not the generated problems")
     check.add_argument("--solve-tol", type=float, default=None, metavar="TAU",
                        help="the accuracy of the stepper's inner solve per step (relative to 1 + |x|): errors at "
                             "what it accumulates pass as exact to it")

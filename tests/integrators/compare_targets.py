@@ -10,4 +10,4 @@ problem = linear.lipschitz_input()
 adaptive = vm.Adaptive(vm.solve_adaptive, rate=1.0, order=1.0, scheme="proximal", name="solve_adaptive",
                        tolerances=[1e-2, 10 ** -2.5, 1e-3])
 proximal = vm.Stepper(vm.solve, name="solve (uniform)")
-radau = solve_ivp_stepper("Radau", rate=1.0, order=5, tolerances=[1e-3, 1e-4, 1e-5, 1e-6])
+radau = solve_ivp_stepper("Radau", rate=1.0, order=5, tolerances=[1e-3, 1e-5, 1e-7, 1e-9, 1e-11])

@@ -52,10 +52,28 @@ def test_verdicts(scale):
     assert rec["work_precision"].details["undecided_reason"] == "timing noise"
     # against the number of steps there is no noise: equal curves hold both ways
     assert rec["work_precision_steps"].status == "passed"
-    # a high-order curve whose tightest run is cheaper than the other's loosest is credited with it
-    hi_order = curve("hi", scale * np.array([0.1, 0.2, 0.3]), [1e-6, 1e-9, 1e-12])
+    # a high-order curve measured where the other was too: judged over the common range only
+    hi_order = curve("hi", scale * np.array([0.1, 0.2, 4.0]), [1e-6, 1e-9, 1e-12])
     assert wp(hi_order, slow).compare("hi", "slow")[0] == "passed"
     assert wp(slow, hi_order).compare("slow", "hi")[0] == "failed"
+
+
+@pytest.mark.parametrize("work", ["time", "steps"])
+def test_disjoint_work_ranges_are_undecided(work):
+    # the runs: my_rk45 measured between 0.00026 and 0.0018 s, Radau between 0.00235 and 0.0201 s; Radau
+    # was credited "465x more accurate" at works my_rk45 never ran at.  Neither is compared beyond its runs
+    mine = curve("my_rk45", [0.00026, 0.0006, 0.0018], [1e-3, 1e-4, 1e-5])
+    radau = curve("Radau", [0.00235, 0.006, 0.0201], [1e-7, 1e-10, 1e-12])
+    for a, b in (("my_rk45", "Radau"), ("Radau", "my_rk45")):
+        status, msg, worst = wp(mine, radau).compare(a, b, work)
+        assert status == "undecided" and "share no range of work" in msg and worst != worst, msg
+        assert "noise" not in msg                  # not the timing noise: a run with it exits 2, not 0
+    rec = {r.check: r for r in wp(mine, radau).records()}
+    key = "work_precision" if work == "time" else "work_precision_steps"
+    assert rec[key].status == "undecided" and rec[key].details["undecided_reason"] == "work ranges do not overlap"
+    # the control: overlapping by one run, the same curves are judged (Radau more accurate where both ran)
+    radau_wide = curve("Radau", [0.0015, 0.006, 0.0201], [1e-7, 1e-10, 1e-12])
+    assert wp(mine, radau_wide).compare("my_rk45", "Radau", work)[0] == "failed"
 
 
 def test_records_report_section_and_notebook():

@@ -32,6 +32,7 @@ from ..core.naming import subject_name
 from ..core.problem import Problem
 from ..records.results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult, Report
 from ..records.verdicts import new_record
+from ..execution.timeouts import note_progress, run_unit
 from .core import Holds, Outcome, law, laws_of, record_of_exception, run
 from .partitions import single
 from . import bounds, trajectory_laws  # noqa: F401 - the laws local to steps join the registry
@@ -67,7 +68,8 @@ def _once(decl: Any, stepper: Any, problem: Problem, **kw: Any) -> CheckResult:
      subject="stepper", driver=_once, requires=(Holds(_has_exact),), battery=False)
 def check_tolerance_rate(stepper: Adaptive, problem: Problem, *, controls: Sequence[float] | None = None) -> Outcome:
     """The tolerance study's verdict (module docstring)."""
-    study = tolerance_study(stepper, problem, controls)
+    # each run that returned is stated to the unit budget: stopped between runs, the record is undecided
+    study = tolerance_study(stepper, problem, controls, on_run=lambda k: note_progress(k, True, "tolerance runs"))
     ok, msg = study.verdict()
     if ok is None:
         return Outcome(None, details={"tolerance_study": study.to_dict()}, message=msg, status=UNDECIDED)
@@ -123,6 +125,7 @@ def own_partition_laws(stepper: Adaptive, problem: Problem, *, controls: Sequenc
     try:
         for c in chosen:
             runs[f"own partition ({stepper.control} {c:g})"] = own_run(stepper, p, c)
+            note_progress(len(runs), True, "runs")      # stated to the unit budget (check_adaptive)
     except Exception as exc:   # noqa: BLE001 - the stepper failed on a valid input: every law fails with it
         return [record_of_exception(n, subject, exc) for n in laws]
     replay = Stepper(_Replay(runs, p.x0), scheme="proximal", name=subject_name(stepper),
@@ -194,15 +197,34 @@ def check_adaptive(stepper: Adaptive, problems: Sequence[Problem] | None = None,
     if not problems:
         raise InvalidCheckArgument("check_adaptive was given an empty list of problems: it would verify nothing")
     report = Report()
+    name = subject_name(stepper)
     for p in problems:
-        report.add(check_tolerance_rate(stepper, p, controls=controls))
+        # every check under the unit time budget, as every check of a grid stepper: a stepper that runs past it
+        # is judged by the one policy of a unit out of time (undecided when every run that returned held)
+        subject = f"{name} on {subject_name(p)}"
+        report.add(run_unit(lambda: check_tolerance_rate(stepper, p, controls=controls), check="tolerance_rate",
+                            subject=subject))
         if laws:
-            for rec in own_partition_laws(stepper, p, controls=controls):
+            out = run_unit(lambda: own_partition_laws(stepper, p, controls=controls), check=LOCAL_LAWS[0],
+                           subject=f"{subject} (own steps)")
+            for rec in (out if isinstance(out, list) else _each_law(out)):
                 report.add(rec)
         times = (switching or {}).get(p.name, switching_times(p) if switching is None else None)
         if times is not None and p.exact is not None:
-            report.add(check_switching_times(stepper, p, times=times, controls=controls))
+            report.add(run_unit(lambda: check_switching_times(stepper, p, times=times, controls=controls),
+                                check="switching_times", subject=subject))
     return report
+
+
+def _each_law(timed_out: CheckResult) -> list[CheckResult]:
+    """The records of the laws local to steps whose shared runs ran out of the unit budget: one per law, each
+    with the timeout's status and message (the record keys stay those of a finished battery)."""
+    out = []
+    for n in LOCAL_LAWS:
+        rec = new_record(n, timed_out.subject, timed_out.status, message=timed_out.message,
+                         details=dict(timed_out.details), duration=timed_out.duration)
+        out.append(rec)
+    return out
 
 
 __all__ = ["check_tolerance_rate", "check_switching_times", "own_partition_laws", "check_adaptive", "LOCAL_LAWS",

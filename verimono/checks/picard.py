@@ -71,7 +71,7 @@ def check_picard(stepper: Callable, p: Problem, *, L: float | None = None, itera
         fx = np.array([np.asarray(p.f(x), dtype=float) for x in xl[:-1]])
         Phi = base + np.vstack([np.zeros((1, p.dim)), np.cumsum(h[:, None] * fx, axis=0)])
         q = Problem(p.operator, p.x0, p.T, U=_primitive(t, Phi), name=f"{p.name} (Picard iterate {ell + 1})",
-                    initial_jump=p.initial_jump)
+                    initial_jump=p.initial_jump, data=p.data)
         iterates.append(run_stepper(stepper, q, t))
     E = [np.linalg.norm(iterates[ell + 1] - iterates[ell], axis=1) for ell in range(iterations)]
     E0 = float(np.max(E[0]))

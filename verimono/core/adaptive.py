@@ -386,10 +386,12 @@ class ToleranceStudy:
         return to_jsonable(d)
 
 
-def tolerance_study(stepper: Adaptive, problem: Problem, controls: Sequence[float] | None = None) -> ToleranceStudy:
+def tolerance_study(stepper: Adaptive, problem: Problem, controls: Sequence[float] | None = None, *,
+                    on_run: Callable[[int], None] | None = None) -> ToleranceStudy:
     """Run ``stepper`` at every control (default: its own ``tolerances``, else :data:`DEFAULT_TOLERANCES`, or
     the problem's ``steps`` for ``control="step"``) and fit its errors (module docstring).  The problem must
-    have an exact solution (:class:`verimono.InvalidProblem` otherwise)."""
+    have an exact solution (:class:`verimono.InvalidProblem` otherwise).  ``on_run(k)`` is called after the
+    ``k``-th run returned (the checks state their progress to the unit budget with it)."""
     if not isinstance(stepper, Adaptive):
         raise InvalidClaim(f"a tolerance study needs a verimono.Adaptive stepper, got {subject_name(stepper)}")
     if problem.exact is None:
@@ -405,6 +407,8 @@ def tolerance_study(stepper: Adaptive, problem: Problem, controls: Sequence[floa
         runs.append(run)
         errs.append(e)
         scales.append(sc)
+        if on_run is not None:
+            on_run(len(runs))
     norms = list(errs[0])
     errors = {n: [e[n] for e in errs] for n in norms}
     precision = coarser(*[r.precision for r in runs])

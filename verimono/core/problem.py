@@ -6,7 +6,7 @@ import dataclasses
 import math
 import numbers
 import weakref
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from typing import Any, Callable, Sequence
 
 import numpy as np
@@ -102,6 +102,20 @@ def _steps(steps: Any) -> list[float] | None:
     return out
 
 
+def _data(data: Any) -> dict[str, Any]:
+    """``data`` (the user's own parameters) as a new dict with string keys; ``None`` is ``{}``.  A copy: the
+    caller's mapping changed later does not change the problem (a shallow copy: the values are the caller's)."""
+    if data is None:
+        return {}
+    if not isinstance(data, Mapping):
+        raise InvalidProblem(f"data must be a mapping of the problem's own parameters (a dict), got "
+                             f"{type(data).__name__}")
+    bad = [k for k in data if not isinstance(k, str)]
+    if bad:
+        raise InvalidProblem(f"data's keys must be strings (parameter names), got {bad[0]!r}")
+    return dict(data)
+
+
 @dataclasses.dataclass(frozen=True, init=False, repr=False, eq=False)
 class Problem:
     """``x' ∈ -F(t, x) + f(x) + u(t)`` on ``[0, T]`` with ``x(0) = x0``.
@@ -128,7 +142,11 @@ class Problem:
     quadrature when given), ``lipschitz`` (the Lipschitz constant of ``f``), ``phi``/``sigma``/``theta``
     (the functions of assumptions (A3), (LG), (YB) when known), ``steps`` (step sizes for which the
     expected order is asymptotic), ``initial_jump`` (allow ``x0 ∉ cl dom F(0)``: the catching-up
-    scheme then jumps to the projection in its first step), ``notes``.
+    scheme then jumps to the projection in its first step), ``notes``, and ``data``: the user's own parameters
+    (a mapping with string keys, e.g. ``data={"radius": 0.5, "delay": 0.1}``), carried unchanged to every
+    copy of the problem (:meth:`replace`, the shrinking of a failure, worker processes) so that a
+    problem-specific stepper reads ``problem.data["radius"]`` instead of looking its parameters up by
+    ``problem.name``; verimono never reads it and never writes it into a record or a report.
 
     A frozen dataclass: fields cannot be reassigned; :meth:`replace` (or :func:`dataclasses.replace`)
     builds a changed copy through the same validation.  Equality is identity (the fields hold arrays and
@@ -151,12 +169,14 @@ class Problem:
     steps: list[float] | None = None
     initial_jump: bool = False
     notes: str = ""
+    data: Mapping[str, Any] = dataclasses.field(default_factory=dict)
 
     def __init__(self, operator: Any, x0: Any, T: float, *, f: Callable | None = None,
                  u: Callable | None = None, exact: Callable | None = None, order: Any = None,
                  name: str | None = None, U: Callable | None = None, lipschitz: float | None = None,
                  phi: Callable | None = None, sigma: Callable | None = None, theta: Callable | None = None,
-                 steps: Sequence[float] | None = None, initial_jump: bool = False, notes: str = "") -> None:
+                 steps: Sequence[float] | None = None, initial_jump: bool = False, notes: str = "",
+                 data: Mapping[str, Any] | None = None) -> None:
         if not hasattr(operator, "resolvent") or not hasattr(operator, "dim"):
             raise InvalidProblem(f"operator must be a verimono.Operator (with .dim and .resolvent), got {operator!r}")
         x0 = _finite_array(x0, "x0")
@@ -182,7 +202,7 @@ class Problem:
         fields = dict(operator=operator, x0=x0, T=T, f=f, u=u, exact=exact, order=_as_order(order),
                       name=name or f"{getattr(operator, 'name', 'F')} problem", U=U,
                       lipschitz=_lipschitz(lipschitz), phi=phi, sigma=sigma, theta=theta, steps=_steps(steps),
-                      initial_jump=bool(initial_jump), notes=notes)
+                      initial_jump=bool(initial_jump), notes=notes, data=_data(data))
         for key, value in fields.items():
             object.__setattr__(self, key, value)  # frozen: the one place the fields are set
         if f is not None:

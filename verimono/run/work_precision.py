@@ -17,16 +17,18 @@ interval instead of a minimum.
 (:meth:`WorkPrecisionSet.compare`).  At a work ``W`` a stepper is credited with the best error among its
 runs that cost at most ``W`` and, between two of its runs, the diagram's line (``log error`` linear in
 ``log work``) where that is better (:func:`envelope`); errors below the round-off floor count at the floor.
-From the work at which both can run (the larger of their cheapest runs) to the largest work measured, A
-*holds* when its credited error, its work taken at the upper ends of its time intervals, is nowhere above
+Over the range of work where both were measured — from the larger of their cheapest runs to the smaller of
+their costliest (the overlap of their CPU-time ranges, or of their step-count ranges) — A *holds* when its credited error, its work taken at the upper ends of its time intervals, is nowhere above
 B's with B's at the lower ends (A at least as accurate even with the noise against it); it *fails* when,
 somewhere, A's credited error with its work at the lower ends is above B's with B's at the upper ends (B
 more accurate for the same work even with the noise in A's favour); otherwise the noise cannot decide, and
 the rounds are measured again once up to ``max_rounds`` (each look at ``α/2``, as
 :func:`verimono.execution.timing.judge`), then the verdict is *undecided* with ``undecided_reason = "timing
 noise"`` — which does not fail a run.  Against the number of steps there is no noise: holds or fails.  No
-extrapolation: a high-order stepper whose tightest run costs less than a low-order one's loosest is credited
-beyond it with that run's error (it can be run there), never with a better one.
+extrapolation: curves measured over disjoint ranges of work (a high-order stepper whose tightest run costs
+less than a low-order one's loosest) are not compared — neither was run at the other's work — and the verdict
+is *undecided* with ``undecided_reason = "work ranges do not overlap"`` (:data:`WORK_RANGE_REASON`), naming
+both ranges and which controls would make them meet.
 
 Records: ``work_precision[A vs B on P]`` (CPU time) and ``work_precision_steps[A vs B on P]`` for the first
 stepper A against each other B, the set in ``details["work_precision"]`` (the report's diagram).
@@ -59,6 +61,8 @@ NORMS = ("sup", "l2", "final")
 #: outlying round on each side) and the budget of a second look (:mod:`verimono.run.performance`'s)
 ROUNDS, MAX_ROUNDS = 9, 27
 WORKS = ("time", "steps")
+#: why a comparison is undecided when the two curves were measured over disjoint ranges of work
+WORK_RANGE_REASON = "work ranges do not overlap"
 
 
 @dataclasses.dataclass
@@ -140,17 +144,29 @@ class WorkPrecisionSet:
         wA_good, wB_bad = A.work(work, sides[1]), B.work(work, sides[0])          # the noise for A
         if np.any(wA_bad <= 0) or np.any(wB_bad <= 0) or not (np.all(np.isfinite(wA_bad)) and np.all(np.isfinite(wB_bad))):
             return UNDECIDED, f"the {what} could not be bounded (too few rounds)", math.nan
-        lo = max(wA_bad.min(), wB_good.min())            # where both can run (the noise against A)
-        hi = max(wA_bad.max(), wB_good.max(), wA_good.max(), wB_bad.max())
+        mA, mB = A.work(work), B.work(work)
+        lo, hi = max(mA.min(), mB.min()), min(mA.max(), mB.max())
+        if lo > hi:        # measured over disjoint ranges: neither is credited with what it was not run at
+            return UNDECIDED, (f"{a} ran at {what} {mA.min():.3g}-{mA.max():.3g} and {b} at {mB.min():.3g}-"
+                               f"{mB.max():.3g}: the curves share no range of work, so no comparison for the same "
+                               f"{what} was measured ({WORK_RANGE_REASON}; give {a} {'tighter' if mA.max() < lo else 'looser'} "
+                               f"controls, or {b} {'looser' if mA.max() < lo else 'tighter'} ones)"), math.nan
         every = np.concatenate([wA_bad, wB_good, wA_good, wB_bad])
-        at = np.unique(np.concatenate([[lo], every[(every >= lo) & (every <= hi)]]))
-        against = envelope(wA_bad, eA, at) / envelope(wB_good, eB, at)
-        lo_f = max(wA_good.min(), wB_bad.min())          # with the noise for A
-        at_f = np.unique(np.concatenate([[lo_f], every[(every >= lo_f) & (every <= hi)]]))
-        favour = envelope(wA_good, eA, at_f) / envelope(wB_bad, eB, at_f)
+
+        def ratios(wa: np.ndarray, wb: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            """A's credited error over B's at the works both were measured at (``wa``, ``wb``: the sides)."""
+            s_lo, s_hi = max(wa.min(), wb.min()), min(wa.max(), wb.max())
+            if s_lo > s_hi:              # the noise leaves no common range on this side
+                return np.array([math.inf]), np.array([s_lo])
+            at = np.unique(np.concatenate([[s_lo, s_hi], every[(every >= s_lo) & (every <= s_hi)]]))
+            return envelope(wa, eA, at) / envelope(wb, eB, at), at
+
+        against, _ = ratios(wA_bad, wB_good)             # the noise against A
+        favour, at_f = ratios(wA_good, wB_bad)           # the noise for A
+        favour = np.where(np.isfinite(favour), favour, 0.0)   # no common range with the noise for A: no failure seen
         worst = float(against.max())
         k = int(np.argmax(favour))
-        rng = f"{what} {lo:.3g}-{hi:.3g}"
+        rng = f"{what} {lo:.3g}-{hi:.3g}, where both were measured"
         if worst <= 1.0:
             noise = ", within the measured noise" if work == "time" else ""
             return PASSED, (f"{a} is at least as accurate as {b} for the same {what}{noise} ({norm} error at most "
@@ -183,7 +199,9 @@ class WorkPrecisionSet:
         out = []
         for v in self.verdicts(subject):
             details: dict[str, Any] = {"work": v["work"], "norm": self.norm, "baseline": v["baseline"]}
-            if v["status"] == UNDECIDED and v["work"] == "time" and "noise" in v["message"]:
+            if v["status"] == UNDECIDED and WORK_RANGE_REASON in v["message"]:
+                details["undecided_reason"] = WORK_RANGE_REASON
+            elif v["status"] == UNDECIDED and v["work"] == "time" and "noise" in v["message"]:
                 details["undecided_reason"] = timing.NOISE_REASON
             if v["work"] == "time":
                 details["work_precision"] = self.to_dict()

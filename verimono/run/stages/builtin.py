@@ -196,8 +196,9 @@ def trajectory_laws_stage(profile: Profile, context: RunContext) -> Report:
     problem list, on ``profile.generated_subjects`` sampled problems)."""
     stepper = solve if context.stepper is None else context.stepper
     seed = context.seed_for(profile)
-    checks = list(stepper_checks(stepper, context.problems, seed=0 if seed is None else seed,
-                                     generated=profile.generated_subjects, orders=False))
+    checks = [] if context.problems == [] else \
+        list(stepper_checks(stepper, context.problems, seed=0 if seed is None else seed,
+                            generated=profile.generated_subjects, orders=False))   # [] under `check --only`
     if context.extra_problems:      # --problem: besides the references and the sampled problems
         checks += stepper_checks(stepper, context.extra_problems, seed=0 if seed is None else seed, orders=False)
     # one unit per subject problem (the battery of checks ``law[problem]`` on it), in first-seen order;
