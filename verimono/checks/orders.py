@@ -31,7 +31,7 @@ from ..core.grids import uniform_grid
 from ..core.problem import Problem, origin_of
 from ..records.results import FAILED, PASSED, UNDECIDED
 from ..core.stepping import solve
-from .core import Holds, Outcome, law, subject_name
+from .core import Outcome, law, subject_name
 from .partitions import run_once
 from .shared_runs import note_partitions
 
@@ -49,7 +49,7 @@ def limit_agreement(stepper: Callable, study: Any, problem: Problem) -> tuple[bo
     their estimated errors there (each from its own study on the same grids), plus both round-off floors."""
     grids = study.grids()                         # coarse to fine, the grids the study chose
     if any(g is None for g in grids):             # explicit nonuniform grids: those the problem gave
-        grids = sorted(study_grids(problem.T, problem.steps), key=len)
+        grids = sorted(study_grids(problem.T, default_steps(problem)), key=len)
     k = int(np.argmin(study.mesh))
     grid = grids[k]
     ref = convergence_study(solve, problem, [grids[int(np.argsort(study.mesh)[1])], grid], adapt=False)
@@ -66,8 +66,16 @@ def limit_agreement(stepper: Callable, study: Any, problem: Problem) -> tuple[bo
                    f"estimated errors {e_ours:.3g} + {e_ref:.3g}: self-convergence alone does not show the limit"), info
 
 
-def _states_order(p: Problem) -> str | None:
-    return None if p.order is not None and p.steps else "the problem states no expected order or no step sizes"
+#: the step sizes of a study on a problem that states none, as fractions of ``T`` (the study adds coarser and finer
+#: grids as its verdict asks, :mod:`verimono.core.grid_design`)
+DEFAULT_STEPS = (1 / 10, 1 / 20, 1 / 40, 1 / 80)
+
+
+def default_steps(p: Problem) -> list[float]:
+    """The problem's recommended step sizes, or :data:`DEFAULT_STEPS` of its horizon: every problem is studied
+    (issue 40: a problem without an exact solution against a fine-grid reference, at the order the stepper
+    claims or the theorem gives, never a silent skip)."""
+    return list(p.steps) if p.steps else [p.T * f for f in DEFAULT_STEPS]
 
 
 def run_order(decl: Any, stepper: Callable, problem: Problem, steps: Any = None, executor: Any = None,
@@ -79,7 +87,7 @@ def run_order(decl: Any, stepper: Callable, problem: Problem, steps: Any = None,
 
 
 @law("convergence_order", "thm:main (convergence) and each reference's stated order", subject="stepper",
-     driver=run_order, requires=(Holds(_states_order),))
+     driver=run_order)
 def check_convergence_order(stepper: Callable, problem: Problem, *, executor: Any = None, steps: Any = None,
                             step_range: Any = None) -> Outcome:
     """Whether ``stepper`` reaches the order it must on ``problem`` (one record, study in ``details``): the
@@ -111,7 +119,8 @@ def check_convergence_order(stepper: Callable, problem: Problem, *, executor: An
         except InvalidProblem as exc:       # a range that fits this problem's horizon no study: nothing decided
             return Outcome(None, message=f"not studied: {exc}", status=UNDECIDED)
     try:
-        study = convergence_study(stepper, problem, steps, step_range=step_range, executor=executor,
+        study = convergence_study(stepper, problem, steps if steps is not None or step_range is not None or problem.steps
+                                  else default_steps(problem), step_range=step_range, executor=executor,
                                   adapt=steps is None and step_range is None)
     except NotImplementedError as exc:
         refused = _refuses_fine_grids(stepper, problem, exc)
@@ -144,16 +153,16 @@ def _refuses_fine_grids(stepper: Callable, problem: Problem, exc: NotImplemented
     (NotImplementedError) on a finer one — convergence is a statement about every partition as ``h → 0``, so
     it cannot be shown, and such a stepper was reported ok (its order record skipped, the stage passed) —
     or ``None`` when the coarsest grid raises too (the stepper does not run this problem at all)."""
-    h = max(problem.steps)
+    h = max(default_steps(problem))
     try:
         stepper(problem, uniform_grid(problem.T, h))
     except NotImplementedError:
         return None
     msg = (f"the stepper runs the coarsest grid (h = {h:g}) but raised NotImplementedError on a finer one of the "
-           f"study (h = {', '.join(f'{s:g}' for s in problem.steps)}): {exc}; convergence is a statement about every "
+           f"study (h = {', '.join(f'{s:g}' for s in default_steps(problem))}): {exc}; convergence is a statement about every "
            "partition as h → 0, so a stepper that refuses fine grids cannot be shown to converge")
     return Outcome(math.inf, details={"refused_grids": f"NotImplementedError: {exc}"}, message=msg, status=FAILED,
-                   counter={"steps": list(problem.steps), "message": msg})
+                   counter={"steps": default_steps(problem), "message": msg})
 
 
 def reproduction_script(problem: Problem) -> str:

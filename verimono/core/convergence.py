@@ -62,15 +62,23 @@ def solve_floor(steps: int, solve_tol: float, scale: float) -> float:
     return float(steps) * float(solve_tol) * (1.0 + float(scale))
 
 
+#: the order of the proximal scheme on a problem that states none: ``O(h^{1/2})`` for a maximal monotone ``F``
+#: and ``x0 ∈ dom F`` (Crandall–Liggett; Rulla, SIAM J. Numer. Anal. 1996; for moving sets with Lipschitz
+#: motion, Moreau's catching-up estimate: shared/literature.md), which the paper's setting contains
+GENERAL_ORDER = Order(0.5, "the proximal scheme's order for a maximal monotone F with x0 in dom F(0), O(h^(1/2)) "
+                           "(Crandall-Liggett; Rulla 1996; Moreau's catching-up): the problem states none")
+
+
 def expected_order(stepper: Callable, problem: Problem) -> Order | None:
-    """The order ``stepper`` must reach on ``problem``: the reference's order for the proximal scheme,
+    """The order ``stepper`` must reach on ``problem``: the reference's order for the proximal scheme (on a
+    problem that states none, the general :data:`GENERAL_ORDER`),
     ``min(claimed, regularity)`` for a scheme claiming ``scheme="any"`` with an order (:meth:`Order.for_claim`),
     the claim alone where the problem states none."""
     claim = claim_of(stepper)
     if claim.proximal and claim.inexact is not None:
         return inexact_order(claim.inexact, problem)
     if claim.proximal:
-        return problem.order
+        return GENERAL_ORDER if problem.order is None else problem.order
     if problem.order is None:
         return Order(claim.order, "the claimed order (the problem states no regularity)")
     return problem.order.for_claim(claim.order)
