@@ -15,8 +15,9 @@ ways:
    form in ``d`` whose worst direction is an extreme eigenvector: of ``sym M`` (monotonicity of ``J`` and of
    ``I − J``, i.e. of ``F`` and ``Y_λ``), of ``MᵀM`` (nonexpansiveness), of ``MᵀM − sym M`` (firm
    nonexpansiveness, ``λ``-cocoercivity of ``Y_λ``) and of ``(I − M)ᵀ(I − M)`` (the Lipschitz constant of
-   ``λY_λ``).  Both extreme eigenvectors of each, with both signs, at radius ``r`` and ``r/1000``;
-2. **the sphere**: ``points`` directions drawn uniformly on ``S^{n-1}`` (normalised Gaussians, seeded);
+   ``λY_λ``).  Both extreme eigenvectors of each, with both signs, at radius ``r``;
+2. **the sphere**: ``points`` directions drawn uniformly on ``S^{n-1}`` (normalised Gaussians, seeded), at most
+   :data:`PER_DIMENSION` ``n``;
 3. **refinement**: a (1+1) evolution strategy on the sphere from the worst direction found — a random
    rotation by an angle ``θ`` kept when the ratio grows (``θ`` × 1.5), ``θ`` × 0.8 otherwise — with
    ``points / 2`` evaluations, down to :data:`FINEST` radians.
@@ -42,9 +43,17 @@ from .samples import NUMPY_DIM, Sample
 FIRST_ANGLE = 0.3
 FINEST = 1e-4
 #: the radii of the sketch's candidate directions, relative to the worst pair's ``r``
-SKETCH_RADII = (1.0, 1e-3)
+SKETCH_RADII = (1.0,)
+#: directions drawn per dimension at most (:func:`drawn_count`)
+PER_DIMENSION = 4
 #: the distance of the pair searched when the worst sample is a pair ``x1 = x2``, relative to ``1 + |x1|``
 PAIR_RADIUS = 1e-2
+
+
+def drawn_count(points: int, n: int) -> int:
+    """Directions drawn on ``S^{n-1}``: the budget's ``points``, but no more than :data:`PER_DIMENSION` per
+    dimension (the circle of ``R^2`` needs no 729 directions; the sketch and the refinement cover the rest)."""
+    return max(1, min(int(points), PER_DIMENSION * n))
 
 
 def _unit(v: np.ndarray) -> np.ndarray | None:
@@ -116,7 +125,7 @@ def direction_search(evaluate: Callable[[Sample], float], op: Any, s: Sample, po
             for sign in (1.0, -1.0):
                 ev(sign * d, radius)
                 count += 1
-    for _ in range(max(1, int(points))):
+    for _ in range(drawn_count(points, n)):
         d = _unit(rng.standard_normal(n))
         if d is not None:
             ev(d)
@@ -140,7 +149,8 @@ def direction_search(evaluate: Callable[[Sample], float], op: Any, s: Sample, po
             theta *= 0.8
     return {"coordinate": "direction", "read": True, "points": count, "log": False, "unit": "rad",
             "range": [0.0, math.pi], "resolution": float(min(theta, FIRST_ANGLE)), "sphere": f"S^{n - 1}",
-            "drawn": int(points), "sketched": len(sketched)}
+            "drawn": drawn_count(points, n), "sketched": len(sketched)}
 
 
-__all__ = ["direction_search", "sketch_directions", "FIRST_ANGLE", "FINEST", "SKETCH_RADII"]
+__all__ = ["direction_search", "sketch_directions", "drawn_count", "FIRST_ANGLE", "FINEST", "SKETCH_RADII",
+           "PER_DIMENSION"]
