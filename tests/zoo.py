@@ -153,7 +153,7 @@ def build(name: str) -> Operator:
     return ZOO[name][0]()
 
 
-# -- the input's form (verimono.checks.forms): bugs that only arrays other than fresh contiguous float64 meet --
+# -- the input's form (verimono.checks.engine.forms): bugs that only arrays other than fresh contiguous float64 meet --
 
 _BALL = sets.Ball([0.0, 0.0], 1.0)
 _BALL_CONE = NormalCone(_BALL)

@@ -14,7 +14,7 @@ import verimono as vm
 from verimono.checks import core
 from verimono.checks.assumptions import ASSUMPTION_LAWS, check_assumptions
 from verimono.checks.operator_battery import LAWS as OPERATOR_LAWS
-from verimono.checks.search import ROOT_LAW
+from verimono.checks.engine.search import ROOT_LAW
 from verimono.checks.stepper_battery import CHECKS, LAWS as STEPPER_LAWS
 from verimono.reference import get
 from verimono.records.results import CheckResult

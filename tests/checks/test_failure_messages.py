@@ -17,7 +17,7 @@ import pytest
 import zoo
 from verimono.checks import run_law
 from verimono.checks.core import Outcome
-from verimono.checks.search import violation_text
+from verimono.checks.engine.search import violation_text
 
 NUM = r"([-+]?(?:\d+\.?\d*(?:e[-+]?\d+)?|inf|nan))"
 STATED = re.compile(r"lhs " + NUM + r" > rhs " + NUM + r" \+ slack " + NUM)

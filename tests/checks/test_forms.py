@@ -1,4 +1,4 @@
-"""The input's form (verimono.checks.forms): the operator laws pass a sample's points as int64, as strided and
+"""The input's form (verimono.checks.engine.forms): the operator laws pass a sample's points as int64, as strided and
 offset views into garbage, read-only and in the declared dtype; a member that writes into its input fails.
 The zoo's form bugs (tests/zoo.py) are seen failing in tests/checks/test_operator_laws.py; here the forms
 themselves, the record and the replay, and the lawful controls."""
@@ -11,9 +11,9 @@ import pytest
 import zoo
 import verimono as vm
 from verimono.checks import LAWS, check_operator, run_law
-from verimono.checks.forms import (FORMS, INTEGER, READONLY, SLICE, STRIDED, InputModified, form_search, forms_for,
+from verimono.checks.engine.forms import (FORMS, INTEGER, READONLY, SLICE, STRIDED, InputModified, form_search, forms_for,
                                    in_form)
-from verimono.checks.samples import Sample
+from verimono.checks.engine.samples import Sample
 
 BALL = vm.sets.Ball([0.0, 0.0], 1.0)
 

@@ -10,8 +10,8 @@ import pytest
 
 import verimono as vm
 from verimono.checks import operator_laws, prox_laws  # noqa: F401 - the laws register on import
-from verimono.checks.samples import Sample
-from verimono.checks.search import run_law
+from verimono.checks.engine.samples import Sample
+from verimono.checks.engine.search import run_law
 from verimono.records.results import FAILED, PASSED
 
 pyproximal = pytest.importorskip("pyproximal", reason="PyProximal is in the test extra")

@@ -109,7 +109,7 @@ def test_yosida_limit_at_a_kink_reached_through_rounded_shifts():
     import numpy as np
     import verimono as vm
     from verimono.checks.operator_laws import check_yosida_limit
-    from verimono.checks.samples import Sample
+    from verimono.checks.engine.samples import Sample
 
     op = vm.Shifted(vm.Shifted(vm.NormSubdifferential(1.0), [0.1]), [0.2])
     sample = Sample(np.zeros(1), np.zeros(1), 1.0, 1.0, 1.0, 0.0)
@@ -132,7 +132,7 @@ def test_yosida_limit_next_to_a_kink_closer_than_the_rounding_floor():
     import numpy as np
     import verimono as vm
     from verimono.checks.operator_laws import check_yosida_limit
-    from verimono.checks.samples import Sample
+    from verimono.checks.engine.samples import Sample
 
     op = vm.Shifted(vm.L1Subdifferential(1.0, dim=2), lambda t: np.array([t, t]))
     s = Sample(np.array([1.0, 1e-8]), np.zeros(2), 1.0, 1.0, 1.0, 1.0)
@@ -153,7 +153,7 @@ def test_yosida_limit_where_min_norm_and_resolvent_round_a_kink_differently():
     import numpy as np
     import verimono as vm
     from verimono.checks.operator_laws import check_yosida_limit
-    from verimono.checks.samples import Sample
+    from verimono.checks.engine.samples import Sample
 
     c = np.array([2.0, 0.5])
     soft = lambda z, lam, t: np.sign(z) * np.maximum(np.abs(z) - lam * c, 0.0)          # noqa: E731
@@ -175,7 +175,7 @@ def test_laws_on_points_closer_than_the_square_root_of_the_smallest_double():
     import numpy as np
     import verimono as vm
     from verimono.checks.operator_laws import check_yosida_monotone
-    from verimono.checks.samples import Sample
+    from verimono.checks.engine.samples import Sample
 
     s = Sample(np.zeros(1), np.array([-1.882470261721448e-250]), 0.5, 1.0, 1.0, 0.0)
     assert check_yosida_monotone(vm.LogBarrier(1.0), sample=s).status == "passed"
@@ -185,7 +185,7 @@ def test_default_effort_follows_the_profile(monkeypatch):
     """examples=None: the run configuration's profile's ``law_examples`` (dev/ci/thorough) is the effort, and
     its sweep the sweep, recorded in the record's details and the report's meta; an explicit ``examples``
     still wins.  The API's ``profile=`` chooses it for one call; the environment does not overrule it."""
-    from verimono.checks.sweep import sweep_count
+    from verimono.checks.engine.sweep import sweep_count
     from verimono.execution.config import using
     from verimono.execution.profiles import get_profile
 
@@ -217,7 +217,7 @@ def _rejecting(contains_result=False):
 def test_min_norm_least_with_an_always_rejecting_contains_is_never_passed():
     """Every y0 is uncertified: each sample is inconclusive, counted, and the record is skipped, not passed."""
     from verimono.checks.operator_laws import check_min_norm_least
-    from verimono.checks.samples import Sample
+    from verimono.checks.engine.samples import Sample
 
     r = check_min_norm_least(_rejecting(), seed=0, examples=15)
     assert r.status == "skipped", str(r)
@@ -233,7 +233,7 @@ def test_inconclusive_samples_of_yosida_limit_are_counted():
     """The rounding-kink sample of yosida_limit is inconclusive: alone it gives a skip; counted in details."""
     import verimono as vm
     from verimono.checks.operator_laws import check_yosida_limit
-    from verimono.checks.samples import Sample
+    from verimono.checks.engine.samples import Sample
 
     op = vm.Shifted(vm.Shifted(vm.NormSubdifferential(1.0), [0.1]), [0.2])
     r = check_yosida_limit(op, sample=Sample(np.zeros(1), np.zeros(1), 1.0, 1.0, 1.0, 0.0))
@@ -345,7 +345,7 @@ def test_a_limit_of_verimonos_own_solvers_is_undecided_never_failed_nor_passed()
 def test_a_law_sees_the_numpy_draws_then_a_short_hypothesis_search_then_the_sweep_then_the_coordinates():
     """examples NumPy draws, then examples // HYPOTHESIS_SHARE hypothesis examples (at least HYPOTHESIS_MIN),
     then the scale sweep, then the coordinate search: every sample counted once in details["evaluations"]."""
-    from verimono.checks import search as L
+    from verimono.checks.engine import search as L
     from verimono.reference import get
 
     op = get("t|x| (n=3)").operator
@@ -361,7 +361,7 @@ def test_a_violation_only_the_draws_meet_is_shrunk_and_replays(monkeypatch):
     the NumPy draws: recorded as theirs, shrunk greedily, and replayed by sample=."""
     from hypothesis import strategies as st
 
-    from verimono.checks import coordinates, samples, search as L
+    from verimono.checks.engine import coordinates, samples, search as L
 
     harmless = st.just(samples.Sample(np.zeros(2), np.zeros(2), 1.0, 1.0, 1.0, 0.0))
     monkeypatch.setattr(L, "law_samples", lambda n, horizon=1.0: harmless)
@@ -381,8 +381,8 @@ def test_law_draws_are_seeded_in_range_and_favour_simple_values():
     """The NumPy draws follow law_samples: x1 in [-10, 10]^n, x2 within 1e-2 of x1 about half the time, step
     sizes in [1e-3, 10] (the strategy's simple ones about half the time), t in [0, T]; the same seed draws
     the same samples, another seed others."""
-    from verimono.checks.samples import Sample
-    from verimono.checks.sweep import law_draws
+    from verimono.checks.engine.samples import Sample
+    from verimono.checks.engine.sweep import law_draws
 
     a = law_draws(3, 5, 2.0, 400, Sample)
     assert [s.to_dict() for s in a] == [s.to_dict() for s in law_draws(3, 5, 2.0, 400, Sample)]

@@ -11,7 +11,7 @@ import pytest
 
 import verimono as vm
 from verimono.checks import operator_laws, prox_laws  # noqa: F401 - the laws join the registry on import
-from verimono.checks.search import run_law
+from verimono.checks.engine.search import run_law
 
 
 def ball_projection32(x, lam):

@@ -1,5 +1,5 @@
 """Issue 32 for the operator laws: a violation confined to a narrow band of ``λ`` or to the points just
-outside the domain is searched for (:mod:`verimono.checks.coordinates`, the sweep), and a subject that raises
+outside the domain is searched for (:mod:`verimono.checks.engine.coordinates`, the sweep), and a subject that raises
 on part of its domain or in the batched calls it declared is never ok (item 7).  Each planted subject
 passed before; each has its lawful control."""
 
@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 from verimono import operator_from_resolvent
-from verimono.checks.batches import batch_sizes
+from verimono.checks.engine.batches import batch_sizes
 from verimono.checks.operator_battery import check_operator
-from verimono.checks.search import MIN_EVALUATED, run_law
-from verimono.checks.supremum import budgets
+from verimono.checks.engine.search import MIN_EVALUATED, run_law
+from verimono.checks.engine.supremum import budgets
 from verimono.records.results import FAILED, PASSED, SKIPPED, UNDECIDED
 
 
@@ -127,7 +127,7 @@ def test_a_law_with_too_few_evaluated_samples_is_undecided(monkeypatch):
     # verimono's own solver decides only points with no positive coordinate: a handful of the ~60 samples of
     # the draws, hypothesis and the sweep have both points so, fewer than the stated minimum — undecided with
     # the counts, not passed on them (the coordinate phase, which would multiply the decided sample, is off)
-    from verimono.checks import search as L
+    from verimono.checks.engine import search as L
     from verimono.core.errors import UnverifiedSolution
 
     monkeypatch.setattr(L, "_coordinates", lambda *a, **k: None)

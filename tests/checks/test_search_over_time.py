@@ -4,7 +4,7 @@ are claims about every t, and every record says what was searched.
 Each test plants a violation on a window of width ``T/w`` at an irrational time (``1/π``, ``e/7``, ``√2/5``,
 ...), where the seven sample times and the 16-cell grid of issue 24 were blind (each of these passed before),
 and puts the lawful control beside it: the same subject with the bound holding by a 1% margin, or the
-spike within the stated bound.  Budgets are set with :func:`verimono.checks.supremum.budgets` so that the
+spike within the stated bound.  Budgets are set with :func:`verimono.checks.engine.supremum.budgets` so that the
 coverage grid resolves the window (``ci``'s 512 points resolve ``T/384``; a window of ``T/1000`` needs
 more); a window narrower than the resolution is *outside what was searched*, and the record says so."""
 
@@ -19,7 +19,7 @@ import verimono as vm
 from verimono import Problem, operator_from_resolvent
 from verimono.checks.assumption_bounds import check_assumption_A3, check_assumption_LG, check_assumption_YB
 from verimono.checks.assumptions import check_assumption_A1
-from verimono.checks.supremum import Space, budgets, maximise
+from verimono.checks.engine.supremum import Space, budgets, maximise
 from verimono.records.results import FAILED, PASSED
 
 TIMES = [1 / math.pi, math.e / 7, math.sqrt(2) / 5, 0.7 + 1 / 300 * math.sqrt(3)]

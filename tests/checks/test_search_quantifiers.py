@@ -1,5 +1,5 @@
 """The quantifiers of the operator laws searched as coordinates: the direction of ``x2 − x1`` over the whole
-sphere (:mod:`verimono.checks.directions`) and the step ``λ`` over every decade the precision represents
+sphere (:mod:`verimono.checks.engine.directions`) and the step ``λ`` over every decade the precision represents
 (:func:`verimono.core.tolerances.current_step_range`).  Each plant is seen failing beside a lawful control
 within a few percent of it, and each plant passes when its coordinate is not searched (the coordinate, not
 luck, finds it)."""
@@ -10,9 +10,10 @@ import numpy as np
 import pytest
 
 from verimono import operator_from_resolvent
-from verimono.checks import coordinates, operator_laws  # noqa: F401 - the laws register on import
-from verimono.checks.search import run_law
-from verimono.checks.supremum import budgets
+from verimono.checks import operator_laws  # noqa: F401 - the laws register on import
+from verimono.checks.engine import coordinates
+from verimono.checks.engine.search import run_law
+from verimono.checks.engine.supremum import budgets
 from verimono.execution.config import chosen
 from verimono.core.tolerances import STEP_RANGE_BY_PRECISION
 from verimono.records.results import FAILED, PASSED

@@ -15,7 +15,7 @@ from verimono import Linear, Problem, operator_from_resolvent
 from verimono.checks.assumption_a2 import check_assumption_A2
 from verimono.checks.assumption_bounds import check_assumption_LG
 from verimono.checks.hoffman import check_hoffman, thin_cone
-from verimono.checks.supremum import budgets
+from verimono.checks.engine.supremum import budgets
 from verimono.checks.section7 import check_rel_int, check_v_bounded
 from verimono.lcs import Complementarity, LinearRelationSystem, check_hypotheses
 from verimono.lcs.hoffman import hoffman_constant

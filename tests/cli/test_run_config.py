@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from verimono.checks.sweep import sweep_count
+from verimono.checks.engine.sweep import sweep_count
 from verimono.cli import main
 from verimono.execution.profiles import PROFILES, get_profile
 

@@ -53,8 +53,8 @@ def test_step_keyword_and_projection_without_step():
 
 
 def test_a_batched_prox_is_called_once_per_batch(monkeypatch):
-    from verimono.checks import search as L
-    from verimono.checks.batches import batch_sizes
+    from verimono.checks.engine import search as L
+    from verimono.checks.engine.batches import batch_sizes
 
     monkeypatch.setattr(L, "_coordinates", lambda *a, **k: None)     # the phases that know their samples only
     one = Counting()

@@ -72,7 +72,7 @@ CASES = [
     ("examples<0", lambda: vm.check_operator(NSUB, examples=-3, seed=0), InvalidCheckArgument, "examples"),
     ("examples fractional", lambda: vm.check_operator(NSUB, examples=2.5, seed=0), InvalidCheckArgument,
      "examples"),
-    ("run_law examples=0", lambda: __import__("verimono.checks.search", fromlist=["x"]).run_law(
+    ("run_law examples=0", lambda: __import__("verimono.checks.engine.search", fromlist=["x"]).run_law(
         "monotone", NSUB, examples=0, seed=0), InvalidCheckArgument, "examples"),
     ("horizon<0", lambda: vm.check_operator(NSUB, examples=2, seed=0, horizon=-1.0), InvalidCheckArgument,
      "horizon"),

@@ -18,7 +18,7 @@ SCRIPT = textwrap.dedent('''
     if sys.argv[1] == "import":
         import user_constants          # an unrelated module of the user, full of numeric literals
     if sys.argv[2] == "unguarded":     # the mechanism verimono switches off, left on
-        import contextlib, verimono.checks.search as search
+        import contextlib, verimono.checks.engine.search as search
         search.no_local_constants = contextlib.nullcontext
     import verimono as vm
     soft = lambda x, lam: np.sign(x) * np.maximum(np.abs(x) - lam, 0.0)

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import verimono as vm
-from verimono.checks.search import ROOT_LAW, _SLOW
+from verimono.checks.engine.search import ROOT_LAW, _SLOW
 from verimono.reference import get
 from verimono.records.results import PASSED, CheckResult
 from verimono.execution.timeouts import budget, supported

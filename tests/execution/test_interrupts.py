@@ -166,7 +166,7 @@ def test_what_a_library_raises_after_an_interrupt_is_the_timeout():
 def test_a_law_out_of_time_before_any_sample_with_nothing_in_flight_is_undecided(monkeypatch):
     """The budget spent by the harness (here its draws, made slow) before the first sample was FAILED
     ("timed out ... (0 samples evaluated before)") although no call of the subject was running."""
-    import verimono.checks.search as search
+    import verimono.checks.engine.search as search
 
     draws = search.law_draws
 

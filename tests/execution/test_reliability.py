@@ -279,7 +279,7 @@ def _hanging_resolvent(x, lam, t):
 
 
 def test_a_hanging_resolvent_becomes_a_failed_record_and_the_run_goes_on():
-    from verimono.checks.search import run_law
+    from verimono.checks.engine.search import run_law
     from verimono.execution.timeouts import budget
 
     op = vm.operator_from_resolvent(_hanging_resolvent, 2, name="hangs")
@@ -327,8 +327,8 @@ def test_check_operator_passes_a_correct_operator_at_n_2000():
     assert rep.ok and len(rep) == len(LAWS), rep.summary()
     assert passed == set(LAWS) - {"prox_minimiser"}, rep.summary()   # every law but prox_minimiser (n <= 4 only)
     # a recorded sample of 2000 coordinates is a recipe of a few numbers, and it replays
-    from verimono.checks.samples import Sample
-    from verimono.checks.search import run_law
+    from verimono.checks.engine.samples import Sample
+    from verimono.checks.engine.search import run_law
 
     sample = rep.by_check("monotone")[0].details["worst_sample"]
     assert "recipe" in sample and len(json.dumps(sample)) < 1000
@@ -349,7 +349,7 @@ def test_large_operators_still_catch_a_broken_one():
 def test_a_harness_limitation_is_undecided_not_failed(monkeypatch):
     import hypothesis.errors
 
-    from verimono.checks import search as ol
+    from verimono.checks.engine import search as ol
 
     def unsatisfiable(n, horizon=1.0):
         from hypothesis import strategies as st

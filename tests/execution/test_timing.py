@@ -358,7 +358,7 @@ def test_an_operator_law_out_of_budget_after_samples_that_held_is_undecided():
 
     import verimono as vm
     from verimono.checks import operator_laws  # noqa: F401 - the operator laws join the registry on import
-    from verimono.checks.search import run_law
+    from verimono.checks.engine.search import run_law
 
     def slow(x, lam, t):
         time.sleep(0.004)

@@ -160,7 +160,7 @@ def test_membership_within_rounding_of_the_edge_of_dom_H():
     accept it (its contract: a graph point within tol in each coordinate) — a 20-seed sweep of the operator
     laws found yosida_in_graph failing here — while pairs far from the graph are still rejected."""
     from verimono.checks.operator_laws import check_yosida_in_graph
-    from verimono.checks.samples import Sample
+    from verimono.checks.engine.samples import Sample
     from verimono.reference.lcs_example import ramp_problem
 
     H = ramp_problem().operator

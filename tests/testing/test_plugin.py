@@ -246,7 +246,7 @@ def test_the_plugin_installs_the_sessions_profile_as_the_run_configuration(monke
     """``pytest --hypothesis-profile thorough``: the checks of the session search at thorough's effort (the
     search read ``$HYPOTHESIS_PROFILE``/``$CI`` before, whatever profile hypothesis had loaded)."""
     from verimono import plugin
-    from verimono.checks.search import default_examples
+    from verimono.checks.engine.search import default_examples
     from verimono.execution import config as run_config
 
     class Config:

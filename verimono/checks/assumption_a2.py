@@ -21,7 +21,7 @@ Where it runs: the sample times; every jump of ``t ↦ J_λ(t) p`` (:mod:`verimo
 adjacent floats ``a < b``; the jump time is the end with the shorter decimal — ``t <= 0.45`` switches right
 after 0.45 — and a jump whose side cannot be decided is undecided, see :func:`check_assumption_A2`); and the
 point where ``t ↦ J_λ(t) p`` varies fastest — the sup over ``t`` of ``|J_λ(t + ε)p − J_λ(t)p|``
-(:mod:`verimono.checks.supremum`), then a zoom toward it (:func:`verimono.checks.supremum.zoom`): an
+(:mod:`verimono.checks.engine.supremum`), then a zoom toward it (:func:`verimono.checks.engine.supremum.zoom`): an
 oscillation like ``sin(1/(t − τ))`` is fastest near ``τ``, where the right limit fails to settle.
 (A2) is *not* implied by (A3) for subdifferentials, whatever Lemma ``lem:A3ImpliesA2`` says: ``c(t)|x|`` with
 ``c = 1`` on ``[0, ½]``, 2 after, has a fixed domain and fails (A2) at ½ (the proof needs ``g``
@@ -39,7 +39,7 @@ from ..records.results import UNDECIDED
 from .assumption_samples import A2_LAMBDAS, EVIDENCE, run_assumption, sampled
 from .core import Outcome, law
 from .jumps import jump_time
-from .supremum import Space, maximise, zoom
+from .engine.supremum import Space, maximise, zoom
 
 #: (A2): right limits t + δ_k, δ_k = (T - t) A2_RATIO^k for k = 0, ..., A2_LEVELS (down to 1.5e-5 (T - t))
 A2_LEVELS = 8

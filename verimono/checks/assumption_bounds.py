@@ -1,6 +1,6 @@
 """(A3), (LG), (YB): the assumptions with a bounding function φ, σ, θ — each stated function a claim about
 every ``t`` (and every ``x``), compared with the sup of what it bounds, searched
-(:mod:`verimono.checks.supremum`) over ``t`` from the sample times and the times just after every jump
+(:mod:`verimono.checks.engine.supremum`) over ``t`` from the sample times and the times just after every jump
 found, and for (LG) over the distance of ``x`` from ``x0`` and from the kink ``0``.
 
 * ``assumption_A3`` — ``D(s,t) = max_z dist(z, dom F(t))`` over sampled ``z ∈ dom F(s)`` (``project_domain`` of
@@ -35,7 +35,7 @@ from .assumption_samples import EVIDENCE, f0_norm, growth, min_norm_or_none, run
 from .core import Outcome, law
 from .jumps import JUMP_GRID, find_jumps, jump_time
 from .over_time import Sup, sup_over_time
-from .supremum import Space, maximise
+from .engine.supremum import Space, maximise
 
 #: the rays of the (LG) search: ``s`` from ``RAY_RANGE[0]·r`` to ``RAY_RANGE[1]·r`` (r = 1 + |x0|)
 RAY_RANGE = (1e-9, 1e7)

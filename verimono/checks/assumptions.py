@@ -4,7 +4,7 @@
 and near the kink ``0`` (:mod:`verimono.checks.assumption_samples`), and step sizes ``λ``, and uses only the
 operator's resolvent (plus ``min_norm``/``project_domain`` when provided): ``z = J_λ p ∈ dom F(t,·)`` with
 ``Y_λ p ∈ F(t, z)`` (Prop. ``prop:maxmon-resolvent-Yosida`` v) gives graph points without knowing the domain.
-Every "for all t" is searched (:mod:`verimono.checks.supremum`) from the sample times and the times just after
+Every "for all t" is searched (:mod:`verimono.checks.engine.supremum`) from the sample times and the times just after
 every jump found, and every record says what was searched (``details["searched"]``).  One record per
 assumption:
 
@@ -36,7 +36,7 @@ from .assumption_samples import (A2_LAMBDAS, EVIDENCE, LAMBDAS, min_norm_or_none
                                  sampled)
 from .core import Outcome, law, laws_of, run, subject_name
 from .subjects import require_problem
-from .supremum import Space, maximise
+from .engine.supremum import Space, maximise
 
 
 def _non_monotone(Z: np.ndarray, Y: np.ndarray, P: np.ndarray):

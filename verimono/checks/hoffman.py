@@ -15,7 +15,7 @@ random; ``ε`` drawn from :data:`THIN` — every ``n − 1`` of the simplex rows
 so an estimator that looks at too few rows at once understates the constant).
 
 Points: :data:`HOFFMAN_POINTS` random directions at three radii around each polyhedron, then the worst
-direction **searched** (:mod:`verimono.checks.supremum`'s ``points`` budget per polyhedron):
+direction **searched** (:mod:`verimono.checks.engine.supremum`'s ``points`` budget per polyhedron):
 ``scipy.optimize.differential_evolution`` over directions ``u ∈ [−1, 1]^n`` (at the radius of the worst
 sample), its first population the largest sampled ratios, then a Nelder–Mead polish.  Evidence, not proof.
 """
@@ -32,7 +32,7 @@ from ..records.results import CheckResult
 from ..core.sets import Polyhedron
 from ..core.tolerances import tolerance
 from .core import Outcome, law, run, subject_name
-from .supremum import budget
+from .engine.supremum import budget
 
 #: random polyhedra per seed
 HOFFMAN_RANDOM = 4

@@ -14,7 +14,7 @@ import numpy as np
 from ..core.arrays import as_float64
 from ..core.errors import NotApplicable, OutsideDomain
 from ..core.tolerances import current_eps, tolerance
-from .samples import NUMPY_DIM
+from .engine.samples import NUMPY_DIM
 
 
 class _BadOutput(Exception):

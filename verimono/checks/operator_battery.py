@@ -18,7 +18,7 @@ from . import operator_laws, prox_laws  # noqa: F401 - the laws join the registr
 from .core import Law, laws_of, subject_name
 from .isolated import isolating, run_isolated
 from .arguments import valid_horizon, valid_seed
-from .search import default_examples, fresh_seed, positive_examples, run_law  # noqa: F401 - public here with its laws
+from .engine.search import default_examples, fresh_seed, positive_examples, run_law  # noqa: F401 - public here with its laws
 from .subjects import require_operator
 
 #: the operator laws (:class:`verimono.checks.core.Law`), in the order they run

@@ -11,13 +11,13 @@ which the search detects from what the operator returns and records (``details["
 ``|J_λx - J_λy|² / ⟨J_λx - J_λy, x - y⟩`` for firm nonexpansiveness), and for laws with ``rhs = 0``
 (identities, membership) the ratio counts violations in units of the stated tolerance.
 
-A sample is ``(x1, x2, λ, μ, ν, t)`` (:class:`verimono.checks.samples.Sample`).  Points known to lie in
+A sample is ``(x1, x2, λ, μ, ν, t)`` (:class:`verimono.checks.engine.samples.Sample`).  Points known to lie in
 ``dom F(t,·)`` are produced as ``x = J_ν x1``, which comes with the graph element ``y0 = Y_ν x1 ∈ F(t, x)``
 (item v) — so the minimal-section laws need no knowledge of the domain.
 
-The decorator (:func:`verimono.checks.search.operator_law`) makes each the public
+The decorator (:func:`verimono.checks.engine.search.operator_law`) makes each the public
 ``check_<law>(op, *, seed=None, examples=None, horizon=1.0, sample=None) -> CheckResult``: the search of
-:mod:`verimono.checks.search` for a sample that breaks it.  A law needing a member the operator does not
+:mod:`verimono.checks.engine.search` for a sample that breaks it.  A law needing a member the operator does not
 provide is skipped before it runs; the value laws of ``prox_{λg}`` are in :mod:`verimono.checks.prox_laws`.
 """
 
@@ -32,8 +32,8 @@ from ..core.tolerances import LIMIT_FLOOR, STALL_RATIO, STALL_WINDOW, current_ep
 from .core import Member, Outcome
 from .members import (_ROUNDOFF_BOUNDARY, listed, min_norm, norm, outside_by_roundoff_of_dom_g, point, resolvent,
                       within_roundoff_of_domain)
-from .samples import Sample
-from .search import operator_law
+from .engine.samples import Sample
+from .engine.search import operator_law
 
 #: tolerance multiples tried when grading a failed membership test ``y ∈ F(t, x)``
 GRADES = tuple(10.0 ** k for k in range(0, 13, 2))

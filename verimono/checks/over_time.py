@@ -6,7 +6,7 @@ fixed times, and a fixed set of times is blind to whatever happens between them:
 ``0.5 sin 6πt`` is at 0 at every ``k/6``, so the seven sample times ``k/6`` passed φ ≡ 0; ``F = (1 + 5 sin²
 6πt) x`` passed σ ≡ 1 (the true sup of ``|F^0|/(1 + |x|)`` is 6); and a 16-cell grid with a local search at
 its three worst nodes passed a σ broken on a window of width ``T/300`` at an irrational time.
-:func:`sup_over_time` is the one search of :mod:`verimono.checks.supremum` on the space ``t ∈ [lo, hi]``:
+:func:`sup_over_time` is the one search of :mod:`verimono.checks.engine.supremum` on the space ``t ∈ [lo, hi]``:
 its design (the base grid of the jump search, :func:`verimono.checks.jumps.base_grid`, or the law's own
 times), a coverage grid and DIRECT on the largest families, a bounded Brent maximisation around the largest
 points (with ``refine=True`` a golden-section search down to adjacent floats), with the profile's budget
@@ -26,9 +26,9 @@ from typing import Callable, Sequence
 import numpy as np
 
 from .jumps import base_grid
-from .supremum import NODES, PER_NODE, REFINE_STEPS, Space, Sup, maximise
+from .engine.supremum import NODES, PER_NODE, REFINE_STEPS, Space, Sup, maximise
 
-#: the names this module had (the search is :mod:`verimono.checks.supremum`'s)
+#: the names this module had (the search is :mod:`verimono.checks.engine.supremum`'s)
 SUP_NODES, SUP_FAMILIES, SUP_REFINE_STEPS = NODES, PER_NODE, REFINE_STEPS
 
 
@@ -38,7 +38,7 @@ def sup_over_time(values: Callable[[float, Sequence[int] | None], np.ndarray], l
                   seed: int = 0, design: Sequence[float] = ()) -> Sup:
     """The sup over ``t ∈ [lo, hi]`` and the families of ``values(t, which)`` — an array over the families
     ``which`` (``None``: all of them, in a fixed order; ``-inf`` where a family is not defined at ``t``) —
-    by :func:`verimono.checks.supremum.maximise`.  ``grid`` replaces the base grid as the design, ``design``
+    by :func:`verimono.checks.engine.supremum.maximise`.  ``grid`` replaces the base grid as the design, ``design``
     adds times to it (the times just after a jump); ``bounds(f)`` restricts family ``f`` to a sub-interval
     (the times ``s ≤ T − λ`` of a step ``λ``); ``points``: the budget (default: the profile's)."""
     ts = base_grid(hi, lo) if grid is None else np.asarray(grid, dtype=float)

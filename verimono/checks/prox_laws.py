@@ -13,7 +13,7 @@ one (a wrong weight, another norm's formula, a degenerate functional).  The More
 ``Y_λx = (x - p)/λ``, hence two-sided bounds between any two points.
 
 Each law is a decorated evaluator ``check_<law>(op, s) -> Outcome`` (``s`` a
-:class:`verimono.checks.samples.Sample`) whose ratio is the violation in units of its slack
+:class:`verimono.checks.engine.samples.Sample`) whose ratio is the violation in units of its slack
 (``(lhs - rhs)/slack``), so a negative or small ratio holds; it needs the operator's ``value`` (``g``), and
 is skipped before it runs on an operator that does not state it.  Slacks: ``τ = tolerance(x, p, z)`` per point (the resolvent's accuracy,
 :mod:`verimono.core.tolerances`), propagated through each side, plus ``tolerance`` of the function values.
@@ -34,7 +34,7 @@ from .members import ROUNDOFF_ULPS, outside_by_roundoff_of_dom_g
 from .members import norm as _nrm
 from .members import resolvent as _J
 from .members import value as _g
-from .search import operator_law
+from .engine.search import operator_law
 
 #: the independent minimiser (scipy.optimize, derivative-free Powell) runs only on R^n with n ≤ this
 MINIMISER_MAX_DIM = 4

@@ -12,7 +12,7 @@ battery.  Records are labelled **evidence, not proof** where they rest on sample
   ``t`` by linear programming (:func:`verimono.lcs.hypotheses.rel_int_margin`), then minimised over ``t``
   (:mod:`verimono.checks.over_time`);
 * ``lcs.v_bounded`` (item iv): sup of ``|v|`` searched over ``t`` and zoomed into, growth toward a
-  singularity detected (:mod:`verimono.checks.supremum`); ``lcs.v_ac`` (``e: linear case-comp`` iii,
+  singularity detected (:mod:`verimono.checks.engine.supremum`); ``lcs.v_ac`` (``e: linear case-comp`` iii,
   ``v ∈ AC``): no jump — the largest increments of ``v`` must vanish when bisected (the search of
   :mod:`verimono.checks.jumps`) — and a settled total variation; a jump fails with its location;
 * ``lcs.least_norm_growth`` (item vi, from Proposition ``p:lcp2`` iv–v for PSD ``D``): the least-norm
@@ -42,7 +42,7 @@ from ..core.tolerances import EPS, RTOL, STALL_WINDOW, tolerance
 from .core import Outcome, law, laws_of, run, subject_name
 from .jumps import find_jumps
 from .over_time import sup_over_time
-from .supremum import Space, maximise, unbounded, zoom
+from .engine.supremum import Space, maximise, unbounded, zoom
 
 EVIDENCE = "evidence from samples, not a proof"
 #: sample grid of ``v`` on ``[0, T]`` (intervals); the total variation is compared on its last two dyadic
@@ -198,9 +198,9 @@ def _v_on_grid(system: Any, T: float) -> tuple[np.ndarray, np.ndarray]:
 @system_law("lcs.v_bounded", "thm: linear case iv")
 def check_v_bounded(system: Any, T: float, *, samples: int, seed: int) -> Outcome:
     """Theorem ``thm: linear case`` iv: ``v`` bounded on ``[0, T]``.  The sup of ``|v|`` is searched over
-    ``t`` (:func:`verimono.checks.supremum.maximise`: the :data:`AC_GRID` grid, a coverage grid, DIRECT and
-    Brent), then zoomed into (:func:`verimono.checks.supremum.zoom`, down to adjacent floats): a ``|v|`` still
-    growing there (:func:`verimono.checks.supremum.unbounded`: ``v = −1/|t − τ|`` doubles per halving) is
+    ``t`` (:func:`verimono.checks.engine.supremum.maximise`: the :data:`AC_GRID` grid, a coverage grid, DIRECT and
+    Brent), then zoomed into (:func:`verimono.checks.engine.supremum.zoom`, down to adjacent floats): a ``|v|`` still
+    growing there (:func:`verimono.checks.engine.supremum.unbounded`: ``v = −1/|t − τ|`` doubles per halving) is
     unbounded and fails, as does a value that is not finite; a narrow spike settles at its height."""
     fine, V = _v_on_grid(system, T)
     if not np.all(np.isfinite(V)):

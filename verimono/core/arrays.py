@@ -245,7 +245,7 @@ def batch_chunks(count: int, pad: bool = True):
 
 def prefetch_key(x: np.ndarray, lam: float, t: float) -> tuple:
     """The key of a prefetched ``J_λ x`` at ``t`` (exact: the bytes of ``x``;
-    :func:`verimono.checks.batches.prefetched`)."""
+    :func:`verimono.checks.engine.batches.prefetched`)."""
     return (np.ascontiguousarray(x, dtype=float).tobytes(), float(lam), float(t))
 
 
@@ -279,7 +279,7 @@ def library_hint(exc: BaseException, given: str = "numpy") -> str:
 
 #: while set (:func:`as_given`), a NumPy subject's adapter hands it the NumPy arrays it is called with as they
 #: are — integer dtypes, strided or offset views, read-only arrays — instead of a float64 copy: the input
-#: forms of the operator laws (:mod:`verimono.checks.forms`) reach the user's own function
+#: forms of the operator laws (:mod:`verimono.checks.engine.forms`) reach the user's own function
 _AS_GIVEN: contextvars.ContextVar[bool] = contextvars.ContextVar("verimono_as_given", default=False)
 
 

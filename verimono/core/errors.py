@@ -114,7 +114,7 @@ class ProxOutputError(VerimonoError, TypeError):
 
 class InputModified(VerimonoError, RuntimeError):
     """A member of the subject wrote into the point it was given (or into the buffer around it): the caller's
-    array changed (:mod:`verimono.checks.forms`)."""
+    array changed (:mod:`verimono.checks.engine.forms`)."""
 
 
 class InvalidCheckArgument(VerimonoError, ValueError):

@@ -150,7 +150,7 @@ class _FromResolvent(Operator):
         self._io = io if io is not None else Boundary(None)
         #: the resolvent maps a batch: points (B, n), steps (B,), times (B,)
         self.batched = bool(batched)
-        #: resolvent values of a batch evaluated ahead of the laws (verimono.checks.batches)
+        #: resolvent values of a batch evaluated ahead of the laws (verimono.checks.engine.batches)
         self._prefetched: dict | None = None
 
     @property

@@ -107,7 +107,7 @@ class ProxOperator(Operator):
         self._io = Boundary(array_kind(array, dtype=dtype, device=device))
         #: the prox maps a batch (B, *shape) with steps (B,) (and times (B,)) at once
         self.batched = bool(batched)
-        #: prox values of a batch evaluated ahead of the laws (verimono.checks.batches)
+        #: prox values of a batch evaluated ahead of the laws (verimono.checks.engine.batches)
         self._prefetched: dict | None = None
 
     @property
@@ -251,7 +251,7 @@ def operator_from_prox(prox: Callable, *, value: Callable | None = None, shape: 
 
     ``batched=True``: ``prox`` maps a batch — points ``(B, *shape)``, steps ``(B,)`` (and times ``(B,)``) —
     to ``(B, *shape)`` (``jax.vmap``, ``torch.vmap`` or vectorised code); the search then evaluates its
-    NumPy draws and its sweep a batch at a time (:mod:`verimono.checks.batches`)."""
+    NumPy draws and its sweep a batch at a time (:mod:`verimono.checks.engine.batches`)."""
     if shape is None:
         raise InvalidProblem("operator_from_prox needs shape= (an int n for R^n, or a tuple such as (m, n))")
     return ProxOperator(prox, value=value, shape=shape, name=name, unwrap=unwrap, array=array, dtype=dtype,

@@ -5,7 +5,7 @@ A verification is started from an *entry point* — the command line (``verimono
 :func:`verimono.run.execute.execute`) or the pytest plugin (:mod:`verimono.plugin`) — and the entry point alone
 decides how hard it searches.  What it decides is one :class:`RunConfig`, held for the duration of the work
 (:func:`using`) and read by everything that depends on it: the operator search's examples and scale sweep
-(:mod:`verimono.checks.search`), every unit's time budget (:mod:`verimono.execution.timeouts`) and the worker
+(:mod:`verimono.checks.engine.search`), every unit's time budget (:mod:`verimono.execution.timeouts`) and the worker
 processes, which receive it with each unit (:mod:`verimono.execution.executors`).
 
 The environment only supplies the default, here and nowhere else (:func:`from_environment`):

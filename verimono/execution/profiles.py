@@ -61,7 +61,7 @@ class Profile:
     derandomize: bool
     unit_budget: float = 1600.0
     stage_budget_scale: float = 1.0
-    #: points of a space one search of :mod:`verimono.checks.supremum` evaluates: ``time`` — a sup over ``t``
+    #: points of a space one search of :mod:`verimono.checks.engine.supremum` evaluates: ``time`` — a sup over ``t``
     #: of a problem's hypothesis (its coverage grid holds three quarters of them: ``ci`` resolves windows of
     #: ``T/384``, ``thorough`` of ``T/6144``); ``coordinate`` — a step size, time or distance of an operator
     #: law's worst sample; ``points`` — a point search in ``R^n`` (Hoffman's bound)

@@ -19,7 +19,7 @@ how many samples were evaluated) when everything the law inside had evaluated he
 and no call in flight had run long — a correct subject on a slow machine — and *failed* when the law had
 seen a violation, or for a call that never returns: one in flight longer than :data:`HANG_MULTIPLE` x any
 that returned before it, half the budget and a tenth of a second.  (The operator laws' search bounds itself
-the same way, :mod:`verimono.checks.search`.)
+the same way, :mod:`verimono.checks.engine.search`.)
 
 The interrupt is raised as an internal ``BaseException`` while it travels through the unit's code, so a
 check's own ``except Exception`` (which turns an operator's error into a failed sample) or hypothesis'

@@ -40,10 +40,10 @@ from typing import Callable, Iterator, Sequence
 import numpy as np
 from scipy.optimize import direct, minimize_scalar
 
-from ..core.errors import UnverifiedSolution
-from ..core.tolerances import STALL_RATIO, STALL_WINDOW, tolerance
-from ..execution.config import current as current_config
-from ..execution.profiles import UnknownProfile, get_profile
+from ...core.errors import UnverifiedSolution
+from ...core.tolerances import STALL_RATIO, STALL_WINDOW, tolerance
+from ...execution.config import current as current_config
+from ...execution.profiles import UnknownProfile, get_profile
 
 #: families searched in the coverage and global phases (the largest at the design points; ties broken by
 #: the law's own ``rank``, e.g. the distance of a point from the domain)

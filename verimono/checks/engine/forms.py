@@ -60,8 +60,8 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from ..core.arrays import as_given
-from ..core.errors import InputModified
+from ...core.arrays import as_given
+from ...core.errors import InputModified
 
 CONTIGUOUS, INTEGER, STRIDED, SLICE, READONLY, DECLARED = (
     "contiguous", "integer", "strided", "slice", "readonly", "declared_dtype")

@@ -29,7 +29,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..core.tolerances import current_largest
+from ...core.tolerances import current_largest
 
 #: magnitudes of the swept points: tiny (below the rounding scale of a unit problem), unit, huge, far
 SCALES = (1e-9, 1e-7, 5e-7, 1e-5, 1e-3, 1e-1, 1.0, 3.0, 10.0, 1e2, 1e3, 1e6)

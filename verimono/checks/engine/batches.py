@@ -25,8 +25,8 @@ from typing import Any, Iterator, Sequence
 
 import numpy as np
 
-from ..core.arrays import MAX_BATCH
-from ..core.arrays import prefetch_key as key
+from ...core.arrays import MAX_BATCH
+from ...core.arrays import prefetch_key as key
 
 #: the leading batch sizes, every one (then the divisors of the dimension, then the rest in one batch)
 SMALL_BATCHES = 8

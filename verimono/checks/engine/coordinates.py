@@ -33,7 +33,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..core.tolerances import current_largest, current_step_range
+from ...core.tolerances import current_largest, current_step_range
 from .directions import direction_search
 from .samples import Sample
 from .supremum import Searched, Space, maximise

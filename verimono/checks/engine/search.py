@@ -60,18 +60,18 @@ import hypothesis.errors
 import numpy as np
 from hypothesis import HealthCheck, Phase, Verbosity, given, settings
 
-from ..core.arrays import library_hint
-from ..core._reproducible import no_local_constants
-from .arguments import valid_horizon, valid_seed
-from ..core.errors import InvalidCheckArgument, UnitTimeout
-from ..execution.config import current as current_config
-from ..records.results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
-from ..execution.timeouts import (checkpoint, current_budget, interrupted, interruptible, note_progress,
+from ...core.arrays import library_hint
+from ...core._reproducible import no_local_constants
+from ..arguments import valid_horizon, valid_seed
+from ...core.errors import InvalidCheckArgument, UnitTimeout
+from ...execution.config import current as current_config
+from ...records.results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
+from ...execution.timeouts import (checkpoint, current_budget, interrupted, interruptible, note_progress,
                                   time_limit)
-from ..records.verdicts import timeout_verdict
+from ...records.verdicts import timeout_verdict
 from .batches import _BatchFailure, prefetched
 from .coordinates import coordinate_search, searched
-from .core import REGISTRY, Law, Outcome, classify, law, new_record, run, subject_name
+from ..core import REGISTRY, Law, Outcome, classify, law, new_record, run, subject_name
 from .forms import CONTIGUOUS, cycled, form_note, form_search, forms_for, in_form
 from .samples import NUMPY_DIM, Sample, law_samples
 from .supremum import budget

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from hypothesis import strategies as st
 
-from ..strategies.values import points, step_sizes, times
+from ...strategies.values import points, step_sizes, times
 from .forms import CONTIGUOUS, FORMS, INTEGER, integral
 
 #: above this dimension the points of a sample are drawn by NumPy from a seed (and a kind) that hypothesis

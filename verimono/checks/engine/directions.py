@@ -35,8 +35,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..execution.interrupts import interruptible
-from .members import norm
+from ...execution.interrupts import interruptible
+from ..members import norm
 from .samples import NUMPY_DIM, Sample
 
 #: the refinement's first and finest rotation angles (radians)
