@@ -72,7 +72,7 @@ from .execution.profiles import PROFILES
 from .run.progress import Progress
 from .records.results import FAILED, SKIPPED, Report
 from .records.verdicts import SUBJECT_EXITS
-from .run.execute import (EXIT_FAILED, EXIT_OK, EXIT_UNDECIDED, execute, exit_status, interruptible, merge_resumed)
+from .run.execute import (EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, EXIT_UNDECIDED, execute, exit_status, interruptible, merge_resumed)
 from .run.targets import load_target
 
 
@@ -697,7 +697,33 @@ def main(argv: list[str] | None = None) -> int:
     from .run.console import guarded
 
     with guarded():
-        return _main(argv)
+        try:
+            return _main(argv)
+        except KeyboardInterrupt as exc:
+            # an interrupt outside the run's own handler (reading the options, importing the target, building
+            # the references, writing the report): one line, never a traceback; a folder marked in progress
+            # stays marked (the gate refuses what is there), and the previous results are untouched
+            print(f"\nverimono: interrupted ({interrupt_name(exc)}) before the run finished; no results of "
+                  "this run were written", file=sys.stderr)
+            return EXIT_INTERRUPTED
+
+
+def interrupt_name(exc: BaseException) -> str:
+    """What interrupted: ``Ctrl-C`` or the signal raised as a :class:`KeyboardInterrupt` (``SIGTERM``, ...)."""
+    return str(exc.args[0]) if exc.args and str(exc.args[0]).startswith("SIG") else "Ctrl-C"
+
+
+def terminating_signals() -> list[Any]:
+    """The signals that end a command as Ctrl-C does: SIGTERM and, where it exists, SIGHUP (a closed terminal)."""
+    import signal
+
+    return [getattr(signal, n) for n in ("SIGTERM", "SIGHUP") if hasattr(signal, n)]
+
+
+def _as_interrupt(signum: int, frame: Any) -> None:
+    import signal
+
+    raise KeyboardInterrupt(signal.Signals(signum).name)
 
 
 def _main(argv: list[str] | None) -> int:
@@ -755,8 +781,18 @@ def console_main() -> int:
     2-second ``verimono check`` here, 20 ms after.  The exit is otherwise the usual one (atexit handlers,
     modules cleared, files flushed and closed); :func:`main` itself, called in-process, frees nothing less."""
     import gc
+    import signal
 
-    status = main()
+    # the command's own handlers (replacing those of its first imports, verimono.core._early_signals): Ctrl-C,
+    # SIGTERM and SIGHUP are one KeyboardInterrupt, answered by the run (its finished stages, marked
+    # incomplete) or by main (one line): exit 130, never a traceback
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    for sig in terminating_signals():
+        signal.signal(sig, _as_interrupt)
+    try:
+        status = main()
+    except KeyboardInterrupt:       # between main's end and here
+        status = EXIT_INTERRUPTED
     gc.freeze()
     return status
 

@@ -140,7 +140,7 @@ ISOLATE_ADVICE = ("`--executor process:N` runs each unit in a worker process, so
 def interruptible(run: Callable[[Callable], Report], out: Path, *, command: str, profile: str,
                    stages: list[str] | None, previous: Report | None = None, run_id: str | None = None,
                    advice: str | None = None, checkpoint: bool = False) -> Report | int:
-    """``run(on_done)`` with SIGTERM treated as an interrupt; on an interrupt write the stages finished so
+    """``run(on_done)`` with SIGTERM and SIGHUP treated as an interrupt; on an interrupt write the stages finished so
     far (with ``previous``'s, when resuming) to ``out`` marked ``incomplete`` (as the run ``run_id``) and
     return the exit status.  ``advice``: how to go on, printed after the interrupt (default: ``verimono
     run --resume``, which only ``run`` has).
@@ -215,9 +215,11 @@ def interruptible(run: Callable[[Callable], Report], out: Path, *, command: str,
             watchdog.end_process(EXIT_FAILED)
 
     def term(signum, frame):
-        raise KeyboardInterrupt(f"signal {signum}")
+        raise KeyboardInterrupt(signal.Signals(signum).name)
 
-    old = signal.signal(signal.SIGTERM, term) if _main_thread() else None
+    # SIGTERM and SIGHUP (a terminal closed, an SSH session dropped) as Ctrl-C
+    held = [getattr(signal, n) for n in ("SIGTERM", "SIGHUP") if hasattr(signal, n)] if _main_thread() else []
+    old = {sig: signal.signal(sig, term) for sig in held}
     try:
         with watchdog.scope() as root, watchdog.on_hang(on_hang):
             stage_scope.append(root)
@@ -230,8 +232,8 @@ def interruptible(run: Callable[[Callable], Report], out: Path, *, command: str,
               f"{advice or f'continue with `verimono {command} --resume`'}", file=sys.stderr)
         return EXIT_INTERRUPTED
     finally:
-        if old is not None:
-            signal.signal(signal.SIGTERM, old)
+        for sig, handler in old.items():
+            signal.signal(sig, handler)
 
 
 def _main_thread() -> bool:
