@@ -286,13 +286,18 @@ def _finish(report: Report, out: Path, baseline: Report | None, run_id: str | No
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from .records.atomic import ensure_writable_dir, in_progress
+    from .records.atomic import ensure_writable_dir, in_progress, partial_path
     from .records.results import load
     out = ensure_writable_dir(args.out)           # before any work: a run must not be lost at the end
     previous, stages = None, args.stage
     if args.resume:
         results, killed = out / "results.json", in_progress(out / "results.json")
         previous = load(results) if results.is_file() else None
+        saved = partial_path(results)    # the stages a run killed outright saved beside the previous results
+        if killed is not None and saved.is_file():
+            candidate = load(saved)
+            if candidate.meta.get("incomplete") and candidate.meta.get("run_id") == killed.get("run_id"):
+                previous, results = candidate, saved
         if previous is None or not previous.meta.get("incomplete"):
             what = "absent" if previous is None else f"the complete run {previous.meta.get('run_id')}"
             if killed is not None:

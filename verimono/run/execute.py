@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from ..execution import watchdog
-from ..records.atomic import write_text
+from ..records.atomic import partial_path, write_text
 from ..records.environment import environment
 from ..execution.executors import BLAS_THREADS, make_runner
 from ..execution.config import RunConfig
@@ -165,15 +165,18 @@ def interruptible(run: Callable[[Callable], Report], out: Path, *, command: str,
             save_checkpoint()
 
     def save_checkpoint() -> None:
-        """The stages finished so far, on disk as each finishes (``results.json`` only, marked incomplete, with
-        this run's id; the in-progress mark stays): a run killed with SIGKILL, which no handler sees, leaves
-        them for ``--resume``.  A checkpoint that cannot be written costs the run nothing but that."""
+        """The stages finished so far, on disk as each finishes (``results.json.partial``, marked incomplete,
+        with this run's id; the in-progress mark stays): a run killed with SIGKILL, which no handler sees,
+        leaves them for ``--resume`` — beside the previous results and report, which stay as they were until
+        this run's own pair replaces them (:func:`verimono.records.atomic.partial_path`).  A checkpoint that
+        cannot be written costs the run nothing but that."""
         partial, _ = partial_report()
         partial.meta["run_id"] = run_id
+        where = partial_path(out / "results.json")
         try:
-            write_text(out / "results.json", partial.to_json())
+            write_text(where, partial.to_json())
         except OSError as exc:  # OutputNotWritable too: the final write says it again, with what it keeps
-            print(f"verimono: could not save the finished stages to {out / 'results.json'} "
+            print(f"verimono: could not save the finished stages to {where} "
                   f"({getattr(exc, 'strerror', None) or exc}); the run goes on", file=sys.stderr)
 
     def partial_report() -> tuple[Report, list[str]]:
