@@ -740,6 +740,13 @@ def _main(argv: list[str] | None) -> int:
 
     given = list(sys.argv[1:] if argv is None else argv)
     command = next((a for a in given if not a.startswith("-")), None)
+    if command is not None and not {"-h", "--help", "--version"} & set(given):
+        try:
+            os.getcwd()
+        except OSError as exc:       # deleted under the shell: relative paths (--out, a target file) mean nothing
+            print(f"verimono {command}: the current working directory no longer exists ({exc.strerror or exc}); "
+                  "cd to an existing folder and run the command again", file=sys.stderr)
+            return EXIT_UNDECIDED
     with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
         # the run's first calibration is measured on the other core while this process imports the checks
         # and reads its target (about 0.4 s; the measurement takes 0.2 s): it is not waited for; the copy
