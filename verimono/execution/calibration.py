@@ -21,6 +21,8 @@ from typing import Callable
 
 import numpy as np
 
+from .lifetime import die_with, quiet_signals
+
 
 #: the steps of the calibration workload's loop
 WORKLOAD_STEPS = 20000
@@ -168,8 +170,6 @@ class PendingCalibration:
         if pid == 0:                                     # the copy: measure, answer, and end at once
             code = 1
             try:
-                from .lifetime import die_with, quiet_signals
-
                 quiet_signals()                          # Ctrl-C is the leader's; SIGTERM/SIGHUP end it quietly
                 die_with(leader)                         # and it ends with the leader, however that ends
                 os.close(r)

@@ -20,6 +20,7 @@ from typing import Any
 from . import config as _config
 from . import watchdog
 from .calibration import calibration, set_calibration
+from .lifetime import die_with, quiet_signals
 from .config import RunConfig
 from ..core.errors import BadExecutor
 from .profiles import load_hypothesis_profile
@@ -149,8 +150,6 @@ def _process_worker(conn: Any, job: tuple | None = None, leader: int | None = No
     (:func:`verimono.execution.lifetime.quiet_signals`: Ctrl-C is the leader's; SIGTERM and SIGHUP end it
     quietly)."""
     import threading
-
-    from .lifetime import die_with, quiet_signals
 
     quiet_signals()
     if leader is not None:
