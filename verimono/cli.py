@@ -8,7 +8,7 @@
         2 when nothing failed but a check was undecided (a limitation of the harness) — except a speed the machine
         was too noisy to judge (a timing record undecided for "timing noise"), which exits 0 and says so.
         The output folder is checked writable before any work; both files are written atomically with one
-        run id.  An interrupt (Ctrl-C, SIGTERM) writes the finished stages to a results file marked
+        run id.  An interrupt (Ctrl-C, SIGTERM, SIGHUP) writes the finished stages to a results file marked
         incomplete (the gate refuses it, exit 2) and exits 130; ``--resume`` runs the stages that file lacks
         and completes it (it names the run id it continues; the result records it in ``meta.resumed_from``).
         ``--timeout S``: seconds per unit of work (one law on one operator, one check of one stepper;
@@ -23,7 +23,9 @@
         are written marked incomplete, one line names the call, its time and the file — with exit 1.
         Before any work the run marks DIR/results.json in progress (``results.json.in-progress``, with its
         run id) and removes the mark once its pair is written: files beside a mark that stays (a run killed,
-        or stopped by an error) are not that run's, and the gate refuses them (exit 2).  When the pair
+        or stopped by an error) are not that run's, and the gate refuses them (exit 2).  Its finished stages
+        are saved as each finishes to ``results.json.partial`` beside the results, never over them: a run
+        killed outright (SIGKILL) leaves the previous pair intact, and ``--resume`` continues from that file.  When the pair
         cannot be written (a full disk, an unwritable folder) the previous pair stays, the results are kept
         in the temporary folder, and a one-line message names both paths (exit 2).
     verimono check MODULE:OBJECT [--profile P] [--out DIR] [--seed N] [run's --timeout, --executor, ...]
