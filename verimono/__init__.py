@@ -6,6 +6,14 @@ Data flow one way: Problem → stepper → Trajectory → checks → results →
 """
 
 import importlib
+import sys as _sys
+
+if _sys.argv and _sys.argv[0].replace("\\", "/").rpartition("/")[2].split(".")[0] in ("verimono", "verimono-script"):
+    # the `verimono` command: a signal during its first imports (about 2 s) is one line, not a traceback
+    # (verimono.cli.console_main takes over once it runs: docs/run.md "Exit status, and what survives")
+    from .core._early_signals import quiet_until_main as _quiet
+
+    _quiet()
 
 from .core.errors import (BadTarget, BatchStepError, IncompatibleBaseline, InfeasibleStep, InvalidCheckArgument,
                           InvalidClaim, InvalidGrid, InvalidProblem, MissingOptionalDependency, NotMonotone,

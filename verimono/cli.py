@@ -8,7 +8,7 @@
         2 when nothing failed but a check was undecided (a limitation of the harness) — except a speed the machine
         was too noisy to judge (a timing record undecided for "timing noise"), which exits 0 and says so.
         The output folder is checked writable before any work; both files are written atomically with one
-        run id.  An interrupt (Ctrl-C, SIGTERM) writes the finished stages to a results file marked
+        run id.  An interrupt (Ctrl-C, SIGTERM, SIGHUP) writes the finished stages to a results file marked
         incomplete (the gate refuses it, exit 2) and exits 130; ``--resume`` runs the stages that file lacks
         and completes it (it names the run id it continues; the result records it in ``meta.resumed_from``).
         ``--timeout S``: seconds per unit of work (one law on one operator, one check of one stepper;
@@ -23,7 +23,9 @@
         are written marked incomplete, one line names the call, its time and the file — with exit 1.
         Before any work the run marks DIR/results.json in progress (``results.json.in-progress``, with its
         run id) and removes the mark once its pair is written: files beside a mark that stays (a run killed,
-        or stopped by an error) are not that run's, and the gate refuses them (exit 2).  When the pair
+        or stopped by an error) are not that run's, and the gate refuses them (exit 2).  Its finished stages
+        are saved as each finishes to ``results.json.partial`` beside the results, never over them: a run
+        killed outright (SIGKILL) leaves the previous pair intact, and ``--resume`` continues from that file.  When the pair
         cannot be written (a full disk, an unwritable folder) the previous pair stays, the results are kept
         in the temporary folder, and a one-line message names both paths (exit 2).
     verimono check MODULE:OBJECT [--profile P] [--out DIR] [--seed N] [run's --timeout, --executor, ...]
@@ -76,7 +78,7 @@ from .execution.profiles import PROFILES
 from .run.progress import Progress
 from .records.results import FAILED, SKIPPED, Report
 from .records.verdicts import SUBJECT_EXITS
-from .run.execute import (EXIT_FAILED, EXIT_OK, EXIT_UNDECIDED, execute, exit_status, interruptible, merge_resumed)
+from .run.execute import (EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, EXIT_UNDECIDED, execute, exit_status, interruptible, merge_resumed)
 from .run.targets import load_target
 
 
@@ -306,13 +308,18 @@ def _finish(report: Report, out: Path, baseline: Report | None, run_id: str | No
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from .records.atomic import ensure_writable_dir, in_progress
+    from .records.atomic import ensure_writable_dir, in_progress, partial_path
     from .records.results import load
     out = ensure_writable_dir(args.out)           # before any work: a run must not be lost at the end
     previous, stages = None, args.stage
     if args.resume:
         results, killed = out / "results.json", in_progress(out / "results.json")
         previous = load(results) if results.is_file() else None
+        saved = partial_path(results)    # the stages a run killed outright saved beside the previous results
+        if killed is not None and saved.is_file():
+            candidate = load(saved)
+            if candidate.meta.get("incomplete") and candidate.meta.get("run_id") == killed.get("run_id"):
+                previous, results = candidate, saved
         if previous is None or not previous.meta.get("incomplete"):
             what = "absent" if previous is None else f"the complete run {previous.meta.get('run_id')}"
             if killed is not None:
@@ -732,7 +739,33 @@ def main(argv: list[str] | None = None) -> int:
     from .run.console import guarded
 
     with guarded():
-        return _main(argv)
+        try:
+            return _main(argv)
+        except KeyboardInterrupt as exc:
+            # an interrupt outside the run's own handler (reading the options, importing the target, building
+            # the references, writing the report): one line, never a traceback; a folder marked in progress
+            # stays marked (the gate refuses what is there), and the previous results are untouched
+            print(f"\nverimono: interrupted ({interrupt_name(exc)}) before the run finished; no results of "
+                  "this run were written", file=sys.stderr)
+            return EXIT_INTERRUPTED
+
+
+def interrupt_name(exc: BaseException) -> str:
+    """What interrupted: ``Ctrl-C`` or the signal raised as a :class:`KeyboardInterrupt` (``SIGTERM``, ...)."""
+    return str(exc.args[0]) if exc.args and str(exc.args[0]).startswith("SIG") else "Ctrl-C"
+
+
+def terminating_signals() -> list[Any]:
+    """The signals that end a command as Ctrl-C does: SIGTERM and, where it exists, SIGHUP (a closed terminal)."""
+    import signal
+
+    return [getattr(signal, n) for n in ("SIGTERM", "SIGHUP") if hasattr(signal, n)]
+
+
+def _as_interrupt(signum: int, frame: Any) -> None:
+    import signal
+
+    raise KeyboardInterrupt(signal.Signals(signum).name)
 
 
 def _main(argv: list[str] | None) -> int:
@@ -744,6 +777,13 @@ def _main(argv: list[str] | None) -> int:
 
     given = list(sys.argv[1:] if argv is None else argv)
     command = next((a for a in given if not a.startswith("-")), None)
+    if command is not None and not {"-h", "--help", "--version"} & set(given):
+        try:
+            os.getcwd()
+        except OSError as exc:       # deleted under the shell: relative paths (--out, a target file) mean nothing
+            print(f"verimono {command}: the current working directory no longer exists ({exc.strerror or exc}); "
+                  "cd to an existing folder and run the command again", file=sys.stderr)
+            return EXIT_UNDECIDED
     with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
         # the run's first calibration is measured on the other core while this process imports the checks
         # and reads its target (about 0.4 s; the measurement takes 0.2 s): it is not waited for; the copy
@@ -790,8 +830,18 @@ def console_main() -> int:
     2-second ``verimono check`` here, 20 ms after.  The exit is otherwise the usual one (atexit handlers,
     modules cleared, files flushed and closed); :func:`main` itself, called in-process, frees nothing less."""
     import gc
+    import signal
 
-    status = main()
+    # the command's own handlers (replacing those of its first imports, verimono.core._early_signals): Ctrl-C,
+    # SIGTERM and SIGHUP are one KeyboardInterrupt, answered by the run (its finished stages, marked
+    # incomplete) or by main (one line): exit 130, never a traceback
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    for sig in terminating_signals():
+        signal.signal(sig, _as_interrupt)
+    try:
+        status = main()
+    except KeyboardInterrupt:       # between main's end and here
+        status = EXIT_INTERRUPTED
     gc.freeze()
     return status
 

@@ -254,6 +254,12 @@ class _Collector:
             # baseline --from refuses them; the gate shows what they lack against a baseline)
             self.report.meta[MISSING_RECORDS] = {"crashed": list(self.crashed), "hidden": list(self.hidden)}
         self.report.meta.update({"duration": time.perf_counter() - self.start, "environment": environment()})
+        stopped = _stopped_early(session, exitstatus)
+        if stopped:
+            # an interrupted session (Ctrl-C, SIGTERM: pytest's exit status 2) or one told to stop early (-x,
+            # --maxfail) verified only part of what it collected: its report says so, and the gate and
+            # `verimono baseline --from` refuse it as they refuse an interrupted `verimono run`
+            self.report.meta.update({"incomplete": True, "stopped": stopped})
         if self.baseline is not None:
             from .run.gate import check_runs_compatible, compare
             from .records.results import SchemaError
@@ -286,6 +292,9 @@ class _Collector:
                           "runner, or with pytest-xdist (-n N)", red=True)
         if self.out is not None:
             tr.write_line(f"report: {self.out / 'report.html'}  records: {self.out / 'results.json'}")
+        if self.report.meta.get("incomplete"):
+            tr.write_line(f"verimono: the session stopped early ({self.report.meta.get('stopped')}): its report is "
+                          "marked incomplete (the gate and `verimono baseline --from` refuse it)", red=True)
         if self.gate_error:
             tr.write_line(f"verimono gate: cannot compare: {self.gate_error} (exit status 4)", red=True)
         elif self.comparison is not None:
@@ -293,6 +302,15 @@ class _Collector:
                 tr.write_line(f"  {c}", red=True)
             tr.write_line(f"verimono gate: {self.comparison.summary()}",
                           green=self.comparison.ok, red=not self.comparison.ok)
+
+
+def _stopped_early(session: pytest.Session, exitstatus: Any) -> str | None:
+    """Why ``session`` ended before every collected test ran (``None`` when it did not): interrupted, or
+    told to stop (``-x``, ``--maxfail``)."""
+    if exitstatus == pytest.ExitCode.INTERRUPTED or session.exitstatus == pytest.ExitCode.INTERRUPTED:
+        return "interrupted"
+    why = session.shouldstop or session.shouldfail
+    return str(why) if why else None
 
 
 def _is_verimono_check(value: Any) -> bool:

@@ -509,3 +509,46 @@ def test_in_domain_keeps_every_valid_alternative_passing_at_low_orders():
                     continue
                 rec = check_in_domain(s, q)
                 assert rec.status == PASSED, str(rec)
+
+
+def test_the_unique_limits_interpolant_is_np_interp_of_every_coordinate_at_once():
+    """``unique_limit`` interpolated column by column (one ``np.interp`` call per coordinate: 840 000 calls at
+    n = 10^4); the interpolant of all coordinates at once is the same, node values exact, constant outside."""
+    from verimono.checks.limits import _distances, _interp
+
+    rng = np.random.default_rng(3)
+    t = np.concatenate([[0.0], np.sort(rng.uniform(0, 1, 18)), [1.0]])
+    x = rng.normal(size=(20, 7))
+    tau = np.concatenate([rng.uniform(-0.1, 1.1, 300), t])
+    ref = np.stack([np.interp(tau, t, x[:, j]) for j in range(7)], axis=-1)
+    assert np.allclose(_interp(t, x, tau), ref, rtol=0, atol=1e-14) and np.array_equal(_interp(t, x, t), x)
+    g2 = np.linspace(0, 1, 9)
+    x2 = rng.normal(size=(9, 7))
+    want = np.linalg.norm(ref - np.stack([np.interp(tau, g2, x2[:, j]) for j in range(7)], axis=-1), axis=-1)
+    assert np.allclose(_distances(t, x, g2, x2, tau), want, rtol=1e-13, atol=1e-14)
+
+
+@pytest.mark.parametrize("slow", ["_interp", "_norms"])
+def test_unique_limit_stopped_in_the_harness_is_undecided_not_a_stepper_that_never_returns(slow, monkeypatch):
+    """At n = 10^6 unique_limit spent its budget in its own comparisons of the stepper's (correct, returned)
+    solutions, stated no progress, and the budget's verdict counted the whole law as one call of the stepper that
+    never returned: failed.  Every run that returns is now progress, so a law stopped in the harness is undecided.
+    (Here the harness is slowed down, at two places of its comparisons, instead of run at n = 10^6.)"""
+    import time as _time
+
+    import verimono.checks.limits as limits
+    from verimono.execution.timeouts import budget
+    from verimono.reference import subdifferential
+
+    real = getattr(limits, slow)
+
+    def slowed(*args, **kwargs):
+        _time.sleep(0.05)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(limits, slow, slowed)
+    with budget(0.6):
+        (rec,) = check_stepper(solve, [subdifferential.t_norm((0.6, -0.8))], laws=["unique_limit"], orders=False,
+                               generated=0).results
+    assert rec.check == "unique_limit" and rec.status == "undecided", rec
+    assert rec.details.get("undecided_reason") == "time budget" and rec.details["evaluated"] >= 3, rec.details

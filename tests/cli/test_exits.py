@@ -304,3 +304,24 @@ def test_an_exit_raised_outside_any_check_is_no_verdict_not_a_pass(monkeypatch, 
     monkeypatch.setattr(cli, "_cmd_gate", ends)
     assert main(["gate", "--baseline", str(passing_results), "--results", str(passing_results)]) == 2
     assert "no verdict" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("command", [["check", "verimono:solve", "--stage", "convergence"], ["run", "--stage", "section7"]])
+def test_a_command_started_in_a_deleted_folder_is_a_clear_error(command, tmp_path):
+    """A run started from a working directory deleted under the shell died on os.getcwd() with a traceback (and
+    `check` exited 0): now one line saying so, exit 2, before any work."""
+    import os
+    import subprocess
+    import sys
+
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    code = ("import os, sys; os.chdir(sys.argv[1]); os.rmdir(sys.argv[1]); from verimono.cli import main; "
+            "sys.exit(main(sys.argv[2:]))")
+    proc = subprocess.run([sys.executable, "-c", code, str(gone), *command, "--out", str(tmp_path / "out")],
+                          capture_output=True, text=True, timeout=300,
+                          env=dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path)))
+    assert proc.returncode == 2, proc.stderr[-2000:]
+    assert "working directory no longer exists" in proc.stderr and "Traceback" not in proc.stderr
+    assert not (tmp_path / "out").exists()

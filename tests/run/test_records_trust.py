@@ -168,15 +168,43 @@ def test_resume_continues_a_run_killed_after_finished_stages(tmp_path, capsys):
     proc = subprocess.run([sys.executable, "-c", STAGE_KILLER, *args], env=_env(), capture_output=True, text=True,
                           timeout=300)
     assert proc.returncode == -signal.SIGKILL, proc.stderr[-2000:]
-    partial = load(out / "results.json")
+    partial = load(out / "results.json.partial")     # beside the results, never over them
     mark = json.loads((out / "results.json.in-progress").read_text())
     assert partial.meta["incomplete"] and partial.meta["finished_stages"] == ["convergence"]
-    assert partial.meta["run_id"] == mark["run_id"]
-    code, text = _run(capsys, "gate", "--baseline", str(out / "results.json"), "--results", str(out / "results.json"))
-    assert code == 2                                  # still refused: marked in progress, and incomplete
+    assert partial.meta["run_id"] == mark["run_id"] and not (out / "results.json").exists()
     resumed = subprocess.run([sys.executable, "-m", "verimono.cli", *args, "--resume"], env=_env(), capture_output=True,
                              text=True, timeout=300)   # a process of its own, as the killed one
     assert resumed.returncode == 0, resumed.stderr[-2000:]
     done = load(out / "results.json")
     assert [s["name"] for s in done.meta["stages"]] == ["convergence", "section7"]
     assert done.meta["resumed_from"] == mark["run_id"] and not (out / "results.json.in-progress").exists()
+    assert not (out / "results.json.partial").exists()
+
+
+@pytest.mark.slow
+def test_a_run_killed_halfway_leaves_the_previous_results_and_report_intact(tmp_path, capsys):
+    """Each finished stage was saved over results.json: a SIGKILL halfway left the previous run's results (and its
+    report, now of another run id) replaced by partial ones.  Now the previous pair stays byte for byte until a new
+    run completes; the killed run's stages wait beside it (results.json.partial) for --resume, and the gate refuses
+    the folder meanwhile (the mark)."""
+    out = tmp_path / "out"
+    args = ["run", "--stage", "convergence", "--stage", "section7", *ONE_REF, "--out", str(out)]
+    first = subprocess.run([sys.executable, "-m", "verimono.cli", *args], env=_env(), capture_output=True, text=True,
+                           timeout=300)
+    assert first.returncode == 0, first.stderr[-2000:]
+    before = {name: (out / name).read_bytes() for name in ("results.json", "report.html")}
+    proc = subprocess.run([sys.executable, "-c", STAGE_KILLER, *args], env=_env(), capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == -signal.SIGKILL, proc.stderr[-2000:]
+    assert {name: (out / name).read_bytes() for name in before} == before
+    mark = json.loads((out / "results.json.in-progress").read_text())
+    assert load(out / "results.json.partial").meta["run_id"] == mark["run_id"]
+    code, text = _run(capsys, "gate", "--baseline", str(out / "results.json"), "--results", str(out / "results.json"))
+    assert code == 2 and "never completed" in text
+    resumed = subprocess.run([sys.executable, "-m", "verimono.cli", *args, "--resume"], env=_env(), capture_output=True,
+                             text=True, timeout=300)
+    assert resumed.returncode == 0, resumed.stderr[-2000:]
+    done = load(out / "results.json")
+    assert done.meta["resumed_from"] == mark["run_id"] and [s["name"] for s in done.meta["stages"]] == [
+        "convergence", "section7"]
+    assert not (out / "results.json.partial").exists() and not (out / "results.json.in-progress").exists()

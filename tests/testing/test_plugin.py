@@ -259,3 +259,48 @@ def test_the_plugin_installs_the_sessions_profile_as_the_run_configuration(monke
     cfg = run_config.current()
     assert (cfg.profile, cfg.source) == ("thorough", "--hypothesis-profile")
     assert default_examples() == (200, "thorough")
+
+
+INTERRUPTED_PROJECT = '''
+import os, signal
+import pytest
+from verimono.records.results import CheckResult, emit
+
+
+def test_first():
+    emit(CheckResult("my_law", "my operator", "passed", worst=0.5, bound=1.0))
+
+
+def test_second():
+    {stop}
+
+
+def test_third():
+    emit(CheckResult("my_law", "another operator", "passed", worst=0.5, bound=1.0))
+'''
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("stop,args", [
+    ("raise KeyboardInterrupt", ()),                       # Ctrl-C in the middle of the session
+    ("os.kill(os.getpid(), signal.SIGINT)", ("-n", "2")),  # the signal, under xdist (the report the controller writes)
+    ("assert False", ("-x",)),                             # told to stop at the first failure
+])
+def test_a_session_that_stopped_early_writes_a_report_marked_incomplete(pytester, stop, args):
+    """`pytest -n 2 --verimono-report DIR` interrupted wrote its report as if the session had run everything
+    (an empty one, not marked incomplete), and the gate and `verimono baseline --from` took it; now the report
+    says the session stopped early, and `verimono baseline --from` refuses it."""
+    import subprocess
+    import sys
+
+    pytester.makepyfile(test_stop=INTERRUPTED_PROJECT.format(stop=stop))
+    if "-n" in args:
+        pytest.importorskip("xdist")
+    result = pytester.runpytest_subprocess(*_plugin_args(), "-p", "no:cacheprovider", *args, "--verimono-report", "out")
+    assert result.ret != 0
+    doc = json.loads((pytester.path / "out" / "results.json").read_text())
+    assert doc["meta"]["incomplete"] is True and doc["meta"]["stopped"], doc["meta"]
+    refused = subprocess.run([sys.executable, "-m", "verimono.cli", "baseline", "--from",
+                              str(pytester.path / "out" / "results.json"), "--out", str(pytester.path / "b.json")],
+                             capture_output=True, text=True, timeout=300)
+    assert refused.returncode == 2 and "incomplete" in refused.stderr, refused.stderr[-2000:]

@@ -294,17 +294,36 @@ def check_bounds_yb(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int =
 ALL_PAIRS = 1500
 
 
-def _pairs(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Index pairs ``i < j`` of ``n`` sorted times: all of them up to :data:`ALL_PAIRS` times; beyond, the
-    consecutive ones — which bound the rest: with ``ψ`` nondecreasing, the triangle inequality gives
-    ``|x(τ_j) − x(τ_i)| ≤ Σ_k |x(τ_{k+1}) − x(τ_k)| ≤ max_k r_k (ψ(τ_j) − ψ(τ_i))``, ``r_k`` the consecutive
-    ratios — and every pair of :data:`ALL_PAIRS` evenly spaced times (the ratios the tolerance shapes)."""
-    if n <= ALL_PAIRS:
+#: at most this many coordinates of pair differences are formed at once, and the all-pairs subsample is cut so
+#: that its pairs hold no more (each pair is a difference of two states of the problem's dimension: at n = 10^6
+#: the 3 000 pairs of 80 times were 3e9 numbers, 24 GB, and the battery had no verdict after 120 s)
+PAIR_ELEMENTS = 1 << 24
+
+
+def _pairs(n: int, dim: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """Index pairs ``i < j`` of ``n`` sorted times of states of dimension ``dim``: all of them up to
+    :data:`ALL_PAIRS` times (fewer when their differences would hold more than :data:`PAIR_ELEMENTS`
+    numbers); beyond, the consecutive ones — which bound the rest: with ``ψ`` nondecreasing, the triangle
+    inequality gives ``|x(τ_j) − x(τ_i)| ≤ Σ_k |x(τ_{k+1}) − x(τ_k)| ≤ max_k r_k (ψ(τ_j) − ψ(τ_i))``, ``r_k``
+    the consecutive ratios — and every pair of that many evenly spaced times (the ratios the tolerance shapes).
+    The work per time is then linear in ``dim``."""
+    dim = max(1, int(dim))
+    m = int((1 + np.sqrt(1 + 8 * PAIR_ELEMENTS / dim)) / 2)      # m (m - 1) / 2 pairs of dim numbers each
+    m = max(2, min(ALL_PAIRS, m))
+    if n <= m:
         return np.triu_indices(n, 1)
     k = np.arange(n - 1)
-    sub = np.unique(np.linspace(0, n - 1, ALL_PAIRS).round().astype(int))
+    sub = np.unique(np.linspace(0, n - 1, m).round().astype(int))
     si, sj = np.triu_indices(len(sub), 1)
     return np.concatenate([k, sub[si]]), np.concatenate([k + 1, sub[sj]])
+
+
+def _pair_norms(X: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+    """``|X[j] - X[i]|`` for every pair, at most :data:`PAIR_ELEMENTS` numbers formed at once."""
+    X = X.reshape(len(X), -1)
+    step = max(1, PAIR_ELEMENTS // max(1, X.shape[1]))
+    return np.concatenate([norms(X[j[a:a + step]] - X[i[a:a + step]]) for a in range(0, len(i), step)] or
+                          [np.zeros(0)])
 
 
 @stepper_law("psi_interpolation", "lem:bndEquiCont", PROXIMAL_CLAIM, _either(_lg_requirements, _yb_requirements))
@@ -314,8 +333,8 @@ def check_psi_interpolation(stepper: Callable, p: Problem, t: np.ndarray, *, see
 
     ``ψ`` from lem:bndSeq and/or lem:bndSeqYB (whichever applies); ``x_Δ`` from
     :meth:`verimono.Trajectory.interpolate` with ``kind="psi"``; all pairs among the nodes, cell
-    midpoints and ``samples`` random times (beyond :data:`ALL_PAIRS` times, the consecutive pairs, which bound
-    the others, and all pairs of a subsample: :func:`_pairs`).
+    midpoints and ``samples`` random times (beyond :data:`ALL_PAIRS` times, or fewer in a large dimension, the
+    consecutive pairs, which bound the others, and all pairs of a subsample: :func:`_pairs`).
 
     Claim: ``proximal`` — ``x_Δ`` interpolates the proximal iterates with the ψ of their lemmas.
     """
@@ -341,8 +360,8 @@ def check_psi_interpolation(stepper: Callable, p: Problem, t: np.ndarray, *, see
         psi = bounds.psi_function(np.union1d(t, tau))
         X = traj.interpolate(tau, kind="psi", psi=psi)
         P = np.array([psi(s) for s in tau])
-        i, j = _pairs(len(tau))
-        lhs = norms(X[j] - X[i])
+        i, j = _pairs(len(tau), int(np.prod(X.shape[1:])))
+        lhs = _pair_norms(X, i, j)
         rhs = P[j] - P[i]
         ratio = lhs / (rhs + slack + tolerance(X, P))
         m = int(np.argmax(ratio))

@@ -21,6 +21,8 @@ from typing import Callable
 
 import numpy as np
 
+from .lifetime import die_with, quiet_signals
+
 
 #: the steps of the calibration workload's loop
 WORKLOAD_STEPS = 20000
@@ -159,6 +161,7 @@ class PendingCalibration:
         if not (sys.platform.startswith("linux") and threading.active_count() == 1):
             return
         r, w = os.pipe()
+        leader = os.getpid()
         try:
             pid = os.fork()
         except OSError:
@@ -167,6 +170,8 @@ class PendingCalibration:
         if pid == 0:                                     # the copy: measure, answer, and end at once
             code = 1
             try:
+                quiet_signals()                          # Ctrl-C is the leader's; SIGTERM/SIGHUP end it quietly
+                die_with(leader)                         # and it ends with the leader, however that ends
                 os.close(r)
                 wall, cpus = calibrate_times(repeats)
                 os.write(w, struct.pack(f"<{1 + repeats}d", wall, *cpus))

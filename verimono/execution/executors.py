@@ -56,6 +56,7 @@ from . import watchdog
 from ..core.errors import BadExecutor
 from .config import RunConfig
 from ..records.results import Report
+from .lifetime import started_from_main_thread
 from .timeouts import unlimited
 from .units import UNIT_CHECK, Unit, config_for, raised, unit_failure, unit_raised, unit_record  # noqa: F401
 from .workers import (BLAS_THREADS, FORK_UNSAFE, HANG_EXIT, WORKER_START_TIMEOUT, _decode, _decode_answer,  # noqa: F401
@@ -127,7 +128,8 @@ class ProcessRunner:
         for _ in range(max(0, count)):
             parent, child = ctx.Pipe(duplex=True)
             # not a daemon: a unit may itself start a process pool (a large convergence study)
-            proc = ctx.Process(target=_process_worker, args=(child,), name="verimono-unit-worker")
+            proc = ctx.Process(target=_process_worker, args=(child,), name="verimono-unit-worker",
+                               kwargs={"leader": os.getpid(), "kernel": started_from_main_thread()})
             proc.start()
             child.close()
             started.append((proc, parent))
@@ -324,7 +326,8 @@ def run_forked(unit: Unit, cfg: RunConfig, timeout: float | None = None) -> Repo
     parent, child = ctx.Pipe(duplex=True)
     job = (cfg, unit.fn, unit.args, _limits(), unit.stage, unit.label)
     sys.stdout.flush(), sys.stderr.flush()       # a forked copy must not write this process's buffers again
-    proc = ctx.Process(target=_process_worker, args=(child, job), name="verimono-unit-worker")
+    proc = ctx.Process(target=_process_worker, args=(child, job), name="verimono-unit-worker",
+                       kwargs={"leader": os.getpid(), "kernel": started_from_main_thread()})
     proc.start()
     child.close()
     start = time.monotonic()
@@ -347,13 +350,63 @@ def run_forked(unit: Unit, cfg: RunConfig, timeout: float | None = None) -> Repo
         parent.close()
 
 
+#: seconds an executor address has to answer as a dask scheduler (connect, and answer who it is)
+CONNECT_TIMEOUT = 30.0
+
+
+def answers_as_dask(address: str, seconds: float = CONNECT_TIMEOUT) -> dict:
+    """The identity a dask scheduler at ``address`` gives within ``seconds`` (connect, send
+    ``{"op": "identity"}``, read the answer: every step bounded); :class:`BadExecutor` in one line when nothing
+    answers there, or something that is not a dask scheduler (an HTTP server took the connection and the
+    handshake, then never answered: ``distributed.Client`` waited on it past 120 s, silently).  Runs in a
+    thread of its own, with its own event loop, so it works from inside a running loop (Jupyter) too."""
+    import asyncio
+    import threading
+
+    async def probe() -> Any:
+        from distributed.comm import connect
+
+        comm = await asyncio.wait_for(connect(address, timeout=seconds), seconds)
+        try:
+            await asyncio.wait_for(comm.write({"op": "identity"}), seconds)
+            return await asyncio.wait_for(comm.read(), seconds)
+        finally:
+            comm.abort()
+
+    box: dict[str, Any] = {}
+
+    def run() -> None:
+        try:
+            box["answer"] = asyncio.run(probe())
+        except BaseException as exc:  # noqa: BLE001 - told below, in one line
+            box["error"] = exc
+
+    thread = threading.Thread(target=run, name="verimono-dask-probe", daemon=True)
+    thread.start()
+    thread.join(seconds * 3 + 5.0)      # each step is bounded by `seconds`; this only guards the guard
+    answer, exc = box.get("answer"), box.get("error")
+    if isinstance(answer, dict) and str(answer.get("type", "")).lower() == "scheduler":
+        return answer
+    if exc is None and "answer" not in box:
+        why = f"no answer within {seconds:g} s"
+    elif exc is not None:
+        why = ("no answer within {:g} s".format(seconds) if isinstance(exc, (TimeoutError, asyncio.TimeoutError))
+               else f"{type(exc).__name__}: {exc}")
+    else:
+        why = f"it answered {str(answer)[:80]!r}, not as a dask scheduler"
+    raise BadExecutor(f"--executor {address}: no dask scheduler answers there ({why}; a scheduler is started with "
+                      "`dask scheduler`, tcp://host:8786 by default)")
+
+
 class DaskRunner:
     """The workers of a ``dask.distributed`` scheduler at ``address`` (or an existing ``Client``).
 
     At most as many units are in flight as the cluster has worker threads, so a unit's ``timeout`` counts
     from when it could start; a unit still unfinished then is cancelled and reported."""
 
-    def __init__(self, address: Any, timeout: float | None = None) -> None:
+    def __init__(self, address: Any, timeout: float | None = None, *,
+                 connect_timeout: float | None = None) -> None:
+        connect_timeout = CONNECT_TIMEOUT if connect_timeout is None else float(connect_timeout)
         try:
             from distributed import Client
         except ImportError:
@@ -364,8 +417,9 @@ class DaskRunner:
             self.client, self._own = address, False
             self.spec = str(address.scheduler.address if address.scheduler else address)
         else:
+            answers_as_dask(address, connect_timeout)
             try:
-                self.client, self._own = Client(address, timeout="30s"), True
+                self.client, self._own = Client(address, timeout=f"{connect_timeout:g}s"), True
             except (OSError, TimeoutError) as exc:
                 raise BadExecutor(f"--executor {address}: no dask scheduler answers there ({exc})") from None
             self.spec = str(address)
@@ -486,5 +540,5 @@ def make_runner(spec: Any = None, *, timeout: float | None = None) -> Any:
     raise BadExecutor(f"executor must be serial, process:N, a dask scheduler address or Client, got {spec!r}")
 
 
-__all__ = ["Unit", "UNIT_CHECK", "AUTO_MAX_WORKERS", "ship_by_value", "BadExecutor", "SerialRunner", "ProcessRunner", "DaskRunner", "make_runner",
+__all__ = ["Unit", "UNIT_CHECK", "AUTO_MAX_WORKERS", "CONNECT_TIMEOUT", "answers_as_dask", "ship_by_value", "BadExecutor", "SerialRunner", "ProcessRunner", "DaskRunner", "make_runner",
            "unit_failure", "unit_record", "unit_raised", "raised", "run_payload", "run_here", "run_forked"]

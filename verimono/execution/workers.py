@@ -20,6 +20,7 @@ from typing import Any
 from . import config as _config
 from . import watchdog
 from .calibration import calibration, set_calibration
+from .lifetime import die_with, quiet_signals
 from .config import RunConfig
 from ..core.errors import BadExecutor
 from .profiles import load_hypothesis_profile
@@ -131,7 +132,7 @@ WORKER_START_TIMEOUT = 300.0
 HANG_EXIT = 3
 
 
-def _process_worker(conn: Any, job: tuple | None = None) -> None:
+def _process_worker(conn: Any, job: tuple | None = None, leader: int | None = None, kernel: bool = True) -> None:
     """Loop of a ``process:N`` worker: say ``ready`` once verimono is imported (so a unit's timeout does
     not count the worker's start), then receive a payload and answer, until an empty message.  With ``job``
     (the arguments of :func:`run_job`, in the memory of a forked process: nothing of it was pickled) it runs
@@ -141,8 +142,18 @@ def _process_worker(conn: Any, job: tuple | None = None) -> None:
     interrupted: the watchdog thread answers for the unit instead — ``("hang", report)``, the records the
     unit finished and the failed record of the hung call — ends the call's child processes and exits
     (status :data:`HANG_EXIT`); the parent replaces the worker.  One answer per payload, whichever comes
-    first (``lock``)."""
+    first (``lock``).
+
+    ``leader``: the pid of the process that started it: the worker ends when that process ends, however it
+    ends — ``SIGKILL`` included (:func:`verimono.execution.lifetime.die_with`; ``kernel``: it was started from
+    the leader's main thread, so the kernel may watch) — and has a helper's signal dispositions
+    (:func:`verimono.execution.lifetime.quiet_signals`: Ctrl-C is the leader's; SIGTERM and SIGHUP end it
+    quietly)."""
     import threading
+
+    quiet_signals()
+    if leader is not None:
+        die_with(leader, kernel=kernel)
 
     import cloudpickle
     import scipy.linalg  # noqa: F401  (with numpy and verimono, imported here: what every unit needs)

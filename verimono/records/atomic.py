@@ -18,6 +18,10 @@ Rules:
   next to it, holding the run id) before it starts and removes the mark once its own pair is in place
   (:func:`clear_in_progress`); a mark left behind (a run killed, or stopped by an error) says that the
   files beside it are not that run's, and the gate refuses them (:func:`in_progress`);
+* a run's finished stages are saved as each finishes to ``results.json.partial`` next to the results
+  (:func:`partial_path`), never over them: a run killed outright (``SIGKILL``, which no handler sees) leaves
+  the previous results and report as they were, beside its mark and its partial file (``--resume`` reads it);
+  the partial file goes with the mark once the run's own pair is in place (:func:`clear_in_progress`);
 * :func:`keep_elsewhere` saves a document that could not be written where asked in the temporary folder.
 """
 
@@ -237,12 +241,24 @@ def in_progress(results: str | os.PathLike) -> dict | None:
 
 def clear_in_progress(results: str | os.PathLike, run_id: str) -> bool:
     """Remove the in-progress mark of ``results`` if it is the run ``run_id``'s (another run that started
-    since keeps its own); whether it was removed."""
+    since keeps its own), and that run's partial file (:func:`partial_path`); whether it was removed."""
     facts = in_progress(results)
     if facts is None or facts.get("run_id") != run_id:
         return False
+    _unlink(partial_path(results))
     _unlink(in_progress_path(results))
     return True
+
+
+#: suffix of the file a run saves its finished stages to while it runs (``results.json.partial``)
+PARTIAL_SUFFIX = ".partial"
+
+
+def partial_path(results: str | os.PathLike) -> Path:
+    """Where a run saves its finished stages while it runs (``results.json.partial``): beside the results,
+    never over them, so that a run killed outright leaves the previous results intact."""
+    results = Path(results)
+    return results.with_name(results.name + PARTIAL_SUFFIX)
 
 
 def keep_elsewhere(text: str, name: str) -> Path:
@@ -264,5 +280,5 @@ def keep_elsewhere(text: str, name: str) -> Path:
 
 
 __all__ = ["OutputNotWritable", "replace_all", "write_text", "ensure_writable_dir", "ensure_writable_file",
-           "file_mode", "not_writable", "in_progress_path", "mark_in_progress", "in_progress", "clear_in_progress",
+           "file_mode", "not_writable", "in_progress_path", "mark_in_progress", "in_progress", "clear_in_progress", "partial_path", "PARTIAL_SUFFIX",
            "keep_elsewhere", "IN_PROGRESS_SUFFIX"]

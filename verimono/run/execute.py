@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from ..execution import watchdog
-from ..records.atomic import write_text
+from ..records.atomic import partial_path, write_text
 from ..records.environment import environment
 from ..execution.executors import BLAS_THREADS, make_runner
 from ..execution.config import RunConfig
@@ -140,7 +140,7 @@ ISOLATE_ADVICE = ("`--executor process:N` runs each unit in a worker process, so
 def interruptible(run: Callable[[Callable], Report], out: Path, *, command: str, profile: str,
                    stages: list[str] | None, previous: Report | None = None, run_id: str | None = None,
                    advice: str | None = None, checkpoint: bool = False) -> Report | int:
-    """``run(on_done)`` with SIGTERM treated as an interrupt; on an interrupt write the stages finished so
+    """``run(on_done)`` with SIGTERM and SIGHUP treated as an interrupt; on an interrupt write the stages finished so
     far (with ``previous``'s, when resuming) to ``out`` marked ``incomplete`` (as the run ``run_id``) and
     return the exit status.  ``advice``: how to go on, printed after the interrupt (default: ``verimono
     run --resume``, which only ``run`` has).
@@ -165,15 +165,18 @@ def interruptible(run: Callable[[Callable], Report], out: Path, *, command: str,
             save_checkpoint()
 
     def save_checkpoint() -> None:
-        """The stages finished so far, on disk as each finishes (``results.json`` only, marked incomplete, with
-        this run's id; the in-progress mark stays): a run killed with SIGKILL, which no handler sees, leaves
-        them for ``--resume``.  A checkpoint that cannot be written costs the run nothing but that."""
+        """The stages finished so far, on disk as each finishes (``results.json.partial``, marked incomplete,
+        with this run's id; the in-progress mark stays): a run killed with SIGKILL, which no handler sees,
+        leaves them for ``--resume`` — beside the previous results and report, which stay as they were until
+        this run's own pair replaces them (:func:`verimono.records.atomic.partial_path`).  A checkpoint that
+        cannot be written costs the run nothing but that."""
         partial, _ = partial_report()
         partial.meta["run_id"] = run_id
+        where = partial_path(out / "results.json")
         try:
-            write_text(out / "results.json", partial.to_json())
+            write_text(where, partial.to_json())
         except OSError as exc:  # OutputNotWritable too: the final write says it again, with what it keeps
-            print(f"verimono: could not save the finished stages to {out / 'results.json'} "
+            print(f"verimono: could not save the finished stages to {where} "
                   f"({getattr(exc, 'strerror', None) or exc}); the run goes on", file=sys.stderr)
 
     def partial_report() -> tuple[Report, list[str]]:
@@ -215,9 +218,11 @@ def interruptible(run: Callable[[Callable], Report], out: Path, *, command: str,
             watchdog.end_process(EXIT_FAILED)
 
     def term(signum, frame):
-        raise KeyboardInterrupt(f"signal {signum}")
+        raise KeyboardInterrupt(signal.Signals(signum).name)
 
-    old = signal.signal(signal.SIGTERM, term) if _main_thread() else None
+    # SIGTERM and SIGHUP (a terminal closed, an SSH session dropped) as Ctrl-C
+    held = [getattr(signal, n) for n in ("SIGTERM", "SIGHUP") if hasattr(signal, n)] if _main_thread() else []
+    old = {sig: signal.signal(sig, term) for sig in held}
     try:
         with watchdog.scope() as root, watchdog.on_hang(on_hang):
             stage_scope.append(root)
@@ -230,8 +235,8 @@ def interruptible(run: Callable[[Callable], Report], out: Path, *, command: str,
               f"{advice or f'continue with `verimono {command} --resume`'}", file=sys.stderr)
         return EXIT_INTERRUPTED
     finally:
-        if old is not None:
-            signal.signal(signal.SIGTERM, old)
+        for sig, handler in old.items():
+            signal.signal(sig, handler)
 
 
 def _main_thread() -> bool:
