@@ -33,26 +33,66 @@ SEED_STRIDE = 1_000_003
 @functools.lru_cache(maxsize=256)
 def generated_problem(seed: int, index: int) -> Problem:
     """Problem ``#index`` of battery seed ``seed`` (module docstring)."""
-    from hypothesis import HealthCheck, Phase, given, settings
-    from hypothesis import seed as hseed
-
     from ..strategies.problems import stated_problems
 
     seed, index = valid_count(seed, "seed"), valid_count(index, "index")
     placement, size, terms = STRATA[index % len(STRATA)]
-    drawn: list[Problem] = []
-
-    # two examples: hypothesis' first is the simplest (every choice at its minimum), the second is drawn
-    @settings(max_examples=2, derandomize=False, database=None, phases=[Phase.generate], deadline=None,
-              suppress_health_check=list(HealthCheck))
-    @given(stated_problems(size=size, placement=placement, terms=terms))
-    def collect(p: Problem) -> None:
-        drawn.append(p)
-
-    hseed(seed * SEED_STRIDE + index)(collect)()
-    p = drawn[-1]
+    p = draw(stated_problems(size=size, placement=placement, terms=terms), seed * SEED_STRIDE + index)
     return p.replace(name=f"generated #{index} (seed {seed}): {p.name}",
                      notes=f"generated_problem({seed}, {index}); {p.notes}")
+
+
+def draw(strategy, seed: int):
+    """One value of the hypothesis ``strategy``, a function of ``seed`` alone.
+
+    A test run of hypothesis is not: besides its seed, it draws with some probability among the constants it
+    finds in the source of the local modules imported so far (hypothesis ≥ 6.131), so the same seed gave
+    another problem once ``verimono.reference`` was imported.  Here one choice sequence is drawn from
+    ``random.Random(seed)`` by hypothesis' own provider with those constants switched off — no test engine,
+    no first "simplest" example (2 ms a problem instead of 50).  A hypothesis without that provider
+    interface is driven through ``@given`` and ``@seed`` instead."""
+    import random
+
+    try:
+        from hypothesis.control import BuildContext
+        from hypothesis.internal.conjecture.data import ConjectureData
+
+        data = ConjectureData(random=random.Random(seed), provider=_provider())
+        context = BuildContext(data, is_final=False, wrapped_test=draw)
+    except (ImportError, TypeError, AttributeError):      # another hypothesis release: its test engine
+        return _draw_with_engine(strategy, seed)
+    with context:
+        return data.draw(strategy)
+
+
+@functools.lru_cache(maxsize=1)
+def _provider() -> type:
+    from hypothesis.internal.conjecture.providers import HypothesisProvider
+
+    class SeedOnly(HypothesisProvider):
+        """Hypothesis' provider, never drawing the constants of the imported modules (:func:`draw`)."""
+
+        def _maybe_draw_constant(self, *args, **kwargs):
+            return None
+
+    return SeedOnly
+
+
+def _draw_with_engine(strategy, seed: int):
+    from hypothesis import HealthCheck, Phase, given, settings
+    from hypothesis import seed as hseed
+
+    drawn: list = []
+
+    # two examples: the engine's first is the simplest (every choice at its minimum), the second is drawn
+    @settings(max_examples=2, derandomize=False, database=None, phases=[Phase.generate], deadline=None,
+              suppress_health_check=list(HealthCheck))
+    @given(strategy)
+    def collect(value) -> None:
+        drawn.append(value)
+
+    hseed(seed)(collect)()
+    return drawn[-1]
 
 
 def generated_problems(seed: int = 0, count: int = len(STRATA)) -> list[Problem]:
@@ -60,4 +100,4 @@ def generated_problems(seed: int = 0, count: int = len(STRATA)) -> list[Problem]
     return [generated_problem(int(seed), i) for i in range(valid_count(count))]
 
 
-__all__ = ["STRATA", "SEED_STRIDE", "generated_problem", "generated_problems"]
+__all__ = ["STRATA", "SEED_STRIDE", "generated_problem", "generated_problems", "draw"]

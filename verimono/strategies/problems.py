@@ -16,8 +16,9 @@ The coordinates of the problem space a stepper can get wrong, each drawn:
   :func:`ac_inputs` input plus a constant with every entry at least 1/4 in magnitude, :class:`OffsetInput`,
   with its exact primitive ``U``) — both act on every coordinate; ``terms`` says which are present;
 * where ``x0`` lies (``placement``, :data:`PLACEMENTS`): ``"inside"`` (an interior point of a moving domain,
-  or any point of ``cl dom F(0)``), ``"on"`` the boundary of the moving domain (the projection of a far point
-  along the free motion ``f + u`` — where the constraint is active from ``t = 0``), ``"near_inside"`` and
+  or any point of ``cl dom F(0)``), ``"on"`` the boundary of the moving domain (where a ray from an interior point
+  along the free motion ``f + u``, else along another direction, leaves it — the first such point where the
+  constraint is active at ``t = 0``: the free motion leaves the moving domain), ``"near_inside"`` and
   ``"near_outside"`` (``NEAR = 1e-6`` inside or outside along the outer normal at that boundary point; outside,
   ``x0 ∉ cl dom F(0)`` and the problem starts with the catching-up jump, ``initial_jump=True``).
 
@@ -242,20 +243,55 @@ def every_coordinate_inputs(n: int, T: float) -> st.SearchStrategy[OffsetInput]:
     return st.builds(OffsetInput, ac_inputs(n, T, scale=1.0), _signed(n, 0.25, 1.0))
 
 
-def _boundary_point(op: Any, m: np.ndarray, drift: np.ndarray | None, seed_dir: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(x_on, ν)``: the projection onto ``S(0)`` of a far point from the interior point ``m`` along the free
-    motion ``drift`` (else along ``seed_dir``), and the unit outer normal ``ν`` there."""
-    scale = 10.0 * (1.0 + float(np.linalg.norm(m)))
-    for d in ([drift] if drift is not None else []) + [seed_dir, -seed_dir]:
+#: the step over which a boundary start is tested for an active constraint
+ACTIVE_STEP = 1e-3
+
+
+def _boundary_point(op: Any, m: np.ndarray, drift: Any, seed_dir: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(x_on, ν)``: a point of the boundary of ``S(0)`` where the constraint is active — the free motion
+    ``x_on + δ drift(x_on)`` leaves ``S(δ)`` for ``δ = ACTIVE_STEP`` — and the unit outer normal ``ν`` there.
+
+    Candidates, in order: where the ray from the interior point ``m`` along ``drift(m)``, ``±seed_dir``, ``±e_i``
+    leaves ``S(0)`` (doubling and bisection; the projection of the point one unit beyond the exit, with
+    ``ν ∈ N_S(x_on)`` from it); the first active one, else the first found (``drift = None``: no ``f``, no
+    ``u``; then active means the domain moves inward there)."""
+    def gap(z: np.ndarray, t: float = 0.0) -> float:
+        return float(np.linalg.norm(np.asarray(op.project_domain(z, t), float) - z))
+
+    def outside(z: np.ndarray) -> bool:
+        return gap(z) > 1e-9 * (1.0 + float(np.linalg.norm(z)))
+
+    def push(z: np.ndarray) -> np.ndarray:
+        return np.zeros_like(z) if drift is None else np.asarray(drift(z), dtype=float)
+
+    basis = np.eye(m.size)
+    first = None
+    # a bounded set is left along every direction; a half-space along one of ±e_i
+    for d in [push(m), seed_dir, -seed_dir, *basis, *(-basis)]:
         nd = float(np.linalg.norm(d))
         if not nd > 0:
             continue
-        far = m + scale * d / nd
+        d = d / nd
+        lo, hi = 0.0, 0.5
+        while hi < 1e4 and not outside(m + hi * d):
+            lo, hi = hi, 2.0 * hi
+        if hi >= 1e4:
+            continue
+        for _ in range(30):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (lo, mid) if outside(m + mid * d) else (mid, hi)
+        far = m + (hi + 1.0) * d
         on = np.asarray(op.project_domain(far, 0.0), dtype=float)
-        gap = float(np.linalg.norm(far - on))
-        if gap > 1e-3 * scale:                         # the far point is outside: ``on`` is on the boundary
-            return on, (far - on) / gap
-    raise ValueError("no boundary point found along the drawn directions")  # a half-space has one of ±d
+        g = float(np.linalg.norm(far - on))
+        if not g > 0.1:
+            continue
+        found = (on, (far - on) / g)
+        if gap(on + ACTIVE_STEP * push(on), ACTIVE_STEP) > 1e-3 * ACTIVE_STEP:
+            return found
+        first = first or found
+    if first is None:
+        raise ValueError("no boundary point found along any direction")    # a solid domain is never all of R^n
+    return first
 
 
 def stated_problems(n: int | None = None, T: float | None = None, *, size: str | None = None,
@@ -294,7 +330,8 @@ def _problems(draw, n, T, size, placement, terms) -> Problem:
     if interior is not None and where != "inside":
         drift = None
         if f is not None or u is not None:
-            drift = (f(interior) if f is not None else 0.0) + (u(0.0) if u is not None else 0.0)
+            def drift(x, f=f, u=u):
+                return (f(x) if f is not None else 0.0) + (u(0.0) if u is not None else 0.0)
         seed_dir = draw(_vec(k, -1.0, 1.0).filter(lambda v: np.linalg.norm(v) > 0.1), label="direction")
         on, nu = _boundary_point(op, interior, drift, seed_dir)
         x0 = {"on": on, "near_inside": on - NEAR * nu, "near_outside": on + NEAR * nu}[where]
