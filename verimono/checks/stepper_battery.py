@@ -20,7 +20,7 @@ from ..records.results import CheckResult, Report
 from ..execution.timeouts import run_unit
 from . import bounds, limits, picard, trajectory_laws  # noqa: F401 - the laws join the registry on import
 from . import orders as _order_law  # noqa: F401 - convergence_order joins the registry on import
-from ..execution.config import chosen
+from ..execution.config import chosen, current
 from ..execution.executors import Unit
 from .core import laws_of, stepper_subject
 from .isolated import isolating, run_check, run_isolated
@@ -56,8 +56,6 @@ def generated_count(generated: object = None) -> int:
     """``generated`` as a number of generated problems (:func:`valid_count`); ``None``: the current profile's
     ``generated_subjects`` (:mod:`verimono.execution.profiles`; 3 for a profile of the user's own)."""
     if generated is None:
-        from ..execution.config import current
-
         effort = current().effort
         return 3 if effort is None else int(effort.generated_subjects)
     return valid_count(generated)

@@ -13,8 +13,9 @@ The coordinates of the problem space a stepper can get wrong, each drawn:
   moving with a stated (A3) rate > 0), ``∂(c(t)|·|)``, ``∂(c(t)|·|₁)`` or a linear ``M0 + g(t) M1``;
 * the Lipschitz field ``f`` (:class:`LipschitzField`: ``B x + b`` or ``B tanh(x) + b``, ``‖B‖₂ = L`` stated
   as ``lipschitz``, every ``b_i`` at least 0.3 in magnitude, ``L T ≤ 3``) and the input ``u`` (an
-  :func:`ac_inputs` input plus a constant with every entry at least 1/4 in magnitude, :class:`OffsetInput`,
-  with its exact primitive ``U``) — both act on every coordinate; ``terms`` says which are present;
+  :func:`ac_inputs` input plus a constant that keeps every ``|u_j(t)| ≥ 1/4`` on ``[0, T]``,
+  :class:`OffsetInput`, with its exact primitive ``U``) — both act on every coordinate; ``terms`` says which
+  are present;
 * where ``x0`` lies (``placement``, :data:`PLACEMENTS`): ``"inside"`` (an interior point of a moving domain,
   or any point of ``cl dom F(0)``), ``"on"`` the boundary of the moving domain (where a ray from an interior point
   along the free motion ``f + u``, else along another direction, leaves it — the first such point where the
@@ -238,9 +239,23 @@ def lipschitz_fields(draw, n: int, T: float) -> LipschitzField:
     return LipschitzField(B, draw(_signed(n, 0.3, 1.5), label="b"), kind)
 
 
+def _entry_bounds(u: ACInput, T: float) -> np.ndarray:
+    """``sup_{[0, T]} |u_j|`` for every coordinate ``j`` (``|u_j|`` is convex on each affine piece)."""
+    if u.kind == "const":
+        return np.abs(u.a)
+    if u.kind == "affine":
+        return np.maximum(np.abs(u.a), np.abs(u.a + T * u.b))
+    if u.kind == "sin":
+        return np.abs(u.a) + np.abs(u.b)
+    return np.max(np.abs(u.values), axis=0)
+
+
 def every_coordinate_inputs(n: int, T: float) -> st.SearchStrategy[OffsetInput]:
-    """:func:`ac_inputs` on ``R^n`` plus a constant with every entry of magnitude in ``[1/4, 1]``."""
-    return st.builds(OffsetInput, ac_inputs(n, T, scale=1.0), _signed(n, 0.25, 1.0))
+    """:func:`ac_inputs` ``u0`` on ``R^n`` plus a constant ``c`` with ``|c_j| = sup|u0_j| + s_j``, ``s_j ∈ [1/4, 1]``:
+    ``|u_j(t)| ≥ 1/4`` on ``[0, T]`` for every coordinate ``j`` — the input acts on every coordinate throughout."""
+    def build(u0: ACInput, s: np.ndarray) -> OffsetInput:
+        return OffsetInput(u0, np.sign(s) * (_entry_bounds(u0, T) + np.abs(s)))
+    return st.builds(build, ac_inputs(n, T, scale=1.0), _signed(n, 0.25, 1.0))
 
 
 #: the step over which a boundary start is tested for an active constraint
