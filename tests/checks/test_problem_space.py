@@ -172,11 +172,13 @@ def test_the_plants_moved_fail_at_seeds_0_to_2(plant, law, least):
 def test_a_failing_record_names_the_recipe_that_replays_it():
     """The record's subject holds ``generated #i (seed s)``; ``generated_problem(s, i)`` given back to
     ``check_stepper`` reproduces the failure alone."""
-    rep = vm.check_stepper(drops_f(1, 3), generated_problems(1, 2), laws=["selections"], orders=False)
-    subject = rep.failures[-1].subject.split(" on ", 1)[1]
+    rep = vm.check_stepper(drops_f(1, 3), generated_problems(0, 3)[2:], laws=["selections"], orders=False)
+    subject = rep.failures[0].subject.split(" on ", 1)[1]
     i, s = int(subject.split("#")[1].split(" ")[0]), int(subject.split("seed ")[1].split(")")[0])
+    generated_problem.cache_clear()                      # rebuilt from the recipe, not the cached object
     again = vm.check_stepper(drops_f(1, 3), [generated_problem(s, i)], laws=["selections"], orders=False)
-    assert (i, s) == (1, 1) and [r.subject for r in again.failures] == [rep.failures[-1].subject]
+    assert (i, s) == (2, 0) and [r.subject for r in again.failures] == [rep.failures[0].subject]
+    assert again.failures[0].worst == rep.failures[0].worst
 
 
 # -- the laws on problems without an exact solution -------------------------------------------------------------

@@ -21,11 +21,12 @@ from ..core.problem import Problem
 from .sample_problems import valid_count
 
 #: ``(placement, size, terms)`` of draw ``i`` is ``STRATA[i % 6]``: the first three (``dev``'s) hold a start on
-#: the boundary, an interior one in ``n ≥ 13`` and one just inside the boundary in ``5 ≤ n ≤ 12``, each with
-#: ``f`` and ``u``; the next three a start just outside (the catching-up jump) with ``f`` alone, and two where
-#: the bounds of lem:bndSeq/lem:bndSeqYB apply (``f = 0``): no input, and a boundary start with ``u``
-STRATA = (("on", "small", "f+u"), ("inside", "large", "f+u"), ("near_inside", "medium", "f+u"),
-          ("near_outside", "small", "f"), ("inside", "small", "none"), ("on", "medium", "u"))
+#: the boundary with ``u`` (where the bounds of lem:bndSeq apply), an interior one in ``n ≥ 13`` and one just
+#: inside the boundary in ``5 ≤ n ≤ 12``, both with ``f`` and ``u``; the next three a start just outside (the
+#: catching-up jump) with ``f`` alone, one with neither (where lem:bndSeqYB applies too) and a boundary start
+#: in ``5 ≤ n ≤ 12`` with ``f`` and ``u``
+STRATA = (("on", "small", "u"), ("inside", "large", "f+u"), ("near_inside", "medium", "f+u"),
+          ("near_outside", "small", "f"), ("inside", "small", "none"), ("on", "medium", "f+u"))
 #: the seed of draw ``i`` of battery seed ``s`` is ``s * SEED_STRIDE + i``
 SEED_STRIDE = 1_000_003
 
