@@ -93,11 +93,37 @@ class OffsetInput:
     base: ACInput
     c: np.ndarray
 
+    def __post_init__(self) -> None:
+        if self.base.kind == "pwlinear":    # the laws call u and U at every node: one interpolation of all rows
+            tk, v = np.asarray(self.base.knots, float), np.asarray(self.base.values, float)
+            cum = np.concatenate([np.zeros((1, v.shape[1])),
+                                  np.cumsum(0.5 * np.diff(tk)[:, None] * (v[:-1] + v[1:]), axis=0)])
+            object.__setattr__(self, "_pw", (tk, v, cum))
+
+    def _piece(self, t: float) -> tuple[int, float]:
+        tk = self._pw[0]
+        j = int(np.clip(np.searchsorted(tk, t, side="right") - 1, 0, len(tk) - 2))
+        return j, float(np.clip((t - tk[j]) / (tk[j + 1] - tk[j]), 0.0, 1.0))
+
     def __call__(self, t: float) -> np.ndarray:
-        return self.base(t) + self.c
+        if self.base.kind != "pwlinear":
+            return self.base(t) + self.c
+        j, w = self._piece(float(t))
+        v = self._pw[1]
+        return (1.0 - w) * v[j] + w * v[j + 1] + self.c
 
     def integral(self, t: float) -> np.ndarray:
-        return self.base.integral(t) + float(t) * self.c
+        t = float(t)
+        if self.base.kind != "pwlinear":
+            return self.base.integral(t) + t * self.c
+        tk, v, cum = self._pw
+        if t <= tk[0]:
+            return t * self.c
+        if t >= tk[-1]:
+            return cum[-1] + (t - tk[-1]) * v[-1] + t * self.c
+        j, w = self._piece(t)
+        s = t - tk[j]
+        return cum[j] + s * (v[j] + 0.5 * w * (v[j + 1] - v[j])) + t * self.c
 
     @property
     def bound(self) -> float:
