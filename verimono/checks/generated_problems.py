@@ -18,6 +18,7 @@ from __future__ import annotations
 import functools
 
 from ..core.problem import Problem
+from .arguments import valid_seed
 from .sample_problems import valid_count
 
 #: ``(placement, size, terms)`` of draw ``i`` is ``STRATA[i % 6]``: the first three (``dev``'s) hold a start on
@@ -29,6 +30,9 @@ STRATA = (("on", "small", "u"), ("inside", "large", "f+u"), ("near_inside", "med
           ("near_outside", "small", "f"), ("inside", "small", "none"), ("on", "medium", "f+u"))
 #: the seed of draw ``i`` of battery seed ``s`` is ``s * SEED_STRIDE + i``
 SEED_STRIDE = 1_000_003
+#: a draw a strategy's filter or ``assume`` rejects is drawn again from seed ``+ k * ATTEMPT_STRIDE``,
+#: ``k = 1, 2, ...`` (still a function of the seed alone), up to ``DRAW_ATTEMPTS`` times
+ATTEMPT_STRIDE, DRAW_ATTEMPTS = 7_919_000_003, 20
 
 
 @functools.lru_cache(maxsize=256)
@@ -36,7 +40,7 @@ def generated_problem(seed: int, index: int) -> Problem:
     """Problem ``#index`` of battery seed ``seed`` (module docstring)."""
     from ..strategies.problems import stated_problems
 
-    seed, index = valid_count(seed, "seed"), valid_count(index, "index")
+    seed, index = valid_seed(seed), valid_count(index, "index")
     placement, size, terms = STRATA[index % len(STRATA)]
     p = draw(stated_problems(size=size, placement=placement, terms=terms), seed * SEED_STRIDE + index)
     return p.replace(name=f"generated #{index} (seed {seed}): {p.name}",
@@ -50,20 +54,28 @@ def draw(strategy, seed: int):
     finds in the source of the local modules imported so far (hypothesis ≥ 6.131), so the same seed gave
     another problem once ``verimono.reference`` was imported.  Here one choice sequence is drawn from
     ``random.Random(seed)`` by hypothesis' own provider with those constants switched off — no test engine,
-    no first "simplest" example (2 ms a problem instead of 50).  A hypothesis without that provider
+    no first "simplest" example (about 25 ms a problem instead of 50).  A hypothesis without that provider
     interface is driven through ``@given`` and ``@seed`` instead."""
     import random
 
     try:
         from hypothesis.control import BuildContext
-        from hypothesis.internal.conjecture.data import ConjectureData
-
-        data = ConjectureData(random=random.Random(seed), provider=_provider())
-        context = BuildContext(data, is_final=False, wrapped_test=draw)
-    except (ImportError, TypeError, AttributeError):      # another hypothesis release: its test engine
+        from hypothesis.errors import UnsatisfiedAssumption
+        from hypothesis.internal.conjecture.data import ConjectureData, StopTest
+    except ImportError:                                   # another hypothesis release: its test engine
         return _draw_with_engine(strategy, seed)
-    with context:
-        return data.draw(strategy)
+    for attempt in range(DRAW_ATTEMPTS):
+        try:
+            data = ConjectureData(random=random.Random(seed + attempt * ATTEMPT_STRIDE), provider=_provider())
+            context = BuildContext(data, is_final=False, wrapped_test=draw)
+        except (TypeError, AttributeError):               # another hypothesis release: its test engine
+            return _draw_with_engine(strategy, seed)
+        try:
+            with context:
+                return data.draw(strategy)
+        except (StopTest, UnsatisfiedAssumption):         # a filter or assume of a strategy rejected the draw
+            continue
+    raise RuntimeError(f"no valid draw in {DRAW_ATTEMPTS} attempts from seed {seed}")
 
 
 @functools.lru_cache(maxsize=1)
@@ -98,7 +110,7 @@ def _draw_with_engine(strategy, seed: int):
 
 def generated_problems(seed: int = 0, count: int = len(STRATA)) -> list[Problem]:
     """Problems ``#0 .. #count-1`` of battery seed ``seed``."""
-    return [generated_problem(int(seed), i) for i in range(valid_count(count))]
+    return [generated_problem(valid_seed(seed), i) for i in range(valid_count(count))]
 
 
 __all__ = ["STRATA", "SEED_STRIDE", "generated_problem", "generated_problems", "draw"]

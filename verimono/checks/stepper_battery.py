@@ -124,8 +124,8 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
     ``problems=None`` means the whole catalog of :mod:`verimono.reference` (orders and laws) plus
     ``generated`` problems drawn from ``seed`` (laws only; ``None``: the profile's ``generated_subjects`` —
     ``dev`` 3, ``ci`` 6, ``thorough`` 30): :mod:`verimono.checks.generated_problems`, whose records name the
-    recipe ``generated #i (seed s)``, rebuilt by ``generated_problem(s, i)``.  The records come first per problem for the
-    convergence orders (in the order of ``problems``), then one record per (problem, law);
+    recipe ``generated #i (seed s)``, rebuilt by ``generated_problem(s, i)``.  The records come first per
+    problem for the convergence orders (in the order of ``problems``), then one record per (problem, law);
     ``laws=False`` keeps the orders only, a list of law names selects laws, ``orders=False`` keeps the laws
     only.  What is not a stepper, a bad seed or an empty selection is refused before anything runs
     (:class:`verimono.InvalidCheckArgument`).  The convergence studies choose their grids for the claimed order

@@ -5,7 +5,8 @@ functions of the paper's assumptions that hold for them (:class:`verimono.Proble
 
 The coordinates of the problem space a stepper can get wrong, each drawn:
 
-* the dimension ``n`` — ``size="small"`` (1–4), ``"medium"`` (5–12) or ``"large"`` (13–:data:`MAX_PROBLEM_DIM` = 50);
+* the dimension ``n`` — ``size="small"`` (1–4), ``"medium"`` (5–12) or ``"large"`` (13 to
+  :data:`MAX_PROBLEM_DIM` = 50);
 * the horizon ``T`` — one of :data:`HORIZONS` (0.3, 1, 2.5, 2π) or any in ``[0.2, 6.5]``;
 * the operator ``F`` — from :func:`verimono.strategies.stated_operators` (every family, shifted or not) for an
   interior start in ``n ≤ MAX_DIM``; otherwise a time-dependent one: a normal cone of a *solid* moving domain
@@ -27,8 +28,8 @@ Stated constants: those of :class:`verimono.strategies.Stated` for the operator 
 ``φ = rate·t``, (LG) with σ ≡ 0, (YB) not stated since it fails for a moving set; ``∂(c|·|)``: σ = c,
 θ = Lip(c) t; linear: σ = ‖M(t)‖₂); ``lipschitz = ‖B‖₂`` rounded up by 1e-10 relative (the computed
 spectral norm is within ``n·eps`` of the true one).  Large arrays (``B``, the matrices of a linear ``F`` in
-``n > MAX_DIM``) come from a NumPy generator seeded by a drawn integer: drawing 2500 entries one by one would
-take hypothesis most of its buffer.
+``n > MAX_DIM``) come from a NumPy generator seeded by a drawn integer: hypothesis draws a float in about
+0.1 ms here, so the ``2n²`` entries of two matrices in ``n = 50`` would take half a second a problem.
 """
 
 from __future__ import annotations
@@ -236,7 +237,7 @@ def _time_dependent_operators(draw, n: int, T: float) -> tuple[Stated, str, np.n
 
 @st.composite
 def _weights(draw) -> TimeFunction:
-    """``c(t) ≥ 0``: ``c0 + c1 t`` or ``c0 + c1 sin ωt`` with ``c1 ∈ [0.2, 1.5]`` (``c0 ≥ c1`` for the sinusoid)."""
+    """``c(t) ≥ 0``: ``c0 + c1 t`` or ``c0 + c1 sin ωt``, ``c1 ∈ [0.2, 1.5]`` (``c0 ≥ c1`` for the sinusoid)."""
     kind = draw(st.sampled_from(["affine", "sin"]), label="kind")
     c1 = draw(floats(0.2, 1.5), label="c1")
     if kind == "affine":
@@ -245,8 +246,8 @@ def _weights(draw) -> TimeFunction:
 
 
 def _psd(rng: np.random.Generator, n: int) -> np.ndarray:
-    """``M = LLᵀ/n + (W - Wᵀ)/√n`` (``M + Mᵀ = 2LLᵀ/n ⪰ 0``), entries of ``L, W`` uniform in ``[-1, 1]``: ``‖M‖``
-    of order 1 in every dimension."""
+    """``M = LLᵀ/n + (W - Wᵀ)/√n`` (``M + Mᵀ = 2LLᵀ/n ⪰ 0``), entries of ``L, W`` uniform in ``[-1, 1]``:
+    ``‖M‖`` of order 1 in every dimension."""
     L = rng.uniform(-1.0, 1.0, (n, n))
     W = rng.uniform(-1.0, 1.0, (n, n))
     P = L @ L.T / n
@@ -373,7 +374,7 @@ def _problems(draw, n, T, size, placement, terms) -> Problem:
         if f is not None or u is not None:
             def drift(x, f=f, u=u):
                 return (f(x) if f is not None else 0.0) + (u(0.0) if u is not None else 0.0)
-        seed_dir = draw(_vec(k, -1.0, 1.0).filter(lambda v: np.linalg.norm(v) > 0.1), label="direction")
+        seed_dir = draw(_nonzero_vectors(k, 0.5, 1.0), label="direction")
         on, nu = _boundary_point(op, interior, drift, seed_dir)
         x0 = {"on": on, "near_inside": on - NEAR * nu, "near_outside": on + NEAR * nu}[where]
         jump = where == "near_outside"
