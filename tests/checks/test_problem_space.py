@@ -38,7 +38,7 @@ def _dist(p, x, t=0.0):
 def test_generated_problems_are_valid_where_their_recipe_says(seed):
     """Every stratum's promise, measured: the size class of n, f and u present and nonzero on every coordinate,
     ``lipschitz`` a true Lipschitz constant of f on random pairs, ``U`` the primitive of ``u``, x0 in
-    ``cl dom F(0)`` — on its boundary for ``on`` (a step of 1e-6 along the outer normal leaves it), within
+    ``cl dom F(0)`` — on its boundary for ``on`` (some coordinate step of 1e-7 leaves it), within
     ``NEAR`` inside or outside for ``near_*`` (outside only with the catching-up jump)."""
     rng = np.random.default_rng(seed)
     for i, p in enumerate(generated_problems(seed, len(STRATA))):
