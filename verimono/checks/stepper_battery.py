@@ -20,12 +20,13 @@ from ..records.results import CheckResult, Report
 from ..execution.timeouts import run_unit
 from . import bounds, limits, picard, trajectory_laws  # noqa: F401 - the laws join the registry on import
 from . import orders as _order_law  # noqa: F401 - convergence_order joins the registry on import
-from ..execution.config import chosen
+from ..execution.config import chosen, current
 from ..execution.executors import Unit
 from .core import laws_of, stepper_subject
 from .isolated import isolating, run_check, run_isolated
 from .partitions import single
-from .sample_problems import sample_problems, valid_count
+from .generated_problems import generated_problems
+from .sample_problems import valid_count
 from .arguments import valid_executor, valid_flag, valid_laws, valid_problems, valid_seed, valid_step_range
 from .shared_runs import shared_runs
 from .subjects import require_problem, require_stepper
@@ -53,6 +54,15 @@ def reproduce(stepper: Callable, problem: Problem, record: CheckResult) -> Check
     return law(stepper, p, **kw)
 
 
+def generated_count(generated: object = None) -> int:
+    """``generated`` as a number of generated problems (:func:`valid_count`); ``None``: the current profile's
+    ``generated_subjects`` (:mod:`verimono.execution.profiles`; 3 for a profile of the user's own)."""
+    if generated is None:
+        effort = current().effort
+        return 3 if effort is None else int(effort.generated_subjects)
+    return valid_count(generated)
+
+
 def _selected(laws: Sequence[str]) -> tuple[str, ...]:
     unknown = [n for n in laws if n not in CHECKS]
     if unknown:
@@ -71,19 +81,20 @@ def law_checks(problems: Iterable[Problem], laws: Sequence[str] = LAWS, seed: in
 
 
 def stepper_checks(stepper: Callable | None = None, problems: Iterable[Problem] | None = None, *,
-                   seed: int = 0, generated: int = 4, laws: Sequence[str] = LAWS, orders: bool = True,
+                   seed: int = 0, generated: int | None = None, laws: Sequence[str] = LAWS, orders: bool = True,
                    executor: Any = None, step_range: Sequence[float] | None = None
                    ) -> Iterator[tuple[str, Callable[[Callable], CheckResult]]]:
     """The battery of a stepper, as ``(name, check)`` pairs.
 
-    ``problems=None``: the reference catalog (convergence orders and laws) plus ``generated`` sampled
-    problems (:func:`verimono.checks.sample_problems.sample_problems`, laws only).  ``stepper`` is unused
+    ``problems=None``: the reference catalog (convergence orders and laws) plus ``generated`` problems drawn
+    from the seed (:func:`verimono.checks.generated_problems.generated_problems`, laws only; ``None``: the
+    current profile's ``generated_subjects``, :func:`generated_count`).  ``stepper`` is unused
     (the battery does not depend on it); it is accepted for the protocol ``stepper_checks(stepper)``.
     ``step_range = (h_min, h_max)`` confines every convergence study to those steps
     (:func:`verimono.convergence_study`).
     """
     seed = valid_seed(seed)
-    generated = valid_count(generated)
+    generated = generated_count(generated)
     orders = valid_flag(orders, "orders")
     step_range = valid_step_range(step_range)
     executor = valid_executor(executor)
@@ -92,7 +103,7 @@ def stepper_checks(stepper: Callable | None = None, problems: Iterable[Problem] 
         from verimono.reference import catalog   # the catalog builds every reference: on first use only
 
         refs = catalog()
-        extra = sample_problems(seed, generated)
+        extra = generated_problems(seed, generated)
     else:
         refs, extra = [require_problem(p) for p in problems], []
     if orders:
@@ -104,7 +115,7 @@ def stepper_checks(stepper: Callable | None = None, problems: Iterable[Problem] 
 
 def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, *, scheme: str | None = None,
                   order: float | None = None, seed: int | None = None, executor: Any = None,
-                  laws: bool | Iterable[str] = True, generated: int = 4, orders: bool = True,
+                  laws: bool | Iterable[str] = True, generated: int | None = None, orders: bool = True,
                   profile: str | None = None, step_range: Sequence[float] | None = None) -> Report:
     """Result records for ``stepper``: convergence orders on the references, then the trajectory laws.
 
@@ -113,8 +124,10 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
     with that reason, and ``convergence_order``/``in_domain`` hold an ``"any"`` scheme to its order.
 
     ``problems=None`` means the whole catalog of :mod:`verimono.reference` (orders and laws) plus
-    ``generated`` seeded sample problems (laws only).  The records come first per problem for the
-    convergence orders (in the order of ``problems``), then one record per (problem, law);
+    ``generated`` problems drawn from ``seed`` (laws only; ``None``: the profile's ``generated_subjects`` —
+    ``dev`` 3, ``ci`` 6, ``thorough`` 30): :mod:`verimono.checks.generated_problems`, whose records name the
+    recipe ``generated #i (seed s)``, rebuilt by ``generated_problem(s, i)``.  The records come first per
+    problem for the convergence orders (in the order of ``problems``), then one record per (problem, law);
     ``laws=False`` keeps the orders only, a list of law names selects laws, ``orders=False`` keeps the laws
     only.  What is not a stepper, a bad seed or an empty selection is refused before anything runs
     (:class:`verimono.InvalidCheckArgument`).  The convergence studies choose their grids for the claimed order
@@ -147,7 +160,7 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
     problems = valid_problems(problems)
     given, stepper = stepper, with_claim(stepper, scheme, order)
     seed = 0 if seed is None else valid_seed(seed)
-    generated = valid_count(generated)
+    generated = generated_count(generated)
     orders = valid_flag(orders, "orders")
     step_range = valid_step_range(step_range)
     executor = valid_executor(executor)
@@ -179,4 +192,5 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
     return report
 
 
-__all__ = ["LAWS", "CHECKS", "ORDER_LAW", "stepper_checks", "check_stepper", "law_checks", "reproduce"]
+__all__ = ["LAWS", "CHECKS", "ORDER_LAW", "stepper_checks", "check_stepper", "law_checks", "reproduce",
+           "generated_count"]

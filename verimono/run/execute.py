@@ -50,7 +50,7 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
 
     from threadpoolctl import threadpool_limits
 
-    from .stages import run_stages   # the checks and what they need (scipy): imported once a run begins
+    from .stages import prepare_stages, run_stages   # the checks and what they need (scipy): once a run begins
 
     profile = get_profile(profile_name)
     load_hypothesis_profile(profile_name)
@@ -63,6 +63,7 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
     cal, cal_cpus = calibration.times() if calibration is not None else calibrate_times()  # before any worker
     set_calibration(cal)              # the unit of this process's time budgets (verimono.execution.timeouts)
     if hasattr(runner, "prestart"):   # the workers import while this process builds the catalog
+        prepare_stages(stages, profile, context)     # what forked workers then inherit instead of importing
         runner.prestart()
     waits_on_workers = getattr(runner, "workers", 1) >= 2
     if waits_on_workers and drawing_elsewhere() and hasattr(runner, "on_report"):

@@ -29,8 +29,9 @@ Drawn objects have readable reprs (numbers rounded to 4 digits) so counterexampl
 The strategies live in one module per concept — :mod:`.values` (points, step sizes, times, matrices, functions
 of time, inputs, the functions φ/σ/θ of the assumptions), :mod:`.sets` (convex and moving sets),
 :mod:`.operators` (operators with their stated assumptions, the fixed catalog), :mod:`.systems` (passive and
-complementarity systems of Section 7) and :mod:`.partitions` (time grids) — and every name is re-exported
-here: ``verimono.strategies.<name>`` is the public spelling.
+complementarity systems of Section 7), :mod:`.partitions` (time grids) and :mod:`.problems` (whole problems
+with ``f``, ``u`` and ``x0`` on or near a moving boundary, for the stepper battery) — and every name is
+re-exported here: ``verimono.strategies.<name>`` is the public spelling.
 """
 
 from __future__ import annotations
@@ -44,11 +45,24 @@ from .operators import (LOGBARRIER_YB, Stated, catalog, catalog_operators, maxim
 from .systems import LCS_MU_FLOOR, PassiveSystem, lcs_operators, passive_systems
 from .partitions import grids
 
+#: names of :mod:`.problems` (problems of the stepper battery), imported on first use: a run that never draws a
+#: problem does not make its strategies
+_LAZY = ("stated_problems", "moving_domains", "lipschitz_fields", "every_coordinate_inputs", "LipschitzField",
+         "OffsetInput", "MAX_PROBLEM_DIM")
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        from . import problems
+
+        return getattr(problems, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 __all__ = [
     "MAX_DIM", "POINT_SCALE", "SET_SCALE", "floats", "points", "step_sizes", "times", "TimeFunction",
     "time_functions", "psd_matrices", "monotone_linear_operators", "convex_sets", "MovingSet", "moving_sets",
     "subdifferential_operators", "maximal_monotone_operators", "catalog", "catalog_operators", "PassiveSystem",
     "passive_systems", "Stated", "stated_linear_operators", "stated_subdifferential_operators",
     "stated_moving_set_normal_cones", "stated_operators", "lcs_operators", "LCS_MU_FLOOR", "LOGBARRIER_YB",
-    "ACInput", "ac_inputs", "grids", "Constant", "Rate", "ZERO", "ENTRY_FLOOR", "MAX_CELLS",
+    "ACInput", "ac_inputs", "grids", "Constant", "Rate", "ZERO", "ENTRY_FLOOR", "MAX_CELLS", *_LAZY,
 ]

@@ -32,6 +32,7 @@ from ...checks.picard import check_picard
 from ...checks.pseudo_distance import check_pseudo_distance
 from ...checks.shared_runs import note_partitions, shared_runs
 from ...checks.siconos import check_siconos_case, check_siconos_lcps
+from ...checks.generated_problems import generated_problems
 from ...checks.stepper_battery import stepper_checks
 from .registry import RunContext, register_stage
 
@@ -190,7 +191,16 @@ def _operator_unit(check_operator: Callable, label: str, op: Any, seed: int | No
     return rep
 
 
-@register_stage("trajectory_laws", "contraction, uniqueness of the limit, domain, a-priori bounds, selections")
+def _draw_generated(profile: Profile, context: RunContext) -> None:
+    """The stage's generated problems, drawn before the workers fork (:func:`prepare_stages`): hypothesis and
+    the strategies they are made of are then imported once, here, not again by every worker unpickling them."""
+    if context.problems is None and profile.generated_subjects:
+        seed = context.seed_for(profile)
+        generated_problems(0 if seed is None else seed, profile.generated_subjects)
+
+
+@register_stage("trajectory_laws", "contraction, uniqueness of the limit, domain, a-priori bounds, selections",
+                prepare=_draw_generated)
 def trajectory_laws_stage(profile: Profile, context: RunContext) -> Report:
     """The trajectory laws of the stepper under test on every reference (and, without a user-given
     problem list, on ``profile.generated_subjects`` sampled problems)."""

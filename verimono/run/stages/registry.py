@@ -140,9 +140,24 @@ class Stage:
     fn: Callable[[Profile, RunContext], Report]
     description: str = ""
     default: bool = True
+    #: ``prepare(profile, context)``, run in this process before the worker processes start (:func:`prepare_stages`):
+    #: what the stage's units will unpickle is then imported once, here, and inherited by forked workers
+    prepare: Callable[[Profile, RunContext], None] | None = None
 
 
 STAGES: dict[str, Stage] = {}
+
+
+def prepare_stages(names: Iterable[str] | None, profile: Profile, context: RunContext) -> None:
+    """Each stage's ``prepare`` (:class:`Stage`) for the stages ``names`` (``None``: the default ones); one that
+    raises is left to its stage, which meets the same error and records it."""
+    for n in default_stages() if names is None else names:
+        stage = STAGES.get(n)
+        if stage is not None and stage.prepare is not None:
+            try:
+                stage.prepare(profile, context)
+            except Exception:  # noqa: BLE001 - the stage itself reports it
+                pass
 
 
 def default_stages() -> list[str]:
@@ -150,12 +165,13 @@ def default_stages() -> list[str]:
     return [n for n, s in STAGES.items() if s.default]
 
 
-def register_stage(name: str, description: str = "", *, default: bool = True) -> Callable:
+def register_stage(name: str, description: str = "", *, default: bool = True,
+                   prepare: Callable[[Profile, RunContext], None] | None = None) -> Callable:
     """Decorator registering ``fn(profile, context) -> Report`` as the stage ``name`` (replaces same name);
-    ``default=False``: a stage on request (:class:`Stage`)."""
+    ``default=False``: a stage on request; ``prepare``: run before the workers start (:class:`Stage`)."""
 
     def deco(fn: Callable[[Profile, RunContext], Report]) -> Callable:
-        STAGES[name] = Stage(name, fn, description or (fn.__doc__ or "").strip().split("\n")[0], default)
+        STAGES[name] = Stage(name, fn, description or (fn.__doc__ or "").strip().split("\n")[0], default, prepare)
         return fn
 
     return deco
@@ -252,4 +268,4 @@ def locate_data(explicit: str | os.PathLike | None = None) -> Path:
     return path
 
 
-__all__ = ["STAGES", "Stage", "default_stages", "RunContext", "register_stage", "run_stages", "locate_data", "timed_unit", "UNIT_TIME"]
+__all__ = ["STAGES", "Stage", "default_stages", "RunContext", "register_stage", "run_stages", "prepare_stages", "locate_data", "timed_unit", "UNIT_TIME"]
