@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 from verimono import NormalCone, Shifted
 from verimono import strategies as vs
 from verimono.checks.operator_battery import LAWS, operator_checks
-from verimono.checks.samples import law_samples
+from verimono.checks.engine.samples import law_samples
 from verimono.execution.config import current as current_config
 from verimono.execution.profiles import get_profile
 from verimono.records.results import FAILED
