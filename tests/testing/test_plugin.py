@@ -222,9 +222,13 @@ def test_checks_passed_as_arguments_are_recorded_and_the_sink_takes_records_only
         RecordSink(None).add("passed")
 
 
-def test_a_steppers_battery_never_imports_hypothesis(tmp_path):
-    """The stepper laws draw with NumPy (no search): ``verimono check`` of a stepper does not pay hypothesis'
-    import (the profile is armed for the moment it is imported)."""
+@pytest.mark.slow       # a whole verimono check in a subprocess (10 s)
+@pytest.mark.parametrize("only, imported", [(True, False), (False, True)])
+def test_a_steppers_battery_imports_hypothesis_only_for_its_generated_problems(tmp_path, only, imported):
+    """The stepper laws draw with NumPy (no search): ``verimono check`` of a stepper on the references alone
+    (``--only --reference``) does not pay hypothesis' import; its generated problems are drawn with the package's
+    hypothesis strategies (issue 42: the problems are searched too), so the default battery imports it (the
+    profile is armed for the moment it is imported)."""
     import subprocess
     import sys
 
@@ -234,12 +238,12 @@ def test_a_steppers_battery_never_imports_hypothesis(tmp_path):
 import sys
 from verimono.cli import main
 code = main(["check", {str(tmp_path / 'mystep.py')!r} + ":stepper", "--profile", "ci", "--executor", "serial",
-             "--out", {str(tmp_path / 'out')!r}])
+             "--out", {str(tmp_path / 'out')!r}] + {["--only", "--reference", "tnorm-1"] if only else []!r})
 print(code, "hypothesis" in sys.modules)
 """
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
     assert out.returncode == 0, out.stderr
-    assert out.stdout.split()[-2:] == ["0", "False"]
+    assert out.stdout.split()[-2:] == ["0", str(imported)]
 
 
 def test_the_plugin_installs_the_sessions_profile_as_the_run_configuration(monkeypatch):
