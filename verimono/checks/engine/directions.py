@@ -90,7 +90,8 @@ def direction_search(evaluate: Callable[[Sample], float], op: Any, s: Sample, po
                      seed: int) -> dict | None:
     """The direction of ``x2 − x1`` searched from the worst sample ``s`` (module docstring); ``evaluate`` returns
     the law's ratio (``-inf`` when inconclusive) and raises on a violation, which ends the search.  ``None`` when
-    the direction cannot move (``n = 1``, ``x1 = x2``, a recipe sample)."""
+    the direction cannot move (``n = 1``, ``n`` above :data:`NUMPY_DIM`, a recipe sample); a pair ``x1 = x2`` is
+    opened to ``r =`` :data:`PAIR_RADIUS` ``(1 + |x1|)``."""
     n = s.x1.size
     if s.recipe is not None or n < 2 or n > NUMPY_DIM:
         return None
