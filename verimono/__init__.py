@@ -16,8 +16,8 @@ if _sys.argv and _sys.argv[0].replace("\\", "/").rpartition("/")[2].split(".")[0
     _quiet()
 
 from .core.errors import (BadTarget, BatchStepError, IncompatibleBaseline, InfeasibleStep, InvalidCheckArgument,
-                          InvalidClaim, InvalidGrid, InvalidProblem, MissingOptionalDependency, NotMonotone,
-                          OutsideDomain, SchemaError, SolverFailure, StageUnavailable, UnitTimeout, UnknownProfile,
+                          InvalidClaim, InvalidGrid, InvalidProblem, MissingOptionalDependency, NotApplicable,
+                          NotMonotone, OutsideDomain, SchemaError, SolverFailure, StageUnavailable, UnitTimeout, UnknownProfile,
                           UnknownStage, UnverifiedSolution, VerimonoError)
 from .core.grids import graded_grid, random_grid, refine, uniform_grid, validate_grid
 from .core.operators import (L1Subdifferential, Linear, LogBarrier, NormalCone, NormSubdifferential, Operator,
@@ -133,6 +133,7 @@ __version__ = "0.1.0"
 __all__ = [
     "VerimonoError", "InvalidProblem", "InvalidGrid", "OutsideDomain", "NotMonotone", "InfeasibleStep",
     "BatchStepError", "SolverFailure", "UnverifiedSolution", "UnknownProfile", "UnknownStage", "StageUnavailable", "BadTarget", "SchemaError",
+    "NotApplicable",   # a stepper (or a law) raises it for a problem it does not apply to: a counted skip
     "IncompatibleBaseline", "MissingOptionalDependency", "InvalidClaim",
     "InvalidCheckArgument", "UnitTimeout",
     "Operator", "operator_from_resolvent", "operator_from_prox", "ProxOperator", "ProxOutputError", "Linear",
@@ -146,7 +147,3 @@ __all__ = [
     "Adaptive", "ToleranceStudy", "tolerance_study", "solve_adaptive", "work_precision", "WorkPrecisionSet",
     "check_adaptive", "check_tolerance_rate", "check_switching_times",
 ]
-
-# a stepper (or a law) raises it for a problem it does not apply to: a counted skip with the reason, never a failure
-from .core.errors import NotApplicable as NotApplicable  # noqa: E402
-__all__.append("NotApplicable")
