@@ -9,8 +9,11 @@ the largest ratio, each coordinate is maximised over its whole space with the ot
 violation that needs two coordinates at once (a band of large ``λ`` that shows only at points larger than
 ``λ``) is outside this phase:
 
-* ``lam``, and with a budget of at least :data:`MORE_FROM` ``mu``, ``nu`` — step sizes across decades,
-  ``[10^-4, Λ]`` with ``Λ = 10`` (:data:`STEPS`);
+* ``direction`` first — the direction of ``x2 − x1`` over the sphere (:mod:`.directions`); the coordinates
+  below then start from the worst direction found;
+* ``lam``, and with a budget of at least :data:`MORE_FROM` ``mu``, ``nu`` — step sizes over every decade the
+  precision represents (:func:`_decades`, :func:`verimono.core.tolerances.current_step_range`: float64
+  ``[10^-153, 10^7]``), and ``[10^-4, Λ]`` with ``Λ = 10`` (:data:`STEPS`) at the budget's full density;
 * ``t`` — ``[0, horizon]``;
 * ``scale`` (with a budget of at least :data:`MORE_FROM`; the sweep's points span ``10^-9`` to ``10^6`` at
   every budget) — the points ``x1, x2`` scaled together so that ``|x1|`` runs over ``[10^-9, 10^6]``: tiny
