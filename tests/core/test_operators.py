@@ -329,3 +329,26 @@ def test_the_resolvent_kernel_returns_exactly_the_resolvent(name, problem):
     finally:
         del op.resolvent
     assert calls == [0.5]
+
+
+@pytest.mark.parametrize("far", [4e154, 3e200, 1e300])
+def test_far_points_beyond_the_square_root_of_the_largest_double(far):
+    """The operator laws' step decades reach resolvent arguments of 1e154 and more (the resolvent identity at
+    λ = 1e-153); there d·d overflows.  The ball's projection came back as its centre (d·(r/inf) = 0), the log
+    barrier's resolvent warned of an overflow: both now compute without it; the ball's kernel (solve's path) gives
+    the same point."""
+    import warnings
+
+    ball = vm.NormalCone(Ball(np.array([1.0, -2.0]), 2.0))
+    x = np.array([0.6 * far, -0.8 * far])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        p = ball.resolvent(x, 1.0, 0.0)
+        np.testing.assert_allclose(p, [1.0 + 1.2, -2.0 - 1.6], rtol=1e-12)
+        barrier = vm.LogBarrier(1.0, 2)
+        y = barrier.resolvent(np.array([-far, far]), 10.0, 0.0)
+        assert np.all(np.isfinite(y)) and y[1] == far and 0.0 < y[0] <= 2.0 * 10.0 / far
+    step = ball._kernel(np.zeros(2))       # the per-step kernel: the same point (numpy may warn of its d·d)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        np.testing.assert_allclose(step(x, 1.0, 0.0), p, rtol=1e-15)

@@ -481,7 +481,7 @@ class LogBarrier(Operator):
         # the root of y² − x y − λc = 0 that is positive, without cancellation: (x + r)/2 for x ≥ 0, and for
         # x < 0 its equal 2λc/(r − x) = 2λc/(r + |x|), whose denominator is ≥ r > 0 for every x (the entries
         # np.where discards never divide by a vanishing r − x)
-        r = np.sqrt(x * x + 4.0 * lam * c)
+        r = np.hypot(x, 2.0 * np.sqrt(lam * c))       # sqrt(x² + 4λc) without overflow for |x| > 1e154
         return np.where(x >= 0.0, 0.5 * (x + r), 2.0 * lam * c / (r + np.abs(x)))
 
     def _accepts_batches(self):

@@ -85,6 +85,15 @@ def _fast(param) -> Callable[[float], np.ndarray]:
     return param
 
 
+def _scaled_norm(d: np.ndarray) -> np.ndarray:
+    """``|d|`` over the last axis (kept) without overflow: ``m·|d/m|`` with ``m = max|d_i|``, for rows whose
+    ``d·d`` overflows (``|d| > 1.3e154``; the projection of such a point used to come back as the centre)."""
+    m = np.max(np.abs(d), axis=-1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        q = d / np.where(m > 0, m, 1.0)
+    return m * np.sqrt(np.sum(q * q, axis=-1, keepdims=True))
+
+
 class Ball(ConvexSet):
     """Closed Euclidean ball ``{x : |x - center(t)| ≤ radius(t)}``."""
 
@@ -129,7 +138,10 @@ class Ball(ConvexSet):
         # points inside are returned unchanged (not as c + (x - c), which may differ in the last bit)
         c = self._c(t)
         d = x - c
-        nrm = np.sqrt(dot_rows(d, d))[..., None]
+        with np.errstate(over="ignore"):
+            nrm = np.sqrt(dot_rows(d, d))[..., None]
+        if np.isinf(nrm).any():          # |d| beyond 1.3e154: d·d overflows; the norm itself does not
+            nrm = np.where(np.isinf(nrm), _scaled_norm(d), nrm)
         r = batch_column(self._radius_at(t), x, "radius")
         outside = nrm > r
         if not outside.any():  # the common case along a trajectory: nothing to project
@@ -157,6 +169,8 @@ class Ball(ConvexSet):
                     raise bad_lam(lam, name)
                 d = x - c
                 nrm = _sqrt(d.dot(d))
+                if nrm == _INF:
+                    nrm = float(_scaled_norm(d)[0])
                 if nrm > r:
                     return c + d * (r / nrm)
                 return x
@@ -170,6 +184,8 @@ class Ball(ConvexSet):
             c = center(t)
             d = x - c
             nrm = _sqrt(d.dot(d))
+            if nrm == _INF:
+                nrm = float(_scaled_norm(d)[0])
             r = float(rfn(t))
             if not r >= 0.0:         # also nan: 0 if it is round-off, else the ball is empty
                 r = float(radius_at(t))
