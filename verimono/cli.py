@@ -257,27 +257,26 @@ def _seconds(text: str) -> float:
     return seconds
 
 
+def _whole_number(text: str, least: int, what: str) -> int:
+    """An integer ``>= least`` from the command line, or the parser's error ``must be {what}``."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be {what}, got {text!r}") from None
+    if value < least:
+        raise argparse.ArgumentTypeError(f"must be {what}, got {text!r}")
+    return value
+
+
 def _seed(text: str) -> int:
     """``--seed``: a non-negative integer, checked before any work (a bad seed is misuse, never a failure
     charged to the subject)."""
-    try:
-        seed = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a non-negative integer, got {text!r}") from None
-    if seed < 0:
-        raise argparse.ArgumentTypeError(f"must be a non-negative integer, got {text!r}")
-    return seed
+    return _whole_number(text, 0, "a non-negative integer")
 
 
 def _rounds(text: str) -> int:
     """``--rounds``: a whole number of timed rounds >= 1, checked before any work (exit 2)."""
-    try:
-        rounds = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a whole number of rounds >= 1, got {text!r}") from None
-    if rounds < 1:
-        raise argparse.ArgumentTypeError(f"must be a whole number of rounds >= 1, got {text!r}")
-    return rounds
+    return _whole_number(text, 1, "a whole number of rounds >= 1")
 
 
 def _finish(report: Report, out: Path, baseline: Report | None, run_id: str | None = None) -> int:

@@ -12,10 +12,8 @@ averages the coarse end with the fine end, and its wide interval "reached" the c
 
 from __future__ import annotations
 
-import math
 import re
 
-import numpy as np
 import pytest
 
 import verimono as vm
@@ -25,15 +23,6 @@ from verimono.reference import get, linear
 
 SCHEMES = {"euler": (zi.euler_on_grid, 1), "heun": (zi.heun_on_grid, 2), "bosh3": (zi.bosh3_on_grid, 3),
            "rk4": (zi.rk4_on_grid, 4)}
-M = np.array([[1.0, 2.0], [-2.0, 0.5]])
-
-
-@pytest.fixture(scope="module")
-def manufactured():
-    """x* = (I + M)^{-1} z(t) on the default figure eight: smooth (no kink), its input from finite differences."""
-    return vm.manufactured_problem(vm.Linear(M), T=2 * math.pi, name="manufactured smooth linear")
-
-
 def _problem(name, request):
     return request.getfixturevalue("manufactured") if name == "manufactured" else get(name)
 

@@ -24,15 +24,6 @@ from verimono.core.grid_design import MIN_GRIDS, ladder, ladder_ratio
 from verimono.reference import catalog, get
 
 SMOOTH = ["linear x' = -Mx", "Lipschitz field and input", "Example ex, v = (−t, 0)", "static ball, x0 inside"]
-M = np.array([[1.0, 2.0], [-2.0, 0.5]])
-
-
-@pytest.fixture(scope="module")
-def manufactured():
-    """x* = (I + M)^{-1} z(t) on the default figure eight: smooth (no kink), its input from finite differences."""
-    return vm.manufactured_problem(vm.Linear(M), T=2 * math.pi, name="manufactured smooth linear")
-
-
 def _problem(name, request):
     return request.getfixturevalue("manufactured") if name == "manufactured" else get(name)
 
