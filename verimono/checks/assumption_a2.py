@@ -39,7 +39,8 @@ from ..records.results import UNDECIDED
 from .assumption_samples import A2_LAMBDAS, EVIDENCE, run_assumption, sampled
 from .core import Outcome, law
 from .jumps import jump_time
-from .engine.supremum import Space, maximise, zoom
+from .engine.supremum import zoom
+from .engine.times import search_time, searched_t
 
 #: (A2): right limits t + δ_k, δ_k = (T - t) A2_RATIO^k for k = 0, ..., A2_LEVELS (down to 1.5e-5 (T - t))
 A2_LEVELS = 8
@@ -187,12 +188,12 @@ def _fastest(S, lam: float) -> tuple[list[float], int, dict]:
     def values(t, which):
         return speed(t, list(range(len(P))) if which is None else list(which), A2_SPEED_STEP * T)
 
-    sup = maximise(values, Space("t", 0.0, T), design=S.design(), seed=S.seed, kind="time")
+    sup = search_time(values, 0.0, T, design=S.design(), seed=S.seed)
     f = sup.family
     z = zoom(lambda t, w: float(speed(t, [f], max(1e-4 * w * w, floor))[0]), 0.0, T, sup.at,
              2 * sup.searched.resolution, scaled=True, probes=A2_ZOOM_PROBES, shrink=A2_ZOOM_SHRINK,
              levels=A2_ZOOM_LEVELS)
-    return z.points[::-1], f, {"speed_search": sup.as_dict(),
+    return z.points[::-1], f, {"speed_search": sup.as_dict(), "searched_t": searched_t(sup),
                                "zoom": {"at": z.at, "levels": len(z.widths), "evaluations": z.evaluations}}
 
 
@@ -258,7 +259,7 @@ def check_assumption_A2(S) -> Outcome:
                 no_limit, zoom_witness = dict(nl, **how), True
     details = {"evidence": EVIDENCE, "sequences": sequences, "unsettled": unsettled, "jumps": found,
                "jump_search": searched, "undecided_jumps": len(undecided), "fastest": fast,
-               "searched": {"t": fast["speed_search"]["searched"], "x_range": S.x_range(), "lambda": [lam, lam]}}
+               "searched": {"t": fast["searched_t"], "x_range": S.x_range(), "lambda": [lam, lam]}}
     if no_limit is not None and not worst > no_limit["ratio"]:
         c = no_limit
         return Outcome(c["ratio"], details=details, counter={**c, "message": (

@@ -33,19 +33,29 @@ from ..core.tolerances import GROWTH_FLAG, STALL_RATIO, STALL_WINDOW, quotient_t
 from ..records.results import FAILED, PASSED, SKIPPED
 from .assumption_samples import EVIDENCE, f0_norm, growth, min_norm_or_none, run_assumption, sampled
 from .core import Outcome, law
-from .jumps import JUMP_GRID, find_jumps, jump_time
-from .over_time import Sup, sup_over_time
-from .engine.supremum import Space, maximise
+from .jumps import find_jumps, jump_time
+from .engine.supremum import Sup
+from .engine.times import search_time, searched_t
+from .engine.sphere import sphere_maximise
+from .engine.supremum import Space, budget, maximise
 
 #: the rays of the (LG) search: ``s`` from ``RAY_RANGE[0]·r`` to ``RAY_RANGE[1]·r`` (r = 1 + |x0|)
 RAY_RANGE = (1e-9, 1e7)
 #: rays per centre (x0 and the kink 0) of the (LG) search
 RAY_DIRECTIONS = 3
+#: (A3): boundary points exposed in this many seeded directions (at most 2n) are families of the search over
+#: time; the far point ``x0 + R d`` projected has ``R = EXPOSED_RADIUS·(1 + |x0|)``; the direction is searched
+#: over the sphere at the ``EXPOSED_WINDOWS`` worst windows
+EXPOSED = 8
+EXPOSED_RADIUS = 100.0
+EXPOSED_WINDOWS = 3
+#: (A3): the widths of the windows ``[s, s + w]`` searched over ``s``, relative to T
+A3_WINDOWS = (1 / 16, 1 / 256, 1 / 4096)
 
 
 def _searched(S, sup: Sup, **more: Any) -> dict:
     """The record's ``details["searched"]``: the time search, the range of ``|p|``, and ``more``."""
-    return {"t": sup.searched.as_dict(), "x_range": S.x_range(), **more}
+    return {"t": searched_t(sup), "x_range": S.x_range(), **more}
 
 
 @law("assumption_A3", "(A3)", subject="problem", driver=run_assumption)
@@ -94,7 +104,7 @@ def check_assumption_A3(S) -> Outcome:
     details["phi_stated"] = phi
     sup, c = _phi_sup(S, off)
     details["sup_search"] = sup.as_dict()
-    details["searched"] = _searched(S, sup)
+    details["searched"] = _searched(S, sup, boundary=sup.local[-1]["exposed_search"])
     if sup.value > worst:
         worst, counter = sup.value, c
     return sampled("assumption_A3", worst, counter, details,
@@ -102,10 +112,13 @@ def check_assumption_A3(S) -> Outcome:
                              f"for z in dom F(s), s = {c['s']!r}, t = {c['t']!r}"
                              + (" (found by the search over time)" if c.get("found_by") else "")
                              + ": the stated φ is contradicted",
-                   f"stated φ bounds every sampled domain motion: at {n} sample times, and on windows of length "
-                   f"T/{JUMP_GRID} searched over s ∈ [0, T − T/{JUMP_GRID}] ({sup.searched.points} windows, "
-                   f"resolution {sup.searched.resolution:.3g}: {sup.searched.outside()}; largest ratio "
-                   f"{sup.value:.3g} at s = {sup.t:.4g}) ({EVIDENCE})")
+                   f"stated φ bounds every sampled domain motion: at {n} sample times, and on windows of lengths "
+                   + ", ".join(f"T/{round(1 / f)}" for f in A3_WINDOWS)
+                   + f" searched over s ({sup.searched.points} windows, resolution {sup.searched.resolution:.3g}: "
+                   f"{sup.searched.outside()}), and at the worst windows over the boundary points of dom F(s) "
+                   f"exposed in every direction of {details['searched']['boundary']['sphere']} "
+                   f"({details['searched']['boundary']['points']} directions); largest ratio {sup.value:.3g} at "
+                   f"s = {sup.t:.4g} ({EVIDENCE})")
 
 
 def _phi_ratio(dist: float, phi_s: float, phi_t: float) -> float:
@@ -118,27 +131,77 @@ def _phi_ratio(dist: float, phi_s: float, phi_t: float) -> float:
 
 
 def _phi_sup(S, off: np.ndarray) -> tuple[Sup, dict]:
-    """The stated φ against the domain motion on every window ``[s, s + w]``, ``w = T/JUMP_GRID``, searched
-    over ``s`` (families: the sample points)."""
-    op, P, T, phi = S.op, S.near, S.T, S.problem.phi
-    w = T / JUMP_GRID
+    """The stated φ against the domain motion on every window ``[s, s + w]``, ``w ∈`` :data:`A3_WINDOWS`
+    ``·T``, searched over ``s`` (:func:`verimono.checks.engine.times.search_time`; families: the window's
+    width and the point — the sample points around ``x0`` and the boundary points exposed in
+    :data:`EXPOSED` seeded directions), then over the boundary of ``dom F(s)`` at the worst windows: the
+    point exposed in a direction ``d`` searched over the sphere (:func:`_exposed_search`).  The excess of
+    one set over another is subadditive (``e(A, C) ≤ e(A, B) + e(B, C)``) and φ's increments add up: a φ that
+    bounds the motion on every short window bounds it on every longer one, and a motion periodic with a
+    divisor of one width is seen by the others."""
+    op, T, phi = S.op, S.T, S.problem.phi
+    widths = [T * f for f in A3_WINDOWS]
+    x0, R = S.points[0], EXPOSED_RADIUS * S.scale
+    rng = np.random.default_rng([int(S.seed) % (2 ** 63), S.problem.dim, 0xA3])
+    dirs = rng.standard_normal((min(EXPOSED, 2 * S.problem.dim), S.problem.dim))
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    P = np.vstack([S.near, x0 + R * dirs])
+    nP, hi = len(P), T - min(widths)
 
-    def one(i: int, s: float) -> tuple[float, dict]:
+    def at(p: np.ndarray, s: float, w: float) -> tuple[float, dict]:
         t = min(s + w, T)
-        z = np.asarray(op.project_domain(P[i], s), dtype=float)
+        z = np.asarray(op.project_domain(p, s), dtype=float)
         q = np.asarray(op.project_domain(z, t), dtype=float)
         d = float(np.linalg.norm(z - q))
         ps, pt = float(phi(s)), float(phi(t))
         return _phi_ratio(d, ps, pt), {"s": s, "t": t, "z": z, "dist": d, "phi_s": ps, "phi_t": pt}
 
+    def one(f: int, s: float) -> float:
+        wi, pi = divmod(int(f), nP)
+        return at(P[pi], s, widths[wi])[0] if s + widths[wi] <= T else -np.inf
+
     def values(s: float, which):
-        return np.array([one(i, s)[0] for i in (range(len(P)) if which is None else which)])
+        return np.array([one(f, s) for f in (range(len(widths) * nP) if which is None else which)])
 
     # ties (a φ never approached at the design times) broken toward the points farthest from the domain,
-    # whose projections move with it
-    sup = maximise(values, Space("t", 0.0, T - w), design=S.design(0.0, T - w), seed=S.seed, rank=off)
-    _, c = one(sup.family, sup.t)
-    return sup, dict(c, found_by="search over time")
+    # whose projections move with it (the exposed boundary points first), the shortest windows first
+    rank = np.concatenate([np.r_[off, np.full(len(dirs), 1e300)] + k for k in range(len(widths))])
+    sup = search_time(values, 0.0, hi, design=S.design(0.0, hi), seed=S.seed, rank=rank,
+                      bounds=lambda f: (0.0, T - widths[int(f) // nP]))
+    wi, pi = divmod(sup.family, nP)
+    value, c = at(P[pi], sup.t, widths[wi])
+    c = dict(c, found_by="search over time", window=widths[wi])
+    windows = [sup.t] + [e["argmax"] for e in sup.local if e["argmax"] != sup.t]
+    ex = _exposed_search(S, at, x0, R, windows[:EXPOSED_WINDOWS], widths[wi], start=[P[pi] - x0])
+    counter = ex.pop("counter")
+    if ex["value"] > max(value, sup.value):
+        c = dict(counter, found_by="search over time", window=widths[wi],
+                 exposed_by="the search over the boundary points of dom F(s) exposed in every direction")
+        sup.value, sup.at = ex["value"], c["s"]
+    sup.local.append({"exposed_search": ex})
+    return sup, c
+
+
+def _exposed_search(S, at, x0: np.ndarray, R: float, windows, w: float, start=()) -> dict:
+    """At each window ``[s, s + w]`` of ``windows``, the domain's motion at the boundary point of
+    ``dom F(s)`` exposed in ``d`` (the projection of ``x0 + R d``) searched over ``d ∈ S^{n-1}``
+    (:func:`verimono.checks.engine.sphere.sphere_maximise`, :func:`verimono.checks.engine.supremum.budget`
+    ``("points")`` evaluations per window at least ``12 n + 60``)."""
+    n = S.problem.dim
+    points = max(budget("points"), 12 * n + 60)
+    best = {"value": -np.inf, "counter": None, "windows": [], "points": 0, "sphere": f"S^{n - 1}", "radius": R}
+    for k, s in enumerate(windows):
+        if s + w > S.T:
+            continue
+        r = sphere_maximise(lambda d, _s=float(s): at(x0 + R * d, _s, w)[0], n, points=points,
+                            seed=S.seed + 7919 * k, start=[u for u in start if np.linalg.norm(u) > 0])
+        best["windows"].append(float(s))
+        best["points"] += r["points"]
+        best["resolution"] = r["resolution"]
+        if r["value"] > best["value"]:
+            best["value"] = r["value"]
+            best["counter"] = dict(at(x0 + R * r["direction"], float(s), w)[1], direction=r["direction"])
+    return best
 
 
 def _excess(S, a: float, b: float) -> tuple[float, np.ndarray, float]:
@@ -214,7 +277,7 @@ def check_assumption_LG(S) -> Outcome:
     ray, c_ray, far_growth = _rays(S, t_ray)
     details["ray_search"] = ray.as_dict()
     details["far_growth"] = far_growth
-    details["searched"] = {"t": details["sup_search"]["searched"] if sigma is not None else None,
+    details["searched"] = {"t": searched_t(sup) if sigma is not None else None,
                            "x_range": S.x_range(), "rays": ray.searched.as_dict()}
     if sigma is not None:
         if ray.value > worst:
@@ -265,7 +328,7 @@ def _sigma_sup(S) -> tuple[Sup, dict]:
             out.append(_sigma_ratio(S, resolvent_rows(op, P[pi:pi + 1], lams[li], t)[0], t)[0])
         return np.array(out)
 
-    sup = sup_over_time(values, 0.0, S.T, grid=S.design(), seed=S.seed)
+    sup = search_time(values, 0.0, S.T, design=S.design(), seed=S.seed)
     li, pi = divmod(sup.family, len(P))
     z = S.rows(P[pi:pi + 1], lams[li], sup.t)[0]
     _, c = _sigma_ratio(S, z, sup.t) if np.all(np.isfinite(z)) else (None, None)
@@ -364,8 +427,8 @@ def _theta_sup(S, key: str) -> tuple[Sup, dict]:
         return np.array(out)
 
     hi = T - min(lams)
-    sup = sup_over_time(values, 0.0, hi, grid=S.design(0.0, hi), seed=S.seed,
-                        bounds=lambda f: (0.0, T - lams[f // nP]))
+    sup = search_time(values, 0.0, hi, design=S.design(0.0, hi), seed=S.seed,
+                      bounds=lambda f: (0.0, T - lams[f // nP]))
     _, c = one(sup.family, sup.t)
     return sup, dict(c or {"form": key, "s": sup.t, "lambda": lams[sup.family // nP], "z": P[sup.family % nP],
                            "lhs": np.nan, "rhs": np.nan}, found_by="search over time")
@@ -422,7 +485,7 @@ def check_assumption_YB(S) -> Outcome:
     if theta is not None:
         sup, c = _theta_sup(S, key)
         details["sup_search"] = sup.as_dict()
-        details["searched"]["t"] = sup.searched.as_dict()
+        details["searched"]["t"] = searched_t(sup)
         if sup.value > worst[key]:
             worst[key], counter[key] = sup.value, c
         # (YB) is the assumption; (YB') is stronger (|Y_λ(s, z)| ≤ |F^0(s, z)|) and only implies it.  With

@@ -36,7 +36,7 @@ from .assumption_samples import (A2_LAMBDAS, EVIDENCE, LAMBDAS, min_norm_or_none
                                  sampled)
 from .core import Outcome, law, laws_of, run, subject_name
 from .subjects import require_problem
-from .engine.supremum import Space, maximise
+from .engine.times import search_time, searched_t
 
 
 def _non_monotone(Z: np.ndarray, Y: np.ndarray, P: np.ndarray):
@@ -85,7 +85,7 @@ def check_assumption_A1(S) -> Outcome:
     if sup.value > worst:
         worst, counter = sup.value, c
     details = {"evidence": EVIDENCE, "pairs": pairs, "sup_search": sup.as_dict(),
-               "searched": {"t": sup.searched.as_dict(), "x_range": S.x_range(),
+               "searched": {"t": searched_t(sup), "x_range": S.x_range(),
                             "lambda": [min(S.lambdas), max(S.lambdas)]}}
     return sampled("assumption_A1", max(worst, 0.0), counter, details,
                    lambda c: f"<z1 - z2, y1 - y2> = {c['inner']:.3g} < 0 for graph points of F(t = {c['t']!r})"
@@ -113,15 +113,20 @@ def _a1_sup(S):
         return z, y, np.where(np.isnan(ratio), -np.inf, ratio), inner, i, j
 
     def values(t: float, which):
-        if which is None:
-            return np.concatenate([pairs(t, li, np.arange(len(P)))[2] for li in range(len(lams))])
-        out = []
-        for f in which:
-            li, k = divmod(int(f), per)
-            out.append(float(pairs(t, li, np.array([ia[k], ib[k]]))[2][0]))
-        return np.array(out)
+        if which is not None and len(which) <= 2:      # the local search: one pair's two resolvents
+            out = []
+            for f in which:
+                li, k = divmod(int(f), per)
+                out.append(float(pairs(t, li, np.array([ia[k], ib[k]]))[2][0]))
+            return np.array(out)
+        # every family in one batched resolvent call per λ (the coverage follows all of them)
+        every = np.concatenate([pairs(t, li, np.arange(len(P)))[2] for li in range(len(lams))])
+        return every if which is None else every[np.asarray(list(which), dtype=int)]
 
-    sup = maximise(values, Space("t", 0.0, S.T), design=S.design(), seed=S.seed, kind="time")
+    # the coverage follows every pair at every step where the operator maps a batch in one call (four calls
+    # per time), else the pair largest at the design (two calls per time)
+    every = len(lams) * per if S.op._accepts_batches() else 1
+    sup = search_time(values, 0.0, S.T, design=S.design(), seed=S.seed, families=every)
     li, k = divmod(sup.family, per)
     z, y, ratio, inner, _, _ = pairs(sup.t, li, np.array([ia[k], ib[k]]))
     return sup, {"t": sup.t, "lam": lams[li], "z1": z[0], "y1": y[0], "z2": z[1], "y2": y[1],

@@ -269,14 +269,16 @@ def maximise(values: Callable[[float, Sequence[int] | None], np.ndarray], space:
              design: Sequence[float] | None = None, points: int | None = None, kind: str = "time",
              families: int = FAMILIES, nodes: int = NODES, per_node: int = PER_NODE, refine: bool = False,
              seed: int = 0, bounds: Callable[[int], tuple[float, float]] | None = None,
-             global_search: bool = True, rank: Sequence[float] | None = None) -> Sup:
+             global_search: bool = True, rank: Sequence[float] | None = None,
+             cover: Sequence[float] | None = None) -> Sup:
     """The sup over ``x ∈ space`` and the families of ``values(x, which)`` — an array over the families
     ``which`` (``None``: all of them in a fixed order; ``-inf`` where a family is not defined at ``x``) — by
     the four phases of the module docstring, with ``points`` points of the space (default :func:`budget` of
     ``kind``).  ``design``: the law's own points (default: 17 equally spaced ones); ``bounds(f)`` restricts
     family ``f`` to a sub-interval; ``global_search=False`` skips the coverage and DIRECT phases (a design
     that is already dense); ``rank`` (one number per family) orders families whose largest design values
-    tie, largest first."""
+    tie, largest first.  ``cover``: the coverage phase's points (:mod:`.times`' stratified, jittered design of a
+    time search) instead of the uniform grid with a seeded offset."""
     points = budget(kind) if points is None else int(points)
     ev = _Evaluator(values, space)
     xs = np.linspace(space.lo, space.hi, 17) if design is None else np.asarray(design, dtype=float)
@@ -299,12 +301,13 @@ def maximise(values: Callable[[float, Sequence[int] | None], np.ndarray], space:
         return (space.lo, space.hi) if bounds is None else bounds(f)
 
     if global_search:
-        cover = max(0, int(points * COVER_SHARE) - len(xs))
-        off = _offset(seed)
-        for i in range(cover):
-            x = space.value((i + off) / cover)
-            r = ev.some(x, chosen)
-            found.append((x, float(r.max()), r, chosen))
+        if cover is None:
+            count = max(0, int(points * COVER_SHARE) - len(xs))
+            off = _offset(seed)
+            cover = [space.value((i + off) / count) for i in range(count)]
+        for x in cover:
+            r = ev.some(float(x), chosen)
+            found.append((float(x), float(r.max()), r, chosen))
         maxfun = int(points * DIRECT_SHARE)
         if maxfun >= 3:
             def neg(u: np.ndarray) -> float:
