@@ -29,7 +29,7 @@ import numpy as np
 
 from ..core.errors import UnverifiedSolution
 from ..core.operators import resolvent_rows
-from ..core.tolerances import GROWTH_FLAG, STALL_RATIO, STALL_WINDOW, quotient_tolerance, tolerance
+from ..core.tolerances import GROWTH_FLAG, current_rtol, STALL_RATIO, STALL_WINDOW, quotient_tolerance, tolerance
 from ..records.results import FAILED, PASSED, SKIPPED
 from .assumption_samples import EVIDENCE, f0_norm, growth, min_norm_or_none, run_assumption, sampled
 from .core import Outcome, law
@@ -123,9 +123,10 @@ def check_assumption_A3(S) -> Outcome:
 
 def _phi_ratio(dist: float, phi_s: float, phi_t: float) -> float:
     """``dist / (φ(t) − φ(s) + tol)``; at least 2 when ``φ`` decreases (not allowed by (A3))."""
-    rhs = phi_t - phi_s
-    r = dist / (max(rhs, 0.0) + tolerance(dist, phi_s, phi_t))
-    if rhs < -tolerance(phi_s, phi_t):
+    rhs, rtol = phi_t - phi_s, current_rtol()     # tolerance() of three floats, without its array dispatch
+    big = max(abs(phi_s), abs(phi_t))
+    r = dist / (max(rhs, 0.0) + rtol * (1.0 + max(abs(dist), big)))
+    if rhs < -rtol * (1.0 + big):
         r = max(r, 2.0)
     return float(r)
 

@@ -21,6 +21,7 @@ say so); ``failed`` means a sample contradicts it (or the stated function) or th
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -112,21 +113,28 @@ def _a1_sup(S):
         ratio, inner, i, j = _non_monotone(z, y, np.abs(p).max(axis=1) / lam)
         return z, y, np.where(np.isnan(ratio), -np.inf, ratio), inner, i, j
 
+    def one(t: float, f: int) -> float:
+        """The ratio of family ``f`` alone (two resolvents; :func:`_non_monotone`'s formula for one pair)."""
+        li, k = divmod(int(f), per)
+        lam, p = lams[li], P[[ia[k], ib[k]]]
+        z = S.rows(p, lam, t)
+        y = (p - z) / lam
+        dz, dy = z[0] - z[1], y[0] - y[1]
+        inner = float(dz @ dy)
+        size = np.abs(p).max(axis=1) / lam
+        tol = RTOL * (math.sqrt(float(dz @ dz)) * (1.0 + max(size[0], size[1]))
+                      + math.sqrt(float(dy @ dy)) * (1.0 + float(np.abs(z).max())))
+        r = -inner / (tol + 1e-300)
+        return -math.inf if r != r else r
+
     def values(t: float, which):
-        if which is not None and len(which) <= 2:      # the local search: one pair's two resolvents
-            out = []
-            for f in which:
-                li, k = divmod(int(f), per)
-                out.append(float(pairs(t, li, np.array([ia[k], ib[k]]))[2][0]))
-            return np.array(out)
-        # every family in one batched resolvent call per λ (the coverage follows all of them)
+        if which is not None and len(which) <= 2:      # the coverage and the local search: one pair
+            return np.array([one(t, f) for f in which])
+        # every family: one batched resolvent call per λ
         every = np.concatenate([pairs(t, li, np.arange(len(P)))[2] for li in range(len(lams))])
         return every if which is None else every[np.asarray(list(which), dtype=int)]
 
-    # the coverage follows every pair at every step where the operator maps a batch in one call (four calls
-    # per time), else the pair largest at the design (two calls per time)
-    every = len(lams) * per if S.op._accepts_batches() else 1
-    sup = search_time(values, 0.0, S.T, design=S.design(), seed=S.seed, families=every)
+    sup = search_time(values, 0.0, S.T, design=S.design(), seed=S.seed)
     li, k = divmod(sup.family, per)
     z, y, ratio, inner, _, _ = pairs(sup.t, li, np.array([ia[k], ib[k]]))
     return sup, {"t": sup.t, "lam": lams[li], "z1": z[0], "y1": y[0], "z2": z[1], "y2": y[1],

@@ -270,7 +270,7 @@ def maximise(values: Callable[[float, Sequence[int] | None], np.ndarray], space:
              families: int = FAMILIES, nodes: int = NODES, per_node: int = PER_NODE, refine: bool = False,
              seed: int = 0, bounds: Callable[[int], tuple[float, float]] | None = None,
              global_search: bool = True, rank: Sequence[float] | None = None,
-             cover: Sequence[float] | None = None) -> Sup:
+             cover: Sequence[float] | None = None, direct_points: int | None = None) -> Sup:
     """The sup over ``x ∈ space`` and the families of ``values(x, which)`` — an array over the families
     ``which`` (``None``: all of them in a fixed order; ``-inf`` where a family is not defined at ``x``) — by
     the four phases of the module docstring, with ``points`` points of the space (default :func:`budget` of
@@ -278,7 +278,8 @@ def maximise(values: Callable[[float, Sequence[int] | None], np.ndarray], space:
     family ``f`` to a sub-interval; ``global_search=False`` skips the coverage and DIRECT phases (a design
     that is already dense); ``rank`` (one number per family) orders families whose largest design values
     tie, largest first.  ``cover``: the coverage phase's points (:mod:`.times`' stratified, jittered design of a
-    time search) instead of the uniform grid with a seeded offset."""
+    time search) instead of the uniform grid with a seeded offset; ``direct_points``: DIRECT's evaluations
+    (default: a share of ``points``)."""
     points = budget(kind) if points is None else int(points)
     ev = _Evaluator(values, space)
     xs = np.linspace(space.lo, space.hi, 17) if design is None else np.asarray(design, dtype=float)
@@ -308,7 +309,7 @@ def maximise(values: Callable[[float, Sequence[int] | None], np.ndarray], space:
         for x in cover:
             r = ev.some(float(x), chosen)
             found.append((float(x), float(r.max()), r, chosen))
-        maxfun = int(points * DIRECT_SHARE)
+        maxfun = int(points * DIRECT_SHARE) if direct_points is None else int(direct_points)
         if maxfun >= 3:
             def neg(u: np.ndarray) -> float:
                 x = space.value(float(u[0]))

@@ -27,12 +27,11 @@ evaluates ten times ``ci``'s times and more, ``dev`` fewer.
 
 from __future__ import annotations
 
-import math
 from typing import Callable, Sequence
 
 import numpy as np
 
-from .supremum import COVER_SHARE, Space, Sup, budget, maximise
+from .supremum import Space, Sup, budget, maximise
 
 #: the jitter of a stratum's point, as a fraction of the stratum (its point lies in the middle
 #: ``JITTER`` of it): gaps between ``(1 − JITTER)`` and ``(1 + JITTER)`` strata
@@ -41,6 +40,10 @@ JITTER = 0.5
 #: searches of other laws, Section 7's, keep): ``ci``'s 512 give 3072 strata, resolving ``(1 + JITTER)/3072 =
 #: T/2048``
 STRATA_PER_POINT = 6
+#: the refinement at the worst windows: DIRECT's evaluations, and the local phase's, are the design's count
+#: over ``REFINE_PER`` each (``ci``: 64, as before the design), at least ``LOCAL_MIN_POINTS``
+REFINE_PER = 48
+LOCAL_MIN_POINTS = 16
 
 
 def strata(profile: str | None = None) -> int:
@@ -67,7 +70,7 @@ def search_time(values: Callable[[float, Sequence[int] | None], np.ndarray], lo:
                 design: Sequence[float] = (), seed: int = 0, count: int | None = None,
                 bounds: Callable[[int], tuple[float, float]] | None = None, rank: Sequence[float] | None = None,
                 families: int = 1, nodes: int | None = None, per_node: int | None = None,
-                refine: bool = False) -> Sup:
+                golden: bool = False) -> Sup:
     """The sup over ``t ∈ [lo, hi]`` and the families of ``values(t, which)`` (an array over the families
     ``which``; ``None``: all of them) on the law's own ``design`` (sample times, times just after a jump)
     and :func:`time_design` (``count`` strata), refined at the worst windows by
@@ -80,12 +83,13 @@ def search_time(values: Callable[[float, Sequence[int] | None], np.ndarray], lo:
     own = np.asarray([d for d in design if lo <= d <= hi], dtype=float)
     if own.size == 0:
         own = np.array([lo, hi])
-    points = len(own) + int(math.ceil(count / COVER_SHARE))
+    refine = max(LOCAL_MIN_POINTS, count // REFINE_PER)       # DIRECT's evaluations, and the local phase's
+    points = len(own) + len(cover) + 2 * refine
     more = {} if nodes is None else {"nodes": nodes}
     if per_node is not None:
         more["per_node"] = per_node
     return maximise(values, Space("t", lo, hi), design=own, cover=cover, points=points, seed=seed, bounds=bounds,
-                    rank=rank, families=families, refine=refine, **more)
+                    rank=rank, families=families, refine=golden, direct_points=refine, **more)
 
 
 def searched_t(sup: Sup, count: int | None = None) -> dict:
