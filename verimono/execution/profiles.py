@@ -62,8 +62,9 @@ class Profile:
     unit_budget: float = 1600.0
     stage_budget_scale: float = 1.0
     #: points of a space one search of :mod:`verimono.checks.engine.supremum` evaluates: ``time`` — a sup over ``t``
-    #: of a problem's hypothesis (its coverage grid holds three quarters of them: ``ci`` resolves windows of
-    #: ``T/384``, ``thorough`` of ``T/6144``); ``coordinate`` — a step size, time or distance of an operator
+    #: (Section 7's: its coverage grid holds three quarters of them, ``ci`` resolving ``T/384``; the assumption
+    #: laws' time design, :mod:`verimono.checks.engine.times`, has six strata per point: ``ci`` resolves
+    #: ``T/2048``, ``thorough`` ``T/32768``, ``dev`` ``T/1024``); ``coordinate`` — a step size, time or distance of an operator
     #: law's worst sample; ``points`` — a point search in ``R^n`` (Hoffman's bound)
     search: dict = dataclasses.field(default_factory=lambda: {"time": 512, "coordinate": 27, "points": 100})
 
