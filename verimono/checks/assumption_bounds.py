@@ -1,13 +1,15 @@
 """(A3), (LG), (YB): the assumptions with a bounding function φ, σ, θ — each stated function a claim about
-every ``t`` (and every ``x``), compared with the sup of what it bounds, searched
-(:mod:`verimono.checks.engine.supremum`) over ``t`` from the sample times and the times just after every jump
-found, and for (LG) over the distance of ``x`` from ``x0`` and from the kink ``0``.
+every ``t`` (and every ``x``), compared with the sup of what it bounds, searched over ``t`` by count
+(:mod:`verimono.checks.engine.times`: both ends, jittered strata, refined at the worst windows) from the sample
+times and the times just after every jump found, and for (LG) over the distance of ``x`` from ``x0`` and from the kink ``0``.
 
 * ``assumption_A3`` — ``D(s,t) = max_z dist(z, dom F(t))`` over sampled ``z ∈ dom F(s)`` (``project_domain`` of
   ``x0`` and the points around it);
   the least nondecreasing ``φ̂`` with ``φ̂(t) - φ̂(s) ≥ D(s,t)`` on the sampled times is reported.  A stated
-  ``problem.phi`` is compared with ``D`` at the sample times and on every window ``[s, s + T/16]`` searched
-  over ``s``.  With or without a stated φ, a jump of φ̂ disproves (A3) (φ must be absolutely continuous):
+  ``problem.phi`` is compared with ``D`` at the sample times and on every window ``[s, s + w]``,
+  ``w ∈`` :data:`A3_WINDOWS` ``·T``, searched over ``s``, and at the worst windows over the boundary points of
+  ``dom F(s)`` exposed in every direction (:mod:`verimono.checks.engine.sphere`): the motion's sup over
+  ``z ∈ dom F(s)`` is attained on the boundary, which the points around ``x0`` meet only at an angle.  With or without a stated φ, a jump of φ̂ disproves (A3) (φ must be absolutely continuous):
   the jumps of the projections ``t ↦ proj_{dom F(t)} p`` are searched (:mod:`verimono.checks.jumps`), and
   one across which ``D(a, b)`` stays above tolerance (stalled) fails, with its time and size.
 * ``assumption_LG`` — ``σ̂(t) = max |F^0(t,z)|/(1 + |z|)``; a stated ``problem.sigma`` below a sample is

@@ -8,7 +8,8 @@ the **kink** of every norm, ``0`` and ``10^{-k} r u``, ``k ∈`` :data:`KINK_DEC
 on its boundary are ``J_λ(t) p`` of the far points.  Step sizes ``λ = T, T/10, T/100, T/1000`` reach points
 ever closer to the boundary of the domain.  Times: ``times`` equally spaced ones, and (:meth:`_Samples.design`)
 the times just after every jump of ``t ↦ J_λ(t) p`` found (:mod:`verimono.checks.jumps`), where a bound
-that holds up to a jump is most likely to break.
+that holds up to a jump is most likely to break: the law's own design, from which each "for all t" is
+searched by count (:mod:`verimono.checks.engine.times`).
 
 The far and kink points serve the laws whose bound grows with ``|x|`` or breaks near ``0`` ((A1), (LG),
 (YB)); the domain's motion (A3) and the right limits (A2) are sampled at ``x0`` and the points around it

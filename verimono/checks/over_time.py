@@ -10,7 +10,8 @@ its three worst nodes passed a σ broken on a window of width ``T/300`` at an ir
 its design (the base grid of the jump search, :func:`verimono.checks.jumps.base_grid`, or the law's own
 times), a coverage grid and DIRECT on the largest families, a bounded Brent maximisation around the largest
 points (with ``refine=True`` a golden-section search down to adjacent floats), with the profile's budget
-of points (``search["time"]``: ``ci`` resolves windows of ``T/1000``).
+of points (``search["time"]``: ``ci`` resolves windows of ``T/384``).  The assumption laws search time by count
+instead (:mod:`verimono.checks.engine.times`: jittered strata, ``ci`` to ``T/2048``).
 
 The largest value seen by any evaluation is the result, with its time and family: the search can only
 raise the design's value.  An evaluation that verimono's own solvers cannot verify

@@ -8,7 +8,9 @@
   represents, the time, the offset from the boundary, the scale); :mod:`.directions` — the direction of
   ``x2 − x1`` over the sphere; :mod:`.forms` — the form the input is passed in (integer, views, read-only);
 * :mod:`.supremum` — the one-dimensional supremum (design, coverage, DIRECT, Brent) of every law over ``t``,
-  ``λ`` or a distance, with its resolution; :mod:`.batches` — batched subjects' calls.
+  ``λ`` or a distance, with its resolution; :mod:`.batches` — batched subjects' calls;
+* :mod:`.times` — the time coordinate of the assumption laws, by count (jittered strata, both ends, refined by
+  :mod:`.supremum`); :mod:`.sphere` — the largest value of a function of a direction over ``S^{n-1}``.
 
 The laws (:mod:`verimono.checks.operator_laws`, ...) and the batteries import from here; the engine imports only
 the checks' core (declarations, records, members) and the layers below.
