@@ -154,3 +154,17 @@ def test_a_half_space_receding_far_from_x0_fails_a_short_phi(dim):
         good = check_assumption_A3(problem(1.01), seed=0)
     assert bad.status == FAILED, str(bad)
     assert good.status == PASSED, str(good)
+
+
+@pytest.mark.slow
+def test_thorough_searches_ten_times_ci_and_dev_less_in_the_records():
+    problem = gain(lambda t: 1.0 + 0.5 * math.sin(7 * t), dim=1, sigma=lambda t: 1.6)
+    counts = {}
+    for name in ("dev", "ci", "thorough"):
+        with budgets(time=budget("time", name)):
+            rec = check_assumption_A1(problem, seed=0)
+        assert rec.status == PASSED, str(rec)
+        counts[name] = rec.details["searched"]["t"]["points"]      # times searched (the family values at the
+        # law's 7 design times, 544 here, are the same at every profile)
+        assert rec.details["searched"]["t"]["resolution"] <= rec.details["searched"]["t"]["promised_resolution"]
+    assert counts["dev"] < counts["ci"] and counts["thorough"] >= 10 * counts["ci"], counts
