@@ -5,7 +5,8 @@ function of ``t`` (and of its *families*: a sample point, a step size, a pair) a
 over the **time design** of :func:`time_design`:
 
 * **by count, the same on every machine**: ``N =`` :func:`strata` ``= STRATA_PER_POINT · budget("time")`` points
-  (``dev`` 1536, ``ci`` 3072, ``thorough`` 49152; ``budgets(time=n)`` sets ``6n`` for a block), fixed by the
+  (``dev`` 1536, ``ci`` 3072, ``thorough`` 32768 — at most :data:`MOST_STRATA`; ``budgets(time=n)`` sets ``6n``
+  for a block), fixed by the
   profile and the seed — a busy machine evaluates the
   same points as an idle one, only more slowly.  The unit's time budget is a guard: a search it stops is
   recorded undecided (the unit's timeout), never passed;
@@ -46,9 +47,16 @@ REFINE_PER = 48
 LOCAL_MIN_POINTS = 16
 
 
+#: the most strata of one design: ``thorough``'s, a little over ten times ``ci``'s (its stage budgets are ten
+#: times ``ci``'s; 6 x 8192 would be 16 times, and the LCS references' evaluations, one LP each, would outrun
+#: them)
+MOST_STRATA = 32768
+
+
 def strata(profile: str | None = None) -> int:
-    """The time design's count at ``profile`` (default: the active one, or what ``budgets(time=...)`` set)."""
-    return STRATA_PER_POINT * budget("time", profile)
+    """The time design's count at ``profile`` (default: the active one, or what ``budgets(time=...)`` set):
+    ``STRATA_PER_POINT · search["time"]``, at most :data:`MOST_STRATA`."""
+    return min(STRATA_PER_POINT * budget("time", profile), MOST_STRATA)
 
 
 def promised_resolution(count: int) -> float:
@@ -101,4 +109,4 @@ def searched_t(sup: Sup, count: int | None = None) -> dict:
             "promised_resolution": promised_resolution(count) * (space.hi - space.lo)}
 
 
-__all__ = ["time_design", "search_time", "searched_t", "promised_resolution", "strata", "JITTER", "STRATA_PER_POINT"]
+__all__ = ["time_design", "search_time", "searched_t", "promised_resolution", "strata", "JITTER", "STRATA_PER_POINT", "MOST_STRATA"]
