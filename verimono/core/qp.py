@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
+from typing import Any
 
 import numpy as np
 from scipy.optimize import nnls
@@ -209,11 +210,38 @@ def _badness(rep: KKTReport, S: ScaledQP, y: np.ndarray) -> float:
     return max(rep.primal, rep.dual, rep.comp, S.far_violation(y))
 
 
+#: qpsolvers' back-ends that import JAX (its package imports every back-end installed, when it is imported)
+JAX_BACKENDS = ("jaxopt_osqp", "qpax")
+
+
+def _qpsolvers(full: bool = False) -> Any:
+    """qpsolvers, imported without its JAX back-ends (:data:`JAX_BACKENDS`) when JAX is not imported yet: its
+    package imports every back-end it finds, and the jaxopt one imports JAX, 0.4-1.9 s of CPU in every process
+    that solves a QP (each worker of ``verimono check``) for back-ends :data:`BACKENDS` never names (qpsolvers
+    itself 0.07 s then).  ``full`` (a JAX back-end asked for by name), a process that imported JAX first, or one
+    that imported qpsolvers itself first, gets them all."""
+    import sys
+
+    if full or "qpsolvers" in sys.modules or "jax" in sys.modules:
+        import qpsolvers
+
+        return qpsolvers
+    hidden = [m for m in ("jax", "jaxopt", "qpax") if m not in sys.modules]
+    for m in hidden:
+        sys.modules[m] = None       # an ImportError for qpsolvers' JAX back-ends, which it skips
+    try:
+        import qpsolvers
+    finally:
+        for m in hidden:
+            if sys.modules.get(m, 0) is None:
+                del sys.modules[m]   # JAX importable again, for the subject and the user
+    return qpsolvers
+
+
 def _attempt(name: str, S: ScaledQP) -> tuple[np.ndarray | None, str, bool]:
     """One back-end on the equilibrated ``S``: ``(verified minimiser or None, reason, whether it returned a
     point)``."""
-    import qpsolvers
-
+    qpsolvers = _qpsolvers(full=name in JAX_BACKENDS)
     if name not in qpsolvers.available_solvers:
         return None, f"{name}: not installed", False
     try:
