@@ -210,38 +210,42 @@ def _badness(rep: KKTReport, S: ScaledQP, y: np.ndarray) -> float:
     return max(rep.primal, rep.dual, rep.comp, S.far_violation(y))
 
 
-#: qpsolvers' back-ends that import JAX (its package imports every back-end installed, when it is imported)
-JAX_BACKENDS = ("jaxopt_osqp", "qpax")
+#: the packages of qpsolvers' back-ends that :data:`BACKENDS` does not name (qpsolvers imports every back-end it
+#: finds when it is imported: JAX for jaxopt_osqp, Jinja2 for OSQP's code generation, ...)
+UNUSED_BACKEND_PACKAGES = ("jax", "jaxopt", "qpax", "osqp", "scs", "highspy", "clarabel", "cvxopt", "kvxopt", "ecos",
+                           "gurobipy", "mosek", "piqp", "qpalm", "qpoases", "qpSWIFT", "quadprog", "hpipm_python",
+                           "coptpy", "pyqpmad", "sip_qp_python", "nppro", "pdhcg", "qtqp")
 
 
 def _qpsolvers(full: bool = False) -> Any:
-    """qpsolvers, imported without its JAX back-ends (:data:`JAX_BACKENDS`) when JAX is not imported yet: its
-    package imports every back-end it finds, and the jaxopt one imports JAX, 0.4-1.9 s of CPU in every process
-    that solves a QP (each worker of ``verimono check``) for back-ends :data:`BACKENDS` never names (qpsolvers
-    itself 0.07 s then).  ``full`` (a JAX back-end asked for by name), a process that imported JAX first, or one
-    that imported qpsolvers itself first, gets them all."""
+    """qpsolvers, imported without the back-ends :data:`BACKENDS` never names when none of their packages is
+    imported yet (:data:`UNUSED_BACKEND_PACKAGES`): its package imports every back-end it finds, the jaxopt one
+    importing JAX — 0.4-1.9 s of CPU in every process that solves a QP (a worker of ``verimono check``), where
+    qpsolvers with ProxQP and DAQP alone takes 0.07 s.  ``full`` (a back-end outside :data:`BACKENDS` asked for
+    by name), a process that imported JAX first, or one that imported qpsolvers itself first, gets them all;
+    the packages stay importable (for the subject, for the user)."""
     import sys
 
     if full or "qpsolvers" in sys.modules or "jax" in sys.modules:
         import qpsolvers
 
         return qpsolvers
-    hidden = [m for m in ("jax", "jaxopt", "qpax") if m not in sys.modules]
+    hidden = [m for m in UNUSED_BACKEND_PACKAGES if m not in sys.modules]
     for m in hidden:
-        sys.modules[m] = None       # an ImportError for qpsolvers' JAX back-ends, which it skips
+        sys.modules[m] = None       # an ImportError for those back-ends, which qpsolvers skips
     try:
         import qpsolvers
     finally:
         for m in hidden:
-            if sys.modules.get(m, 0) is None:
-                del sys.modules[m]   # JAX importable again, for the subject and the user
+            if m in sys.modules and sys.modules[m] is None:
+                del sys.modules[m]
     return qpsolvers
 
 
 def _attempt(name: str, S: ScaledQP) -> tuple[np.ndarray | None, str, bool]:
     """One back-end on the equilibrated ``S``: ``(verified minimiser or None, reason, whether it returned a
     point)``."""
-    qpsolvers = _qpsolvers(full=name in JAX_BACKENDS)
+    qpsolvers = _qpsolvers(full=name not in BACKENDS)
     if name not in qpsolvers.available_solvers:
         return None, f"{name}: not installed", False
     try:
