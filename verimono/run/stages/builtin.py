@@ -13,6 +13,7 @@ from typing import Any, Callable, Iterable
 
 import numpy as np
 
+from .. import performance
 from ...core._jsonable import to_jsonable
 from ...core.adaptive import Adaptive
 from ...core.adaptive_proximal import solve_adaptive
@@ -375,16 +376,12 @@ def performance_stage(profile: Profile, context: RunContext) -> Report:
             future = pool.submit(context.executor.map, [unit], profile.name, lambda done, total, label: None)
             pool.shutdown(wait=False)
             return lambda: future.result()[0].results[0]
-    from .. import performance      # the speed stage's own module: imported when it runs (not by `check`)
-
     return performance.performance_report(performance.SIZES[profile.name], stepper=context.stepper, progress=context.progress,
                                    aside=aside)
 
 
 def _memory_unit(steps: int, stepper: Any) -> Report:
     """The memory record (:func:`verimono.run.performance.check_memory`) as a unit of work."""
-    from .. import performance
-
     return Report([performance.check_memory(steps=steps, stepper=stepper)])
 
 
