@@ -223,7 +223,8 @@ def _qpsolvers(full: bool = False) -> Any:
     importing JAX — 0.4-1.9 s of CPU in every process that solves a QP (a worker of ``verimono check``), where
     qpsolvers with ProxQP and DAQP alone takes 0.07 s.  ``full`` (a back-end outside :data:`BACKENDS` asked for
     by name), a process that imported JAX first, or one that imported qpsolvers itself first, gets them all;
-    the packages stay importable (for the subject, for the user)."""
+    the packages stay importable (for the subject, for the user) — except to another thread importing one of
+    them during the 10 ms of this first import, which would see an ImportError."""
     import sys
 
     if full or "qpsolvers" in sys.modules or "jax" in sys.modules:
