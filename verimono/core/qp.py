@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
+from typing import Any
 
 import numpy as np
 from scipy.optimize import nnls
@@ -209,11 +210,43 @@ def _badness(rep: KKTReport, S: ScaledQP, y: np.ndarray) -> float:
     return max(rep.primal, rep.dual, rep.comp, S.far_violation(y))
 
 
+#: the packages of qpsolvers' back-ends that :data:`BACKENDS` does not name (qpsolvers imports every back-end it
+#: finds when it is imported: JAX for jaxopt_osqp, Jinja2 for OSQP's code generation, ...)
+UNUSED_BACKEND_PACKAGES = ("jax", "jaxopt", "qpax", "osqp", "scs", "highspy", "clarabel", "cvxopt", "kvxopt", "ecos",
+                           "gurobipy", "mosek", "piqp", "qpalm", "qpoases", "qpSWIFT", "quadprog", "hpipm_python",
+                           "coptpy", "pyqpmad", "sip_qp_python", "nppro", "pdhcg", "qtqp")
+
+
+def _qpsolvers(full: bool = False) -> Any:
+    """qpsolvers, imported without the back-ends :data:`BACKENDS` never names when none of their packages is
+    imported yet (:data:`UNUSED_BACKEND_PACKAGES`): its package imports every back-end it finds, the jaxopt one
+    importing JAX — 0.4-1.9 s of CPU in every process that solves a QP (a worker of ``verimono check``), where
+    qpsolvers with ProxQP and DAQP alone takes 0.07 s.  ``full`` (a back-end outside :data:`BACKENDS` asked for
+    by name), a process that imported JAX first, or one that imported qpsolvers itself first, gets them all;
+    the packages stay importable (for the subject, for the user) — except to another thread importing one of
+    them during the 10 ms of this first import, which would see an ImportError."""
+    import sys
+
+    if full or "qpsolvers" in sys.modules or "jax" in sys.modules:
+        import qpsolvers
+
+        return qpsolvers
+    hidden = [m for m in UNUSED_BACKEND_PACKAGES if m not in sys.modules]
+    for m in hidden:
+        sys.modules[m] = None       # an ImportError for those back-ends, which qpsolvers skips
+    try:
+        import qpsolvers
+    finally:
+        for m in hidden:
+            if m in sys.modules and sys.modules[m] is None:
+                del sys.modules[m]
+    return qpsolvers
+
+
 def _attempt(name: str, S: ScaledQP) -> tuple[np.ndarray | None, str, bool]:
     """One back-end on the equilibrated ``S``: ``(verified minimiser or None, reason, whether it returned a
     point)``."""
-    import qpsolvers
-
+    qpsolvers = _qpsolvers(full=name not in BACKENDS)
     if name not in qpsolvers.available_solvers:
         return None, f"{name}: not installed", False
     try:

@@ -1,0 +1,25 @@
+"""qpsolvers is imported without its JAX back-ends (verimono.core.qp._qpsolvers): a worker solving its first QP does
+not import JAX (0.4-1.9 s), and JAX stays importable afterwards."""
+
+import subprocess
+import sys
+
+import pytest
+
+CODE = r"""
+import sys, numpy as np
+from verimono.core.qp import BACKENDS, _qpsolvers, solve_qp
+assert "jax" not in sys.modules
+z = solve_qp(np.eye(2), np.array([-2.0, 0.0]), G=np.array([[1.0, 0.0]]), h=np.array([1.0]))
+assert np.allclose(z, [1.0, 0.0]), z                 # the projection of (2, 0) onto x1 <= 1
+assert not {"jax", "jaxopt", "osqp", "jinja2"} & set(sys.modules), "qpsolvers imported unused back-ends"
+import osqp  # still importable
+assert any(b in _qpsolvers().available_solvers for b in BACKENDS)
+print("ok")
+"""
+
+
+@pytest.mark.slow   # a fresh interpreter: about 1-2 s
+def test_first_qp_imports_no_jax():
+    out = subprocess.run([sys.executable, "-c", CODE], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0 and out.stdout.strip() == "ok", out.stderr[-2000:]
