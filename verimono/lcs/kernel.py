@@ -42,6 +42,8 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import math
+import threading
+from array import array
 
 import numpy as np
 
@@ -70,6 +72,54 @@ def _row_fn(ncols: int):
     return fn
 
 
+def _loop_fn(p, n: int, ne: int, nrows: int):
+    """A single run's steps through pattern ``p`` while its candidate passes: a loop of straight-line Python
+    with ``p``'s coefficients as literals (``repr`` of a float reads back the same double), doing
+    :meth:`StepKernel.try_row`'s multiply-adds in the same order and its test (every sign row ``> τ``,
+    every row finite: ``−1e999 < y < 1e999``, ``1e999`` being ``inf``; the padding's repeated rows left out).
+
+    ``loop(x, k, K, El, emax, xs, pid) -> (k, x)``: appends ``x_{k+1}`` to ``xs`` (an ``array("d")``) for every step it
+    makes from ``k``, and returns the first step it could not make (``K`` when none) and the state there."""
+    xs_ = [f"x{j}" for j in range(n)]
+    es_ = [f"e{j}" for j in range(ne)]
+    lines = [f"def loop(x, k, K, El, emax, xs, pid):",
+             f"    {', '.join(xs_)}, = x",
+             "    app = xs.append",
+             "    while k < K:"]
+    if ne:
+        lines.append(f"        {', '.join(es_)}, = El[k]")
+        lines.append("        em = emax[k]")
+    seen: dict = {}
+    names = []
+    for i in range(nrows):
+        row = tuple(p.rows[i])
+        if i >= n:
+            if row in seen:           # a repeated (padding) sign row: the same value, tested once
+                continue
+            seen[row] = i
+        terms = [repr(row[0])] + [f"({row[1 + j]!r})*{v}" for j, v in enumerate(xs_ + es_)]
+        lines.append(f"        y{i} = {' + '.join(terms)}")
+        names.append(i)
+    # max(map(abs, x)) without calls: the same value (x is finite here; a zero's sign cannot change τ, whose
+    # other term ``rb`` is ≥ 0 or −5e-324)
+    for j, v in enumerate(xs_):
+        lines.append(f"        a{j} = {v} if {v} >= 0.0 else -{v}")
+        if j:
+            lines.append(f"        a0 = a0 if a0 >= a{j} else a{j}")
+    tau = "({!r})*a0 + ({!r})*em + ({!r})".format(p.ra, p.re, p.rb) if ne else "({!r})*a0 + ({!r})".format(p.ra, p.rb)
+    lines.append(f"        tau = {tau}")
+    tests = [f"tau < y{i} < 1e999" for i in names if i >= n] + [f"-1e999 < y{i} < 1e999" for i in names if i < n]
+    lines.append(f"        if not ({' and '.join(tests)}):")
+    lines.append(f"            return k, [{', '.join(xs_)}]")
+    lines.append(f"        {', '.join(xs_)}, = {', '.join(f'y{j}' for j in range(n))},")
+    lines.extend(f"        app({v})" for v in xs_)
+    lines.append("        k += 1")
+    lines.append(f"    return k, [{', '.join(xs_)}]")
+    ns: dict = {}
+    exec("\n".join(lines), {}, ns)  # noqa: S102  (generated from floats' reprs only)
+    return ns["loop"]
+
+
 @dataclasses.dataclass
 class RowFailure:
     """Why row ``row`` of a batch stopped: at step ``step`` (``t_step → t_{step+1}``) with ``error``."""
@@ -84,7 +134,8 @@ class RowFailure:
 
 
 class _Pattern:
-    __slots__ = ("key", "s", "rows", "const", "cols", "oconst", "ocols", "coef", "ra", "re", "rb", "pcomp", "pnew")
+    __slots__ = ("key", "s", "rows", "const", "cols", "oconst", "ocols", "coef", "ra", "re", "rb", "pcomp", "pnew",
+                 "loop")
 
 
 #: steps post-processed at a time when the outputs ``z``, ``w`` are evaluated after the loop (bounds memory)
@@ -133,6 +184,7 @@ class StepKernel:
         self.enum = int(np.prod(self.nstates.astype(float))) <= ENUM_PATTERNS
         self.is_lcp = bool(rel.is_lcp)
         self._deg: dict = {}
+        self._lock = threading.Lock()
 
     # -- patterns --------------------------------------------------------------------------------------
     def pattern(self, s: np.ndarray) -> _Pattern | None:
@@ -141,10 +193,14 @@ class StepKernel:
         key = np.asarray(s).astype(np.int8).tobytes()
         if key in self.cache:
             return self.cache[key]
-        p = self.cache[key] = self._build(np.frombuffer(key, dtype=np.int8))
-        if p is not None:
-            p.key = len(self.by_id)
-            self.by_id.append(p)
+        with self._lock:   # a kernel is shared by the runs of its system (threads too): ids stay by_id's indices
+            if key in self.cache:
+                return self.cache[key]
+            p = self._build(np.frombuffer(key, dtype=np.int8))
+            if p is not None:
+                p.key = len(self.by_id)
+                self.by_id.append(p)
+            self.cache[key] = p
         return p
 
     def _build(self, s: np.ndarray) -> _Pattern | None:
@@ -205,6 +261,7 @@ class StepKernel:
         p.re = RTOL * float(np.abs(cols[P, n:]).sum(axis=1).max(initial=0.0)) if self.ne else 0.0
         p.rb = RTOL * float(np.abs(const[P]).max())
         p.pcomp, p.pnew = np.array(pcomp), np.array(pnew)
+        p.loop = None
         if not I.size and not np.any(fixed):
             # z = 0: no solution has a smaller norm, so w ≥ 0 (not strict, as in solve_lcp's q ≥ 0) suffices;
             # ``min > −5e-324`` is ``min ≥ 0`` in doubles
@@ -357,7 +414,8 @@ class StepKernel:
 
     # -- runs ------------------------------------------------------------------------------------------
     def run(self, x0: np.ndarray, E: np.ndarray | None, t: np.ndarray):
-        """One trajectory: ``x (K+1, n)``, ``z``, ``w`` ``(K, m)``; errors name the step."""
+        """One trajectory: ``x (K+1, n)``, ``z``, ``w`` ``(K, m)``; errors name the step.  The steps of one
+        pattern run in that pattern's generated loop (:func:`_loop_fn`), the others in :meth:`slow_row`."""
         K = t.size - 1
         n = self.n
         x = x0.tolist()
@@ -365,32 +423,38 @@ class StepKernel:
         emax = np.abs(E).max(axis=1).tolist() if E is not None and self.ne else None
         empty: list = []
         pid = -1
-        xs = [x]
-        pids = []
+        xs = array("d", x)
+        segs = []          # (first step, pattern) of every run of steps with one pattern
         explicit = {}
-        by_id, fn, ne, isfinite = self.by_id, self.fn, self.ne, math.isfinite
-        for k in range(K):
+        by_id, ne, L = self.by_id, self.ne, self.L
+        k = 0
+        while k < K:
+            if pid >= 0:
+                p = by_id[pid]
+                if p.loop is None:
+                    p.loop = _loop_fn(p, n, ne, L)
+                k1, x = p.loop(x, k, K, El, emax, xs, pid)
+                if k1 > k:
+                    segs.append((k, pid))
+                    k = k1
+                    if k >= K:
+                        break
             e = El[k] if El is not None else empty
             em = emax[k] if emax is not None else 0.0
-            if pid >= 0:   # try_row, inlined: the step rows of the guess and their checks
-                p = by_id[pid]
-                y = fn(p.rows, *x, *e)
-                tau = p.ra * max(map(abs, x)) + p.re * em + p.rb if ne else p.ra * max(map(abs, x)) + p.rb
-                if min(y[n:]) > tau and all(map(isfinite, y)):
-                    x = y[:n]
-                    xs.append(x)
-                    pids.append(pid)
-                    continue
             try:
                 x, this, pid, zw = self.slow_row(pid, x, e, em)
             except (InfeasibleStep, SolverFailure, InvalidProblem) as exc:
                 raise type(exc)(f"step {k} (t = {t[k]:.6g} → {t[k + 1]:.6g}): {exc}") from exc
             if zw is not None:
                 explicit[k] = zw
-            xs.append(x)
-            pids.append(this)
-        X = np.array(xs)
-        Z, W = self.outputs(X, np.array(pids, dtype=np.int64), E, explicit)
+            xs.extend(x)
+            segs.append((k, this))
+            k += 1
+        X = np.frombuffer(xs, dtype=float).reshape(K + 1, n).copy()
+        starts = [a for a, _ in segs] + [K]
+        PID = np.repeat(np.array([b for _, b in segs], dtype=np.int64), np.diff(starts)) if segs else \
+            np.empty(0, dtype=np.int64)
+        Z, W = self.outputs(X, PID, E, explicit)
         return X, Z, W
 
     # -- batches ---------------------------------------------------------------------------------------
