@@ -82,7 +82,7 @@ def _loop_fn(p, n: int, ne: int, nrows: int):
     makes from ``k``, and returns the first step it could not make (``K`` when none) and the state there."""
     xs_ = [f"x{j}" for j in range(n)]
     es_ = [f"e{j}" for j in range(ne)]
-    lines = [f"def loop(x, k, K, El, emax, xs, pid):",
+    lines = ["def loop(x, k, K, El, emax, xs, pid):",
              f"    {', '.join(xs_)}, = x",
              "    app = xs.append",
              "    while k < K:"]
@@ -472,31 +472,47 @@ class StepKernel:
         return self._stack, self._margins
 
     def _eval_rows(self, pids: np.ndarray, XT: np.ndarray, ET, em):
-        """Candidates ``(L + 2m, b)`` of the patterns ``pids`` at the states ``XT (n, b)`` (exogenous ``ET``:
-        ``(ne,)`` shared or ``(ne, b)``) and whether their step rows pass: the multiply-adds of
-        :meth:`try_row`, in the same order, elementwise."""
+        """Candidates ``(L + 2m, b)`` (step rows, then output rows) of the patterns ``pids`` at the states ``XT (n, b)`` (exogenous ``ET``:
+        ``(ne,)`` shared or ``(ne, b)``) and whether they pass: the multiply-adds of :meth:`try_row`, in the same
+        order, elementwise, and its test."""
         st, mg = self._stacked()
-        return self._eval_T(np.ascontiguousarray(st[pids].transpose(1, 2, 0)), mg[pids].T, XT, ET, em)
+        CT = np.ascontiguousarray(st[pids].transpose(1, 2, 0))
+        Y = np.empty(CT.shape[1:])
+        return Y, self._eval_T(CT, mg[pids].T, XT, ET, em, Y, np.empty_like(Y), np.empty(Y.shape[1]))
 
-    def _eval_T(self, CT, MG, XT, ET, em):
+    def _eval_T(self, CT, MG, XT, ET, em, Y, T, ax):
+        """Into the buffers ``Y``, ``T`` ``(L + 2m, b)`` and ``ax`` ``(b,)``: ``Y = c + a_0 x_0 + … + a_{n−1} x_{n−1}
+        + b_0 e_0 + …`` (summed left to right: ``Y = a_0 x_0; Y += c`` is ``c + a_0 x_0``, addition commuting
+        exactly), ``τ = ra·max_j |x_j| + re·|e|_∞ + rb``, and the mask of the columns whose sign rows are all
+        ``> τ`` and whose rows are all finite (``NaN`` fails every comparison and propagates through min/max)."""
         n, L = self.n, self.L
-        Y = CT[0] + CT[1] * XT[0]
+        np.multiply(CT[1], XT[0], out=Y)
+        Y += CT[0]
         for j in range(1, n):
-            Y = Y + CT[1 + j] * XT[j]
+            np.multiply(CT[1 + j], XT[j], out=T)
+            Y += T
         for j in range(self.ne):
-            Y = Y + CT[1 + n + j] * ET[j]
-        ax = np.abs(XT[0])
+            np.multiply(CT[1 + n + j], ET[j], out=T)
+            Y += T
+        np.abs(XT[0], out=ax)
         for j in range(1, n):
-            ax = np.maximum(ax, np.abs(XT[j]))
-        tau = MG[0] * ax + MG[1] * em + MG[2] if self.ne else MG[0] * ax + MG[2]
-        ok = (Y[n:L].min(axis=0) > tau) & np.isfinite(Y[:L]).all(axis=0)
-        return Y, ok
+            np.maximum(ax, np.abs(XT[j]), out=ax)
+        ax *= MG[0]
+        if self.ne:
+            ax += MG[1] * em
+        ax += MG[2]
+        ok = Y[n:L].min(axis=0) > ax
+        ok &= Y[:L].max(axis=0) < math.inf
+        ok &= (Y[:n].min(axis=0) if n > 1 else Y[0]) > -math.inf
+        return ok
 
     def _flip_rows(self, pid: np.ndarray, YP: np.ndarray) -> np.ndarray:
         """:meth:`flipped` for many rows (``YP``: their sign rows, ``(P, b)``): the pattern ids the violated
-        signs point to (−1 where that pattern is unusable; the zero pattern for rows without a guess)."""
+        signs point to (−1 where that pattern is unusable; the zero pattern for rows without a guess).  Rows
+        are grouped by their new pattern (a base-3 code), so :meth:`pattern` runs once per distinct one."""
         out = np.full(pid.size, -1, dtype=np.int64)
-        for p_id in set(pid.tolist()):
+        w3 = 3 ** np.arange(self.m, dtype=np.int64)
+        for p_id in np.unique(pid).tolist():
             sel = np.flatnonzero(pid == p_id)
             if p_id < 0:
                 z = self.pattern(np.zeros(self.m, dtype=np.int8))
@@ -505,11 +521,12 @@ class StepKernel:
             p = self.by_id[p_id]
             S = np.broadcast_to(p.s, (sel.size, self.m)).copy()
             viol = YP[:, sel] <= 0.0
-            for r in range(viol.shape[0]):
+            for r in np.flatnonzero(viol.any(axis=1)).tolist():
                 S[viol[r], p.pcomp[r]] = p.pnew[r]
-            for j, srow in zip(sel.tolist(), S):
-                q = self.pattern(srow)
-                out[j] = -1 if q is None else q.key
+            codes, first, inv = np.unique(S.astype(np.int64) @ w3, return_index=True, return_inverse=True)
+            ids = np.array([-1 if q is None else q.key for q in (self.pattern(S[i]) for i in first.tolist())],
+                           dtype=np.int64)
+            out[sel] = ids[inv.reshape(-1)]
         return out
 
     def run_batch(self, X0: np.ndarray, E: np.ndarray | None, t: np.ndarray):
@@ -518,10 +535,11 @@ class StepKernel:
         is NaN from its failure on; ``failures`` is the :class:`RowFailure` list.
 
         Every row keeps its pattern's coefficients in columns of ``CT (1 + ncols, L + 2m, B)``, so a step is a
-        few elementwise operations on rows of length ``B``.  A failed guess is followed, for all failed rows at
-        once, by the patterns :meth:`slow_row` tries (the flipped one, then every pattern when there are few),
-        then by :meth:`slow_row` row by row: a candidate that passes is the unique solution, so the rows get
-        the same bits as single runs."""
+        few elementwise operations on rows of length ``B`` into preallocated buffers (the output rows ``z``, ``w``
+        too: evaluated after the loop, gathering each (step, row)'s coefficients cost more than twice as much).
+        A failed guess is followed, for all failed rows at once, by the patterns :meth:`slow_row`
+        tries (the flipped one, then every pattern when there are few), then by :meth:`slow_row` row by row: a
+        candidate that passes is the unique solution, so the rows get the same bits as single runs."""
         K = t.size - 1
         B = X0.shape[0]
         n, m, L, ne = self.n, self.m, self.L, self.ne
@@ -535,6 +553,7 @@ class StepKernel:
         st, mg = self._stacked()
         CT = np.ascontiguousarray(st[pid].transpose(1, 2, 0))
         MG = np.ascontiguousarray(mg[pid].T)
+        Yb, Tb, axb = np.empty((L + 2 * m, B)), np.empty((L + 2 * m, B)), np.empty(B)
         alive = np.ones(B, dtype=bool)
         failures: list[RowFailure] = []
         shared = E is not None and E.ndim == 2
@@ -563,9 +582,9 @@ class StepKernel:
             return ~ok
 
         for k in range(K):
-            Y, ok = self._eval_T(CT, MG, XT, *exo(k, None))
-            XA[k + 1] = Y[:n]
-            ZW[k] = Y[L:]
+            ok = self._eval_T(CT, MG, XT, *exo(k, None), Yb, Tb, axb)
+            XA[k + 1] = Yb[:n]
+            ZW[k] = Yb[L:]
             XT_old, XT = XT, XA[k + 1]
             if ok.all():
                 continue
@@ -575,8 +594,7 @@ class StepKernel:
             stepped[rows] = False
             old = pid[rows].copy()
             XTr = XT_old[:, rows]
-            Er, em = exo(k, rows)
-            guess = self._flip_rows(old, Y[n:L][:, rows])
+            guess = self._flip_rows(old, Yb[n:L][:, rows])
             cur, Xc = rows, XTr                  # the rows still following their violated signs
             for _ in range(m):
                 live = guess >= 0
@@ -644,11 +662,22 @@ class StepKernel:
         failures.sort(key=lambda f: f.row)
         return X, Z, W, failures
 
+    def _out_rows(self, p: _Pattern, Xk: np.ndarray, Ek: np.ndarray | None) -> np.ndarray:
+        """``(z, w)`` rows ``(N, 2m)`` of pattern ``p`` at the states ``Xk (N, n)`` and exogenous terms ``Ek``
+        ``(N, ne)``: elementwise, so a step's outputs do not depend on which other steps are evaluated with it
+        (a batch and a single run agree bit for bit)."""
+        Y = p.oconst + p.ocols[0] * Xk[:, 0:1]
+        for j in range(1, self.n):
+            Y = Y + p.ocols[j] * Xk[:, j:j + 1]
+        for j in range(self.ne):
+            Y = Y + p.ocols[self.n + j] * Ek[:, j:j + 1]
+        return Y
+
     def outputs(self, X: np.ndarray, PID: np.ndarray, E: np.ndarray | None, explicit: dict):
         """``z``, ``w`` ``(K, m)`` of a single run: each run of steps with one pattern through its output rows
         (the multiply-adds of the batch, elementwise), the solver's where it made the step."""
         K = PID.size
-        m, n, ne = self.m, self.n, self.ne
+        m, ne = self.m, self.ne
         Z = np.empty((K, m))
         W = np.empty((K, m))
         cuts = np.concatenate([[0], np.flatnonzero(PID[1:] != PID[:-1]) + 1, [K]]).tolist()
@@ -656,13 +685,7 @@ class StepKernel:
             p_id = int(PID[a])
             if p_id < 0:
                 continue
-            p = self.by_id[p_id]
-            Xk = X[a:b]
-            Y = p.oconst + p.ocols[0] * Xk[:, 0:1]
-            for j in range(1, n):
-                Y = Y + p.ocols[j] * Xk[:, j:j + 1]
-            for j in range(ne):
-                Y = Y + p.ocols[n + j] * E[a:b, j:j + 1]
+            Y = self._out_rows(self.by_id[p_id], X[a:b], None if not ne else E[a:b])
             Z[a:b], W[a:b] = Y[:, :m], Y[:, m:]
         for k, (z, w) in explicit.items():
             Z[k], W[k] = z, w
