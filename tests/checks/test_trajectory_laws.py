@@ -528,7 +528,7 @@ def test_the_unique_limits_interpolant_is_np_interp_of_every_coordinate_at_once(
     assert np.allclose(_distances(t, x, g2, x2, tau), want, rtol=1e-13, atol=1e-14)
 
 
-@pytest.mark.parametrize("slow", ["_interp", "_norms"])
+@pytest.mark.parametrize("slow", ["_cells", "_norms"])
 def test_unique_limit_stopped_in_the_harness_is_undecided_not_a_stepper_that_never_returns(slow, monkeypatch):
     """At n = 10^6 unique_limit spent its budget in its own comparisons of the stepper's (correct, returned)
     solutions, stated no progress, and the budget's verdict counted the whole law as one call of the stepper that
