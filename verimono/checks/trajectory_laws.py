@@ -428,8 +428,10 @@ def resolvent_witnesses(stepper: Callable, p: Problem, t: np.ndarray) -> tuple[n
         # the operator's resolvent kernel (its own resolvent's values, validated once: 2-4x fewer microseconds
         # a node on the catalog's operators; a user's operator has none and is called as it is)
         step = resolvent_kernel(p.operator, np.asarray(p.x0, dtype=float))
-        back = np.array([as_float64(step(x[k + 1] + mu[k] * y[k], float(mu[k]), float(t[k + 1])))
-                         for k in range(len(mu))]).reshape(y.shape)
+        back = np.empty(y.shape)      # filled row by row: no list of K arrays copied again into one
+        for k in range(len(mu)):
+            back[k] = np.reshape(as_float64(step(x[k + 1] + mu[k] * y[k], float(mu[k]), float(t[k + 1]))),
+                                 y.shape[1:])
         return y, back
 
     # the states are in the key: a run dropped from the block and made again by a stepper that is not
