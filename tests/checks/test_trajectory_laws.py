@@ -611,3 +611,40 @@ def test_pair_norms_and_witness_keys_do_not_copy_the_trajectory(monkeypatch):
     assert fingerprint(X) == fingerprint(X.copy()) and fingerprint(X) != fingerprint(Y)
     monkeypatch.setattr(bounds, "PAIR_BLOCK", bounds.PAIR_ELEMENTS)
     assert _peak_bytes(lambda: bounds._pair_norms(X, i, j)) > small
+
+
+@pytest.mark.slow
+def test_the_stepper_battery_never_forms_an_n_by_n_array(monkeypatch):
+    """Per-node work linear in n, counted in memory: the whole battery (9 laws, ``orders=False``) at n = 4000 holds
+    at most 16 trajectories' worth of numbers at once (161 × n doubles is 5 MB; measured 42 MB; an n × n array
+    is 128 MB; the shared runs, which keep up to 64 MB, keep nothing here).
+    Seen failing when one helper forms an n × n array (``norms`` through an outer product)."""
+    import sys
+
+    import verimono as vm
+    import verimono.checks.trajectory_laws as laws
+
+    n = 4000
+    p = vm.Problem(vm.NormSubdifferential(1.0, dim=n), np.linspace(-1.0, 1.0, n), 1.0, name="|x| n=4000")
+    bound = 16 * 161 * n * 8          # 16 trajectories on the finest (160-cell) partition: 82 MB < n × n's 128 MB
+    # nothing kept between laws (the shared runs hold up to MAX_BYTES = 64 MB): the peak is the laws' own work
+    monkeypatch.setattr(sys.modules["verimono.checks.shared_runs"], "MAX_BYTES", 0)
+
+    def battery():
+        rep = check_stepper(solve, [p], orders=False, generated=0)
+        assert not [r for r in rep.results if r.status == "failed"], rep.summary()
+
+    assert _peak_bytes(battery) <= bound
+    real = laws.norms
+    formed = []
+
+    def quadratic(a):
+        a = np.asarray(a, dtype=float)
+        if a.ndim and a.shape[-1] == n and not formed:     # once is enough to be seen
+            row = a.reshape(-1, n)[0]
+            formed.append(np.outer(row, row).shape)
+        return real(a)
+
+    monkeypatch.setattr(laws, "norms", quadratic)
+    monkeypatch.setattr(sys.modules["verimono.checks.bounds"], "norms", quadratic)
+    assert _peak_bytes(battery) > bound and formed == [(n, n)]
