@@ -3,7 +3,8 @@ h = 1e-6, against the floor of a Python step loop (:func:`verimono.run.performan
 matrix–vector product per step), both measured in the same run.
 
 * one trajectory of 5000 steps (also in the un-timed run: the one-off cost of building the maps of the
-  patterns met, ~2 ms, would dominate fewer steps): ``simulate`` per step within ``LCS_TARGET`` (5x) the
+  patterns met, ~2 ms, paid by a system's first run, would dominate fewer steps): ``simulate`` per step
+  within ``LCS_TARGET`` (2x) the
   floor per step, its trajectory within ``LCS_AGREEMENT`` of the step-by-step verified solver;
 * a batch of B = 1000 trajectories: per trajectory-step at most ``LCS_BATCH_TARGET`` (0.25x) the floor per
   step (Siconos' C ``lcp_lexicolemke`` takes 0.23 µs per step where the floor takes about 1 µs), rows

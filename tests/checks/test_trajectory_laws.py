@@ -528,7 +528,7 @@ def test_the_unique_limits_interpolant_is_np_interp_of_every_coordinate_at_once(
     assert np.allclose(_distances(t, x, g2, x2, tau), want, rtol=1e-13, atol=1e-14)
 
 
-@pytest.mark.parametrize("slow", ["_interp", "_norms"])
+@pytest.mark.parametrize("slow", ["_cells", "_norms"])
 def test_unique_limit_stopped_in_the_harness_is_undecided_not_a_stepper_that_never_returns(slow, monkeypatch):
     """At n = 10^6 unique_limit spent its budget in its own comparisons of the stepper's (correct, returned)
     solutions, stated no progress, and the budget's verdict counted the whole law as one call of the stepper that
@@ -552,3 +552,99 @@ def test_unique_limit_stopped_in_the_harness_is_undecided_not_a_stepper_that_nev
                                generated=0).results
     assert rec.check == "unique_limit" and rec.status == "undecided", rec
     assert rec.details.get("undecided_reason") == "time budget" and rec.details["evaluated"] >= 3, rec.details
+
+
+def _peak_bytes(fn):
+    import tracemalloc
+
+    tracemalloc.start()
+    try:
+        fn()
+        return tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+
+
+def test_unique_limits_distances_are_formed_in_cache_sized_blocks(monkeypatch):
+    """Work linear in n, in blocks: ``_distances`` of two solutions of n = 20 000 coordinates holds at most a few
+    blocks of ``BLOCK_ELEMENTS`` (or one time's n) numbers at once, never all the times' interpolated states;
+    its values are the distances of the two ``np.interp`` interpolants.  With the former block (``1 << 22``
+    numbers, every time at once here) the same call holds ten times more: the bound can fail."""
+    import verimono.checks.limits as limits
+
+    rng = np.random.default_rng(5)
+    n = 20_000
+    ga, gb = np.linspace(0.0, 1.0, 11), np.sort(np.r_[0.0, rng.uniform(0.0, 1.0, 39), 1.0])
+    xa, xb = rng.normal(size=(11, n)), rng.normal(size=(41, n))
+    tau = np.union1d(ga, gb)[1:]
+    got = limits._distances(ga, xa, gb, xb, tau)
+    cols = slice(0, n, 997)
+    ia = np.stack([np.interp(tau, ga, xa[:, j]) for j in range(n)[cols]], axis=-1)
+    ib = np.stack([np.interp(tau, gb, xb[:, j]) for j in range(n)[cols]], axis=-1)
+    sub = limits._distances(ga, xa[:, cols], gb, xb[:, cols], tau)
+    assert np.allclose(sub, np.linalg.norm(ia - ib, axis=-1), rtol=1e-13, atol=0.0)
+    assert got.shape == tau.shape and np.all(got > 0.0)
+    bound = 6 * max(limits.BLOCK_ELEMENTS, n) * 8 + 64 * tau.size
+    assert _peak_bytes(lambda: limits._distances(ga, xa, gb, xb, tau)) <= bound
+    monkeypatch.setattr(limits, "BLOCK_ELEMENTS", 1 << 22)
+    assert _peak_bytes(lambda: limits._distances(ga, xa, gb, xb, tau)) > bound
+
+
+def test_pair_norms_and_witness_keys_do_not_copy_the_trajectory(monkeypatch):
+    """``psi_interpolation``'s pair differences are formed ``PAIR_BLOCK`` numbers at a time, and the key of the
+    resolvent witnesses fingerprints the states without a copy of them (``tobytes`` held the whole trajectory):
+    at n = 20 000 and 60 times each holds a small part of the 9.6 MB of the states; the former block
+    (``PAIR_ELEMENTS``) holds them all."""
+    import verimono.checks.bounds as bounds
+    from verimono.checks.shared_runs import fingerprint
+
+    rng = np.random.default_rng(6)
+    X = rng.normal(size=(60, 20_000))
+    i, j = (a[:40] for a in np.triu_indices(60, 1))
+    want = np.linalg.norm(X[j] - X[i], axis=-1)
+    assert np.allclose(bounds._pair_norms(X, i, j), want, rtol=1e-13, atol=0.0)
+    small = X.nbytes // 4
+    assert _peak_bytes(lambda: bounds._pair_norms(X, i, j)) <= small
+    assert _peak_bytes(lambda: fingerprint(X)) <= 4096
+    Y = X.copy()
+    Y[3, 7] += 1.0
+    assert fingerprint(X) == fingerprint(X.copy()) and fingerprint(X) != fingerprint(Y)
+    monkeypatch.setattr(bounds, "PAIR_BLOCK", bounds.PAIR_ELEMENTS)
+    assert _peak_bytes(lambda: bounds._pair_norms(X, i, j)) > small
+
+
+@pytest.mark.slow
+def test_the_stepper_battery_never_forms_an_n_by_n_array(monkeypatch):
+    """Per-node work linear in n, counted in memory: the whole battery (9 laws, ``orders=False``) at n = 4000 holds
+    at most 16 trajectories' worth of numbers at once (161 × n doubles is 5 MB; measured 42 MB; an n × n array
+    is 128 MB; the shared runs, which keep up to 64 MB, keep nothing here).
+    Seen failing when one helper forms an n × n array (``norms`` through an outer product)."""
+    import sys
+
+    import verimono as vm
+    import verimono.checks.trajectory_laws as laws
+
+    n = 4000
+    p = vm.Problem(vm.NormSubdifferential(1.0, dim=n), np.linspace(-1.0, 1.0, n), 1.0, name="|x| n=4000")
+    bound = 16 * 161 * n * 8          # 16 trajectories on the finest (160-cell) partition: 82 MB < n × n's 128 MB
+    # nothing kept between laws (the shared runs hold up to MAX_BYTES = 64 MB): the peak is the laws' own work
+    monkeypatch.setattr(sys.modules["verimono.checks.shared_runs"], "MAX_BYTES", 0)
+
+    def battery():
+        rep = check_stepper(solve, [p], orders=False, generated=0)
+        assert not [r for r in rep.results if r.status == "failed"], rep.summary()
+
+    assert _peak_bytes(battery) <= bound
+    real = laws.norms
+    formed = []
+
+    def quadratic(a):
+        a = np.asarray(a, dtype=float)
+        if a.ndim and a.shape[-1] == n and not formed:     # once is enough to be seen
+            row = a.reshape(-1, n)[0]
+            formed.append(np.outer(row, row).shape)
+        return real(a)
+
+    monkeypatch.setattr(laws, "norms", quadratic)
+    monkeypatch.setattr(sys.modules["verimono.checks.bounds"], "norms", quadratic)
+    assert _peak_bytes(battery) > bound and formed == [(n, n)]

@@ -318,10 +318,15 @@ def _pairs(n: int, dim: int = 1) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate([k, sub[si]]), np.concatenate([k + 1, sub[sj]])
 
 
+#: numbers of pair differences formed at once by :func:`_pair_norms`: a block that stays in the cache (blocks of
+#: PAIR_ELEMENTS, 128 MiB each, made the differences memory-bound)
+PAIR_BLOCK = 1 << 16
+
+
 def _pair_norms(X: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
-    """``|X[j] - X[i]|`` for every pair, at most :data:`PAIR_ELEMENTS` numbers formed at once."""
+    """``|X[j] - X[i]|`` for every pair, at most :data:`PAIR_BLOCK` numbers (or one pair) formed at once."""
     X = X.reshape(len(X), -1)
-    step = max(1, PAIR_ELEMENTS // max(1, X.shape[1]))
+    step = max(1, PAIR_BLOCK // max(1, X.shape[1]))
     return np.concatenate([norms(X[j[a:a + step]] - X[i[a:a + step]]) for a in range(0, len(i), step)] or
                           [np.zeros(0)])
 

@@ -42,6 +42,8 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import math
+import threading
+from array import array
 
 import numpy as np
 
@@ -70,6 +72,54 @@ def _row_fn(ncols: int):
     return fn
 
 
+def _loop_fn(p, n: int, ne: int, nrows: int):
+    """A single run's steps through pattern ``p`` while its candidate passes: a loop of straight-line Python
+    with ``p``'s coefficients as literals (``repr`` of a float reads back the same double), doing
+    :meth:`StepKernel.try_row`'s multiply-adds in the same order and its test (every sign row ``> τ``,
+    every row finite: ``−1e999 < y < 1e999``, ``1e999`` being ``inf``; the padding's repeated rows left out).
+
+    ``loop(x, k, K, El, emax, xs, pid) -> (k, x)``: appends ``x_{k+1}`` to ``xs`` (an ``array("d")``) for every step it
+    makes from ``k``, and returns the first step it could not make (``K`` when none) and the state there."""
+    xs_ = [f"x{j}" for j in range(n)]
+    es_ = [f"e{j}" for j in range(ne)]
+    lines = ["def loop(x, k, K, El, emax, xs, pid):",
+             f"    {', '.join(xs_)}, = x",
+             "    app = xs.append",
+             "    while k < K:"]
+    if ne:
+        lines.append(f"        {', '.join(es_)}, = El[k]")
+        lines.append("        em = emax[k]")
+    seen: dict = {}
+    names = []
+    for i in range(nrows):
+        row = tuple(p.rows[i])
+        if i >= n:
+            if row in seen:           # a repeated (padding) sign row: the same value, tested once
+                continue
+            seen[row] = i
+        terms = [repr(row[0])] + [f"({row[1 + j]!r})*{v}" for j, v in enumerate(xs_ + es_)]
+        lines.append(f"        y{i} = {' + '.join(terms)}")
+        names.append(i)
+    # max(map(abs, x)) without calls: the same value (x is finite here; a zero's sign cannot change τ, whose
+    # other term ``rb`` is ≥ 0 or −5e-324)
+    for j, v in enumerate(xs_):
+        lines.append(f"        a{j} = {v} if {v} >= 0.0 else -{v}")
+        if j:
+            lines.append(f"        a0 = a0 if a0 >= a{j} else a{j}")
+    tau = "({!r})*a0 + ({!r})*em + ({!r})".format(p.ra, p.re, p.rb) if ne else "({!r})*a0 + ({!r})".format(p.ra, p.rb)
+    lines.append(f"        tau = {tau}")
+    tests = [f"tau < y{i} < 1e999" for i in names if i >= n] + [f"-1e999 < y{i} < 1e999" for i in names if i < n]
+    lines.append(f"        if not ({' and '.join(tests)}):")
+    lines.append(f"            return k, [{', '.join(xs_)}]")
+    lines.append(f"        {', '.join(xs_)}, = {', '.join(f'y{j}' for j in range(n))},")
+    lines.extend(f"        app({v})" for v in xs_)
+    lines.append("        k += 1")
+    lines.append(f"    return k, [{', '.join(xs_)}]")
+    ns: dict = {}
+    exec("\n".join(lines), {}, ns)  # noqa: S102  (generated from floats' reprs only)
+    return ns["loop"]
+
+
 @dataclasses.dataclass
 class RowFailure:
     """Why row ``row`` of a batch stopped: at step ``step`` (``t_step → t_{step+1}``) with ``error``."""
@@ -84,7 +134,8 @@ class RowFailure:
 
 
 class _Pattern:
-    __slots__ = ("key", "s", "rows", "const", "cols", "oconst", "ocols", "coef", "ra", "re", "rb", "pcomp", "pnew")
+    __slots__ = ("key", "s", "rows", "const", "cols", "oconst", "ocols", "coef", "ra", "re", "rb", "pcomp", "pnew",
+                 "loop")
 
 
 #: steps post-processed at a time when the outputs ``z``, ``w`` are evaluated after the loop (bounds memory)
@@ -133,6 +184,7 @@ class StepKernel:
         self.enum = int(np.prod(self.nstates.astype(float))) <= ENUM_PATTERNS
         self.is_lcp = bool(rel.is_lcp)
         self._deg: dict = {}
+        self._lock = threading.Lock()
 
     # -- patterns --------------------------------------------------------------------------------------
     def pattern(self, s: np.ndarray) -> _Pattern | None:
@@ -141,10 +193,14 @@ class StepKernel:
         key = np.asarray(s).astype(np.int8).tobytes()
         if key in self.cache:
             return self.cache[key]
-        p = self.cache[key] = self._build(np.frombuffer(key, dtype=np.int8))
-        if p is not None:
-            p.key = len(self.by_id)
-            self.by_id.append(p)
+        with self._lock:   # a kernel is shared by the runs of its system (threads too): ids stay by_id's indices
+            if key in self.cache:
+                return self.cache[key]
+            p = self._build(np.frombuffer(key, dtype=np.int8))
+            if p is not None:
+                p.key = len(self.by_id)
+                self.by_id.append(p)
+            self.cache[key] = p
         return p
 
     def _build(self, s: np.ndarray) -> _Pattern | None:
@@ -205,6 +261,7 @@ class StepKernel:
         p.re = RTOL * float(np.abs(cols[P, n:]).sum(axis=1).max(initial=0.0)) if self.ne else 0.0
         p.rb = RTOL * float(np.abs(const[P]).max())
         p.pcomp, p.pnew = np.array(pcomp), np.array(pnew)
+        p.loop = None
         if not I.size and not np.any(fixed):
             # z = 0: no solution has a smaller norm, so w ≥ 0 (not strict, as in solve_lcp's q ≥ 0) suffices;
             # ``min > −5e-324`` is ``min ≥ 0`` in doubles
@@ -357,7 +414,8 @@ class StepKernel:
 
     # -- runs ------------------------------------------------------------------------------------------
     def run(self, x0: np.ndarray, E: np.ndarray | None, t: np.ndarray):
-        """One trajectory: ``x (K+1, n)``, ``z``, ``w`` ``(K, m)``; errors name the step."""
+        """One trajectory: ``x (K+1, n)``, ``z``, ``w`` ``(K, m)``; errors name the step.  The steps of one
+        pattern run in that pattern's generated loop (:func:`_loop_fn`), the others in :meth:`slow_row`."""
         K = t.size - 1
         n = self.n
         x = x0.tolist()
@@ -365,32 +423,38 @@ class StepKernel:
         emax = np.abs(E).max(axis=1).tolist() if E is not None and self.ne else None
         empty: list = []
         pid = -1
-        xs = [x]
-        pids = []
+        xs = array("d", x)
+        segs = []          # (first step, pattern) of every run of steps with one pattern
         explicit = {}
-        by_id, fn, ne, isfinite = self.by_id, self.fn, self.ne, math.isfinite
-        for k in range(K):
+        by_id, ne, L = self.by_id, self.ne, self.L
+        k = 0
+        while k < K:
+            if pid >= 0:
+                p = by_id[pid]
+                if p.loop is None:
+                    p.loop = _loop_fn(p, n, ne, L)
+                k1, x = p.loop(x, k, K, El, emax, xs, pid)
+                if k1 > k:
+                    segs.append((k, pid))
+                    k = k1
+                    if k >= K:
+                        break
             e = El[k] if El is not None else empty
             em = emax[k] if emax is not None else 0.0
-            if pid >= 0:   # try_row, inlined: the step rows of the guess and their checks
-                p = by_id[pid]
-                y = fn(p.rows, *x, *e)
-                tau = p.ra * max(map(abs, x)) + p.re * em + p.rb if ne else p.ra * max(map(abs, x)) + p.rb
-                if min(y[n:]) > tau and all(map(isfinite, y)):
-                    x = y[:n]
-                    xs.append(x)
-                    pids.append(pid)
-                    continue
             try:
                 x, this, pid, zw = self.slow_row(pid, x, e, em)
             except (InfeasibleStep, SolverFailure, InvalidProblem) as exc:
                 raise type(exc)(f"step {k} (t = {t[k]:.6g} → {t[k + 1]:.6g}): {exc}") from exc
             if zw is not None:
                 explicit[k] = zw
-            xs.append(x)
-            pids.append(this)
-        X = np.array(xs)
-        Z, W = self.outputs(X, np.array(pids, dtype=np.int64), E, explicit)
+            xs.extend(x)
+            segs.append((k, this))
+            k += 1
+        X = np.frombuffer(xs, dtype=float).reshape(K + 1, n).copy()
+        starts = [a for a, _ in segs] + [K]
+        PID = np.repeat(np.array([b for _, b in segs], dtype=np.int64), np.diff(starts)) if segs else \
+            np.empty(0, dtype=np.int64)
+        Z, W = self.outputs(X, PID, E, explicit)
         return X, Z, W
 
     # -- batches ---------------------------------------------------------------------------------------
@@ -408,31 +472,47 @@ class StepKernel:
         return self._stack, self._margins
 
     def _eval_rows(self, pids: np.ndarray, XT: np.ndarray, ET, em):
-        """Candidates ``(L + 2m, b)`` of the patterns ``pids`` at the states ``XT (n, b)`` (exogenous ``ET``:
-        ``(ne,)`` shared or ``(ne, b)``) and whether their step rows pass: the multiply-adds of
-        :meth:`try_row`, in the same order, elementwise."""
+        """Candidates ``(L + 2m, b)`` (step rows, then output rows) of the patterns ``pids`` at the states ``XT (n, b)`` (exogenous ``ET``:
+        ``(ne,)`` shared or ``(ne, b)``) and whether they pass: the multiply-adds of :meth:`try_row`, in the same
+        order, elementwise, and its test."""
         st, mg = self._stacked()
-        return self._eval_T(np.ascontiguousarray(st[pids].transpose(1, 2, 0)), mg[pids].T, XT, ET, em)
+        CT = np.ascontiguousarray(st[pids].transpose(1, 2, 0))
+        Y = np.empty(CT.shape[1:])
+        return Y, self._eval_T(CT, mg[pids].T, XT, ET, em, Y, np.empty_like(Y), np.empty(Y.shape[1]))
 
-    def _eval_T(self, CT, MG, XT, ET, em):
+    def _eval_T(self, CT, MG, XT, ET, em, Y, T, ax):
+        """Into the buffers ``Y``, ``T`` ``(L + 2m, b)`` and ``ax`` ``(b,)``: ``Y = c + a_0 x_0 + … + a_{n−1} x_{n−1}
+        + b_0 e_0 + …`` (summed left to right: ``Y = a_0 x_0; Y += c`` is ``c + a_0 x_0``, addition commuting
+        exactly), ``τ = ra·max_j |x_j| + re·|e|_∞ + rb``, and the mask of the columns whose sign rows are all
+        ``> τ`` and whose rows are all finite (``NaN`` fails every comparison and propagates through min/max)."""
         n, L = self.n, self.L
-        Y = CT[0] + CT[1] * XT[0]
+        np.multiply(CT[1], XT[0], out=Y)
+        Y += CT[0]
         for j in range(1, n):
-            Y = Y + CT[1 + j] * XT[j]
+            np.multiply(CT[1 + j], XT[j], out=T)
+            Y += T
         for j in range(self.ne):
-            Y = Y + CT[1 + n + j] * ET[j]
-        ax = np.abs(XT[0])
+            np.multiply(CT[1 + n + j], ET[j], out=T)
+            Y += T
+        np.abs(XT[0], out=ax)
         for j in range(1, n):
-            ax = np.maximum(ax, np.abs(XT[j]))
-        tau = MG[0] * ax + MG[1] * em + MG[2] if self.ne else MG[0] * ax + MG[2]
-        ok = (Y[n:L].min(axis=0) > tau) & np.isfinite(Y[:L]).all(axis=0)
-        return Y, ok
+            np.maximum(ax, np.abs(XT[j]), out=ax)
+        ax *= MG[0]
+        if self.ne:
+            ax += MG[1] * em
+        ax += MG[2]
+        ok = Y[n:L].min(axis=0) > ax
+        ok &= Y[:L].max(axis=0) < math.inf
+        ok &= (Y[:n].min(axis=0) if n > 1 else Y[0]) > -math.inf
+        return ok
 
     def _flip_rows(self, pid: np.ndarray, YP: np.ndarray) -> np.ndarray:
         """:meth:`flipped` for many rows (``YP``: their sign rows, ``(P, b)``): the pattern ids the violated
-        signs point to (−1 where that pattern is unusable; the zero pattern for rows without a guess)."""
+        signs point to (−1 where that pattern is unusable; the zero pattern for rows without a guess).  Rows
+        are grouped by their new pattern (a base-3 code), so :meth:`pattern` runs once per distinct one."""
         out = np.full(pid.size, -1, dtype=np.int64)
-        for p_id in set(pid.tolist()):
+        w3 = 3 ** np.arange(self.m, dtype=np.int64)
+        for p_id in np.unique(pid).tolist():
             sel = np.flatnonzero(pid == p_id)
             if p_id < 0:
                 z = self.pattern(np.zeros(self.m, dtype=np.int8))
@@ -441,11 +521,12 @@ class StepKernel:
             p = self.by_id[p_id]
             S = np.broadcast_to(p.s, (sel.size, self.m)).copy()
             viol = YP[:, sel] <= 0.0
-            for r in range(viol.shape[0]):
+            for r in np.flatnonzero(viol.any(axis=1)).tolist():
                 S[viol[r], p.pcomp[r]] = p.pnew[r]
-            for j, srow in zip(sel.tolist(), S):
-                q = self.pattern(srow)
-                out[j] = -1 if q is None else q.key
+            codes, first, inv = np.unique(S.astype(np.int64) @ w3, return_index=True, return_inverse=True)
+            ids = np.array([-1 if q is None else q.key for q in (self.pattern(S[i]) for i in first.tolist())],
+                           dtype=np.int64)
+            out[sel] = ids[inv.reshape(-1)]
         return out
 
     def run_batch(self, X0: np.ndarray, E: np.ndarray | None, t: np.ndarray):
@@ -454,10 +535,11 @@ class StepKernel:
         is NaN from its failure on; ``failures`` is the :class:`RowFailure` list.
 
         Every row keeps its pattern's coefficients in columns of ``CT (1 + ncols, L + 2m, B)``, so a step is a
-        few elementwise operations on rows of length ``B``.  A failed guess is followed, for all failed rows at
-        once, by the patterns :meth:`slow_row` tries (the flipped one, then every pattern when there are few),
-        then by :meth:`slow_row` row by row: a candidate that passes is the unique solution, so the rows get
-        the same bits as single runs."""
+        few elementwise operations on rows of length ``B`` into preallocated buffers (the output rows ``z``, ``w``
+        too: evaluated after the loop, gathering each (step, row)'s coefficients cost more than twice as much).
+        A failed guess is followed, for all failed rows at once, by the patterns :meth:`slow_row`
+        tries (the flipped one, then every pattern when there are few), then by :meth:`slow_row` row by row: a
+        candidate that passes is the unique solution, so the rows get the same bits as single runs."""
         K = t.size - 1
         B = X0.shape[0]
         n, m, L, ne = self.n, self.m, self.L, self.ne
@@ -471,6 +553,7 @@ class StepKernel:
         st, mg = self._stacked()
         CT = np.ascontiguousarray(st[pid].transpose(1, 2, 0))
         MG = np.ascontiguousarray(mg[pid].T)
+        Yb, Tb, axb = np.empty((L + 2 * m, B)), np.empty((L + 2 * m, B)), np.empty(B)
         alive = np.ones(B, dtype=bool)
         failures: list[RowFailure] = []
         shared = E is not None and E.ndim == 2
@@ -499,9 +582,9 @@ class StepKernel:
             return ~ok
 
         for k in range(K):
-            Y, ok = self._eval_T(CT, MG, XT, *exo(k, None))
-            XA[k + 1] = Y[:n]
-            ZW[k] = Y[L:]
+            ok = self._eval_T(CT, MG, XT, *exo(k, None), Yb, Tb, axb)
+            XA[k + 1] = Yb[:n]
+            ZW[k] = Yb[L:]
             XT_old, XT = XT, XA[k + 1]
             if ok.all():
                 continue
@@ -511,8 +594,7 @@ class StepKernel:
             stepped[rows] = False
             old = pid[rows].copy()
             XTr = XT_old[:, rows]
-            Er, em = exo(k, rows)
-            guess = self._flip_rows(old, Y[n:L][:, rows])
+            guess = self._flip_rows(old, Yb[n:L][:, rows])
             cur, Xc = rows, XTr                  # the rows still following their violated signs
             for _ in range(m):
                 live = guess >= 0
@@ -580,11 +662,22 @@ class StepKernel:
         failures.sort(key=lambda f: f.row)
         return X, Z, W, failures
 
+    def _out_rows(self, p: _Pattern, Xk: np.ndarray, Ek: np.ndarray | None) -> np.ndarray:
+        """``(z, w)`` rows ``(N, 2m)`` of pattern ``p`` at the states ``Xk (N, n)`` and exogenous terms ``Ek``
+        ``(N, ne)``: elementwise, so a step's outputs do not depend on which other steps are evaluated with it
+        (a batch and a single run agree bit for bit)."""
+        Y = p.oconst + p.ocols[0] * Xk[:, 0:1]
+        for j in range(1, self.n):
+            Y = Y + p.ocols[j] * Xk[:, j:j + 1]
+        for j in range(self.ne):
+            Y = Y + p.ocols[self.n + j] * Ek[:, j:j + 1]
+        return Y
+
     def outputs(self, X: np.ndarray, PID: np.ndarray, E: np.ndarray | None, explicit: dict):
         """``z``, ``w`` ``(K, m)`` of a single run: each run of steps with one pattern through its output rows
         (the multiply-adds of the batch, elementwise), the solver's where it made the step."""
         K = PID.size
-        m, n, ne = self.m, self.n, self.ne
+        m, ne = self.m, self.ne
         Z = np.empty((K, m))
         W = np.empty((K, m))
         cuts = np.concatenate([[0], np.flatnonzero(PID[1:] != PID[:-1]) + 1, [K]]).tolist()
@@ -592,13 +685,7 @@ class StepKernel:
             p_id = int(PID[a])
             if p_id < 0:
                 continue
-            p = self.by_id[p_id]
-            Xk = X[a:b]
-            Y = p.oconst + p.ocols[0] * Xk[:, 0:1]
-            for j in range(1, n):
-                Y = Y + p.ocols[j] * Xk[:, j:j + 1]
-            for j in range(ne):
-                Y = Y + p.ocols[n + j] * E[a:b, j:j + 1]
+            Y = self._out_rows(self.by_id[p_id], X[a:b], None if not ne else E[a:b])
             Z[a:b], W[a:b] = Y[:, :m], Y[:, m:]
         for k, (z, w) in explicit.items():
             Z[k], W[k] = z, w

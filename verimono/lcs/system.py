@@ -209,7 +209,22 @@ class LinearRelationSystem:
         from .kernel import StepKernel
 
         K, B = t.size - 1, X0.shape[0]
-        sm = self.step_matrices(t[-1] / K, theta, gamma)
+        h = t[-1] / K
+        # the step matrices and the kernel (its patterns' maps, built as steps meet them) depend on the system's
+        # matrices, h, θ, γ and which exogenous terms vary: kept for the next run with the same ones, keyed by
+        # the matrices' bytes (an attribute reassigned or edited in place makes a new key)
+        exo_u, exo_v = dU is not None, V is not None or (vc is not None and bool(np.any(vc != 0.0)))
+        key = (float(h), float(theta), gamma, exo_u, exo_v, id(self.relation),
+               self.A.tobytes(), self.B.tobytes(), self.C.tobytes(), self.D.tobytes())
+        cache = self.__dict__.setdefault("_kernels", {})
+        kern = cache.get(key)
+        if kern is None:
+            if len(cache) >= 8:
+                cache.clear()
+            sm = self.step_matrices(h, theta, gamma)
+            kern = cache[key] = StepKernel(self, sm, exo_u=exo_u, exo_v=exo_v, v_const=None)
+            kern.relation = self.relation    # the key's id(relation) stays this object's while the kernel lives
+        sm = kern.sm
         parts = []
         if dU is not None:
             flat = dU.reshape(-1, self.n)
@@ -228,8 +243,6 @@ class LinearRelationSystem:
             if any(p.ndim == 3 for p in parts):
                 parts = [np.broadcast_to(p[:, None, :], (K, B, p.shape[-1])) if p.ndim == 2 else p for p in parts]
             E = np.concatenate(parts, axis=-1)
-        kern = StepKernel(self, sm, exo_u=dU is not None, exo_v=V is not None or vrow,
-                          v_const=None)
         with np.errstate(over="ignore", invalid="ignore"):   # overflow becomes a typed error naming the step
             if not batched and (E is None or E.ndim == 2):
                 x, z, w = kern.run(X0[0], E, t)
