@@ -1,5 +1,6 @@
 """qpsolvers is imported without its JAX back-ends (verimono.core.qp._qpsolvers): a worker solving its first QP does
-not import JAX (0.4-1.9 s), and JAX stays importable afterwards."""
+not import JAX (0.4-1.9 s), JAX stays importable afterwards, and the user's own ``import qpsolvers`` afterwards gets
+every back-end (a subject solving with OSQP is not failed by verimono's private import)."""
 
 import subprocess
 import sys
@@ -15,6 +16,11 @@ assert np.allclose(z, [1.0, 0.0]), z                 # the projection of (2, 0) 
 assert not {"jax", "jaxopt", "osqp", "jinja2"} & set(sys.modules), "qpsolvers imported unused back-ends"
 import osqp  # still importable
 assert any(b in _qpsolvers().available_solvers for b in BACKENDS)
+import qpsolvers  # the user's own import: the whole package, every back-end installed
+assert "osqp" in qpsolvers.available_solvers, qpsolvers.available_solvers
+assert qpsolvers is not _qpsolvers.__globals__["_PRIVATE"][0]
+x = qpsolvers.solve_qp(np.eye(2), np.array([-2.0, 0.0]), G=np.array([[1.0, 0.0]]), h=np.array([1.0]), solver="osqp")
+assert np.allclose(x, [1.0, 0.0], atol=1e-3), x
 print("ok")
 """
 

@@ -217,21 +217,29 @@ UNUSED_BACKEND_PACKAGES = ("jax", "jaxopt", "qpax", "osqp", "scs", "highspy", "c
                            "coptpy", "pyqpmad", "sip_qp_python", "nppro", "pdhcg", "qtqp")
 
 
+_PRIVATE: list = []
+
+
 def _qpsolvers(full: bool = False) -> Any:
-    """qpsolvers, imported without the back-ends :data:`BACKENDS` never names when none of their packages is
-    imported yet (:data:`UNUSED_BACKEND_PACKAGES`): its package imports every back-end it finds, the jaxopt one
-    importing JAX — 0.4-1.9 s of CPU in every process that solves a QP (a worker of ``verimono check``), where
-    qpsolvers with ProxQP and DAQP alone takes 0.07 s.  ``full`` (a back-end outside :data:`BACKENDS` asked for
-    by name), a process that imported JAX first, or one that imported qpsolvers itself first, gets them all;
-    the packages stay importable (for the subject, for the user) — except to another thread importing one of
-    them during the 10 ms of this first import, which would see an ImportError."""
+    """qpsolvers for verimono's own QPs, imported without the back-ends :data:`BACKENDS` never names
+    (:data:`UNUSED_BACKEND_PACKAGES`): its package imports every back-end it finds, the jaxopt one importing JAX —
+    0.4-1.9 s of CPU in every process that solves a QP (a worker of ``verimono check``), where qpsolvers with ProxQP
+    and DAQP alone takes 0.07 s.  That import is verimono's **private copy**: it is taken out of ``sys.modules``
+    again, so the user's code (a subject solving its own QPs with OSQP, say) that imports qpsolvers later gets the
+    whole package with every back-end, as without verimono.  ``full`` (a back-end outside :data:`BACKENDS` asked for
+    by name), or a process that imported qpsolvers or JAX before, gets the shared, whole package.  The hidden
+    packages stay importable — except to another thread importing one of them during the 10 ms of this first
+    import, which would see an ImportError."""
     import sys
 
     if full or "qpsolvers" in sys.modules or "jax" in sys.modules:
         import qpsolvers
 
         return qpsolvers
+    if _PRIVATE:
+        return _PRIVATE[0]
     hidden = [m for m in UNUSED_BACKEND_PACKAGES if m not in sys.modules]
+    before = set(sys.modules)
     for m in hidden:
         sys.modules[m] = None       # an ImportError for those back-ends, which qpsolvers skips
     try:
@@ -240,6 +248,10 @@ def _qpsolvers(full: bool = False) -> Any:
         for m in hidden:
             if m in sys.modules and sys.modules[m] is None:
                 del sys.modules[m]
+    # the partial package stays verimono's: the next ``import qpsolvers`` (the user's) imports the whole one
+    for m in [m for m in sys.modules if (m == "qpsolvers" or m.startswith("qpsolvers.")) and m not in before]:
+        del sys.modules[m]
+    _PRIVATE.append(qpsolvers)
     return qpsolvers
 
 
