@@ -374,7 +374,7 @@ class _Search:
         try:
             with prefetched(self.op, samples):
                 try:
-                    if self.runs:
+                    if self.runs or not samples:
                         self.evaluate_many(samples)
                     else:       # the first sample alone: a member the operator lacks stops the search there
                         self.evaluate(samples[0])
