@@ -165,23 +165,29 @@ def row_resolvents(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok:
     J = np.zeros_like(X)
     if rows_accepted(op):
         pairs = np.stack([lams, ts], axis=1)
-        uniq, inverse = np.unique(pairs, axis=0, return_inverse=True)
-        inverse = inverse.reshape(-1)
-        groups = [np.arange(len(lams))] if len(uniq) == 1 else [np.flatnonzero(inverse == g) for g in range(len(uniq))]
-        for g, idx in enumerate(groups):
-            lam, t = float(uniq[g, 0]), float(uniq[g, 1])
+        uniq, inverse, counts = np.unique(pairs, axis=0, return_inverse=True, return_counts=True)
+        order = np.argsort(inverse.reshape(-1), kind="stable")
+        Xs, Js, fine = X[order], np.zeros_like(X), np.ones(len(lams), dtype=bool)     # rows grouped by (λ, t)
+        resolvent, n, lo = op.resolvent, X.shape[1], 0
+        for g, c in enumerate(counts.tolist()):
+            hi = lo + c
             try:
-                P = as_float64(op.resolvent(X[idx], lam, t))      # fancy indexing: a copy
+                P = resolvent(Xs[lo:hi], float(uniq[g, 0]), float(uniq[g, 1]))      # the group's rows: a copy
+                if type(P) is not np.ndarray or P.dtype != np.float64:
+                    P = as_float64(P)
             except Exception:   # noqa: BLE001 - the law's evaluator of one sample meets it and judges it
                 if interrupted():
                     raise
-                ok[idx] = False
+                fine[lo:hi] = False
+                lo = hi
                 continue
-            if P.shape != (len(idx), X.shape[1]):
-                ok[idx] = False
-                continue
-            J[idx] = P
-            ok[idx] &= np.isfinite(P).all(axis=1)
+            if P.shape == (c, n):
+                Js[lo:hi] = P
+            else:
+                fine[lo:hi] = False
+            lo = hi
+        J[order] = Js
+        ok[order] &= fine & np.isfinite(Js).all(axis=1)
         return J
     for i in range(X.shape[0]):
         try:

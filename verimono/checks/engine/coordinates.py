@@ -60,7 +60,7 @@ _MORE = ("mu", "nu", "scale")
 #: gets a design of ``DENSE_SHARE`` times the coordinate budget on every coordinate (at most :data:`DENSE_MAX`
 #: points), spread evenly over the whole space (log-evenly on a logarithmic one): ci's 27 points make 432, a
 #: step every 0.37 decade of float64's 160 (instead of every third decade) — fixed by the profile, never by time
-DENSE_SHARE = 16
+DENSE_SHARE = 4
 DENSE_MAX = 4096
 
 def _norm(v: np.ndarray) -> float:
