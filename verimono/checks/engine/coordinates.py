@@ -57,10 +57,13 @@ MORE_FROM = 81
 DECADE_SHARE = 2
 _MORE = ("mu", "nu", "scale")
 #: a law with a vectorised form (:mod:`.batches`, whose evaluations of a list cost about one subject call each)
-#: gets a design of ``DENSE_SHARE`` times the coordinate budget on every coordinate (at most :data:`DENSE_MAX`
-#: points), spread evenly over the whole space (log-evenly on a logarithmic one): ci's 27 points make 432, a
-#: step every 0.37 decade of float64's 160 (instead of every third decade) — fixed by the profile, never by time
-DENSE_SHARE = 4
+#: gets a design of ``DENSE_SHARE`` times the coordinate budget on the step and time coordinates (one subject call
+#: per point: each has its own λ or t) and ``DENSE_SHARE_BATCHED`` times on the points' coordinates (``offset``,
+#: ``scale``: one λ and t, so one batched call for the whole design on an operator that maps batches), at most
+#: :data:`DENSE_MAX` points, spread evenly over the whole space (log-evenly on a logarithmic one) — fixed by the
+#: profile, never by time
+DENSE_SHARE = 2
+DENSE_SHARE_BATCHED = 16
 DENSE_MAX = 4096
 
 def _norm(v: np.ndarray) -> float:
@@ -146,7 +149,7 @@ def coordinate_search(evaluate: Callable[[Sample], float], op: Any, start: Sampl
             done.append(_decades(evaluate, space, at, points, seed, name, many, dense))
             space = Space(name, *STEPS, log=True)       # the steps the samples are drawn from, at full density
         if dense:
-            design = design + _even(space, dense_count(points))
+            design = design + _even(space, dense_count(points, name))
         design = [float(min(max(v, space.lo), space.hi)) for v in design]
         first = many([at(v) for v in design])
         if len(set(first)) <= 1:     # flat to the last bit: a coordinate the law does not read
@@ -154,7 +157,7 @@ def coordinate_search(evaluate: Callable[[Sample], float], op: Any, start: Sampl
                          "range": [space.lo, space.hi], "log": space.log})
             continue
         sup = maximise(_cached(evaluate, at, design, first), space, design=design, points=points,
-                       seed=seed, nodes=1, per_node=1)
+                       seed=seed, nodes=1, per_node=1, global_search=not dense)     # a dense design covers it
         done.append({"coordinate": name, "read": True, **_brief(sup.searched)})
     return done
 
@@ -184,9 +187,10 @@ def _decades(evaluate: Callable[[Sample], float], space: Space, at: Callable[[fl
     return {"coordinate": f"{name} decades", "read": True, "stride": stride, **_brief(sup.searched)}
 
 
-def dense_count(points: int) -> int:
-    """Design points of one coordinate of a law with a vectorised form at a coordinate budget of ``points``."""
-    return min(DENSE_MAX, DENSE_SHARE * max(1, int(points)))
+def dense_count(points: int, name: str = "lam") -> int:
+    """Design points of coordinate ``name`` of a law with a vectorised form at a coordinate budget of ``points``."""
+    share = DENSE_SHARE_BATCHED if name in ("offset", "scale") else DENSE_SHARE
+    return min(DENSE_MAX, share * max(1, int(points)))
 
 
 def _even(space: Space, count: int) -> list[float]:
