@@ -22,6 +22,9 @@ violation that needs two coordinates at once (a band of large ``λ`` that shows 
   outside it), ``n`` the outer normal ``(x1 − b)/|x1 − b|``, ``s ∈ [10^-12, 10^3](1 + |b|)``, and
   ``x2 = b + 1000 s n``: a pair just outside the boundary, on one normal.
 
+A law with a vectorised form (:mod:`.batches`) gets dense designs (:data:`DENSE_SHARE`, :data:`DENSE_SHARE_BATCHED`),
+evaluated as one list (``many``), the local search of :func:`maximise` then refining around the largest value.
+
 A coordinate whose ratio is the same to the last bit at every design point (one the law does not read,
 or an identity that holds exactly there) is covered by its design points only (``"read": False`` in the
 record).  Samples of more than ``NUMPY_DIM`` coordinates (recorded by recipe) are searched in

@@ -17,11 +17,16 @@ search evaluates it, in order, on
    input form (:mod:`verimono.checks.forms`: integer, strided and offset views into garbage, read-only, the
    declared dtype — forms the NumPy draws cycle through too), the operator's input unchanged by every call.
 
+Lists of samples known in advance — the draws, the sweep, each coordinate's design — are evaluated by the law's
+vectorised form where it has one (:meth:`_Search.evaluate_many`, :mod:`verimono.checks.engine.batches`): a row
+is accepted at its vectorised ratio only clearly inside the bound, every other row by the law's own evaluator.
+
 Every record says what was searched (``details["searched"]``: the range of ``|x|`` and of the step sizes,
 the largest gap between the sampled times, each coordinate's range and resolution, the samples evaluated in
 each input form).
 
-Hypothesis's engine costs about 1.7 ms per example here against about 0.02 ms per NumPy draw.  One given
+Hypothesis's engine costs about 1.7 ms per example here against about 0.02 ms per NumPy draw, and a
+vectorised evaluation about 7 µs per sample (one batched call) to 25 µs (one call per distinct step size).  One given
 ``sample=`` (a :class:`~verimono.checks.samples.Sample` or its dict from a counterexample) is evaluated
 alone instead: that is how a failure is replayed and how outer ``@given`` tests drive the laws.
 
