@@ -61,12 +61,12 @@ DECADE_SHARE = 2
 _MORE = ("mu", "nu", "scale")
 #: a law with a vectorised form (:mod:`.batches`, whose evaluations of a list cost about one subject call each)
 #: gets a design of ``DENSE_SHARE`` times the coordinate budget on the step and time coordinates (one subject call
-#: per point: each has its own λ or t) and ``DENSE_SHARE_BATCHED`` times on the points' coordinates (``offset``,
-#: ``scale``: one λ and t, so one batched call for the whole design on an operator that maps batches), at most
+#: per point: each has its own λ or t) and, on an operator that maps batches, ``DENSE_SHARE_BATCHED`` times on the
+#: points' coordinates (``offset``, ``scale``: one λ and t, so one batched call for the whole design), at most
 #: :data:`DENSE_MAX` points, spread evenly over the whole space (log-evenly on a logarithmic one) — fixed by the
-#: profile, never by time
+#: profile and the operator's declaration, never by time
 DENSE_SHARE = 2
-DENSE_SHARE_BATCHED = 16
+DENSE_SHARE_BATCHED = 8
 DENSE_MAX = 4096
 
 def _norm(v: np.ndarray) -> float:
@@ -115,12 +115,14 @@ def _moves(s: Sample, name: str, op: Any, horizon: float) -> tuple[Space, Callab
 
 def coordinate_search(evaluate: Callable[[Sample], float], op: Any, start: Sample, horizon: float, points: int,
                       seed: int, stop: Callable[[], bool],
-                      many: Callable[[list[Sample]], list[float]] | None = None, dense: bool = False) -> list[dict]:
+                      many: Callable[[list[Sample]], list[float]] | None = None, dense: bool = False,
+                      rows: bool = False) -> list[dict]:
     """Each coordinate of ``start`` maximised on its own (module docstring); ``evaluate(sample)`` returns the
     law's ratio (and raises to end the search, as on a violation); ``many(samples)`` the ratios of a list
     (default: ``evaluate`` of each; the search's evaluates a law's vectorised form over all of them at once —
     the design points of every coordinate); ``dense``: the law has a vectorised form, so every coordinate's
-    design is :func:`dense_count` points of its space; ``stop()`` ends it between coordinates.
+    design is :func:`dense_count` points of its space (``rows``: the operator maps batches, so the points'
+    coordinates are denser still); ``stop()`` ends it between coordinates.
     Returns what each coordinate's search covered."""
     if many is None:
         many = lambda ss: [evaluate(s) for s in ss]     # noqa: E731
@@ -152,7 +154,7 @@ def coordinate_search(evaluate: Callable[[Sample], float], op: Any, start: Sampl
             done.append(_decades(evaluate, space, at, points, seed, name, many, dense))
             space = Space(name, *STEPS, log=True)       # the steps the samples are drawn from, at full density
         if dense:
-            design = design + _even(space, dense_count(points, name))
+            design = design + _even(space, dense_count(points, name, rows))
         design = [float(min(max(v, space.lo), space.hi)) for v in design]
         first = many([at(v) for v in design])
         if len(set(first)) <= 1:     # flat to the last bit: a coordinate the law does not read
@@ -190,9 +192,10 @@ def _decades(evaluate: Callable[[Sample], float], space: Space, at: Callable[[fl
     return {"coordinate": f"{name} decades", "read": True, "stride": stride, **_brief(sup.searched)}
 
 
-def dense_count(points: int, name: str = "lam") -> int:
-    """Design points of coordinate ``name`` of a law with a vectorised form at a coordinate budget of ``points``."""
-    share = DENSE_SHARE_BATCHED if name in ("offset", "scale") else DENSE_SHARE
+def dense_count(points: int, name: str = "lam", rows: bool = False) -> int:
+    """Design points of coordinate ``name`` of a law with a vectorised form at a coordinate budget of ``points``
+    (``rows``: on an operator that maps batches)."""
+    share = DENSE_SHARE_BATCHED if rows and name in ("offset", "scale") else DENSE_SHARE
     return min(DENSE_MAX, share * max(1, int(points)))
 
 

@@ -74,7 +74,7 @@ from ...records.results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
 from ...execution.timeouts import (checkpoint, current_budget, interrupted, interruptible, note_progress,
                                   time_limit)
 from ...records.verdicts import timeout_verdict
-from .batches import ROW_CELLS, SUSPECT, VECTORISED, Rows, _BatchFailure, batched, prefetched
+from .batches import ROW_CELLS, SUSPECT, VECTORISED, Rows, _BatchFailure, batched, prefetched, rows_accepted
 from .coordinates import coordinate_search, searched
 from ..core import REGISTRY, Law, Outcome, classify, law, new_record, run, subject_name
 from .forms import CONTIGUOUS, cycled, form_note, form_search, forms_for, in_form
@@ -198,6 +198,11 @@ def bounded_root_cause(op: Any, horizon: float = 1.0) -> str | None:
     return cause
 
 
+def _amax(x: np.ndarray) -> float:
+    """``max |x_i|`` (0 for an empty point), without ``np.max``'s dispatch (once per point of every sample)."""
+    return float(np.abs(x).max()) if x.size else 0.0
+
+
 class _Violation(Exception):
     """Raised inside the hypothesis test when a sample breaks the law (so hypothesis shrinks it)."""
 
@@ -251,7 +256,7 @@ class _Search:
                 return None
         self.in_flight, self.slowest = None, max(self.slowest, time.perf_counter() - start)
         self.runs += 1
-        self.xs += [float(np.max(np.abs(s.x1), initial=0.0)), float(np.max(np.abs(s.x2), initial=0.0))]
+        self.xs += [_amax(s.x1), _amax(s.x2)]
         self.lams += [s.lam, s.mu, s.nu]
         self.ts.append(s.t)
         self.forms[s.form] = self.forms.get(s.form, 0) + 1
@@ -463,7 +468,8 @@ def _coordinates(state: _Search, seed: int, horizon: float, how: dict) -> None:
             formed = form_search(ratio, start, forms_for(state.op))      # the input's form, first: a few samples
             state.coordinates = coordinate_search(ratio, state.op, start, horizon, budget("coordinate"), seed,
                                                   lambda: state.unsupported is not None, ratios,
-                                                  dense=state.decl.name in VECTORISED and not batched(state.op))
+                                                  dense=state.decl.name in VECTORISED and not batched(state.op),
+                                                  rows=rows_accepted(state.op))
             state.coordinates += [formed] if formed else []
     except _Violation:
         state.shrunk_into(state.failing, state.failure, "the search over each coordinate of the worst sample (shrunk greedily)")
