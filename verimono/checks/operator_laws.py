@@ -28,10 +28,12 @@ import math
 import numpy as np
 
 from ..core.errors import NotApplicable, OutsideDomain, VerimonoError
-from ..core.tolerances import LIMIT_FLOOR, STALL_RATIO, STALL_WINDOW, current_eps, repeat_tolerance, tolerance
+from ..core.tolerances import (LIMIT_FLOOR, STALL_RATIO, STALL_WINDOW, current_eps, repeat_tolerance, row_tolerances,
+                               tolerance)
 from .core import Member, Outcome
 from .members import (_ROUNDOFF_BOUNDARY, listed, min_norm, norm, outside_by_roundoff_of_dom_g, point, resolvent,
                       within_roundoff_of_domain)
+from .engine.batches import row_dots, row_norms, row_ratios, row_resolvents, vectorised
 from .engine.samples import Sample
 from .engine.search import operator_law
 
@@ -385,3 +387,91 @@ def _only_within_rounding(op, x, y, t, tol) -> bool:
         return bool(op.contains(x.copy(), y.copy(), t, tol)) and not op.contains(x.copy(), y.copy(), t, 0.0)
     except NotImplementedError:
         return False
+
+
+# -- the vectorised forms (verimono.checks.engine.batches): the same inequalities over many samples at once ----
+# Each returns the ratio of every row of ``r`` (a Rows); the search re-evaluates by the law's own evaluator every
+# row not clearly inside the bound, so these only ever pass a sample, and with the laws' own slack.
+
+def _pair(op, r, lam2=None):
+    """``J_λ x1`` and ``J_{λ2} x2`` (λ2 defaults to λ) of every row."""
+    a = row_resolvents(op, r.x1, r.lam, r.t, r.ok)
+    b = row_resolvents(op, r.x2, r.lam if lam2 is None else lam2, r.t, r.ok)
+    return a, b
+
+
+@vectorised("resolvent_nonexpansive")
+def _rows_resolvent_nonexpansive(op, r):
+    a, b = _pair(op, r)
+    tau = row_tolerances(r.x1, r.x2, a, b)
+    return row_ratios(row_norms(a - b), row_norms(r.x1 - r.x2), 4 * tau)
+
+
+@vectorised("resolvent_firmly_nonexpansive")
+def _rows_resolvent_firmly_nonexpansive(op, r):
+    a, b = _pair(op, r)
+    dJ, dx = a - b, r.x1 - r.x2
+    tau = row_tolerances(r.x1, r.x2, a, b)
+    return row_ratios(row_dots(dJ, dJ), row_dots(dJ, dx), 4 * tau * (row_norms(dJ) + row_norms(dx) + tau))
+
+
+@vectorised("resolvent_identity")
+def _rows_resolvent_identity(op, r):
+    a = row_resolvents(op, r.x1, r.lam, r.t, r.ok)
+    q = r.mu / r.lam
+    z = q[:, None] * r.x1 + (1.0 - q)[:, None] * a
+    b = row_resolvents(op, z, r.mu, r.t, r.ok)
+    tau = row_tolerances(r.x1, a, z)
+    return row_ratios(row_norms(a - b), np.zeros_like(tau), tau * (4.0 + np.abs(1.0 - q)))
+
+
+@vectorised("monotone")
+def _rows_monotone(op, r):
+    a, b = _pair(op, r, r.mu)
+    ya, yb = (r.x1 - a) / r.lam[:, None], (r.x2 - b) / r.mu[:, None]
+    dx, dy = a - b, ya - yb
+    ex = 2 * row_tolerances(r.x1, r.x2, a, b)
+    ey = ex * (1.0 / r.lam + 1.0 / r.mu)
+    return row_ratios(-row_dots(dx, dy), np.zeros_like(ex),
+                      2 * (ex * row_norms(dy) + ey * row_norms(dx) + ex * ey))
+
+
+@vectorised("yosida_lipschitz")
+def _rows_yosida_lipschitz(op, r):
+    a, b = _pair(op, r)
+    dY = ((r.x1 - a) - (r.x2 - b)) / r.lam[:, None]
+    return row_ratios(r.lam * row_norms(dY), row_norms(r.x1 - r.x2), 4 * row_tolerances(r.x1, r.x2, a, b))
+
+
+@vectorised("yosida_monotone")
+def _rows_yosida_monotone(op, r):
+    a, b = _pair(op, r)
+    dx = r.x1 - r.x2
+    dY = (dx - (a - b)) / r.lam[:, None]
+    tau = row_tolerances(r.x1, r.x2, a, b)
+    return row_ratios(-row_dots(dY, dx), np.zeros_like(tau), 4 * tau * row_norms(dx) / r.lam)
+
+
+@vectorised("yosida_nonincreasing")
+def _rows_yosida_nonincreasing(op, r):
+    lo, hi = np.minimum(r.lam, r.mu), np.maximum(r.lam, r.mu)
+    hi = np.where(hi == lo, 2.0 * lo, hi)
+    a = row_resolvents(op, r.x1, lo, r.t, r.ok)
+    b = row_resolvents(op, r.x1, hi, r.t, r.ok)
+    ylo, yhi = (r.x1 - a) / lo[:, None], (r.x1 - b) / hi[:, None]
+    tau = row_tolerances(r.x1, a, b)
+    return row_ratios(row_norms(yhi), row_norms(ylo), 4 * tau * (1.0 / lo + 1.0 / hi))
+
+
+@vectorised("resolvent_limit")
+def _rows_resolvent_limit(op, r):
+    x = row_resolvents(op, r.x1, r.nu, r.t, r.ok)
+    y0 = (r.x1 - x) / r.nu[:, None]
+    tau, ny = row_tolerances(r.x1, x), row_norms(y0)
+    worst = np.full(len(tau), -np.inf)
+    for k in range(6):
+        lam = r.lam * 4.0 ** (-k)
+        d = row_norms(row_resolvents(op, x, lam, r.t, r.ok) - x)
+        q = row_ratios(d, lam * ny, tau * (4.0 + lam / r.nu))
+        worst = np.where(np.isnan(q) | (q > worst), q, worst)
+    return worst

@@ -25,7 +25,8 @@ from typing import Any, Iterator, Sequence
 
 import numpy as np
 
-from ...core.arrays import MAX_BATCH
+from ...core.arrays import MAX_BATCH, as_float64
+from ...execution.timeouts import interrupted
 from ...core.arrays import prefetch_key as key
 
 #: the leading batch sizes, every one (then the divisors of the dimension, then the rest in one batch)
@@ -102,3 +103,130 @@ def prefetched(op: Any, samples: Sequence[Any]) -> Iterator[int]:
 
 
 __all__ = ["prefetched", "batched", "batch_sizes", "_BatchFailure", "SMALL_BATCHES"]
+
+
+# -- vectorised law arithmetic over many samples ---------------------------------------------------------
+# A law may state, besides its evaluator of one sample, a **vectorised** form ``fn(op, rows) -> ratios``
+# (:func:`vectorised`): the same inequality over the rows of :class:`Rows` (the samples' points stacked ``(B, n)``,
+# their step sizes and times ``(B,)``), its resolvents from :func:`row_resolvents` — one call per distinct
+# ``(λ, t)`` when the operator maps batches row by row (``_accepts_batches``: the catalog's, bit-identical to
+# separate calls), else one call per row — and its arithmetic over all rows at once.  The search
+# (:meth:`verimono.checks.engine.search._Search.evaluate_many`) accepts a row's vectorised ratio only when it is
+# finite and at most :data:`SUSPECT`; every other row (a call that raised or returned no finite point of the
+# input's shape, a ratio near or above the bound, NaN) is evaluated again by the law's own evaluator, which alone
+# decides a failure and writes the record's numbers.  The vectorised form therefore never fails a sample, and
+# passes one only with a ratio at least ``1 - SUSPECT`` inside the bound (far beyond the rounding differences of
+# row-wise sums).
+
+#: law name → its vectorised form ``fn(op, rows) -> ratios (B,)`` (:func:`vectorised`)
+VECTORISED: dict[str, Any] = {}
+#: a vectorised ratio above this (or not finite) is evaluated again by the law's evaluator of one sample
+SUSPECT = 0.999
+#: the most coordinates stacked in one vectorised evaluation (rows × n): bounds its memory at n = 10^6
+ROW_CELLS = 1 << 20
+
+
+def vectorised(name: str):
+    """Register ``fn(op, rows: Rows) -> np.ndarray`` as the vectorised form of the operator law ``name``."""
+    def register(fn):
+        VECTORISED[name] = fn
+        return fn
+    return register
+
+
+class Rows:
+    """Samples stacked: ``x1``, ``x2`` ``(B, n)``; ``lam``, ``mu``, ``nu``, ``t`` ``(B,)``; ``ok`` ``(B,)`` the rows
+    every resolvent call of the vectorised law answered with a finite point of the right shape."""
+
+    __slots__ = ("x1", "x2", "lam", "mu", "nu", "t", "ok")
+
+    def __init__(self, samples: Sequence[Any]) -> None:
+        self.x1 = np.stack([s.x1 for s in samples]).astype(float, copy=False)
+        self.x2 = np.stack([s.x2 for s in samples]).astype(float, copy=False)
+        self.lam, self.mu, self.nu, self.t = (np.array([getattr(s, k) for s in samples], dtype=float)
+                                              for k in ("lam", "mu", "nu", "t"))
+        self.ok = np.ones(len(samples), dtype=bool)
+
+
+def rows_accepted(op: Any) -> bool:
+    """Whether the operator's resolvent maps a batch ``(B, n)`` row by row, as separate calls would (its class
+    says so, and no resolvent was set on the object itself: an instrumented or patched one is called per row)."""
+    if "resolvent" in getattr(op, "__dict__", {}):
+        return False
+    try:
+        return bool(op._accepts_batches())
+    except Exception:   # noqa: BLE001 - a user's object without the hook: one call per row
+        return False
+
+
+def row_resolvents(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok: np.ndarray) -> np.ndarray:
+    """``J_{λ_i} X_i`` at ``t_i`` for every row (on copies of the rows); a row whose call raised or returned no
+    finite point of its shape is marked ``False`` in ``ok`` (its values are then meaningless)."""
+    J = np.zeros_like(X)
+    if rows_accepted(op):
+        pairs = np.stack([lams, ts], axis=1)
+        uniq, inverse, counts = np.unique(pairs, axis=0, return_inverse=True, return_counts=True)
+        order = np.argsort(inverse.reshape(-1), kind="stable")
+        Xs, Js, fine = X[order], np.zeros_like(X), np.ones(len(lams), dtype=bool)     # rows grouped by (λ, t)
+        resolvent, n, lo = op.resolvent, X.shape[1], 0
+        for g, c in enumerate(counts.tolist()):
+            hi = lo + c
+            try:
+                P = resolvent(Xs[lo:hi], float(uniq[g, 0]), float(uniq[g, 1]))      # the group's rows: a copy
+                if type(P) is not np.ndarray or P.dtype != np.float64:
+                    P = as_float64(P)
+            except Exception:   # noqa: BLE001 - the law's evaluator of one sample meets it and judges it
+                if interrupted():
+                    raise
+                fine[lo:hi] = False
+                lo = hi
+                continue
+            if P.shape == (c, n):
+                Js[lo:hi] = P
+            else:
+                fine[lo:hi] = False
+            lo = hi
+        J[order] = Js
+        ok[order] &= fine & np.isfinite(Js).all(axis=1)
+        return J
+    for i in range(X.shape[0]):
+        try:
+            p = as_float64(op.resolvent(X[i].copy(), float(lams[i]), float(ts[i])))
+        except Exception:   # noqa: BLE001 - as above
+            if interrupted():
+                raise
+            ok[i] = False
+            continue
+        if p.shape != X[i].shape or not np.isfinite(p).all():
+            ok[i] = False
+            continue
+        J[i] = p
+    return J
+
+
+def row_norms(V: np.ndarray) -> np.ndarray:
+    """:func:`verimono.checks.members.norm` of every row (scaled by the row's largest entry: no underflow; 0 for
+    a zero row and, as there, for a row whose largest entry is not finite)."""
+    m = np.abs(V).max(axis=1, initial=0.0)
+    good = (m > 0.0) & np.isfinite(m)
+    safe = np.where(good, m, 1.0)
+    out = safe * np.sqrt(np.einsum("ij,ij->i", V / safe[:, None], V / safe[:, None]))
+    return np.where(good, out, 0.0)
+
+
+def row_dots(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    return np.einsum("ij,ij->i", A, B)
+
+
+def row_ratios(lhs: np.ndarray, rhs: np.ndarray, slack: np.ndarray) -> np.ndarray:
+    """:func:`verimono.checks.core.ratio` of every row: ``lhs / (rhs + slack)``, ``inf`` when a side is not
+    finite, 0 or ``inf`` when the denominator is 0 (NaN never: it would compare as a pass)."""
+    den = rhs + slack
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        r = np.where(den > 0.0, lhs / np.where(den > 0.0, den, 1.0), np.where(lhs <= 0.0, 0.0, np.inf))
+    bad = ~(np.isfinite(lhs) & np.isfinite(den)) | np.isnan(r)
+    return np.where(bad, np.inf, r)
+
+
+__all__ += ["VECTORISED", "SUSPECT", "ROW_CELLS", "vectorised", "Rows", "rows_accepted", "row_resolvents",
+            "row_norms", "row_dots", "row_ratios"]

@@ -22,6 +22,9 @@ violation that needs two coordinates at once (a band of large ``λ`` that shows 
   outside it), ``n`` the outer normal ``(x1 − b)/|x1 − b|``, ``s ∈ [10^-12, 10^3](1 + |b|)``, and
   ``x2 = b + 1000 s n``: a pair just outside the boundary, on one normal.
 
+A law with a vectorised form (:mod:`.batches`) gets dense designs (:data:`DENSE_SHARE`, :data:`DENSE_SHARE_BATCHED`),
+evaluated as one list (``many``), the local search of :func:`maximise` then refining around the largest value.
+
 A coordinate whose ratio is the same to the last bit at every design point (one the law does not read,
 or an identity that holds exactly there) is covered by its design points only (``"read": False`` in the
 record).  Samples of more than ``NUMPY_DIM`` coordinates (recorded by recipe) are searched in
@@ -56,6 +59,15 @@ MORE_FROM = 81
 #: the decades of the step range (:func:`_decades`) get a design of ``DECADE_SHARE`` times the coordinate budget
 DECADE_SHARE = 2
 _MORE = ("mu", "nu", "scale")
+#: a law with a vectorised form (:mod:`.batches`, whose evaluations of a list cost about one subject call each)
+#: gets a design of ``DENSE_SHARE`` times the coordinate budget on the step and time coordinates (one subject call
+#: per point: each has its own λ or t) and, on an operator that maps batches, ``DENSE_SHARE_BATCHED`` times on the
+#: points' coordinates (``offset``, ``scale``: one λ and t, so one batched call for the whole design), at most
+#: :data:`DENSE_MAX` points, spread evenly over the whole space (log-evenly on a logarithmic one) — fixed by the
+#: profile and the operator's declaration, never by time
+DENSE_SHARE = 2
+DENSE_SHARE_BATCHED = 8
+DENSE_MAX = 4096
 
 def _norm(v: np.ndarray) -> float:
     m = float(np.max(np.abs(v), initial=0.0))
@@ -102,10 +114,18 @@ def _moves(s: Sample, name: str, op: Any, horizon: float) -> tuple[Space, Callab
 
 
 def coordinate_search(evaluate: Callable[[Sample], float], op: Any, start: Sample, horizon: float, points: int,
-                      seed: int, stop: Callable[[], bool]) -> list[dict]:
+                      seed: int, stop: Callable[[], bool],
+                      many: Callable[[list[Sample]], list[float]] | None = None, dense: bool = False,
+                      rows: bool = False) -> list[dict]:
     """Each coordinate of ``start`` maximised on its own (module docstring); ``evaluate(sample)`` returns the
-    law's ratio (and raises to end the search, as on a violation); ``stop()`` ends it between coordinates.
+    law's ratio (and raises to end the search, as on a violation); ``many(samples)`` the ratios of a list
+    (default: ``evaluate`` of each; the search's evaluates a law's vectorised form over all of them at once —
+    the design points of every coordinate); ``dense``: the law has a vectorised form, so every coordinate's
+    design is :func:`dense_count` points of its space (``rows``: the operator maps batches, so the points'
+    coordinates are denser still); ``stop()`` ends it between coordinates.
     Returns what each coordinate's search covered."""
+    if many is None:
+        many = lambda ss: [evaluate(s) for s in ss]     # noqa: E731
     done, here = [], start
     best: list = [-math.inf, start]          # the largest ratio the direction search met, and its sample
 
@@ -131,22 +151,25 @@ def coordinate_search(evaluate: Callable[[Sample], float], op: Any, start: Sampl
             continue
         space, at, design = moved
         if name in ("lam", "mu", "nu"):
-            done.append(_decades(evaluate, space, at, points, seed, name))
+            done.append(_decades(evaluate, space, at, points, seed, name, many, dense))
             space = Space(name, *STEPS, log=True)       # the steps the samples are drawn from, at full density
+        if dense:
+            design = design + _even(space, dense_count(points, name, rows))
         design = [float(min(max(v, space.lo), space.hi)) for v in design]
-        first = [evaluate(at(v)) for v in design]
+        first = many([at(v) for v in design])
         if len(set(first)) <= 1:     # flat to the last bit: a coordinate the law does not read
             done.append({"coordinate": name, "points": len(design), "read": False,
                          "range": [space.lo, space.hi], "log": space.log})
             continue
-        sup = maximise(lambda v, which: np.array([evaluate(at(v))]), space, design=design, points=points,
-                       seed=seed, nodes=1, per_node=1)
+        sup = maximise(_cached(evaluate, at, design, first), space, design=design, points=points,
+                       seed=seed, nodes=1, per_node=1, global_search=not dense)     # a dense design covers it
         done.append({"coordinate": name, "read": True, **_brief(sup.searched)})
     return done
 
 
 def _decades(evaluate: Callable[[Sample], float], space: Space, at: Callable[[float], Sample], points: int,
-             seed: int, name: str) -> dict:
+             seed: int, name: str, many: Callable[[list[Sample]], list[float]] | None = None,
+             dense: bool = False) -> dict:
     """The step coordinate ``name`` over every decade the precision represents (``space``,
     :func:`verimono.core.tolerances.current_step_range`): a design of every ``stride``-th decade, ``stride`` the
     smallest that ``DECADE_SHARE · points`` evaluations pay (ci: every 3rd decade of float64's 160, dev every 6th,
@@ -154,15 +177,45 @@ def _decades(evaluate: Callable[[Sample], float], space: Space, at: Callable[[fl
     step: ``"read": False``), the local search of :func:`maximise` around the largest design values (the design
     is the coverage: its stride is the resolution promised)."""
     lo, hi = math.ceil(math.log10(space.lo)), math.floor(math.log10(space.hi))
-    stride = max(1, math.ceil((hi - lo) / (DECADE_SHARE * max(1, points))))
-    design = [10.0 ** k for k in range(lo, hi + 1, stride)] + [space.hi]
-    first = [evaluate(at(v)) for v in design]
+    stride: float = max(1, math.ceil((hi - lo) / (DECADE_SHARE * max(1, points))))
+    design = [10.0 ** k for k in range(lo, hi + 1, int(stride))] + [space.hi]
+    if dense:          # a vectorised law: DENSE_SHARE x DECADE_SHARE x the budget, log-evenly over every decade
+        extra = _even(space, min(DENSE_MAX, DECADE_SHARE * dense_count(points)))
+        stride = min(float(stride), (math.log10(space.hi) - math.log10(space.lo)) / max(1, len(extra) - 1))
+        design = sorted(set(design + extra))
+    first = many([at(v) for v in design]) if many is not None else [evaluate(at(v)) for v in design]
     if len(set(first)) <= 1:
         return {"coordinate": f"{name} decades", "read": False, "stride": stride, "points": len(design),
                 "range": [space.lo, space.hi], "log": True}
-    sup = maximise(lambda v, which: np.array([evaluate(at(v))]), space, design=design, points=points,
+    sup = maximise(_cached(evaluate, at, design, first), space, design=design, points=points,
                    seed=seed, nodes=1, per_node=1, global_search=False)
     return {"coordinate": f"{name} decades", "read": True, "stride": stride, **_brief(sup.searched)}
+
+
+def dense_count(points: int, name: str = "lam", rows: bool = False) -> int:
+    """Design points of coordinate ``name`` of a law with a vectorised form at a coordinate budget of ``points``
+    (``rows``: on an operator that maps batches)."""
+    share = DENSE_SHARE_BATCHED if rows and name in ("offset", "scale") else DENSE_SHARE
+    return min(DENSE_MAX, share * max(1, int(points)))
+
+
+def _even(space: Space, count: int) -> list[float]:
+    """``count`` points evenly spread over ``space`` (log-evenly on a logarithmic one), both ends included."""
+    if space.log:
+        return [float(v) for v in np.logspace(math.log10(space.lo), math.log10(space.hi), count)]
+    return [float(v) for v in np.linspace(space.lo, space.hi, count)]
+
+
+def _cached(evaluate: Callable[[Sample], float], at: Callable[[float], Sample], design: list[float],
+            first: list[float]) -> Callable:
+    """The values callback of :func:`maximise`: the design's ratios already evaluated (by ``many``) are taken
+    as they are, every other point evaluated."""
+    known = dict(zip(design, first))
+
+    def values(v: float, which) -> np.ndarray:
+        v = float(v)
+        return np.array([known[v] if v in known else evaluate(at(v))])
+    return values
 
 
 def _brief(s: Searched) -> dict:

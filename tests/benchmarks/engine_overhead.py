@@ -1,0 +1,174 @@
+"""The engine's overhead per evaluation of an operator law (issue 43, item 1), measured on a subject: the CPU
+time of ``check_operator`` split into the subject's own time (inside its resolvent, timed by a wrapper) and
+verimono's (the rest), per law evaluation; and the search resolution the records state per CPU second.
+
+Importable by the benchmarks (:mod:`test_bench_engine_overhead`) and runnable as a script under any version of
+verimono (public names only), so that the code before the issue and today's are measured side by side::
+
+    cd /tmp && /work/venv-old016/bin/python /path/to/engine_overhead.py     # the code before
+    python tests/benchmarks/engine_overhead.py                               # today's
+
+**Resolution** of a record: its ``details["searched"]["coordinates"]`` read as *cells* — a coordinate searched
+to a resolution ``ρ`` over ``[lo, hi]`` holds ``log(hi/lo)/log ρ`` cells (a logarithmic one; a factor ``ρ``)
+or ``(hi - lo)/ρ`` (a linear one: the direction's radians, the time); one the law does not read counts its
+design points.  The resolution per second of a battery is the sum of its records' cells over its CPU seconds.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any, Callable
+
+import numpy as np
+
+
+class SubjectClock:
+    """Wraps a resolvent ``f(x, lam, t)``: counts the rows it mapped and the CPU time spent inside it."""
+
+    def __init__(self, f: Callable) -> None:
+        self.f, self.seconds, self.calls, self.rows = f, 0.0, 0, 0
+
+    def __call__(self, *args, **kwargs):
+        start = time.process_time()
+        try:
+            return self.f(*args, **kwargs)
+        finally:
+            self.seconds += time.process_time() - start
+            self.calls += 1
+            x = args[1] if len(args) > 1 and hasattr(args[1], "ndim") else args[0]
+            self.rows += x.shape[0] if getattr(x, "ndim", 1) == 2 else 1
+
+
+def cells(searched: dict) -> float:
+    """The resolution cells of one record's ``details["searched"]`` (module docstring)."""
+    total = 0.0
+    for c in (searched or {}).get("coordinates", []):
+        if c.get("coordinate") == "form":
+            continue
+        lo, hi = c.get("range", [0.0, 0.0])
+        res = c.get("resolution")
+        if not c.get("read") or res is None:
+            total += float(c.get("points", 0))
+        elif c.get("log"):
+            total += math.log(hi / lo) / math.log(res) if res > 1.0 else 0.0
+        else:
+            total += (hi - lo) / res if res > 0 else 0.0
+    return total
+
+
+def measure(op: Any, seed: int = 0, profile: str = "ci", clock: SubjectClock | None = None) -> dict:
+    """``check_operator(op)`` at ``profile``: CPU seconds, law evaluations, subject seconds and calls (``clock``,
+    when the subject's resolvent is wrapped by one), the engine's own time per evaluation and the resolution
+    cells of the records."""
+    import verimono as vm
+    if clock is not None:
+        clock.seconds = clock.calls = clock.rows = 0
+    start = time.process_time()
+    rep = vm.check_operator(op, seed=seed, profile=profile)
+    cpu = time.process_time() - start
+    evals = sum(int(r.details.get("evaluations", 0) or 0) for r in rep.results)
+    res = sum(cells(r.details.get("searched", {})) for r in rep.results)
+    out = {"cpu_s": cpu, "evaluations": evals, "cells": res, "cells_per_cpu_s": res / cpu,
+           "evaluations_per_cpu_s": evals / cpu, "failed": rep.counts.get("failed", 0),
+           "passed": rep.counts.get("passed", 0)}
+    if clock is not None:
+        own = cpu - clock.seconds
+        out.update(subject_s=clock.seconds, subject_calls=clock.calls, subject_rows=clock.rows,
+                   own_us_per_eval=1e6 * own / max(1, evals), subject_us_per_eval=1e6 * clock.seconds / max(1, evals),
+                   own_over_subject=own / clock.seconds if clock.seconds > 0 else math.inf)
+    return out
+
+
+def single_call_us(f: Callable, x: np.ndarray, rounds: int = 2000) -> float:
+    """The subject's own cost of one call at ``x`` (median of 5 batches of ``rounds`` calls), µs."""
+    times = []
+    for _ in range(5):
+        start = time.process_time()
+        for _ in range(rounds):
+            f(x, 0.5, 0.0)
+        times.append((time.process_time() - start) / rounds)
+    return 1e6 * sorted(times)[2]
+
+
+def catalog() -> dict[str, Callable[[], Any]]:
+    """Cheap catalog operators in R^3 (public names, as old as the package)."""
+    import verimono as vm
+    from verimono.core.sets import Ball, Box
+    return {
+        "NormalCone(Ball) n=3": lambda: vm.NormalCone(Ball(np.zeros(3), 1.0)),
+        "NormalCone(Box) n=3": lambda: vm.NormalCone(Box(-np.ones(3), np.ones(3))),
+        "NormSubdifferential n=3": lambda: vm.NormSubdifferential(1.0, dim=3),
+        "Linear n=3": lambda: vm.Linear(np.array([[2.0, 1.0, 0.0], [-1.0, 1.0, 0.0], [0.0, 0.0, 0.5]])),
+    }
+
+
+def timed_catalog(name: str):
+    """The catalog operator ``name`` with its class's resolvent wrapped by a :class:`SubjectClock` (on the class,
+    so that the operator keeps its fast paths); returns ``(op, clock, undo)``."""
+    op = catalog()[name]()
+    cls = type(op)
+    original = cls.__dict__.get("resolvent")
+    inner = getattr(cls, "resolvent")
+    clock = SubjectClock(inner)
+
+    def resolvent(self, x, lam, t=0.0):
+        return clock(self, x, lam, t)
+    cls.resolvent = resolvent
+
+    def undo() -> None:
+        if original is None:
+            del cls.resolvent
+        else:
+            cls.resolvent = original
+    return op, clock, undo
+
+
+def pyproximal_box(dim: int = 3):
+    """PyProximal's projection onto the box ``[-1, 1]^n`` as an operator (its resolvent timed), or ``None``."""
+    try:
+        import pyproximal
+    except ImportError:
+        return None
+    import verimono as vm
+    box = pyproximal.Box(-1.0, 1.0)
+    clock = SubjectClock(lambda x, lam, t: box.prox(x, lam))
+    return vm.operator_from_resolvent(clock, dim, name="pyproximal.Box"), clock
+
+
+def torch_soft_threshold(dim: int = 3):
+    """A PyTorch prox (soft thresholding, ``F = ∂|·|_1``) as an operator, or ``None`` without torch."""
+    try:
+        import torch
+    except ImportError:
+        return None
+    import verimono as vm
+
+    def prox(x, lam, t):
+        x = torch.as_tensor(x, dtype=torch.float64)
+        return torch.sign(x) * torch.clamp(torch.abs(x) - lam, min=0.0)
+    clock = SubjectClock(prox)
+    return vm.operator_from_resolvent(clock, dim, name="torch soft threshold"), clock
+
+
+def main(rounds: int = 3) -> None:
+    import json
+    import verimono as vm
+    rows = {}
+    for name in catalog():
+        got = []
+        for r in range(rounds):
+            op, clock, undo = timed_catalog(name)
+            try:
+                got.append(measure(op, seed=r, clock=clock))
+            finally:
+                undo()
+        rows[name] = got
+    lib = pyproximal_box()
+    if lib is not None:
+        rows["pyproximal.Box n=3"] = [measure(lib[0], seed=r, clock=lib[1]) for r in range(rounds)]
+    print(json.dumps({"verimono": getattr(vm, "__version__", "?"), "rows": rows}))
+
+
+if __name__ == "__main__":
+    main()

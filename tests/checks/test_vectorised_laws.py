@@ -1,0 +1,84 @@
+"""The operator laws' vectorised forms (verimono.checks.engine.batches): the same inequalities over many samples at
+once.  A vectorised ratio must equal the law's own ratio sample by sample (same tolerances, same slack), on lawful
+operators and on broken ones alike, whether the operator maps batches (one call per distinct (λ, t)) or is called
+row by row; the search accepts a vectorised ratio only clearly inside the bound and re-evaluates every other row by
+the law's own evaluator, so a failure is still found, recorded with the law's own numbers and replayed."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import zoo
+import verimono as vm
+from verimono.checks import operator_laws  # noqa: F401 - the laws and their vectorised forms register
+from verimono.checks.core import REGISTRY
+from verimono.checks.engine.batches import SUSPECT, VECTORISED, Rows, rows_accepted
+from verimono.checks.engine.samples import Sample
+from verimono.checks.engine.search import evaluate_sample, run_law
+from verimono.checks.engine.supremum import budgets
+from verimono.checks.engine.sweep import law_draws, sweep_samples
+from verimono.core.sets import Ball
+
+#: the laws' sums are BLAS dots (scalar) and einsum (rows): their ratios agree to a few units of rounding of the
+#: larger side, i.e. relatively, and absolutely in units of the bound (1) where a ratio is a cancellation ~1e-9
+AGREE = 1e-9
+
+
+def _samples(op, count=12):
+    return (law_draws(op.dim, 5, 1.0, count, Sample) + sweep_samples(op, 5, 1.0, count, Sample))
+
+
+@pytest.mark.parametrize("law", sorted(VECTORISED))
+@pytest.mark.parametrize("make", [lambda: vm.NormalCone(Ball(np.zeros(3), 1.0)),
+                                  lambda: vm.NormSubdifferential(lambda t: 1.0 + t, dim=3),
+                                  lambda: zoo.build("explicit_step"), lambda: zoo.build("non_monotone_linear")],
+                         ids=["ball", "norm", "explicit_step", "non_monotone_linear"])
+def test_a_vectorised_ratio_is_the_laws_own_ratio(law, make):
+    op = make()
+    ss = _samples(op)
+    rows = Rows(ss)
+    with np.errstate(all="ignore"):
+        q = VECTORISED[law](op, rows)
+    own = np.array([evaluate_sample(REGISTRY["operator"][law], op, s).ratio for s in ss])
+    fine = rows.ok & np.isfinite(own)
+    assert fine.sum() >= len(ss) // 2
+    assert np.allclose(q[fine], own[fine], rtol=AGREE, atol=AGREE), (law, q[fine], own[fine])
+    assert not (q[fine] <= SUSPECT)[own[fine] > 1.0].any()       # a violated row is never accepted
+
+
+def test_the_catalog_maps_batches_and_a_patched_resolvent_is_called_row_by_row():
+    op = vm.NormalCone(Ball(np.zeros(3), 1.0))
+    assert rows_accepted(op)
+    op.resolvent = lambda x, lam, t=0.0: np.zeros(3)           # instrumented on the object: one call per row
+    assert not rows_accepted(op)
+
+
+@pytest.mark.slow       # three searches through hypothesis: ~3 s
+def test_a_row_the_vectorised_form_cannot_decide_is_failed_by_the_law_itself():
+    """A ball's projection that triples points of |x| < 10^-3 (expansive there, by 3): the vectorised form passes
+    the rows it sees inside the bound, the tiny rows of the sweep it does not are evaluated by the law, which fails
+    one with its own numbers (ratio 3 up to the slack); the control (correct everywhere, same seed) passes."""
+    def proj(x, lam, t=0.0):
+        x = np.asarray(x, dtype=float)
+        r = np.linalg.norm(x)
+        return x * (3.0 if r < 1e-3 else 1.0) / max(1.0, r)
+    bad = vm.operator_from_resolvent(proj, 3, name="triples tiny points")
+    good = vm.operator_from_resolvent(lambda x, lam, t=0.0: np.asarray(x, float) / max(1.0, np.linalg.norm(x)), 3,
+                                      name="ball projection")
+    with budgets(coordinate=3):         # the draws and the sweep decide here: a short coordinate phase
+        rec = run_law("resolvent_nonexpansive", bad, seed=1, examples=20)
+        ctl = run_law("resolvent_nonexpansive", good, seed=1, examples=20)
+    cex = rec.counterexample
+    assert rec.status == "failed" and abs(cex["lhs"] / cex["rhs"] - 3.0) < 1e-9, str(rec)     # |ΔJ| = 3|Δx|
+    again = run_law("resolvent_nonexpansive", bad, sample=rec.counterexample)
+    assert again.status == "failed"
+    assert ctl.status == "passed", str(ctl)
+
+
+def test_the_points_searched_are_fixed_by_seed_and_profile():
+    op = vm.NormalCone(Ball(np.zeros(3), 1.0))
+    with budgets(coordinate=9):
+        a, b = (run_law("monotone", op, seed=7, examples=10) for _ in range(2))
+    assert a.details["evaluations"] == b.details["evaluations"] and a.worst == b.worst
+    assert a.details["searched"]["coordinates"] == b.details["searched"]["coordinates"]
