@@ -96,6 +96,7 @@ def outside_by_roundoff_of_dom_g(op: Any, p: np.ndarray, t: float, scale: float,
     a violation of the law but of nothing (section "Judged at the subject's precision" of docs/precision.md).
     A point farther out stays the resolvent's fault."""
     base = current_eps() * (1.0 + float(scale))
+    reach = ROUNDOFF_ULPS[-1] * base
     dirs = []
     for v in (normal, p):
         if v is None:
@@ -103,13 +104,41 @@ def outside_by_roundoff_of_dom_g(op: Any, p: np.ndarray, t: float, scale: float,
         m = norm(v)
         if m > 0.0 and math.isfinite(m):
             dirs += [-np.asarray(v, dtype=float) / m, np.asarray(v, dtype=float) / m]
-    for k in ROUNDOFF_ULPS:
-        for d in dirs:
-            try:
-                if math.isfinite(value(op, p + k * base * d, t)):
-                    return True
-            except Exception:   # noqa: BLE001 - a neighbour the value function cannot judge excuses nothing
-                continue
+    if _finite_near(op, p, t, base, dirs):
+        return True
+    # a thin domain (an affine set, the simplex's hyperplane: g finite only within round-off of it) is met by no
+    # probe along a few directions; the subject's own resolvent proposes its nearest point, J_μ p, which the
+    # value function then judges (J is only asked for a candidate: a wrong J proposes a point g rejects, or one
+    # farther than the reach).  Its round-off is eps·|p|, not eps·|x|: from p far smaller than the x it came from,
+    # J_μ p lands within the equalities' round-off
+    for mu in _PROPOSAL_STEPS:
+        try:
+            q = resolvent(op, p, mu, t)
+        except Exception:   # noqa: BLE001 - no proposal: nothing excused
+            continue
+        if _finite_near(op, q, t, current_eps() * (1.0 + norm(q)), dirs, at_p=True, centre=p, reach=reach):
+            return True
+    return False
+
+
+#: the steps ``μ`` at which the subject's resolvent proposes a point of ``dom g`` near a rejected ``p``: any ``μ``
+#: for an indicator (``J_μ`` is the projection), a small one for another ``g`` (``J_μ p → proj_{cl dom g} p``)
+_PROPOSAL_STEPS = (1.0, 1e-6)
+
+
+def _finite_near(op: Any, p: np.ndarray, t: float, base: float, dirs: list[np.ndarray], at_p: bool = False,
+                 centre: np.ndarray | None = None, reach: float = math.inf) -> bool:
+    """``g`` finite at ``p + k·base·d`` (``k`` in :data:`ROUNDOFF_ULPS`, ``d`` in ``dirs``), or at ``p`` itself
+    when ``at_p``, among the points within ``reach`` of ``centre``."""
+    points = ([p] if at_p else []) + [p + k * base * d for k in ROUNDOFF_ULPS for d in dirs]
+    for z in points:
+        if centre is not None and not norm(z - centre) <= reach:
+            continue
+        try:
+            if math.isfinite(value(op, z, t)):
+                return True
+        except Exception:   # noqa: BLE001 - a neighbour the value function cannot judge excuses nothing
+            continue
     return False
 
 
