@@ -117,7 +117,8 @@ def _jax_sets():
     }
     def on_affine(x):
         A, eps = jnp.asarray(A_AFF, x.dtype), jnp.finfo(x.dtype).eps
-        return (jnp.abs(A @ x - B_AFF) <= EQ_ULPS * eps * (1 + jnp.abs(A) @ jnp.abs(x) + jnp.abs(B_AFF))).all()
+        b = jnp.asarray(B_AFF, x.dtype)
+        return (jnp.abs(A @ x - b) <= EQ_ULPS * eps * (1 + jnp.abs(A) @ jnp.abs(x) + jnp.abs(b))).all()
 
     def on_simplex(x):
         eps = jnp.finfo(x.dtype).eps
