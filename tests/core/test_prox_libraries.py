@@ -106,3 +106,18 @@ def test_pytorch_recipes():
     seen = []
     op = vm.operator_from_prox(lambda x, lam: seen.append(type(x)) or ns["l1"].prox(x, lam), shape=3, array="torch")
     assert op.resolvent([1.0, -2.0, 0.1], 0.5).dtype == np.float64 and seen == [torch.Tensor]
+
+
+@pytest.mark.sweep      # seed 0 is test_jax_recipes / test_pytorch_recipes above
+@pytest.mark.parametrize("heading, names, libs", [
+    ("## JAX (jaxopt)", ("lasso", "ball", "batched"), ("jax", "jaxopt")),
+    ("## PyTorch (ProxTorch)", ("torch_l1", "torch_ball", "torch_batched"), ("torch", "proxtorch"))], ids=["jax", "torch"])
+def test_recipes_pass_every_law_at_seeds_1_to_19(heading, names, libs):
+    for lib in libs:
+        pytest.importorskip(lib, reason=f"{lib} is not installed (pip install 'verimono[arrays]')")
+    ns = _recipes(heading)
+    for seed in range(1, 20):
+        for name in names:
+            rep = vm.check_operator(ns[name], seed=seed)
+            assert rep.ok, f"{name}, seed {seed}:\n" + "\n".join(map(str, rep.failures))
+            assert {r.details["dtype"] for r in rep if r.status == "passed"} == {"float32"}

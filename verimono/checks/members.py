@@ -7,6 +7,7 @@ counterexamples."""
 from __future__ import annotations
 
 import math
+import zlib
 from typing import Any
 
 import numpy as np
@@ -89,13 +90,15 @@ def outside_by_roundoff_of_dom_g(op: Any, p: np.ndarray, t: float, scale: float,
                                  normal: np.ndarray | None = None) -> bool:
     """Whether ``g(p) = +inf`` only by round-off: ``g`` is finite at a point within ``k·eps·(1 + scale)`` of ``p``
     (``k`` in :data:`ROUNDOFF_ULPS`, ``eps`` the unit round-off of the precision under judgement), along
-    ``±normal`` (the outer normal ``x − p`` of a projection) or ``±p``.
+    ``±normal`` (the outer normal ``x − p`` of a projection), ``±p`` or spare directions
+    (:func:`_spare_directions`), or at a point the resolvent proposes within that reach (thin domains, below).
 
     A resolvent exact to its precision leaves its set by up to ``eps·|x|`` (a float32 projection from
     ``|x| = 10^6`` by ~0.1), and a strict indicator (``+inf`` at every point outside) rejects that point: not
     a violation of the law but of nothing (section "Judged at the subject's precision" of docs/precision.md).
     A point farther out stays the resolvent's fault."""
     base = current_eps() * (1.0 + float(scale))
+    reach = ROUNDOFF_ULPS[-1] * base
     dirs = []
     for v in (normal, p):
         if v is None:
@@ -103,13 +106,68 @@ def outside_by_roundoff_of_dom_g(op: Any, p: np.ndarray, t: float, scale: float,
         m = norm(v)
         if m > 0.0 and math.isfinite(m):
             dirs += [-np.asarray(v, dtype=float) / m, np.asarray(v, dtype=float) / m]
-    for k in ROUNDOFF_ULPS:
-        for d in dirs:
-            try:
-                if math.isfinite(value(op, p + k * base * d, t)):
-                    return True
-            except Exception:   # noqa: BLE001 - a neighbour the value function cannot judge excuses nothing
-                continue
+    dirs += _spare_directions(p)
+    if _finite_near(op, p, t, base, dirs):
+        return True
+    # a thin domain (an affine set, the simplex's hyperplane: g finite only within round-off of it) is met by no
+    # probe along a few directions; the subject's own resolvent proposes its nearest point, J_μ p, which the
+    # value function then judges (J is only asked for a candidate: a wrong J proposes a point g rejects, or one
+    # farther than the reach).  Its round-off is eps·|p|, not eps·|x|: from p far smaller than the x it came from,
+    # J_μ p lands within the equalities' round-off
+    for mu in _PROPOSAL_STEPS:
+        try:
+            q = resolvent(op, p, mu, t)
+        except Exception:   # noqa: BLE001 - no proposal: nothing excused
+            continue
+        if _finite_near(op, q, t, current_eps() * (1.0 + norm(q)), dirs, at_p=True, centre=p, reach=reach):
+            return True
+    return False
+
+
+#: coordinates probed, besides the normal, ``p`` and :data:`SPARE_RANDOM` seeded directions
+SPARE_COORDINATES = 4
+SPARE_RANDOM = 2
+
+
+def _spare_directions(p: np.ndarray) -> list[np.ndarray]:
+    """``±e_i`` (the first :data:`SPARE_COORDINATES`) and ``±`` seeded unit directions (deterministic in ``p``).
+
+    The normal ``x − p`` is no direction when the resolvent returned ``x`` itself: a point on a half-space's
+    boundary whose projection moves it by less than an ulp of ``x`` is its own correctly rounded projection,
+    outside by one rounding of ``a·x`` (float64 PyTorch, ``|x| = 37``: ``a·p − b = 9.4e-16``), and ``±p`` may be
+    nearly tangent to the set; any direction with an inward component gets in within the reach."""
+    n = p.size
+    out = []
+    for i in range(min(n, SPARE_COORDINATES)):
+        e = np.zeros(n)
+        e.flat[i] = 1.0
+        out += [e, -e]
+    rng = np.random.default_rng(zlib.crc32(np.ascontiguousarray(p, dtype=float).tobytes()))
+    for _ in range(SPARE_RANDOM):
+        v = rng.standard_normal(n)
+        v /= norm(v)
+        out += [v, -v]
+    return [d.reshape(p.shape) for d in out]
+
+
+#: the steps ``μ`` at which the subject's resolvent proposes a point of ``dom g`` near a rejected ``p``: any ``μ``
+#: for an indicator (``J_μ`` is the projection), a small one for another ``g`` (``J_μ p → proj_{cl dom g} p``)
+_PROPOSAL_STEPS = (1.0, 1e-6)
+
+
+def _finite_near(op: Any, p: np.ndarray, t: float, base: float, dirs: list[np.ndarray], at_p: bool = False,
+                 centre: np.ndarray | None = None, reach: float = math.inf) -> bool:
+    """``g`` finite at ``p + k·base·d`` (``k`` in :data:`ROUNDOFF_ULPS`, ``d`` in ``dirs``), or at ``p`` itself
+    when ``at_p``, among the points within ``reach`` of ``centre``."""
+    points = ([p] if at_p else []) + [p + k * base * d for k in ROUNDOFF_ULPS for d in dirs]
+    for z in points:
+        if centre is not None and not norm(z - centre) <= reach:
+            continue
+        try:
+            if math.isfinite(value(op, z, t)):
+                return True
+        except Exception:   # noqa: BLE001 - a neighbour the value function cannot judge excuses nothing
+            continue
     return False
 
 
