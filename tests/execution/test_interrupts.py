@@ -163,6 +163,29 @@ def test_what_a_library_raises_after_an_interrupt_is_the_timeout():
     assert "IndexError: pop from empty list" in rec.details["harness_error"] and "IndexError" in rec.message
 
 
+def test_a_vectorised_pass_is_judged_call_by_call():
+    """The vectorised laws evaluate many samples in one pass (one subject call per row for a user's operator):
+    the pass is many calls, each timed on its own.  Timed as one, a subject slow at every call after a few
+    fast ones (0.1 s a call, budget 0.8 s) looked like a call that never returns (failed); it is the time budget
+    (undecided).  A call that really hangs in the pass (20 s, after fast ones) still fails."""
+    def make(pause):
+        calls = []
+
+        def resolvent(x, lam, t):
+            calls.append(1)
+            if len(calls) > 12:
+                time.sleep(pause)
+            return np.asarray(x, dtype=float) / (1.0 + lam)
+        return vm.operator_from_resolvent(resolvent, 2, name=f"pause {pause}")
+
+    with timeouts.budget(0.8):
+        slow = run_law("monotone", make(0.1), seed=0, examples=50)
+    assert slow.status == UNDECIDED and slow.details["undecided_reason"] == "time budget", slow
+    with timeouts.budget(0.8):
+        hung = run_law("monotone", make(20.0), seed=0, examples=50)
+    assert hung.status == FAILED and "in flight" in hung.message, hung
+
+
 def test_a_law_out_of_time_before_any_sample_with_nothing_in_flight_is_undecided(monkeypatch):
     """The budget spent by the harness (here its draws, made slow) before the first sample was FAILED
     ("timed out ... (0 samples evaluated before)") although no call of the subject was running."""

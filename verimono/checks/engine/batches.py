@@ -21,6 +21,7 @@ are evaluated as they come (a batch of one).
 from __future__ import annotations
 
 import contextlib
+import time
 from typing import Any, Iterator, Sequence
 
 import numpy as np
@@ -159,9 +160,27 @@ def rows_accepted(op: Any) -> bool:
         return False
 
 
+#: the search whose vectorised evaluation is running (``[state]`` while it runs): every subject call of
+#: :func:`row_resolvents` is timed on it as a call of its own (:func:`_call_starts`)
+CLOCK: list = []
+
+
+def _call_starts() -> None:
+    """A subject call starts: the running search's ``in_flight`` is its start, and the call before it, now
+    returned, counts toward ``slowest``.  A vectorised pass is many calls, judged one by one as the search
+    judges its samples (:func:`verimono.records.verdicts.never_returned`): a subject slow at every call is no
+    subject that hangs (the pass as one call would have been, at ``HANG_MULTIPLE`` x its fast first calls)."""
+    if CLOCK:
+        state, now = CLOCK[-1], time.perf_counter()
+        if state.in_flight is not None:
+            state.slowest = max(state.slowest, now - state.in_flight)
+        state.in_flight = now
+
+
 def row_resolvents(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok: np.ndarray) -> np.ndarray:
     """``J_{λ_i} X_i`` at ``t_i`` for every row (on copies of the rows); a row whose call raised or returned no
-    finite point of its shape is marked ``False`` in ``ok`` (its values are then meaningless)."""
+    finite point of its shape is marked ``False`` in ``ok`` (its values are then meaningless).  Each subject
+    call is timed as a call of its own (:func:`_call_starts`)."""
     J = np.zeros_like(X)
     if rows_accepted(op):
         pairs = np.stack([lams, ts], axis=1)
@@ -171,6 +190,7 @@ def row_resolvents(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok:
         resolvent, n, lo = op.resolvent, X.shape[1], 0
         for g, c in enumerate(counts.tolist()):
             hi = lo + c
+            _call_starts()
             try:
                 P = resolvent(Xs[lo:hi], float(uniq[g, 0]), float(uniq[g, 1]))      # the group's rows: a copy
                 if type(P) is not np.ndarray or P.dtype != np.float64:
@@ -190,6 +210,7 @@ def row_resolvents(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok:
         ok[order] &= fine & np.isfinite(Js).all(axis=1)
         return J
     for i in range(X.shape[0]):
+        _call_starts()
         try:
             p = as_float64(op.resolvent(X[i].copy(), float(lams[i]), float(ts[i])))
         except Exception:   # noqa: BLE001 - as above

@@ -74,7 +74,7 @@ from ...records.results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
 from ...execution.timeouts import (checkpoint, current_budget, interrupted, interruptible, note_progress,
                                   time_limit)
 from ...records.verdicts import timeout_verdict
-from .batches import ROW_CELLS, SUSPECT, VECTORISED, Rows, _BatchFailure, batched, prefetched, rows_accepted
+from .batches import CLOCK, ROW_CELLS, SUSPECT, VECTORISED, Rows, _BatchFailure, batched, prefetched, rows_accepted
 from .coordinates import coordinate_search, searched
 from ..core import REGISTRY, Law, Outcome, classify, law, new_record, run, subject_name
 from .forms import CONTIGUOUS, cycled, form_note, form_search, forms_for, in_form
@@ -302,9 +302,10 @@ class _Search:
         if not idx:
             return {}
         checkpoint()
-        start = self.in_flight = time.perf_counter()
+        self.in_flight = time.perf_counter()     # each subject call of the pass restarts it (batches._call_starts)
         batch = [samples[i] for i in idx]
         r = Rows(batch)
+        CLOCK.append(self)
         try:
             with np.errstate(all="ignore"):
                 q = np.asarray(fn(self.op, r), dtype=float)
@@ -315,7 +316,9 @@ class _Search:
                 raise
             self.in_flight = None
             return {}
-        self.in_flight, self.slowest = None, max(self.slowest, time.perf_counter() - start)
+        finally:
+            CLOCK.pop()
+        self.in_flight, self.slowest = None, max(self.slowest, time.perf_counter() - self.in_flight)
         good = r.ok & np.isfinite(q) & (q <= SUSPECT)
         k = int(good.sum())
         if not k:
