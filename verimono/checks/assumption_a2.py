@@ -197,7 +197,7 @@ def _fastest(S, lam: float) -> tuple[list[float], int, dict]:
                                "zoom": {"at": z.at, "levels": len(z.widths), "evaluations": z.evaluations}}
 
 
-@law("assumption_A2", "(A2)", subject="problem", driver=run_assumption)
+@law("assumption_A2", "(A2)", subject="problem", driver=run_assumption, over=("t", "points"))
 def check_assumption_A2(S) -> Outcome:
     """(A2): outer semicontinuity from the right of ``t ↦ graph F(t,·)``: every right limit
     ``lim J_λ(t+δ) p`` exists and equals ``J_λ(t) p`` at the sampled times, at every jump of ``t ↦ J_λ(t) p``

@@ -60,7 +60,7 @@ def _searched(S, sup: Sup, **more: Any) -> dict:
     return {"t": searched_t(sup), "x_range": S.x_range(), **more}
 
 
-@law("assumption_A3", "(A3)", subject="problem", driver=run_assumption)
+@law("assumption_A3", "(A3)", subject="problem", driver=run_assumption, over=("t", "points", "direction"))
 def check_assumption_A3(S) -> Outcome:
     """(A3): ``sup_{z ∈ dom F(s)} dist(z, dom F(t)) ≤ φ(t) - φ(s)``: the least nondecreasing ``φ̂`` of the
     sampled domain motion, compared with a stated ``φ``; a jump of the domain fails it (φ must be absolutely
@@ -240,7 +240,7 @@ def _a3_jump(S, details: dict) -> dict | None:
 
 # -- (LG) ---------------------------------------------------------------------------------------------
 
-@law("assumption_LG", "(LG)", subject="problem", driver=run_assumption)
+@law("assumption_LG", "(LG)", subject="problem", driver=run_assumption, over=("t", "points", "direction"))
 def check_assumption_LG(S) -> Outcome:
     """(LG): ``|F^0(t, z)| ≤ σ(t)(1 + |z|)``: the estimated ``σ̂`` against a stated ``σ`` — at the sampled
     points, over ``t`` and along rays far from ``x0`` and near the kink ``0`` — or, without one, growth of
@@ -437,7 +437,7 @@ def _theta_sup(S, key: str) -> tuple[Sup, dict]:
                            "lhs": np.nan, "rhs": np.nan}, found_by="search over time")
 
 
-@law("assumption_YB", "(YB)/(YB')", subject="problem", driver=run_assumption)
+@law("assumption_YB", "(YB)/(YB')", subject="problem", driver=run_assumption, over=("t", "points", "lam"))
 def check_assumption_YB(S) -> Outcome:
     """(YB)/(YB'): the Yosida increment ``|Y_λ(s+λ, z)| - |F^0(s, z)| ≤ θ(s+λ) - θ(s)`` against a stated
     ``θ``, or, without one, growth of the increment per unit time like ``1/λ`` (evidence that (YB) fails)."""

@@ -52,7 +52,7 @@ def _non_monotone(Z: np.ndarray, Y: np.ndarray, P: np.ndarray):
     return -inner / (tol + 1e-300), inner, i, j
 
 
-@law("assumption_A1", "(A1)", subject="problem", driver=run_assumption)
+@law("assumption_A1", "(A1)", subject="problem", driver=run_assumption, over=("t", "points", "lam"))
 def check_assumption_A1(S) -> Outcome:
     """(A1): monotonicity ``⟨z1 - z2, y1 - y2⟩ ≥ 0`` on sampled graph pairs of ``F(t,·)`` (resolvent pairs
     ``(J_λ p, Y_λ p)`` and ``(z, F^0(z))``) at the sample times, and over the pairs of resolvent graph points

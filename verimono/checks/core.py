@@ -49,6 +49,23 @@ from ..core.tolerances import judged_precision
 
 SUBJECTS = ("operator", "stepper", "problem", "system", "estimator")
 
+#: the typed domains a law's statement quantifies over ("for all ..."), each searched by the engine
+#: (:mod:`verimono.checks.engine`) when a law declares it (:attr:`Law.over`); the record's ``details["searched"]``
+#: states what was reached on each
+QUANTIFIERS = {
+    "points": "x ∈ R^n: NumPy draws, hypothesis, the scale sweep (|x| from 10^-9 to 10^6, on and just outside the "
+              "domain's boundary)",
+    "direction": "the direction of x2 − x1 (or of the exposed boundary point) over the sphere S^{n−1}",
+    "lam": "the step λ over every decade the precision represents (float64 [1e-153, 1e7])",
+    "mu": "the step μ, as λ",
+    "nu": "the step ν, as λ",
+    "t": "t ∈ [0, T], both ends (the operator laws: the horizon; the assumption laws: a stratified, jittered "
+         "design by count, T/2048 at ci)",
+    "offset": "the distance of x1 from the domain's boundary along its outer normal, 10^-12 to 10^3 (1 + |x|)",
+    "scale": "|x| over 10^-9 to 10^6 (the kink 0 and far points)",
+    "form": "the input's form: int64, strided and offset views, read-only, the declared dtype",
+}
+
 
 # -- the one outcome type ---------------------------------------------------------------------------
 
@@ -210,6 +227,8 @@ class Law:
     battery: bool = True
     #: the public ``check_<name>`` the decorator made
     public: Callable[..., CheckResult] | None = dataclasses.field(default=None, compare=False, repr=False)
+    #: the statement's quantifiers, as data: names of :data:`QUANTIFIERS` the engine searches for this law
+    over: tuple = ()
 
     def unmet(self, ctx: Context) -> str | None:
         """The first unmet requirement's reason (``None`` when the law applies)."""
@@ -228,13 +247,19 @@ REGISTRY: dict[str, dict[str, Law]] = {kind: {} for kind in SUBJECTS}
 
 
 def law(name: str, label: str, *, subject: str, driver: Callable[..., CheckResult],
-        requires: Iterable = (), battery: bool = True) -> Callable[[Callable], Callable[..., CheckResult]]:
+        requires: Iterable = (), battery: bool = True,
+        over: Iterable[str] = ()) -> Callable[[Callable], Callable[..., CheckResult]]:
     """Declare the decorated evaluator as the law ``name`` of ``subject`` kind (registered in declaration
     order) and return the public check: ``driver`` applied to the law, with the evaluator's docstring and
     the driver's keyword arguments (``check.law`` is the :class:`Law`).  ``battery=False``: a law run on
-    its own (by a stage of the run), not by its kind's battery."""
+    its own (by a stage of the run), not by its kind's battery.  ``over``: the statement's quantifiers
+    (:data:`QUANTIFIERS`), which the engine searches for it."""
     if subject not in SUBJECTS:
         raise ValueError(f"subject must be one of {SUBJECTS}, got {subject!r}")
+    over = tuple(over)
+    unknown = [q for q in over if q not in QUANTIFIERS]
+    if unknown:
+        raise ValueError(f"unknown quantifiers {unknown}: each is one of {tuple(QUANTIFIERS)}")
 
     def deco(evaluate: Callable) -> Callable[..., CheckResult]:
         @functools.wraps(evaluate)
@@ -242,7 +267,7 @@ def law(name: str, label: str, *, subject: str, driver: Callable[..., CheckResul
             return driver(decl, *args, **kwargs)
 
         decl = Law(name, label, subject, evaluate, tuple(requires), inspect.cleandoc(evaluate.__doc__ or ""),
-                   driver, battery, check)
+                   driver, battery, check, over)
         REGISTRY[subject][name] = decl
         params = list(inspect.signature(driver).parameters.values())[1:]
         check.__signature__ = inspect.Signature(params, return_annotation=CheckResult)
@@ -308,6 +333,6 @@ def record(name: str, subject: str, outcome: Outcome, **kw: Any) -> CheckResult:
                       **ratio, **kw)
 
 
-__all__ = ["Outcome", "Law", "law", "laws_of", "REGISTRY", "run", "record", "record_of_exception", "classify", "new_record",
+__all__ = ["Outcome", "Law", "law", "laws_of", "REGISTRY", "QUANTIFIERS", "run", "record", "record_of_exception", "classify", "new_record",
            "Member", "Claimed", "Holds", "Context", "provides", "NotApplicable", "PROXIMAL_CLAIM",
            "CONTRACTION_CLAIM", "SUBJECTS", "subject_name", "stepper_subject", "ratio", "worst_of"]

@@ -116,13 +116,14 @@ def _moves(s: Sample, name: str, op: Any, horizon: float) -> tuple[Space, Callab
 def coordinate_search(evaluate: Callable[[Sample], float], op: Any, start: Sample, horizon: float, points: int,
                       seed: int, stop: Callable[[], bool],
                       many: Callable[[list[Sample]], list[float]] | None = None, dense: bool = False,
-                      rows: bool = False) -> list[dict]:
+                      rows: bool = False, over: tuple = COORDINATES) -> list[dict]:
     """Each coordinate of ``start`` maximised on its own (module docstring); ``evaluate(sample)`` returns the
     law's ratio (and raises to end the search, as on a violation); ``many(samples)`` the ratios of a list
     (default: ``evaluate`` of each; the search's evaluates a law's vectorised form over all of them at once —
     the design points of every coordinate); ``dense``: the law has a vectorised form, so every coordinate's
     design is :func:`dense_count` points of its space (``rows``: the operator maps batches, so the points'
-    coordinates are denser still); ``stop()`` ends it between coordinates.
+    coordinates are denser still); ``stop()`` ends it between coordinates; ``over``: the law's declared
+    quantifiers (:attr:`verimono.checks.core.Law.over`) — a coordinate it does not declare is not searched.
     Returns what each coordinate's search covered."""
     if many is None:
         many = lambda ss: [evaluate(s) for s in ss]     # noqa: E731
@@ -135,7 +136,7 @@ def coordinate_search(evaluate: Callable[[Sample], float], op: Any, start: Sampl
             best[:] = [v, s]
         return v
 
-    for name in COORDINATES:
+    for name in (c for c in COORDINATES if c in over):
         if stop():
             break
         if name in _MORE and points < MORE_FROM:

@@ -75,7 +75,7 @@ from ...execution.timeouts import (checkpoint, current_budget, interrupted, inte
                                   time_limit)
 from ...records.verdicts import timeout_verdict
 from .batches import CLOCK, ROW_CELLS, SUSPECT, VECTORISED, Rows, _BatchFailure, batched, prefetched, rows_accepted
-from .coordinates import coordinate_search, searched
+from .coordinates import COORDINATES, coordinate_search, searched
 from ..core import REGISTRY, Law, Outcome, classify, law, new_record, run, subject_name
 from .forms import CONTIGUOUS, cycled, form_note, form_search, forms_for, in_form
 from .samples import NUMPY_DIM, Sample, law_samples
@@ -468,11 +468,12 @@ def _coordinates(state: _Search, seed: int, horizon: float, how: dict) -> None:
     start, before = dataclasses.replace(state.worst_sample, form=CONTIGUOUS), state.runs
     try:
         with time_limit(current_budget(), f"{state.decl.name} on {subject_name(state.op)}"):
-            formed = form_search(ratio, start, forms_for(state.op))      # the input's form, first: a few samples
+            over = state.decl.over or OPERATOR_DOMAIN          # the law's declared quantifiers
+            formed = form_search(ratio, start, forms_for(state.op)) if "form" in over else None   # a few samples
             state.coordinates = coordinate_search(ratio, state.op, start, horizon, budget("coordinate"), seed,
                                                   lambda: state.unsupported is not None, ratios,
                                                   dense=state.decl.name in VECTORISED and not batched(state.op),
-                                                  rows=rows_accepted(state.op))
+                                                  rows=rows_accepted(state.op), over=over)
             state.coordinates += [formed] if formed else []
     except _Violation:
         state.shrunk_into(state.failing, state.failure, "the search over each coordinate of the worst sample (shrunk greedily)")
@@ -650,11 +651,18 @@ def run_law(decl: Law | str, op: Any, *, seed: int | None = None, examples: int 
     return rec
 
 
-def operator_law(name: str, label: str, *requires: Any) -> Callable:
-    """Declare ``check_<name>(op, s) -> Outcome`` as an operator law driven by :func:`run_law`."""
-    return law(name, label, subject="operator", driver=run_law, requires=requires)
+#: what an operator law quantifies over unless it says otherwise: points (the draws, hypothesis, the sweep),
+#: the input's form and every coordinate of :func:`verimono.checks.engine.coordinates.coordinate_search`
+OPERATOR_DOMAIN = ("points", "form") + COORDINATES
+
+
+def operator_law(name: str, label: str, *requires: Any, over: tuple = OPERATOR_DOMAIN) -> Callable:
+    """Declare ``check_<name>(op, s) -> Outcome`` as an operator law driven by :func:`run_law`; ``over``: the
+    statement's quantifiers (:data:`verimono.checks.core.QUANTIFIERS`) — the coordinates the search maximises
+    and the input forms are searched only when declared."""
+    return law(name, label, subject="operator", driver=run_law, requires=requires, over=over)
 
 
 __all__ = ["run_law", "operator_law", "evaluate_sample", "root_cause", "bounded_root_cause", "fresh_seed", "default_examples",
            "positive_examples", "valid_seed", "valid_horizon", "DEFAULT_EXAMPLES", "BOUND", "ROOT_LAW",
-           "HARNESS_LIMIT", "HYPOTHESIS_SHARE", "HYPOTHESIS_MIN"]
+           "HARNESS_LIMIT", "HYPOTHESIS_SHARE", "HYPOTHESIS_MIN", "OPERATOR_DOMAIN"]
