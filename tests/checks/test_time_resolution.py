@@ -168,3 +168,37 @@ def test_thorough_searches_ten_times_ci_and_dev_less_in_the_records():
         # law's 7 design times, 544 here, are the same at every profile)
         assert rec.details["searched"]["t"]["resolution"] <= rec.details["searched"]["t"]["promised_resolution"]
     assert counts["dev"] < counts["ci"] and counts["thorough"] >= 10 * counts["ci"], counts
+
+
+def test_a_time_search_the_unit_budget_stops_is_undecided_with_the_resolution_reached():
+    """A time search slow at every evaluation (1 ms), stopped by a unit budget of 0.3 s: undecided, with the times
+    evaluated and the resolution reached against the promised one (``details["searched"]["t"]``).  And (A1) on a
+    correct subject slow at every call (0.2 ms a resolvent) under a unit budget of 0.5 s: undecided — it was FAILED,
+    the law having stated no progress to the unit, so the whole of it counted as one call that never returned."""
+    import time
+
+    from verimono.checks.engine.times import search_time
+    from verimono.execution import timeouts
+    from verimono.execution.timeouts import run_unit
+    from verimono.records.results import UNDECIDED
+
+    def values(t, which):
+        time.sleep(1e-3)
+        return np.array([-1.0])
+
+    with timeouts.budget(0.3), budgets(time=CI):
+        cut = run_unit(lambda: search_time(values, 0.0, 2.0, seed=0), check="a time search", subject="slow values")
+    assert cut.status == UNDECIDED and cut.details["undecided_reason"] == "time budget", cut
+    t = cut.details["searched"]["t"]
+    assert 0 < t["points"] < 6 * CI and t["range"] == [0.0, 2.0], t
+    assert t["resolution_reached"] > t["promised_resolution"] == promised_resolution(6 * CI) * 2.0, t
+
+    def resolvent(x, lam, t):
+        time.sleep(2e-4)
+        return x / (1.0 + lam)
+
+    op = operator_from_resolvent(resolvent, 2, min_norm=lambda x, t: x, name="slow identity")
+    with timeouts.budget(0.5):
+        rec = run_unit(lambda: check_assumption_A1(Problem(op, np.ones(2), 1.0), seed=0), check="assumption_A1",
+                       subject="slow identity")
+    assert rec.status == UNDECIDED and rec.details["undecided_reason"] == "time budget", rec

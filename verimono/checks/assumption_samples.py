@@ -27,6 +27,7 @@ from ..core.errors import OutsideDomain, UnverifiedSolution
 from ..core.operators import resolvent_rows
 from ..core.problem import Problem
 from ..core.tolerances import GROWTH_FLAG
+from ..execution.timeouts import note_progress
 from ..records.results import PASSED, CheckResult
 from .core import Outcome, run, subject_name
 from .jumps import find_jumps
@@ -71,11 +72,14 @@ class _Samples:
         self._jumps: tuple | None = None
         #: resolvents at sampled points that verimono's own solver could not verify (skipped)
         self.unverified = 0
+        #: batches of the subject's resolvent calls made (stated to the unit's budget: :meth:`progress`)
+        self.calls = 0
 
     def rows(self, P: np.ndarray, lam: float, t: float) -> np.ndarray:
         """``J_λ(t)`` of every row of ``P``; a row where verimono's own solver cannot verify the resolvent
         (a far point, one near a kink of an LCS operator) is NaN and counted in ``unverified``: no evidence
         either way there, and the law goes on at the others."""
+        self.progress()
         try:
             return resolvent_rows(self.op, P, lam, t)
         except UnverifiedSolution:
@@ -101,8 +105,18 @@ class _Samples:
         once."""
         if self._jumps is None:
             lam = A2_LAMBDAS[0] * self.T
-            self._jumps = find_jumps(lambda t: resolvent_rows(self.op, self.near, lam, t), self.T)
+            def at(t: float) -> np.ndarray:
+                self.progress()
+                return resolvent_rows(self.op, self.near, lam, t)
+            self._jumps = find_jumps(at, self.T)
         return self._jumps
+
+    def progress(self) -> None:
+        """A call of the subject starts (:func:`verimono.execution.timeouts.note_progress`): a unit budget that
+        stops the law between such calls of a subject slow at every one finds progress, not a call that never
+        returns (a law that stated none counted as one call: failed)."""
+        self.calls += 1
+        note_progress(self.calls, True, "batches of resolvent calls")
 
     def design(self, lo: float = 0.0, hi: float | None = None) -> np.ndarray:
         """Times a sup search starts from: the sample times and the times just after every jump found."""

@@ -274,16 +274,20 @@ def checkpoint() -> None:
         _LIMITS[-1].interrupt()
 
 
-def note_progress(evaluated: int, held: bool, what: str = "samples") -> None:
+def note_progress(evaluated: int, held: bool, what: str = "samples", searched: Callable[[], dict] | None = None) -> None:
     """State what the law running inside the current :func:`run_unit` has evaluated so far: ``evaluated``
     ``what`` (samples, partitions), every one of which held when ``held``; the next evaluation starts now.
     Should the unit's budget stop it later, the record is *undecided* (time budget, ``evaluated`` ``what``)
     instead of failed — too few for a verdict, none against the subject — unless the evaluation in flight
-    then counts as a call that does not return (:func:`never_returned`).  Outside a unit it does nothing."""
+    then counts as a call that does not return (:func:`never_returned`).  ``searched``: what the search has
+    covered so far (a function returning the record's ``details["searched"]``, called only if the budget stops
+    the unit).  Outside a unit it does nothing."""
     if _PROGRESS:
         progress, now = _PROGRESS[-1], time.perf_counter()
         progress.update(evaluated=int(evaluated), held=bool(held), what=what, at=now,
                         slowest=max(progress.get("slowest", 0.0), now - progress["at"]))
+        if searched is not None:
+            progress["searched"] = searched
 
 
 #: the progress of the units running now, innermost last (:func:`note_progress`)
@@ -324,6 +328,8 @@ def _run_unit(fn: Callable[[], object], *, check: str, subject: str, seconds: fl
                         "held": progress.get("held", True), "what": progress.get("what", "samples"),
                         "in_flight": _stopped_at(exc) - progress["at"], "slowest": progress.get("slowest", 0.0),
                         "budget": limit}
+        if progress.get("searched") is not None:     # the resolution the stopped search had reached
+            exc.evidence["searched"] = progress["searched"]()
         return record_of_exception(check, subject, exc, details=details, duration=elapsed)
     except SUBJECT_EXITS as exc:     # sys.exit() in the subject: its failure, never the end of the run
         return record_of_exception(check, subject, exc, duration=time.perf_counter() - start)

@@ -169,6 +169,8 @@ def record_of_exception(check: str, subject: str, exc: BaseException, *, prefix:
     if isinstance(exc, UnitTimeout):
         evidence = getattr(exc, "evidence", {})
         details.update(timeout_verdict(str(exc), **evidence)[2])
+        if evidence.get("searched"):       # what a search stopped short had reached (engine.times.reached)
+            details["searched"] = evidence["searched"]
         if evidence.get("harness_error"):
             details["harness_error"] = evidence["harness_error"]
     if status != SKIPPED:

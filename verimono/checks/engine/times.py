@@ -32,6 +32,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 
+from ...execution.timeouts import note_progress
 from .supremum import Space, Sup, budget, maximise
 
 #: the jitter of a stratum's point, as a fraction of the stratum (its point lies in the middle
@@ -96,8 +97,33 @@ def search_time(values: Callable[[float, Sequence[int] | None], np.ndarray], lo:
     more = {} if nodes is None else {"nodes": nodes}
     if per_node is not None:
         more["per_node"] = per_node
-    return maximise(values, Space("t", lo, hi), design=own, cover=cover, points=points, seed=seed, bounds=bounds,
+    seen: list[float] = []
+    held = [True]
+
+    def covered() -> dict:
+        return {"t": reached(seen, lo, hi, count)}
+
+    def tracked(t: float, which):
+        v = values(t, which)
+        seen.append(float(t))
+        held[0] = held[0] and not np.any(np.asarray(v, dtype=float) > 1.0)     # every ratio's bound is 1
+        # to the unit's budget: a subject slow at every call is no hang, and a search it stops is undecided with
+        # the resolution it had reached (the record's details["searched"])
+        note_progress(len(seen), held[0], "times", searched=covered)
+        return v
+
+    return maximise(tracked, Space("t", lo, hi), design=own, cover=cover, points=points, seed=seed, bounds=bounds,
                     rank=rank, families=families, refine=golden, direct_points=refine, **more)
+
+
+def reached(seen: Sequence[float], lo: float, hi: float, count: int) -> dict:
+    """What a search (stopped short by the unit's budget, say) had covered of ``[lo, hi]``: the times evaluated and the largest gap between
+    them, the interval's ends included (``resolution_reached``; ``hi − lo`` when none was), against the
+    resolution the full design promises."""
+    pts = np.unique(np.clip(np.asarray(seen, dtype=float), lo, hi))
+    gaps = np.diff(np.r_[lo, pts, hi])
+    return {"points": int(pts.size), "resolution_reached": float(gaps.max()) if gaps.size else float(hi - lo),
+            "promised_resolution": promised_resolution(count) * (hi - lo), "strata": int(count), "range": [lo, hi]}
 
 
 def searched_t(sup: Sup, count: int | None = None) -> dict:
@@ -109,4 +135,4 @@ def searched_t(sup: Sup, count: int | None = None) -> dict:
             "promised_resolution": promised_resolution(count) * (space.hi - space.lo)}
 
 
-__all__ = ["time_design", "search_time", "searched_t", "promised_resolution", "strata", "JITTER", "STRATA_PER_POINT", "MOST_STRATA"]
+__all__ = ["time_design", "search_time", "searched_t", "reached", "promised_resolution", "strata", "JITTER", "STRATA_PER_POINT", "MOST_STRATA"]
