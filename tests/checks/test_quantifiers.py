@@ -41,24 +41,25 @@ def test_each_declared_coordinate_is_in_the_record(law):
     assert "form" in seen
 
 
-def _band_law(name: str, over: tuple):
-    """A toy operator law broken only for λ in (1e-100, 1e-90): no draw, hypothesis example or sweep point has a
-    step there; the step decades do."""
+def _band_law(name: str, over: tuple, band: tuple):
+    """A toy operator law broken only for λ in ``band`` (far below the steps any draw, hypothesis example or
+    sweep point has); the step decades reach it."""
     def check(op, s):
-        bad = 1e-100 < s.lam < 1e-90
+        bad = band[0] < s.lam < band[1]
         return Outcome.compare(2.0 if bad else 0.5, 1.0, 0.0, "a toy bound in λ")
     return operator_law(name, "toy", over=over)(check)
 
 
-def test_the_engine_searches_what_the_law_declares():
+@pytest.mark.parametrize("band", [(1e-100, 1e-90), (1e-20, 1e-12)])
+def test_the_engine_searches_what_the_law_declares(band):
     declared, undeclared = "_toy_band_declared", "_toy_band_undeclared"
     try:
-        with_lam = _band_law(declared, OPERATOR_DOMAIN)(BALL, seed=0)
-        without = _band_law(undeclared, ("points", "form", "t"))(BALL, seed=0)
+        with_lam = _band_law(declared, OPERATOR_DOMAIN, band)(BALL, seed=0)
+        without = _band_law(undeclared, ("points", "form", "t"), band)(BALL, seed=0)
     finally:
         REGISTRY["operator"].pop(declared, None)
         REGISTRY["operator"].pop(undeclared, None)
-    assert with_lam.status == FAILED and 1e-100 < with_lam.counterexample["lam"] < 1e-90, with_lam
+    assert with_lam.status == FAILED and band[0] < with_lam.counterexample["lam"] < band[1], with_lam
     assert without.status == PASSED, without
     seen = {c["coordinate"] for c in without.details["searched"]["coordinates"]}
     assert "lam decades" not in seen and "lam" not in seen and "direction" not in seen, seen

@@ -24,6 +24,8 @@ from typing import Callable, Sequence
 
 import numpy as np
 
+from .supremum import _golden
+
 #: directions drawn per dimension in the first phase
 DRAWN_PER_DIM = 2
 #: gradient-and-line-search steps of the ascent, the golden-section steps of each line search, and the
@@ -86,20 +88,8 @@ def sphere_maximise(f: Callable[[np.ndarray], float], n: int, *, points: int, se
         g = _unit(g - (g @ d) * d)
         if g is None:
             break
-        a, b = 0.0, math.pi / 2
-        gold = (math.sqrt(5.0) - 1.0) / 2.0
-        along = lambda th: ev(math.cos(th) * d + math.sin(th) * g)      # noqa: E731
-        c, e2 = b - gold * (b - a), a + gold * (b - a)
-        fc, fe = along(c), along(e2)
-        for _ in range(LINE_STEPS):
-            if fc >= fe:
-                b, e2, fe = e2, c, fc
-                c = b - gold * (b - a)
-                fc = along(c)
-            else:
-                a, c, fc = c, e2, fe
-                e2 = a + gold * (b - a)
-                fe = along(e2)
+        # the line search along the great circle from d toward g (ev keeps the best point it meets)
+        _golden(lambda th, d=d, g=g: -ev(math.cos(th) * d + math.sin(th) * g), 0.0, math.pi / 2, steps=LINE_STEPS)
     theta, d = FIRST_ANGLE, best[1]
     while count[0] < points and theta >= FINEST:
         g = rng.standard_normal(n)

@@ -377,12 +377,11 @@ def maximise(values: Callable[[float, Sequence[int] | None], np.ndarray], space:
     return Sup(b["value"], b["at"], b["family"], grid_value, grid_at, searched, local, ev.limited)
 
 
-def _golden(neg: Callable[[float], float], a: float, b: float) -> float:
-    """Golden-section minimisation of ``neg`` on ``[a, b]`` down to adjacent floats (or
-    :data:`REFINE_STEPS` steps)."""
+def _golden(neg: Callable[[float], float], a: float, b: float, steps: int = REFINE_STEPS) -> float:
+    """Golden-section minimisation of ``neg`` on ``[a, b]`` down to adjacent floats (or ``steps`` steps)."""
     c, d = b - _GOLDEN * (b - a), a + _GOLDEN * (b - a)
     fc, fd = neg(c), neg(d)
-    for _ in range(REFINE_STEPS):
+    for _ in range(steps):
         if not (a < c < d < b):
             break
         if fc <= fd:
