@@ -412,3 +412,32 @@ def test_a_subject_that_cannot_be_pickled_runs_where_nothing_is_pickled(method, 
         assert "forked for it" in lines[0] and os.getpid() not in ran_in and len(ran_in) == 1
     else:
         assert "in this process" in lines[0] and ran_in == {os.getpid()}
+
+
+class _ChangesUnderThePickler:
+    """An argument whose first ``failures`` picklings meet a dict that changed size (as when another thread
+    imports while the unit is pickled)."""
+
+    def __init__(self, failures):
+        self.failures = failures
+
+    def __reduce__(self):
+        if self.failures > 0:
+            self.failures -= 1
+            raise RuntimeError("dictionary changed size during iteration")
+        return (_ChangesUnderThePickler, (0,))
+
+
+def test_a_dict_changing_under_the_pickler_is_tried_again_and_the_units_own_error_stays_its_own():
+    """Two transient failures: the unit still travels (it went to 'cannot be sent', under double load, with
+    the locked module's real reason lost).  Failing at every attempt: the error is the caller's to report."""
+    import cloudpickle
+
+    from verimono.execution.workers import SHIP_ATTEMPTS, _ship
+
+    assert SHIP_ATTEMPTS >= 3
+    unit = Unit("s", "a", _ok, (_ChangesUnderThePickler(2),))
+    config, fn, args, *_ = cloudpickle.loads(_ship(unit, "dev"))
+    assert fn is _ok and isinstance(args[0], _ChangesUnderThePickler) and args[0].failures == 0
+    with pytest.raises(RuntimeError, match="changed size"):
+        _ship(Unit("s", "b", _ok, (_ChangesUnderThePickler(SHIP_ATTEMPTS),)), "dev")

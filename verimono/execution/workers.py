@@ -203,11 +203,26 @@ def _limits() -> dict[str, float | None]:
     return {"calibration": calibration()}
 
 
+SHIP_ATTEMPTS = 3
+
+
 def _ship(unit: Unit, profile: RunConfig | str | None) -> bytes:
+    """``unit`` pickled for a worker.  A ``RuntimeError`` while pickling (a dict or set the pickler walks changed
+    size under it: another thread importing, a collection run by a weakref callback) is transient, so it is
+    tried again, up to ``SHIP_ATTEMPTS`` times in all; any other error, or the same one every time, is the
+    unit's own and the caller runs it where nothing is pickled.  (Under double load on 2 cores, one attempt in a
+    few thousand met a changed dict, and the locked module's real "cannot pickle" went unreported.)"""
     import cloudpickle
 
     _register_targets_by_value()
-    return cloudpickle.dumps((config_for(profile), unit.fn, unit.args, _limits(), unit.stage, unit.label))
+    payload = (config_for(profile), unit.fn, unit.args, _limits(), unit.stage, unit.label)
+    for attempt in range(SHIP_ATTEMPTS):
+        try:
+            return cloudpickle.dumps(payload)
+        except RuntimeError:
+            if attempt == SHIP_ATTEMPTS - 1:
+                raise
+    raise AssertionError("unreachable")  # pragma: no cover
 
 
 def _register_targets_by_value() -> None:
