@@ -249,10 +249,13 @@ def test_example_records_for_the_run_stage(monkeypatch):
 
 def test_batched_scheme_record_passes_and_fails_on_an_unchecked_kernel(monkeypatch):
     """The Section 7 stage's batched record: 64 trajectories in one simulate equal the closed-form scheme; a
-    batch kernel that accepts every guess unchecked (seen failing) breaks it."""
+    batch kernel that accepts every guess unchecked (seen failing) breaks it.  The NumPy batch kernel here; the
+    compiled one's planted fault is in test_lcs_batch_kernel.py."""
+    from verimono.lcs import kernel as K
+
+    monkeypatch.setattr(K, "BATCH_KERNEL", "numpy")
     rec = example_checks.check_batched_scheme()
     assert rec.status == "passed" and rec.worst <= 1.0
-    from verimono.lcs import kernel as K
 
     orig = K.StepKernel._eval_T
 

@@ -33,8 +33,11 @@ results are **bit-identical** to ``B`` separate runs).  A row whose step is infe
 the others run to the end, then :class:`BatchStepError` carries every row's results (``valid`` masks the
 steps after a row's failure, which hold NaN) and names each failed row and step.
 
-Pure Python/NumPy: a compiled kernel (numba) would cost seconds of import and JIT per process, more than a
-whole Section 7 run takes with this one.
+Pure Python/NumPy, with an optional compiled batch kernel (:mod:`verimono.lcs._batch_numba`, numba,
+``pip install verimono[fast]``; ``BATCH_KERNEL``): it makes the same multiply-adds, tests and pattern changes per
+row and leaves to Python what needs a new pattern's map, a degenerate step or the solver, so batches keep the
+same bits with either kernel.  Single runs stay in Python: a compiled kernel would cost more in import and JIT
+per process than a whole Section 7 run takes with the generated loops.
 """
 
 from __future__ import annotations
@@ -42,6 +45,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import math
+import os
 import threading
 from array import array
 
@@ -55,6 +59,44 @@ from .relations import BoxRelation
 
 #: largest number of patterns (``∏ states``) that a failed guess is followed by trying all of
 ENUM_PATTERNS = 64
+
+#: which batch kernel :meth:`StepKernel.run_batch` uses: ``"auto"`` (the compiled one of
+#: :mod:`verimono.lcs._batch_numba` when numba is installed — ``pip install verimono[fast]`` — the relation has
+#: at most ``NUMBA_MAX_M`` components and the batch makes at least ``NUMBA_MIN_WORK`` trajectory-steps; the
+#: NumPy one otherwise), ``"numba"`` (the compiled one whenever numba is installed) or ``"numpy"``.  Both give
+#: the same bits (``tests/lcs/test_lcs_batch_kernel.py``); ``StepKernel.last_backend`` says which ran.  Set from
+#: the environment variable ``VERIMONO_BATCH_KERNEL`` at import; assign to change it.
+BATCH_KERNEL = os.environ.get("VERIMONO_BATCH_KERNEL", "auto")
+#: the compiled kernel looks patterns up in a table of ``3^m`` ids
+NUMBA_MAX_M = 10
+#: below this many trajectory-steps a batch takes the NumPy kernel under ``"auto"``: importing numba and loading
+#: a compiled shape from the disk cache cost about 0.5–1 s per process (compiling a new shape ~10 s, once per
+#: machine), which the NumPy kernel (~0.13 µs per trajectory-step) spends on about 10^7 trajectory-steps
+NUMBA_MIN_WORK = 100_000
+
+_NUMBA: list = []
+
+
+def _numba_advance():
+    """:func:`verimono.lcs._batch_numba.load`, or None when numba cannot be imported (tried once)."""
+    if not _NUMBA:
+        try:
+            import numba  # noqa: F401
+
+            from ._batch_numba import load
+        except ImportError:
+            load = None
+        _NUMBA.append(load)
+    return _NUMBA[0]
+
+
+def batch_backend(m: int = 1, work: float = math.inf) -> str:
+    """The batch kernel a batch with ``m`` components and ``work`` trajectory-steps would use now: ``"numba"``
+    or ``"numpy"``."""
+    if BATCH_KERNEL == "numpy" or m > NUMBA_MAX_M or (BATCH_KERNEL == "auto" and work < NUMBA_MIN_WORK):
+        return "numpy"
+    return "numba" if _numba_advance() is not None else "numpy"
+
 
 _ROW_FNS: dict[int, object] = {}
 
@@ -185,6 +227,7 @@ class StepKernel:
         self.is_lcp = bool(rel.is_lcp)
         self._deg: dict = {}
         self._lock = threading.Lock()
+        self.last_backend: str | None = None   # the kernel of the last batch: "numba" or "numpy"
 
     # -- patterns --------------------------------------------------------------------------------------
     def pattern(self, s: np.ndarray) -> _Pattern | None:
@@ -543,6 +586,7 @@ class StepKernel:
         K = t.size - 1
         B = X0.shape[0]
         n, m, L, ne = self.n, self.m, self.L, self.ne
+        backend = batch_backend(m, B * K)
         XA = np.empty((K + 1, n, B))
         ZW = np.empty((K, 2 * m, B))
         X = XA.transpose(0, 2, 1)
@@ -581,20 +625,14 @@ class StepKernel:
                 MG[:, r] = mg[newp].T
             return ~ok
 
-        for k in range(K):
-            ok = self._eval_T(CT, MG, XT, *exo(k, None), Yb, Tb, axb)
-            XA[k + 1] = Yb[:n]
-            ZW[k] = Yb[L:]
-            XT_old, XT = XT, XA[k + 1]
-            if ok.all():
-                continue
-            rows = np.flatnonzero(~ok & alive)
-            if not rows.size:
-                continue
+        def resolve(k, rows, YP):
+            """Rows ``rows`` (live) whose guess failed at step ``k`` (``YP``: their guesses' sign rows): the
+            patterns :meth:`slow_row` tries, for all of them at once, then :meth:`slow_row` row by row."""
             stepped[rows] = False
             old = pid[rows].copy()
+            XT_old = XA[k]
             XTr = XT_old[:, rows]
-            guess = self._flip_rows(old, Yb[n:L][:, rows])
+            guess = self._flip_rows(old, YP)
             cur, Xc = rows, XTr                  # the rows still following their violated signs
             for _ in range(m):
                 live = guess >= 0
@@ -648,8 +686,27 @@ class StepKernel:
                 st, mg = self._stacked()
                 CT[:, :, i] = st[nxt]
                 MG[:, i] = mg[nxt]
-            if not alive.any():
-                break
+
+        nb = _numba_advance() if backend == "numba" else None
+        if nb is not None:
+            nb = nb(n, L, L + 2 * m, ne)
+        self.last_backend = "numba" if nb is not None else "numpy"
+        if nb is not None:
+            self._run_numba(nb, K, B, XA, ZW, pid, alive, E, emax, shared, resolve, exo)
+        else:
+            for k in range(K):
+                ok = self._eval_T(CT, MG, XT, *exo(k, None), Yb, Tb, axb)
+                XA[k + 1] = Yb[:n]
+                ZW[k] = Yb[L:]
+                XT = XA[k + 1]
+                if ok.all():
+                    continue
+                rows = np.flatnonzero(~ok & alive)
+                if not rows.size:
+                    continue
+                resolve(k, rows, Yb[n:L][:, rows])
+                if not alive.any():
+                    break
         # a finite state with a non-finite multiplier or output (overflow in the output rows only)
         bad = ~np.isfinite(ZW).all(axis=1)
         bad[:, ~alive] = False
@@ -661,6 +718,58 @@ class StepKernel:
             ZW[k:, :, i] = np.nan
         failures.sort(key=lambda f: f.row)
         return X, Z, W, failures
+
+    def _nb_tables(self):
+        """The compiled kernel's view of the patterns built so far: ``(stack, margins, table, pstate, pcomp,
+        pnew)`` (see :mod:`verimono.lcs._batch_numba`), rebuilt when a pattern was added."""
+        key = (len(self.by_id), len(self.cache))
+        if getattr(self, "_nb_key", None) != key:
+            st, mg = self._stacked()
+            m, P = self.m, self.L - self.n
+            w3 = 3 ** np.arange(m, dtype=np.int64)
+            table = np.full(3 ** m, -2, dtype=np.int64)
+            for k, p in list(self.cache.items()):
+                table[int(np.frombuffer(k, dtype=np.int8).astype(np.int64) @ w3)] = -1 if p is None else p.key
+            npat = max(len(self.by_id), 1)
+            pstate = np.zeros((npat, m), dtype=np.int64)
+            pcomp = np.zeros((npat, P), dtype=np.int64)
+            pnew = np.zeros((npat, P), dtype=np.int64)
+            for p in self.by_id:
+                pstate[p.key], pcomp[p.key], pnew[p.key] = p.s, p.pcomp, p.pnew
+            self._nb = (np.ascontiguousarray(st), np.ascontiguousarray(mg), table, pstate, pcomp, pnew)
+            self._nb_key = key
+        return self._nb
+
+    def _run_numba(self, advance, K, B, XA, ZW, pid, alive, E, emax, shared, resolve, exo):
+        """:meth:`run_batch`'s loop through the compiled kernel: it makes every step it can, and returns the
+        step where rows need Python's :meth:`slow_row` path (``resolve``), which runs before it resumes."""
+        n, m, L, ne = self.n, self.m, self.L, self.ne
+        w3 = 3 ** np.arange(m, dtype=np.int64)
+        if not hasattr(self, "_enum_codes"):
+            self._enum_codes = np.array([int(s.astype(np.int64) @ w3) for s in self.all_patterns()] if self.enum
+                                        else [], dtype=np.int64)
+        if ne:
+            E3 = np.ascontiguousarray(E[:, None, :] if shared else E, dtype=float)
+            EM = np.ascontiguousarray(emax[:, None] if shared else emax, dtype=float)
+        else:
+            E3, EM = np.zeros((1, 1, 1)), np.zeros((1, 1))
+        need = np.zeros(B, dtype=np.bool_)
+        y = np.empty(L + 2 * m)
+        k = 0
+        while k < K:
+            st, mg, table, pstate, pcomp, pnew = self._nb_tables()
+            k = advance(st, mg, table, self._enum_codes, pstate, pcomp, pnew, w3, pid, alive, XA, ZW, E3, EM,
+                        bool(shared), k, K, n, L, ne, m, need, y)
+            if k >= K:
+                break
+            rows = np.flatnonzero(need)
+            need[rows] = False
+            Er, em = exo(k, rows)
+            Y0, _ = self._eval_rows(pid[rows], XA[k][:, rows], Er, em)
+            resolve(k, rows, Y0[n:L])
+            if not alive.any():
+                break
+            k += 1
 
     def _out_rows(self, p: _Pattern, Xk: np.ndarray, Ek: np.ndarray | None) -> np.ndarray:
         """``(z, w)`` rows ``(N, 2m)`` of pattern ``p`` at the states ``Xk (N, n)`` and exogenous terms ``Ek``
@@ -695,4 +804,5 @@ class StepKernel:
         return Z, W
 
 
-__all__ = ["StepKernel", "BatchStepError", "RowFailure", "ENUM_PATTERNS"]
+__all__ = ["StepKernel", "BatchStepError", "RowFailure", "ENUM_PATTERNS", "BATCH_KERNEL", "NUMBA_MAX_M", "NUMBA_MIN_WORK",
+           "batch_backend"]
