@@ -7,8 +7,10 @@ matrix–vector product per step), both measured in the same run.
   within ``LCS_TARGET`` (2x) the
   floor per step, its trajectory within ``LCS_AGREEMENT`` of the step-by-step verified solver;
 * a batch of B = 1000 trajectories: per trajectory-step at most ``LCS_BATCH_TARGET`` (0.25x) the floor per
-  step (Siconos' C ``lcp_lexicolemke`` takes 0.23 µs per step where the floor takes about 1 µs), rows
-  bit-identical to their single runs.
+  step with the NumPy batch kernel, ``LCS_BATCH_TARGET_COMPILED`` (0.05x) with the compiled one (numba, used
+  when installed: ``pip install verimono[fast]``; the record's ``details["kernel"]`` says which ran) (Siconos'
+  C ``lcp_lexicolemke`` takes 0.23 µs per step where the floor takes about 1 µs), rows bit-identical to their
+  single runs.
 """
 
 from __future__ import annotations

@@ -130,3 +130,37 @@ def test_a_compiled_kernel_that_skips_the_sign_test_is_seen_failing(monkeypatch,
     monkeypatch.setenv("VERIMONO_NUMBA_DIR", str(tmp_path))
     bad = example_checks.check_batched_scheme()
     assert bad.status == "failed" and bad.worst > 1e3 and {"row", "step"} <= set(bad.counterexample)
+
+
+def test_the_performance_record_names_the_kernel_and_its_bound(monkeypatch):
+    """``performance_lcs_batch`` states the kernel that ran and applies its bound (0.25x NumPy, 0.05x compiled)."""
+    from verimono.run import performance as perf
+
+    monkeypatch.setattr(K, "BATCH_KERNEL", "numpy")
+    rec = perf.check_lcs_batch(batch=8, steps=10, rounds=1, max_rounds=1)
+    assert rec.details["kernel"] == "numpy" and rec.details["target"] == perf.LCS_BATCH_TARGET == 0.25
+    assert rec.details["identical"] and "judged as" not in rec.message
+
+
+@pytest.mark.slow
+def test_a_record_judged_for_a_kernel_that_did_not_run_fails(monkeypatch):
+    """A planted ``batch_backend`` claiming numba while the compiled kernel cannot load (so NumPy runs): the
+    record is judged against 0.05x but fails, naming the kernel that ran."""
+    from verimono.run import performance as perf
+
+    monkeypatch.setattr(K, "batch_backend", lambda m=1, work=0: "numba")
+    monkeypatch.setattr(K, "_numba_advance", lambda: None)
+    bad = perf.check_lcs_batch(batch=8, steps=10, rounds=1, max_rounds=1)
+    assert bad.status == "failed" and bad.details["target"] == perf.LCS_BATCH_TARGET_COMPILED == 0.05
+    assert "ran the numpy kernel, judged as numba's" in bad.message
+
+
+@pytest.mark.slow
+@needs_numba
+def test_the_performance_record_under_the_compiled_kernel(monkeypatch):
+    from verimono.run import performance as perf
+
+    monkeypatch.setattr(K, "BATCH_KERNEL", "numba")
+    rec = perf.check_lcs_batch(batch=8, steps=10, rounds=1, max_rounds=1)
+    assert rec.details["kernel"] == "numba" and rec.details["target"] == 0.05 and rec.details["identical"]
+    assert "judged as" not in rec.message
