@@ -27,4 +27,4 @@ def test_diode_bridge_simulate_vs_floor_loop(gate):
 
 
 def test_diode_bridge_batch_vs_floor_loop(gate):
-    gate.check(check_lcs_batch(batch=1000, steps=gate.size(5000, 200), rounds=gate.rounds(3, 2), runner=gate.runner))
+    gate.check(check_lcs_batch(batch=1000, steps=gate.size(5000, 200), rounds=gate.rounds(7, 2), runner=gate.runner))

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from verimono import InfeasibleStep
+from verimono import InfeasibleStep, SolverFailure
 from verimono.lcs import Complementarity, LinearRelationSystem
 from verimono.lcs import kernel as K
 from verimono.lcs.siconos_cases import diode_bridge, filippov, relay_oscillator
@@ -81,6 +81,9 @@ def _cases():
         "infeasible_rows": (LinearRelationSystem([[0.0]], [[1.0]], [[0.0]], [[0.0]], Complementarity()),
                             np.array([[0.1], [0.2], [0.3], [0.4]]), np.linspace(0.0, 1.0, 11),
                             {"v": lambda s: np.array([[1.0], [0.45 - s], [2.0], [-1.0]])}),
+        # a row that overflows (SolverFailure) beside one that stays at 0
+        "overflow_rows": (LinearRelationSystem([[1e300]], [[1.0]], [[1.0]], [[1.0]], Complementarity()),
+                          np.array([[0.0], [1e10], [0.0]]), np.linspace(0.0, 1.0, 4), {"theta": 0.0}),
     }
 
 
@@ -99,6 +102,8 @@ def test_the_compiled_batch_kernel_gives_the_numpy_kernels_bits(name, monkeypatc
     assert fa == fb
     if name == "infeasible_rows":
         assert fa == [(1, 4, InfeasibleStep), (3, 0, InfeasibleStep)]
+    if name == "overflow_rows":
+        assert [(r, e) for r, _, e in fa] == [(1, SolverFailure)]
     # and a row equals its single run (the NumPy kernel's bits are tested against single runs elsewhere too)
     if "inputs" not in name and fa is None:
         one = sys.simulate(X0[-1], t, **kw)

@@ -13,7 +13,8 @@ and outputs are bit-identical to the NumPy kernel's and to single runs (``tests/
 A row whose step needs a pattern not built yet (its map's LU and check are Python's), or none of whose
 candidates passes (a degenerate step, the solver), is left to Python: ``need[i]`` is set, the row's state at
 ``k + 1``, its outputs at ``k`` and ``pid[i]`` are not touched, and ``advance`` returns ``k`` once the other rows
-have made step ``k``.  ``table[code]`` (``code = Σ s_i 3^i``) is a pattern's id, −1 for an unusable pattern
+have made step ``k``.  ``badk[i]`` (``K`` when none) is the first step at which row ``i``'s multiplier or output,
+as this kernel made it, is not finite.  ``table[code]`` (``code = Σ s_i 3^i``) is a pattern's id, −1 for an unusable pattern
 (:meth:`StepKernel.pattern` returned None), −2 for one not built yet.
 
 The row's usual step (its pattern's candidate passes) is straight-line code generated for the shapes ``(n, L,
@@ -121,7 +122,7 @@ def advance_source(n: int, L: int, Lf: int, ne: int) -> str:
     ind = " " * 12
     out = ["", "", "@njit(cache=True, nogil=True, boundscheck=False)",
            "def advance(st, mg, table, enum_codes, pstate, pcomp, pnew, w3, pid, alive, XA, ZW, E, EM, shared,",
-           "            k0, K, n, L, ne, m, need, y):",
+           "            k0, K, n, L, ne, m, need, y, badk):",
            "    B = pid.size",
            "    sf = st.ravel()",
            "    s = np.zeros(m, np.int64)",
@@ -159,7 +160,11 @@ def advance_source(n: int, L: int, Lf: int, ne: int) -> str:
             f"{ind}        continue"]
     out += [f"{ind}    y{j} = y[{j}]" for j in range(n)]
     out.append(f"{ind}b = p * {nc * Lf}")
-    out += [f"{ind}ZW[k, {r - L}, i] = {row(r)}" for r in range(L, Lf)]
+    out += [f"{ind}o{r - L} = {row(r)}" for r in range(L, Lf)]
+    out += [f"{ind}ZW[k, {r - L}, i] = o{r - L}" for r in range(L, Lf)]
+    # the first step of each row whose multiplier or output is not finite (NumPy's isfinite pass, in registers)
+    finite = " and ".join(f"-inf < o{r - L} < inf" for r in range(L, Lf))
+    out += [f"{ind}if badk[i] == K and not ({finite}):", f"{ind}    badk[i] = k"]
     out += [f"{ind}XA[k + 1, {j}, i] = y{j}" for j in range(n)]
     out += [f"{ind}pid[i] = p",
             "        if nneed:",
