@@ -53,8 +53,8 @@ LCS_TARGET = 2.0
 #: trajectory-step (Siconos' C ``lcp_lexicolemke`` takes 0.23 µs per step where the floor takes about 1 µs)
 LCS_BATCH_TARGET = 0.25
 #: the same with the compiled batch kernel (numba, ``pip install verimono[fast]``; the bound the record applies
-#: when that kernel runs, ``details["kernel"]`` says which ran): issue 43's ≤ 0.05x (measured 0.035-0.041x,
-#: medians of 7-9 interleaved rounds at load 7-9; the NumPy kernel 0.14-0.16x)
+#: when that kernel runs, ``details["kernel"]`` says which ran): issue 43's ≤ 0.05x (measured 0.025-0.050x,
+#: medians of 5-9 interleaved rounds at load 8-11, B = 1000, 200 and 5000 steps; the NumPy kernel 0.12-0.18x)
 LCS_BATCH_TARGET_COMPILED = 0.05
 #: simulate's trajectory must agree with the step-by-step verified solver (:func:`minimal_lcs`) to this,
 #: relative to the trajectory's size: the two differ by the rounding of the kernel's precomputed maps
