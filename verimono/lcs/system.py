@@ -26,12 +26,12 @@ from ..core.errors import InfeasibleStep, InvalidProblem, OutsideDomain, SolverF
 from ..core.grids import validate_grid
 from ..core.operators import Operator
 from ..core.problem import Problem
-from ..core.qp import solve_qp
 from ..core.stepping import Trajectory
 from ..core.tolerances import tolerance
 from ._lu import lu_factor, lu_solve
 from .kernel import BatchStepError
-from .lcp import _box_lcp, _feasible, is_psd, proved_solvable, select_over_sol, solve_lcp
+from ._warm_qp import row_infeasible, solve_qp_warm
+from .lcp import _box_lcp, _feasible, is_psd, proved_solvable, sol_polyhedron, solve_lcp
 from .relations import BoxRelation, as_relation
 
 
@@ -375,6 +375,9 @@ class LCSOperator(Operator):
         self.static = system.v_constant
         self._mats: dict[float, StepMatrices] = {}
         self._recent: StepMatrices | None = None
+        # the active sets of the last selection and projection QPs (:mod:`verimono.lcs._warm_qp`)
+        self._warm_select: dict = {}
+        self._warm_project: dict = {}
 
     def _sm(self, lam: float) -> StepMatrices:
         sm = self._mats.get(lam)
@@ -430,6 +433,8 @@ class LCSOperator(Operator):
         eta, scale = s.C @ x + v, s.q_scale(x, v)
         lo, hi = rel.bounds(s.m)
         big, qq, fin = _box_lcp(s.D, eta, lo, hi)
+        if row_infeasible(big, qq):     # a row of the multipliers' constraints no z ≥ 0 meets, by a margin
+            raise OutsideDomain(f"x = {x} is not in dom H(t={t}): Cx + v(t) ∉ im(𝓜 + D)")
         try:   # a solution proves x ∈ dom H(t): the linear program is needed only when there is none
             r = solve_lcp(big, qq, least_norm=False, scale=scale, info=True)
         except InfeasibleStep:
@@ -445,7 +450,9 @@ class LCSOperator(Operator):
         P[:s.m, :s.m] = P_lam
         c = np.zeros(k)
         c[:s.m] = c_lam + P_lam @ lo
-        zz = select_over_sol(big, qq, zbar, P, c, scale=scale)
+        G, h, A, b = sol_polyhedron(big, qq, zbar, scale)     # select_over_sol, warm-started
+        zz = solve_qp_warm(self._warm_select, P, c, G, h, A if len(A) else None, b if len(A) else None,
+                           scale=scale)
         return lo + zz[:s.m]
 
     def min_norm(self, x, t=0.0):
@@ -496,8 +503,9 @@ class LCSOperator(Operator):
             return x.copy()  # bounded box: 𝓜 + D is surjective, dom H = R^n
         v = s.v(t)
         big, qq, fin = _box_lcp(s.D, s.C @ x + v, lo, hi)
-        # a verified multiplier proves x ∈ dom H(t) at a fraction of the linear program's cost
-        if proved_solvable(big, qq, s.q_scale(x, v)) or _feasible(big, qq):
+        # a verified multiplier proves x ∈ dom H(t) at a fraction of the linear program's cost, and a row no
+        # z ≥ 0 meets proves x ∉ dom H(t) at a fraction of it too
+        if not row_infeasible(big, qq) and (proved_solvable(big, qq, s.q_scale(x, v)) or _feasible(big, qq)):
             return x.copy()
         # min ½|x' − x|² over {(x', z): z ≥ 0, D z + C x' + v ≥ 0} (complementarity: dom = C^{-1}(Q_D^+ − v))
         if not rel.is_lcp:
@@ -507,7 +515,7 @@ class LCSOperator(Operator):
         P[:n, :n] = np.eye(n)
         G = np.block([[np.zeros((m, n)), -np.eye(m)], [-s.C, -s.D]])
         h = np.concatenate([np.zeros(m), s.v(t)])
-        return solve_qp(P, np.concatenate([-x, np.zeros(m)]), G, h)[:n]
+        return solve_qp_warm(self._warm_project, P, np.concatenate([-x, np.zeros(m)]), G, h)[:n]
 
 
 __all__ = ["LinearRelationSystem", "LCSOperator", "StepMatrices", "BatchStepError"]
