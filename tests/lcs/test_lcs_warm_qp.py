@@ -2,6 +2,7 @@
 :func:`verimono.core.qp.solve_qp` and the linear program they spare, on the paper's Example."""
 
 import numpy as np
+from pytest import approx
 
 from verimono.core.qp import solve_qp
 from verimono.lcs._warm_qp import INFEASIBLE_MARGIN, row_infeasible, solve_qp_warm
@@ -53,3 +54,17 @@ def test_project_domain_and_min_norm_closed_forms():
             assert abs(H.project_domain(np.array([x]), t)[0] - max(x, 0.0)) <= 1e-12
         for x in (0.0, 0.0, 1e-6, 0.7):
             assert abs(H.min_norm(np.array([x]), t)[0] + t) <= 1e-9 * (1 + t)
+
+
+def test_resolvent_alternating_between_patterns_solves_twice_and_answers_the_closed_form():
+    """Points alternately inside ``dom H`` and sent to its edge (two active patterns): the resolvent's stepper
+    answers ``J = max(x + λ max(−v1, 0), −v2)`` (closed form) from its remembered patterns after one full solve
+    per pattern, not one per change of pattern."""
+    from verimono.reference.lcs_example import closed_form_resolvent
+
+    op = example_system(lambda t: np.array([-t, 0.0])).operator()
+    lam, t = 0.1, 0.5
+    for k in range(20):
+        x = np.array([0.4 + 0.01 * k if k % 2 else -0.4 - 0.01 * k])
+        assert op.resolvent(x, lam, t) == approx(closed_form_resolvent(x, lam, -t, 0.0), abs=1e-14)
+    assert op._mats[lam].step.full_solves == 2
