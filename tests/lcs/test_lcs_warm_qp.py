@@ -68,3 +68,17 @@ def test_resolvent_alternating_between_patterns_solves_twice_and_answers_the_clo
         x = np.array([0.4 + 0.01 * k if k % 2 else -0.4 - 0.01 * k])
         assert op.resolvent(x, lam, t) == approx(closed_form_resolvent(x, lam, -t, 0.0), abs=1e-14)
     assert op._mats[lam].step.full_solves == 2
+
+
+def test_memo_answers_again_with_a_fresh_copy():
+    """``H^0`` and ``proj_dom H`` asked again at the same ``(t, x)`` are the closed forms, computed once, and a
+    caller writing into an answer does not change the next one."""
+    H = example_system(lambda t: np.array([np.sin(t), 0.0])).operator()
+    for _ in range(2):
+        p = H.project_domain(np.array([-1.5]), 4.0)
+        assert p[0] == approx(0.0, abs=1e-12)
+        p[0] = 7.0
+        f = H.min_norm(np.array([0.25]), 4.0)
+        assert f[0] == approx(-max(-np.sin(4.0), 0.0), abs=1e-12)
+        f[0] = 7.0
+    assert len(H._memo) == 2

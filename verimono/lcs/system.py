@@ -358,6 +358,10 @@ def _increments(u, t: np.ndarray, n: int, B: int | None) -> np.ndarray | None:
     return total
 
 
+#: entries of an operator's memo of ``H^0(t, x)`` and ``proj_dom H(t,·)(x)`` (:meth:`LCSOperator._memoised`)
+MEMO_SIZE = 8192
+
+
 class LCSOperator(Operator):
     """``H(t, x) = −Ax + B(𝓜 + D)^{-1}(Cx + v(t))`` (``e:defht``); its resolvent is the one-step problem
 
@@ -378,6 +382,21 @@ class LCSOperator(Operator):
         # the active sets of the last selection and projection QPs (:mod:`verimono.lcs._warm_qp`)
         self._warm_select: dict = {}
         self._warm_project: dict = {}
+        self._memo: dict = {}
+
+    def _memoised(self, kind: str, x: np.ndarray, t, compute):
+        """``compute()`` once per ``(kind, t, x)``: an assumption law asks ``H^0`` and ``proj_dom H`` at the same
+        points and times again (about one call in five on the paper's Example at ci); what it returns depends on
+        ``(t, x)`` alone (the system's matrices and ``v`` are fixed once built).  At most :data:`MEMO_SIZE`
+        entries, forgotten all at once."""
+        key = (kind, float(t), x.tobytes())
+        out = self._memo.get(key)
+        if out is None:
+            out = compute()
+            if len(self._memo) >= MEMO_SIZE:
+                self._memo.clear()
+            self._memo[key] = out
+        return out.copy()
 
     def _sm(self, lam: float) -> StepMatrices:
         sm = self._mats.get(lam)
@@ -459,6 +478,9 @@ class LCSOperator(Operator):
         x = np.asarray(x, dtype=float)
         if x.ndim == 2:
             return np.array([self.min_norm(xi, t) for xi in x])
+        return self._memoised("min_norm", x, t, lambda: self._min_norm(x, t))
+
+    def _min_norm(self, x, t):
         s = self.system
         Ax = s.A @ x
         lam = self._select(x, t, s.B.T @ s.B, s.B.T @ Ax)
@@ -497,6 +519,9 @@ class LCSOperator(Operator):
         x = np.asarray(x, dtype=float)
         if x.ndim == 2:
             return np.array([self.project_domain(xi, t) for xi in x])
+        return self._memoised("project_domain", x, t, lambda: self._project_domain(x, t))
+
+    def _project_domain(self, x, t):
         rel, s = self._box(), self.system
         lo, hi = rel.bounds(s.m)
         if np.all(np.isfinite(hi)):
