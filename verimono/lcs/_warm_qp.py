@@ -38,7 +38,8 @@ def _on_active(S, act: np.ndarray) -> np.ndarray:
         return np.linalg.solve(S.P, -S.q)
     E, e = np.vstack(blocks), np.concatenate(rhs)
     m = E.shape[0]
-    K = np.block([[S.P, E.T], [E, np.zeros((m, m))]])
+    K = np.zeros((n + m, n + m))      # np.block([[P, Eᵀ], [E, 0]]), assembled directly
+    K[:n, :n], K[:n, n:], K[n:, :n] = S.P, E.T, E
     return np.linalg.lstsq(K, np.concatenate([-S.q, e]), rcond=None)[0][:n]
 
 
