@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import itertools
 
 import numpy as np
@@ -13,6 +14,15 @@ from verimono.lcs import check_hypotheses
 from verimono.core.pseudo_distance import pseudo_distance_lower_bound
 from verimono.reference import lcs_example as E
 from verimono.core.tolerances import RTOL
+
+_INPUTS = {"ramp": lambda t: np.array([-t, 0.0]), "sine": lambda t: np.array([np.sin(t), 0.0])}
+
+
+@functools.cache
+def _hypotheses(kind: str):
+    """``check_hypotheses`` of the Example with input ``kind`` on ``[0, 2]``, computed once per process: three
+    tests read the ramp's report (nothing writes to it), each used to recompute the whole battery."""
+    return check_hypotheses(E.example_system(_INPUTS[kind]), T=2.0)
 
 
 def _enumerated_least_norm_lcp(M, q, tol=1e-12):
@@ -146,7 +156,7 @@ def test_sine_reference_first_order_with_constant_one_half():
 def test_pseudo_distance_grows_without_bound_while_hypotheses_hold():
     for rho, b in E.pseudo_distance_demo():
         assert b.value >= (rho + 1) / 2 - 1e-12
-    rep = check_hypotheses(E.example_system(lambda t: np.array([-t, 0.0])), T=2.0)
+    rep = _hypotheses("ramp")
     assert rep.ok and all(r.status == "passed" for r in rep), [str(r) for r in rep if r.status != "passed"]
 
 
@@ -154,10 +164,9 @@ def _jump(t):
     return np.array([0.0, -1.0 if t >= 1.0 else 0.0])
 
 
-@pytest.mark.parametrize("v", [lambda t: np.array([-t, 0.0]), lambda t: np.array([np.sin(t), 0.0])],
-                         ids=["ramp", "sine"])
+@pytest.mark.parametrize("v", ["ramp", "sine"])
 def test_example_hypotheses_hold_for_continuous_inputs(v):
-    rep = check_hypotheses(E.example_system(v), T=2.0)
+    rep = _hypotheses(v)
     assert rep.ok and all(r.status == "passed" for r in rep), [str(r) for r in rep if r.status != "passed"]
     (ac,) = rep.by_check("lcs.v_ac")
     # the largest grid increment of a Lipschitz v halves with the mesh: |v'| ≤ 1 gives ≤ 2/N
@@ -197,7 +206,7 @@ def test_v_ac_tells_steep_continuous_inputs_from_jumps(v, jump_at):
 def test_least_norm_growth_constant_of_the_example():
     """LCP(q, D), D = [[0, 1], [−1, 0]]: solvable iff q2 ≥ 0 (Q_D^+), z*(q) = (0, max(−q1, 0)) (the case
     analysis of reference/lcs_example.py), so α = sup |z*(q)|/|q| = 1, attained at q = (−1, 0)."""
-    (r,) = check_hypotheses(E.example_system(lambda t: np.array([-t, 0.0])), T=2.0).by_check("lcs.least_norm_growth")
+    (r,) = _hypotheses("ramp").by_check("lcs.least_norm_growth")
     assert r.status == "passed" and r.worst <= r.bound
     assert r.details["alpha"] == pytest.approx(1.0, abs=1e-12)
     assert r.details["least_norm_checked"] == r.details["samples"]

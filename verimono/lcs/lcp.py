@@ -456,6 +456,8 @@ def _box_lcp(M, q, lower, upper):
     """The LCP of size ``m + f`` equivalent to the box problem: ``λ = l + z``, ``s = (−y)⁺`` on finite ``u``."""
     m = q.shape[0]
     fin = np.flatnonzero(np.isfinite(upper))
+    if fin.size == 0:       # complementarity: the LCP itself (np.block's result, without its 0.3 ms)
+        return np.array(M, dtype=float), M @ lower + q, fin
     E = np.eye(m)[:, fin]
     big = np.block([[M, E], [-E.T, np.zeros((fin.size, fin.size))]])
     qq = np.concatenate([M @ lower + q, (upper - lower)[fin]])

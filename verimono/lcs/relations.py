@@ -21,7 +21,7 @@ from ..core.errors import InvalidProblem, NotMonotone, UnverifiedSolution
 from ..core.operators import Operator
 from ..core.tolerances import QP_RTOL, RTOL, tolerance
 from ._lu import lu_factor, lu_solve
-from .lcp import LCPResult, lcp_scale, solve_box, solve_lcp
+from .lcp import LCPResult, is_psd, lcp_scale, solve_box, solve_lcp
 
 
 class Relation:
@@ -99,16 +99,36 @@ class Relay(BoxRelation):
             raise InvalidProblem("Relay bounds must be finite (use Complementarity for [0, ∞))")
 
 
+#: active patterns a stepper of a PSD ``M`` tries after its last one, before a full solve
+RECENT_PATTERNS = 8
+
+
 class _BoxStepper:
-    """``q ↦ (z, w)`` for a constant ``M``: the last pattern's factorisation first, a full solve otherwise."""
+    """``q ↦ (z, w)`` for a constant ``M``: the last pattern's factorisation first, then (PSD ``M``) the
+    :data:`RECENT_PATTERNS` patterns that solved before it, a full solve otherwise.
+
+    A pattern's answer is taken only when strictly complementary with a nonsingular ``M_II`` (:meth:`_try`): an
+    isolated solution, hence for PSD ``M`` (whose solution set is convex) *the* solution, which the full solve's
+    least-norm answer equals up to rounding.  Points that alternate between a few patterns (an assumption law's
+    sample points, some inside ``dom H``, some sent to its edge) so cost a factorised solve each, not a full one
+    (the paper's Example, (YB) at ci: 6066 full solves of 7142 before, a few dozen after)."""
 
     def __init__(self, rel: BoxRelation, M: np.ndarray) -> None:
         self.rel, self.M = rel, M
         self.lo, self.hi = rel.bounds(M.shape[0])
         self.cache: dict[bytes, tuple] = {}
         self.last: bytes | None = None
+        self.recent: list[bytes] = []
+        self.psd = is_psd(M)
         self.full_solves = 0
         self.m_norm = float(np.abs(M).sum(axis=1).max(initial=0.0))
+
+    def _remember(self, pat: bytes) -> None:
+        self.last = pat
+        if pat in self.recent:
+            self.recent.remove(pat)
+        self.recent.insert(0, pat)
+        del self.recent[RECENT_PATTERNS:]
 
     def _entry(self, pat: bytes):
         e = self.cache.get(pat)
@@ -158,12 +178,19 @@ class _BoxStepper:
             out = self._try(self.last, q)
             if out is not None:
                 return out
+            if self.psd:
+                for pat in self.recent:
+                    if pat != self.last:
+                        out = self._try(pat, q)
+                        if out is not None:
+                            self._remember(pat)
+                            return out
         r = self.rel.solve(self.M, q, scale)
         self.full_solves += 1
         lam = r.z
         tau = RTOL * lcp_scale(self.M, q, lam)
         s = np.where(lam - self.lo <= tau, 0, np.where(self.hi - lam <= tau, 2, 1)).astype(np.int8)
-        self.last = s.tobytes()
+        self._remember(s.tobytes())
         return r.z, r.w
 
 

@@ -26,12 +26,12 @@ from ..core.errors import InfeasibleStep, InvalidProblem, OutsideDomain, SolverF
 from ..core.grids import validate_grid
 from ..core.operators import Operator
 from ..core.problem import Problem
-from ..core.qp import solve_qp
 from ..core.stepping import Trajectory
 from ..core.tolerances import tolerance
 from ._lu import lu_factor, lu_solve
 from .kernel import BatchStepError
-from .lcp import _box_lcp, _feasible, is_psd, proved_solvable, select_over_sol, solve_lcp
+from ._warm_qp import row_infeasible, solve_qp_warm
+from .lcp import _box_lcp, _feasible, is_psd, proved_solvable, sol_polyhedron, solve_lcp
 from .relations import BoxRelation, as_relation
 
 
@@ -358,6 +358,10 @@ def _increments(u, t: np.ndarray, n: int, B: int | None) -> np.ndarray | None:
     return total
 
 
+#: entries of an operator's memo of ``H^0(t, x)`` and ``proj_dom H(t,·)(x)`` (:meth:`LCSOperator._memoised`)
+MEMO_SIZE = 8192
+
+
 class LCSOperator(Operator):
     """``H(t, x) = −Ax + B(𝓜 + D)^{-1}(Cx + v(t))`` (``e:defht``); its resolvent is the one-step problem
 
@@ -375,6 +379,24 @@ class LCSOperator(Operator):
         self.static = system.v_constant
         self._mats: dict[float, StepMatrices] = {}
         self._recent: StepMatrices | None = None
+        # the active sets of the last selection and projection QPs (:mod:`verimono.lcs._warm_qp`)
+        self._warm_select: dict = {}
+        self._warm_project: dict = {}
+        self._memo: dict = {}
+
+    def _memoised(self, kind: str, x: np.ndarray, t, compute):
+        """``compute()`` once per ``(kind, t, x)``: an assumption law asks ``H^0`` and ``proj_dom H`` at the same
+        points and times again (about one call in five on the paper's Example at ci); what it returns depends on
+        ``(t, x)`` alone (the system's matrices and ``v`` are fixed once built).  At most :data:`MEMO_SIZE`
+        entries, forgotten all at once."""
+        key = (kind, float(t), x.tobytes())
+        out = self._memo.get(key)
+        if out is None:
+            out = compute()
+            if len(self._memo) >= MEMO_SIZE:
+                self._memo.clear()
+            self._memo[key] = out
+        return out.copy()
 
     def _sm(self, lam: float) -> StepMatrices:
         sm = self._mats.get(lam)
@@ -430,6 +452,8 @@ class LCSOperator(Operator):
         eta, scale = s.C @ x + v, s.q_scale(x, v)
         lo, hi = rel.bounds(s.m)
         big, qq, fin = _box_lcp(s.D, eta, lo, hi)
+        if row_infeasible(big, qq):     # a row of the multipliers' constraints no z ≥ 0 meets, by a margin
+            raise OutsideDomain(f"x = {x} is not in dom H(t={t}): Cx + v(t) ∉ im(𝓜 + D)")
         try:   # a solution proves x ∈ dom H(t): the linear program is needed only when there is none
             r = solve_lcp(big, qq, least_norm=False, scale=scale, info=True)
         except InfeasibleStep:
@@ -445,13 +469,18 @@ class LCSOperator(Operator):
         P[:s.m, :s.m] = P_lam
         c = np.zeros(k)
         c[:s.m] = c_lam + P_lam @ lo
-        zz = select_over_sol(big, qq, zbar, P, c, scale=scale)
+        G, h, A, b = sol_polyhedron(big, qq, zbar, scale)     # select_over_sol, warm-started
+        zz = solve_qp_warm(self._warm_select, P, c, G, h, A if len(A) else None, b if len(A) else None,
+                           scale=scale)
         return lo + zz[:s.m]
 
     def min_norm(self, x, t=0.0):
         x = np.asarray(x, dtype=float)
         if x.ndim == 2:
             return np.array([self.min_norm(xi, t) for xi in x])
+        return self._memoised("min_norm", x, t, lambda: self._min_norm(x, t))
+
+    def _min_norm(self, x, t):
         s = self.system
         Ax = s.A @ x
         lam = self._select(x, t, s.B.T @ s.B, s.B.T @ Ax)
@@ -490,14 +519,18 @@ class LCSOperator(Operator):
         x = np.asarray(x, dtype=float)
         if x.ndim == 2:
             return np.array([self.project_domain(xi, t) for xi in x])
+        return self._memoised("project_domain", x, t, lambda: self._project_domain(x, t))
+
+    def _project_domain(self, x, t):
         rel, s = self._box(), self.system
         lo, hi = rel.bounds(s.m)
         if np.all(np.isfinite(hi)):
             return x.copy()  # bounded box: 𝓜 + D is surjective, dom H = R^n
         v = s.v(t)
         big, qq, fin = _box_lcp(s.D, s.C @ x + v, lo, hi)
-        # a verified multiplier proves x ∈ dom H(t) at a fraction of the linear program's cost
-        if proved_solvable(big, qq, s.q_scale(x, v)) or _feasible(big, qq):
+        # a verified multiplier proves x ∈ dom H(t) at a fraction of the linear program's cost, and a row no
+        # z ≥ 0 meets proves x ∉ dom H(t) at a fraction of it too
+        if not row_infeasible(big, qq) and (proved_solvable(big, qq, s.q_scale(x, v)) or _feasible(big, qq)):
             return x.copy()
         # min ½|x' − x|² over {(x', z): z ≥ 0, D z + C x' + v ≥ 0} (complementarity: dom = C^{-1}(Q_D^+ − v))
         if not rel.is_lcp:
@@ -507,7 +540,7 @@ class LCSOperator(Operator):
         P[:n, :n] = np.eye(n)
         G = np.block([[np.zeros((m, n)), -np.eye(m)], [-s.C, -s.D]])
         h = np.concatenate([np.zeros(m), s.v(t)])
-        return solve_qp(P, np.concatenate([-x, np.zeros(m)]), G, h)[:n]
+        return solve_qp_warm(self._warm_project, P, np.concatenate([-x, np.zeros(m)]), G, h)[:n]
 
 
 __all__ = ["LinearRelationSystem", "LCSOperator", "StepMatrices", "BatchStepError"]

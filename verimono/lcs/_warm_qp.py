@@ -1,0 +1,93 @@
+"""Active-set warm starts for the small QPs an :class:`~verimono.lcs.system.LCSOperator` solves again and again
+(the projection onto ``dom H(t,·)``, the selection over the multipliers of ``H(t, x)``), and a cheap proof of
+infeasibility of ``FEA(q, M)``.
+
+:func:`verimono.core.qp.solve_qp` hands each QP to a back-end (ProxQP, ~1 ms through qpsolvers on these 2×2 to
+4×4 problems), *polishes* its answer by re-solving the KKT system on the detected active set, and accepts that
+polished point only when its own KKT check passes.  An assumption law evaluates the same operator at thousands
+of neighbouring ``(t, x)`` whose QPs have the same few active sets: :func:`solve_qp_warm` first re-solves the KKT
+system on the active sets that verified last (most recent first, :data:`WARM_SETS` of them) — the very
+polishing step of ``solve_qp``, on the same equilibrated data — and returns the first candidate that passes the
+same KKT check (and the far half-spaces' check), so what it returns carries the guarantee ``solve_qp``'s
+answers carry, and it is bit for bit ``solve_qp``'s answer whenever the back-end's point has that active set.
+Otherwise (no warm set, or none verifies) it calls ``solve_qp`` itself and remembers the active set of its
+answer.  The memory belongs to the caller (one per operator and QP kind), so nothing is shared between
+operators or between tests.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..core.qp import ACTIVE_RTOL, equilibrate, kkt_residual, solve_qp
+from ..core.tolerances import QP_RTOL
+
+#: active sets remembered per QP shape (most recent first)
+WARM_SETS = 4
+
+
+def _on_active(S, act: np.ndarray) -> np.ndarray:
+    """``solve_qp``'s polishing step (``verimono.core.qp._polish``) with the active rows ``act`` given."""
+    n = S.P.shape[0]
+    blocks, rhs = [], []
+    if S.G is not None:
+        blocks.append(S.G[act]); rhs.append(S.h[act])
+    if S.A is not None:
+        blocks.append(S.A); rhs.append(S.b)
+    if not blocks:
+        return np.linalg.solve(S.P, -S.q)
+    E, e = np.vstack(blocks), np.concatenate(rhs)
+    m = E.shape[0]
+    K = np.zeros((n + m, n + m))      # np.block([[P, Eᵀ], [E, 0]]), assembled directly
+    K[:n, :n], K[:n, n:], K[n:, :n] = S.P, E.T, E
+    return np.linalg.lstsq(K, np.concatenate([-S.q, e]), rcond=None)[0][:n]
+
+
+def solve_qp_warm(memory: dict, P, q, G=None, h=None, A=None, b=None, *, scale: float | None = None) -> np.ndarray:
+    """:func:`verimono.core.qp.solve_qp` (same arguments, same verification), trying the active sets kept in
+    ``memory`` first (see the module docstring)."""
+    P = np.array(P, float); q = np.array(q, float)
+    G = None if G is None or len(G) == 0 else np.atleast_2d(np.array(G, float))
+    h = None if G is None else np.atleast_1d(np.array(h, float))
+    A = None if A is None or len(A) == 0 else np.atleast_2d(np.array(A, float))
+    b = None if A is None else np.atleast_1d(np.array(b, float))
+    S = equilibrate(P, q, G, h, A, b, scale)
+    key = (P.shape[0], None if S.G is None else S.G.shape[0], None if S.A is None else S.A.shape[0],
+           S.G_far is None)
+    sets = memory.setdefault(key, [])
+    for k, act in enumerate(sets):
+        with np.errstate(all="ignore"):
+            y = _on_active(S, act)
+        if not np.all(np.isfinite(y)):
+            continue
+        rep = kkt_residual(S.P, S.q, S.G, S.h, S.A, S.b, y)
+        if rep.ok and S.far_violation(y) <= QP_RTOL:
+            if k:
+                sets.insert(0, sets.pop(k))
+            return S.scale * y
+    z = solve_qp(P, q, G, h, A, b, scale=scale)
+    if S.G is not None:
+        y = z / S.scale
+        act = S.G @ y - S.h >= -ACTIVE_RTOL * (1.0 + np.abs(y).max(initial=0.0))
+        if not any(np.array_equal(act, a) for a in sets):
+            sets.insert(0, act)
+            del sets[WARM_SETS:]
+    return z
+
+
+def row_infeasible(M: np.ndarray, q: np.ndarray) -> bool:
+    """A proof, by one row, that ``FEA(q, M) = {z ≥ 0 : Mz + q ≥ 0}`` is empty, with a margin: some row ``i`` has
+    ``M_i ≤ 0`` (every entry) and ``q_i < −MARGIN·(1 + |q|∞ + max|M|)``, so ``(Mz + q)_i ≤ q_i < 0`` for every
+    ``z ≥ 0`` (the Farkas certificate ``y = e_i``).  The margin keeps the answer the one of the linear program of
+    :func:`verimono.lcs.lcp._feasible` (HiGHS, feasibility tolerance 1e-7), which it spares: a row violated by
+    less is left to that program.  ``False`` proves nothing."""
+    tol = INFEASIBLE_MARGIN * (1.0 + float(np.abs(q).max(initial=0.0)) + float(np.abs(M).max(initial=0.0)))
+    rows = np.all(M <= 0.0, axis=1) & (q < -tol)
+    return bool(np.any(rows))
+
+
+#: how far (relative to the data) a row must be violated for :func:`row_infeasible` to decide without the LP
+INFEASIBLE_MARGIN = 1e-5
+
+
+__all__ = ["solve_qp_warm", "row_infeasible", "WARM_SETS", "INFEASIBLE_MARGIN"]
