@@ -33,7 +33,7 @@ from ..core.tolerances import (LIMIT_FLOOR, STALL_RATIO, STALL_WINDOW, current_e
 from .core import Member, Outcome
 from .members import (_ROUNDOFF_BOUNDARY, listed, min_norm, norm, outside_by_roundoff_of_dom_g, point, resolvent,
                       within_roundoff_of_domain)
-from .engine.batches import row_dots, row_norms, row_ratios, row_resolvents, vectorised
+from .engine.batches import rounding, row_dots, row_norms, row_ratios, row_resolvents, vectorised
 from .engine.samples import Sample
 from .engine.search import operator_law
 
@@ -391,7 +391,10 @@ def _only_within_rounding(op, x, y, t, tol) -> bool:
 
 # -- the vectorised forms (verimono.checks.engine.batches): the same inequalities over many samples at once ----
 # Each returns the ratio of every row of ``r`` (a Rows); the search re-evaluates by the law's own evaluator every
-# row not clearly inside the bound, so these only ever pass a sample, and with the laws' own slack.
+# row not clearly inside the bound, so these only ever pass a sample, and with the laws' own slack.  Each repeats
+# its law's elementwise operations in the same order (bit-identical) and states the rounding bound of its sums
+# (:func:`verimono.checks.engine.batches.rounding`: the norms relatively, each dot product by ``|a||b|``), so
+# that a row is accepted up to that bound from the law's own ratio.
 
 def _pair(op, r, lam2=None):
     """``J_λ x1`` and ``J_{λ2} x2`` (λ2 defaults to λ) of every row."""
@@ -404,7 +407,9 @@ def _pair(op, r, lam2=None):
 def _rows_resolvent_nonexpansive(op, r):
     a, b = _pair(op, r)
     tau = row_tolerances(r.x1, r.x2, a, b)
-    return row_ratios(row_norms(a - b), row_norms(r.x1 - r.x2), 4 * tau)
+    q = row_ratios(row_norms(a - b), row_norms(r.x1 - r.x2), 4 * tau)
+    rounding(r, q, np.ones_like(q))
+    return q
 
 
 @vectorised("resolvent_firmly_nonexpansive")
@@ -412,7 +417,11 @@ def _rows_resolvent_firmly_nonexpansive(op, r):
     a, b = _pair(op, r)
     dJ, dx = a - b, r.x1 - r.x2
     tau = row_tolerances(r.x1, r.x2, a, b)
-    return row_ratios(row_dots(dJ, dJ), row_dots(dJ, dx), 4 * tau * (row_norms(dJ) + row_norms(dx) + tau))
+    nJ, nx = row_norms(dJ), row_norms(dx)
+    rhs, slack = row_dots(dJ, dx), 4 * tau * (nJ + nx + tau)
+    q = row_ratios(row_dots(dJ, dJ), rhs, slack)
+    rounding(r, q, rhs + slack, nJ * nJ, (1.0 + np.abs(q)) * nJ * nx)
+    return q
 
 
 @vectorised("resolvent_identity")
@@ -422,7 +431,9 @@ def _rows_resolvent_identity(op, r):
     z = q[:, None] * r.x1 + (1.0 - q)[:, None] * a
     b = row_resolvents(op, z, r.mu, r.t, r.ok)
     tau = row_tolerances(r.x1, a, z)
-    return row_ratios(row_norms(a - b), np.zeros_like(tau), tau * (4.0 + np.abs(1.0 - q)))
+    out = row_ratios(row_norms(a - b), np.zeros_like(tau), tau * (4.0 + np.abs(1.0 - q)))
+    rounding(r, out, np.ones_like(out))
+    return out
 
 
 @vectorised("monotone")
@@ -432,15 +443,20 @@ def _rows_monotone(op, r):
     dx, dy = a - b, ya - yb
     ex = 2 * row_tolerances(r.x1, r.x2, a, b)
     ey = ex * (1.0 / r.lam + 1.0 / r.mu)
-    return row_ratios(-row_dots(dx, dy), np.zeros_like(ex),
-                      2 * (ex * row_norms(dy) + ey * row_norms(dx) + ex * ey))
+    ndx, ndy = row_norms(dx), row_norms(dy)
+    slack = 2 * (ex * ndy + ey * ndx + ex * ey)
+    q = row_ratios(-row_dots(dx, dy), np.zeros_like(ex), slack)
+    rounding(r, q, slack, ndx * ndy)
+    return q
 
 
 @vectorised("yosida_lipschitz")
 def _rows_yosida_lipschitz(op, r):
     a, b = _pair(op, r)
     dY = ((r.x1 - a) - (r.x2 - b)) / r.lam[:, None]
-    return row_ratios(r.lam * row_norms(dY), row_norms(r.x1 - r.x2), 4 * row_tolerances(r.x1, r.x2, a, b))
+    q = row_ratios(r.lam * row_norms(dY), row_norms(r.x1 - r.x2), 4 * row_tolerances(r.x1, r.x2, a, b))
+    rounding(r, q, np.ones_like(q))
+    return q
 
 
 @vectorised("yosida_monotone")
@@ -449,7 +465,11 @@ def _rows_yosida_monotone(op, r):
     dx = r.x1 - r.x2
     dY = (dx - (a - b)) / r.lam[:, None]
     tau = row_tolerances(r.x1, r.x2, a, b)
-    return row_ratios(-row_dots(dY, dx), np.zeros_like(tau), 4 * tau * row_norms(dx) / r.lam)
+    ndx = row_norms(dx)
+    slack = 4 * tau * ndx / r.lam
+    q = row_ratios(-row_dots(dY, dx), np.zeros_like(tau), slack)
+    rounding(r, q, slack, row_norms(dY) * ndx)
+    return q
 
 
 @vectorised("yosida_nonincreasing")
@@ -460,7 +480,9 @@ def _rows_yosida_nonincreasing(op, r):
     b = row_resolvents(op, r.x1, hi, r.t, r.ok)
     ylo, yhi = (r.x1 - a) / lo[:, None], (r.x1 - b) / hi[:, None]
     tau = row_tolerances(r.x1, a, b)
-    return row_ratios(row_norms(yhi), row_norms(ylo), 4 * tau * (1.0 / lo + 1.0 / hi))
+    q = row_ratios(row_norms(yhi), row_norms(ylo), 4 * tau * (1.0 / lo + 1.0 / hi))
+    rounding(r, q, np.ones_like(q))
+    return q
 
 
 @vectorised("resolvent_limit")
@@ -474,4 +496,5 @@ def _rows_resolvent_limit(op, r):
         d = row_norms(row_resolvents(op, x, lam, r.t, r.ok) - x)
         q = row_ratios(d, lam * ny, tau * (4.0 + lam / r.nu))
         worst = np.where(np.isnan(q) | (q > worst), q, worst)
+    rounding(r, worst, np.ones_like(worst))
     return worst

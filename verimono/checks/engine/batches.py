@@ -117,7 +117,10 @@ __all__ = ["prefetched", "batched", "batch_sizes", "_BatchFailure", "SMALL_BATCH
 # input's shape, a ratio near or above the bound, NaN) is evaluated again by the law's own evaluator, which alone
 # decides a failure and writes the record's numbers.  The vectorised form therefore never fails a sample, and
 # passes one only with a ratio at least ``1 - SUSPECT`` inside the bound (far beyond the rounding differences of
-# row-wise sums).
+# row-wise sums) — or, when the form states a bound on those differences (:func:`rounding`, ``Rows.err``), with
+# the ratio plus that bound within the bound: the forms repeat the law's elementwise operations (bit-identical in
+# IEEE arithmetic; the catalog's batched resolvents are bit-identical to separate calls), and only their sums —
+# norms and dot products, reduced in another order — may differ, by at most a few ``n·eps`` of the summands.
 
 #: law name → its vectorised form ``fn(op, rows) -> ratios (B,)`` (:func:`vectorised`)
 VECTORISED: dict[str, Any] = {}
@@ -137,9 +140,11 @@ def vectorised(name: str):
 
 class Rows:
     """Samples stacked: ``x1``, ``x2`` ``(B, n)``; ``lam``, ``mu``, ``nu``, ``t`` ``(B,)``; ``ok`` ``(B,)`` the rows
-    every resolvent call of the vectorised law answered with a finite point of the right shape."""
+    every resolvent call of the vectorised law answered with a finite point of the right shape; ``err`` ``(B,)``,
+    when the form states it (:func:`rounding`), a bound on the difference between each row's vectorised ratio and
+    the law's own (``None``: the margin ``1 - SUSPECT``)."""
 
-    __slots__ = ("x1", "x2", "lam", "mu", "nu", "t", "ok")
+    __slots__ = ("x1", "x2", "lam", "mu", "nu", "t", "ok", "err")
 
     def __init__(self, samples: Sequence[Any]) -> None:
         self.x1 = np.stack([s.x1 for s in samples]).astype(float, copy=False)
@@ -147,6 +152,15 @@ class Rows:
         self.lam, self.mu, self.nu, self.t = (np.array([getattr(s, k) for s in samples], dtype=float)
                                               for k in ("lam", "mu", "nu", "t"))
         self.ok = np.ones(len(samples), dtype=bool)
+        self.err = None
+
+    def accepted(self, q: np.ndarray, bound: float = 1.0) -> np.ndarray:
+        """The rows decided by their vectorised ratios ``q``: every call answered, ``q`` finite and ``q`` plus its
+        rounding bound (``err``; ``1 - SUSPECT`` when the form states none) within ``bound``."""
+        with np.errstate(invalid="ignore"):
+            if self.err is None:
+                return self.ok & np.isfinite(q) & (q <= SUSPECT * bound)
+            return self.ok & np.isfinite(q) & np.isfinite(self.err) & (q + self.err <= bound)
 
 
 def rows_accepted(op: Any) -> bool:
@@ -235,6 +249,26 @@ def row_norms(V: np.ndarray) -> np.ndarray:
     return np.where(good, out, 0.0)
 
 
+#: the safety factor of :func:`rounding` over the textbook bounds (``γ_n ≈ n·eps`` for a sum of ``n`` terms)
+ROUNDING_SAFETY = 8.0
+
+
+def rounding(r: Rows, q: np.ndarray, den: np.ndarray, *products: np.ndarray) -> np.ndarray:
+    """Set and return ``r.err``: a bound on ``|q - q_law|`` for ratios ``q = lhs / den`` whose norms (and
+    tolerances, exact maxima) the law computes in another summation order — each norm relatively within
+    ``(n + 2)·eps``, so ``q`` within ``g·|q|``, ``g = ROUNDING_SAFETY·(n + 4)·eps`` — and whose ``products`` (``|a|·|b|``
+    of each dot product in ``lhs`` or ``den``; a sum of ``n`` products is within ``γ_n Σ|a_i b_i| ≤ γ_n |a||b|``
+    of its exact value in any order) add ``g·|a||b| / den`` each (``inf`` where ``den ≤ 0``)."""
+    n = r.x1.shape[1] if r.x1.ndim == 2 else 1
+    g = ROUNDING_SAFETY * (n + 4) * np.finfo(float).eps
+    with np.errstate(all="ignore"):
+        e = g * np.abs(q)
+        for p in products:
+            e = e + np.where(den > 0.0, g * p / np.where(den > 0.0, den, 1.0), np.inf)
+    r.err = np.where(np.isnan(e), np.inf, e)
+    return r.err
+
+
 def row_dots(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     return np.einsum("ij,ij->i", A, B)
 
@@ -249,5 +283,6 @@ def row_ratios(lhs: np.ndarray, rhs: np.ndarray, slack: np.ndarray) -> np.ndarra
     return np.where(bad, np.inf, r)
 
 
-__all__ += ["VECTORISED", "SUSPECT", "ROW_CELLS", "vectorised", "Rows", "rows_accepted", "row_resolvents",
+__all__ += ["VECTORISED", "SUSPECT", "ROW_CELLS", "ROUNDING_SAFETY", "vectorised", "Rows", "rows_accepted", "rounding",
+            "row_resolvents",
             "row_norms", "row_dots", "row_ratios"]
