@@ -45,6 +45,10 @@ def test_a_vectorised_ratio_is_the_laws_own_ratio(law, make):
     assert fine.sum() >= len(ss) // 2
     assert np.allclose(q[fine], own[fine], rtol=AGREE, atol=AGREE), (law, q[fine], own[fine])
     assert not (q[fine] <= SUSPECT)[own[fine] > 1.0].any()       # a violated row is never accepted
+    if rows.err is not None:      # the form's stated rounding bound covers its difference from the law's own ratio
+        finite = fine & np.isfinite(q)
+        assert (np.abs(q - own)[finite] <= rows.err[finite]).all(), (law, np.abs(q - own)[finite], rows.err[finite])
+        assert not rows.accepted(q)[fine & (own > 1.0)].any()
 
 
 def test_the_catalog_maps_batches_and_a_patched_resolvent_is_called_row_by_row():
