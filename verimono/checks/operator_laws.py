@@ -28,12 +28,13 @@ import math
 import numpy as np
 
 from ..core.errors import NotApplicable, OutsideDomain, VerimonoError
-from ..core.tolerances import (LIMIT_FLOOR, STALL_RATIO, STALL_WINDOW, current_eps, repeat_tolerance, row_tolerances,
-                               tolerance)
+from ..core.tolerances import (LIMIT_FLOOR, REPEAT_ULPS, RTOL, STALL_RATIO, STALL_WINDOW, current_eps, repeat_tolerance,
+                               row_tolerances, tolerance)
 from .core import Member, Outcome
 from .members import (_ROUNDOFF_BOUNDARY, listed, min_norm, norm, outside_by_roundoff_of_dom_g, point, resolvent,
                       within_roundoff_of_domain)
-from .engine.batches import rounding, row_dots, row_norms, row_ratios, row_resolvents, vectorised
+from .engine.batches import (rounding, row_contains, row_dots, row_member, row_norms, row_ratios, row_resolvents,
+                             vectorised)
 from .engine.samples import Sample
 from .engine.search import operator_law
 
@@ -498,3 +499,102 @@ def _rows_resolvent_limit(op, r):
         worst = np.where(np.isnan(q) | (q > worst), q, worst)
     rounding(r, worst, np.ones_like(worst))
     return worst
+
+
+# the laws whose evaluator calls a member besides the resolvent (one call per row: row_member, row_contains) or
+# decides by a truth value: a membership accepted at the law's own tolerance is the law's ratio 1 exactly (its
+# grade), so it is stated with no rounding bound (the tolerance is the same elementwise arithmetic, bit for bit);
+# a membership refused, a member that raised, a limit not closed at the first step: the law's evaluator decides
+
+@vectorised("resolvent_single_valued")
+def _rows_resolvent_single_valued(op, r):
+    # two calls on (copies of) the same rows; row_resolvents marks a row whose call modified its input
+    a = row_resolvents(op, r.x1, r.lam, r.t, r.ok)
+    b = row_resolvents(op, r.x1, r.lam, r.t, r.ok)
+    t = row_tolerances(r.x1, a, b, rtol=RTOL)
+    tau = np.maximum(t, REPEAT_ULPS * current_eps() * (t / RTOL))
+    q = row_ratios(row_norms(a - b), np.zeros_like(tau), tau)
+    rounding(r, q, np.ones_like(q))
+    return q
+
+
+@vectorised("resolvent_in_domain")
+def _rows_resolvent_in_domain(op, r):
+    a = row_resolvents(op, r.x1, r.lam, r.t, r.ok)
+    p = row_member(op.project_domain, a, r.t, r.ok)
+    q = row_ratios(row_norms(p - a), np.zeros(len(r.ok)), 2 * row_tolerances(r.x1, a))
+    rounding(r, q, np.ones_like(q))
+    return q
+
+
+def _granted(ok: np.ndarray, inside: np.ndarray) -> np.ndarray:
+    """Ratio 1 (the law's grade at its own tolerance) where the membership was accepted; the other rows go to the
+    law's evaluator (``ok`` cleared: it grades them)."""
+    ok &= inside
+    return np.ones(len(ok))
+
+
+@vectorised("yosida_in_graph")
+def _rows_yosida_in_graph(op, r):
+    a = row_resolvents(op, r.x1, r.lam, r.t, r.ok)
+    y = (r.x1 - a) / r.lam[:, None]
+    tol = row_tolerances(r.x1, a, r.lam[:, None] * y) * (2.0 + 2.0 / r.lam)
+    q = _granted(r.ok, row_contains(op, a, y, r.t, tol, r.ok))
+    r.err = np.zeros(len(q))
+    return q
+
+
+def _rows_domain_pair(op, r):
+    """``x = J_ν x1``, ``y0 = Y_ν x1`` and the tolerance of ``x`` of every row (:func:`_domain_pair`)."""
+    x = row_resolvents(op, r.x1, r.nu, r.t, r.ok)
+    return x, (r.x1 - x) / r.nu[:, None], row_tolerances(r.x1, x)
+
+
+@vectorised("min_norm_in_graph")
+def _rows_min_norm_in_graph(op, r):
+    x, _, _ = _rows_domain_pair(op, r)
+    f0 = row_member(op.min_norm, x, r.t, r.ok)
+    q = _granted(r.ok, row_contains(op, x, f0, r.t, 2 * row_tolerances(x, f0), r.ok))
+    r.err = np.zeros(len(q))
+    return q
+
+
+@vectorised("yosida_bounded_by_min_norm")
+def _rows_yosida_bounded_by_min_norm(op, r):
+    x, _, tau = _rows_domain_pair(op, r)
+    f0 = row_member(op.min_norm, x, r.t, r.ok)
+    a = row_resolvents(op, x, r.lam, r.t, r.ok)
+    y = (x - a) / r.lam[:, None]
+    q = row_ratios(row_norms(y), row_norms(f0),
+                   4 * row_tolerances(x, a) / r.lam + 2 * tau / r.lam + row_tolerances(f0))
+    rounding(r, q, np.ones_like(q))
+    return q
+
+
+@vectorised("min_norm_least")
+def _rows_min_norm_least(op, r):
+    x, y0, tau = _rows_domain_pair(op, r)
+    f0 = row_member(op.min_norm, x, r.t, r.ok)
+    # y0 certified in F(t, x) where contains can tell (the law's sample is inconclusive otherwise: its evaluator says so)
+    r.ok &= row_contains(op, x, y0, r.t, row_tolerances(x, y0) * (2.0 + 2.0 / r.nu), r.ok, lacking=True)
+    q = row_ratios(row_norms(f0), row_norms(y0), 4 * tau / r.nu + row_tolerances(f0))
+    rounding(r, q, np.ones_like(q))
+    return q
+
+
+@vectorised("yosida_limit")
+def _rows_yosida_limit(op, r):
+    # the law's first step only: a gap within tolerance at λ = max(λ, floor) is its ratio; a row whose gap is not
+    # closed there (or whose F^0 is 0 within rounding) is the evaluator's, which halves λ
+    x, _, _ = _rows_domain_pair(op, r)
+    f0 = row_norms(row_member(op.min_norm, x, r.t, r.ok))
+    tx = row_tolerances(x)
+    r.ok &= r.lam > 2 * LIMIT_FLOOR * tx / (1.0 + f0) * (1.0 + 1e-9)     # λ above the floor (the law's own λ, bit for bit)
+    lam = r.lam
+    a = row_resolvents(op, x, lam, r.t, r.ok)
+    y = row_norms((x - a) / lam[:, None])
+    gap, slack = np.abs(f0 - y), row_tolerances(f0, y) + 2 * tx / lam
+    r.ok &= gap <= slack
+    q = row_ratios(gap, np.zeros_like(gap), slack)
+    rounding(r, q, slack, f0 + y)
+    return q

@@ -192,8 +192,8 @@ def _call_starts() -> None:
 
 
 def row_resolvents(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok: np.ndarray) -> np.ndarray:
-    """``J_{λ_i} X_i`` at ``t_i`` for every row (on copies of the rows); a row whose call raised or returned no
-    finite point of its shape is marked ``False`` in ``ok`` (its values are then meaningless).  Each subject
+    """``J_{λ_i} X_i`` at ``t_i`` for every row (on copies of the rows); a row whose call raised, returned no
+    finite point of its shape or modified its input is marked ``False`` in ``ok`` (its values are then meaningless).  Each subject
     call is timed as a call of its own (:func:`_call_starts`)."""
     J = np.zeros_like(X)
     if rows_accepted(op):
@@ -221,13 +221,36 @@ def row_resolvents(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok:
                 fine[lo:hi] = False
             lo = hi
         J[order] = Js
-        ok[order] &= fine & np.isfinite(Js).all(axis=1)
+        ok[order] &= fine & np.isfinite(Js).all(axis=1) & (Xs == X[order]).all(axis=1)   # inputs left unchanged
         return J
     for i in range(X.shape[0]):
         _call_starts()
+        xi = X[i].copy()
         try:
-            p = as_float64(op.resolvent(X[i].copy(), float(lams[i]), float(ts[i])))
+            p = as_float64(op.resolvent(xi, float(lams[i]), float(ts[i])))
         except Exception:   # noqa: BLE001 - as above
+            if interrupted():
+                raise
+            ok[i] = False
+            continue
+        if p.shape != X[i].shape or not np.isfinite(p).all() or not (xi == X[i]).all():
+            ok[i] = False
+            continue
+        J[i] = p
+    return J
+
+
+def row_member(member: Any, X: np.ndarray, ts: np.ndarray, ok: np.ndarray) -> np.ndarray:
+    """``member(X_i, t_i)`` of every row, one call per row on a copy (a member other than the resolvent —
+    ``min_norm``, ``project_domain`` — is no batch map the catalog promises); a row whose call raised (an
+    ``OutsideDomain`` among them: the law's evaluator judges it) or returned no finite point of its shape is
+    marked ``False`` in ``ok``.  Each call is timed as a call of its own (:func:`_call_starts`)."""
+    out = np.zeros_like(X)
+    for i in np.flatnonzero(ok).tolist():
+        _call_starts()
+        try:
+            p = as_float64(member(X[i].copy(), float(ts[i])))
+        except Exception:   # noqa: BLE001 - the law's evaluator of one sample meets it and judges it
             if interrupted():
                 raise
             ok[i] = False
@@ -235,8 +258,37 @@ def row_resolvents(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok:
         if p.shape != X[i].shape or not np.isfinite(p).all():
             ok[i] = False
             continue
-        J[i] = p
-    return J
+        out[i] = p
+    return out
+
+
+def row_contains(op: Any, X: np.ndarray, Y: np.ndarray, ts: np.ndarray, tols: np.ndarray,
+                 ok: np.ndarray, lacking: bool = False) -> np.ndarray:
+    """``op.contains(X_i, Y_i, t_i, tol_i)`` of every row still ``ok`` (one call each, on copies); a row whose call
+    raised or answered other than a truth value is marked ``False`` in ``ok`` — one that raised
+    ``NotImplementedError`` counts as inside with ``lacking`` (a law that certifies by ``contains`` only where it
+    can)."""
+    got = np.zeros(len(ok), dtype=bool)
+    for i in np.flatnonzero(ok).tolist():
+        _call_starts()
+        try:
+            v = op.contains(X[i].copy(), Y[i].copy(), float(ts[i]), float(tols[i]))
+        except NotImplementedError:
+            if lacking:
+                got[i] = True
+            else:
+                ok[i] = False
+            continue
+        except Exception:   # noqa: BLE001 - as above
+            if interrupted():
+                raise
+            ok[i] = False
+            continue
+        if not isinstance(v, (bool, np.bool_)):
+            ok[i] = False
+            continue
+        got[i] = bool(v)
+    return got
 
 
 def row_norms(V: np.ndarray) -> np.ndarray:
@@ -284,5 +336,5 @@ def row_ratios(lhs: np.ndarray, rhs: np.ndarray, slack: np.ndarray) -> np.ndarra
 
 
 __all__ += ["VECTORISED", "SUSPECT", "ROW_CELLS", "ROUNDING_SAFETY", "vectorised", "Rows", "rows_accepted", "rounding",
-            "row_resolvents",
+            "row_resolvents", "row_member", "row_contains",
             "row_norms", "row_dots", "row_ratios"]
