@@ -211,6 +211,8 @@ def main_members(rounds: int = 3, seeds: tuple = (0, 1, 2)) -> None:
     """As :func:`main`, with every member of the catalog's operators timed as the subject's own (``members=True``):
     prints one JSON row per operator and seed."""
     import json
+    import verimono as vm
+    vm.check_operator(catalog()["NormalCone(Ball) n=3"](), seed=99, profile="ci")     # warm: imports, caches
     for name in catalog():
         for r in seeds[:rounds]:
             op, clock, undo = timed_catalog(name, members=True)
