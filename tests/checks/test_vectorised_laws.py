@@ -11,7 +11,7 @@ import pytest
 
 import zoo
 import verimono as vm
-from verimono.checks import operator_laws  # noqa: F401 - the laws and their vectorised forms register
+from verimono.checks import operator_laws, prox_laws  # noqa: F401 - the laws and their vectorised forms register
 from verimono.checks.core import REGISTRY, Member, provides
 from verimono.checks.engine.batches import SUSPECT, VECTORISED, Rows, rows_accepted
 from verimono.checks.engine.samples import Sample

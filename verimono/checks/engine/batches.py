@@ -262,6 +262,28 @@ def row_member(member: Any, X: np.ndarray, ts: np.ndarray, ok: np.ndarray) -> np
     return out
 
 
+def row_values(op: Any, Z: np.ndarray, ts: np.ndarray, ok: np.ndarray) -> np.ndarray:
+    """``g(t_i, Z_i)`` (``op.value``, as :func:`verimono.checks.members.value` reads it) of every row still ``ok``,
+    one call each on a copy; a row whose call raised or whose value is not finite is marked ``False`` in ``ok``
+    (the law's evaluator judges a point outside ``dom g``)."""
+    out = np.zeros(len(ok))
+    for i in np.flatnonzero(ok).tolist():
+        _call_starts()
+        try:
+            v = op.value(np.array(Z[i], dtype=float), float(ts[i]))
+            v = float(v if type(v) is float else as_float64(v))
+        except Exception:   # noqa: BLE001 - as above
+            if interrupted():
+                raise
+            ok[i] = False
+            continue
+        if not np.isfinite(v):
+            ok[i] = False
+            continue
+        out[i] = v
+    return out
+
+
 def row_contains(op: Any, X: np.ndarray, Y: np.ndarray, ts: np.ndarray, tols: np.ndarray,
                  ok: np.ndarray, lacking: bool = False) -> np.ndarray:
     """``op.contains(X_i, Y_i, t_i, tol_i)`` of every row still ``ok`` (one call each, on copies); a row whose call
@@ -336,5 +358,5 @@ def row_ratios(lhs: np.ndarray, rhs: np.ndarray, slack: np.ndarray) -> np.ndarra
 
 
 __all__ += ["VECTORISED", "SUSPECT", "ROW_CELLS", "ROUNDING_SAFETY", "vectorised", "Rows", "rows_accepted", "rounding",
-            "row_resolvents", "row_member", "row_contains",
+            "row_resolvents", "row_member", "row_contains", "row_values",
             "row_norms", "row_dots", "row_ratios"]
