@@ -24,20 +24,45 @@ import numpy as np
 
 
 class SubjectClock:
-    """Wraps a resolvent ``f(x, lam, t)``: counts the rows it mapped and the CPU time spent inside it."""
+    """Wraps a resolvent ``f(x, lam, t)``: counts the rows it mapped and the CPU time spent inside it.  With
+    :meth:`member`, the operator's other members (``min_norm``, ``contains``, ``project_domain``, ``value``) are
+    timed on the same clock (the subject's own code too; the outermost call only, so a member calling another is
+    counted once)."""
 
     def __init__(self, f: Callable) -> None:
-        self.f, self.seconds, self.calls, self.rows = f, 0.0, 0, 0
+        self.f, self.seconds, self.calls, self.rows, self.depth = f, 0.0, 0, 0, 0
+        self.member_seconds, self.member_calls = 0.0, 0
 
     def __call__(self, *args, **kwargs):
+        if self.depth:
+            return self.f(*args, **kwargs)
+        self.depth += 1
         start = time.process_time()
         try:
             return self.f(*args, **kwargs)
         finally:
+            self.depth -= 1
             self.seconds += time.process_time() - start
             self.calls += 1
             x = args[1] if len(args) > 1 and hasattr(args[1], "ndim") else args[0]
             self.rows += x.shape[0] if getattr(x, "ndim", 1) == 2 else 1
+
+    def member(self, f: Callable) -> Callable:
+        """``f`` (a member other than the resolvent) timed on this clock."""
+        def timed(*args, **kwargs):
+            if self.depth:
+                return f(*args, **kwargs)
+            self.depth += 1
+            start = time.process_time()
+            try:
+                return f(*args, **kwargs)
+            finally:
+                self.depth -= 1
+                spent = time.process_time() - start
+                self.seconds += spent
+                self.member_seconds += spent
+                self.member_calls += 1
+        return timed
 
 
 def cells(searched: dict) -> float:
@@ -63,7 +88,7 @@ def measure(op: Any, seed: int = 0, profile: str = "ci", clock: SubjectClock | N
     cells of the records."""
     import verimono as vm
     if clock is not None:
-        clock.seconds = clock.calls = clock.rows = 0
+        clock.seconds = clock.calls = clock.rows = clock.member_seconds = clock.member_calls = 0
     start = time.process_time()
     rep = vm.check_operator(op, seed=seed, profile=profile)
     cpu = time.process_time() - start
@@ -75,6 +100,7 @@ def measure(op: Any, seed: int = 0, profile: str = "ci", clock: SubjectClock | N
     if clock is not None:
         own = cpu - clock.seconds
         out.update(subject_s=clock.seconds, subject_calls=clock.calls, subject_rows=clock.rows,
+                   member_s=clock.member_seconds, member_calls=clock.member_calls,
                    own_us_per_eval=1e6 * own / max(1, evals), subject_us_per_eval=1e6 * clock.seconds / max(1, evals),
                    own_over_subject=own / clock.seconds if clock.seconds > 0 else math.inf)
     return out
@@ -103,24 +129,35 @@ def catalog() -> dict[str, Callable[[], Any]]:
     }
 
 
-def timed_catalog(name: str):
+#: the members besides the resolvent timed as the subject's own by ``timed_catalog(..., members=True)``
+MEMBERS = ("min_norm", "contains", "project_domain", "value")
+
+
+def timed_catalog(name: str, members: bool = False):
     """The catalog operator ``name`` with its class's resolvent wrapped by a :class:`SubjectClock` (on the class,
-    so that the operator keeps its fast paths); returns ``(op, clock, undo)``."""
+    so that the operator keeps its fast paths) — with ``members``, its other :data:`MEMBERS` on the same clock;
+    returns ``(op, clock, undo)``."""
     op = catalog()[name]()
     cls = type(op)
-    original = cls.__dict__.get("resolvent")
+    originals = {m: cls.__dict__.get(m) for m in ("resolvent",) + MEMBERS}
     inner = getattr(cls, "resolvent")
     clock = SubjectClock(inner)
 
     def resolvent(self, x, lam, t=0.0):
         return clock(self, x, lam, t)
     cls.resolvent = resolvent
+    if members:
+        for m in MEMBERS:
+            if callable(getattr(cls, m, None)):
+                setattr(cls, m, clock.member(getattr(cls, m)))
 
     def undo() -> None:
-        if original is None:
-            del cls.resolvent
-        else:
-            cls.resolvent = original
+        for m, original in originals.items():
+            if original is None:
+                if m in cls.__dict__:
+                    delattr(cls, m)
+            else:
+                setattr(cls, m, original)
     return op, clock, undo
 
 
@@ -170,5 +207,29 @@ def main(rounds: int = 3) -> None:
     print(json.dumps({"verimono": getattr(vm, "__version__", "?"), "rows": rows}))
 
 
+def main_members(rounds: int = 3, seeds: tuple = (0, 1, 2)) -> None:
+    """As :func:`main`, with every member of the catalog's operators timed as the subject's own (``members=True``):
+    prints one JSON row per operator and seed."""
+    import json
+    import verimono as vm
+    vm.check_operator(catalog()["NormalCone(Ball) n=3"](), seed=99, profile="ci")     # warm: imports, caches
+    for name in catalog():
+        for r in seeds[:rounds]:
+            op, clock, undo = timed_catalog(name, members=True)
+            try:
+                print(json.dumps({"operator": name, "seed": r, **measure(op, seed=r, clock=clock)}), flush=True)
+            finally:
+                undo()
+    lib = pyproximal_box()
+    if lib is not None:
+        for r in seeds[:rounds]:
+            print(json.dumps({"operator": "pyproximal.Box n=3", "seed": r, **measure(lib[0], seed=r, clock=lib[1])}),
+                  flush=True)
+
+
 if __name__ == "__main__":
-    main()
+    import sys
+    if "--members" in sys.argv:
+        main_members()
+    else:
+        main()

@@ -78,7 +78,8 @@ def test_a_resolvent_wrong_only_at_far_decades_of_lambda_fails(where, a, monkeyp
     assert rec.status == FAILED and where(rec.counterexample["lam"]), str(rec)
     assert good.status == PASSED, str(good)
     found = {c["coordinate"]: c for c in good.details["searched"]["coordinates"]}
-    assert found["lam decades"]["stride"] == 3 and found["lam decades"]["range"] == list(STEP_RANGE_BY_PRECISION["float64"])
+    # every third decade at least (ci's; a law with a vectorised form, as yosida_in_graph now, is searched denser)
+    assert found["lam decades"]["stride"] <= 3 and found["lam decades"]["range"] == list(STEP_RANGE_BY_PRECISION["float64"])
     monkeypatch.setattr(coordinates, "current_step_range", lambda: (1e-4, 10.0))     # today's range alone
     with budgets(coordinate=27):
         assert run_law("yosida_in_graph", plant, seed=0).status == PASSED

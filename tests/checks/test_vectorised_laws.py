@@ -11,8 +11,8 @@ import pytest
 
 import zoo
 import verimono as vm
-from verimono.checks import operator_laws  # noqa: F401 - the laws and their vectorised forms register
-from verimono.checks.core import REGISTRY
+from verimono.checks import operator_laws, prox_laws  # noqa: F401 - the laws and their vectorised forms register
+from verimono.checks.core import REGISTRY, Member, provides
 from verimono.checks.engine.batches import SUSPECT, VECTORISED, Rows, rows_accepted
 from verimono.checks.engine.samples import Sample
 from verimono.checks.engine.search import evaluate_sample, run_law
@@ -25,6 +25,10 @@ from verimono.core.sets import Ball
 AGREE = 1e-9
 
 
+#: the lawful operators of the parametrisation: most of their rows are decided by the vectorised form
+LAWFUL = ("ball", "norm")
+
+
 def _samples(op, count=12):
     return (law_draws(op.dim, 5, 1.0, count, Sample) + sweep_samples(op, 5, 1.0, count, Sample))
 
@@ -34,17 +38,30 @@ def _samples(op, count=12):
                                   lambda: vm.NormSubdifferential(lambda t: 1.0 + t, dim=3),
                                   lambda: zoo.build("explicit_step"), lambda: zoo.build("non_monotone_linear")],
                          ids=["ball", "norm", "explicit_step", "non_monotone_linear"])
-def test_a_vectorised_ratio_is_the_laws_own_ratio(law, make):
+def test_a_vectorised_ratio_is_the_laws_own_ratio(law, make, request):
     op = make()
+    decl = REGISTRY["operator"][law]
+    lacking = [m.name for m in decl.requires if isinstance(m, Member) and not provides(op, m.name)]
+    if lacking:       # the law is skipped on this operator before it runs: its form is never called there
+        assert run_law(law, op, seed=1, examples=3).status == "skipped"
+        return
     ss = _samples(op)
     rows = Rows(ss)
     with np.errstate(all="ignore"):
         q = VECTORISED[law](op, rows)
-    own = np.array([evaluate_sample(REGISTRY["operator"][law], op, s).ratio for s in ss])
+    own = np.array([evaluate_sample(decl, op, s).ratio for s in ss])
     fine = rows.ok & np.isfinite(own)
-    assert fine.sum() >= len(ss) // 2
-    assert np.allclose(q[fine], own[fine], rtol=AGREE, atol=AGREE), (law, q[fine], own[fine])
+    if request.node.callspec.id.split("-")[0] in LAWFUL:      # a broken operator's rows may all go to the law
+        assert fine.sum() >= len(ss) // 2
+    # to AGREE, or within the form's stated rounding bound where its law's ratio is a cancellation of two norms
+    # (yosida_limit's gap ||F^0| - |Y_λx||: up to ~eps/rtol in units of the slack)
+    agree = np.maximum(AGREE * (1.0 + np.abs(own)), 0.0 if rows.err is None else rows.err)
+    assert (np.abs(q - own)[fine] <= agree[fine]).all(), (law, q[fine], own[fine])
     assert not (q[fine] <= SUSPECT)[own[fine] > 1.0].any()       # a violated row is never accepted
+    if rows.err is not None:      # the form's stated rounding bound covers its difference from the law's own ratio
+        finite = fine & np.isfinite(q)
+        assert (np.abs(q - own)[finite] <= rows.err[finite]).all(), (law, np.abs(q - own)[finite], rows.err[finite])
+        assert not rows.accepted(q)[fine & (own > 1.0)].any()
 
 
 def test_the_catalog_maps_batches_and_a_patched_resolvent_is_called_row_by_row():

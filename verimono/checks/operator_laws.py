@@ -28,12 +28,13 @@ import math
 import numpy as np
 
 from ..core.errors import NotApplicable, OutsideDomain, VerimonoError
-from ..core.tolerances import (LIMIT_FLOOR, STALL_RATIO, STALL_WINDOW, current_eps, repeat_tolerance, row_tolerances,
-                               tolerance)
+from ..core.tolerances import (LIMIT_FLOOR, REPEAT_ULPS, RTOL, STALL_RATIO, STALL_WINDOW, current_eps, repeat_tolerance,
+                               row_tolerances, tolerance)
 from .core import Member, Outcome
 from .members import (_ROUNDOFF_BOUNDARY, listed, min_norm, norm, outside_by_roundoff_of_dom_g, point, resolvent,
                       within_roundoff_of_domain)
-from .engine.batches import row_dots, row_norms, row_ratios, row_resolvents, vectorised
+from .engine.batches import (rounding, row_contains, row_dots, row_member, row_norms, row_ratios, row_resolvents,
+                             vectorised)
 from .engine.samples import Sample
 from .engine.search import operator_law
 
@@ -391,7 +392,10 @@ def _only_within_rounding(op, x, y, t, tol) -> bool:
 
 # -- the vectorised forms (verimono.checks.engine.batches): the same inequalities over many samples at once ----
 # Each returns the ratio of every row of ``r`` (a Rows); the search re-evaluates by the law's own evaluator every
-# row not clearly inside the bound, so these only ever pass a sample, and with the laws' own slack.
+# row not clearly inside the bound, so these only ever pass a sample, and with the laws' own slack.  Each repeats
+# its law's elementwise operations in the same order (bit-identical) and states the rounding bound of its sums
+# (:func:`verimono.checks.engine.batches.rounding`: the norms relatively, each dot product by ``|a||b|``), so
+# that a row is accepted up to that bound from the law's own ratio.
 
 def _pair(op, r, lam2=None):
     """``J_λ x1`` and ``J_{λ2} x2`` (λ2 defaults to λ) of every row."""
@@ -404,7 +408,9 @@ def _pair(op, r, lam2=None):
 def _rows_resolvent_nonexpansive(op, r):
     a, b = _pair(op, r)
     tau = row_tolerances(r.x1, r.x2, a, b)
-    return row_ratios(row_norms(a - b), row_norms(r.x1 - r.x2), 4 * tau)
+    q = row_ratios(row_norms(a - b), row_norms(r.x1 - r.x2), 4 * tau)
+    rounding(r, q, np.ones_like(q))
+    return q
 
 
 @vectorised("resolvent_firmly_nonexpansive")
@@ -412,7 +418,11 @@ def _rows_resolvent_firmly_nonexpansive(op, r):
     a, b = _pair(op, r)
     dJ, dx = a - b, r.x1 - r.x2
     tau = row_tolerances(r.x1, r.x2, a, b)
-    return row_ratios(row_dots(dJ, dJ), row_dots(dJ, dx), 4 * tau * (row_norms(dJ) + row_norms(dx) + tau))
+    nJ, nx = row_norms(dJ), row_norms(dx)
+    rhs, slack = row_dots(dJ, dx), 4 * tau * (nJ + nx + tau)
+    q = row_ratios(row_dots(dJ, dJ), rhs, slack)
+    rounding(r, q, rhs + slack, nJ * nJ, (1.0 + np.abs(q)) * nJ * nx)
+    return q
 
 
 @vectorised("resolvent_identity")
@@ -422,7 +432,9 @@ def _rows_resolvent_identity(op, r):
     z = q[:, None] * r.x1 + (1.0 - q)[:, None] * a
     b = row_resolvents(op, z, r.mu, r.t, r.ok)
     tau = row_tolerances(r.x1, a, z)
-    return row_ratios(row_norms(a - b), np.zeros_like(tau), tau * (4.0 + np.abs(1.0 - q)))
+    out = row_ratios(row_norms(a - b), np.zeros_like(tau), tau * (4.0 + np.abs(1.0 - q)))
+    rounding(r, out, np.ones_like(out))
+    return out
 
 
 @vectorised("monotone")
@@ -432,15 +444,20 @@ def _rows_monotone(op, r):
     dx, dy = a - b, ya - yb
     ex = 2 * row_tolerances(r.x1, r.x2, a, b)
     ey = ex * (1.0 / r.lam + 1.0 / r.mu)
-    return row_ratios(-row_dots(dx, dy), np.zeros_like(ex),
-                      2 * (ex * row_norms(dy) + ey * row_norms(dx) + ex * ey))
+    ndx, ndy = row_norms(dx), row_norms(dy)
+    slack = 2 * (ex * ndy + ey * ndx + ex * ey)
+    q = row_ratios(-row_dots(dx, dy), np.zeros_like(ex), slack)
+    rounding(r, q, slack, ndx * ndy)
+    return q
 
 
 @vectorised("yosida_lipschitz")
 def _rows_yosida_lipschitz(op, r):
     a, b = _pair(op, r)
     dY = ((r.x1 - a) - (r.x2 - b)) / r.lam[:, None]
-    return row_ratios(r.lam * row_norms(dY), row_norms(r.x1 - r.x2), 4 * row_tolerances(r.x1, r.x2, a, b))
+    q = row_ratios(r.lam * row_norms(dY), row_norms(r.x1 - r.x2), 4 * row_tolerances(r.x1, r.x2, a, b))
+    rounding(r, q, np.ones_like(q))
+    return q
 
 
 @vectorised("yosida_monotone")
@@ -449,7 +466,11 @@ def _rows_yosida_monotone(op, r):
     dx = r.x1 - r.x2
     dY = (dx - (a - b)) / r.lam[:, None]
     tau = row_tolerances(r.x1, r.x2, a, b)
-    return row_ratios(-row_dots(dY, dx), np.zeros_like(tau), 4 * tau * row_norms(dx) / r.lam)
+    ndx = row_norms(dx)
+    slack = 4 * tau * ndx / r.lam
+    q = row_ratios(-row_dots(dY, dx), np.zeros_like(tau), slack)
+    rounding(r, q, slack, row_norms(dY) * ndx)
+    return q
 
 
 @vectorised("yosida_nonincreasing")
@@ -460,7 +481,9 @@ def _rows_yosida_nonincreasing(op, r):
     b = row_resolvents(op, r.x1, hi, r.t, r.ok)
     ylo, yhi = (r.x1 - a) / lo[:, None], (r.x1 - b) / hi[:, None]
     tau = row_tolerances(r.x1, a, b)
-    return row_ratios(row_norms(yhi), row_norms(ylo), 4 * tau * (1.0 / lo + 1.0 / hi))
+    q = row_ratios(row_norms(yhi), row_norms(ylo), 4 * tau * (1.0 / lo + 1.0 / hi))
+    rounding(r, q, np.ones_like(q))
+    return q
 
 
 @vectorised("resolvent_limit")
@@ -474,4 +497,104 @@ def _rows_resolvent_limit(op, r):
         d = row_norms(row_resolvents(op, x, lam, r.t, r.ok) - x)
         q = row_ratios(d, lam * ny, tau * (4.0 + lam / r.nu))
         worst = np.where(np.isnan(q) | (q > worst), q, worst)
+    rounding(r, worst, np.ones_like(worst))
     return worst
+
+
+# the laws whose evaluator calls a member besides the resolvent (one call per row: row_member, row_contains) or
+# decides by a truth value: a membership accepted at the law's own tolerance is the law's ratio 1 exactly (its
+# grade), so it is stated with no rounding bound (the tolerance is the same elementwise arithmetic, bit for bit);
+# a membership refused, a member that raised, a limit not closed at the first step: the law's evaluator decides
+
+@vectorised("resolvent_single_valued")
+def _rows_resolvent_single_valued(op, r):
+    # two calls on (copies of) the same rows; row_resolvents marks a row whose call modified its input
+    a = row_resolvents(op, r.x1, r.lam, r.t, r.ok)
+    b = row_resolvents(op, r.x1, r.lam, r.t, r.ok)
+    t = row_tolerances(r.x1, a, b, rtol=RTOL)
+    tau = np.maximum(t, REPEAT_ULPS * current_eps() * (t / RTOL))
+    q = row_ratios(row_norms(a - b), np.zeros_like(tau), tau)
+    rounding(r, q, np.ones_like(q))
+    return q
+
+
+@vectorised("resolvent_in_domain")
+def _rows_resolvent_in_domain(op, r):
+    a = row_resolvents(op, r.x1, r.lam, r.t, r.ok)
+    p = row_member(op.project_domain, a, r.t, r.ok)
+    q = row_ratios(row_norms(p - a), np.zeros(len(r.ok)), 2 * row_tolerances(r.x1, a))
+    rounding(r, q, np.ones_like(q))
+    return q
+
+
+def _granted(ok: np.ndarray, inside: np.ndarray) -> np.ndarray:
+    """Ratio 1 (the law's grade at its own tolerance) where the membership was accepted; the other rows go to the
+    law's evaluator (``ok`` cleared: it grades them)."""
+    ok &= inside
+    return np.ones(len(ok))
+
+
+@vectorised("yosida_in_graph")
+def _rows_yosida_in_graph(op, r):
+    a = row_resolvents(op, r.x1, r.lam, r.t, r.ok)
+    y = (r.x1 - a) / r.lam[:, None]
+    tol = row_tolerances(r.x1, a, r.lam[:, None] * y) * (2.0 + 2.0 / r.lam)
+    q = _granted(r.ok, row_contains(op, a, y, r.t, tol, r.ok))
+    r.err = np.zeros(len(q))
+    return q
+
+
+def _rows_domain_pair(op, r):
+    """``x = J_ν x1``, ``y0 = Y_ν x1`` and the tolerance of ``x`` of every row (:func:`_domain_pair`)."""
+    x = row_resolvents(op, r.x1, r.nu, r.t, r.ok)
+    return x, (r.x1 - x) / r.nu[:, None], row_tolerances(r.x1, x)
+
+
+@vectorised("min_norm_in_graph")
+def _rows_min_norm_in_graph(op, r):
+    x, _, _ = _rows_domain_pair(op, r)
+    f0 = row_member(op.min_norm, x, r.t, r.ok)
+    q = _granted(r.ok, row_contains(op, x, f0, r.t, 2 * row_tolerances(x, f0), r.ok))
+    r.err = np.zeros(len(q))
+    return q
+
+
+@vectorised("yosida_bounded_by_min_norm")
+def _rows_yosida_bounded_by_min_norm(op, r):
+    x, _, tau = _rows_domain_pair(op, r)
+    f0 = row_member(op.min_norm, x, r.t, r.ok)
+    a = row_resolvents(op, x, r.lam, r.t, r.ok)
+    y = (x - a) / r.lam[:, None]
+    q = row_ratios(row_norms(y), row_norms(f0),
+                   4 * row_tolerances(x, a) / r.lam + 2 * tau / r.lam + row_tolerances(f0))
+    rounding(r, q, np.ones_like(q))
+    return q
+
+
+@vectorised("min_norm_least")
+def _rows_min_norm_least(op, r):
+    x, y0, tau = _rows_domain_pair(op, r)
+    f0 = row_member(op.min_norm, x, r.t, r.ok)
+    # y0 certified in F(t, x) where contains can tell (the law's sample is inconclusive otherwise: its evaluator says so)
+    r.ok &= row_contains(op, x, y0, r.t, row_tolerances(x, y0) * (2.0 + 2.0 / r.nu), r.ok, lacking=True)
+    q = row_ratios(row_norms(f0), row_norms(y0), 4 * tau / r.nu + row_tolerances(f0))
+    rounding(r, q, np.ones_like(q))
+    return q
+
+
+@vectorised("yosida_limit")
+def _rows_yosida_limit(op, r):
+    # the law's first step only: a gap within tolerance at λ = max(λ, floor) is its ratio; a row whose gap is not
+    # closed there (or whose F^0 is 0 within rounding) is the evaluator's, which halves λ
+    x, _, _ = _rows_domain_pair(op, r)
+    f0 = row_norms(row_member(op.min_norm, x, r.t, r.ok))
+    tx = row_tolerances(x)
+    r.ok &= r.lam > 2 * LIMIT_FLOOR * tx / (1.0 + f0) * (1.0 + 1e-9)     # λ above the floor (the law's own λ, bit for bit)
+    lam = r.lam
+    a = row_resolvents(op, x, lam, r.t, r.ok)
+    y = row_norms((x - a) / lam[:, None])
+    gap, slack = np.abs(f0 - y), row_tolerances(f0, y) + 2 * tx / lam
+    r.ok &= gap <= slack
+    q = row_ratios(gap, np.zeros_like(gap), slack)
+    rounding(r, q, slack, f0 + y)
+    return q

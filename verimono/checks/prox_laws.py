@@ -34,7 +34,9 @@ from .members import ROUNDOFF_ULPS, outside_by_roundoff_of_dom_g
 from .members import norm as _nrm
 from .members import resolvent as _J
 from .members import value as _g
+from .engine.batches import rounding, row_dots, row_norms, row_ratios, row_resolvents, row_values, vectorised
 from .engine.search import operator_law
+from ..core.tolerances import row_tolerances
 
 #: the independent minimiser (scipy.optimize, derivative-free Powell) runs only on R^n with n ≤ this
 MINIMISER_MAX_DIM = 4
@@ -129,6 +131,32 @@ def check_prox_inequality(op, s, p, gp):
                              {"p": p.tolist(), "z": z.tolist(), "z_is": lab, "g(p)": gp, "g(z)": gz})
         if worst is None or not ev.ratio <= worst.ratio:
             worst = ev
+    return worst
+
+
+@vectorised("prox_inequality")
+def _rows_prox_inequality(op, r):
+    """The prox inequality over rows (:mod:`verimono.checks.engine.batches`): the law's six candidates, every value
+    one call per row; a row where a resolvent or a value failed or is not finite (``p`` or a candidate outside
+    ``dom g``) goes to the law's evaluator, the others take the worst candidate's ratio, within the rounding bound
+    of the dot product ``⟨x - p, z - p⟩`` (the values themselves are the same calls)."""
+    x, lam, t = r.x1, r.lam, r.t
+    p = row_resolvents(op, x, lam, t, r.ok)
+    gp = row_values(op, p, t, r.ok)
+    cands = [r.x2, x, np.zeros_like(x), row_resolvents(op, r.x2, r.mu, t, r.ok), row_resolvents(op, x, r.mu, t, r.ok),
+             row_resolvents(op, r.x2, r.nu, t, r.ok)]
+    worst, err = np.full(len(r.ok), -np.inf), np.zeros(len(r.ok))
+    for z in cands:
+        gz = row_values(op, z, t, r.ok)
+        tau = row_tolerances(x, p, z)
+        nxp, nzp = row_norms(x - p), row_norms(z - p)
+        lhs = row_dots(x - p, z - p)
+        rhs = lam * (gz - gp)
+        slack = 4 * tau * (nxp + nzp + tau) + 4 * lam * row_tolerances(gp, gz)
+        q = row_ratios(lhs - rhs, np.zeros_like(lhs), slack)
+        err = np.maximum(err, rounding(r, q, slack, nxp * nzp))
+        worst = np.where(np.isnan(q) | (q > worst), q, worst)
+    r.err = err
     return worst
 
 

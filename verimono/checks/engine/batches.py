@@ -117,7 +117,10 @@ __all__ = ["prefetched", "batched", "batch_sizes", "_BatchFailure", "SMALL_BATCH
 # input's shape, a ratio near or above the bound, NaN) is evaluated again by the law's own evaluator, which alone
 # decides a failure and writes the record's numbers.  The vectorised form therefore never fails a sample, and
 # passes one only with a ratio at least ``1 - SUSPECT`` inside the bound (far beyond the rounding differences of
-# row-wise sums).
+# row-wise sums) — or, when the form states a bound on those differences (:func:`rounding`, ``Rows.err``), with
+# the ratio plus that bound within the bound: the forms repeat the law's elementwise operations (bit-identical in
+# IEEE arithmetic; the catalog's batched resolvents are bit-identical to separate calls), and only their sums —
+# norms and dot products, reduced in another order — may differ, by at most a few ``n·eps`` of the summands.
 
 #: law name → its vectorised form ``fn(op, rows) -> ratios (B,)`` (:func:`vectorised`)
 VECTORISED: dict[str, Any] = {}
@@ -137,9 +140,11 @@ def vectorised(name: str):
 
 class Rows:
     """Samples stacked: ``x1``, ``x2`` ``(B, n)``; ``lam``, ``mu``, ``nu``, ``t`` ``(B,)``; ``ok`` ``(B,)`` the rows
-    every resolvent call of the vectorised law answered with a finite point of the right shape."""
+    every resolvent call of the vectorised law answered with a finite point of the right shape; ``err`` ``(B,)``,
+    when the form states it (:func:`rounding`), a bound on the difference between each row's vectorised ratio and
+    the law's own (``None``: the margin ``1 - SUSPECT``)."""
 
-    __slots__ = ("x1", "x2", "lam", "mu", "nu", "t", "ok")
+    __slots__ = ("x1", "x2", "lam", "mu", "nu", "t", "ok", "err")
 
     def __init__(self, samples: Sequence[Any]) -> None:
         self.x1 = np.stack([s.x1 for s in samples]).astype(float, copy=False)
@@ -147,6 +152,15 @@ class Rows:
         self.lam, self.mu, self.nu, self.t = (np.array([getattr(s, k) for s in samples], dtype=float)
                                               for k in ("lam", "mu", "nu", "t"))
         self.ok = np.ones(len(samples), dtype=bool)
+        self.err = None
+
+    def accepted(self, q: np.ndarray, bound: float = 1.0) -> np.ndarray:
+        """The rows decided by their vectorised ratios ``q``: every call answered, ``q`` finite and ``q`` plus its
+        rounding bound (``err``; ``1 - SUSPECT`` when the form states none) within ``bound``."""
+        with np.errstate(invalid="ignore"):
+            if self.err is None:
+                return self.ok & np.isfinite(q) & (q <= SUSPECT * bound)
+            return self.ok & np.isfinite(q) & np.isfinite(self.err) & (q + self.err <= bound)
 
 
 def rows_accepted(op: Any) -> bool:
@@ -178,8 +192,8 @@ def _call_starts() -> None:
 
 
 def row_resolvents(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok: np.ndarray) -> np.ndarray:
-    """``J_{λ_i} X_i`` at ``t_i`` for every row (on copies of the rows); a row whose call raised or returned no
-    finite point of its shape is marked ``False`` in ``ok`` (its values are then meaningless).  Each subject
+    """``J_{λ_i} X_i`` at ``t_i`` for every row (on copies of the rows); a row whose call raised, returned no
+    finite point of its shape or modified its input is marked ``False`` in ``ok`` (its values are then meaningless).  Each subject
     call is timed as a call of its own (:func:`_call_starts`)."""
     J = np.zeros_like(X)
     if rows_accepted(op):
@@ -207,13 +221,36 @@ def row_resolvents(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok:
                 fine[lo:hi] = False
             lo = hi
         J[order] = Js
-        ok[order] &= fine & np.isfinite(Js).all(axis=1)
+        ok[order] &= fine & np.isfinite(Js).all(axis=1) & (Xs == X[order]).all(axis=1)   # inputs left unchanged
         return J
     for i in range(X.shape[0]):
         _call_starts()
+        xi = X[i].copy()
         try:
-            p = as_float64(op.resolvent(X[i].copy(), float(lams[i]), float(ts[i])))
+            p = as_float64(op.resolvent(xi, float(lams[i]), float(ts[i])))
         except Exception:   # noqa: BLE001 - as above
+            if interrupted():
+                raise
+            ok[i] = False
+            continue
+        if p.shape != X[i].shape or not np.isfinite(p).all() or not (xi == X[i]).all():
+            ok[i] = False
+            continue
+        J[i] = p
+    return J
+
+
+def row_member(member: Any, X: np.ndarray, ts: np.ndarray, ok: np.ndarray) -> np.ndarray:
+    """``member(X_i, t_i)`` of every row, one call per row on a copy (a member other than the resolvent —
+    ``min_norm``, ``project_domain`` — is no batch map the catalog promises); a row whose call raised (an
+    ``OutsideDomain`` among them: the law's evaluator judges it) or returned no finite point of its shape is
+    marked ``False`` in ``ok``.  Each call is timed as a call of its own (:func:`_call_starts`)."""
+    out = np.zeros_like(X)
+    for i in np.flatnonzero(ok).tolist():
+        _call_starts()
+        try:
+            p = as_float64(member(X[i].copy(), float(ts[i])))
+        except Exception:   # noqa: BLE001 - the law's evaluator of one sample meets it and judges it
             if interrupted():
                 raise
             ok[i] = False
@@ -221,8 +258,59 @@ def row_resolvents(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok:
         if p.shape != X[i].shape or not np.isfinite(p).all():
             ok[i] = False
             continue
-        J[i] = p
-    return J
+        out[i] = p
+    return out
+
+
+def row_values(op: Any, Z: np.ndarray, ts: np.ndarray, ok: np.ndarray) -> np.ndarray:
+    """``g(t_i, Z_i)`` (``op.value``, as :func:`verimono.checks.members.value` reads it) of every row still ``ok``,
+    one call each on a copy; a row whose call raised or whose value is not finite is marked ``False`` in ``ok``
+    (the law's evaluator judges a point outside ``dom g``)."""
+    out = np.zeros(len(ok))
+    for i in np.flatnonzero(ok).tolist():
+        _call_starts()
+        try:
+            v = op.value(np.array(Z[i], dtype=float), float(ts[i]))
+            v = float(v if type(v) is float else as_float64(v))
+        except Exception:   # noqa: BLE001 - as above
+            if interrupted():
+                raise
+            ok[i] = False
+            continue
+        if not np.isfinite(v):
+            ok[i] = False
+            continue
+        out[i] = v
+    return out
+
+
+def row_contains(op: Any, X: np.ndarray, Y: np.ndarray, ts: np.ndarray, tols: np.ndarray,
+                 ok: np.ndarray, lacking: bool = False) -> np.ndarray:
+    """``op.contains(X_i, Y_i, t_i, tol_i)`` of every row still ``ok`` (one call each, on copies); a row whose call
+    raised or answered other than a truth value is marked ``False`` in ``ok`` — one that raised
+    ``NotImplementedError`` counts as inside with ``lacking`` (a law that certifies by ``contains`` only where it
+    can)."""
+    got = np.zeros(len(ok), dtype=bool)
+    for i in np.flatnonzero(ok).tolist():
+        _call_starts()
+        try:
+            v = op.contains(X[i].copy(), Y[i].copy(), float(ts[i]), float(tols[i]))
+        except NotImplementedError:
+            if lacking:
+                got[i] = True
+            else:
+                ok[i] = False
+            continue
+        except Exception:   # noqa: BLE001 - as above
+            if interrupted():
+                raise
+            ok[i] = False
+            continue
+        if not isinstance(v, (bool, np.bool_)):
+            ok[i] = False
+            continue
+        got[i] = bool(v)
+    return got
 
 
 def row_norms(V: np.ndarray) -> np.ndarray:
@@ -233,6 +321,26 @@ def row_norms(V: np.ndarray) -> np.ndarray:
     safe = np.where(good, m, 1.0)
     out = safe * np.sqrt(np.einsum("ij,ij->i", V / safe[:, None], V / safe[:, None]))
     return np.where(good, out, 0.0)
+
+
+#: the safety factor of :func:`rounding` over the textbook bounds (``γ_n ≈ n·eps`` for a sum of ``n`` terms)
+ROUNDING_SAFETY = 8.0
+
+
+def rounding(r: Rows, q: np.ndarray, den: np.ndarray, *products: np.ndarray) -> np.ndarray:
+    """Set and return ``r.err``: a bound on ``|q - q_law|`` for ratios ``q = lhs / den`` whose norms (and
+    tolerances, exact maxima) the law computes in another summation order — each norm relatively within
+    ``(n + 2)·eps``, so ``q`` within ``g·|q|``, ``g = ROUNDING_SAFETY·(n + 4)·eps`` — and whose ``products`` (``|a|·|b|``
+    of each dot product in ``lhs`` or ``den``; a sum of ``n`` products is within ``γ_n Σ|a_i b_i| ≤ γ_n |a||b|``
+    of its exact value in any order) add ``g·|a||b| / den`` each (``inf`` where ``den ≤ 0``)."""
+    n = r.x1.shape[1] if r.x1.ndim == 2 else 1
+    g = ROUNDING_SAFETY * (n + 4) * np.finfo(float).eps
+    with np.errstate(all="ignore"):
+        e = g * np.abs(q)
+        for p in products:
+            e = e + np.where(den > 0.0, g * p / np.where(den > 0.0, den, 1.0), np.inf)
+    r.err = np.where(np.isnan(e), np.inf, e)
+    return r.err
 
 
 def row_dots(A: np.ndarray, B: np.ndarray) -> np.ndarray:
@@ -249,5 +357,6 @@ def row_ratios(lhs: np.ndarray, rhs: np.ndarray, slack: np.ndarray) -> np.ndarra
     return np.where(bad, np.inf, r)
 
 
-__all__ += ["VECTORISED", "SUSPECT", "ROW_CELLS", "vectorised", "Rows", "rows_accepted", "row_resolvents",
+__all__ += ["VECTORISED", "SUSPECT", "ROW_CELLS", "ROUNDING_SAFETY", "vectorised", "Rows", "rows_accepted", "rounding",
+            "row_resolvents", "row_member", "row_contains", "row_values",
             "row_norms", "row_dots", "row_ratios"]

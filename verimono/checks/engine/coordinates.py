@@ -33,7 +33,6 @@ record).  Samples of more than ``NUMPY_DIM`` coordinates (recorded by recipe) ar
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from typing import Any, Callable
 
@@ -69,6 +68,15 @@ DENSE_SHARE = 2
 DENSE_SHARE_BATCHED = 8
 DENSE_MAX = 4096
 
+def _replace(s: Sample, **changes: Any) -> Sample:
+    """``dataclasses.replace(s, **changes)`` without its ``__init__`` (``Sample`` has no ``__post_init__``; a design
+    builds thousands of samples): a copy of ``s``'s fields with ``changes``."""
+    out = object.__new__(Sample)
+    out.__dict__.update(s.__dict__)
+    out.__dict__.update(changes)
+    return out
+
+
 def _norm(v: np.ndarray) -> float:
     m = float(np.max(np.abs(v), initial=0.0))
     return 0.0 if m == 0.0 or not math.isfinite(m) else m * float(np.linalg.norm(v / m))
@@ -80,11 +88,11 @@ def _moves(s: Sample, name: str, op: Any, horizon: float) -> tuple[Space, Callab
     if name in ("lam", "mu", "nu"):
         lo, hi = current_step_range()
         space = Space(name, lo, hi, log=True)
-        return space, (lambda v: dataclasses.replace(s, **{name: float(v)})), \
+        return space, (lambda v: _replace(s, **{name: float(v)})), \
             [10.0 ** k for k in range(-4, 2)] + [lo, hi, getattr(s, name)]
     if name == "t":
         space = Space("t", 0.0, float(horizon))
-        return space, (lambda v: dataclasses.replace(s, t=float(v))), [0.0, horizon / 2, float(horizon), s.t]
+        return space, (lambda v: _replace(s, t=float(v))), [0.0, horizon / 2, float(horizon), s.t]
     if s.recipe is not None:
         return None
     if name == "scale":
@@ -92,7 +100,7 @@ def _moves(s: Sample, name: str, op: Any, horizon: float) -> tuple[Space, Callab
         if r == 0.0:
             return None
         space = Space("|x1|", SCALE[0], min(SCALE[1], current_largest() / 64.0), log=True)
-        return space, (lambda v: dataclasses.replace(s, x1=s.x1 * (v / r), x2=s.x2 * (v / r))), \
+        return space, (lambda v: _replace(s, x1=s.x1 * (v / r), x2=s.x2 * (v / r))), \
             [10.0 ** k for k in range(-9, 7, 3)] + [min(max(r, SCALE[0]), SCALE[1])]
     # offset from the boundary: x1 = b + s n
     try:
@@ -109,7 +117,7 @@ def _moves(s: Sample, name: str, op: Any, horizon: float) -> tuple[Space, Callab
     if not OFFSET[0] * size < hi:
         return None
     space = Space("offset", OFFSET[0] * size, hi, log=True)
-    return space, (lambda v: dataclasses.replace(s, x1=b + v * n, x2=b + 1e3 * v * n)), \
+    return space, (lambda v: _replace(s, x1=b + v * n, x2=b + 1e3 * v * n)), \
         [10.0 ** k * size for k in range(-12, 4, 3)]
 
 

@@ -74,7 +74,7 @@ from ...records.results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
 from ...execution.timeouts import (checkpoint, current_budget, interrupted, interruptible, note_progress,
                                   time_limit)
 from ...records.verdicts import timeout_verdict
-from .batches import CLOCK, ROW_CELLS, SUSPECT, VECTORISED, Rows, _BatchFailure, batched, prefetched, rows_accepted
+from .batches import CLOCK, ROW_CELLS, VECTORISED, Rows, _BatchFailure, batched, prefetched, rows_accepted
 from .coordinates import COORDINATES, coordinate_search, searched
 from ..core import REGISTRY, Law, Outcome, classify, law, new_record, run, subject_name
 from .forms import CONTIGUOUS, cycled, form_note, form_search, forms_for, in_form
@@ -282,7 +282,7 @@ class _Search:
         """:meth:`evaluate` of every sample, in order, with the law's vectorised form where it has one
         (:data:`verimono.checks.engine.batches.VECTORISED`; not for a declared batched subject, whose calls the
         prefetch batches, nor for the input forms): the rows its arithmetic shows clearly inside the bound
-        (ratio finite and at most ``SUSPECT``) are counted as evaluated at that ratio, and every other sample is
+        (ratio finite and, with its rounding bound, within it: :meth:`Rows.accepted`) are counted as evaluated at that ratio, and every other sample is
         evaluated by the law's own evaluator (a failure is only ever decided, and recorded, there).  Returns the
         ratios (``None`` where :meth:`evaluate` would)."""
         fn = VECTORISED.get(self.decl.name)
@@ -319,7 +319,7 @@ class _Search:
         finally:
             CLOCK.pop()
         self.in_flight, self.slowest = None, max(self.slowest, time.perf_counter() - self.in_flight)
-        good = r.ok & np.isfinite(q) & (q <= SUSPECT)
+        good = r.accepted(q, BOUND)
         k = int(good.sum())
         if not k:
             return {}
