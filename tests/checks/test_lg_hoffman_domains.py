@@ -7,6 +7,11 @@ plant (:func:`cone`) is maximal monotone — ``F = ∇ψ``, ``ψ(x) = ½|x|² + 
 times ``1/(1 + δ)`` of its largest value is broken only in the cone ``θ < α'`` (``α' < α``) and only far from
 the origin (the ratio is ``|F(u)| |x|/(1 + |x|)``).  The code before (three ray directions from the sample
 points, 71 ray points) passed every one of them (seen in the commit that added this file).
+
+Hoffman's bound ``dist(x, 𝓡) ≤ α(|Rx| + |max(0, Qx − q)|)`` for every ``x`` (and every ``q``: α depends on ``Q, R``
+only): the points are searched from the origin and from the boundary point exposed in every direction, over
+distance decades, and the polyhedra include a box whose faces lie at ``10^3`` (:func:`far_box`).  An estimator
+that drops short rows passes the code before at every seed (its points all lie within 10 of the origin).
 """
 
 from __future__ import annotations
@@ -18,6 +23,8 @@ import pytest
 
 from verimono import Problem, operator_from_resolvent
 from verimono.checks.assumption_bounds import check_assumption_LG
+from verimono.checks.hoffman import DECADES, FAR_FACES, check_hoffman, far_box
+from verimono.lcs.hoffman import hoffman_constant
 from verimono.records.results import FAILED, PASSED
 
 
@@ -85,3 +92,52 @@ def test_LG_broken_only_in_a_cone_on_a_window_of_t_fails_and_its_control_passes(
     """Direction and time jointly: outside the window ``F(t, x) = x`` reads no direction; the time search
     along the worst direction and its opposite finds the window, the sphere is searched again there."""
     test_LG_broken_only_in_a_cone_fails_and_a_control_within_2_percent_passes(n, half, window)
+
+
+# -- Hoffman's bound: points in R^n, far decades and near the boundary ---------------------------------------
+
+def hoffman_drops_short_rows(Q, R=None):
+    """Hoffman's constant with the rows shorter than 1/8 of the longest dropped as negligible: right on every
+    polyhedron of unit-size rows, understated by ``1/w`` on a box with a row of norm ``w`` (the far box)."""
+    Q = np.atleast_2d(np.asarray(Q, dtype=float))
+    lengths = np.linalg.norm(Q, axis=1)
+    return hoffman_constant(Q[lengths >= lengths.max() / 8], R)
+
+
+def test_the_far_box_measures_its_own_violation_beyond_the_short_face_only():
+    """Without verimono: beyond the short row's face (at 1e3) ``dist = 1`` and the residual is ``w``, so the
+    plant's ``α = 1`` is broken by ``1/w``; every point within 10 of the origin (the old sampling's radii
+    0.5, 2, 10) is inside the box, where both sides are 0."""
+    for seed in range(3):
+        _, Q, _, q = far_box(seed)
+        n = Q.shape[1]
+        w, u = np.linalg.norm(Q[n - 1]), Q[n - 1] / np.linalg.norm(Q[n - 1])
+        x = (FAR_FACES + 1.0) * u
+        residual = np.linalg.norm(np.maximum(0.0, Q @ x - q))
+        assert residual == pytest.approx(w) and hoffman_drops_short_rows(Q) == pytest.approx(1.0)
+        assert hoffman_constant(Q) == pytest.approx(1 / w) and 1 / w >= 10
+        ball = np.random.default_rng(seed).standard_normal((200, n))
+        ball *= 10.0 / np.linalg.norm(ball, axis=1, keepdims=True)
+        assert np.all(ball @ Q.T <= q)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", [0, 1, 4])
+def test_hoffman_understated_beyond_a_far_face_fails_and_the_exact_constant_passes(seed):
+    bad = check_hoffman(hoffman_drops_short_rows, seed=seed)
+    assert bad.status == FAILED and bad.counterexample["polyhedron"].startswith("far box"), str(bad)
+    assert bad.worst > 10 and np.linalg.norm(bad.counterexample["x"]) > FAR_FACES
+    good = check_hoffman(seed=seed)
+    assert good.status == PASSED, str(good)
+    far = [r for r in good.details["polyhedra"] if r["polyhedron"].startswith("far box")][0]
+    assert 0.99 <= far["sampled_sup"] / far["alpha"] <= 1.0 + 1e-9      # the bound is tight there, and found
+    searched = good.details["searched"]
+    assert searched["decades"]["range"] == list(DECADES) and searched["direction"]["points"] > 0
+
+
+@pytest.mark.slow
+def test_hoffman_two_percent_understated_fails_where_the_bound_is_tight():
+    """The control's lawful twin: ``0.98 α`` is broken by 2% where the bound is tight (the far box beyond its
+    short face, the triangle's vertices), ``α`` holds."""
+    bad = check_hoffman(lambda Q, R=None: 0.98 * hoffman_constant(Q, R), seed=0)
+    assert bad.status == FAILED and 1.01 < bad.worst < 1.03, str(bad)
