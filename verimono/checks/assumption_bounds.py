@@ -38,7 +38,7 @@ from .assumption_samples import EVIDENCE, f0_norm, growth, min_norm_or_none, run
 from .core import Outcome, law
 from .jumps import find_jumps, jump_time
 from .engine.supremum import Sup
-from .engine.times import search_time, searched_t
+from .engine.times import search_time, searched_t, strata
 from .engine.sphere import DRAWN_PER_DIM, sphere_maximise
 from .engine.supremum import Space, budget, maximise
 
@@ -52,6 +52,9 @@ RAY_GROWTH = (1e4, 1e7)
 #: the (LG) direction search evaluates :func:`budget` ``("points")·(1 + n/RAY_SPHERE_DIM)`` directions of
 #: ``S^{n-1}``: a sphere of more dimensions needs more draws before the ascent climbs
 RAY_SPHERE_DIM = 10
+#: the (LG) rays' time search has ``1/RAY_TIME_SHARE`` of the strata of the law's own (ci: 1024, ``T/680``): it
+#: follows two families (the worst direction and its opposite), each evaluation a call of ``min_norm``
+RAY_TIME_SHARE = 3
 #: (A3): boundary points exposed in this many seeded directions (at most 2n) are families of the search over
 #: time; the far point ``x0 + R d`` projected has ``R = EXPOSED_RADIUS·(1 + |x0|)``; the direction is searched
 #: over the sphere at the ``EXPOSED_WINDOWS`` worst windows
@@ -358,7 +361,8 @@ def _rays(S, t: float):
     2. **direction**: at the worst centre and distance, ``u`` searched over the whole sphere
        (:func:`~verimono.checks.engine.sphere.sphere_maximise`: drawn, ascended, refined at the worst; at least
        :func:`budget` ``("points")·(1 + n/``:data:`RAY_SPHERE_DIM` ``)`` evaluations);
-    3. **time**: ``t ∈ [0, T]`` searched at the worst centre, direction and distance;
+    3. **time**: ``t ∈ [0, T]`` by count (:data:`RAY_TIME_SHARE`) along the worst direction and its opposite at
+       the worst centre and distance, the sphere searched again at a better ``t``;
     4. **decades again**: ``s`` searched along the worst direction from both centres at the worst time.
 
     The objective is the ratio against the stated σ, or without one the growth ``ρ(10^7 r)/ρ(10^4 r)`` of the
@@ -433,7 +437,8 @@ def _rays(S, t: float):
             return np.array([grow(*rays_t[f], tt) for f in fams])
         return np.array([value(*rays_t[f], s_best, tt) for f in fams])
 
-    over_t = search_time(t_values, 0.0, T, design=np.r_[S.times, t], seed=S.seed, families=2)
+    count = max(1, strata() // RAY_TIME_SHARE)
+    over_t = search_time(t_values, 0.0, T, design=np.r_[S.times, t], seed=S.seed, families=2, count=count)
     if over_t.value > best:
         t_best = over_t.t
         u_best, best = rays_t[over_t.family][1], over_t.value
@@ -471,7 +476,7 @@ def _rays(S, t: float):
                 "decades": {"range": [math.log10(RAY_RANGE[0]), math.log10(RAY_RANGE[1])], "relative_to": r,
                             "points": first.searched.points + last.searched.points,
                             "resolution": max(first.searched.resolution, last.searched.resolution)},
-                "t": searched_t(over_t), "centres": ["x0", "0"],
+                "t": searched_t(over_t, count), "centres": ["x0", "0"],
                 "objective": "ratio against the stated σ" if sigma is not None else
                              f"growth of |F^0|/(1+|z|) from {RAY_GROWTH[0]:.0e} r to {RAY_GROWTH[1]:.0e} r"}
     return sup, c, far, searched
@@ -616,4 +621,4 @@ def check_assumption_YB(S) -> Outcome:
 
 
 __all__ = ["check_assumption_A3", "check_assumption_LG", "check_assumption_YB", "RAY_RANGE", "RAY_DIRECTIONS",
-           "RAY_GROWTH", "RAY_SPHERE_DIM"]
+           "RAY_GROWTH", "RAY_SPHERE_DIM", "RAY_TIME_SHARE"]
