@@ -25,6 +25,7 @@ times and the times just after every jump found, and for (LG) over the distance 
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -37,14 +38,23 @@ from .assumption_samples import EVIDENCE, f0_norm, growth, min_norm_or_none, run
 from .core import Outcome, law
 from .jumps import find_jumps, jump_time
 from .engine.supremum import Sup
-from .engine.times import search_time, searched_t
-from .engine.sphere import sphere_maximise
+from .engine.times import search_time, searched_t, strata
+from .engine.sphere import DRAWN_PER_DIM, sphere_maximise
 from .engine.supremum import Space, budget, maximise
 
 #: the rays of the (LG) search: ``s`` from ``RAY_RANGE[0]·r`` to ``RAY_RANGE[1]·r`` (r = 1 + |x0|)
 RAY_RANGE = (1e-9, 1e7)
-#: rays per centre (x0 and the kink 0) of the (LG) search
+#: rays per centre (x0 and the kink 0) of the (LG) search's first phase (the directions of sample points);
+#: the direction is then searched over the whole sphere
 RAY_DIRECTIONS = 3
+#: the (LG) growth evidence without a stated σ: the raw ratio from ``RAY_GROWTH[0]·r`` to ``RAY_GROWTH[1]·r``
+RAY_GROWTH = (1e4, 1e7)
+#: the (LG) direction search evaluates :func:`budget` ``("points")·(1 + n/RAY_SPHERE_DIM)`` directions of
+#: ``S^{n-1}``: a sphere of more dimensions needs more draws before the ascent climbs
+RAY_SPHERE_DIM = 10
+#: the (LG) rays' time search has ``1/RAY_TIME_SHARE`` of the strata of the law's own (ci: 1024, ``T/680``): it
+#: follows two families (the worst direction and its opposite), each evaluation a call of ``min_norm``
+RAY_TIME_SHARE = 3
 #: (A3): boundary points exposed in this many seeded directions (at most 2n) are families of the search over
 #: time; the far point ``x0 + R d`` projected has ``R = EXPOSED_RADIUS·(1 + |x0|)``; the direction is searched
 #: over the sphere at the ``EXPOSED_WINDOWS`` worst windows
@@ -277,11 +287,12 @@ def check_assumption_LG(S) -> Outcome:
         if sup.value > worst:
             worst, counter = sup.value, c
         t_ray = sup.t
-    ray, c_ray, far_growth = _rays(S, t_ray)
+    ray, c_ray, far_growth, ray_searched = _rays(S, t_ray)
     details["ray_search"] = ray.as_dict()
     details["far_growth"] = far_growth
     details["searched"] = {"t": searched_t(sup) if sigma is not None else None,
-                           "x_range": S.x_range(), "rays": ray.searched.as_dict()}
+                           "x_range": S.x_range(), "rays": ray_searched,
+                           "direction": ray_searched["direction"], "decades": ray_searched["decades"]}
     if sigma is not None:
         if ray.value > worst:
             worst, counter = ray.value, c_ray
@@ -294,18 +305,18 @@ def check_assumption_LG(S) -> Outcome:
                        f"stated σ bounds every sample, at {len(S.times)} sample times, searched over time "
                        f"({sup.searched.points} times, resolution {sup.searched.resolution:.3g}: "
                        f"{sup.searched.outside()}; largest ratio {sup.value:.3g} at t = {sup.t:.4g}) and along "
-                       f"rays from x0 and 0 ({ray.searched.describe()}; largest ratio {ray.value:.3g}); |p| in "
+                       f"rays from x0 and 0 ({_describe_rays(ray_searched)}; largest ratio {ray.value:.3g}); |p| in "
                        f"[{S.x_range()[0]:.3g}, {S.x_range()[1]:.3g}] ({EVIDENCE})")
     if far_growth > GROWTH_FLAG:
         return Outcome(far_growth, bound=GROWTH_FLAG, details=details, counter={
             "far_growth": far_growth, "message": f"|F^0(t,z)|/(1+|z|) grows {far_growth:.3g}-fold along a ray from "
                                                  f"|z| = 1e4 r to 1e7 r: faster than linear growth, evidence that "
-                                                 "(LG) fails"})
+                                                 f"(LG) fails ({_describe_rays(ray_searched)})"})
     return growth(grow, {"sup_ratio_by_lambda": by_lam}, details,
                   f"sup |F^0(t,z)|/(1+|z|) grows {grow:.3g}-fold as z approaches the boundary of dom F: evidence "
                   "that (LG) fails",
                   f"estimated σ̂ ≤ {float(np.max(sig_hat)):.4g} ({EVIDENCE}; F^0 by {how}; rays up to |x| = "
-                  f"{RAY_RANGE[1]:.0e} r grow {far_growth:.3g}-fold)")
+                  f"{RAY_RANGE[1]:.0e} r grow {far_growth:.3g}-fold; {_describe_rays(ray_searched)})")
 
 
 def _sigma_ratio(S, z: np.ndarray, t: float) -> tuple[float, dict | None]:
@@ -313,8 +324,9 @@ def _sigma_ratio(S, z: np.ndarray, t: float) -> tuple[float, dict | None]:
     if val is None:
         return -np.inf, None
     sig = float(S.problem.sigma(t))
-    rhs = sig * (1.0 + float(np.linalg.norm(z)))
-    return val / (rhs + tolerance(rhs, val)), {"t": t, "z": z, "F0_norm": val, "sigma_t": sig}
+    rhs = sig * (1.0 + math.sqrt(float(z @ z)))
+    tol = current_rtol() * (1.0 + max(abs(rhs), abs(val)))    # tolerance(rhs, val), without its array dispatch
+    return val / (rhs + tol), {"t": t, "z": z, "F0_norm": val, "sigma_t": sig}
 
 
 def _sigma_sup(S) -> tuple[Sup, dict]:
@@ -340,48 +352,141 @@ def _sigma_sup(S) -> tuple[Sup, dict]:
 
 
 def _rays(S, t: float):
-    """The search along rays ``c + s u`` (centres ``x0`` and ``0``, :data:`RAY_DIRECTIONS` directions each,
-    ``s ∈ RAY_RANGE·r``) at time ``t``, of ``z = J_λ(t)(c + s u)`` with the smallest ``λ``: the ratio against
-    the stated σ, or without one ``|F^0(t,z)|/(1+|z|)``; and the growth of that raw ratio from ``s = 10^4 r``
-    to ``10^7 r`` (the largest over the rays)."""
-    op, lam, r = S.op, S.lambdas[-1], S.scale
+    """The (LG) search over the coordinates of its statement away from the sampled points (module docstring):
+    ``z = J_λ(t)(c + s u)`` with the smallest ``λ``, centre ``c ∈ {x0, 0}``, direction ``u ∈ S^{n-1}``,
+    distance ``s ∈ RAY_RANGE·r`` (a decade coordinate) and time ``t``, in four phases through the engine —
+
+    1. **decades**: ``s`` searched (:func:`~verimono.checks.engine.supremum.maximise`, ``coordinate`` kind) along
+       :data:`RAY_DIRECTIONS` directions of the sample points from each centre, at ``t``;
+    2. **direction**: at the worst centre and distance, ``u`` searched over the whole sphere
+       (:func:`~verimono.checks.engine.sphere.sphere_maximise`: drawn, ascended, refined at the worst; at least
+       :func:`budget` ``("points")·(1 + n/``:data:`RAY_SPHERE_DIM` ``)`` evaluations);
+    3. **time**: ``t ∈ [0, T]`` by count (:data:`RAY_TIME_SHARE`) along the worst direction and its opposite at
+       the worst centre and distance, the sphere searched again at a better ``t``;
+    4. **decades again**: ``s`` searched along the worst direction from both centres at the worst time.
+
+    The objective is the ratio against the stated σ, or without one the growth ``ρ(10^7 r)/ρ(10^4 r)`` of the
+    raw ratio ``ρ = |F^0(t,z)|/(1+|z|)`` along the ray.  Returns ``(sup, counter, far_growth, searched)``:
+    ``sup`` the largest ratio (phases 1–4), ``far_growth`` the largest growth met, ``searched`` what each
+    coordinate reached (directions drawn and refined and the finest angle, the decades and their factor, the
+    times)."""
+    op, lam, r, T = S.op, S.lambdas[-1], S.scale, S.T
+    n = S.problem.dim
     x0 = S.points[0]
     dirs = S.points[1:1 + RAY_DIRECTIONS] - x0
     dirs = dirs / np.maximum(np.linalg.norm(dirs, axis=1, keepdims=True), 1e-300)
-    rays = [(c, u) for c in (x0, np.zeros_like(x0)) for u in dirs]
+    centres = (x0, np.zeros_like(x0))
     sigma = S.problem.sigma
 
-    def raw(z: np.ndarray) -> float:
-        val, _ = f0_norm(op, z, t, 1e-6 * S.T)
+    def raw(z: np.ndarray, tt: float) -> float:
+        val, _ = f0_norm(op, z, tt, 1e-6 * T)
         return -np.inf if val is None else val / (1.0 + float(np.linalg.norm(z)))
 
-    def point(f: int, s: float) -> np.ndarray:
-        c, u = rays[f]
-        return resolvent_rows(op, (c + s * u)[None, :], lam, t)[0]
+    def point(c: np.ndarray, u: np.ndarray, s: float, tt: float) -> np.ndarray | None:
+        try:
+            z = resolvent_rows(op, (c + s * u)[None, :], lam, tt)[0]
+        except UnverifiedSolution:      # verimono's own solver: no evidence at this point
+            return None
+        return z if np.all(np.isfinite(z)) else None
 
-    def values(s: float, which):
-        fams = range(len(rays)) if which is None else which
-        if sigma is None:
-            return np.array([raw(point(f, s)) for f in fams])
-        return np.array([_sigma_ratio(S, point(f, s), t)[0] for f in fams])
+    def value(c: np.ndarray, u: np.ndarray, s: float, tt: float) -> float:
+        z = point(c, u, s, tt)
+        if z is None:
+            return -np.inf
+        return raw(z, tt) if sigma is None else _sigma_ratio(S, z, tt)[0]
+
+    def grow(c: np.ndarray, u: np.ndarray, tt: float) -> float:
+        za, zb = point(c, u, RAY_GROWTH[0] * r, tt), point(c, u, RAY_GROWTH[1] * r, tt)
+        if za is None or zb is None:
+            return -np.inf
+        a, b = raw(za, tt), raw(zb, tt)
+        return b / a if a > 1e-9 and np.isfinite(b) else 1.0
 
     space = Space("|x − c|", RAY_RANGE[0] * r, RAY_RANGE[1] * r, log=True)
-    design = [10.0 ** k * r for k in range(-9, 8)]
-    sup = maximise(values, space, design=design, families=2, kind="coordinate", seed=S.seed)
+    decades = [10.0 ** k * r for k in range(round(math.log10(RAY_RANGE[0])), round(math.log10(RAY_RANGE[1])) + 1)]
+
+    def along(rays, tt: float) -> Sup:
+        def values(s: float, which):
+            return np.array([value(c, u, s, tt) for c, u in (rays if which is None else [rays[f] for f in which])])
+        return maximise(values, space, design=decades, families=2, kind="coordinate", seed=S.seed)
+
+    # 1. decades along the sample directions from both centres
+    rays = [(c, u) for c in centres for u in dirs]
+    first = along(rays, t)
+    ci, u0 = first.family // len(dirs), dirs[first.family % len(dirs)]
+    far = max([1.0] + [g for c, u in rays if np.isfinite(g := grow(c, u, t))])
+    # 2. the direction over the whole sphere, at the worst centre and distance (without σ: the far growth)
+    c_best, s_best = centres[ci], first.at
+    per_sphere = round(budget("points") * (1 + n / RAY_SPHERE_DIM))
+
+    def on_sphere(tt: float, start: np.ndarray) -> dict:
+        goal = (lambda u: grow(c_best, u, tt)) if sigma is None else (lambda u: value(c_best, u, s_best, tt))
+        return sphere_maximise(goal, n, points=per_sphere, seed=S.seed + 0x4C47, start=[start])
+
+    sph = on_sphere(t, u0)
+    u_best, t_best, best = sph["direction"], t, sph["value"]
+    spheres = [sph]
+    # 3. time by count (the engine's time design, both ends) along the worst direction and its opposite (a
+    #    direction the ratio does not read at t may be the wrong half of the sphere at another time); at a
+    #    better time the direction is searched again from there
+    rays_t = [(c_best, u_best), (c_best, -u_best)]
+
+    def t_values(tt: float, which):
+        fams = range(len(rays_t)) if which is None else which
+        if sigma is None:
+            return np.array([grow(*rays_t[f], tt) for f in fams])
+        return np.array([value(*rays_t[f], s_best, tt) for f in fams])
+
+    count = max(1, strata() // RAY_TIME_SHARE)
+    over_t = search_time(t_values, 0.0, T, design=np.r_[S.times, t], seed=S.seed, families=2, count=count)
+    if over_t.value > best:
+        t_best = over_t.t
+        u_best, best = rays_t[over_t.family][1], over_t.value
+        again = on_sphere(t_best, u_best)
+        spheres.append(again)
+        if again["value"] > best:
+            u_best, best = again["direction"], again["value"]
+    if sigma is None:
+        far = max(far, best)
+    # 4. decades again along the worst direction from both centres, at the worst time
+    last = along([(c, u_best) for c in centres], t_best)
+    sup = max((first, last), key=lambda s: s.value)
+    if sigma is not None and best > sup.value:     # the sphere's or the time's own best
+        sup.value, sup.at = best, s_best
+        where = (c_best, u_best, s_best, t_best)
+    elif sup is first:
+        where = (rays[first.family][0], rays[first.family][1], first.at, t)
+    else:
+        where = (centres[last.family], u_best, last.at, t_best)
     c = None
     if sigma is not None:
-        _, c = _sigma_ratio(S, point(sup.family, sup.at), t)
-        c = dict(c or {}, found_by="search along rays far from x0 and near the kink 0", ray=sup.family,
-                 distance=sup.at)
-    far = 1.0
-    for f in range(len(rays)):
-        try:
-            a, b = raw(point(f, 1e4 * r)), raw(point(f, 1e7 * r))
-        except UnverifiedSolution:      # verimono's own solver: no evidence along this ray
-            continue
-        if a > 1e-9 and np.isfinite(b):
-            far = max(far, b / a)
-    return sup, c, far
+        cc, uu, ss, tt = where
+        z = point(cc, uu, ss, tt)
+        _, c = _sigma_ratio(S, z, tt) if z is not None else (None, None)
+        c = dict(c or {"t": tt, "z": cc + ss * uu, "F0_norm": np.nan, "sigma_t": np.nan},
+                 found_by="search along rays (centre, direction, |x| decade, t)",
+                 centre="x0" if cc is x0 else "0", direction=uu, distance=ss)
+    turns = sum(h["points"] for h in spheres)
+    points = sum(s.searched.points for s in (first, last)) + turns + over_t.searched.points
+    searched = {"space": space.name, "range": [space.lo, space.hi], "log": True, "points": points,
+                "resolution": max(first.searched.resolution, last.searched.resolution),
+                "direction": {"sphere": sph["sphere"], "drawn": len(spheres) * (DRAWN_PER_DIM * n if n > 1 else 2),
+                              "points": turns, "searches": len(spheres), "unit": "rad",
+                              "resolution": max(h["resolution"] for h in spheres)},
+                "decades": {"range": [math.log10(RAY_RANGE[0]), math.log10(RAY_RANGE[1])], "relative_to": r,
+                            "points": first.searched.points + last.searched.points,
+                            "resolution": max(first.searched.resolution, last.searched.resolution)},
+                "t": searched_t(over_t, count), "centres": ["x0", "0"],
+                "objective": "ratio against the stated σ" if sigma is not None else
+                             f"growth of |F^0|/(1+|z|) from {RAY_GROWTH[0]:.0e} r to {RAY_GROWTH[1]:.0e} r"}
+    return sup, c, far, searched
+
+
+def _describe_rays(sr: dict) -> str:
+    d, k = sr["direction"], sr["decades"]
+    return (f"{sr['points']} ray points: directions over {d['sphere']} ({d['points']}, {d['drawn']} drawn, refined "
+            f"to {d['resolution']:.2g} rad), |x − c| over 10^{k['range'][0]:.0f}..10^{k['range'][1]:.0f} r "
+            f"({k['points']} points, to within a factor {k['resolution']:.3g}), t at {sr['t']['points']} points")
 
 
 # -- (YB) ---------------------------------------------------------------------------------------------
@@ -515,4 +620,5 @@ def check_assumption_YB(S) -> Outcome:
                   f"estimated θ̂(t) = {rho:.4g} t ({key}; {EVIDENCE})")
 
 
-__all__ = ["check_assumption_A3", "check_assumption_LG", "check_assumption_YB", "RAY_RANGE", "RAY_DIRECTIONS"]
+__all__ = ["check_assumption_A3", "check_assumption_LG", "check_assumption_YB", "RAY_RANGE", "RAY_DIRECTIONS",
+           "RAY_GROWTH", "RAY_SPHERE_DIM", "RAY_TIME_SHARE"]

@@ -25,14 +25,15 @@ from __future__ import annotations
 from typing import Any, Callable
 
 import numpy as np
-from scipy.optimize import differential_evolution, minimize
 
+from ..core.errors import UnverifiedSolution
 from ..lcs.hoffman import hoffman_constant
 from ..records.results import CheckResult
 from ..core.sets import Polyhedron
 from ..core.tolerances import tolerance
 from .core import Outcome, law, run, subject_name
-from .engine.supremum import budget
+from .engine.sphere import sphere_maximise
+from .engine.supremum import Space, budget, maximise
 
 #: random polyhedra per seed
 HOFFMAN_RANDOM = 4
@@ -46,6 +47,15 @@ HOFFMAN_MAX_DIM = 5
 THIN = (0.01, 0.2)
 #: the population of the direction search (rows of its first generation: the best sampled directions)
 POPULATION = 10
+#: the far box (:func:`far_box`): its faces' distance from the origin, and the range of its short row's norm
+FAR_FACES = 1e3
+SHORT_ROW = (0.02, 0.1)
+#: the decades of the distance searched (:func:`_point_search`): ``|x|`` from the origin, and ``s`` from the
+#: boundary point exposed in a direction, ``10^DECADES[0]`` to ``10^DECADES[1]``
+DECADES = (-6, 5)
+#: the boundary point exposed in the direction ``d``: the projection of ``EXPOSED_RADIUS · r · d``, ``r`` the
+#: polyhedron's size (``1 +`` its faces' largest distance from the origin)
+EXPOSED_RADIUS = 10.0
 
 
 def thin_cone(n: int, eps: float, rng: np.random.Generator, simplex: bool = True) -> np.ndarray:
@@ -89,7 +99,24 @@ def hoffman_polyhedra(seed: int = 0) -> list[tuple[str, np.ndarray, np.ndarray |
         Q = thin_cone(n, eps, rng, simplex)
         out.append((f"thin cone (n = {n}, {'simplex' if simplex else 'square'}, ε = {eps:.3g})", Q, None,
                     np.zeros(Q.shape[0])))
+    out.append(far_box(seed))
     return out
+
+
+def far_box(seed: int = 0) -> tuple[str, np.ndarray, None, np.ndarray]:
+    """A rotated box ``{ζ : |w_i (Uᵀζ)_i| ≤ w_i D}`` of ``R^n`` (``n`` from 2 to :data:`HOFFMAN_MAX_DIM`) whose
+    faces all lie at the distance ``D =`` :data:`FAR_FACES` from the origin, one of its rows short (``w_n`` from
+    :data:`SHORT_ROW`, the others 1): Hoffman's constant is ``1/w_n``, attained beyond that face only — a
+    polyhedron no point within ``10`` of the origin leaves (its own generator: the other polyhedra's draws are
+    unchanged)."""
+    rng = np.random.default_rng([int(seed) % (2 ** 63), 0xFA8])
+    n = int(rng.integers(2, HOFFMAN_MAX_DIM + 1))
+    w = np.ones(n)
+    w[-1] = float(np.exp(rng.uniform(np.log(SHORT_ROW[0]), np.log(SHORT_ROW[1]))))
+    U, _ = np.linalg.qr(rng.standard_normal((n, n)))
+    rows = w[:, None] * U.T
+    return (f"far box (n = {n}, faces at {FAR_FACES:.0e}, a row of norm {w[-1]:.3g})", np.vstack([rows, -rows]),
+            None, np.r_[w, w] * FAR_FACES)
 
 
 def run_hoffman(decl: Any, estimator: Callable | None = None, *, seed: int = 0) -> CheckResult:
@@ -98,33 +125,83 @@ def run_hoffman(decl: Any, estimator: Callable | None = None, *, seed: int = 0) 
     return run(decl, subject_name(est), lambda: decl.evaluate(est, seed=seed), seed=seed)
 
 
-def _worst_direction(ratio: Callable[[np.ndarray], float], starts: np.ndarray, points: int, seed: int):
-    """The largest ``ratio(u)`` over ``u ∈ [−1, 1]^n``: differential evolution whose first population is
-    ``starts``, then Nelder–Mead from its best; returns ``(u, value, evaluations)``."""
-    count = [0]
+def _point_search(measure: Callable[[np.ndarray], tuple], P: Polyhedron, Q: np.ndarray, q: np.ndarray,
+                  d0: np.ndarray, seed: int) -> dict:
+    """The largest ratio of ``measure`` over the points of ``R^n`` (module docstring), through the engine: the
+    point ``x = s d`` (from the origin) or ``x = b(d) + s w(d)`` (from the boundary point ``b(d)`` exposed in
+    the direction ``d`` — the projection of ``EXPOSED_RADIUS · d`` — along its outer normal ``w(d)``: a face's
+    or vertex's own cone, where the ratio is largest as ``s → 0``), in three phases —
 
-    def neg(u: np.ndarray) -> float:
-        count[0] += 1
-        v = ratio(u)
-        return -v if np.isfinite(v) else -1e300
+    1. **decades**: ``s ∈ 10^DECADES`` (:func:`~verimono.checks.engine.supremum.maximise`, ``coordinate``
+       budget) along ``d0`` (the worst sampled direction), both families;
+    2. **direction**: ``d ∈ S^{n-1}`` at the worst family and ``s``
+       (:func:`~verimono.checks.engine.sphere.sphere_maximise`, :func:`budget` ``("points")`` evaluations);
+    3. **decades again** along the worst direction, both families.
 
-    n = starts.shape[1]
-    gens = max(1, (3 * points // 4) // len(starts) - 1)
-    de = differential_evolution(neg, [(-1.0, 1.0)] * n, init=np.clip(starts, -1.0, 1.0), maxiter=gens, tol=0.0,
-                                atol=0.0, polish=False, seed=seed, updating="immediate")
-    nm = minimize(neg, de.x, method="Nelder-Mead", options={"maxfev": max(points // 4, 2 * n), "xatol": 1e-9,
-                                                            "fatol": 0.0})
-    best = nm if nm.fun < de.fun else de
-    return np.asarray(best.x), -float(best.fun), count[0]
+    Returns ``{"value", "x", "points", "direction": {...}, "decades": {...}}``."""
+    n = d0.size
+    exposed: dict[bytes, tuple] = {}
+    size = 1.0 + float(np.max(np.abs(q) / np.maximum(np.linalg.norm(Q, axis=1), 1e-300), initial=0.0))
+
+    def normal(d: np.ndarray) -> tuple:
+        key = d.tobytes()
+        if key not in exposed:
+            far = EXPOSED_RADIUS * size * d
+            b = np.asarray(P.project(far), dtype=float)
+            w = far - b
+            nw = float(np.linalg.norm(w))
+            exposed[key] = (b, w / nw if nw > 0 else None)
+        return exposed[key]
+
+    def point(f: int, d: np.ndarray, s: float) -> np.ndarray | None:
+        if f == 0:
+            return s * d
+        b, w = normal(d)
+        return None if w is None else b + s * w     # d in the recession cone: no boundary exposed
+
+    unverified = [0]
+
+    def value(f: int, d: np.ndarray, s: float) -> float:
+        try:
+            x = point(f, d, s)
+            return -np.inf if x is None else measure(x)[0]
+        except UnverifiedSolution:      # verimono's own QP could not verify a projection: no evidence there
+            unverified[0] += 1
+            return -np.inf
+
+    space = Space("s", 10.0 ** DECADES[0], 10.0 ** DECADES[1], log=True)
+    design = [10.0 ** k for k in range(DECADES[0], DECADES[1] + 1)]
+
+    def decades(d: np.ndarray):
+        return maximise(lambda s, which: np.array([value(f, d, s) for f in ((0, 1) if which is None else which)]),
+                        space, design=design, families=2, kind="coordinate", seed=seed)
+
+    first = decades(d0)
+    f, s_best = first.family, first.at
+    sph = sphere_maximise(lambda d: value(f, d, s_best), n, points=budget("points"), seed=seed + 0x40FF,
+                          start=[d0])
+    last = decades(sph["direction"])
+    runs = [(first.value, first.family, d0, first.at), (sph["value"], f, sph["direction"], s_best),
+            (last.value, last.family, sph["direction"], last.at)]
+    v, fam, d, s_at = max(runs, key=lambda r: r[0])
+    try:
+        x = point(fam, d, s_at) if np.isfinite(v) else None
+    except UnverifiedSolution:
+        x = None
+    return {"value": v, "x": x, "unverified": unverified[0], "family": "from the origin" if fam == 0 else "from the boundary",
+            "points": first.searched.evaluations + sph["points"] + last.searched.evaluations,
+            "direction": {"sphere": sph["sphere"], "points": sph["points"], "resolution": sph["resolution"]},
+            "decades": {"range": list(DECADES), "points": first.searched.points + last.searched.points,
+                        "resolution": max(first.searched.resolution, last.searched.resolution)}}
 
 
-@law("hoffman_bound", "e:hoffman", subject="estimator", driver=run_hoffman, battery=False)
+@law("hoffman_bound", "e:hoffman", subject="estimator", driver=run_hoffman, battery=False,
+     over=("points", "direction", "scale"))
 def check_hoffman(est: Callable, *, seed: int = 0) -> Outcome:
     """``dist(x, 𝓡) ≤ α (|Rx| + |max(0, Qx − q)|)`` on every polyhedron, at the sampled points and the
     worst direction searched (module docstring)."""
     rng = np.random.default_rng(seed)
     worst, counter, rows, searched = 0.0, None, [], 0
-    per = budget("points")
     for name, Q, R, q in hoffman_polyhedra(seed):
         alpha = float(est(Q, R))
         P = Polyhedron(Q, q, R, None if R is None else np.zeros(R.shape[0]))
@@ -141,30 +218,31 @@ def check_hoffman(est: Callable, *, seed: int = 0) -> Outcome:
         X = np.vstack([r * u for r in radii])
         found = [(measure(x), x) for x in X]
         sup = max((d / res if res > 0 else 0.0) for (_, d, res), _ in found)
-        # the search: directions at the radius of the worst sample, from the best sampled ones
-        order = sorted(range(len(found)), key=lambda k: -found[k][0][0])
-        radius = radii[order[0] // HOFFMAN_POINTS]
-        starts = np.array([X[k] / radius for k in order[:POPULATION]])
-
-        def ratio(v: np.ndarray) -> float:
-            nv = float(np.linalg.norm(v))
-            return measure(radius * v / nv)[0] if nv > 1e-12 else 0.0
-
-        v, _, used = _worst_direction(ratio, starts, per, seed)
+        # the search: the point's direction and distance decades, from the origin and from the boundary
+        d0 = X[max(range(len(found)), key=lambda k: found[k][0][0])]
+        got = _point_search(measure, P, Q, q, d0 / float(np.linalg.norm(d0)), seed)
+        used = got["points"]
         searched += used
-        x = radius * v / max(float(np.linalg.norm(v)), 1e-300)
-        found.append((measure(x), x))
+        if got["x"] is not None:
+            found.append((measure(got["x"]), got["x"]))
         for (r, d, res), x in found:
             sup = max(sup, d / res if res > 0 else 0.0)
             if r > worst:
                 worst = r
                 counter = {"polyhedron": name, "x": x, "dist": d, "residual": res, "alpha": alpha, "seed": seed}
-        rows.append({"polyhedron": name, "alpha": alpha, "sampled_sup": sup, "dimension": n, "searched": used})
+        rows.append({"polyhedron": name, "alpha": alpha, "sampled_sup": sup, "dimension": n, "searched": used,
+                     "unverified": got["unverified"],
+                     "worst_from": got["family"], "direction": got["direction"], "decades": got["decades"]})
     c = counter or {"polyhedron": "", "dist": 0.0, "residual": 0.0, "alpha": 0.0}
     dims = sorted({r["dimension"] for r in rows})
     return Outcome(worst, details={"polyhedra": rows, "searched": {"polyhedra": len(rows), "dimensions": dims,
                                                                    "points": len(rows) * 3 * HOFFMAN_POINTS + searched,
-                                                                   "directions_searched": searched}},
+                                                                   "directions_searched": searched,
+                                                                   "direction": {
+                                                                       "points": sum(r["direction"]["points"] for r in rows),
+                                                                       "resolution": max(r["direction"]["resolution"] for r in rows)},
+                                                                   "decades": {"range": list(DECADES), "points": sum(
+                                                                       r["decades"]["points"] for r in rows)}}},
                    counter={**c, "message": f"dist(x, 𝓡) = {c['dist']:.4g} > α·(|Rx| + |max(0, Qx − q)|) = "
                                             f"{c['alpha'] * c['residual']:.4g} on the {c['polyhedron']} (α = "
                                             f"{c['alpha']:.4g}, e:hoffman)"},
@@ -174,5 +252,5 @@ def check_hoffman(est: Callable, *, seed: int = 0) -> Outcome:
                            f"{max(r['sampled_sup'] / r['alpha'] for r in rows):.3g}; evidence, not proof)")
 
 
-__all__ = ["check_hoffman", "hoffman_polyhedra", "thin_cone", "HOFFMAN_RANDOM", "HOFFMAN_POINTS",
-           "HOFFMAN_MAX_DIM", "THIN"]
+__all__ = ["check_hoffman", "hoffman_polyhedra", "thin_cone", "far_box", "HOFFMAN_RANDOM", "HOFFMAN_POINTS",
+           "HOFFMAN_MAX_DIM", "THIN", "FAR_FACES", "SHORT_ROW", "DECADES", "EXPOSED_RADIUS"]

@@ -26,8 +26,10 @@ A law with a vectorised form (:mod:`.batches`) gets dense designs (:data:`DENSE_
 evaluated as one list (``many``), the local search of :func:`maximise` then refining around the largest value.
 
 A coordinate whose ratio is the same to the last bit at every design point (one the law does not read,
-or an identity that holds exactly there) is covered by its design points only (``"read": False`` in the
-record).  Samples of more than ``NUMPY_DIM`` coordinates (recorded by recipe) are searched in
+or an identity that holds exactly there) is covered by the budget's points more (:func:`_covering`: one in
+each of ``points`` equal cells, so ``thorough`` covers it 27 times as densely as ``ci``), and if still flat
+there by those only (``"read": False`` in the record); the step decades get ``DECADE_SHARE`` times the budget
+log-evenly once that exceeds one point a decade (``thorough``).  Samples of more than ``NUMPY_DIM`` coordinates (recorded by recipe) are searched in
 ``lam, mu, nu, t`` only.  What was searched is recorded: :func:`searched` of the whole search.
 """
 
@@ -166,6 +168,9 @@ def coordinate_search(evaluate: Callable[[Sample], float], op: Any, start: Sampl
             design = design + _even(space, dense_count(points, name, rows))
         design = [float(min(max(v, space.lo), space.hi)) for v in design]
         first = many([at(v) for v in design])
+        if len(set(first)) <= 1 and not dense:     # flat at the design: covered by the budget's points
+            more = [v for v in _covering(space, points, seed) if v not in set(design)]
+            design, first = design + more, first + many([at(v) for v in more])
         if len(set(first)) <= 1:     # flat to the last bit: a coordinate the law does not read
             done.append({"coordinate": name, "points": len(design), "read": False,
                          "range": [space.lo, space.hi], "log": space.log})
@@ -188,8 +193,9 @@ def _decades(evaluate: Callable[[Sample], float], space: Space, at: Callable[[fl
     lo, hi = math.ceil(math.log10(space.lo)), math.floor(math.log10(space.hi))
     stride: float = max(1, math.ceil((hi - lo) / (DECADE_SHARE * max(1, points))))
     design = [10.0 ** k for k in range(lo, hi + 1, int(stride))] + [space.hi]
-    if dense:          # a vectorised law: DENSE_SHARE x DECADE_SHARE x the budget, log-evenly over every decade
-        extra = _even(space, min(DENSE_MAX, DECADE_SHARE * dense_count(points)))
+    if dense or DECADE_SHARE * points > hi - lo:   # a vectorised law, or a budget beyond one point a decade
+        # (thorough): DECADE_SHARE x the budget (x DENSE_SHARE when vectorised), log-evenly over every decade
+        extra = _even(space, min(DENSE_MAX, DECADE_SHARE * (dense_count(points) if dense else points)))
         stride = min(float(stride), (math.log10(space.hi) - math.log10(space.lo)) / max(1, len(extra) - 1))
         design = sorted(set(design + extra))
     first = many([at(v) for v in design]) if many is not None else [evaluate(at(v)) for v in design]
@@ -206,6 +212,13 @@ def dense_count(points: int, name: str = "lam", rows: bool = False) -> int:
     (``rows``: on an operator that maps batches)."""
     share = DENSE_SHARE_BATCHED if rows and name in ("offset", "scale") else DENSE_SHARE
     return min(DENSE_MAX, share * max(1, int(points)))
+
+
+def _covering(space: Space, count: int, seed: int) -> list[float]:
+    """``count`` points of ``space``, one in each of ``count`` equal cells (log-equal on a logarithmic space) at a
+    seeded offset: the coverage of a coordinate flat at its design (the same points at a seed on every machine)."""
+    off = float(np.random.default_rng([int(seed) % (2 ** 63), 0xC0FE]).uniform(0.05, 0.95))
+    return [space.value((i + off) / count) for i in range(max(0, int(count)))]
 
 
 def _even(space: Space, count: int) -> list[float]:
