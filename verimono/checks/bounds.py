@@ -30,7 +30,7 @@ from ..core.stepping import Trajectory
 from ..core.tolerances import tolerance
 from .core import PROXIMAL_CLAIM, Holds, Outcome
 from .partitions import run_stepper, single, stepper_law
-from .trajectory_laws import norms
+from .trajectory_laws import ROW_BLOCK, norms, step_norms
 
 
 def _vals(fn: Callable, t: Iterable[float]) -> np.ndarray:
@@ -210,7 +210,7 @@ def _lg_setup(p: Problem, t: np.ndarray):
     """Bounds of lem:bndSeq and the sequence they bound (``ξ_k = x_k - Φ(t_k)`` with an input)."""
     _lg_requirements(p)
     (phi, phi_src), (sigma, sigma_src) = _phi_of(p), _sigma_of(p)
-    shift = np.zeros((len(t), p.dim))
+    shift = None           # no input: ξ = x (no trajectory-sized array of zeros subtracted)
     extra = {"phi": phi_src, "sigma": sigma_src}
     absu = None
     if p.u is not None or p.U is not None:
@@ -227,7 +227,7 @@ def _lg_setup(p: Problem, t: np.ndarray):
 def _yb_setup(p: Problem, t: np.ndarray):
     _yb_requirements(p)
     theta, src = _theta_of(p)
-    return YBBounds(p.x0, theta, p.operator, p.T), np.zeros((len(t), p.dim)), {"theta": src}
+    return YBBounds(p.x0, theta, p.operator, p.T), None, {"theta": src}
 
 
 def _bounded(stepper: Callable, p: Problem, t: np.ndarray, setup: Callable, label: str, passed: str) -> Outcome:
@@ -235,10 +235,10 @@ def _bounded(stepper: Callable, p: Problem, t: np.ndarray, setup: Callable, labe
     (``ξ = x`` without an input, ``x - Φ`` with one), with the lemma's β and ψ from ``setup``."""
     bounds, shift, extra = setup(p, t)
     x = run_stepper(stepper, p, t)
-    xi = x - shift
+    xi = x if shift is None else x - shift
     psi = bounds.psi_nodes(t)
     nx = norms(xi)
-    steps = norms(np.diff(xi, axis=0))
+    steps = step_norms(xi)
     dpsi = np.diff(psi)
     # an inexact resolvent (Inexact): x_k is within E_k = Σ_{j≤k} ε(h_j) of the exact scheme's iterate, which
     # the lemma bounds (nonexpansive steps, f = 0 here)
@@ -249,7 +249,7 @@ def _bounded(stepper: Callable, p: Problem, t: np.ndarray, setup: Callable, labe
     bad = np.flatnonzero(ratios > 1.0)
     k = int(bad[0]) + 1 if bad.size else int(np.argmax(ratios)) + 1
     which = "|x_k| <= beta" if r_beta[k] >= r_step[k - 1] else "|x_k - x_(k-1)| <= psi(t_k) - psi(t_(k-1))"
-    counter = {"k": k, "t_k": t[k], "x_k": xi[k], "x_k_minus_1": xi[k - 1], "bound": which,
+    counter = {"k": k, "t_k": t[k], "x_k": xi[k].copy(), "x_k_minus_1": xi[k - 1].copy(), "bound": which,
                "norm_x_k": nx[k], "step": steps[k - 1], "psi_increment": dpsi[k - 1], **bounds.constants(),
                **extra,
                "message": f"{label}: {which} fails at k = {k}, t_k = {t[k]:.6g}: |x_k| = {nx[k]:.6g}, "
@@ -331,6 +331,28 @@ def _pair_norms(X: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
                           [np.zeros(0)])
 
 
+def _psi_interpolant(t: np.ndarray, x: np.ndarray, tau: np.ndarray, psi: Callable) -> np.ndarray:
+    """:meth:`verimono.Trajectory.interpolate` ``(tau, kind="psi", psi=psi)`` of the states ``x`` on ``t`` — the same
+    numbers — into one array, the rows formed :data:`verimono.checks.trajectory_laws.ROW_BLOCK` numbers at a time
+    (``interpolate`` forms four arrays of all the times' states: 1 GB each for 121 times at n = 10^6)."""
+    if x.size <= ROW_BLOCK or x.ndim != 2:
+        return Trajectory(t, x, None).interpolate(tau, kind="psi", psi=psi)
+    tau = np.asarray(tau, dtype=float)
+    Trajectory(t, x[:, :1], None).interpolate(tau, kind="psi", psi=psi)   # its checks of tau and psi, on one coordinate
+    k = np.clip(np.searchsorted(t, tau, side="right") - 1, 0, len(t) - 2)
+    ps = np.vectorize(lambda s: float(psi(s)))
+    a, b, s = ps(t[k]), ps(t[k + 1]), ps(tau)
+    w = (s - a) / (b - a)
+    out = np.empty((len(tau), x.shape[1]))
+    tmp = np.empty(x.shape[1])
+    for r in range(len(tau)):
+        # (1 - w) x_k + w x_{k+1}, as interpolate computes it
+        np.multiply(1.0 - w[r], x[k[r]], out=out[r])
+        np.multiply(w[r], x[k[r] + 1], out=tmp)
+        out[r] += tmp
+    return out
+
+
 @stepper_law("psi_interpolation", "lem:bndEquiCont", PROXIMAL_CLAIM, _either(_lg_requirements, _yb_requirements))
 def check_psi_interpolation(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int = 0,
                             samples: int = 40) -> Outcome:
@@ -361,9 +383,8 @@ def check_psi_interpolation(stepper: Callable, p: Problem, t: np.ndarray, *, see
     tau = np.unique(np.concatenate([t, 0.5 * (t[:-1] + t[1:]), rng.uniform(0.0, p.T, samples)]))
     worst, best, det = -np.inf, None, {}
     for label, bounds, shift, extra in setups:
-        traj = Trajectory(t, x - shift, None)
         psi = bounds.psi_function(np.union1d(t, tau))
-        X = traj.interpolate(tau, kind="psi", psi=psi)
+        X = _psi_interpolant(t, x if shift is None else x - shift, tau, psi)
         P = np.array([psi(s) for s in tau])
         i, j = _pairs(len(tau), int(np.prod(X.shape[1:])))
         lhs = _pair_norms(X, i, j)
@@ -375,7 +396,8 @@ def check_psi_interpolation(stepper: Callable, p: Problem, t: np.ndarray, *, see
             worst = float(ratio[m])
             k = int(np.searchsorted(t, tau[j[m]], side="left"))
             best = {"k": max(1, min(k, len(t) - 1)), "lemma": label, "tau_low": tau[i[m]],
-                    "tau_high": tau[j[m]], "x_low": X[i[m]], "x_high": X[j[m]], "lhs": lhs[m], "rhs": rhs[m],
+                    "tau_high": tau[j[m]], "x_low": X[i[m]].copy(), "x_high": X[j[m]].copy(), "lhs": lhs[m],
+                    "rhs": rhs[m],
                     **bounds.constants(),
                     "message": f"{label}/lem:bndEquiCont: |x_D(tau') - x_D(tau)| = {lhs[m]:.6g} > "
                                f"psi(tau') - psi(tau) = {rhs[m]:.6g} for tau = {tau[i[m]]:.6g}, "

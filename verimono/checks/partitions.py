@@ -89,9 +89,19 @@ def _validated_run(stepper: Callable, problem: Problem, grid: np.ndarray) -> tup
     if x.shape != (len(grid),) + problem.x0.shape:
         raise ValueError(f"stepper {stepper_subject(stepper, problem).split(' on ')[0]} returned shape {x.shape}, "
                          f"expected {(len(grid),) + problem.x0.shape}")
-    if not np.all(np.isfinite(x)):
+    if not all_finite(x):
         raise ValueError("the stepper returned non-finite states")
     return x, precision
+
+
+def all_finite(x: np.ndarray) -> bool:
+    """Whether every number of ``x`` is finite: its sum is finite then (a NaN or an infinity makes it NaN or
+    infinite), read in one pass without the boolean array ``np.isfinite`` forms (161 MB for a 161-node run at
+    n = 10^6); a sum that overflows on finite numbers is decided by ``np.isfinite``."""
+    with np.errstate(all="ignore"):
+        if np.isfinite(np.add.reduce(x, axis=None)):
+            return True
+    return bool(np.all(np.isfinite(x)))
 
 
 def _built_once(build: Callable[..., dict[str, np.ndarray]]) -> Callable[..., dict[str, np.ndarray]]:
