@@ -85,6 +85,11 @@ def _sigma_of(problem: Problem) -> tuple[Callable[[float], float], str]:
         return problem.sigma, "stated"
     op = problem.operator
     if provides(op, "growth"):
+        if getattr(op, "static", False):
+            # F(t,·) = F(0,·): its growth is one number, asked once (the bounds ask σ at every node of every
+            # partition, and a growth may cost O(n): |F^0(t, (1, ..., 1))|, 750 evaluations at n = 10^6 in a battery)
+            value = op.growth(0.0)
+            return (lambda t: value), f"derived: the growth {op.name} states (static: at t = 0)"
         return op.growth, f"derived: the growth {op.name} states"
     raise NotApplicable("the problem states no σ of (LG)")
 
@@ -353,6 +358,58 @@ def _psi_interpolant(t: np.ndarray, x: np.ndarray, tau: np.ndarray, psi: Callabl
     return out
 
 
+def _streamed_pairs(t: np.ndarray, x: np.ndarray, tau: np.ndarray, psi: Callable, i: np.ndarray, j: np.ndarray):
+    """``(rows, lhs, xmax)`` of the ψ-interpolant at ``tau`` formed one time at a time (:func:`_psi_interpolant`'s
+    arithmetic): ``lhs`` the norms ``|X[j] − X[i]|`` of the pairs (as :func:`_pair_norms` forms them when a row holds
+    :data:`PAIR_BLOCK` numbers or more), ``xmax = |X|_∞``, ``rows`` a mapping ``index -> X[index]`` of the rows a
+    non-consecutive pair reads (a few at large n, :func:`_pairs`) and of those :func:`check_psi_interpolation`'s
+    counterexample may read.  ``xmax``: each row's ``|X_r|_∞`` (what ``tolerance`` reads of ``X``).  Memory: O(n) per
+    kept row, not O(len(tau) n)."""
+    T = len(tau)
+    Trajectory(t, x[:, :1], None).interpolate(tau, kind="psi", psi=psi)   # its checks of tau and psi
+    k = np.clip(np.searchsorted(t, tau, side="right") - 1, 0, len(t) - 2)
+    ps = np.vectorize(lambda s: float(psi(s)))
+    a, b, s = ps(t[k]), ps(t[k + 1]), ps(tau)
+    w = (s - a) / (b - a)
+    consecutive = j == i + 1
+    keep = set(i[~consecutive].tolist()) | set(j[~consecutive].tolist())
+    by_j: dict[int, list[int]] = {}
+    for p in np.flatnonzero(consecutive):
+        by_j.setdefault(int(j[p]), []).append(int(p))
+    lhs = np.empty(len(i))
+    rows: dict[int, np.ndarray] = {}
+    xmax = np.empty(T)
+    prev, row, tmp = None, np.empty(x.shape[1]), np.empty(x.shape[1])
+    for r in range(T):
+        np.multiply(1.0 - w[r], x[k[r]], out=row)
+        np.multiply(w[r], x[k[r] + 1], out=tmp)
+        row += tmp
+        xmax[r] = max(row.max(), -row.min())         # |X_r|_∞ (a NaN stays a NaN)
+        for p in by_j.get(r, ()):
+            np.subtract(row, prev, out=tmp)
+            lhs[p] = norms(tmp[None])[0]
+        if r in keep:
+            rows[r] = row.copy()
+        prev, row = row, (prev if prev is not None else np.empty(x.shape[1]))
+    for p in np.flatnonzero(~consecutive):
+        lhs[p] = norms((rows[int(j[p])] - rows[int(i[p])])[None])[0]
+    return _Rows(rows, t, x, k, w), lhs, xmax
+
+
+class _Rows:
+    """The rows of the ψ-interpolant by index: kept ones as they were formed, others formed again (the same
+    arithmetic)."""
+
+    def __init__(self, rows, t, x, k, w):
+        self.rows, self.x, self.k, self.w = rows, x, k, w
+
+    def __getitem__(self, r):
+        r = int(r)
+        if r not in self.rows:
+            self.rows[r] = (1.0 - self.w[r]) * self.x[self.k[r]] + self.w[r] * self.x[self.k[r] + 1]
+        return self.rows[r]
+
+
 @stepper_law("psi_interpolation", "lem:bndEquiCont", PROXIMAL_CLAIM, _either(_lg_requirements, _yb_requirements))
 def check_psi_interpolation(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int = 0,
                             samples: int = 40) -> Outcome:
@@ -384,12 +441,19 @@ def check_psi_interpolation(stepper: Callable, p: Problem, t: np.ndarray, *, see
     worst, best, det = -np.inf, None, {}
     for label, bounds, shift, extra in setups:
         psi = bounds.psi_function(np.union1d(t, tau))
-        X = _psi_interpolant(t, x if shift is None else x - shift, tau, psi)
         P = np.array([psi(s) for s in tau])
-        i, j = _pairs(len(tau), int(np.prod(X.shape[1:])))
-        lhs = _pair_norms(X, i, j)
+        i, j = _pairs(len(tau), int(np.prod(x.shape[1:])))
+        xs = x if shift is None else x - shift
+        if xs.ndim == 2 and xs.size > ROW_BLOCK:
+            # the interpolant's rows one at a time: the pairs' norms and |X|_∞ as they come, the rows of the
+            # non-consecutive pairs kept (the same numbers as below without the array of all the times' states)
+            X, lhs, xmax = _streamed_pairs(t, xs, tau, psi, i, j)
+        else:
+            X = _psi_interpolant(t, xs, tau, psi)
+            lhs = _pair_norms(X, i, j)
+            xmax = X
         rhs = P[j] - P[i]
-        ratio = lhs / (rhs + slack + tolerance(X, P))
+        ratio = lhs / (rhs + slack + tolerance(xmax, P))
         m = int(np.argmax(ratio))
         det[label] = float(ratio[m])
         if ratio[m] > worst:

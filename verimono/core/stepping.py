@@ -264,7 +264,10 @@ def _returned(value: Any, what: str) -> np.ndarray:
 
 
 def _check_finite(out, start, before, t, problem):
-    if np.isfinite(out).all():
+    with np.errstate(all="ignore"):   # a finite sum: every state finite, read without a boolean array of them all
+        if np.isfinite(np.add.reduce(out, axis=None)):
+            return
+    if np.isfinite(out).all():        # a sum that overflowed on finite states
         return
     bad = int(np.flatnonzero(~np.isfinite(out.reshape(out.shape[0], -1)).all(axis=1))[0])
     prev = out[bad - 1] if bad > 0 else before
