@@ -30,6 +30,7 @@ from ..core.stepping import Trajectory
 from ..core.tolerances import tolerance
 from .core import PROXIMAL_CLAIM, Holds, Outcome
 from .partitions import run_stepper, single, stepper_law
+from .shared_runs import fingerprint, remembered_value, run_serial
 from .trajectory_laws import ROW_BLOCK, norms, step_norms
 
 
@@ -242,8 +243,7 @@ def _bounded(stepper: Callable, p: Problem, t: np.ndarray, setup: Callable, labe
     x = run_stepper(stepper, p, t)
     xi = x if shift is None else x - shift
     psi = bounds.psi_nodes(t)
-    nx = norms(xi)
-    steps = step_norms(xi)
+    nx, steps = _norms_and_steps(xi, stepper, p, t, shift is None)
     dpsi = np.diff(psi)
     # an inexact resolvent (Inexact): x_k is within E_k = Σ_{j≤k} ε(h_j) of the exact scheme's iterate, which
     # the lemma bounds (nonexpansive steps, f = 0 here)
@@ -263,6 +263,16 @@ def _bounded(stepper: Callable, p: Problem, t: np.ndarray, setup: Callable, labe
     details = {**bounds.constants(), **extra, "max_ratio_beta": float(np.max(r_beta)),
                "max_ratio_psi": float(np.max(r_step))}
     return Outcome(float(np.max(ratios)), k, counter, details, message=passed)
+
+
+def _norms_and_steps(xi: np.ndarray, stepper: Callable, p: Problem, t: np.ndarray, own: bool):
+    """``(|ξ_k|, |ξ_k − ξ_{k−1}|)``; of a kept run itself (``own``: no input shift), measured once for both lemmas'
+    laws (:func:`verimono.checks.shared_runs.remembered_value`, keyed by the run's serial number)."""
+    serial = run_serial(xi) if own else None
+    if serial is None:
+        return norms(xi), step_norms(xi)
+    key = ("norms_and_steps", id(stepper), id(p), float(p.T), fingerprint(np.asarray(p.x0)), fingerprint(t), serial)
+    return remembered_value(key, (stepper, p), lambda: (norms(xi), step_norms(xi)))
 
 
 @stepper_law("bounds_lg", "lem:bndSeq", PROXIMAL_CLAIM, _holds(_lg_requirements), every_grid=True,
