@@ -11,6 +11,7 @@ undecided: then the machine could not support a verdict, and the test says so as
 
 from __future__ import annotations
 
+import resource
 import time
 
 import numpy as np
@@ -27,7 +28,8 @@ LINEAR_SLACK = 2.0
 def battery_seconds(n: int) -> tuple[float, float, object]:
     """Wall and CPU seconds of the battery, BLAS held to ``BLAS_THREADS`` as ``verimono run``/``check`` hold it
     (unheld, OpenBLAS's threads spinning for the subject's large dot products on a loaded 2-core machine took
-    77 s of CPU at n = 10^5 instead of 21)."""
+    77 s of CPU at n = 10^5 instead of 21).  ``peak_rss_gb`` in the rows is the process's peak so far (the
+    largest n last)."""
     from threadpoolctl import threadpool_limits
 
     from verimono.execution.workers import BLAS_THREADS
@@ -49,7 +51,8 @@ def test_stepper_battery_is_linear_in_n(gate):
         if undecided:
             pytest.skip(f"n = {n}: undecided, the machine too slow for the budget: "
                         + "; ".join(r.message for r in undecided))
-        rows[n] = {"wall_s": wall, "cpu_s": cpu, "cpu_s_per_coordinate": cpu / n}
+        rows[n] = {"wall_s": wall, "cpu_s": cpu, "cpu_s_per_coordinate": cpu / n,
+                   "peak_rss_gb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e6}
     gate.benchmark.extra_info.update({str(n): r for n, r in rows.items()})
     mid, big = sizes[1], sizes[2]
     per = rows[big]["cpu_s_per_coordinate"] / rows[mid]["cpu_s_per_coordinate"]

@@ -648,3 +648,120 @@ def test_the_stepper_battery_never_forms_an_n_by_n_array(monkeypatch):
     monkeypatch.setattr(laws, "norms", quadratic)
     monkeypatch.setattr(sys.modules["verimono.checks.bounds"], "norms", quadratic)
     assert _peak_bytes(battery) > bound and formed == [(n, n)]
+
+
+# -- large n: counted work and memory (issue 43, item 2) ------------------------------------------------------
+
+def _big_problem(n: int, name: str = "|x| large n"):
+    return Problem(__import__("verimono").NormSubdifferential(1.0, dim=n), np.linspace(-1.0, 1.0, n), 1.0, name=name)
+
+
+def test_witness_rows_are_the_witnesses_per_row_numbers_in_a_few_rows_of_memory():
+    """``witness_rows`` gives what ``in_domain`` and ``selections`` read of the resolvent witnesses — ``|J_k -
+    x_{k+1}|`` and the rows' maxima ``row_tolerances`` takes — the same numbers as the trajectory-sized arrays of
+    :func:`resolvent_witnesses`, holding a few rows at once (n = 5000, 41 nodes: at most 8 rows; the witnesses'
+    arrays, seen with the same bound, hold more than 80)."""
+    from verimono.checks.trajectory_laws import norms, resolvent_witnesses, witness_rows, witness_steps
+
+    n = 5000
+    p, t = _big_problem(n), np.sort(np.r_[0.0, np.random.default_rng(3).uniform(0, 1, 39), 1.0])
+    x = solve(p, t).x
+    w = witness_rows(solve, p, t, x)
+    _, y, back = resolvent_witnesses(solve, p, t)
+    np.testing.assert_array_equal(w["distance"], norms(back - x[1:]))
+    np.testing.assert_array_equal(w["back_max"], np.abs(back).max(axis=1))
+    np.testing.assert_array_equal(w["muy_max"], np.abs(witness_steps(t)[:, None] * y).max(axis=1))
+    np.testing.assert_array_equal(w["hy_max"], np.abs(np.diff(t)[:, None] * y).max(axis=1))
+    np.testing.assert_array_equal(w["x_max"], np.abs(x).max(axis=1))
+    bound = 8 * n * 8
+    assert _peak_bytes(lambda: witness_rows(solve, p, t, x)) <= bound
+    assert _peak_bytes(lambda: resolvent_witnesses(solve, p, t)) > 10 * bound
+
+
+def test_streamed_psi_pairs_are_the_pair_norms_without_the_interpolants_array(monkeypatch):
+    """``psi_interpolation`` at large n forms the ψ-interpolant one time at a time: the same pair norms and
+    ``|X|_∞`` as the array of all the times' states (forced here at n = 3000 with a small ``ROW_BLOCK``), and the
+    same record; its peak at n = 8000 is the subsample's rows and a few more, where the array of 121 times is
+    7.7 MB."""
+    import verimono.checks.bounds as bounds
+
+    n = 3000
+    p, t = _big_problem(n), uniform_grid(1.0, steps=40)
+    x = solve(p, t).x
+    lg = bounds._lg_setup(p, t)[0]
+    tau = np.unique(np.concatenate([t, 0.5 * (t[:-1] + t[1:]), np.random.default_rng(0).uniform(0.0, 1.0, 40)]))
+    psi = lg.psi_function(np.union1d(t, tau))
+    i, j = bounds._pairs(len(tau), n)
+    X = bounds._psi_interpolant(t, x, tau, psi)
+    rows, lhs, xmax = bounds._streamed_pairs(t, x, tau, psi, i, j)
+    np.testing.assert_array_equal(lhs, bounds._pair_norms(X, i, j))
+    assert float(np.max(xmax)) == float(np.abs(X).max())
+    np.testing.assert_array_equal(rows[int(j[-1])], X[int(j[-1])])
+    small = _big_problem(200)
+    before = check_psi_interpolation_record(small)
+    monkeypatch.setattr(bounds, "ROW_BLOCK", 100)
+    after = check_psi_interpolation_record(small)
+    assert (before.status, before.worst) == (after.status, after.worst)
+    monkeypatch.undo()
+    monkeypatch.setattr(bounds, "PAIR_ELEMENTS", 1 << 19)     # a subsample of 11 times at n = 8000
+    n = 8000
+    p, t = _big_problem(n), uniform_grid(1.0, steps=40)
+    x = solve(p, t).x
+    i, j = bounds._pairs(len(tau), n)
+    kept = len(set(i[j != i + 1].tolist()) | set(j[j != i + 1].tolist()))
+    assert kept <= 12
+    bound = (kept + 8) * n * 8
+    assert _peak_bytes(lambda: bounds._streamed_pairs(t, x, tau, psi, i, j)) <= bound
+    assert _peak_bytes(lambda: bounds._psi_interpolant(t, x, tau, psi)) > 5 * bound
+
+
+def check_psi_interpolation_record(p):
+    from verimono.checks.bounds import check_psi_interpolation
+
+    return check_psi_interpolation(solve, p)
+
+
+def test_unique_limits_distances_by_columns_are_the_interpolants_distances(monkeypatch):
+    """In a large dimension ``_distances`` forms every time's interpolated values for a block of coordinates (a
+    sparse interpolation matrix): the distances of the two ``np.interp`` interpolants (forced at n = 3000), and a
+    peak of a few blocks."""
+    import verimono.checks.limits as limits
+
+    rng = np.random.default_rng(11)
+    n = 3000
+    ga, gb = np.linspace(0.0, 1.0, 11), np.sort(np.r_[0.0, rng.uniform(0.0, 1.0, 39), 1.0])
+    xa, xb = rng.normal(size=(11, n)), rng.normal(size=(41, n))
+    tau = np.r_[np.union1d(ga, gb)[1:], 1.5]          # one time beyond the end: held constant
+    ia = np.stack([np.interp(tau, ga, xa[:, j]) for j in range(n)], axis=-1)
+    ib = np.stack([np.interp(tau, gb, xb[:, j]) for j in range(n)], axis=-1)
+    want = np.linalg.norm(ia - ib, axis=-1)
+    monkeypatch.setattr(limits, "SPARSE_COLUMNS", 1000)
+    monkeypatch.setattr(limits, "COLUMN_ELEMENTS", 4096)
+    got = limits._distances(ga, xa, gb, xb, tau)
+    assert np.allclose(got, want, rtol=1e-13, atol=0.0)
+    assert _peak_bytes(lambda: limits._distances(ga, xa, gb, xb, tau)) <= 64 * 4096 * 8
+
+
+def test_the_shared_runs_keep_a_battery_at_n_1e6():
+    """Counted, not timed: every partition the stepper battery judges a problem on fits in the shared runs at
+    n = 10^6 (680 nodes, 5.4 GB), so each is run once — the former 64 MiB kept nothing beyond n = 2·10^5 and the
+    battery ran the stepper 65 times instead of 12 — and a run larger than the bound is run again, never held."""
+    import verimono.checks.shared_runs as shared
+    from verimono.checks.partitions import every_battery_grid
+
+    nodes = sum(len(g) for g in every_battery_grid(_big_problem(3)).values())
+    assert nodes == 680
+    assert nodes * 10 ** 6 * 8 <= shared.MAX_BYTES
+    assert not nodes * 10 ** 6 * 8 <= 64 * 2 ** 20      # the former bound
+
+
+def test_all_finite_reads_a_sum_and_decides_overflow_exactly():
+    from verimono.checks.partitions import all_finite
+
+    a = np.full((4, 5), 1e308)
+    assert all_finite(a)                                # the sum overflows, every number is finite
+    a[2, 3] = np.nan
+    assert not all_finite(a)
+    b = np.zeros((3, 3))
+    b[1, 1] = -np.inf
+    assert not all_finite(b) and all_finite(np.zeros((3, 3)))

@@ -30,7 +30,8 @@ from ..core.stepping import Trajectory
 from ..core.tolerances import tolerance
 from .core import PROXIMAL_CLAIM, Holds, Outcome
 from .partitions import run_stepper, single, stepper_law
-from .trajectory_laws import norms
+from .shared_runs import fingerprint, remembered_value, run_serial
+from .trajectory_laws import ROW_BLOCK, norms, step_norms
 
 
 def _vals(fn: Callable, t: Iterable[float]) -> np.ndarray:
@@ -85,6 +86,11 @@ def _sigma_of(problem: Problem) -> tuple[Callable[[float], float], str]:
         return problem.sigma, "stated"
     op = problem.operator
     if provides(op, "growth"):
+        if getattr(op, "static", False):
+            # F(t,·) = F(0,·): its growth is one number, asked once (the bounds ask σ at every node of every
+            # partition, and a growth may cost O(n): |F^0(t, (1, ..., 1))|, 750 evaluations at n = 10^6 in a battery)
+            value = op.growth(0.0)
+            return (lambda t: value), f"derived: the growth {op.name} states (static: at t = 0)"
         return op.growth, f"derived: the growth {op.name} states"
     raise NotApplicable("the problem states no σ of (LG)")
 
@@ -210,7 +216,7 @@ def _lg_setup(p: Problem, t: np.ndarray):
     """Bounds of lem:bndSeq and the sequence they bound (``ξ_k = x_k - Φ(t_k)`` with an input)."""
     _lg_requirements(p)
     (phi, phi_src), (sigma, sigma_src) = _phi_of(p), _sigma_of(p)
-    shift = np.zeros((len(t), p.dim))
+    shift = None           # no input: ξ = x (no trajectory-sized array of zeros subtracted)
     extra = {"phi": phi_src, "sigma": sigma_src}
     absu = None
     if p.u is not None or p.U is not None:
@@ -227,7 +233,7 @@ def _lg_setup(p: Problem, t: np.ndarray):
 def _yb_setup(p: Problem, t: np.ndarray):
     _yb_requirements(p)
     theta, src = _theta_of(p)
-    return YBBounds(p.x0, theta, p.operator, p.T), np.zeros((len(t), p.dim)), {"theta": src}
+    return YBBounds(p.x0, theta, p.operator, p.T), None, {"theta": src}
 
 
 def _bounded(stepper: Callable, p: Problem, t: np.ndarray, setup: Callable, label: str, passed: str) -> Outcome:
@@ -235,10 +241,9 @@ def _bounded(stepper: Callable, p: Problem, t: np.ndarray, setup: Callable, labe
     (``ξ = x`` without an input, ``x - Φ`` with one), with the lemma's β and ψ from ``setup``."""
     bounds, shift, extra = setup(p, t)
     x = run_stepper(stepper, p, t)
-    xi = x - shift
+    xi = x if shift is None else x - shift
     psi = bounds.psi_nodes(t)
-    nx = norms(xi)
-    steps = norms(np.diff(xi, axis=0))
+    nx, steps = _norms_and_steps(xi, stepper, p, t, shift is None)
     dpsi = np.diff(psi)
     # an inexact resolvent (Inexact): x_k is within E_k = Σ_{j≤k} ε(h_j) of the exact scheme's iterate, which
     # the lemma bounds (nonexpansive steps, f = 0 here)
@@ -249,7 +254,7 @@ def _bounded(stepper: Callable, p: Problem, t: np.ndarray, setup: Callable, labe
     bad = np.flatnonzero(ratios > 1.0)
     k = int(bad[0]) + 1 if bad.size else int(np.argmax(ratios)) + 1
     which = "|x_k| <= beta" if r_beta[k] >= r_step[k - 1] else "|x_k - x_(k-1)| <= psi(t_k) - psi(t_(k-1))"
-    counter = {"k": k, "t_k": t[k], "x_k": xi[k], "x_k_minus_1": xi[k - 1], "bound": which,
+    counter = {"k": k, "t_k": t[k], "x_k": xi[k].copy(), "x_k_minus_1": xi[k - 1].copy(), "bound": which,
                "norm_x_k": nx[k], "step": steps[k - 1], "psi_increment": dpsi[k - 1], **bounds.constants(),
                **extra,
                "message": f"{label}: {which} fails at k = {k}, t_k = {t[k]:.6g}: |x_k| = {nx[k]:.6g}, "
@@ -258,6 +263,16 @@ def _bounded(stepper: Callable, p: Problem, t: np.ndarray, setup: Callable, labe
     details = {**bounds.constants(), **extra, "max_ratio_beta": float(np.max(r_beta)),
                "max_ratio_psi": float(np.max(r_step))}
     return Outcome(float(np.max(ratios)), k, counter, details, message=passed)
+
+
+def _norms_and_steps(xi: np.ndarray, stepper: Callable, p: Problem, t: np.ndarray, own: bool):
+    """``(|ξ_k|, |ξ_k − ξ_{k−1}|)``; of a kept run itself (``own``: no input shift), measured once for both lemmas'
+    laws (:func:`verimono.checks.shared_runs.remembered_value`, keyed by the run's serial number)."""
+    serial = run_serial(xi) if own else None
+    if serial is None:
+        return norms(xi), step_norms(xi)
+    key = ("norms_and_steps", id(stepper), id(p), float(p.T), fingerprint(np.asarray(p.x0)), fingerprint(t), serial)
+    return remembered_value(key, (stepper, p), lambda: (norms(xi), step_norms(xi)))
 
 
 @stepper_law("bounds_lg", "lem:bndSeq", PROXIMAL_CLAIM, _holds(_lg_requirements), every_grid=True,
@@ -331,6 +346,80 @@ def _pair_norms(X: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
                           [np.zeros(0)])
 
 
+def _psi_interpolant(t: np.ndarray, x: np.ndarray, tau: np.ndarray, psi: Callable) -> np.ndarray:
+    """:meth:`verimono.Trajectory.interpolate` ``(tau, kind="psi", psi=psi)`` of the states ``x`` on ``t`` — the same
+    numbers — into one array, the rows formed :data:`verimono.checks.trajectory_laws.ROW_BLOCK` numbers at a time
+    (``interpolate`` forms four arrays of all the times' states: 1 GB each for 121 times at n = 10^6)."""
+    if x.size <= ROW_BLOCK or x.ndim != 2:
+        return Trajectory(t, x, None).interpolate(tau, kind="psi", psi=psi)
+    tau = np.asarray(tau, dtype=float)
+    Trajectory(t, x[:, :1], None).interpolate(tau, kind="psi", psi=psi)   # its checks of tau and psi, on one coordinate
+    k = np.clip(np.searchsorted(t, tau, side="right") - 1, 0, len(t) - 2)
+    ps = np.vectorize(lambda s: float(psi(s)))
+    a, b, s = ps(t[k]), ps(t[k + 1]), ps(tau)
+    w = (s - a) / (b - a)
+    out = np.empty((len(tau), x.shape[1]))
+    tmp = np.empty(x.shape[1])
+    for r in range(len(tau)):
+        # (1 - w) x_k + w x_{k+1}, as interpolate computes it
+        np.multiply(1.0 - w[r], x[k[r]], out=out[r])
+        np.multiply(w[r], x[k[r] + 1], out=tmp)
+        out[r] += tmp
+    return out
+
+
+def _streamed_pairs(t: np.ndarray, x: np.ndarray, tau: np.ndarray, psi: Callable, i: np.ndarray, j: np.ndarray):
+    """``(rows, lhs, xmax)`` of the ψ-interpolant at ``tau`` formed one time at a time (:func:`_psi_interpolant`'s
+    arithmetic): ``lhs`` the norms ``|X[j] − X[i]|`` of the pairs (as :func:`_pair_norms` forms them when a row holds
+    :data:`PAIR_BLOCK` numbers or more), ``xmax = |X|_∞``, ``rows`` a mapping ``index -> X[index]`` of the rows a
+    non-consecutive pair reads (a few at large n, :func:`_pairs`) and of those :func:`check_psi_interpolation`'s
+    counterexample may read.  ``xmax``: each row's ``|X_r|_∞`` (what ``tolerance`` reads of ``X``).  Memory: O(n) per
+    kept row, not O(len(tau) n)."""
+    T = len(tau)
+    Trajectory(t, x[:, :1], None).interpolate(tau, kind="psi", psi=psi)   # its checks of tau and psi
+    k = np.clip(np.searchsorted(t, tau, side="right") - 1, 0, len(t) - 2)
+    ps = np.vectorize(lambda s: float(psi(s)))
+    a, b, s = ps(t[k]), ps(t[k + 1]), ps(tau)
+    w = (s - a) / (b - a)
+    consecutive = j == i + 1
+    keep = set(i[~consecutive].tolist()) | set(j[~consecutive].tolist())
+    by_j: dict[int, list[int]] = {}
+    for p in np.flatnonzero(consecutive):
+        by_j.setdefault(int(j[p]), []).append(int(p))
+    lhs = np.empty(len(i))
+    rows: dict[int, np.ndarray] = {}
+    xmax = np.empty(T)
+    prev, row, tmp = None, np.empty(x.shape[1]), np.empty(x.shape[1])
+    for r in range(T):
+        np.multiply(1.0 - w[r], x[k[r]], out=row)
+        np.multiply(w[r], x[k[r] + 1], out=tmp)
+        row += tmp
+        xmax[r] = max(row.max(), -row.min())         # |X_r|_∞ (a NaN stays a NaN)
+        for p in by_j.get(r, ()):
+            np.subtract(row, prev, out=tmp)
+            lhs[p] = norms(tmp[None])[0]
+        if r in keep:
+            rows[r] = row.copy()
+        prev, row = row, (prev if prev is not None else np.empty(x.shape[1]))
+    for p in np.flatnonzero(~consecutive):
+        lhs[p] = norms((rows[int(j[p])] - rows[int(i[p])])[None])[0]
+    return _Rows(rows, t, x, k, w), lhs, xmax
+
+
+class _Rows:
+    """The rows of the ψ-interpolant by index: kept ones as they were formed, others formed again (the same
+    arithmetic)."""
+
+    def __init__(self, rows, t, x, k, w):
+        self.rows, self.x, self.k, self.w = rows, x, k, w
+
+    def __getitem__(self, r):
+        r = int(r)
+        if r not in self.rows:
+            self.rows[r] = (1.0 - self.w[r]) * self.x[self.k[r]] + self.w[r] * self.x[self.k[r] + 1]
+        return self.rows[r]
+
+
 @stepper_law("psi_interpolation", "lem:bndEquiCont", PROXIMAL_CLAIM, _either(_lg_requirements, _yb_requirements))
 def check_psi_interpolation(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int = 0,
                             samples: int = 40) -> Outcome:
@@ -361,21 +450,28 @@ def check_psi_interpolation(stepper: Callable, p: Problem, t: np.ndarray, *, see
     tau = np.unique(np.concatenate([t, 0.5 * (t[:-1] + t[1:]), rng.uniform(0.0, p.T, samples)]))
     worst, best, det = -np.inf, None, {}
     for label, bounds, shift, extra in setups:
-        traj = Trajectory(t, x - shift, None)
         psi = bounds.psi_function(np.union1d(t, tau))
-        X = traj.interpolate(tau, kind="psi", psi=psi)
         P = np.array([psi(s) for s in tau])
-        i, j = _pairs(len(tau), int(np.prod(X.shape[1:])))
-        lhs = _pair_norms(X, i, j)
+        i, j = _pairs(len(tau), int(np.prod(x.shape[1:])))
+        xs = x if shift is None else x - shift
+        if xs.ndim == 2 and xs.size > ROW_BLOCK:
+            # the interpolant's rows one at a time: the pairs' norms and |X|_∞ as they come, the rows of the
+            # non-consecutive pairs kept (the same numbers as below without the array of all the times' states)
+            X, lhs, xmax = _streamed_pairs(t, xs, tau, psi, i, j)
+        else:
+            X = _psi_interpolant(t, xs, tau, psi)
+            lhs = _pair_norms(X, i, j)
+            xmax = X
         rhs = P[j] - P[i]
-        ratio = lhs / (rhs + slack + tolerance(X, P))
+        ratio = lhs / (rhs + slack + tolerance(xmax, P))
         m = int(np.argmax(ratio))
         det[label] = float(ratio[m])
         if ratio[m] > worst:
             worst = float(ratio[m])
             k = int(np.searchsorted(t, tau[j[m]], side="left"))
             best = {"k": max(1, min(k, len(t) - 1)), "lemma": label, "tau_low": tau[i[m]],
-                    "tau_high": tau[j[m]], "x_low": X[i[m]], "x_high": X[j[m]], "lhs": lhs[m], "rhs": rhs[m],
+                    "tau_high": tau[j[m]], "x_low": X[i[m]].copy(), "x_high": X[j[m]].copy(), "lhs": lhs[m],
+                    "rhs": rhs[m],
                     **bounds.constants(),
                     "message": f"{label}/lem:bndEquiCont: |x_D(tau') - x_D(tau)| = {lhs[m]:.6g} > "
                                f"psi(tau') - psi(tau) = {rhs[m]:.6g} for tau = {tau[i[m]]:.6g}, "

@@ -11,11 +11,13 @@ answers a repeated ``(stepper, problem, partition)`` from the first run instead 
 (measured on the ``ci`` battery of ``verimono.solve``: 881 runs, 367 distinct, 0.69 s of 1.2 s saved).
 
 Every law still judges the stepper's own output on its own partition; only repeats are answered from the
-first answer (a copy: a law that writes into its array cannot change another's), and the precision the
+first answer (the same array, read-only: a law that writes into its array gets NumPy's error and cannot change
+another's; a copy per reuse cost 1 s per 161-node run at n = 10^6, in page faults), and the precision the
 stepper computed in is reported again to the judgement that reuses it (:func:`verimono.core.tolerances.observe`:
 a float32 stepper is judged as float32 by every law).  What is kept is bounded
-(:data:`MAX_BYTES`, oldest first out): a large problem is run again rather than held.  A stepper that
-raises or returns what :func:`run_stepper` refuses is not remembered: every law sees it fail.
+(:data:`MAX_BYTES` of runs, oldest first out): a larger problem is run again rather than held.  A stepper that
+raises or returns what :func:`run_stepper` refuses is not remembered: every law sees it fail.  A kept run has a
+serial number (:func:`run_serial`) that values derived from it can be keyed by, without reading its states again.
 
 :func:`remembered_value` does the same for what laws derive from a run and ask for alike — the resolvent
 points ``J_μ(x_{k+1} + μ y_k)`` that ``in_domain`` takes as witnesses of ``dom F`` and ``selections`` judges
@@ -34,26 +36,68 @@ import numpy as np
 
 from ..core.tolerances import judged_precision, observe
 
-#: bytes of states a :func:`shared_runs` block keeps at most (its oldest runs are dropped first)
-MAX_BYTES = 64 * 2**20
+#: bytes of states a :func:`shared_runs` block keeps at most (its oldest runs are dropped first): a count, the
+#: same on every machine.  The stepper battery's partitions of one problem hold 680 nodes (10 partitions,
+#: :func:`verimono.checks.partitions.every_battery_grid`): 5.4 GB at n = 10^6, all kept under 6 GiB, so each is
+#: run once (at 64 MiB, the former bound, nothing was kept beyond n = 2·10^5 and the battery made 65 runs instead
+#: of 12).  The runs are the arrays the laws judge anyway (kept read-only, never copied): what the bound
+#: adds to a battery's peak memory is the runs of laws already finished.
+MAX_BYTES = 6 * 2**30
+#: bytes of derived values (:func:`remembered_value`) a block keeps at most
+MAX_VALUE_BYTES = 64 * 2**20
 
 _ACTIVE: list["_Runs"] = []
 
 
 class _Runs:
     """What one :func:`shared_runs` block keeps: ``key -> (owners, arrays, precision)``, at most :data:`MAX_BYTES`
-    of arrays in all, the oldest dropped first; and the partitions of each (stepper, problem) the battery's
-    convergence studies ran (:func:`note_partitions`)."""
+    of runs (kept read-only, handed out as they are) and :data:`MAX_VALUE_BYTES` of derived values (copied in and
+    out), the oldest dropped first; and the partitions of each (stepper, problem) the battery's convergence
+    studies ran (:func:`note_partitions`)."""
 
     def __init__(self) -> None:
         self.kept: OrderedDict[tuple, tuple[tuple, tuple[np.ndarray, ...], str | None]] = OrderedDict()
+        self.values: OrderedDict[tuple, tuple[tuple, tuple[np.ndarray, ...], str | None]] = OrderedDict()
         self.bytes = 0
+        self.value_bytes = 0
         self.hits = 0
         self.partitions: dict[tuple, tuple[Any, list[np.ndarray]]] = {}
+        #: id of a kept run's array -> its serial number (only while it is kept: the id cannot be reused then)
+        self.serials: dict[int, int] = {}
+        self.next_serial = 0
 
     def get(self, key: tuple) -> tuple[np.ndarray, ...] | None:
-        """Copies of the arrays kept for ``key`` (their precision observed again), or ``None``."""
+        """The read-only arrays kept for ``key`` (their precision observed again), or ``None``."""
         hit = self.kept.get(key)
+        if hit is None:
+            return None
+        self.hits += 1
+        self.kept.move_to_end(key)
+        if hit[2] not in (None, "float64"):
+            observe(hit[2])
+        return hit[1]
+
+    def put(self, key: tuple, owners: tuple, arrays: tuple[np.ndarray, ...], precision: str | None) -> None:
+        """Keep the run ``arrays`` (the caller's own arrays, made read-only here)."""
+        size = sum(a.nbytes for a in arrays)
+        if size > MAX_BYTES:
+            return
+        for a in arrays:
+            a.setflags(write=False)
+            self.serials[id(a)] = self.next_serial
+            self.next_serial += 1
+        # the owners (stepper, problem) are held with their arrays, so the ids in the key cannot be reused
+        self.kept[key] = (owners, tuple(arrays), precision)
+        self.bytes += size
+        while self.bytes > MAX_BYTES:
+            _, (_, old, _) = self.kept.popitem(last=False)
+            self.bytes -= sum(a.nbytes for a in old)
+            for a in old:
+                self.serials.pop(id(a), None)
+
+    def get_value(self, key: tuple) -> tuple[np.ndarray, ...] | None:
+        """Copies of the derived value kept for ``key`` (its precision observed again), or ``None``."""
+        hit = self.values.get(key)
         if hit is None:
             return None
         self.hits += 1
@@ -61,16 +105,15 @@ class _Runs:
             observe(hit[2])
         return tuple(a.copy() for a in hit[1])
 
-    def put(self, key: tuple, owners: tuple, arrays: tuple[np.ndarray, ...], precision: str | None) -> None:
+    def put_value(self, key: tuple, owners: tuple, arrays: tuple[np.ndarray, ...], precision: str | None) -> None:
         size = sum(a.nbytes for a in arrays)
-        if size > MAX_BYTES:
+        if size > MAX_VALUE_BYTES:
             return
-        # the owners (stepper, problem) are held with their arrays, so the ids in the key cannot be reused
-        self.kept[key] = (owners, tuple(a.copy() for a in arrays), precision)
-        self.bytes += size
-        while self.bytes > MAX_BYTES:
-            _, (_, old, _) = self.kept.popitem(last=False)
-            self.bytes -= sum(a.nbytes for a in old)
+        self.values[key] = (owners, tuple(a.copy() for a in arrays), precision)
+        self.value_bytes += size
+        while self.value_bytes > MAX_VALUE_BYTES:
+            _, (_, old, _) = self.values.popitem(last=False)
+            self.value_bytes -= sum(a.nbytes for a in old)
 
 
 @contextmanager
@@ -99,8 +142,9 @@ def _key(stepper: Any, problem: Any, grid: np.ndarray) -> tuple:
 def remembered(stepper: Any, problem: Any, grid: np.ndarray,
                run: Callable[[], tuple[np.ndarray, str | None]]) -> np.ndarray:
     """The states of ``run()`` — ``(states, precision)``: the validated float64 states of ``stepper`` on
-    ``problem`` and ``grid`` and the precision it computed them in — or, inside :func:`shared_runs`, a copy of
-    those it returned the first time for the same three (their precision observed again)."""
+    ``problem`` and ``grid`` and the precision it computed them in — or, inside :func:`shared_runs`, those it
+    returned the first time for the same three (the same read-only array, its precision observed again; the
+    first caller gets it read-only too)."""
     if not _ACTIVE:
         return run()[0]
     key = _key(stepper, problem, np.asarray(grid, dtype=float))
@@ -147,14 +191,23 @@ def remembered_value(key: tuple, owners: tuple, compute: Callable[[], tuple[np.n
     ``compute`` that raises is not remembered."""
     if not _ACTIVE:
         return compute()
-    hit = _ACTIVE[-1].get(key)
+    hit = _ACTIVE[-1].get_value(key)
     if hit is not None:
         return hit
     with judged_precision() as seen:      # reports what it saw to the judgement in progress as well
         value = compute()
-    _ACTIVE[-1].put(key, owners, value, seen.name)
+    _ACTIVE[-1].put_value(key, owners, value, seen.name)
     return value
 
 
+def run_serial(x: np.ndarray) -> int | None:
+    """Inside :func:`shared_runs`: the serial number of the kept run whose states are the array ``x`` (the object
+    :func:`remembered` returned), ``None`` when ``x`` is not a kept run.  Unique within the block while the run is
+    kept, never reused: a key for what is derived from that run, without fingerprinting its states."""
+    if not _ACTIVE:
+        return None
+    return _ACTIVE[-1].serials.get(id(x))
+
+
 __all__ = ["shared_runs", "remembered", "remembered_value", "note_partitions", "noted_partitions", "MAX_BYTES",
-           "fingerprint"]
+           "MAX_VALUE_BYTES", "fingerprint", "run_serial"]

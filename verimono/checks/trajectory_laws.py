@@ -38,11 +38,11 @@ from ..core.grids import uniform_grid
 from ..core.operator_protocol import resolvent_kernel
 from ..core.problem import Problem
 from ..core.stepping import Trajectory
-from ..core.tolerances import DOMAIN_ORDER_SLACK, current_precision, row_tolerances, tolerance
+from ..core.tolerances import DOMAIN_ORDER_SLACK, current_precision, judged_precision, row_tolerances, tolerance
 from ..records.results import FAILED, PASSED, UNDECIDED
 from .core import CONTRACTION_CLAIM, PROXIMAL_CLAIM, Holds, Member, Outcome
 from .partitions import battery_grids, claimed_grids, default_grids, run_stepper, stepper_law
-from .shared_runs import fingerprint, remembered_value
+from .shared_runs import fingerprint, remembered_value, run_serial
 
 #: cells of the refinement levels of the vanishing-distance form of ``in_domain``
 DOMAIN_LEVELS = (10, 40, 160)
@@ -60,6 +60,44 @@ def norms(a: np.ndarray) -> np.ndarray:
     sum were 3x the time)."""
     a = np.asarray(a, dtype=float)
     return np.sqrt(np.einsum("...i,...i->...", a, a))
+
+
+#: at most this many numbers of a temporary are formed at once by the row-wise helpers below (rows in blocks;
+#: one row when a row is longer): a trajectory-sized temporary at n = 10^6 (a 161-node run is 1.3 GB) costs a
+#: page fault per 4 KiB, about 1 s, where the same arithmetic in a reused block costs 0.1-0.2 s
+ROW_BLOCK = 1 << 16
+
+
+def _row_step(a: np.ndarray) -> int:
+    return max(1, ROW_BLOCK // max(1, int(np.prod(a.shape[1:]))))
+
+
+def diff_norms(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``norms(a - b)`` row by row, the difference formed :data:`ROW_BLOCK` numbers at a time (the same numbers
+    as ``norms(a - b)``: the same subtraction and the same sum per row)."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    if a.ndim < 2 or a.size <= ROW_BLOCK:
+        return norms(a - b)
+    out = np.empty(a.shape[:-1])
+    step = _row_step(a)
+    for i in range(0, len(a), step):
+        out[i:i + step] = norms(a[i:i + step] - b[i:i + step])
+    return out
+
+
+def step_norms(a: np.ndarray) -> np.ndarray:
+    """``norms(np.diff(a, axis=0))`` without the trajectory-sized difference (:func:`diff_norms`)."""
+    return diff_norms(a[1:], a[:-1])
+
+
+def row_absmax(a: np.ndarray) -> np.ndarray:
+    """``max_j |a[k, j]|`` for each row ``k`` (``initial = 0``), without ``np.abs``'s copy: the larger of the row's
+    maximum and minus its minimum (the same number)."""
+    a = np.asarray(a, dtype=float)
+    a = a.reshape(a.shape[0], -1)
+    if a.shape[1] == 0:
+        return np.zeros(a.shape[0])
+    return np.maximum(np.maximum(a.max(axis=1), -a.min(axis=1)), 0.0)
 
 
 # -- contraction ------------------------------------------------------------------------------------
@@ -158,7 +196,7 @@ def check_contraction(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int
     inexact = 2.0 * steps_tolerance(claim_of(stepper), np.diff(t))    # each run's step within ε(h) (Inexact)
     worst, best, glob = -np.inf, None, 0.0
     for z, y in zip(starts, run_starts(stepper, p, starts, t, x)):
-        d = norms(x - y)
+        d = diff_norms(x, y)
         tol = tolerance(x, y)
         ratio = d[1:] / (growth * d[:-1] + inexact + tol)
         glob = max(glob, float(np.max(d / (np.concatenate([[1.0], np.cumprod(growth)]) * d[0] + tol))))
@@ -167,8 +205,9 @@ def check_contraction(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int
         r = float(np.max(ratio))
         if r > worst:
             worst = r
-            best = {"x0_prime": z, "k": k, "t_k": t[k], "x_k": x[k], "x_prime_k": y[k],
-                    "x_k_minus_1": x[k - 1], "x_prime_k_minus_1": y[k - 1],
+            # rows copied: a view would hold the whole trajectory in the record
+            best = {"x0_prime": z, "k": k, "t_k": t[k], "x_k": x[k].copy(), "x_prime_k": y[k].copy(),
+                    "x_k_minus_1": x[k - 1].copy(), "x_prime_k_minus_1": y[k - 1].copy(),
                     "lhs": d[k], "rhs": growth[k - 1] * d[k - 1], "L": L,
                     "message": f"|x_k - x'_k| = {d[k]:.6g} > g_k |x_(k-1) - x'_(k-1)| = "
                                f"{growth[k - 1] * d[k - 1]:.6g} at k = {k}, t_k = {t[k]:.6g}"}
@@ -281,12 +320,13 @@ def check_in_domain(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int =
     exact = np.ones(len(t), dtype=bool)
     exact[:first] = False
     try:
-        _, _, back = resolvent_witnesses(stepper, p, t)
+        w = witness_rows(stepper, p, t, x)
     except Exception:  # noqa: BLE001 - no witness: every node is measured exactly, as the law states
-        back = None
-    if back is not None:
-        bound = norms(back - x[1:])
-        tol = row_tolerances(x[1:], back)
+        w = None
+    if w is not None:
+        # row_tolerances(x[1:], back) of the per-row maxima the witnesses' pass measured
+        bound = w["distance"]
+        tol = current_precision().rtol * (1.0 + np.maximum(w["x_max"][1:], w["back_max"]))
         near = bound <= tol
         dists[1:][near], ratios[1:][near] = bound[near], bound[near] / tol[near]
         exact[1:] &= ~near
@@ -299,7 +339,7 @@ def check_in_domain(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int =
     bad = np.flatnonzero(ratios > 1.0)
     k = int(bad[0]) if bad.size else int(np.argmax(ratios))
     worst = float(np.max(ratios))
-    counter = {"k": k, "t_k": t[k], "x_k": x[k], "distance": dists[k]}
+    counter = {"k": k, "t_k": t[k], "x_k": x[k].copy(), "distance": dists[k]}
     if not worst <= 1.0:     # a failure (a NaN too) shows the projection (a QP for some operators) and says where
         counter["projection"] = p.operator.project_domain(x[k], float(t[k]))
         counter["message"] = (f"x_k = {np.array2string(x[k], precision=6)} is at distance {dists[k]:.3g} "
@@ -326,24 +366,29 @@ def check_selections(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int 
     Claim: ``proximal`` — the discrete velocities of the paper's scheme are selections; another scheme's
     (the midpoint rule, the exact solution sampled) are not, and need not be.
     """
-    x, y, back = resolvent_witnesses(stepper, p, t)
+    x = run_stepper(stepper, p, t)
+    w = witness_rows(stepper, p, t, x)
     h = np.diff(t)
     op = p.operator
     eps = steps_tolerance(claim_of(stepper), h)
+    rtol = current_precision().rtol
     # an inexact resolvent (x_{k+1} within ε of J_h(z_k)): the witness is within 2ε (Inexact), and membership is
     # judged by the distance to the exact resolvent instead (a point ε outside dom F has no selection to test)
-    ratios = norms(back - x[1:]) / (row_tolerances(x[1:], witness_steps(t)[:, None] * y, x[:-1]) + 2.0 * eps)
+    # (row_tolerances(x[1:], μ y, x[:-1]) of the per-row maxima the witnesses' pass measured)
+    xm = w["x_max"]
+    ratios = w["distance"] / (rtol * (1.0 + np.maximum(np.maximum(xm[1:], w["muy_max"]), xm[:-1])) + 2.0 * eps)
     member = np.ones(len(h), dtype=bool)
     contains_available = op.provides("contains") if hasattr(op, "provides") else callable(getattr(op, "contains", None))
     contains_available = contains_available and not eps.any()
-    inexact = _inexact_distances(p, t, x, y, eps) if eps.any() else None
+    inexact = (_inexact_distances(p, t, x, Trajectory(t, x, p).selections, eps) if eps.any() else None)
     if inexact is not None:
         ratios = np.maximum(ratios, inexact["ratios"])
     if contains_available:
-        tols = row_tolerances(x[:-1], x[1:], h[:, None] * y) / h
-        for k in range(len(h)):
+        # row_tolerances(x[:-1], x[1:], h y) / h, the discrete velocities formed one at a time
+        tols = rtol * (1.0 + np.maximum(np.maximum(xm[:-1], xm[1:]), w["hy_max"])) / h
+        for k, yk in enumerate(velocity_rows(p, t, x)):
             try:
-                member[k] = op.contains(x[k + 1], y[k], float(t[k + 1]), tol=float(tols[k]))
+                member[k] = op.contains(x[k + 1], yk, float(t[k + 1]), tol=float(tols[k]))
             except NotImplementedError:
                 contains_available = False
                 member[:] = True
@@ -365,14 +410,16 @@ def check_selections(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int 
                   "" if contains_available else " (resolvent characterisation only: no contains)"))
     if worst <= 1.0:         # held: the counterexample is never shown
         return Outcome(worst, k + 1, {"k": k + 1}, details, message=message)
-    counter = {"k": k + 1, "t_k": t[k + 1], "x_k": x[k], "x_k_plus_1": x[k + 1], "h": h[k], "selection": y[k],
+    yk = velocity_row(p, t, x, k)
+    counter = {"k": k + 1, "t_k": t[k + 1], "x_k": x[k].copy(), "x_k_plus_1": x[k + 1].copy(), "h": h[k],
+               "selection": yk,
                "velocity": velocity, **terms,
                "contains": bool(member[k]) if contains_available else None, "resolvent_residual_ratio": ratios[k]}
     # what each test said: membership only where the operator provides ``contains`` (no "contains: True"
     # for one that has none: it was never asked)
     said = (f"contains: {bool(member[k])}, " if contains_available else "the operator has no contains; ")
     outside = _outside_domain(op, x[k + 1], float(t[k + 1])) if bad.size else None
-    msg = (f"the discrete velocity y = {velocity} = {np.array2string(y[k], precision=6)} is not in "
+    msg = (f"the discrete velocity y = {velocity} = {np.array2string(yk, precision=6)} is not in "
            f"F(t_(k+1), x_(k+1)) at k+1 = {k + 1}, t = {t[k + 1]:.6g}"
            + "".join(f", {name} = {np.array2string(v, precision=6)}" for name, v in terms.items())
            + f" ({said}|J(x + mu y) - x|/tol = {ratios[k]:.3g})")
@@ -440,6 +487,77 @@ def resolvent_witnesses(stepper: Callable, p: Problem, t: np.ndarray) -> tuple[n
            fingerprint(x))
     y, back = remembered_value(key, (stepper, p), compute)
     return x, y, back
+
+
+def velocity_row(p: Problem, t: np.ndarray, x: np.ndarray, k: int) -> np.ndarray:
+    """Row ``k`` of :attr:`verimono.Trajectory.selections` (``y_k = (z_k - x_{k+1})/h_{k+1}``), the same numbers,
+    formed alone: the same operations on the same row."""
+    h = float(t[k + 1] - t[k])
+    z = x[k].copy()
+    if p.f is not None:
+        z += h * as_float64(p.f(x[k]))
+    dU = p.input_increments(t[k:k + 2])
+    if dU is not None:
+        z += np.asarray(dU[0], dtype=float)
+    z -= x[k + 1]
+    z /= h
+    return z
+
+
+def velocity_rows(p: Problem, t: np.ndarray, x: np.ndarray):
+    """The discrete velocities ``y_0, y_1, ...`` one at a time (:func:`velocity_row`), the input's increments
+    computed once: O(n) memory whatever the number of nodes."""
+    if p.f is None and p.input_increments(t[:2]) is None:
+        for k in range(len(t) - 1):
+            z = np.subtract(x[k], x[k + 1])
+            z /= float(t[k + 1] - t[k])
+            yield z
+        return
+    for k in range(len(t) - 1):
+        yield velocity_row(p, t, x, k)
+
+
+def witness_rows(stepper: Callable, p: Problem, t: np.ndarray, x: np.ndarray) -> dict[str, np.ndarray]:
+    """What ``in_domain`` and ``selections`` read of the :func:`resolvent_witnesses`, per row, in one pass that
+    forms one node's arrays at a time (the witnesses' arrays were two trajectory-sized arrays, their
+    differences and tolerances eight more: 13 s per 161-node run at n = 10^6):
+
+    ``distance[k] = |J_k - x_{k+1}|``, ``back_max[k] = |J_k|_∞``, ``muy_max[k] = |μ_k y_k|_∞``,
+    ``hy_max[k] = |h_{k+1} y_k|_∞`` (``k < K``) and ``x_max[k] = |x_k|_∞`` (``k ≤ K``) — the same numbers as
+    ``norms(back - x[1:])`` and the per-row maxima ``row_tolerances`` takes.  Within
+    :func:`verimono.checks.shared_runs.shared_runs` computed once per kept run (keyed by its serial number), the
+    precision the operator computed in observed again on each reuse."""
+
+    def compute() -> tuple[np.ndarray, ...]:
+        mu = witness_steps(t)
+        h = np.diff(t)
+        step = resolvent_kernel(p.operator, np.asarray(p.x0, dtype=float))
+        K = len(mu)
+        dist, back_max, muy_max, hy_max = np.empty(K), np.empty(K), np.empty(K), np.empty(K)
+        for k, yk in enumerate(velocity_rows(p, t, x)):
+            # |μ y|_∞ and |h y|_∞ from |y|_∞: rounding is monotone and symmetric, so max_i |fl(c y_i)| =
+            # fl(c max_i |y_i|) for c > 0 — the same numbers as the products' maxima, without forming h y
+            ymax = _absmax(yk)
+            muy_max[k], hy_max[k] = mu[k] * ymax, h[k] * ymax
+            yk *= mu[k]
+            yk += x[k + 1]
+            back = np.reshape(as_float64(step(yk, float(mu[k]), float(t[k + 1]))), yk.shape)
+            back_max[k] = _absmax(back)
+            dist[k] = float(norms(back - x[k + 1]))
+        return dist, back_max, muy_max, hy_max, row_absmax(x)
+
+    serial = run_serial(x)
+    if serial is None:        # not a kept run: nothing to share it with
+        with judged_precision():
+            value = compute()
+    else:
+        key = ("witness_rows", id(stepper), id(p), float(p.T), fingerprint(np.asarray(p.x0)), fingerprint(t), serial)
+        value = remembered_value(key, (stepper, p), compute)
+    return dict(zip(("distance", "back_max", "muy_max", "hy_max", "x_max"), value))
+
+
+def _absmax(a: np.ndarray) -> float:
+    return float(max(a.max(), -a.min(), 0.0)) if a.size else 0.0
 
 
 def _velocity(p: Problem, t: np.ndarray, x: np.ndarray, k: int) -> tuple[str, dict[str, np.ndarray]]:
@@ -592,4 +710,4 @@ def check_trajectory_immutable(stepper: Callable, p: Problem, *, seed: int = 0, 
 __all__ = ["check_contraction", "check_in_domain", "check_selections", "check_initial_value",
            "check_trajectory_immutable", "domain_vanishing", "perturbed_starts",
            "run_starts", "step_growth", "lipschitz_of", "norms", "domain_distances", "resolvent_witnesses",
-           "witness_steps"]
+           "witness_steps", "witness_rows", "velocity_row", "velocity_rows", "diff_norms", "step_norms", "row_absmax"]

@@ -78,15 +78,20 @@ class Trajectory:
     def selections(self) -> np.ndarray:
         """``y_{k+1} ∈ F(t_{k+1}, x_{k+1})`` for ``k = 0..K-1``: the scheme's discrete velocities."""
         h = self.h.reshape((-1,) + (1,) * (self.x.ndim - 1))
-        z = self.x[:-1].copy()
         p = self.problem
-        if p is not None and p.f is not None:
-            z += h * np.array([p.f(xk) for xk in self.x[:-1]])
-        if p is not None:
-            dU = p.input_increments(self.t)
+        f = p.f if p is not None else None
+        dU = p.input_increments(self.t) if p is not None else None
+        if f is None and dU is None:      # one array formed, not three (at n = 10^6 each is 1.3 GB of page faults)
+            z = np.subtract(self.x[:-1], self.x[1:])
+        else:
+            z = self.x[:-1].copy()
+            if f is not None:
+                z += h * np.array([f(xk) for xk in self.x[:-1]])
             if dU is not None:
                 z += dU.reshape((dU.shape[0],) + (1,) * (self.x.ndim - 2) + (dU.shape[-1],))
-        return (z - self.x[1:]) / h
+            z -= self.x[1:]
+        z /= h
+        return z
 
     def interpolate(self, tau: Any, kind: str = "linear", psi: Callable | None = None) -> np.ndarray:
         """Values at times ``tau``: piecewise linear in ``t``, or in ``ψ`` (the paper's ``e:x delta``).
@@ -259,7 +264,10 @@ def _returned(value: Any, what: str) -> np.ndarray:
 
 
 def _check_finite(out, start, before, t, problem):
-    if np.isfinite(out).all():
+    with np.errstate(all="ignore"):   # a finite sum: every state finite, read without a boolean array of them all
+        if np.isfinite(np.add.reduce(out, axis=None)):
+            return
+    if np.isfinite(out).all():        # a sum that overflowed on finite states
         return
     bad = int(np.flatnonzero(~np.isfinite(out.reshape(out.shape[0], -1)).all(axis=1))[0])
     prev = out[bad - 1] if bad > 0 else before
