@@ -89,6 +89,26 @@ _EFFORT = {
 }
 
 
+#: above ``LARGE_N`` coordinates an operator law's coordinate budget (the design rows of each coordinate,
+#: :mod:`verimono.checks.engine.coordinates`) falls as ``min(count, max(LARGE_FLOOR, count * LARGE_N // n))``: every
+#: design row costs O(n) (a resolvent call and a few norms of n-vectors), so the rows, not the per-row cost,
+#: must fall for a battery at n = 10^6 to end within a minute (ci's 27 points a coordinate made ~330 rows a law,
+#: ~6,300 for the battery; at n = 10^6 that is ~3 min of CPU).  A count of n, profile and seed only, never a
+#: time: the same rows on every machine; for ``n <= LARGE_N`` nothing changes.  Each record states the cap
+#: (``details["searched"]["budget"]``).  The floor keeps every coordinate's design at both ends and a midpoint.
+LARGE_N = 2 ** 14
+LARGE_FLOOR = 3
+
+
+def large_n_count(count: int, n: int, floor: int = LARGE_FLOOR) -> int:
+    """The search count ``count`` of a subject of ``n`` coordinates (:data:`LARGE_N`): ``count`` up to ``LARGE_N``,
+    then ``min(count, max(floor, count * LARGE_N // n))``."""
+    count, n = int(count), int(n)
+    if n <= LARGE_N:
+        return count
+    return min(count, max(int(floor), count * LARGE_N // n))
+
+
 def get_profile(name: str) -> Profile:
     """The :class:`Profile` called ``name``."""
     try:
@@ -194,5 +214,5 @@ class _OnImport:
         return spec
 
 
-__all__ = ["PROFILES", "Profile", "REFERENCE_CALIBRATION_S", "STAGE_BUDGETS", "UnknownProfile", "get_profile", "active_profile",
+__all__ = ["LARGE_N", "LARGE_FLOOR", "large_n_count", "PROFILES", "Profile", "REFERENCE_CALIBRATION_S", "STAGE_BUDGETS", "UnknownProfile", "get_profile", "active_profile",
            "register_hypothesis_profiles", "load_hypothesis_profile"]

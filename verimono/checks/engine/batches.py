@@ -195,7 +195,6 @@ def row_resolvents(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok:
     """``J_{λ_i} X_i`` at ``t_i`` for every row (on copies of the rows); a row whose call raised, returned no
     finite point of its shape or modified its input is marked ``False`` in ``ok`` (its values are then meaningless).  Each subject
     call is timed as a call of its own (:func:`_call_starts`)."""
-    J = np.zeros_like(X)
     if rows_accepted(op):
         pairs = np.stack([lams, ts], axis=1)
         uniq, inverse, counts = np.unique(pairs, axis=0, return_inverse=True, return_counts=True)
@@ -220,9 +219,11 @@ def row_resolvents(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok:
             else:
                 fine[lo:hi] = False
             lo = hi
+        J = np.empty_like(X)     # every row written: ``order`` is a permutation
         J[order] = Js
         ok[order] &= fine & np.isfinite(Js).all(axis=1) & (Xs == X[order]).all(axis=1)   # inputs left unchanged
         return J
+    J = np.zeros_like(X)
     for i in range(X.shape[0]):
         _call_starts()
         xi = X[i].copy()
@@ -319,7 +320,8 @@ def row_norms(V: np.ndarray) -> np.ndarray:
     m = np.abs(V).max(axis=1, initial=0.0)
     good = (m > 0.0) & np.isfinite(m)
     safe = np.where(good, m, 1.0)
-    out = safe * np.sqrt(np.einsum("ij,ij->i", V / safe[:, None], V / safe[:, None]))
+    W = V / safe[:, None]       # one scaled copy (it was made twice: a (rows, n) temporary each)
+    out = safe * np.sqrt(np.einsum("ij,ij->i", W, W))
     return np.where(good, out, 0.0)
 
 

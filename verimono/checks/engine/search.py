@@ -70,6 +70,7 @@ from ...core._reproducible import no_local_constants
 from ..arguments import valid_horizon, valid_seed
 from ...core.errors import InvalidCheckArgument, UnitTimeout
 from ...execution.config import current as current_config
+from ...execution.profiles import LARGE_N, large_n_count
 from ...records.results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
 from ...execution.timeouts import (checkpoint, current_budget, interrupted, interruptible, note_progress,
                                   time_limit)
@@ -198,6 +199,14 @@ def bounded_root_cause(op: Any, horizon: float = 1.0) -> str | None:
     return cause
 
 
+def _row_amax(X: np.ndarray) -> np.ndarray:
+    """``max(|X_i|)`` of every row (0 for an empty row) without a ``(rows, n)`` temporary (no ``abs`` copy, no
+    gather of the rows): ``max(0, max X_i, -min X_i)``, the same numbers for finite rows."""
+    if X.shape[1] == 0:
+        return np.zeros(X.shape[0])
+    return np.maximum(np.maximum(X.max(axis=1), -X.min(axis=1)), 0.0)
+
+
 def _amax(x: np.ndarray) -> float:
     """``max |x_i|`` (0 for an empty point), without ``np.max``'s dispatch (once per point of every sample)."""
     return float(np.abs(x).max()) if x.size else 0.0
@@ -232,6 +241,8 @@ class _Search:
     lams: list = dataclasses.field(default_factory=list)
     ts: list = dataclasses.field(default_factory=list)
     coordinates: list = dataclasses.field(default_factory=list)
+    #: the coordinate budget's cap at large n (:func:`verimono.execution.profiles.large_n_count`), stated in the record
+    budget_note: str = ""
     horizon: float = 1.0
     #: samples evaluated in each input form (verimono.checks.forms)
     forms: dict = dataclasses.field(default_factory=dict)
@@ -325,7 +336,7 @@ class _Search:
             return {}
         g = np.flatnonzero(good)
         self.runs += k
-        m1, m2 = np.abs(r.x1[g]).max(axis=1, initial=0.0), np.abs(r.x2[g]).max(axis=1, initial=0.0)
+        m1, m2 = _row_amax(r.x1)[g], _row_amax(r.x2)[g]
         self.xs += np.column_stack([m1, m2]).ravel().tolist()
         self.lams += np.column_stack([r.lam[g], r.mu[g], r.nu[g]]).ravel().tolist()
         self.ts += r.t[g].tolist()
@@ -470,7 +481,12 @@ def _coordinates(state: _Search, seed: int, horizon: float, how: dict) -> None:
         with time_limit(current_budget(), f"{state.decl.name} on {subject_name(state.op)}"):
             over = state.decl.over or OPERATOR_DOMAIN          # the law's declared quantifiers
             formed = form_search(ratio, start, forms_for(state.op)) if "form" in over else None   # a few samples
-            state.coordinates = coordinate_search(ratio, state.op, start, horizon, budget("coordinate"), seed,
+            points, n = budget("coordinate"), int(np.size(start.x1))
+            capped = large_n_count(points, n)       # design rows fall above LARGE_N coordinates: each costs O(n)
+            if capped < points:
+                state.budget_note = (f"coordinate budget capped at {capped} points for n = {n} "
+                                     f"({current_config().profile} promises {points} for n <= {LARGE_N})")
+            state.coordinates = coordinate_search(ratio, state.op, start, horizon, capped, seed,
                                                   lambda: state.unsupported is not None, ratios,
                                                   dense=state.decl.name in VECTORISED and not batched(state.op),
                                                   rows=rows_accepted(state.op), over=over)
@@ -640,7 +656,8 @@ def run_law(decl: Law | str, op: Any, *, seed: int | None = None, examples: int 
                                           "harness_limited": state.harness_limited, "sweep": how["sweep"],
                                           "coordinate": how.get("coordinate", 0),
                                           "searched": {**searched(state.xs, state.lams, state.ts, horizon,
-                                                                  state.coordinates), "forms": dict(state.forms)}},
+                                                                  state.coordinates), "forms": dict(state.forms),
+                                                 **({"budget": state.budget_note} if state.budget_note else {})}},
                        {"seed": seed, "examples": examples, "horizon": horizon, "operator": repr(op)})
         rec.duration = time.perf_counter() - start
         return rec
