@@ -29,7 +29,7 @@ def test_the_cap_is_a_count_of_n_only():
     assert large_n_count(ci, 2 * LARGE_N) == ci // 2
     assert large_n_count(729, 10 ** 5) == 729 * LARGE_N // 10 ** 5 == 119
     assert large_n_count(ci, 10 ** 6) == LARGE_FLOOR
-    assert large_n_count(1, 10 ** 6) == 1          # a budget below the floor is not raised
+    assert large_n_count(2, 10 ** 6, floor=3) == 2          # a budget below the floor is not raised
     assert all(large_n_count(ci, n) >= large_n_count(ci, n + 1) for n in range(LARGE_N, LARGE_N + 3000, 97))
 
 
@@ -49,18 +49,18 @@ def _block_factor(n: int, factor: float) -> vm.Operator:
 
 
 def test_the_record_states_the_cap_above_large_n():
-    n = 4 * LARGE_N
-    with budgets(coordinate=27):
+    n = LARGE_N + 1          # the first n capped: 4 * LARGE_N // n = 3
+    with budgets(coordinate=4):
         rec = run_law("resolvent_nonexpansive", vm.NormSubdifferential(1.0, n), seed=0, examples=10)
     assert rec.status == PASSED, rec.message
     assert rec.details["searched"]["budget"] == (
-        f"coordinate budget capped at 6 points for n = {n} ({current().profile} promises 27 for n <= {LARGE_N})")
+        f"coordinate budget capped at 3 points for n = {n} ({current().profile} promises 4 for n <= {LARGE_N})")
     small = run_law("resolvent_nonexpansive", vm.NormSubdifferential(1.0, 50), seed=0, examples=10)
     assert "budget" not in small.details["searched"]
 
 
 def test_a_block_factor_fails_above_large_n_and_its_control_passes():
-    n = 2 * LARGE_N
+    n = LARGE_N + 1
     bad = run_law("resolvent_nonexpansive", _block_factor(n, 1.02), seed=0, examples=10)
     good = run_law("resolvent_nonexpansive", _block_factor(n, 1.0), seed=0, examples=10)
     assert bad.status == FAILED, bad.message
@@ -73,7 +73,7 @@ def test_the_battery_at_a_million_coordinates():
     rep = vm.check_operator(vm.NormSubdifferential(lambda t: 1.0 + t, dim=n), seed=0, profile="ci")
     assert rep.counts["failed"] == 0 and rep.counts["undecided"] == 0, rep.summary()
     assert rep.counts["passed"] == len(OPERATOR_LAWS) - 1, rep.summary()     # prox_minimiser: n <= 4 only
-    assert all("capped at 3 points for n = 1000000" in r.details["searched"]["budget"]
+    assert all(f"capped at {LARGE_FLOOR} points for n = 1000000" in r.details["searched"]["budget"]
                for r in rep.results if r.status == PASSED and r.details.get("coordinate"))
     broken = vm.check_operator(_block_factor(n, 1.5), seed=0, profile="ci")
     failed = {r.check for r in broken.results if r.status == FAILED}

@@ -95,9 +95,11 @@ _EFFORT = {
 #: must fall for a battery at n = 10^6 to end within a minute (ci's 27 points a coordinate made ~330 rows a law,
 #: ~6,300 for the battery; at n = 10^6 that is ~3 min of CPU).  A count of n, profile and seed only, never a
 #: time: the same rows on every machine; for ``n <= LARGE_N`` nothing changes.  Each record states the cap
-#: (``details["searched"]["budget"]``).  The floor keeps every coordinate's design at both ends and a midpoint.
+#: (``details["searched"]["budget"]``).  A floor of one point: each coordinate keeps its fixed design (both ends, the
+#: step decades at a stride of 80, the sample's own value) and one point more — at ci about 55 rows a law at
+#: n = 10^6 (20 draws, 5 hypothesis examples, ~30 coordinate rows) instead of 333.
 LARGE_N = 2 ** 14
-LARGE_FLOOR = 3
+LARGE_FLOOR = 1
 
 
 def large_n_count(count: int, n: int, floor: int = LARGE_FLOOR) -> int:
