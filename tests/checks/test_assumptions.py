@@ -20,6 +20,15 @@ def _by(report):
     return {r.check: r for r in report}
 
 
+def _law(name, problem, seed=0):
+    """The record ``name`` of :func:`check_assumptions` (the same evaluator, the same seed, points and times;
+    the five laws do not read each other's records, only the composite does): one law evaluated where a test
+    reads one record, a third of the battery's time for (A2)."""
+    from verimono.checks import laws_of
+
+    return laws_of("problem")[name].check(problem, seed=seed, points=12, times=7)
+
+
 def test_records_are_labelled_evidence():
     rep = check_assumptions(get("t|x| (n=1)"))
     assert [r.check for r in rep] == NAMES + ["assumptions_thm_main"] and rep.ok
@@ -36,7 +45,7 @@ def test_stated_functions_of_sample_problems_survive(seed):
 def test_non_monotone_operator_fails_A1():
     # F = -x/2 (not monotone): J_λ x = x/(1 - λ/2) for λ < 2
     op = operator_from_resolvent(lambda x, lam, t: np.asarray(x) / (1.0 - 0.5 * lam), 2, name="minus_half")
-    rec = _by(check_assumptions(Problem(op, [0.5, 0.2], 1.0)))["assumption_A1"]
+    rec = _law("assumption_A1", Problem(op, [0.5, 0.2], 1.0))
     assert rec.status == FAILED and rec.counterexample["inner"] < 0
 
 
@@ -60,21 +69,21 @@ def test_graph_jumping_right_after_t_fails_A2(after):
 
 def test_right_continuous_jump_satisfies_A2():
     # the same jump with c(0.5) = 2: outer semicontinuous *from the right* (the paper's (A2)) — no evidence
-    rec = _by(check_assumptions(_scaled_identity(lambda t: 1.0 if t < 0.5 else 2.0)))["assumption_A2"]
+    rec = _law("assumption_A2", _scaled_identity(lambda t: 1.0 if t < 0.5 else 2.0))
     assert rec.status == PASSED and rec.details["unsettled"] == 0 and rec.details["sequences"] >= 6 * 13
 
 
 def test_understated_phi_sigma_theta_are_contradicted():
     ball = get("translating ball")                          # moves at |v| = sqrt(1.25)
-    rec = _by(check_assumptions(ball.replace(phi=lambda t: 0.5 * t)))["assumption_A3"]
+    rec = _law("assumption_A3", ball.replace(phi=lambda t: 0.5 * t))
     assert rec.status == FAILED and rec.counterexample["dist"] > 0
     tn = get("t|x| (n=1)")                                  # |F^0(t,x)| = t, |Y_λ(s+λ)| - |Y_λ(s)| ≤ λ
-    rep = _by(check_assumptions(tn.replace(sigma=lambda t: 0.3 * t, theta=lambda t: 0.5 * t)))
-    assert rep["assumption_LG"].status == FAILED and rep["assumption_YB"].status == FAILED
+    understated = tn.replace(sigma=lambda t: 0.3 * t, theta=lambda t: 0.5 * t)
+    assert _law("assumption_LG", understated).status == FAILED and _law("assumption_YB", understated).status == FAILED
 
 
 def test_stated_phi_of_moving_set_is_tight():
-    rec = _by(check_assumptions(get("translating ball")))["assumption_A3"]
+    rec = _law("assumption_A3", get("translating ball"))
     assert rec.status == PASSED and 0.9 < rec.worst <= 1.0        # φ(t) = |v| t is attained
     speed = np.hypot(1.0, 0.5)                                      # sampled sup ≤ the true one
     assert 0.99 * speed <= rec.details["max_rate"] <= speed * (1 + 1e-9)
@@ -82,18 +91,18 @@ def test_stated_phi_of_moving_set_is_tight():
 
 def test_paper_failures_are_flagged():
     # the raw evidence of each law (composite=False: thm_main would make the failing alternative an xfail)
-    lg = _by(check_assumptions(get("x' = c/x from 0 (order 1/2)"), composite=False))["assumption_LG"]
+    lg = _law("assumption_LG", get("x' = c/x from 0 (order 1/2)"))
     assert lg.status == FAILED and "evidence that (LG) fails" in lg.message     # |F^0| = c/x unbounded
-    yb = _by(check_assumptions(get("moving box"), composite=False))["assumption_YB"]
+    yb = _law("assumption_YB", get("moving box"))
     assert yb.status == FAILED and "YB" in yb.message                            # moving domain
-    assert _by(check_assumptions(get("moving box")))["assumption_LG"].status == PASSED  # σ ≡ 0 for N_S
+    assert _law("assumption_LG", get("moving box")).status == PASSED  # σ ≡ 0 for N_S
 
 
 def test_static_operator_has_constant_theta_and_estimated_sigma():
-    rep = _by(check_assumptions(get("linear x' = -Mx")))
-    assert rep["assumption_YB"].details["theta_hat_slope"] <= 1e-6                # Prop. vi
+    linear = get("linear x' = -Mx")
+    assert _law("assumption_YB", linear).details["theta_hat_slope"] <= 1e-6                # Prop. vi
     M = np.array([[1.0, 3.0], [-3.0, 0.5]])
-    assert max(rep["assumption_LG"].details["sigma_hat"]) <= np.linalg.norm(M, 2) + 1e-9
+    assert max(_law("assumption_LG", linear).details["sigma_hat"]) <= np.linalg.norm(M, 2) + 1e-9
 
 
 def test_a_stated_theta_is_judged_on_YB_not_on_the_stronger_YB_prime():
@@ -104,11 +113,11 @@ def test_a_stated_theta_is_judged_on_YB_not_on_the_stronger_YB_prime():
     import verimono as vm
 
     ok = vm.Problem(vm.Linear(lambda t: np.array([[1.0 + t]])), [1.0], 1.0, theta=lambda s: 0.0, name="(1+t)x")
-    rec = check_assumptions(ok).by_check("assumption_YB")[0]
+    rec = _law("assumption_YB", ok)
     assert rec.status == PASSED and rec.details["form"] == "YB", str(rec)
     bad = vm.Problem(vm.Linear(lambda t: np.array([[1.0 + 5.0 * t]])), [1.0], 1.0, theta=lambda s: 0.0,
                      name="(1+5t)x")
-    assert check_assumptions(bad, composite=False).by_check("assumption_YB")[0].status == FAILED
+    assert _law("assumption_YB", bad).status == FAILED
 
 
 def _jumping_ball(t_jump=0.45, size=3.0, right_continuous=True):
@@ -124,7 +133,7 @@ def test_A3_without_a_stated_phi_fails_on_a_jumping_domain():
     """Issue 13 item 1: with no φ given, a ball whose centre jumps by 3 at t = 0.45 passed (φ̂(T) − φ̂(0) =
     2.998 was reported).  The jump search brackets the jump by adjacent floats, and the excess of dom F(a)
     over dom F(b) stays 3 − (rounding of the sampled points) across it: no absolutely continuous φ."""
-    rec = _by(check_assumptions(_jumping_ball()))["assumption_A3"]
+    rec = _law("assumption_A3", _jumping_ball())
     assert rec.status == FAILED, str(rec)
     c = rec.counterexample
     assert c["t"] == 0.45 and c["bracket"][0] < 0.45 <= c["bracket"][1] and c["bracket"][1] - c["bracket"][0] < 1e-15
@@ -140,7 +149,7 @@ def test_A3_absolutely_continuous_motion_still_passes(speed):
     import verimono as vm
 
     move = (lambda t: np.array([2.0 * t, 0.0])) if speed == "lipschitz" else (lambda t: np.array([np.sqrt(t), 0.0]))
-    rec = _by(check_assumptions(Problem(vm.NormalCone(vm.sets.Ball(move, 1.0)), [0.0, 0.0], 1.0)))["assumption_A3"]
+    rec = _law("assumption_A3", Problem(vm.NormalCone(vm.sets.Ball(move, 1.0)), [0.0, 0.0], 1.0))
     assert rec.status == PASSED and rec.details["jump_search"]["bisected"] > 0, str(rec)
 
 
@@ -149,7 +158,7 @@ def test_A2_jumps_between_sample_times_are_found(t_jump):
     """Issue 13 item 2: c(t) = 1 for t ≤ t_jump, 2 after (F = c(t)x) passed when t_jump was no sample time.
     The jump search finds every such jump, wherever it lies, and the right-limit test at the jump time
     fails; the right-continuous variant (c(t_jump) = 2) is found too, and passes."""
-    left = _by(check_assumptions(_scaled_identity(lambda t: 1.0 if t <= t_jump else 2.0)))["assumption_A2"]
+    left = _law("assumption_A2", _scaled_identity(lambda t: 1.0 if t <= t_jump else 2.0))
     assert left.status == FAILED, str(left)
     c = left.counterexample
     assert c["t"] == t_jump, str(left)
@@ -158,7 +167,7 @@ def test_A2_jumps_between_sample_times_are_found(t_jump):
     assert [(j["t"], j["side"]) for j in left.details["jumps"]] == [(t_jump, "left value at t (jump right after t)")]
     np.testing.assert_allclose(c["limit"], c["p"] / (1 + 2 * c["lam"]), rtol=1e-9)          # the right value
     np.testing.assert_allclose(c["resolvent_at_t"], c["p"] / (1 + c["lam"]), rtol=1e-12)     # the left value
-    right = _by(check_assumptions(_scaled_identity(lambda t: 1.0 if t < t_jump else 2.0)))["assumption_A2"]
+    right = _law("assumption_A2", _scaled_identity(lambda t: 1.0 if t < t_jump else 2.0))
     assert right.status == PASSED, str(right)
     assert [j["t"] for j in right.details["jumps"]] == [t_jump] and right.details["jumps"][0]["side"] == "right-continuous"
 
@@ -192,11 +201,11 @@ def test_t_non_auto_YB_claim_is_false_for_a_shifted_operator():
     from verimono.core.operators import Shifted
 
     F = vm.NormSubdifferential(1.0, dim=1)
-    assert _by(check_assumptions(Problem(F, [0.0], 1.0)))["assumption_YB"].status == PASSED
+    assert _law("assumption_YB", Problem(F, [0.0], 1.0)).status == PASSED
     G = Shifted(F, lambda t: np.array([t]))
     s, lam = 0.3, 1e-4
     assert G.min_norm(np.array([-s]), s)[0] == 0.0 and G.yosida(np.array([-s]), lam, s + lam)[0] == pytest.approx(1.0)
-    rec = _by(check_assumptions(Problem(G, [0.0], 1.0), composite=False))["assumption_YB"]
+    rec = _law("assumption_YB", Problem(G, [0.0], 1.0))
     assert rec.status == FAILED and rec.details["growth"] == pytest.approx(100, rel=1e-4), str(rec)   # 1/λ over λ = T/10 … T/1000
     skip = check_bounds_yb(vm.solve, Problem(F, [0.5], 1.0, u=lambda t: np.array([1.0]), theta=lambda t: 0.0))
     assert skip.status == "skipped" and "θ̄ = M_u + θ has the increments of θ" in skip.message, str(skip)

@@ -219,17 +219,20 @@ def test_non_uniform_grids_and_operator_relations_batch_row_by_row():
     sysO = LinearRelationSystem(np.zeros((2, 2)), 2 * np.eye(2), np.eye(2), np.zeros((2, 2)),
                                 NormalCone(Box([-1, -1], [1, 1])))
     sysR = LinearRelationSystem(np.zeros((2, 2)), 2 * np.eye(2), np.eye(2), np.zeros((2, 2)), Relay())
-    t = np.concatenate([[0.0], np.cumsum(np.linspace(1e-3, 3e-3, 100))])
+    # 25 steps growing from 4e-3 to 12e-3 (span 0.2, step ratio 3): the second row reaches the relay's switch
+    # (x = 0) inside the grid, the first does not (100 steps of 1e-3..3e-3 cost 16 s CPU, the same span and ratio)
+    t = np.concatenate([[0.0], np.cumsum(np.linspace(4e-3, 12e-3, 25))])
     X0 = np.array([[1.0, -1.0], [0.2, 0.3]])
-    b = sysR.simulate(X0, t, theta=0.5)
+    bR = sysR.simulate(X0, t, theta=0.5)
     for i in range(2):
-        assert _same(b.x[:, i], sysR.simulate(X0[i], t, theta=0.5).x)
+        assert _same(bR.x[:, i], sysR.simulate(X0[i], t, theta=0.5).x)
     # an operator relation is solved by splitting to its stopping tolerance (two single runs of it differ
     # by ~1e-9 here: its resolvent keeps state), so its rows agree to that accuracy
-    b = sysO.simulate(X0, t, theta=0.5)
+    bO = sysO.simulate(X0, t, theta=0.5)
     for i in range(2):
-        np.testing.assert_allclose(b.x[:, i], sysO.simulate(X0[i], t, theta=0.5).x, rtol=0, atol=1e-8)
-    np.testing.assert_allclose(sysO.simulate(X0, t, theta=0.5).x, sysR.simulate(X0, t, theta=0.5).x, atol=1e-8)
+        np.testing.assert_allclose(bO.x[:, i], sysO.simulate(X0[i], t, theta=0.5).x, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(bO.x, bR.x, atol=1e-8)
+    assert np.all(np.abs(bR.x[-1, 1]) < 1e-12) and np.all(np.abs(bR.x[-1, 0]) > 0.5)     # one row switched, one not
 
 
 def test_a_degenerate_candidate_is_accepted_only_when_it_is_least_norm(monkeypatch):
