@@ -207,11 +207,12 @@ SHIP_ATTEMPTS = 3
 
 
 def _ship(unit: Unit, profile: RunConfig | str | None) -> bytes:
-    """``unit`` pickled for a worker.  A ``RuntimeError`` while pickling (a dict or set the pickler walks changed
-    size under it: another thread importing, a collection run by a weakref callback) is transient, so it is
-    tried again, up to ``SHIP_ATTEMPTS`` times in all; any other error, or the same one every time, is the
-    unit's own and the caller runs it where nothing is pickled.  (Under double load on 2 cores, one attempt in a
-    few thousand met a changed dict, and the locked module's real "cannot pickle" went unreported.)"""
+    """``unit`` pickled for a worker.  A ``RuntimeError`` while pickling (a dict the pickler walks changed size
+    under it: another thread importing, a collection run by a weakref callback) may be transient, so it is tried
+    again, up to ``SHIP_ATTEMPTS`` times in all; any other error, or the same one every time, goes to the caller,
+    which runs the unit where nothing is pickled and says why.  (A long-lived pytest-xdist worker met "dictionary
+    changed size during iteration" at every attempt on a locked module, whose own error is "cannot pickle": which
+    dict changes is not known yet, docs/tests.md.)"""
     import cloudpickle
 
     _register_targets_by_value()
