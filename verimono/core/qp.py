@@ -284,6 +284,17 @@ def _attempt(name: str, S: ScaledQP) -> tuple[np.ndarray | None, str, bool]:
                   f"complementarity {rep.comp:.2e})"), True
 
 
+def qp_arrays(P, q, G=None, h=None, A=None, b=None) -> tuple:
+    """``(P, q, G, h, A, b)`` as :func:`solve_qp` takes them: writable float copies (back-ends such as DAQP reject
+    read-only buffers, and constant parameters are read-only), ``G, h`` and ``A, b`` ``None`` when empty."""
+    P = np.array(P, float); q = np.array(q, float)
+    G = None if G is None or len(G) == 0 else np.atleast_2d(np.array(G, float))
+    h = None if G is None else np.atleast_1d(np.array(h, float))
+    A = None if A is None or len(A) == 0 else np.atleast_2d(np.array(A, float))
+    b = None if A is None else np.atleast_1d(np.array(b, float))
+    return P, q, G, h, A, b
+
+
 def solve_qp(P, q, G=None, h=None, A=None, b=None, *, backends=None, scale: float | None = None) -> np.ndarray:
     """Solve the convex QP (``P ⪰ 0``, unique minimiser) and return a KKT-verified minimiser.
 
@@ -294,12 +305,7 @@ def solve_qp(P, q, G=None, h=None, A=None, b=None, *, backends=None, scale: floa
     phase one certifies infeasibility), :class:`UnverifiedSolution` when candidates exist but none verifies,
     or when no back-end returned a point but infeasibility is not certified (a limit of verimono's solvers).
     """
-    # writable copies: back-ends such as DAQP reject read-only buffers (constant parameters are read-only)
-    P = np.array(P, float); q = np.array(q, float)
-    G = None if G is None or len(G) == 0 else np.atleast_2d(np.array(G, float))
-    h = None if G is None else np.atleast_1d(np.array(h, float))
-    A = None if A is None or len(A) == 0 else np.atleast_2d(np.array(A, float))
-    b = None if A is None else np.atleast_1d(np.array(b, float))
+    P, q, G, h, A, b = qp_arrays(P, q, G, h, A, b)
     S = equilibrate(P, q, G, h, A, b, scale)
     attempts = [("", S)]
     if S.G_far is not None:   # far rows set aside first; with them in the solve (their units) if that fails

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.qp import ACTIVE_RTOL, equilibrate, kkt_residual, solve_qp
+from ..core.qp import ACTIVE_RTOL, equilibrate, kkt_residual, qp_arrays, solve_qp
 from ..core.tolerances import QP_RTOL
 
 #: active sets remembered per QP shape (most recent first)
@@ -46,11 +46,7 @@ def _on_active(S, act: np.ndarray) -> np.ndarray:
 def solve_qp_warm(memory: dict, P, q, G=None, h=None, A=None, b=None, *, scale: float | None = None) -> np.ndarray:
     """:func:`verimono.core.qp.solve_qp` (same arguments, same verification), trying the active sets kept in
     ``memory`` first (see the module docstring)."""
-    P = np.array(P, float); q = np.array(q, float)
-    G = None if G is None or len(G) == 0 else np.atleast_2d(np.array(G, float))
-    h = None if G is None else np.atleast_1d(np.array(h, float))
-    A = None if A is None or len(A) == 0 else np.atleast_2d(np.array(A, float))
-    b = None if A is None else np.atleast_1d(np.array(b, float))
+    P, q, G, h, A, b = qp_arrays(P, q, G, h, A, b)
     S = equilibrate(P, q, G, h, A, b, scale)
     key = (P.shape[0], None if S.G is None else S.G.shape[0], None if S.A is None else S.A.shape[0],
            S.G_far is None)
