@@ -244,6 +244,14 @@ def _cached(evaluate: Callable[[Sample], float], at: Callable[[float], Sample], 
     def values(v: float, which) -> np.ndarray:
         v = float(v)
         return np.array([known[v] if v in known else evaluate(at(v))])
+
+    def table(xs: np.ndarray) -> np.ndarray | None:
+        """The values at ``xs`` (one family) when every one is known (:func:`maximise`'s design), else ``None``."""
+        try:
+            return np.array([known[v] for v in xs.tolist()], dtype=float).reshape(-1, 1)
+        except KeyError:
+            return None
+    values.table = table        # type: ignore[attr-defined]
     return values
 
 
