@@ -367,14 +367,19 @@ def rounding(r: Rows, q: np.ndarray, den: np.ndarray, *products: np.ndarray) -> 
     ``(n + 2)·eps``, so ``q`` within ``g·|q|``, ``g = ROUNDING_SAFETY·(n + 4)·eps`` — and whose ``products`` (``|a|·|b|``
     of each dot product in ``lhs`` or ``den``; a sum of ``n`` products is within ``γ_n Σ|a_i b_i| ≤ γ_n |a||b|``
     of its exact value in any order) add ``g·|a||b| / den`` each (``inf`` where ``den ≤ 0``)."""
-    n = r.x1.shape[1] if r.x1.ndim == 2 else 1
+    r.err = rounding_bound(r.x1.shape[1] if r.x1.ndim == 2 else 1, q, den, *products)
+    return r.err
+
+
+def rounding_bound(n: int, q: np.ndarray, den: np.ndarray, *products: np.ndarray) -> np.ndarray:
+    """The bound of :func:`rounding` for rows of ``n`` coordinates, returned without setting ``Rows.err`` (a form
+    that decides rows at several steps, each with its own bound)."""
     g = ROUNDING_SAFETY * (n + 4) * np.finfo(float).eps
     with np.errstate(all="ignore"):
         e = g * np.abs(q)
         for p in products:
             e = e + np.where(den > 0.0, g * p / np.where(den > 0.0, den, 1.0), np.inf)
-    r.err = np.where(np.isnan(e), np.inf, e)
-    return r.err
+    return np.where(np.isnan(e), np.inf, e)
 
 
 def row_dots(A: np.ndarray, B: np.ndarray) -> np.ndarray:
@@ -392,5 +397,6 @@ def row_ratios(lhs: np.ndarray, rhs: np.ndarray, slack: np.ndarray) -> np.ndarra
 
 
 __all__ += ["VECTORISED", "SUSPECT", "ROW_CELLS", "ROUNDING_SAFETY", "vectorised", "Rows", "rows_accepted", "rounding",
+            "rounding_bound",
             "row_resolvents", "row_member", "row_contains", "row_values",
             "row_norms", "row_dots", "row_ratios"]
