@@ -588,20 +588,24 @@ def _rows_min_norm_least(op, r):
 
 @vectorised("yosida_limit")
 def _rows_yosida_limit(op, r):
-    # the law's halving of λ, over every row at once (each halving one row_resolvents pass over the rows still open;
+    # the law's halving of λ from its first λ (λ, or the law's own floor when λ is below it), over every row at once
+    # (each halving one row_resolvents pass over the rows still open;
     # λ halved as the law halves it, bit for bit): a row is decided at the first λ where its gap closes clearly (its
     # ratio plus its rounding bound within 1) — the law's ratio there; it is halved again only while its gap is
     # clearly open, |Y_λx| clearly above the law's rounding branch and λ/2 clearly above the floor.  Every other row
     # (a gap within rounding of its slack, near that branch or the floor, never closed: the stall analysis; F^0 0
     # within rounding) is the evaluator's
     x, _, _ = _rows_domain_pair(op, r)
-    f0 = row_norms(row_member(op.min_norm, x, r.t, r.ok))
+    F0 = row_member(op.min_norm, x, r.t, r.ok)
+    f0 = row_norms(F0)
     tx = row_tolerances(x)
     floor = 2 * LIMIT_FLOOR * tx / (1.0 + f0)
     near = 1.0 + 1e-9
-    r.ok &= r.lam > floor * near     # λ above the floor (the law's own λ, bit for bit)
+    lam = r.lam.copy()      # the law's first λ, bit for bit: λ itself above the floor, else the law's own floor
+    for j in np.flatnonzero(r.ok & ~(r.lam > floor * near)).tolist():
+        lam[j] = max(float(r.lam[j]), 2 * LIMIT_FLOOR * tolerance(x[j]) / (1.0 + norm(F0[j])))
     n = x.shape[1]
-    q, err, lam, live = np.full(len(r.ok), np.inf), np.full(len(r.ok), np.inf), r.lam.copy(), r.ok.copy()
+    q, err, live = np.full(len(r.ok), np.inf), np.full(len(r.ok), np.inf), r.ok.copy()
     for _ in range(YOSIDA_HALVINGS):
         i = np.flatnonzero(live)
         if i.size < 2:
