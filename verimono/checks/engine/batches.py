@@ -216,6 +216,8 @@ def row_resolvents(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok:
     is one group per row, so the loop's cost per group is the engine's cost per row there."""
     B, n = X.shape
     good = np.ones(B, dtype=bool)
+    if B == 0:
+        return np.zeros_like(X)
     if rows_accepted(op):
         order, bounds = _groups(lams, ts)
         Xs = X.copy() if order is None else X[order]        # the subject's input: one private copy
