@@ -99,3 +99,29 @@ def test_the_points_searched_are_fixed_by_seed_and_profile():
         a, b = (run_law("monotone", op, seed=7, examples=10) for _ in range(2))
     assert a.details["evaluations"] == b.details["evaluations"] and a.worst == b.worst
     assert a.details["searched"]["coordinates"] == b.details["searched"]["coordinates"]
+
+
+def test_yosida_limits_form_halves_lambda_as_the_law_does():
+    """``yosida_limit``'s form halves λ over all rows at once, as the law halves it: on a linear operator
+    (``|Y_λx| → |Ax|`` only as ``λ → 0``, so the gap closes after many halvings) it decides most rows at a later λ,
+    each at the law's own ratio within its stated rounding bound — ratios up to ~1, the gap closing just inside the
+    slack; a row whose λ is below the law's rounding floor starts, as the law does, at that floor (the λ decades of
+    the coordinate search reach 10^-150); on ``wrong_lambda`` (zoo) no row the law fails is accepted."""
+    law, decl = "yosida_limit", REGISTRY["operator"]["yosida_limit"]
+    lin = vm.Linear(np.array([[2.0, 1.0, 0.0], [-1.0, 1.0, 0.0], [0.0, 0.0, 0.5]]))
+    for op, lawful in ((lin, True), (zoo.build("wrong_lambda"), False)):
+        ss = _samples(op, 20)
+        tiny = [Sample(s.x1, s.x2, lam, s.mu, s.nu, s.t) for s in ss[:4] for lam in (1e-150, 1e-40, 1e-16)]
+        ss += tiny
+        rows = Rows(ss)
+        with np.errstate(all="ignore"):
+            q = VECTORISED[law](op, rows)
+        own = np.array([evaluate_sample(decl, op, s).ratio for s in ss])
+        took = rows.accepted(q)
+        assert (np.abs(q - own)[took] <= rows.err[took]).all(), (q[took], own[took])
+        assert not (took & (own > 1.0)).any()
+        if lawful:      # decided after halvings (a ratio well above the first λ's): most rows, not only the easy ones
+            assert took.sum() >= 0.5 * len(ss) and (took & (q > 0.5)).sum() >= 0.2 * len(ss), (took.sum(), q[took])
+            assert took[-len(tiny):].all(), q[-len(tiny):]       # from the floor, where the gap closes at once
+        else:
+            assert (own > 1.0).any()

@@ -33,7 +33,7 @@ from ..core.tolerances import (LIMIT_FLOOR, REPEAT_ULPS, RTOL, STALL_RATIO, STAL
 from .core import Member, Outcome
 from .members import (_ROUNDOFF_BOUNDARY, listed, min_norm, norm, outside_by_roundoff_of_dom_g, point, resolvent,
                       within_roundoff_of_domain)
-from .engine.batches import (rounding, row_contains, row_dots, row_member, row_norms, row_ratios, row_resolvents,
+from .engine.batches import (rounding, rounding_bound, row_contains, row_dots, row_member, row_norms, row_ratios, row_resolvents,
                              vectorised)
 from .engine.samples import Sample
 from .engine.search import operator_law
@@ -298,6 +298,10 @@ def check_yosida_limit(op, s):
 #: that is resolved only below the floor (a 2^-23 offset from a kink of a shifted ∂‖·‖₁, found by a
 #: thorough run); the factor 4 covers the constant of that estimate
 KINK_PROBE = 4.0
+#: the most halvings of λ the vectorised form of yosida_limit makes (from 10^7 to the smallest normal float is
+#: ~1045); it stops earlier when fewer than two rows are open (one row's halvings are cheaper in the law's own
+#: loop): the rows still open are the evaluator's
+YOSIDA_HALVINGS = 1100
 
 
 def _kink_within(op, x: np.ndarray, t: float, delta: float) -> bool:
@@ -584,17 +588,42 @@ def _rows_min_norm_least(op, r):
 
 @vectorised("yosida_limit")
 def _rows_yosida_limit(op, r):
-    # the law's first step only: a gap within tolerance at λ = max(λ, floor) is its ratio; a row whose gap is not
-    # closed there (or whose F^0 is 0 within rounding) is the evaluator's, which halves λ
+    # the law's halving of λ from its first λ (λ, or the law's own floor when λ is below it), over every row at once
+    # (each halving one row_resolvents pass over the rows still open;
+    # λ halved as the law halves it, bit for bit): a row is decided at the first λ where its gap closes clearly (its
+    # ratio plus its rounding bound within 1) — the law's ratio there; it is halved again only while its gap is
+    # clearly open, |Y_λx| clearly above the law's rounding branch and λ/2 clearly above the floor.  Every other row
+    # (a gap within rounding of its slack, near that branch or the floor, never closed: the stall analysis; F^0 0
+    # within rounding) is the evaluator's
     x, _, _ = _rows_domain_pair(op, r)
-    f0 = row_norms(row_member(op.min_norm, x, r.t, r.ok))
+    F0 = row_member(op.min_norm, x, r.t, r.ok)
+    f0 = row_norms(F0)
     tx = row_tolerances(x)
-    r.ok &= r.lam > 2 * LIMIT_FLOOR * tx / (1.0 + f0) * (1.0 + 1e-9)     # λ above the floor (the law's own λ, bit for bit)
-    lam = r.lam
-    a = row_resolvents(op, x, lam, r.t, r.ok)
-    y = row_norms((x - a) / lam[:, None])
-    gap, slack = np.abs(f0 - y), row_tolerances(f0, y) + 2 * tx / lam
-    r.ok &= gap <= slack
-    q = row_ratios(gap, np.zeros_like(gap), slack)
-    rounding(r, q, slack, f0 + y)
+    floor = 2 * LIMIT_FLOOR * tx / (1.0 + f0)
+    near = 1.0 + 1e-9
+    lam = r.lam.copy()      # the law's first λ, bit for bit: λ itself above the floor, else the law's own floor
+    for j in np.flatnonzero(r.ok & ~(r.lam > floor * near)).tolist():
+        lam[j] = max(float(r.lam[j]), 2 * LIMIT_FLOOR * tolerance(x[j]) / (1.0 + norm(F0[j])))
+    n = x.shape[1]
+    q, err, live = np.full(len(r.ok), np.inf), np.full(len(r.ok), np.inf), r.ok.copy()
+    for _ in range(YOSIDA_HALVINGS):
+        i = np.flatnonzero(live)
+        if i.size < 2:
+            break
+        oki = np.ones(i.size, dtype=bool)
+        li = lam[i]
+        a = row_resolvents(op, x[i], li, r.t[i], oki)
+        y = row_norms((x[i] - a) / li[:, None])
+        gap, slack = np.abs(f0[i] - y), row_tolerances(f0[i], y) + 2 * tx[i] / li
+        qi = row_ratios(gap, np.zeros_like(gap), slack)
+        ei = rounding_bound(n, qi, slack, f0[i] + y)
+        done = oki & np.isfinite(qi) & np.isfinite(ei) & (qi + ei <= 1.0)
+        q[i[done]], err[i[done]] = qi[done], ei[done]
+        half = li / 2
+        go = oki & ~done & (qi - ei > 1.0) & (y > 2 * tx[i] / li * near) & (half >= floor[i] * near) & (half > 0.0)
+        r.ok[i[~(done | go)]] = False
+        live[i] = go
+        lam[i] = half
+    r.ok &= ~live        # rows still open after the most halvings: the evaluator's
+    r.err = err
     return q

@@ -191,53 +191,81 @@ def _call_starts() -> None:
         state.in_flight = now
 
 
+def _groups(lams: np.ndarray, ts: np.ndarray) -> tuple[np.ndarray | None, list[int]]:
+    """The rows grouped by the bits of their ``(λ, t)``: a stable order (``None``: one group, the rows as they are)
+    and the groups' bounds in that order (``[0, b_1, ..., B]``)."""
+    B = lams.shape[0]
+    li = np.ascontiguousarray(lams, dtype=float).view(np.int64)
+    ti = np.ascontiguousarray(ts, dtype=float).view(np.int64)
+    if B < 2 or ((li == li[0]).all() and (ti == ti[0]).all()):
+        return None, [0, B]
+    order = np.lexsort((ti, li))
+    ls, tt = li[order], ti[order]
+    cut = np.flatnonzero((ls[1:] != ls[:-1]) | (tt[1:] != tt[:-1])) + 1
+    return order, [0] + cut.tolist() + [B]
+
+
 def row_resolvents(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok: np.ndarray) -> np.ndarray:
     """``J_{λ_i} X_i`` at ``t_i`` for every row (on copies of the rows); a row whose call raised, returned no
     finite point of its shape or modified its input is marked ``False`` in ``ok`` (its values are then meaningless).  Each subject
-    call is timed as a call of its own (:func:`_call_starts`)."""
+    call is timed as a call of its own (:func:`_call_starts`).
+
+    On an operator that maps batches, the rows of each distinct ``(λ, t)`` (the same bits) are one call on a
+    contiguous block of one sorted copy of ``X``; the loop over the groups only calls and stores, and the checks
+    (finite output, input left unchanged) are one pass over all rows after it — a design that moves ``λ`` or ``t``
+    is one group per row, so the loop's cost per group is the engine's cost per row there."""
+    B, n = X.shape
+    good = np.ones(B, dtype=bool)
+    if B == 0:
+        return np.zeros_like(X)
     if rows_accepted(op):
-        pairs = np.stack([lams, ts], axis=1)
-        uniq, inverse, counts = np.unique(pairs, axis=0, return_inverse=True, return_counts=True)
-        order = np.argsort(inverse.reshape(-1), kind="stable")
-        # each (λ, t) group's rows, in their order, are one call on a copy (X[rows]), written straight into J
-        # and checked there: no sorted copy of X, no zero-filled sorted output, no second gather
-        J, resolvent, n, lo = np.zeros_like(X), op.resolvent, X.shape[1], 0
-        for g, c in enumerate(counts.tolist()):
-            hi = lo + c
-            rows = order[lo:hi]
-            lo = hi
-            Xg = X[rows]
+        order, bounds = _groups(lams, ts)
+        Xs = X.copy() if order is None else X[order]        # the subject's input: one private copy
+        lam_l = (lams if order is None else lams[order]).tolist()
+        t_l = (ts if order is None else ts[order]).tolist()
+        Js, resolvent = np.empty_like(Xs), op.resolvent
+        for lo, hi in zip(bounds[:-1], bounds[1:]):
             _call_starts()
             try:
-                P = resolvent(Xg, float(uniq[g, 0]), float(uniq[g, 1]))      # the group's rows: a copy
+                P = resolvent(Xs if hi - lo == B else Xs[lo:hi], lam_l[lo], t_l[lo])
                 if type(P) is not np.ndarray or P.dtype != np.float64:
                     P = as_float64(P)
+                if P.shape != (hi - lo, n):
+                    raise ValueError
             except Exception:   # noqa: BLE001 - the law's evaluator of one sample meets it and judges it
                 if interrupted():
                     raise
-                ok[rows] = False
+                good[lo:hi] = False
+                Js[lo:hi] = 0.0
                 continue
-            if P.shape != (c, n):
-                ok[rows] = False
-                continue
-            J[rows] = P
-            ok[rows] &= np.isfinite(P).all(axis=1) & (Xg == X[rows]).all(axis=1)    # inputs left unchanged
+            Js[lo:hi] = P
+        good &= np.isfinite(Js).all(axis=1) & (Xs == (X if order is None else X[order])).all(axis=1)  # inputs unchanged
+        if order is None:
+            ok &= good
+            return Js
+        J = np.empty_like(Js)
+        J[order] = Js
+        ok[order] &= good
         return J
     J = np.zeros_like(X)
-    for i in range(X.shape[0]):
+    Xc = X.copy()       # row i is the subject's input of call i (a row of a private copy)
+    lam_l, t_l, resolvent = lams.tolist(), ts.tolist(), op.resolvent
+    for i in range(B):
         _call_starts()
-        xi = X[i].copy()
         try:
-            p = as_float64(op.resolvent(xi, float(lams[i]), float(ts[i])))
+            p = resolvent(Xc[i], lam_l[i], t_l[i])
+            if type(p) is not np.ndarray or p.dtype != np.float64:
+                p = as_float64(p)
+            if p.shape != (n,):
+                raise ValueError
         except Exception:   # noqa: BLE001 - as above
             if interrupted():
                 raise
-            ok[i] = False
-            continue
-        if p.shape != X[i].shape or not np.isfinite(p).all() or not (xi == X[i]).all():
-            ok[i] = False
+            good[i] = False
             continue
         J[i] = p
+    good &= np.isfinite(J).all(axis=1) & (Xc == X).all(axis=1)
+    ok &= good
     return J
 
 
@@ -247,19 +275,23 @@ def row_member(member: Any, X: np.ndarray, ts: np.ndarray, ok: np.ndarray) -> np
     ``OutsideDomain`` among them: the law's evaluator judges it) or returned no finite point of its shape is
     marked ``False`` in ``ok``.  Each call is timed as a call of its own (:func:`_call_starts`)."""
     out = np.zeros_like(X)
+    t_l, n, bad = ts.tolist(), X.shape[1], []
     for i in np.flatnonzero(ok).tolist():
         _call_starts()
         try:
-            p = as_float64(member(X[i].copy(), float(ts[i])))
+            p = member(X[i].copy(), t_l[i])
+            if type(p) is not np.ndarray or p.dtype != np.float64:
+                p = as_float64(p)
+            if p.shape != (n,):
+                raise ValueError
         except Exception:   # noqa: BLE001 - the law's evaluator of one sample meets it and judges it
             if interrupted():
                 raise
-            ok[i] = False
-            continue
-        if p.shape != X[i].shape or not np.isfinite(p).all():
-            ok[i] = False
+            bad.append(i)
             continue
         out[i] = p
+    ok[bad] = False
+    ok &= np.isfinite(out).all(axis=1)
     return out
 
 
@@ -268,10 +300,11 @@ def row_values(op: Any, Z: np.ndarray, ts: np.ndarray, ok: np.ndarray) -> np.nda
     one call each on a copy; a row whose call raised or whose value is not finite is marked ``False`` in ``ok``
     (the law's evaluator judges a point outside ``dom g``)."""
     out = np.zeros(len(ok))
+    t_l, value = ts.tolist(), op.value
     for i in np.flatnonzero(ok).tolist():
         _call_starts()
         try:
-            v = op.value(np.array(Z[i], dtype=float), float(ts[i]))
+            v = value(np.array(Z[i], dtype=float), t_l[i])
             v = float(v if type(v) is float else as_float64(v))
         except Exception:   # noqa: BLE001 - as above
             if interrupted():
@@ -292,10 +325,11 @@ def row_contains(op: Any, X: np.ndarray, Y: np.ndarray, ts: np.ndarray, tols: np
     ``NotImplementedError`` counts as inside with ``lacking`` (a law that certifies by ``contains`` only where it
     can)."""
     got = np.zeros(len(ok), dtype=bool)
+    t_l, tol_l, contains = ts.tolist(), np.broadcast_to(tols, ts.shape).tolist(), op.contains
     for i in np.flatnonzero(ok).tolist():
         _call_starts()
         try:
-            v = op.contains(X[i].copy(), Y[i].copy(), float(ts[i]), float(tols[i]))
+            v = contains(X[i].copy(), Y[i].copy(), t_l[i], tol_l[i])
         except NotImplementedError:
             if lacking:
                 got[i] = True
@@ -335,14 +369,19 @@ def rounding(r: Rows, q: np.ndarray, den: np.ndarray, *products: np.ndarray) -> 
     ``(n + 2)·eps``, so ``q`` within ``g·|q|``, ``g = ROUNDING_SAFETY·(n + 4)·eps`` — and whose ``products`` (``|a|·|b|``
     of each dot product in ``lhs`` or ``den``; a sum of ``n`` products is within ``γ_n Σ|a_i b_i| ≤ γ_n |a||b|``
     of its exact value in any order) add ``g·|a||b| / den`` each (``inf`` where ``den ≤ 0``)."""
-    n = r.x1.shape[1] if r.x1.ndim == 2 else 1
+    r.err = rounding_bound(r.x1.shape[1] if r.x1.ndim == 2 else 1, q, den, *products)
+    return r.err
+
+
+def rounding_bound(n: int, q: np.ndarray, den: np.ndarray, *products: np.ndarray) -> np.ndarray:
+    """The bound of :func:`rounding` for rows of ``n`` coordinates, returned without setting ``Rows.err`` (a form
+    that decides rows at several steps, each with its own bound)."""
     g = ROUNDING_SAFETY * (n + 4) * np.finfo(float).eps
     with np.errstate(all="ignore"):
         e = g * np.abs(q)
         for p in products:
             e = e + np.where(den > 0.0, g * p / np.where(den > 0.0, den, 1.0), np.inf)
-    r.err = np.where(np.isnan(e), np.inf, e)
-    return r.err
+    return np.where(np.isnan(e), np.inf, e)
 
 
 def row_dots(A: np.ndarray, B: np.ndarray) -> np.ndarray:
@@ -360,5 +399,6 @@ def row_ratios(lhs: np.ndarray, rhs: np.ndarray, slack: np.ndarray) -> np.ndarra
 
 
 __all__ += ["VECTORISED", "SUSPECT", "ROW_CELLS", "ROUNDING_SAFETY", "vectorised", "Rows", "rows_accepted", "rounding",
+            "rounding_bound",
             "row_resolvents", "row_member", "row_contains", "row_values",
             "row_norms", "row_dots", "row_ratios"]

@@ -146,13 +146,20 @@ def coordinate_search(evaluate: Callable[[Sample], float], op: Any, start: Sampl
             best[:] = [v, s]
         return v
 
+    def evs(ss: list[Sample]) -> list[float]:
+        vals = many(ss)
+        for s, v in zip(ss, vals):
+            if v > best[0]:
+                best[:] = [v, s]
+        return vals
+
     for name in (c for c in COORDINATES if c in over):
         if stop():
             break
         if name in _MORE and points < MORE_FROM:
             continue
         if name == "direction":        # not one-dimensional: the sphere of directions of x2 - x1
-            got = direction_search(ev, op, start, points, seed)
+            got = direction_search(ev, op, start, points, seed, evs)
             if got is not None:
                 done.append(got)
             here = best[1]             # the other coordinates from the worst direction (or the worst sample)
@@ -237,6 +244,14 @@ def _cached(evaluate: Callable[[Sample], float], at: Callable[[float], Sample], 
     def values(v: float, which) -> np.ndarray:
         v = float(v)
         return np.array([known[v] if v in known else evaluate(at(v))])
+
+    def table(xs: np.ndarray) -> np.ndarray | None:
+        """The values at ``xs`` (one family) when every one is known (:func:`maximise`'s design), else ``None``."""
+        try:
+            return np.array([known[v] for v in xs.tolist()], dtype=float).reshape(-1, 1)
+        except KeyError:
+            return None
+    values.table = table        # type: ignore[attr-defined]
     return values
 
 

@@ -89,11 +89,15 @@ def sketch_directions(op: Any, s: Sample, r: float, rng: np.random.Generator) ->
 
 
 def direction_search(evaluate: Callable[[Sample], float], op: Any, s: Sample, points: int,
-                     seed: int) -> dict | None:
+                     seed: int, many: Callable[[list[Sample]], list[float]] | None = None) -> dict | None:
     """The direction of ``x2 − x1`` searched from the worst sample ``s`` (module docstring); ``evaluate`` returns
     the law's ratio (``-inf`` when inconclusive) and raises on a violation, which ends the search.  ``None`` when
     the direction cannot move (``n = 1``, ``n`` above :data:`NUMPY_DIM`, a recipe sample); a pair ``x1 = x2`` is
-    opened to ``r =`` :data:`PAIR_RADIUS` ``(1 + |x1|)``."""
+    opened to ``r =`` :data:`PAIR_RADIUS` ``(1 + |x1|)``.  ``many(samples)``: the ratios of a list, in order (the
+    search's evaluates a law's vectorised form over all of them at once); the directions known before any of
+    them is evaluated — the first four, the flat check's, the sketch's and the drawn ones — are evaluated as
+    lists (the same directions, from the same draws of the generator, as one at a time), the refinement one at
+    a time (each step depends on the last)."""
     n = s.x1.size
     if s.recipe is not None or n < 2 or n > NUMPY_DIM:
         return None
@@ -116,25 +120,32 @@ def direction_search(evaluate: Callable[[Sample], float], op: Any, s: Sample, po
             best[:] = [v, d, radius]
         return v
 
+    def evs(ds: list[tuple[np.ndarray, float]]) -> list[float]:
+        """``ev`` of each ``(d, radius)``, in order, through ``many``."""
+        if many is None or len(ds) < 2:
+            return [ev(d, radius) for d, radius in ds]
+        vals = many([at(d, radius) for d, radius in ds])
+        for (d, radius), v in zip(ds, vals):
+            if v > best[0]:
+                best[:] = [v, d, radius]
+        return list(vals)
+
     drawn = [_unit(rng.standard_normal(n)) for _ in range(3)]
-    first = [ev(best[1])] + [ev(d) for d in drawn if d is not None]
+    first = evs([(best[1], r)] + [(d, r) for d in drawn if d is not None])
     if len(set(first)) <= 1:        # flat at four directions: ``points`` more drawn before it is called unread
-        first += [ev(d) for d in (_unit(rng.standard_normal(n)) for _ in range(int(points))) if d is not None]
+        first += evs([(d, r) for d in (_unit(rng.standard_normal(n)) for _ in range(int(points))) if d is not None])
         if len(set(first)) <= 1:
             return {"coordinate": "direction", "read": False, "points": len(first), "log": False,
                     "range": [0.0, math.pi], "unit": "rad", "sphere": f"S^{n - 1}"}
     count = len(first)
     sketched = sketch_directions(op, s, r, rng)
-    for d in sketched:
-        for radius in (r * k for k in SKETCH_RADII):
-            for sign in (1.0, -1.0):
-                ev(sign * d, radius)
-                count += 1
+    known = [(sign * d, radius) for d in sketched for radius in (r * k for k in SKETCH_RADII) for sign in (1.0, -1.0)]
     for _ in range(drawn_count(points, n)):
         d = _unit(rng.standard_normal(n))
         if d is not None:
-            ev(d)
-            count += 1
+            known.append((d, r))
+    evs(known)
+    count += len(known)
     theta, d, radius = FIRST_ANGLE, best[1], best[2]
     restarts, cur, finest = 0, best[0], theta
     for _ in range(max(1, int(points) // 2)):

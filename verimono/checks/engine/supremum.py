@@ -255,6 +255,18 @@ class _Evaluator:
         self.note(x, vals, which)
         return vals
 
+    def table(self, xs: np.ndarray, table: np.ndarray) -> None:
+        """:meth:`note` of every row of ``table`` (the values of every family at ``xs``, known before: a design the
+        caller evaluated as one list), in order: the same points, counts and best (the first largest value)."""
+        unit = self.space.unit
+        self.us += [unit(x) for x in xs.tolist()]
+        self.evaluations += table.size
+        if table.size:
+            i = int(np.argmax(table))
+            if table.flat[i] > self.best["value"]:
+                self.best.update(value=float(table.flat[i]), at=float(xs[i // table.shape[1]]),
+                                 family=i % table.shape[1])
+
     def every(self, x: float) -> np.ndarray | None:
         """Every family's value at ``x`` (``None`` when an unverified solve prevents the whole row)."""
         try:
@@ -284,11 +296,18 @@ def maximise(values: Callable[[float, Sequence[int] | None], np.ndarray], space:
     ev = _Evaluator(values, space)
     xs = np.linspace(space.lo, space.hi, 17) if design is None else np.asarray(design, dtype=float)
     xs = np.unique(np.clip(xs[np.isfinite(xs)], space.lo, space.hi))
-    rows = [ev.every(float(x)) for x in xs]
-    width = next((r.size for r in rows if r is not None), None)
-    if width is None:
-        raise UnverifiedSolution(f"no point of the design could be evaluated ({len(xs)} tried)")
-    table = np.array([r if r is not None else ev.some(float(x), range(width)) for r, x in zip(rows, xs)])
+    known = getattr(values, "table", None)      # the design's values, evaluated before as one list
+    table = known(xs) if known is not None and xs.size else None
+    if table is not None:
+        table = _finite(table)
+        ev.table(xs, table)
+        width = table.shape[1]
+    else:
+        rows = [ev.every(float(x)) for x in xs]
+        width = next((r.size for r in rows if r is not None), None)
+        if width is None:
+            raise UnverifiedSolution(f"no point of the design could be evaluated ({len(xs)} tried)")
+        table = np.array([r if r is not None else ev.some(float(x), range(width)) for r, x in zip(rows, xs)])
     if table.ndim != 2 or table.shape[1] == 0:
         raise ValueError("values(x, None) must return a nonempty 1-D array (one value per family)")
     grid_value, grid_at = ev.best["value"], ev.best["at"]
@@ -296,7 +315,7 @@ def maximise(values: Callable[[float, Sequence[int] | None], np.ndarray], space:
     ranked = [int(f) for f in np.lexsort((-second, -table.max(axis=0)))]
     chosen = ranked[:max(1, families)]
     everyone = list(range(width))
-    found: list[tuple] = [(float(x), float(r.max()), r, everyone) for x, r in zip(xs, table)]
+    found: list[tuple] = [(x, m, r, everyone) for x, m, r in zip(xs.tolist(), table.max(axis=1).tolist(), table)]
 
     def lim(f: int) -> tuple[float, float]:
         return (space.lo, space.hi) if bounds is None else bounds(f)
