@@ -39,6 +39,12 @@ def t_norm(x0=(1.0,), T: float = 2.0) -> Problem:
     def exact(t):
         return max(1.0 - t * t / (2.0 * r), 0.0) * x0
 
+    def on_times(t):
+        """``exact`` at every time of the array ``t`` at once, bit for bit (the same operations, elementwise):
+        a study's per-node Python calls were a third of its time (0.24 s per 10^5 nodes)."""
+        return np.maximum(1.0 - t * t / (2.0 * r), 0.0)[:, None] * x0
+
+    exact.on_times = on_times
     n = x0.size
     return Problem(
         NormSubdifferential(_tnorm_c, dim=n), x0, T, exact=exact,

@@ -6,6 +6,7 @@ machine is).  Verdicts on real timings, planted slowdowns included, are the benc
 from __future__ import annotations
 
 import math
+import os
 import random
 
 import pytest
@@ -163,10 +164,14 @@ def test_on_worker_processes_the_memory_record_runs_beside_the_timed_ones(monkey
 
     monkeypatch.setitem(performance.SIZES, "ci", SMALL)
     runner = ProcessRunner(2)
+    context = RunContext(executor=runner)
     try:
-        rep = STAGES["performance"].fn(get_profile("ci"), RunContext(executor=runner))
+        rep = STAGES["performance"].fn(get_profile("ci"), context)
     finally:
         runner.close()
+    # the memory unit's CPU is the stage's too (run_stages adds the units run elsewhere): it was left out
+    [unit] = context.unit_times
+    assert unit["label"] == "memory" and unit["cpu"] > 0 and unit["pid"] != os.getpid()
     assert [r.check for r in rep][-3:] == ["performance_lcs_step", "performance_lcs_batch", "performance_memory"]
     assert len(rep) == 15
     mem = rep.results[-1]

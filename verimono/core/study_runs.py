@@ -115,9 +115,14 @@ def _reference_cells(grids: Sequence[np.ndarray], T: float, refinement: int) -> 
 
 
 def exact_on(problem: Problem, t: np.ndarray) -> np.ndarray:
-    """Exact solution at the times ``t``, shape ``(len(t),) + x0.shape``."""
+    """Exact solution at the times ``t``, shape ``(len(t),) + x0.shape``: one call of ``problem.exact`` per time,
+    or one call of ``problem.exact.on_times(t)`` when the exact solution carries that vectorized twin (which must
+    return the same values; the references that have one: ``verimono.reference.subdifferential.t_norm``)."""
     if problem.exact is None:
         raise InvalidProblem(f"{problem.name} has no exact solution")
+    on_times = getattr(problem.exact, "on_times", None)
+    if on_times is not None:    # the same values at every time in one vectorized call (the reference's own)
+        return np.asarray(on_times(np.asarray(t, dtype=float)), dtype=float)
     return np.array([np.asarray(problem.exact(s), dtype=float) for s in t.tolist()])
 
 

@@ -101,7 +101,10 @@ class Sizes:
 #: Rounds: 9 is the fewest whose order-statistics bounds at 97.5% one-sided leave out one outlying round on
 #: each side (r_(2) and r_(8); 8 rounds give only the minimum and maximum), and 27 (the straddle budget) leave
 #: out 7 on each side (:func:`verimono.execution.timing.order_rank`).
-_QUICK = Sizes(per_step_steps=10_000, per_step_rounds=9, ensemble_batch=1000, ensemble_steps=20,
+#: per_step_steps 5000 (was 10 000): the nine per-step records, 2 x 9 rounds at both sizes interleaved at load 5.6-6.7,
+#: gave the same medians (1.15-1.30x against 1.19-1.32x), intervals no wider (widths 0.02-0.32 against 0.04-0.47)
+#: and no straddle (one at 10 000) for 1.3-1.4 s of CPU against 2.9-3.4 s (docs/speed.md, branch perf7)
+_QUICK = Sizes(per_step_steps=5_000, per_step_rounds=9, ensemble_batch=1000, ensemble_steps=20,
                ensemble_rounds=9, lcs_steps=5000, lcs_rounds=9, memory_steps=100_000,
                lcs_batch=1000, lcs_batch_steps=200, lcs_batch_rounds=9, max_rounds=27)
 SIZES = {

@@ -34,7 +34,7 @@ from ...checks.shared_runs import note_partitions, shared_runs
 from ...checks.siconos import check_siconos_case, check_siconos_lcps
 from ...checks.generated_problems import generated_problems
 from ...checks.stepper_battery import stepper_checks
-from .registry import RunContext, register_stage
+from .registry import UNIT_TIME, RunContext, register_stage, timed_unit
 
 #: how many points of a trajectory the report keeps for its plot (enough for a smooth curve)
 TRAJECTORY_SAMPLES = 400
@@ -371,11 +371,19 @@ def performance_stage(profile: Profile, context: RunContext) -> Report:
         def aside(steps: int, stepper: Any) -> Callable[[], CheckResult]:
             import concurrent.futures
 
-            unit = Unit("performance", "memory", _memory_unit, (steps, stepper))
+            unit = Unit("performance", "memory", timed_unit, (_memory_unit, (steps, stepper)))
+
+            def run() -> Report:
+                rep = context.executor.map([unit], profile.name, lambda done, total, label: None)[0]
+                t = rep.meta.pop(UNIT_TIME, None)   # its CPU is the stage's too (the stage's CPU had left it out)
+                if isinstance(t, dict):
+                    context.unit_times.append({"stage": unit.stage, "label": unit.label, **t})
+                return rep
+
             pool = concurrent.futures.ThreadPoolExecutor(1)
-            future = pool.submit(context.executor.map, [unit], profile.name, lambda done, total, label: None)
+            future = pool.submit(run)
             pool.shutdown(wait=False)
-            return lambda: future.result()[0].results[0]
+            return lambda: future.result().results[0]
     return performance.performance_report(performance.SIZES[profile.name], stepper=context.stepper, progress=context.progress,
                                    aside=aside)
 
