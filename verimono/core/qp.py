@@ -30,6 +30,29 @@ from scipy.optimize import nnls
 from .errors import InfeasibleStep, UnverifiedSolution
 from .tolerances import QP_RTOL
 
+try:    # SciPy's own routine behind ``scipy.optimize.nnls`` (its wrapper's argument handling costs more than the solve)
+    from scipy.optimize._slsqplib import nnls as _nnls_routine
+except ImportError:     # pragma: no cover - another SciPy layout: the public function
+    _nnls_routine = None
+
+_EMPTY = np.zeros(0)
+
+
+def _nnls(A, b, maxiter):
+    """``scipy.optimize.nnls(A, b, maxiter=maxiter)``: the same routine with the same arguments (``A`` C-ordered
+    ``float64``, finite, ``b`` of matching length), without the wrapper's argument checks, which cost more than
+    the solve on these small matrices; the same answer bit for bit, the same errors."""
+    if _nnls_routine is None:
+        return nnls(A, b, maxiter=maxiter)
+    A = np.asarray_chkfinite(A, dtype=np.float64, order="C")
+    b = np.asarray_chkfinite(b, dtype=np.float64)
+    if A.ndim != 2 or b.ndim != 1 or A.shape[0] != b.shape[0]:
+        return nnls(A, b, maxiter=maxiter)      # the wrapper's own errors
+    x, rnorm, info = _nnls_routine(A, b, maxiter or 3 * A.shape[1])
+    if info == 3:
+        raise RuntimeError("Maximum number of iterations reached.")
+    return x, rnorm
+
 #: back-ends tried in order, with the options that make them accurate
 BACKENDS: dict[str, dict] = {
     "proxqp": dict(eps_abs=1e-12, eps_rel=0.0, check_duality_gap=True, max_iter=10_000),
@@ -40,6 +63,29 @@ BACKENDS: dict[str, dict] = {
 #: rows whose slack is within this (relative) of zero are candidates for the active set of the KKT check;
 #: complementary slackness then decides: a row with a multiplier must have (almost) no slack
 ACTIVE_RTOL = 1e-7
+
+
+try:    # NumPy's least-squares gufunc, which ``np.linalg.lstsq`` calls after its argument handling
+    from numpy.linalg import _umath_linalg
+    from numpy.linalg._linalg import _raise_linalgerror_lstsq
+except ImportError:     # pragma: no cover - another NumPy layout: the public function
+    _umath_linalg = None
+
+_EPS = float(np.finfo(np.float64).eps)
+
+
+def lstsq_solution(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``np.linalg.lstsq(a, b, rcond=None)[0]`` for a real ``float64`` matrix ``a`` (``m×n``, ``m, n ≥ 1``) and
+    vector ``b`` (``m``): the same gufunc with the same arguments (``rcond = ε·max(m, n)``) and the same error
+    handling, so the same answer bit for bit and the same ``LinAlgError``, without the wrapper's dispatch and
+    type resolution (about half of a call on the 2×2 to 8×8 systems of the small QPs and LCPs)."""
+    if (_umath_linalg is None or a.ndim != 2 or b.ndim != 1 or a.dtype != np.float64 or b.dtype != np.float64
+            or a.shape[0] != b.shape[0] or 0 in a.shape):
+        return np.linalg.lstsq(a, b, rcond=None)[0]
+    m, n = a.shape
+    with np.errstate(call=_raise_linalgerror_lstsq, invalid="call", over="ignore", divide="ignore", under="ignore"):
+        x = _umath_linalg.lstsq(a, b[:, None], _EPS * max(n, m), signature="ddd->ddid")[0]
+    return x[:, 0].copy()
 
 
 @dataclasses.dataclass
@@ -60,28 +106,31 @@ def kkt_residual(P, q, G, h, A, b, z, rtol: float = QP_RTOL) -> KKTReport:
     point, 5e-7 off, for the projection onto the domain of the Example's H).  All three to ``rtol``
     relative to the data.
     """
+    # the same arithmetic as np.max(..., initial=0.0) and np.linalg.norm, through the arrays' own methods: these
+    # QPs have 2-6 variables, where NumPy's wrappers cost more than the reductions (same values, bit for bit)
+    Pz = P @ z
     scale = 1.0 + max(np.abs(q).max(initial=0.0), np.abs(h).max(initial=0.0) if h is not None else 0.0,
-                      np.abs(b).max(initial=0.0) if b is not None else 0.0, np.abs(P @ z).max(initial=0.0))
+                      np.abs(b).max(initial=0.0) if b is not None else 0.0, np.abs(Pz).max(initial=0.0))
     viol = 0.0
-    rows, gaps = [], np.zeros(0)
+    rows, gaps = [], _EMPTY
     if G is not None and len(h):
         slack = G @ z - h
-        viol = max(viol, float(np.max(slack, initial=0.0)))
+        viol = max(viol, float(slack.max(initial=0.0)))
         active = slack >= -ACTIVE_RTOL * scale
         rows.append(G[active])
         gaps = -slack[active]                    # ≥ 0 up to the violation, 0 on the bound
     if A is not None and len(b):
-        viol = max(viol, float(np.max(np.abs(A @ z - b), initial=0.0)))
+        viol = max(viol, float(np.abs(A @ z - b).max(initial=0.0)))
         rows.extend([A, -A])  # free multipliers as differences of nonnegative ones
-    grad = P @ z + q
-    R = np.vstack(rows) if rows else np.zeros((0, z.size))
+    grad = Pz + q
+    R = (rows[0] if len(rows) == 1 else np.vstack(rows)) if rows else np.zeros((0, z.size))
     comp = 0.0
     if R.shape[0]:
-        mu, res = nnls(R.T, -grad, maxiter=50 * max(R.shape))
+        mu, res = _nnls(R.T, -grad, maxiter=50 * max(R.shape))
         if gaps.size:
-            comp = float(np.max(mu[:gaps.size] * np.abs(gaps), initial=0.0)) / (1.0 + float(np.max(mu, initial=0.0)))
+            comp = float((mu[:gaps.size] * np.abs(gaps)).max(initial=0.0)) / (1.0 + float(mu.max(initial=0.0)))
     else:  # no active row (an interior minimiser): SciPy's nnls aborts the process on an empty matrix
-        res = float(np.linalg.norm(grad))
+        res = float(np.sqrt(grad.dot(grad)))     # np.linalg.norm(grad), bit for bit
     primal, dual, comp = viol / scale, res / scale, comp / scale
     return KKTReport(primal, dual, comp, primal <= rtol and dual <= rtol and comp <= rtol)
 
@@ -101,7 +150,7 @@ def _polish(P, q, G, h, A, b, z):
     E, e = np.vstack(blocks), np.concatenate(rhs)
     m = E.shape[0]
     K = np.block([[P, E.T], [E, np.zeros((m, m))]])
-    sol = np.linalg.lstsq(K, np.concatenate([-q, e]), rcond=None)[0]
+    sol = lstsq_solution(K, np.concatenate([-q, e]))
     return sol[:n]
 
 
@@ -131,20 +180,36 @@ def _unit_rows(E, e, kind, ref):
     """Rows of ``E`` scaled to unit length (with ``e``); zero rows dropped after checking ``0 ≤ e``
     (inequalities) or ``0 = e`` (equalities) up to ``QP_RTOL·ref`` (``ref`` the size of the data) — a zero
     row whose right-hand side has the wrong sign beyond rounding is an empty feasible set."""
-    if E is None:
+    if E is None or E.shape[0] == 0:
         return None, None
-    norms = np.linalg.norm(E, axis=1)
-    zero = norms == 0.0
-    if np.any(zero):
+    key = (E.shape, E.dtype.str, E.tobytes()) if E.size <= 256 else None
+    hit = _UNIT_ROWS.get(key) if key is not None else None
+    if hit is None:
+        norms = np.sqrt(np.add.reduce(E * E, axis=1))     # np.linalg.norm(E, axis=1), bit for bit
+        zero = norms == 0.0
+        anyzero = bool(zero.any())
+        hit = (norms, zero, anyzero, None if anyzero else E / norms[:, None])
+        if key is not None:
+            if len(_UNIT_ROWS) >= 256:
+                _UNIT_ROWS.clear()
+            _UNIT_ROWS[key] = hit
+    norms, zero, anyzero, unit = hit
+    if anyzero:
         slack = QP_RTOL * ref
         bad = e[zero] < -slack if kind == "<=" else np.abs(e[zero]) > slack
         if np.any(bad):
             raise InfeasibleStep(f"the QP has a zero constraint row with right-hand side "
                                  f"{e[zero][bad][0]:.3g} ({'0 <= h' if kind == '<=' else '0 = b'} fails)")
         E, e, norms = E[~zero], e[~zero], norms[~zero]
-    if E.shape[0] == 0:
-        return None, None
-    return E / norms[:, None], e / norms
+        if E.shape[0] == 0:
+            return None, None
+        return E / norms[:, None], e / norms
+    return unit.copy(), e / norms
+
+
+#: the unit rows of small constraint matrices by their bytes (:func:`_unit_rows`): a check's QPs share their
+#: constraint matrices (the selection and projection QPs of an LCS operator), only their right-hand sides move
+_UNIT_ROWS: dict[tuple, tuple] = {}
 
 
 #: a half-space ``⟨g, z⟩ ≤ d`` (``|g| = 1``) is *far* when ``d`` exceeds ``FAR`` times the size of all the data
@@ -163,6 +228,8 @@ def _far(h: np.ndarray, core: float) -> np.ndarray:
     hides a nearer one, and rows at every scale below the data's stay)."""
     far = np.zeros(h.shape, dtype=bool)
     size = core
+    if h.size and h.max() <= FAR * core:     # no row beyond FAR times the data (the usual case; NaN: the loop)
+        return far
     order = np.argsort(h)
     for pos, i in enumerate(order):
         if h[i] > FAR * size:

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.qp import ACTIVE_RTOL, equilibrate, kkt_residual, qp_arrays, solve_qp
+from ..core.qp import ACTIVE_RTOL, equilibrate, kkt_residual, lstsq_solution, qp_arrays, solve_qp
 from ..core.tolerances import QP_RTOL
 
 #: active sets remembered per QP shape (most recent first)
@@ -40,7 +40,7 @@ def _on_active(S, act: np.ndarray) -> np.ndarray:
     m = E.shape[0]
     K = np.zeros((n + m, n + m))      # np.block([[P, Eᵀ], [E, 0]]), assembled directly
     K[:n, :n], K[:n, n:], K[n:, :n] = S.P, E.T, E
-    return np.linalg.lstsq(K, np.concatenate([-S.q, e]), rcond=None)[0][:n]
+    return lstsq_solution(K, np.concatenate([-S.q, e]))[:n]
 
 
 def solve_qp_warm(memory: dict, P, q, G=None, h=None, A=None, b=None, *, scale: float | None = None) -> np.ndarray:

@@ -39,7 +39,7 @@ import numpy as np
 from scipy.optimize import linprog
 
 from ..core.errors import InfeasibleStep, InvalidProblem, UnverifiedSolution, VerimonoError
-from ..core.qp import solve_qp
+from ..core.qp import lstsq_solution, solve_qp
 from ..core.tolerances import POLISH_RTOL, QP_RTOL, RTOL
 
 #: largest n for which complementary pieces are enumerated (2^n pieces)
@@ -88,7 +88,7 @@ def _validate(M, q) -> tuple[np.ndarray, np.ndarray]:
 
 def lcp_residual(M: np.ndarray, q: np.ndarray, z: np.ndarray) -> float:
     """Natural residual ``‖min(z, Mz + q)‖∞``: zero iff ``z ∈ SOL(q, M)``."""
-    return float(np.max(np.abs(np.minimum(z, M @ z + q)), initial=0.0))
+    return float(np.abs(np.minimum(z, M @ z + q)).max(initial=0.0))
 
 
 def lcp_scale(M: np.ndarray, q: np.ndarray, z: np.ndarray | None = None) -> float:
@@ -130,7 +130,7 @@ def principal_solve(M: np.ndarray, q: np.ndarray, alpha: np.ndarray) -> np.ndarr
     z = np.zeros(q.shape[0])
     idx = np.flatnonzero(alpha)
     if idx.size:
-        z[idx] = np.linalg.lstsq(M[np.ix_(idx, idx)], -q[idx], rcond=None)[0]
+        z[idx] = lstsq_solution(M[np.ix_(idx, idx)], -q[idx])     # np.linalg.lstsq's, bit for bit
     return z
 
 
@@ -304,7 +304,7 @@ def _row_basis(E: np.ndarray, floors: np.ndarray | None = None) -> np.ndarray:
     was computed from, when it is rounding and drops out (``floors`` default to 0)."""
     if E.size == 0:
         return E
-    norms = np.linalg.norm(E, axis=1)
+    norms = np.sqrt(np.add.reduce(E * E, axis=1))      # np.linalg.norm(E, axis=1), bit for bit
     if floors is not None:
         norms = np.maximum(norms, floors)
     E = E[norms > 0] / norms[norms > 0, None]
@@ -324,7 +324,7 @@ def sol_polyhedron(M, q, zbar, scale: float | None = None):
     n = q.shape[0]
     floors = np.concatenate([np.full(n, float(np.abs(M).max(initial=0.0))), [0.0 if scale is None else float(scale)]])
     A = _row_basis(np.vstack([M + M.T, q[None, :]]), floors)
-    return np.vstack([-np.eye(n), -M]), np.concatenate([np.zeros(n), q]), A, A @ zbar
+    return np.vstack([-_eye(n), -M]), np.concatenate([np.zeros(n), q]), A, A @ zbar
 
 
 def select_over_sol(M, q, zbar, P, c, scale: float | None = None) -> np.ndarray:
@@ -336,12 +336,26 @@ def select_over_sol(M, q, zbar, P, c, scale: float | None = None) -> np.ndarray:
     return solve_qp(P, c, G, h, A if len(A) else None, b if len(A) else None, scale=scale)
 
 
+_EYES: dict[int, np.ndarray] = {}
+
+
+def _eye(n: int) -> np.ndarray:
+    """``np.eye(n)``, read-only and made once per ``n`` (indexed and stacked, never written)."""
+    e = _EYES.get(n)
+    if e is None:
+        e = np.eye(n)
+        e.flags.writeable = False
+        if n <= 64:
+            _EYES[n] = e
+    return e
+
+
 def unique_certificate(M, q, z, w, scale) -> bool:
     """True when ``SOL(q, M)`` is provably ``{z}`` (PSD ``M``): the rows ``M+Mᵀ``, ``e_i (w_i > 0)``,
     ``M_i (z_i > 0)`` have full column rank (see the module docstring)."""
     n = q.shape[0]
     tau = RTOL * scale
-    rows = np.vstack([M + M.T, np.eye(n)[w > tau], M[z > tau]])
+    rows = np.vstack([M + M.T, _eye(n)[w > tau], M[z > tau]])
     s = np.linalg.svd(rows, compute_uv=False)
     return bool(s.size >= n and s[n - 1] > RTOL * max(s[0], 1.0))
 
