@@ -77,9 +77,20 @@ def row_infeasible(M: np.ndarray, q: np.ndarray) -> bool:
     ``z ≥ 0`` (the Farkas certificate ``y = e_i``).  The margin keeps the answer the one of the linear program of
     :func:`verimono.lcs.lcp._feasible` (HiGHS, feasibility tolerance 1e-7), which it spares: a row violated by
     less is left to that program.  ``False`` proves nothing."""
-    tol = INFEASIBLE_MARGIN * (1.0 + float(np.abs(q).max(initial=0.0)) + float(np.abs(M).max(initial=0.0)))
-    rows = np.all(M <= 0.0, axis=1) & (q < -tol)
-    return bool(np.any(rows))
+    key = (M.shape, M.tobytes()) if M.size <= 256 else None
+    hit = _ROWS_OF.get(key) if key is not None else None
+    if hit is None:     # what depends on M alone, once per M (the operator's D at every call)
+        hit = (float(np.abs(M).max(initial=0.0)), np.all(M <= 0.0, axis=1))
+        if key is not None:
+            if len(_ROWS_OF) >= 64:
+                _ROWS_OF.clear()
+            _ROWS_OF[key] = hit
+    m_max, nonpos = hit
+    tol = INFEASIBLE_MARGIN * (1.0 + float(np.abs(q).max(initial=0.0)) + m_max)
+    return bool((nonpos & (q < -tol)).any())
+
+
+_ROWS_OF: dict[tuple, tuple] = {}
 
 
 #: how far (relative to the data) a row must be violated for :func:`row_infeasible` to decide without the LP
