@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import nnls
 
+from ._linalg import lstsq_solution
 from .errors import InfeasibleStep, UnverifiedSolution
 from .tolerances import QP_RTOL
 
@@ -63,29 +64,6 @@ BACKENDS: dict[str, dict] = {
 #: rows whose slack is within this (relative) of zero are candidates for the active set of the KKT check;
 #: complementary slackness then decides: a row with a multiplier must have (almost) no slack
 ACTIVE_RTOL = 1e-7
-
-
-try:    # NumPy's least-squares gufunc, which ``np.linalg.lstsq`` calls after its argument handling
-    from numpy.linalg import _umath_linalg
-    from numpy.linalg._linalg import _raise_linalgerror_lstsq
-except ImportError:     # pragma: no cover - another NumPy layout: the public function
-    _umath_linalg = None
-
-_EPS = float(np.finfo(np.float64).eps)
-
-
-def lstsq_solution(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``np.linalg.lstsq(a, b, rcond=None)[0]`` for a real ``float64`` matrix ``a`` (``m×n``, ``m, n ≥ 1``) and
-    vector ``b`` (``m``): the same gufunc with the same arguments (``rcond = ε·max(m, n)``) and the same error
-    handling, so the same answer bit for bit and the same ``LinAlgError``, without the wrapper's dispatch and
-    type resolution (about half of a call on the 2×2 to 8×8 systems of the small QPs and LCPs)."""
-    if (_umath_linalg is None or a.ndim != 2 or b.ndim != 1 or a.dtype != np.float64 or b.dtype != np.float64
-            or a.shape[0] != b.shape[0] or 0 in a.shape):
-        return np.linalg.lstsq(a, b, rcond=None)[0]
-    m, n = a.shape
-    with np.errstate(call=_raise_linalgerror_lstsq, invalid="call", over="ignore", divide="ignore", under="ignore"):
-        x = _umath_linalg.lstsq(a, b[:, None], _EPS * max(n, m), signature="ddd->ddid")[0]
-    return x[:, 0].copy()
 
 
 @dataclasses.dataclass

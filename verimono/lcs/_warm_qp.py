@@ -19,7 +19,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.qp import ACTIVE_RTOL, equilibrate, kkt_residual, lstsq_solution, qp_arrays, solve_qp
+from ..core._linalg import lstsq_solution
+from ..core.qp import ACTIVE_RTOL, equilibrate, kkt_residual, qp_arrays, solve_qp
 from ..core.tolerances import QP_RTOL
 
 #: active sets remembered per QP shape (most recent first)

@@ -39,7 +39,8 @@ import numpy as np
 from scipy.optimize import linprog
 
 from ..core.errors import InfeasibleStep, InvalidProblem, UnverifiedSolution, VerimonoError
-from ..core.qp import lstsq_solution, solve_qp
+from ..core._linalg import lstsq_solution, singular_values, svd_reduced
+from ..core.qp import solve_qp
 from ..core.tolerances import POLISH_RTOL, QP_RTOL, RTOL
 
 #: largest n for which complementary pieces are enumerated (2^n pieces)
@@ -149,6 +150,10 @@ def lemke(M: np.ndarray, q: np.ndarray, max_iter: int | None = None) -> tuple[np
     n = q.shape[0]
     if np.all(q >= 0):
         return np.zeros(n), "solved"
+    if n <= LEMKE_SMALL:
+        out = _lemke_small(M, q, max_iter)
+        if out is not None:
+            return out
     T = np.hstack([np.eye(n), -M, -np.ones((n, 1)), q[:, None]])
     basis = np.arange(n)
     piv_tol = 1e-12 * max(1.0, float(np.abs(M).max(initial=0.0)))
@@ -182,6 +187,59 @@ def lemke(M: np.ndarray, q: np.ndarray, max_iter: int | None = None) -> tuple[np
     for i, b in enumerate(basis):
         if n <= b < 2 * n:
             z[b - n] = max(T[i, -1], 0.0)
+    return z, "solved"
+
+
+#: :func:`lemke` pivots in Python floats up to this size (its NumPy form costs ~10 µs a pivot in call overhead)
+LEMKE_SMALL = 6
+
+
+def _lemke_small(M: np.ndarray, q: np.ndarray, max_iter: int | None):
+    """:func:`lemke` in Python floats, operation for operation (each pivot row divided by its pivot, each row
+    less its multiple of the pivot row — NumPy's ``outer`` then ``-=``, two roundings, as here — and the same
+    lexicographic ratio test), so the same ``(z, status)`` bit for bit; ``None`` when a ratio is NaN (overflowed
+    data), whose NumPy semantics :func:`lemke` itself then follows."""
+    n = q.shape[0]
+    Ml, ql = M.tolist(), q.tolist()
+    T = [[1.0 if j == i else 0.0 for j in range(n)] + [-v for v in Ml[i]] + [-1.0, ql[i]] for i in range(n)]
+    width = 2 * n + 2
+    basis = list(range(n))
+    piv_tol = 1e-12 * max(1.0, float(np.abs(M).max(initial=0.0)))
+    entering = 2 * n
+    r = int(np.argmin(q))
+    max_iter = max_iter or 1000 + 100 * n
+    order = [width - 1] + list(range(n))
+    for _ in range(max_iter):
+        row = T[r]
+        p = row[entering]
+        row = T[r] = [v / p for v in row]
+        for i in range(n):
+            ci = T[i][entering] if i != r else 0.0
+            Ti = T[i]
+            T[i] = [Ti[j] - ci * row[j] for j in range(width)]
+        leaving, basis[r] = basis[r], entering
+        if leaving == 2 * n:
+            break
+        entering = leaving + n if leaving < n else leaving - n
+        cand = [i for i in range(n) if T[i][entering] > piv_tol]
+        if not cand:
+            return None, "ray termination"
+        for j in order:
+            ratios = [T[i][j] / T[i][entering] for i in cand]
+            if any(x != x for x in ratios):
+                return None
+            best = min(ratios)
+            cut = best + 1e-12 * max(1.0, abs(best))
+            cand = [i for i, x in zip(cand, ratios) if x <= cut]
+            if len(cand) == 1:
+                break
+        r = cand[0]
+    else:
+        return None, "iteration limit"
+    z = np.zeros(n)
+    for i, b in enumerate(basis):
+        if n <= b < 2 * n:
+            z[b - n] = max(T[i][-1], 0.0)
     return z, "solved"
 
 
@@ -310,7 +368,7 @@ def _row_basis(E: np.ndarray, floors: np.ndarray | None = None) -> np.ndarray:
     E = E[norms > 0] / norms[norms > 0, None]
     if E.size == 0:
         return E
-    _, s, Vt = np.linalg.svd(E, full_matrices=False)
+    _, s, Vt = svd_reduced(E)     # np.linalg.svd's, bit for bit
     r = int(np.sum(s > RTOL))     # rows of norm ≤ 1: singular values are absolute
     return Vt[:r]
 
@@ -356,7 +414,7 @@ def unique_certificate(M, q, z, w, scale) -> bool:
     n = q.shape[0]
     tau = RTOL * scale
     rows = np.vstack([M + M.T, _eye(n)[w > tau], M[z > tau]])
-    s = np.linalg.svd(rows, compute_uv=False)
+    s = singular_values(rows)     # np.linalg.svd's, bit for bit
     return bool(s.size >= n and s[n - 1] > RTOL * max(s[0], 1.0))
 
 
