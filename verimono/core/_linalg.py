@@ -58,4 +58,23 @@ def singular_values(a: np.ndarray) -> np.ndarray:
         return _umath_linalg.svd(a, signature="d->d")
 
 
-__all__ = ["lstsq_solution", "svd_reduced", "singular_values"]
+def absmax(a) -> float:
+    """``float(np.abs(a).max(initial=0.0))`` — NaN when an entry is NaN, as NumPy's — in Python floats for the
+    arrays of at most :data:`SMALL` entries a small LCP or QP is made of (the exact same value: ``abs`` and
+    ``max`` round nothing), NumPy's own reduction otherwise."""
+    if a.size > SMALL:
+        return float(np.abs(a).max(initial=0.0))
+    m = 0.0
+    for v in a.ravel().tolist():
+        v = abs(v)
+        if v > m:
+            m = v
+        elif v != v:
+            return float("nan")
+    return float(m)
+
+
+#: arrays up to this many entries are reduced in Python floats by :func:`absmax`
+SMALL = 32
+
+__all__ = ["lstsq_solution", "svd_reduced", "singular_values", "absmax"]

@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import nnls
 
-from ._linalg import lstsq_solution
+from ._linalg import absmax, lstsq_solution
 from .errors import InfeasibleStep, UnverifiedSolution
 from .tolerances import QP_RTOL
 
@@ -87,8 +87,8 @@ def kkt_residual(P, q, G, h, A, b, z, rtol: float = QP_RTOL) -> KKTReport:
     # the same arithmetic as np.max(..., initial=0.0) and np.linalg.norm, through the arrays' own methods: these
     # QPs have 2-6 variables, where NumPy's wrappers cost more than the reductions (same values, bit for bit)
     Pz = P @ z
-    scale = 1.0 + max(np.abs(q).max(initial=0.0), np.abs(h).max(initial=0.0) if h is not None else 0.0,
-                      np.abs(b).max(initial=0.0) if b is not None else 0.0, np.abs(Pz).max(initial=0.0))
+    scale = 1.0 + max(absmax(q), absmax(h) if h is not None else 0.0, absmax(b) if b is not None else 0.0,
+                      absmax(Pz))
     viol = 0.0
     rows, gaps = [], _EMPTY
     if G is not None and len(h):
@@ -98,7 +98,7 @@ def kkt_residual(P, q, G, h, A, b, z, rtol: float = QP_RTOL) -> KKTReport:
         rows.append(G[active])
         gaps = -slack[active]                    # ≥ 0 up to the violation, 0 on the bound
     if A is not None and len(b):
-        viol = max(viol, float(np.abs(A @ z - b).max(initial=0.0)))
+        viol = max(viol, absmax(A @ z - b))
         rows.extend([A, -A])  # free multipliers as differences of nonnegative ones
     grad = Pz + q
     R = (rows[0] if len(rows) == 1 else np.vstack(rows)) if rows else np.zeros((0, z.size))
@@ -228,22 +228,19 @@ def equilibrate(P, q, G, h, A, b, scale: float | None = None, set_aside_far: boo
 
         min ½ yᵀ(P/p)y + (q/(p s))ᵀy   s.t.  (G/‖G_i‖)y ≤ h/(‖G_i‖ s),  (A/‖A_i‖)y = b/(‖A_i‖ s).
     """
-    p = float(np.abs(P).max(initial=0.0)) or 1.0
+    p = absmax(P) or 1.0
     floor = 0.0 if scale is None else float(scale)
-    ref = max(float(np.abs(h).max(initial=0.0)) if h is not None else 0.0,
-              float(np.abs(b).max(initial=0.0)) if b is not None else 0.0,
-              float(np.abs(q).max(initial=0.0)) / p, floor)
+    ref = max(absmax(h) if h is not None else 0.0, absmax(b) if b is not None else 0.0, absmax(q) / p, floor)
     G, h = _unit_rows(G, h, "<=", ref)
     A, b = _unit_rows(A, b, "=", ref)
-    core = max(float(np.abs(b).max(initial=0.0)) if b is not None else 0.0,
-               float(np.abs(q).max(initial=0.0)) / p, floor)
+    core = max(absmax(b) if b is not None else 0.0, absmax(q) / p, floor)
     G_far = h_far = None
     if G is not None and set_aside_far:
         far = _far(h, core)
         if np.any(far):
             G_far, h_far = G[far], h[far]
             G, h = (G[~far], h[~far]) if not np.all(far) else (None, None)
-    s = max(core, float(np.abs(h).max(initial=0.0)) if h is not None else 0.0)
+    s = max(core, absmax(h) if h is not None else 0.0)
     if not (np.isfinite(s) and s > 0.0):
         s = 1.0
     return ScaledQP(P / p, q / (p * s), G, None if h is None else h / s, A, None if b is None else b / s, s,

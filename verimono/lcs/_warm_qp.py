@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core._linalg import lstsq_solution
+from ..core._linalg import absmax, lstsq_solution
 from ..core.qp import ACTIVE_RTOL, equilibrate, kkt_residual, qp_arrays, solve_qp
 from ..core.tolerances import QP_RTOL
 
@@ -87,7 +87,7 @@ def row_infeasible(M: np.ndarray, q: np.ndarray) -> bool:
                 _ROWS_OF.clear()
             _ROWS_OF[key] = hit
     m_max, nonpos = hit
-    tol = INFEASIBLE_MARGIN * (1.0 + float(np.abs(q).max(initial=0.0)) + m_max)
+    tol = INFEASIBLE_MARGIN * (1.0 + absmax(q) + m_max)
     return bool((nonpos & (q < -tol)).any())
 
 

@@ -39,7 +39,7 @@ import numpy as np
 from scipy.optimize import linprog
 
 from ..core.errors import InfeasibleStep, InvalidProblem, UnverifiedSolution, VerimonoError
-from ..core._linalg import lstsq_solution, singular_values, svd_reduced
+from ..core._linalg import absmax, lstsq_solution, singular_values, svd_reduced
 from ..core.qp import solve_qp
 from ..core.tolerances import POLISH_RTOL, QP_RTOL, RTOL
 
@@ -89,13 +89,30 @@ def _validate(M, q) -> tuple[np.ndarray, np.ndarray]:
 
 def lcp_residual(M: np.ndarray, q: np.ndarray, z: np.ndarray) -> float:
     """Natural residual ``‖min(z, Mz + q)‖∞``: zero iff ``z ∈ SOL(q, M)``."""
-    return float(np.abs(np.minimum(z, M @ z + q)).max(initial=0.0))
+    return absmax(np.minimum(z, M @ z + q))
 
 
 def lcp_scale(M: np.ndarray, q: np.ndarray, z: np.ndarray | None = None) -> float:
     """Size of the data a residual is measured against: ``1 + max(|q|∞, ‖M‖∞|z|∞)``."""
-    mz = 0.0 if z is None else float(np.abs(M).sum(axis=1).max(initial=0.0) * np.abs(z).max(initial=0.0))
-    return 1.0 + max(float(np.abs(q).max(initial=0.0)), mz)
+    mz = 0.0 if z is None else float(_row_norm(M) * np.float64(absmax(z)))
+    return 1.0 + max(absmax(q), mz)
+
+
+#: ‖M‖∞ of small matrices by their bytes (:func:`lcp_scale` is asked about the same few at every call)
+_ROW_NORMS: dict[tuple, np.float64] = {}
+
+
+def _row_norm(M: np.ndarray) -> np.float64:
+    """``np.abs(M).sum(axis=1).max(initial=0.0)`` (a NumPy float), made once per small ``M``."""
+    key = (M.shape, M.dtype.str, M.tobytes()) if M.size <= 64 else None
+    out = _ROW_NORMS.get(key) if key is not None else None
+    if out is None:
+        out = np.abs(M).sum(axis=1).max(initial=0.0)
+        if key is not None:
+            if len(_ROW_NORMS) >= 256:
+                _ROW_NORMS.clear()
+            _ROW_NORMS[key] = out
+    return out
 
 
 #: answers of :func:`is_psd` for small matrices, by their bytes: a system's one-step and multiplier problems

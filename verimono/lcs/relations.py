@@ -20,6 +20,7 @@ import numpy as np
 from ..core.errors import InvalidProblem, NotMonotone, UnverifiedSolution
 from ..core.operators import Operator
 from ..core.tolerances import QP_RTOL, RTOL, tolerance
+from ..core._linalg import absmax
 from ._lu import lu_factor, lu_solve
 from .lcp import LCPResult, is_psd, lcp_scale, solve_box, solve_lcp
 
@@ -172,7 +173,7 @@ class _BoxStepper:
             lam[I] = lu_solve(lu, -(q[I] + Mfixed[I]))
         y = self.M @ lam + q
         # lcp_scale(M, q, lam), with ‖M‖∞ computed once
-        tau = RTOL * (1.0 + max(qmax, self.m_norm * float(np.abs(lam).max(initial=0.0))))
+        tau = RTOL * (1.0 + max(qmax, self.m_norm * absmax(lam)))
         if inner:
             lamI = lam[I]
             if (lamI - loI <= tau).any() or (upper and (hiI - lamI <= tau).any()):
@@ -191,7 +192,7 @@ class _BoxStepper:
     def __call__(self, q, scale=None):
         # non-finite data: no pattern is tried, the full solve says what is wrong
         if self.last is not None and np.isfinite(q).all():
-            qmax = float(np.abs(q).max(initial=0.0))
+            qmax = absmax(q)
             out = self._try(self.last, q, qmax)
             if out is not None:
                 return out
