@@ -82,7 +82,7 @@ def _validate(M, q) -> tuple[np.ndarray, np.ndarray]:
         raise InvalidProblem(f"LCP matrix M must be square, got shape {M.shape}")
     if q.shape != (M.shape[0],):
         raise InvalidProblem(f"LCP vector q must have shape ({M.shape[0]},) to match M {M.shape}, got {q.shape}")
-    if not (np.all(np.isfinite(M)) and np.all(np.isfinite(q))):
+    if not (np.isfinite(M).all() and np.isfinite(q).all()):
         raise InvalidProblem("LCP data M and q must be finite")
     return M, q
 
@@ -165,7 +165,7 @@ def lemke(M: np.ndarray, q: np.ndarray, max_iter: int | None = None) -> tuple[np
     For copositive-plus (e.g. PSD) ``M`` ray termination proves ``LCP(q, M)`` infeasible (CPS Thm 4.4.13).
     """
     n = q.shape[0]
-    if np.all(q >= 0):
+    if (q >= 0).all():
         return np.zeros(n), "solved"
     if n <= LEMKE_SMALL:
         out = _lemke_small(M, q, max_iter)
@@ -457,7 +457,7 @@ def solve_lcp(M, q, *, least_norm: bool = True, backends: tuple[str, ...] | None
     """
     M, q = _validate(M, q)
     n = q.shape[0]
-    if np.all(q >= 0):  # z = 0 solves it and has the least norm
+    if (q >= 0).all():  # z = 0 solves it and has the least norm
         res = LCPResult(np.zeros(n), q.copy(), 0.0, lcp_scale(M, q), "trivial (q ≥ 0)", is_psd(M), None, True)
         return res if info else res.z
     s = max(float(np.abs(q).max()), 0.0 if scale is None else float(scale))   # > 0: some q_i < 0
@@ -485,7 +485,7 @@ def _solve_unit(M, q, least_norm, backends) -> LCPResult:
             lemke_ray |= name == "lemke" and status == "ray termination"
             continue
         z = np.asarray(z, dtype=float).reshape(-1)
-        if z.shape != (n,) or not np.all(np.isfinite(z)):
+        if z.shape != (n,) or not np.isfinite(z).all():
             reasons.append(f"{name}: returned a non-finite or misshapen point with status {status!r}")
             continue
         ok, res, scale = _verified(M, q, z)

@@ -81,7 +81,11 @@ class BoxRelation(Relation):
 
     @property
     def is_lcp(self) -> bool:
-        return bool(np.all(self.lower_ == 0.0) and np.all(np.isinf(self.upper_)))
+        key = (self.lower_.tobytes(), self.upper_.tobytes(), self.lower_.shape, self.upper_.shape)
+        hit = self.__dict__.get("_is_lcp")
+        if hit is None or hit[0] != key:    # once per bounds (asked at every multiplier problem)
+            hit = self.__dict__["_is_lcp"] = (key, bool(np.all(self.lower_ == 0.0) and np.all(np.isinf(self.upper_))))
+        return hit[1]
 
     def solve(self, M, q, scale=None):
         if self.is_lcp:

@@ -525,7 +525,7 @@ class LCSOperator(Operator):
     def _project_domain(self, x, t):
         rel, s = self._box(), self.system
         lo, hi = rel.bounds(s.m)
-        if np.all(np.isfinite(hi)):
+        if np.isfinite(hi).all():
             return x.copy()  # bounded box: 𝓜 + D is surjective, dom H = R^n
         v = s.v(t)
         big, qq, fin = _box_lcp(s.D, s.C @ x + v, lo, hi)
