@@ -462,10 +462,37 @@ def solve_lcp(M, q, *, least_norm: bool = True, backends: tuple[str, ...] | None
         return res if info else res.z
     s = max(float(np.abs(q).max()), 0.0 if scale is None else float(scale))   # > 0: some q_i < 0
     beta = float(np.abs(M).max()) or 1.0
-    unit = _solve_unit(M / beta, q / s, least_norm, backends)
+    unit = _solve_unit_memo(M / beta, q / s, least_norm, backends)
     z = unit.z * (s / beta)
     res = dataclasses.replace(unit, z=z, w=M @ z + q, residual=lcp_residual(M, q, z), scale=unit.scale * s)
     return res if info else z
+
+
+#: entries of :func:`_solve_unit_memo`'s memory (forgotten all at once when full)
+UNIT_MEMO_SIZE = 4096
+_UNIT_MEMO: dict[tuple, LCPResult] = {}
+
+
+def _solve_unit_memo(M, q, least_norm, backends) -> LCPResult:
+    """:func:`_solve_unit`, remembered by the exact bytes of its unit-scaled data (and the back-end functions it
+    would call): it is a function of them alone — pivoting, polishing, certificates, QPs and linear programs
+    are deterministic — so a hit returns what the call would compute, bit for bit.  Scaling makes such data
+    repeat where the raw data do not: the multipliers of the paper's Example on the edge ``x = 0`` of
+    ``dom H(t,·)`` are ``LCP((−t, 0), D)`` at every ``t``, all ``LCP((−1, 0), D)`` once scaled (an assumption
+    law asks thousands of such points: three in four of its unit solves are repeats).  Only answers are
+    remembered, never failures, and a hit's arrays are copies."""
+    names = backends or (PSD_BACKENDS if is_psd(M) else GENERAL_BACKENDS)
+    key = (M.shape, M.tobytes(), q.tobytes(), bool(least_norm), tuple(names),
+           tuple(id(BACKENDS.get(n)) for n in names)) if M.size <= 256 else None
+    hit = _UNIT_MEMO.get(key) if key is not None else None
+    if hit is None:
+        hit = _solve_unit(M, q, least_norm, backends)
+        if key is not None:
+            if len(_UNIT_MEMO) >= UNIT_MEMO_SIZE:
+                _UNIT_MEMO.clear()
+            _UNIT_MEMO[key] = hit
+    return dataclasses.replace(hit, z=hit.z.copy(), w=hit.w.copy(),
+                               reasons=None if hit.reasons is None else list(hit.reasons))
 
 
 def _solve_unit(M, q, least_norm, backends) -> LCPResult:
