@@ -141,3 +141,39 @@ def test_box_stepper_rejects_a_planted_wrong_pattern(relation):
         step.last, step.recent = wrong[0], wrong[1:]
         z, w = step(q)
         assert np.allclose(z, ref.z, rtol=1e-9, atol=1e-9) and np.allclose(w, ref.w, rtol=1e-9, atol=1e-9)
+
+
+def _result_bits(r):
+    return (_bits(r.z), _bits(r.w), r.residual, r.scale, r.backend, r.psd, r.unique, r.least_norm, r.reasons)
+
+
+def test_unit_memo_returns_the_unit_solve_bit_for_bit(monkeypatch):
+    """``solve_lcp`` with its memory of unit-scaled solves: the same ``LCPResult`` as without it, bit for bit,
+    on LCPs repeated at many scales (``q·t``: the same unit data, as the Example's edge ``LCP((−t, 0), D)``);
+    a caller writing into an answer does not reach the memory; a back-end replaced is a new key."""
+    rng = np.random.default_rng(7)
+    D = np.array([[0.0, 1.0], [-1.0, 0.0]])
+    cases = [(D, np.array([-1.0, 0.0]) * t) for t in (1e-9, 0.5, 1.0, 3.0, 1e6)]
+    for k in range(40):
+        A = rng.normal(size=(3, 3))
+        M = A @ A.T if k % 2 else A - A.T + 0.1 * np.eye(3)
+        q = rng.normal(size=3)
+        cases += [(M, q * t) for t in (1.0, 2.0 ** -7, 1e3)]
+
+    def run():
+        out = []
+        for M, q in cases:
+            r = lcp.solve_lcp(M, q, least_norm=bool(len(out) % 2), info=True)
+            out.append(_result_bits(r))
+            r.z[...] = np.nan; r.reasons.append("written by the caller")
+        return out
+
+    lcp._UNIT_MEMO.clear()
+    fast = run()
+    assert lcp._UNIT_MEMO          # the repeats were remembered
+    monkeypatch.setattr(lcp, "_UNIT_MEMO", type("NoCache", (dict,), {"__setitem__": lambda *a: None})())
+    assert run() == fast
+    monkeypatch.undo()
+    assert lcp.solve_lcp(D, np.array([-2.0, 0.0]), info=True).backend.startswith("lemke")
+    monkeypatch.setitem(lcp.BACKENDS, "lemke", lambda M, q: (None, "no answer (replaced)"))
+    assert lcp.solve_lcp(D, np.array([-2.0, 0.0]), info=True).backend.startswith("qp")

@@ -483,7 +483,7 @@ def _solve_unit_memo(M, q, least_norm, backends) -> LCPResult:
     remembered, never failures, and a hit's arrays are copies."""
     names = backends or (PSD_BACKENDS if is_psd(M) else GENERAL_BACKENDS)
     key = (M.shape, M.tobytes(), q.tobytes(), bool(least_norm), tuple(names),
-           tuple(id(BACKENDS.get(n)) for n in names)) if M.size <= 256 else None
+           tuple(BACKENDS.get(n) for n in names)) if M.size <= 256 else None
     hit = _UNIT_MEMO.get(key) if key is not None else None
     if hit is None:
         hit = _solve_unit(M, q, least_norm, backends)
