@@ -177,3 +177,37 @@ def test_unit_memo_returns_the_unit_solve_bit_for_bit(monkeypatch):
     assert lcp.solve_lcp(D, np.array([-2.0, 0.0]), info=True).backend.startswith("lemke")
     monkeypatch.setitem(lcp.BACKENDS, "lemke", lambda M, q: (None, "no answer (replaced)"))
     assert lcp.solve_lcp(D, np.array([-2.0, 0.0]), info=True).backend.startswith("qp")
+
+
+def test_warm_qp_trial_memo_is_the_trial_bit_for_bit(monkeypatch):
+    """The Example's minimal sections and projections (its selection and projection QPs, warm-started) with the
+    memory of verified KKT trials: the same points, bit for bit, as without it, on the edge ``x = 0`` of
+    ``dom H(t,·)`` (the same equilibrated QP at every ``t``), inside and outside it; a wrong active set planted
+    in every warm memory is still refused (the trial is remembered with its verdict, not trusted)."""
+    import verimono.lcs._warm_qp as W
+    from verimono.reference.lcs_example import example_system
+
+    ts = np.linspace(0.01, 2.0, 40)
+    xs = [0.0, 0.0, 0.3, -0.2, 1e-9]
+
+    def run(plant=False):
+        op = example_system(lambda t: np.array([-np.sin(3 * t), 0.0])).operator()
+        out = []
+        for t in ts:
+            if plant:
+                for memory in (op._warm_select, op._warm_project):
+                    for sets in memory.values():
+                        sets.insert(0, ~sets[0])
+            for x in xs:
+                p = op.project_domain(np.array([x]), t)
+                out.append((p.tobytes(), op.min_norm(p, t).tobytes()))
+        return out
+
+    W._TRIALS.clear()
+    fast, planted = run(), run(plant=True)
+    assert len(W._TRIALS) > 0
+    monkeypatch.setattr(W, "_TRIALS", type("NoCache", (dict,), {"__setitem__": lambda *a: None})())
+    assert run() == fast
+    assert run(plant=True) == planted
+    for (p, f0), t in zip(fast[::len(xs)], ts):      # x = 0: the edge, H^0 = −max(sin 3t, 0)
+        assert np.frombuffer(f0)[0] == pytest.approx(-max(np.sin(3 * t), 0.0), abs=1e-12)
