@@ -187,7 +187,7 @@ def test_warm_qp_trial_memo_is_the_trial_bit_for_bit(monkeypatch):
     import verimono.lcs._warm_qp as W
     from verimono.reference.lcs_example import example_system
 
-    ts = np.linspace(0.01, 2.0, 40)
+    ts = np.linspace(0.01, 2.0, 16)
     xs = [0.0, 0.0, 0.3, -0.2, 1e-9]
 
     def run(plant=False):
