@@ -215,7 +215,7 @@ def _lemke_small(M: np.ndarray, q: np.ndarray, max_iter: int | None):
     """:func:`lemke` in Python floats, operation for operation (each pivot row divided by its pivot, each row
     less its multiple of the pivot row — NumPy's ``outer`` then ``-=``, two roundings, as here — and the same
     lexicographic ratio test), so the same ``(z, status)`` bit for bit; ``None`` when a ratio is NaN (overflowed
-    data), whose NumPy semantics :func:`lemke` itself then follows."""
+    data) or a cut leaves no candidate, whose NumPy semantics (and errors) :func:`lemke` itself then follows."""
     n = q.shape[0]
     Ml, ql = M.tolist(), q.tolist()
     T = [[1.0 if j == i else 0.0 for j in range(n)] + [-v for v in Ml[i]] + [-1.0, ql[i]] for i in range(n)]
@@ -242,6 +242,8 @@ def _lemke_small(M: np.ndarray, q: np.ndarray, max_iter: int | None):
         if not cand:
             return None, "ray termination"
         for j in order:
+            if not cand:        # a NaN cut emptied it (overflowed data): NumPy's own errors, from lemke
+                return None
             ratios = [T[i][j] / T[i][entering] for i in cand]
             if any(x != x for x in ratios):
                 return None
