@@ -27,8 +27,32 @@ from typing import Any
 import numpy as np
 from scipy.optimize import nnls
 
+from ._linalg import absmax, lstsq_solution
 from .errors import InfeasibleStep, UnverifiedSolution
 from .tolerances import QP_RTOL
+
+try:    # SciPy's own routine behind ``scipy.optimize.nnls`` (its wrapper's argument handling costs more than the solve)
+    from scipy.optimize._slsqplib import nnls as _nnls_routine
+except ImportError:     # pragma: no cover - another SciPy layout: the public function
+    _nnls_routine = None
+
+_EMPTY = np.zeros(0)
+
+
+def _nnls(A, b, maxiter):
+    """``scipy.optimize.nnls(A, b, maxiter=maxiter)``: the same routine with the same arguments (``A`` C-ordered
+    ``float64``, finite, ``b`` of matching length), without the wrapper's argument checks, which cost more than
+    the solve on these small matrices; the same answer bit for bit, the same errors."""
+    if _nnls_routine is None:
+        return nnls(A, b, maxiter=maxiter)
+    A = np.asarray_chkfinite(A, dtype=np.float64, order="C")
+    b = np.asarray_chkfinite(b, dtype=np.float64)
+    if A.ndim != 2 or b.ndim != 1 or A.shape[0] != b.shape[0]:
+        return nnls(A, b, maxiter=maxiter)      # the wrapper's own errors
+    x, rnorm, info = _nnls_routine(A, b, maxiter or 3 * A.shape[1])
+    if info == 3:
+        raise RuntimeError("Maximum number of iterations reached.")
+    return x, rnorm
 
 #: back-ends tried in order, with the options that make them accurate
 BACKENDS: dict[str, dict] = {
@@ -60,28 +84,31 @@ def kkt_residual(P, q, G, h, A, b, z, rtol: float = QP_RTOL) -> KKTReport:
     point, 5e-7 off, for the projection onto the domain of the Example's H).  All three to ``rtol``
     relative to the data.
     """
-    scale = 1.0 + max(np.abs(q).max(initial=0.0), np.abs(h).max(initial=0.0) if h is not None else 0.0,
-                      np.abs(b).max(initial=0.0) if b is not None else 0.0, np.abs(P @ z).max(initial=0.0))
+    # the same arithmetic as np.max(..., initial=0.0) and np.linalg.norm, through the arrays' own methods: these
+    # QPs have 2-6 variables, where NumPy's wrappers cost more than the reductions (same values, bit for bit)
+    Pz = P @ z
+    scale = 1.0 + max(absmax(q), absmax(h) if h is not None else 0.0, absmax(b) if b is not None else 0.0,
+                      absmax(Pz))
     viol = 0.0
-    rows, gaps = [], np.zeros(0)
+    rows, gaps = [], _EMPTY
     if G is not None and len(h):
         slack = G @ z - h
-        viol = max(viol, float(np.max(slack, initial=0.0)))
+        viol = max(viol, float(slack.max(initial=0.0)))
         active = slack >= -ACTIVE_RTOL * scale
         rows.append(G[active])
         gaps = -slack[active]                    # ≥ 0 up to the violation, 0 on the bound
     if A is not None and len(b):
-        viol = max(viol, float(np.max(np.abs(A @ z - b), initial=0.0)))
+        viol = max(viol, absmax(A @ z - b))
         rows.extend([A, -A])  # free multipliers as differences of nonnegative ones
-    grad = P @ z + q
-    R = np.vstack(rows) if rows else np.zeros((0, z.size))
+    grad = Pz + q
+    R = (rows[0] if len(rows) == 1 else np.vstack(rows)) if rows else np.zeros((0, z.size))
     comp = 0.0
     if R.shape[0]:
-        mu, res = nnls(R.T, -grad, maxiter=50 * max(R.shape))
+        mu, res = _nnls(R.T, -grad, maxiter=50 * max(R.shape))
         if gaps.size:
-            comp = float(np.max(mu[:gaps.size] * np.abs(gaps), initial=0.0)) / (1.0 + float(np.max(mu, initial=0.0)))
+            comp = float((mu[:gaps.size] * np.abs(gaps)).max(initial=0.0)) / (1.0 + float(mu.max(initial=0.0)))
     else:  # no active row (an interior minimiser): SciPy's nnls aborts the process on an empty matrix
-        res = float(np.linalg.norm(grad))
+        res = float(np.sqrt(grad.dot(grad)))     # np.linalg.norm(grad), bit for bit
     primal, dual, comp = viol / scale, res / scale, comp / scale
     return KKTReport(primal, dual, comp, primal <= rtol and dual <= rtol and comp <= rtol)
 
@@ -101,7 +128,7 @@ def _polish(P, q, G, h, A, b, z):
     E, e = np.vstack(blocks), np.concatenate(rhs)
     m = E.shape[0]
     K = np.block([[P, E.T], [E, np.zeros((m, m))]])
-    sol = np.linalg.lstsq(K, np.concatenate([-q, e]), rcond=None)[0]
+    sol = lstsq_solution(K, np.concatenate([-q, e]))
     return sol[:n]
 
 
@@ -131,20 +158,36 @@ def _unit_rows(E, e, kind, ref):
     """Rows of ``E`` scaled to unit length (with ``e``); zero rows dropped after checking ``0 ≤ e``
     (inequalities) or ``0 = e`` (equalities) up to ``QP_RTOL·ref`` (``ref`` the size of the data) — a zero
     row whose right-hand side has the wrong sign beyond rounding is an empty feasible set."""
-    if E is None:
+    if E is None or E.shape[0] == 0:
         return None, None
-    norms = np.linalg.norm(E, axis=1)
-    zero = norms == 0.0
-    if np.any(zero):
+    key = (E.shape, E.dtype.str, E.tobytes()) if E.size <= 256 else None
+    hit = _UNIT_ROWS.get(key) if key is not None else None
+    if hit is None:
+        norms = np.sqrt(np.add.reduce(E * E, axis=1))     # np.linalg.norm(E, axis=1), bit for bit
+        zero = norms == 0.0
+        anyzero = bool(zero.any())
+        hit = (norms, zero, anyzero, None if anyzero else E / norms[:, None])
+        if key is not None:
+            if len(_UNIT_ROWS) >= 256:
+                _UNIT_ROWS.clear()
+            _UNIT_ROWS[key] = hit
+    norms, zero, anyzero, unit = hit
+    if anyzero:
         slack = QP_RTOL * ref
         bad = e[zero] < -slack if kind == "<=" else np.abs(e[zero]) > slack
         if np.any(bad):
             raise InfeasibleStep(f"the QP has a zero constraint row with right-hand side "
                                  f"{e[zero][bad][0]:.3g} ({'0 <= h' if kind == '<=' else '0 = b'} fails)")
         E, e, norms = E[~zero], e[~zero], norms[~zero]
-    if E.shape[0] == 0:
-        return None, None
-    return E / norms[:, None], e / norms
+        if E.shape[0] == 0:
+            return None, None
+        return E / norms[:, None], e / norms
+    return unit.copy(), e / norms
+
+
+#: the unit rows of small constraint matrices by their bytes (:func:`_unit_rows`): a check's QPs share their
+#: constraint matrices (the selection and projection QPs of an LCS operator), only their right-hand sides move
+_UNIT_ROWS: dict[tuple, tuple] = {}
 
 
 #: a half-space ``⟨g, z⟩ ≤ d`` (``|g| = 1``) is *far* when ``d`` exceeds ``FAR`` times the size of all the data
@@ -163,6 +206,8 @@ def _far(h: np.ndarray, core: float) -> np.ndarray:
     hides a nearer one, and rows at every scale below the data's stay)."""
     far = np.zeros(h.shape, dtype=bool)
     size = core
+    if h.size and h.max() <= FAR * core:     # no row beyond FAR times the data (the usual case; NaN: the loop)
+        return far
     order = np.argsort(h)
     for pos, i in enumerate(order):
         if h[i] > FAR * size:
@@ -183,22 +228,19 @@ def equilibrate(P, q, G, h, A, b, scale: float | None = None, set_aside_far: boo
 
         min ½ yᵀ(P/p)y + (q/(p s))ᵀy   s.t.  (G/‖G_i‖)y ≤ h/(‖G_i‖ s),  (A/‖A_i‖)y = b/(‖A_i‖ s).
     """
-    p = float(np.abs(P).max(initial=0.0)) or 1.0
+    p = absmax(P) or 1.0
     floor = 0.0 if scale is None else float(scale)
-    ref = max(float(np.abs(h).max(initial=0.0)) if h is not None else 0.0,
-              float(np.abs(b).max(initial=0.0)) if b is not None else 0.0,
-              float(np.abs(q).max(initial=0.0)) / p, floor)
+    ref = max(absmax(h) if h is not None else 0.0, absmax(b) if b is not None else 0.0, absmax(q) / p, floor)
     G, h = _unit_rows(G, h, "<=", ref)
     A, b = _unit_rows(A, b, "=", ref)
-    core = max(float(np.abs(b).max(initial=0.0)) if b is not None else 0.0,
-               float(np.abs(q).max(initial=0.0)) / p, floor)
+    core = max(absmax(b) if b is not None else 0.0, absmax(q) / p, floor)
     G_far = h_far = None
     if G is not None and set_aside_far:
         far = _far(h, core)
         if np.any(far):
             G_far, h_far = G[far], h[far]
             G, h = (G[~far], h[~far]) if not np.all(far) else (None, None)
-    s = max(core, float(np.abs(h).max(initial=0.0)) if h is not None else 0.0)
+    s = max(core, absmax(h) if h is not None else 0.0)
     if not (np.isfinite(s) and s > 0.0):
         s = 1.0
     return ScaledQP(P / p, q / (p * s), G, None if h is None else h / s, A, None if b is None else b / s, s,

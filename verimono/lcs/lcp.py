@@ -39,6 +39,7 @@ import numpy as np
 from scipy.optimize import linprog
 
 from ..core.errors import InfeasibleStep, InvalidProblem, UnverifiedSolution, VerimonoError
+from ..core._linalg import absmax, lstsq_solution, singular_values, svd_reduced
 from ..core.qp import solve_qp
 from ..core.tolerances import POLISH_RTOL, QP_RTOL, RTOL
 
@@ -81,20 +82,37 @@ def _validate(M, q) -> tuple[np.ndarray, np.ndarray]:
         raise InvalidProblem(f"LCP matrix M must be square, got shape {M.shape}")
     if q.shape != (M.shape[0],):
         raise InvalidProblem(f"LCP vector q must have shape ({M.shape[0]},) to match M {M.shape}, got {q.shape}")
-    if not (np.all(np.isfinite(M)) and np.all(np.isfinite(q))):
+    if not (np.isfinite(M).all() and np.isfinite(q).all()):
         raise InvalidProblem("LCP data M and q must be finite")
     return M, q
 
 
 def lcp_residual(M: np.ndarray, q: np.ndarray, z: np.ndarray) -> float:
     """Natural residual ``‖min(z, Mz + q)‖∞``: zero iff ``z ∈ SOL(q, M)``."""
-    return float(np.max(np.abs(np.minimum(z, M @ z + q)), initial=0.0))
+    return absmax(np.minimum(z, M @ z + q))
 
 
 def lcp_scale(M: np.ndarray, q: np.ndarray, z: np.ndarray | None = None) -> float:
     """Size of the data a residual is measured against: ``1 + max(|q|∞, ‖M‖∞|z|∞)``."""
-    mz = 0.0 if z is None else float(np.abs(M).sum(axis=1).max(initial=0.0) * np.abs(z).max(initial=0.0))
-    return 1.0 + max(float(np.abs(q).max(initial=0.0)), mz)
+    mz = 0.0 if z is None else float(_row_norm(M) * np.float64(absmax(z)))
+    return 1.0 + max(absmax(q), mz)
+
+
+#: ‖M‖∞ of small matrices by their bytes (:func:`lcp_scale` is asked about the same few at every call)
+_ROW_NORMS: dict[tuple, np.float64] = {}
+
+
+def _row_norm(M: np.ndarray) -> np.float64:
+    """``np.abs(M).sum(axis=1).max(initial=0.0)`` (a NumPy float), made once per small ``M``."""
+    key = (M.shape, M.dtype.str, M.tobytes()) if M.size <= 64 else None
+    out = _ROW_NORMS.get(key) if key is not None else None
+    if out is None:
+        out = np.abs(M).sum(axis=1).max(initial=0.0)
+        if key is not None:
+            if len(_ROW_NORMS) >= 256:
+                _ROW_NORMS.clear()
+            _ROW_NORMS[key] = out
+    return out
 
 
 #: answers of :func:`is_psd` for small matrices, by their bytes: a system's one-step and multiplier problems
@@ -130,7 +148,7 @@ def principal_solve(M: np.ndarray, q: np.ndarray, alpha: np.ndarray) -> np.ndarr
     z = np.zeros(q.shape[0])
     idx = np.flatnonzero(alpha)
     if idx.size:
-        z[idx] = np.linalg.lstsq(M[np.ix_(idx, idx)], -q[idx], rcond=None)[0]
+        z[idx] = lstsq_solution(M[np.ix_(idx, idx)], -q[idx])     # np.linalg.lstsq's, bit for bit
     return z
 
 
@@ -147,8 +165,12 @@ def lemke(M: np.ndarray, q: np.ndarray, max_iter: int | None = None) -> tuple[np
     For copositive-plus (e.g. PSD) ``M`` ray termination proves ``LCP(q, M)`` infeasible (CPS Thm 4.4.13).
     """
     n = q.shape[0]
-    if np.all(q >= 0):
+    if (q >= 0).all():
         return np.zeros(n), "solved"
+    if n <= LEMKE_SMALL:
+        out = _lemke_small(M, q, max_iter)
+        if out is not None:
+            return out
     T = np.hstack([np.eye(n), -M, -np.ones((n, 1)), q[:, None]])
     basis = np.arange(n)
     piv_tol = 1e-12 * max(1.0, float(np.abs(M).max(initial=0.0)))
@@ -182,6 +204,61 @@ def lemke(M: np.ndarray, q: np.ndarray, max_iter: int | None = None) -> tuple[np
     for i, b in enumerate(basis):
         if n <= b < 2 * n:
             z[b - n] = max(T[i, -1], 0.0)
+    return z, "solved"
+
+
+#: :func:`lemke` pivots in Python floats up to this size (its NumPy form costs ~10 µs a pivot in call overhead)
+LEMKE_SMALL = 6
+
+
+def _lemke_small(M: np.ndarray, q: np.ndarray, max_iter: int | None):
+    """:func:`lemke` in Python floats, operation for operation (each pivot row divided by its pivot, each row
+    less its multiple of the pivot row — NumPy's ``outer`` then ``-=``, two roundings, as here — and the same
+    lexicographic ratio test), so the same ``(z, status)`` bit for bit; ``None`` when a ratio is NaN (overflowed
+    data) or a cut leaves no candidate, whose NumPy semantics (and errors) :func:`lemke` itself then follows."""
+    n = q.shape[0]
+    Ml, ql = M.tolist(), q.tolist()
+    T = [[1.0 if j == i else 0.0 for j in range(n)] + [-v for v in Ml[i]] + [-1.0, ql[i]] for i in range(n)]
+    width = 2 * n + 2
+    basis = list(range(n))
+    piv_tol = 1e-12 * max(1.0, float(np.abs(M).max(initial=0.0)))
+    entering = 2 * n
+    r = int(np.argmin(q))
+    max_iter = max_iter or 1000 + 100 * n
+    order = [width - 1] + list(range(n))
+    for _ in range(max_iter):
+        row = T[r]
+        p = row[entering]
+        row = T[r] = [v / p for v in row]
+        for i in range(n):
+            ci = T[i][entering] if i != r else 0.0
+            Ti = T[i]
+            T[i] = [Ti[j] - ci * row[j] for j in range(width)]
+        leaving, basis[r] = basis[r], entering
+        if leaving == 2 * n:
+            break
+        entering = leaving + n if leaving < n else leaving - n
+        cand = [i for i in range(n) if T[i][entering] > piv_tol]
+        if not cand:
+            return None, "ray termination"
+        for j in order:
+            if not cand:        # a NaN cut emptied it (overflowed data): NumPy's own errors, from lemke
+                return None
+            ratios = [T[i][j] / T[i][entering] for i in cand]
+            if any(x != x for x in ratios):
+                return None
+            best = min(ratios)
+            cut = best + 1e-12 * max(1.0, abs(best))
+            cand = [i for i, x in zip(cand, ratios) if x <= cut]
+            if len(cand) == 1:
+                break
+        r = cand[0]
+    else:
+        return None, "iteration limit"
+    z = np.zeros(n)
+    for i, b in enumerate(basis):
+        if n <= b < 2 * n:
+            z[b - n] = max(T[i][-1], 0.0)
     return z, "solved"
 
 
@@ -304,13 +381,13 @@ def _row_basis(E: np.ndarray, floors: np.ndarray | None = None) -> np.ndarray:
     was computed from, when it is rounding and drops out (``floors`` default to 0)."""
     if E.size == 0:
         return E
-    norms = np.linalg.norm(E, axis=1)
+    norms = np.sqrt(np.add.reduce(E * E, axis=1))      # np.linalg.norm(E, axis=1), bit for bit
     if floors is not None:
         norms = np.maximum(norms, floors)
     E = E[norms > 0] / norms[norms > 0, None]
     if E.size == 0:
         return E
-    _, s, Vt = np.linalg.svd(E, full_matrices=False)
+    _, s, Vt = svd_reduced(E)     # np.linalg.svd's, bit for bit
     r = int(np.sum(s > RTOL))     # rows of norm ≤ 1: singular values are absolute
     return Vt[:r]
 
@@ -324,7 +401,7 @@ def sol_polyhedron(M, q, zbar, scale: float | None = None):
     n = q.shape[0]
     floors = np.concatenate([np.full(n, float(np.abs(M).max(initial=0.0))), [0.0 if scale is None else float(scale)]])
     A = _row_basis(np.vstack([M + M.T, q[None, :]]), floors)
-    return np.vstack([-np.eye(n), -M]), np.concatenate([np.zeros(n), q]), A, A @ zbar
+    return np.vstack([-_eye(n), -M]), np.concatenate([np.zeros(n), q]), A, A @ zbar
 
 
 def select_over_sol(M, q, zbar, P, c, scale: float | None = None) -> np.ndarray:
@@ -336,13 +413,27 @@ def select_over_sol(M, q, zbar, P, c, scale: float | None = None) -> np.ndarray:
     return solve_qp(P, c, G, h, A if len(A) else None, b if len(A) else None, scale=scale)
 
 
+_EYES: dict[int, np.ndarray] = {}
+
+
+def _eye(n: int) -> np.ndarray:
+    """``np.eye(n)``, read-only and made once per ``n`` (indexed and stacked, never written)."""
+    e = _EYES.get(n)
+    if e is None:
+        e = np.eye(n)
+        e.flags.writeable = False
+        if n <= 64:
+            _EYES[n] = e
+    return e
+
+
 def unique_certificate(M, q, z, w, scale) -> bool:
     """True when ``SOL(q, M)`` is provably ``{z}`` (PSD ``M``): the rows ``M+Mᵀ``, ``e_i (w_i > 0)``,
     ``M_i (z_i > 0)`` have full column rank (see the module docstring)."""
     n = q.shape[0]
     tau = RTOL * scale
-    rows = np.vstack([M + M.T, np.eye(n)[w > tau], M[z > tau]])
-    s = np.linalg.svd(rows, compute_uv=False)
+    rows = np.vstack([M + M.T, _eye(n)[w > tau], M[z > tau]])
+    s = singular_values(rows)     # np.linalg.svd's, bit for bit
     return bool(s.size >= n and s[n - 1] > RTOL * max(s[0], 1.0))
 
 
@@ -368,15 +459,42 @@ def solve_lcp(M, q, *, least_norm: bool = True, backends: tuple[str, ...] | None
     """
     M, q = _validate(M, q)
     n = q.shape[0]
-    if np.all(q >= 0):  # z = 0 solves it and has the least norm
+    if (q >= 0).all():  # z = 0 solves it and has the least norm
         res = LCPResult(np.zeros(n), q.copy(), 0.0, lcp_scale(M, q), "trivial (q ≥ 0)", is_psd(M), None, True)
         return res if info else res.z
     s = max(float(np.abs(q).max()), 0.0 if scale is None else float(scale))   # > 0: some q_i < 0
     beta = float(np.abs(M).max()) or 1.0
-    unit = _solve_unit(M / beta, q / s, least_norm, backends)
+    unit = _solve_unit_memo(M / beta, q / s, least_norm, backends)
     z = unit.z * (s / beta)
     res = dataclasses.replace(unit, z=z, w=M @ z + q, residual=lcp_residual(M, q, z), scale=unit.scale * s)
     return res if info else z
+
+
+#: entries of :func:`_solve_unit_memo`'s memory (forgotten all at once when full)
+UNIT_MEMO_SIZE = 4096
+_UNIT_MEMO: dict[tuple, LCPResult] = {}
+
+
+def _solve_unit_memo(M, q, least_norm, backends) -> LCPResult:
+    """:func:`_solve_unit`, remembered by the exact bytes of its unit-scaled data (and the back-end functions it
+    would call): it is a function of them alone — pivoting, polishing, certificates, QPs and linear programs
+    are deterministic — so a hit returns what the call would compute, bit for bit.  Scaling makes such data
+    repeat where the raw data do not: the multipliers of the paper's Example on the edge ``x = 0`` of
+    ``dom H(t,·)`` are ``LCP((−t, 0), D)`` at every ``t``, all ``LCP((−1, 0), D)`` once scaled (an assumption
+    law asks thousands of such points: three in four of its unit solves are repeats).  Only answers are
+    remembered, never failures, and a hit's arrays are copies."""
+    names = backends or (PSD_BACKENDS if is_psd(M) else GENERAL_BACKENDS)
+    key = (M.shape, M.tobytes(), q.tobytes(), bool(least_norm), tuple(names),
+           tuple(BACKENDS.get(n) for n in names)) if M.size <= 256 else None
+    hit = _UNIT_MEMO.get(key) if key is not None else None
+    if hit is None:
+        hit = _solve_unit(M, q, least_norm, backends)
+        if key is not None:
+            if len(_UNIT_MEMO) >= UNIT_MEMO_SIZE:
+                _UNIT_MEMO.clear()
+            _UNIT_MEMO[key] = hit
+    return dataclasses.replace(hit, z=hit.z.copy(), w=hit.w.copy(),
+                               reasons=None if hit.reasons is None else list(hit.reasons))
 
 
 def _solve_unit(M, q, least_norm, backends) -> LCPResult:
@@ -396,7 +514,7 @@ def _solve_unit(M, q, least_norm, backends) -> LCPResult:
             lemke_ray |= name == "lemke" and status == "ray termination"
             continue
         z = np.asarray(z, dtype=float).reshape(-1)
-        if z.shape != (n,) or not np.all(np.isfinite(z)):
+        if z.shape != (n,) or not np.isfinite(z).all():
             reasons.append(f"{name}: returned a non-finite or misshapen point with status {status!r}")
             continue
         ok, res, scale = _verified(M, q, z)

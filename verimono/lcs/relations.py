@@ -20,6 +20,7 @@ import numpy as np
 from ..core.errors import InvalidProblem, NotMonotone, UnverifiedSolution
 from ..core.operators import Operator
 from ..core.tolerances import QP_RTOL, RTOL, tolerance
+from ..core._linalg import absmax
 from ._lu import lu_factor, lu_solve
 from .lcp import LCPResult, is_psd, lcp_scale, solve_box, solve_lcp
 
@@ -62,7 +63,16 @@ class BoxRelation(Relation):
         self.lower_, self.upper_, self.name = lo, hi, name
 
     def bounds(self, m: int) -> tuple[np.ndarray, np.ndarray]:
-        return (np.broadcast_to(self.lower_, (m,)).astype(float), np.broadcast_to(self.upper_, (m,)).astype(float))
+        # made once per (m, bounds) and copied: the one-step and multiplier problems ask at every call
+        key = (m, self.lower_.tobytes(), self.upper_.tobytes(), self.lower_.shape, self.upper_.shape)
+        cache = self.__dict__.setdefault("_bounds", {})
+        hit = cache.get(key)
+        if hit is None:
+            hit = (np.broadcast_to(self.lower_, (m,)).astype(float), np.broadcast_to(self.upper_, (m,)).astype(float))
+            if len(cache) >= 16:
+                cache.clear()
+            cache[key] = hit
+        return hit[0].copy(), hit[1].copy()
 
     def check_dim(self, m: int) -> None:
         for b in (self.lower_, self.upper_):
@@ -71,7 +81,11 @@ class BoxRelation(Relation):
 
     @property
     def is_lcp(self) -> bool:
-        return bool(np.all(self.lower_ == 0.0) and np.all(np.isinf(self.upper_)))
+        key = (self.lower_.tobytes(), self.upper_.tobytes(), self.lower_.shape, self.upper_.shape)
+        hit = self.__dict__.get("_is_lcp")
+        if hit is None or hit[0] != key:    # once per bounds (asked at every multiplier problem)
+            hit = self.__dict__["_is_lcp"] = (key, bool(np.all(self.lower_ == 0.0) and np.all(np.isinf(self.upper_))))
+        return hit[1]
 
     def solve(self, M, q, scale=None):
         if self.is_lcp:
@@ -144,25 +158,31 @@ class _BoxStepper:
                     lu = lu_factor(MII)
                 else:
                     lu = False
-            e = (I, fixed, lu, self.M @ fixed, self.lo[I], self.hi[I], s == 0, s == 2)
+            hiI = self.hi[I]
+            # which checks of :meth:`_try` can fire: an upper bound +∞ is never within τ of a multiplier, an empty
+            # set of rows at a bound has nothing to check (skipping them changes no answer)
+            e = (I, fixed, lu, self.M @ fixed, self.lo[I], hiI, np.flatnonzero(s == 0), np.flatnonzero(s == 2),
+                 bool(I.size), not bool(np.all(hiI == np.inf)), bool(np.any(s == 0)), bool(np.any(s == 2)))
             self.cache[pat] = e
         return e
 
-    def _try(self, pat: bytes, q: np.ndarray):
+    def _try(self, pat: bytes, q: np.ndarray, qmax: float):
         """The pattern's solution for ``q`` if it is strictly complementary (margin ``RTOL`` of
-        :func:`verimono.lcs.lcp.lcp_scale`), else ``None``."""
-        I, fixed, lu, Mfixed, loI, hiI, at_lo, at_hi = self._entry(pat)
-        if lu is False or not np.isfinite(q).all():     # non-finite data: the full solve says what is wrong
+        :func:`verimono.lcs.lcp.lcp_scale`), else ``None``; ``q`` finite, ``qmax = |q|∞``."""
+        I, fixed, lu, Mfixed, loI, hiI, at_lo, at_hi, inner, upper, lower_rows, upper_rows = self._entry(pat)
+        if lu is False:
             return None
         lam = fixed.copy()
-        if I.size:
+        if inner:
             lam[I] = lu_solve(lu, -(q[I] + Mfixed[I]))
         y = self.M @ lam + q
         # lcp_scale(M, q, lam), with ‖M‖∞ computed once
-        tau = RTOL * (1.0 + max(float(np.abs(q).max(initial=0.0)), self.m_norm * float(np.abs(lam).max(initial=0.0))))
-        if I.size and ((lam[I] - loI <= tau).any() or (hiI - lam[I] <= tau).any()):
-            return None
-        if (y[at_lo] <= tau).any() or (y[at_hi] >= -tau).any():
+        tau = RTOL * (1.0 + max(qmax, self.m_norm * absmax(lam)))
+        if inner:
+            lamI = lam[I]
+            if (lamI - loI <= tau).any() or (upper and (hiI - lamI <= tau).any()):
+                return None
+        if (lower_rows and (y[at_lo] <= tau).any()) or (upper_rows and (y[at_hi] >= -tau).any()):
             return None
         return lam, y
 
@@ -174,14 +194,16 @@ class _BoxStepper:
             self.last = other.last
 
     def __call__(self, q, scale=None):
-        if self.last is not None:
-            out = self._try(self.last, q)
+        # non-finite data: no pattern is tried, the full solve says what is wrong
+        if self.last is not None and np.isfinite(q).all():
+            qmax = absmax(q)
+            out = self._try(self.last, q, qmax)
             if out is not None:
                 return out
             if self.psd:
                 for pat in self.recent:
                     if pat != self.last:
-                        out = self._try(pat, q)
+                        out = self._try(pat, q, qmax)
                         if out is not None:
                             self._remember(pat)
                             return out

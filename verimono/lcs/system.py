@@ -28,6 +28,7 @@ from ..core.operators import Operator
 from ..core.problem import Problem
 from ..core.stepping import Trajectory
 from ..core.tolerances import tolerance
+from ..core._linalg import absmax
 from ._lu import lu_factor, lu_solve
 from .kernel import BatchStepError
 from ._warm_qp import row_infeasible, solve_qp_warm
@@ -113,7 +114,7 @@ class LinearRelationSystem:
     def q_scale(self, x: np.ndarray, v: np.ndarray) -> float:
         """``‖C‖∞|x|∞ + |v|∞``: the size of the terms the one-step data ``q = Cx + v`` is summed from, to
         which its rounding errors are relative (the ``scale`` of :func:`verimono.lcs.solve_lcp`)."""
-        return self._c_norm * float(np.abs(x).max(initial=0.0)) + float(np.abs(v).max(initial=0.0))
+        return self._c_norm * absmax(x) + absmax(v)
 
     @property
     def v_constant(self) -> bool:
@@ -524,7 +525,7 @@ class LCSOperator(Operator):
     def _project_domain(self, x, t):
         rel, s = self._box(), self.system
         lo, hi = rel.bounds(s.m)
-        if np.all(np.isfinite(hi)):
+        if np.isfinite(hi).all():
             return x.copy()  # bounded box: 𝓜 + D is surjective, dom H = R^n
         v = s.v(t)
         big, qq, fin = _box_lcp(s.D, s.C @ x + v, lo, hi)
