@@ -37,9 +37,12 @@ def test_records_are_labelled_evidence():
 
 @pytest.mark.parametrize("seed", range(8))
 def test_stated_functions_of_sample_problems_survive(seed):
-    rep = _by(check_assumptions(sample_problem(seed), seed=seed))
+    # the four records read, each law alone (_law: the battery's records but for duration, compared on the eight
+    # seeds; (YB) and the composite, unread, were 15% of the battery's time)
+    problem = sample_problem(seed)
     for name in ("assumption_A1", "assumption_A2", "assumption_A3", "assumption_LG"):
-        assert rep[name].status == PASSED, str(rep[name])
+        rec = _law(name, problem, seed=seed)
+        assert rec.status == PASSED, str(rec)
 
 
 def test_non_monotone_operator_fails_A1():
