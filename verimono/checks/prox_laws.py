@@ -218,14 +218,14 @@ def check_prox_optimal(op, s, p, gp):
     # per perturbation: z = p + c·d made once and handed to g uncopied (it is made for that call: the
     # counterexample's z is made again from c and d, the same numbers), z - x into one buffer, one dot —
     # the same elementwise operations and BLAS dot as λg(z) + |z - x|²/2 was, without four n-sized temporaries
-    w = np.empty_like(x)
+    w, cd = np.empty_like(x), np.empty_like(x)
     worst, at = -math.inf, None
     for d in _directions(x, p, x.size, x):
         for h in PERTURBATIONS:
+            np.multiply(d, h * s0, out=cd)      # (-c)·d = -(c·d) and p + (-(c·d)) = p - c·d exactly: one product for both signs
             for sgn in (1.0, -1.0):
                 c = sgn * h * s0
-                z = np.multiply(d, c)
-                z += p
+                z = np.add(p, cd) if sgn > 0 else np.subtract(p, cd)
                 np.subtract(z, x, out=w)
                 fz = lam * _owned_value(op, z, t) + 0.5 * float(w @ w)
                 if fz == math.inf:
