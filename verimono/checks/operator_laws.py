@@ -30,7 +30,7 @@ import numpy as np
 from ..core.errors import NotApplicable, OutsideDomain, VerimonoError
 from ..core.tolerances import (LIMIT_FLOOR, REPEAT_ULPS, RTOL, STALL_RATIO, STALL_WINDOW, current_eps, repeat_tolerance,
                                row_tolerances, tolerance)
-from .core import Member, Outcome
+from .core import Member, Outcome, ratio
 from .members import (_ROUNDOFF_BOUNDARY, listed, min_norm, norm, outside_by_roundoff_of_dom_g, point, resolvent,
                       within_roundoff_of_domain)
 from .engine.batches import (rounding, rounding_bound, row_contains, row_dots, row_member, row_norms, row_ratios, row_resolvents,
@@ -157,15 +157,16 @@ def check_resolvent_limit(op, s):
     at ``J_λ(x + λy) = x``), hence ``J_λx → x`` as ``λ → 0``.  Tested at ``x = J_νx1``, ``y = Y_νx1`` over
     ``λ, λ/4, …, λ/4^5`` (ratio ``|J_λx - x| / (λ|y| + slack)``)."""
     x, y0, tau = _domain_pair(op, s)
-    worst = None
+    ny, worst = norm(y0), None      # |y| once; the outcome (its points listed) for the worst step only
     for k in range(6):
         lam = s.lam * 4.0 ** (-k)
         d = norm(resolvent(op, x, lam, s.t) - x)
-        ev = Outcome.compare(d, lam * norm(y0), tau * (4.0 + lam / s.nu), "|J_λx - x| ≤ λ|y| for x = J_νx1, y = Y_νx1 ∈ F(x)",
-                   {"x": listed(x), "y": listed(y0), "lam_at_worst": lam})
-        if worst is None or not ev.ratio <= worst.ratio:
-            worst = ev
-    return worst
+        q = ratio(d, lam * ny, tau * (4.0 + lam / s.nu))
+        if worst is None or not q <= worst[0]:
+            worst = (q, d, lam)
+    _, d, lam = worst
+    return Outcome.compare(d, lam * ny, tau * (4.0 + lam / s.nu), "|J_λx - x| ≤ λ|y| for x = J_νx1, y = Y_νx1 ∈ F(x)",
+                           {"x": listed(x), "y": listed(y0), "lam_at_worst": lam})
 
 
 @operator_law("monotone", "(A1)")

@@ -27,11 +27,12 @@ import zlib
 
 import numpy as np
 
+from ..core.arrays import as_float64
 from ..core.tolerances import current_eps, current_precision, current_rtol, tolerance
-from .core import Member, Outcome
+from .core import Member, Outcome, ratio as _ratio
 from ..core.errors import NotApplicable
 from .members import ROUNDOFF_ULPS, outside_by_roundoff_of_dom_g
-from .members import norm as _nrm
+from .members import listed, norm as _nrm
 from .members import resolvent as _J
 from .members import value as _g
 from .engine.batches import rounding, row_dots, row_norms, row_ratios, row_resolvents, row_values, vectorised
@@ -53,6 +54,36 @@ def _tolf(*values: float) -> float:
 _VALUE = Member("value")
 
 
+def _amax(v: np.ndarray) -> float:
+    """``max |v_i|`` (0 for an empty point), as :func:`verimono.core.tolerances.tolerance` reads each array: above
+    4096 entries ``max(max v, -min v)`` (no ``|v|`` copy), the same number."""
+    if not v.size:
+        return 0.0
+    if v.size > 4096 and v.dtype.kind == "f":
+        return float(max(v.max(), -v.min()))
+    return float(np.abs(v).max())
+
+
+def _tol(rtol: float, *maxima: float) -> float:
+    """:func:`verimono.core.tolerances.tolerance` of arrays whose maxima (:func:`_amax`) are known: the same loop
+    (a NaN maximum is passed over there too), so the same number without reading the arrays again."""
+    m = 0.0
+    for a in maxima:
+        if a > m:
+            m = a
+    return rtol * (1.0 + m)
+
+
+def _owned_value(op, z: np.ndarray, t: float) -> float:
+    """``g(t, z)`` as :func:`verimono.checks.members.value` reads it, for a float64 point ``z`` made for this one
+    call and read by nothing after it (no protective copy: at n = 10^6 that copy was a quarter of the optimality
+    law's time)."""
+    v = op.value(z, t)
+    if type(v) is not float:
+        v = as_float64(v)
+    return float(v)
+
+
 def _outside(op, p, gp, what, x, t) -> Outcome:
     """The outcome of a law whose ``p = J_λx`` the user's value function puts outside ``dom g`` (``g(p) = ∞``):
     no sample (:class:`NotApplicable`: inconclusive) when ``g`` is finite within the round-off of ``J`` at that
@@ -71,7 +102,7 @@ def _outside(op, p, gp, what, x, t) -> Outcome:
                            f"round-off at this point is about eps·|x| = {tau:.3g} ({prec}, |x| = {_nrm(x):.3g}): a value function "
                            "that rejects every point outside its set (a strict indicator) also rejects a J that "
                            "leaves it by round-off; give it that tolerance if J is exact to its precision",
-                           {"p": p.tolist(), "g(p)": gp, "outside_dom_g": "the value function says so",
+                           {"p": listed(p), "g(p)": gp, "outside_dom_g": "the value function says so",
                             "resolvent_roundoff": tau, "precision": prec})
 
 
@@ -86,7 +117,7 @@ def _directions(x, p, n, seed_like) -> list[np.ndarray]:
         nv = _nrm(v)
         if nv > 0:
             dirs.append(v / nv)
-    rng = np.random.default_rng(zlib.crc32(np.asarray(seed_like, dtype=float).tobytes()))
+    rng = np.random.default_rng(zlib.crc32(np.ascontiguousarray(seed_like, dtype=float)))   # its bytes, uncopied
     for _ in range(2):
         v = rng.standard_normal(n)
         dirs.append(v / _nrm(v))
@@ -118,20 +149,30 @@ def check_prox_inequality(op, s, p, gp):
             cands.append((lab, _J(op, v, s.mu if k < 2 else s.nu, t)))
         except Exception:   # noqa: BLE001 - other resolvent values are only extra test points
             pass
+    # per sample, once: x - p, its norm, |x|_inf and |p|_inf; per candidate: z - p, one dot, one norm, one g(z),
+    # the numbers of tolerance(x, p, z) and of the outcome exactly as before; the outcome (and its counterexample,
+    # the points as listed(): a summary above NUMPY_DIM coordinates) is built for the worst candidate only
+    rtol = current_rtol()
+    xp = x - p
+    nxp, ax, ap = _nrm(xp), _amax(x), _amax(p)
     worst = None
     for lab, z in cands:
         gz = _g(op, z, t)
         if gz == math.inf:
             continue
-        tau = tolerance(x, p, z)
-        lhs = float((x - p) @ (z - p))
+        tau = _tol(rtol, ax, ap, ax if z is x else _amax(z))
+        zp = z - p
+        lhs = float(xp @ zp)
         rhs = lam * (gz - gp)
-        slack = 4 * tau * (_nrm(x - p) + _nrm(z - p) + tau) + 4 * lam * tolerance(gp, gz)
-        ev = Outcome.compare(lhs - rhs, 0.0, slack, "⟨x - p, z - p⟩ ≤ λ(g(z) - g(p)) for p = prox_{λg}(x), z = " + lab,
-                             {"p": p.tolist(), "z": z.tolist(), "z_is": lab, "g(p)": gp, "g(z)": gz})
-        if worst is None or not ev.ratio <= worst.ratio:
-            worst = ev
-    return worst
+        slack = 4 * tau * (nxp + _nrm(zp) + tau) + 4 * lam * tolerance(gp, gz)
+        q = _ratio(lhs - rhs, 0.0, slack)
+        if worst is None or not q <= worst[0]:
+            worst = (q, lab, z, gz, lhs - rhs, slack)
+    if worst is None:
+        return None
+    _, lab, z, gz, lhs, slack = worst
+    return Outcome.compare(lhs, 0.0, slack, "⟨x - p, z - p⟩ ≤ λ(g(z) - g(p)) for p = prox_{λg}(x), z = " + lab,
+                           {"p": listed(p), "z": listed(z), "z_is": lab, "g(p)": gp, "g(z)": gz})
 
 
 @vectorised("prox_inequality")
@@ -174,27 +215,36 @@ def check_prox_optimal(op, s, p, gp):
     fp = lam * gp + 0.5 * float((p - x) @ (p - x))
     s0 = 1.0 + float(np.max(np.abs(p), initial=0.0))
     tau, dxp = tolerance(x, p), _nrm(x - p)
+    # per perturbation: z = p + c·d made once and handed to g uncopied (it is made for that call: the
+    # counterexample's z is made again from c and d, the same numbers), z - x into one buffer, one dot —
+    # the same elementwise operations and BLAS dot as λg(z) + |z - x|²/2 was, without four n-sized temporaries
+    w, cd = np.empty_like(x), np.empty_like(x)
     worst, at = -math.inf, None
     for d in _directions(x, p, x.size, x):
         for h in PERTURBATIONS:
+            np.multiply(d, h * s0, out=cd)      # (-c)·d = -(c·d) and p + (-(c·d)) = p - c·d exactly: one product for both signs
             for sgn in (1.0, -1.0):
-                z = p + sgn * h * s0 * d
-                fz = _phi(op, z, x, lam, t)
+                c = sgn * h * s0
+                z = np.add(p, cd) if sgn > 0 else np.subtract(p, cd)
+                np.subtract(z, x, out=w)
+                fz = lam * _owned_value(op, z, t) + 0.5 * float(w @ w)
                 if fz == math.inf:
                     continue
                 dz = h * s0
                 slack = 4 * _tolf(fp, fz, lam * gp) + 4 * tau * (dxp + dz + tau)
                 r = (fp + 0.5 * dz * dz - fz) / slack
                 if not r <= worst:
-                    worst, at = r, (z, fz, slack)
+                    worst, at = r, (d, c, fz, slack)
     if at is None:
         return Outcome.compare(0.0, 0.0, 1.0, "optimality: every perturbation left dom g (sample inconclusive)", {},
                                inconclusive=True)
-    z, fz, slack = at
+    d, c, fz, slack = at
+    z = np.multiply(d, c)
+    z += p
     dz2 = float((z - p) @ (z - p))
     return Outcome.compare(fp + 0.5 * dz2 - fz, 0.0, slack,
                            "Φ(p) + |z - p|²/2 ≤ Φ(z), Φ(z) = λg(z) + |z - x|²/2, at z = p + δ (perturbation)",
-                           {"p": p.tolist(), "z": z.tolist(), "Phi(p)": fp, "Phi(z)": fz})
+                           {"p": listed(p), "z": listed(z), "Phi(p)": fp, "Phi(z)": fz})
 
 
 @operator_law("prox_minimiser", "prox optimality (independent minimiser)", _VALUE)
@@ -249,15 +299,16 @@ def check_moreau_envelope(op, s):
     for x, p, gv in ((x1, p1, g1), (x2, p2, g2)):
         if not math.isfinite(gv):
             return _outside(op, p, gv, "Moreau envelope", x, t)
-    e1 = g1 + float((x1 - p1) @ (x1 - p1)) / (2 * lam)
-    e2 = g2 + float((x2 - p2) @ (x2 - p2)) / (2 * lam)
-    y1 = (x1 - p1) / lam
+    d1, d2 = x1 - p1, x2 - p2           # each once (x1 - p1 was made three times)
+    e1 = g1 + float(d1 @ d1) / (2 * lam)
+    e2 = g2 + float(d2 @ d2) / (2 * lam)
+    y1 = d1 / lam
     dx = x2 - x1
     lin = e1 + float(y1 @ dx)
     quad = float(dx @ dx) / (2 * lam)
     tau = tolerance(x1, x2, p1, p2)
     slack = 4 * tolerance(e1, e2, lin, g1, g2) + 4 * tau * (_nrm(y1) + _nrm(dx) / lam + tau / lam) * (1.0 + _nrm(dx))
-    info = {"p1": p1.tolist(), "p2": p2.tolist(), "e1": e1, "e2": e2, "grad1": y1.tolist()}
+    info = {"p1": listed(p1), "p2": listed(p2), "e1": e1, "e2": e2, "grad1": listed(y1)}
     low = Outcome.compare(lin - e2, 0.0, slack, "e_λ(x1) + ⟨Y_λx1, x2 - x1⟩ ≤ e_λ(x2) (the envelope "
                           "e_λ(x) = g(J_λx) + |x - J_λx|²/(2λ) is convex with gradient Y_λx)", info)
     high = Outcome.compare(e2 - lin - quad, 0.0, slack, "e_λ(x2) ≤ e_λ(x1) + ⟨Y_λx1, x2 - x1⟩ + |x2 - x1|²/(2λ) "
