@@ -13,6 +13,7 @@ from ..execution import watchdog
 from ..core.errors import InvalidCheckArgument
 from ..execution.config import chosen
 from ..execution.executors import Unit
+from ..execution.workers import blas_limited
 from ..records.results import Report
 from . import operator_laws, prox_laws  # noqa: F401 - the laws join the registry on import
 from .core import Law, laws_of, subject_name
@@ -53,7 +54,10 @@ def check_operator(op: Any, *, seed: int | None = None, examples: int | None = N
     ``executor="process:N"``: the battery then runs in a worker process (one: its laws share what the
     root-cause probe learnt, :mod:`verimono.checks.isolated`), which such a call ends — the records of the
     laws finished before it and a failed record naming it.  In this process verimono never ends the
-    interpreter on such a call: it warns once and waits for it to return (:mod:`verimono.execution.watchdog`)."""
+    interpreter on such a call: it warns once and waits for it to return (:mod:`verimono.execution.watchdog`).
+
+    The BLAS libraries loaded when it begins run on one thread for the battery, as under ``verimono run`` and
+    ``verimono check``, and get the caller's limits back after (:func:`verimono.execution.workers.blas_limited`)."""
     if profile is not None:
         with chosen(profile):
             return check_operator(op, seed=seed, examples=examples, horizon=horizon, executor=executor)
@@ -73,8 +77,9 @@ def check_operator(op: Any, *, seed: int | None = None, examples: int | None = N
         return report
     if executor not in (None, "serial"):
         raise InvalidCheckArgument(f"check_operator: executor must be None, 'serial' or 'process:N', got {executor!r}")
-    for _, check in operator_checks(op, seed=seed, examples=examples, horizon=horizon):
-        watchdog.finished(report.add(check(op)))    # kept should a later law block in native code
+    with blas_limited():                                # as under the command line (BLAS_THREADS)
+        for _, check in operator_checks(op, seed=seed, examples=examples, horizon=horizon):
+            watchdog.finished(report.add(check(op)))    # kept should a later law block in native code
     return report
 
 

@@ -22,6 +22,7 @@ from . import bounds, limits, picard, trajectory_laws  # noqa: F401 - the laws j
 from . import orders as _order_law  # noqa: F401 - convergence_order joins the registry on import
 from ..execution.config import chosen, current
 from ..execution.executors import Unit
+from ..execution.workers import blas_limited
 from .core import laws_of, stepper_subject
 from .isolated import isolating, run_check, run_isolated
 from .partitions import single
@@ -142,7 +143,9 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
     verimono never ends the interpreter on such a call: it warns once and waits for it to return
     (:mod:`verimono.execution.watchdog`).  ``profile`` (``"dev"``, ``"ci"``, ``"thorough"``) chooses the time
     budget of each check, as ``--profile`` does for ``verimono check``; by default the current run
-    configuration's (:mod:`verimono.execution.config`).
+    configuration's (:mod:`verimono.execution.config`).  In this process the BLAS libraries loaded when the
+    battery begins run on one thread, as under the command line, and get the caller's limits back after
+    (:func:`verimono.execution.workers.blas_limited`).
 
     A :class:`verimono.Adaptive` stepper (it takes a tolerance, not a grid) gets its own battery,
     :func:`verimono.check_adaptive`, on ``problems``.
@@ -178,7 +181,8 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
                  for name, check in checks]
         records = [rec for rep in run_isolated(executor, units, given) for rec in rep.results]
     else:
-        with shared_runs():         # the laws judge the same runs of the stepper: each is made once
+        # the laws judge the same runs of the stepper: each is made once; BLAS as under the command line
+        with shared_runs(), blas_limited():
             # a stepper that never returns: a failed record naming the unit, and the battery goes on
             records = [run_unit(lambda: check(stepper), check=name.partition("[")[0],
                                 subject=stepper_subject(stepper, name.partition("[")[2][:-1]))

@@ -10,12 +10,13 @@ answers ``("ok", report)``, ``("error", ...)`` or, from a worker whose unit bloc
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import os
 import sys
 import time
 import traceback
-from typing import Any
+from typing import Any, Iterator
 
 from . import config as _config
 from . import watchdog
@@ -44,6 +45,24 @@ def _one_blas_thread() -> None:
         threadpool_limits(limits=BLAS_THREADS, user_api="blas")
     except ImportError:  # pragma: no cover - threadpoolctl is a dependency
         pass
+
+
+@contextlib.contextmanager
+def blas_limited() -> Iterator[None]:
+    """:data:`BLAS_THREADS` for the BLAS libraries loaded now, and their own limits again after: what
+    ``verimono run`` and ``verimono check`` hold for their whole process, for one battery called from a user's
+    Python (:func:`verimono.check_operator`, :func:`verimono.check_stepper`).  The subject's own calls in the
+    battery run under it too, as under the command line.  Measured on the 2-core machine under load (branch
+    bigop2, docs/speed.md): ``check_operator`` at n = 10^5 took 63-74 s of CPU with OpenBLAS's default threads
+    against 10 s with one; limiting only verimono's own row arithmetic gave 58.6 s (most threaded products are
+    the laws' norms and the subject's own)."""
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:  # pragma: no cover - threadpoolctl is a dependency
+        yield
+        return
+    with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
+        yield
 
 
 def _prepare_worker(cfg: RunConfig) -> None:
@@ -284,5 +303,5 @@ def start_method() -> str:
     return "fork" if safe else "spawn"
 
 
-__all__ = ["BLAS_THREADS", "FORK_UNSAFE", "HANG_EXIT", "WORKER_START_TIMEOUT", "run_payload", "run_job", "ship_by_value",
+__all__ = ["BLAS_THREADS", "blas_limited", "FORK_UNSAFE", "HANG_EXIT", "WORKER_START_TIMEOUT", "run_payload", "run_job", "ship_by_value",
            "start_method"]
