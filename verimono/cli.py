@@ -720,7 +720,7 @@ MARKED_COMMANDS = {"run": "reports", "check": "reports/check"}
 
 def _early_mark(command: str | None, given: list[str]) -> str | None:
     """Mark ``--out``/results.json in progress before anything else when a previous run's results are there
-    (the parser imports the stages and the checks: 2-3 s on a loaded machine, during which a killed run would
+    (the command line's first imports and the parser: 0.4-1 s on a loaded machine, during which a killed run would
     leave those files unmarked, and the gate would read them as this run's); its run id, or ``None`` — not a
     marked command, ``--help``, ``--resume`` (the interrupted run's own results are marked incomplete: its
     mark is read first, then this run's written, :func:`_cmd_run`), no results there
