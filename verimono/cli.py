@@ -576,9 +576,31 @@ def _version() -> str:
         return f"{__version__} (not installed)"
 
 
-def build_parser() -> argparse.ArgumentParser:
-    from .run.stages import STAGES
+class _StageNames:
+    """The registered stages' names for ``--stage``, read when a ``--stage`` is given or the help is printed:
+    importing the stages imports the checks, the LCS tools and SciPy (0.5-0.8 s CPU here), which ``verimono
+    gate``, ``baseline``, ``report`` and ``--version`` never use; ``check`` and ``run`` import them when the run
+    begins.  ``str()``: the list the help prints (a stage run only on request says so)."""
 
+    def _stages(self) -> dict[str, Any]:
+        from .run.stages import STAGES
+
+        return STAGES
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._stages()
+
+    def __iter__(self):
+        return iter(list(self._stages()))
+
+    def __len__(self) -> int:
+        return len(self._stages())
+
+    def __str__(self) -> str:
+        return ", ".join(n if s.default else f"{n} (on request)" for n, s in self._stages().items())
+
+
+def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="verimono", description=__doc__.split("\n\n")[0],
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"verimono {_version()}",
@@ -590,9 +612,9 @@ def build_parser() -> argparse.ArgumentParser:
                        help="effort and hypothesis profile: the examples per law, the scale sweep and the time budget "
                             "of every unit (default: $HYPOTHESIS_PROFILE when it names one of these, else ci when "
                             "$CI is set, else dev)")
-        p.add_argument("--stage", action="append", choices=list(STAGES), metavar="NAME",
-                       help="run only this stage (repeatable); stages: " + ", ".join(
-                           n if s.default else f"{n} (on request)" for n, s in STAGES.items()))
+        stage = p.add_argument("--stage", action="append", choices=_StageNames(), metavar="NAME",
+                               help="run only this stage (repeatable); stages: %(stage_names)s")
+        stage.stage_names = stage.choices     # argparse formats a help with the action's attributes
         p.add_argument("--seed", type=_seed, default=None, help="seed for the randomized batteries")
         p.add_argument("--data", default=None, help="Siconos data (DIR/siconos/{refs,lcp}); default: the packaged data")
         p.add_argument("--reference", action="append", metavar="ID",
@@ -698,7 +720,7 @@ MARKED_COMMANDS = {"run": "reports", "check": "reports/check"}
 
 def _early_mark(command: str | None, given: list[str]) -> str | None:
     """Mark ``--out``/results.json in progress before anything else when a previous run's results are there
-    (the parser imports the stages and the checks: 2-3 s on a loaded machine, during which a killed run would
+    (the command line's first imports and the parser: 0.4-1 s on a loaded machine, during which a killed run would
     leave those files unmarked, and the gate would read them as this run's); its run id, or ``None`` — not a
     marked command, ``--help``, ``--resume`` (the interrupted run's own results are marked incomplete: its
     mark is read first, then this run's written, :func:`_cmd_run`), no results there

@@ -405,3 +405,33 @@ def test_every_module_imports_only_its_layer_and_the_ones_below():
     """numerics, then records, then checks, then runs, then entry points (:data:`LAYERS`)."""
     found = upward_imports()
     assert not found, "imports against the layer order:\n" + "\n".join(found)
+
+
+#: what a problem built and solved through the facade, and the command line's parser, must not load (the
+#: heavy third-party modules and the layers that import them: the checks, the LCS tools, the strategies)
+NOT_FOR_A_PROBLEM = ("scipy", "hypothesis", "matplotlib", "qpsolvers", "proxsuite", "verimono.checks",
+                     "verimono.strategies", "verimono.lcs", "verimono.core.qp")
+
+
+@pytest.mark.slow
+def test_a_problem_and_the_parser_load_none_of_the_heavy_modules():
+    """``import verimono``, a problem with ``f`` and ``u`` built and solved, then the command line's parser
+    (``verimono gate``/``baseline``/``--version`` need no stage: the stages' names are read on first use), in a
+    fresh interpreter; then ``--stage`` of ``verimono run`` is checked, which loads the stages (and SciPy)."""
+    import subprocess
+    import sys
+
+    code = ("import sys, numpy as np, verimono as vm\n"
+            "loaded = lambda: ' '.join(m for m in sorted(sys.modules) if m in %r or m.startswith(tuple(x + '.' for x in %r)))\n"
+            "p = vm.Problem(operator=vm.NormalCone(vm.sets.Ball(np.zeros(2), 1.0)), x0=np.array([0.5, 0.0]), T=1.0,\n"
+            "               f=lambda x: -x, u=lambda t: np.array([np.sin(t), 0.0]))\n"
+            "x = vm.solve(p, vm.uniform_grid(1.0, steps=8)).x\n"
+            "print(x.shape, loaded() or '-')\n"
+            "from verimono.cli import build_parser\n"
+            "build_parser().parse_args(['gate', '--baseline', 'b.json', '--results', 'r.json'])\n"
+            "print(loaded() or '-')\n"
+            "build_parser().parse_args(['run', '--stage', 'siconos'])\n"
+            "print('verimono.lcs' in sys.modules, 'scipy.optimize' in sys.modules)\n") % (NOT_FOR_A_PROBLEM,
+                                                                                          NOT_FOR_A_PROBLEM)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.splitlines() == ["(9, 2) -", "-", "True True"], out

@@ -351,27 +351,31 @@ class ACInput:
         return f"u=pwlinear(knots={_fmt(self.knots)}, values={_fmt(self.values)})"
 
 
+# made once, at import: hypothesis reads a composite's source each time one is made (5-10 ms), and the
+# battery's six generated problems made this one five times per run; the same draws (arguments, not a closure)
+@st.composite
+def _ac_input(draw, m: int | None, T: float, scale: float) -> ACInput:
+    k = draw(_dim(m), label="m")
+    kind = draw(st.sampled_from(["const", "affine", "sin", "pwlinear"]), label="kind")
+    a = draw(_vec(k, -scale, scale), label="a")
+    if kind == "const":
+        return ACInput("const", a, np.zeros(k), T=T)
+    b = draw(_vec(k, -scale, scale), label="b")
+    if kind == "affine":
+        return ACInput("affine", a, b, T=T)
+    if kind == "sin":
+        w = draw(floats(0.5, 2 * np.pi), label="ω")
+        th = draw(floats(0.0, 2 * np.pi), label="θ")
+        return ACInput("sin", a, b, w, th, T=T)
+    J = draw(st.integers(1, 5), label="cells")
+    w = np.array(draw(st.lists(floats(1.0, 10.0), min_size=J, max_size=J), label="widths"))
+    knots = np.concatenate([[0.0], T * np.cumsum(w) / np.sum(w)])
+    knots[-1] = T
+    vals = np.array(draw(st.lists(_vec(k, -scale, scale), min_size=J + 1, max_size=J + 1), label="values"))
+    return ACInput("pwlinear", a, b, knots=knots, values=vals, T=T)
+
+
 def ac_inputs(m: int | None = None, T: float = 1.0, scale: float = 2.0) -> st.SearchStrategy[ACInput]:
     """Absolutely continuous inputs on ``[0, T]`` with known Lipschitz bound (see :class:`ACInput`);
     values ``≤ scale`` per entry, slopes ``≤ 2·scale``, knots spaced at least ``T/100``."""
-    @st.composite
-    def _draw(draw):
-        k = draw(_dim(m), label="m")
-        kind = draw(st.sampled_from(["const", "affine", "sin", "pwlinear"]), label="kind")
-        a = draw(_vec(k, -scale, scale), label="a")
-        if kind == "const":
-            return ACInput("const", a, np.zeros(k), T=T)
-        b = draw(_vec(k, -scale, scale), label="b")
-        if kind == "affine":
-            return ACInput("affine", a, b, T=T)
-        if kind == "sin":
-            w = draw(floats(0.5, 2 * np.pi), label="ω")
-            th = draw(floats(0.0, 2 * np.pi), label="θ")
-            return ACInput("sin", a, b, w, th, T=T)
-        J = draw(st.integers(1, 5), label="cells")
-        w = np.array(draw(st.lists(floats(1.0, 10.0), min_size=J, max_size=J), label="widths"))
-        knots = np.concatenate([[0.0], T * np.cumsum(w) / np.sum(w)])
-        knots[-1] = T
-        vals = np.array(draw(st.lists(_vec(k, -scale, scale), min_size=J + 1, max_size=J + 1), label="values"))
-        return ACInput("pwlinear", a, b, knots=knots, values=vals, T=T)
-    return _draw()
+    return _ac_input(m, T, scale)
