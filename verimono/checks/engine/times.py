@@ -48,6 +48,10 @@ REFINE_PER = 48
 LOCAL_MIN_POINTS = 16
 
 
+#: times per block of a law's vectorised form (``values.many``) in the coverage: the unit's budget meets the
+#: search between blocks (:func:`verimono.execution.timeouts.note_progress`)
+MANY_BLOCK = 256
+
 #: the most strata of one design: ``thorough``'s, a little over ten times ``ci``'s (its stage budgets are ten
 #: times ``ci``'s; 6 x 8192 would be 16 times, and the LCS references' evaluations, one LP each, would outrun
 #: them)
@@ -111,6 +115,22 @@ def search_time(values: Callable[[float, Sequence[int] | None], np.ndarray], lo:
         # the resolution it had reached (the record's details["searched"])
         note_progress(len(seen), held[0], "times", searched=covered)
         return v
+
+    form = getattr(values, "many", None)
+    if form is not None:     # the law's vectorised form over a list of times: the coverage in blocks
+        def many(ts: np.ndarray, which) -> np.ndarray:
+            out = []
+            for a in range(0, len(ts), MANY_BLOCK):
+                block = ts[a:a + MANY_BLOCK]
+                v = np.asarray(form(block, which), dtype=float).reshape(len(block), len(which))
+                seen.extend(block.tolist())
+                with np.errstate(invalid="ignore"):
+                    held[0] = held[0] and not np.any(v > 1.0)
+                note_progress(len(seen), held[0], "times", searched=covered)
+                out.append(v)
+            return np.vstack(out)
+        many.bound = getattr(form, "bound", 1.0)     # type: ignore[attr-defined]
+        tracked.many = many                          # type: ignore[attr-defined]
 
     return maximise(tracked, Space("t", lo, hi), design=own, cover=cover, points=points, seed=seed, bounds=bounds,
                     rank=rank, families=families, refine=golden, direct_points=refine, **more)
