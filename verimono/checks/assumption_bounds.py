@@ -437,6 +437,38 @@ def _rays(S, t: float):
             return np.array([grow(*rays_t[f], tt) for f in fams])
         return np.array([value(*rays_t[f], s_best, tt) for f in fams])
 
+    def t_many(ts: np.ndarray, which) -> np.ndarray:
+        """``t_values(t, which)`` at every time of ``ts``: at each time the points of every family's ray (two
+        of each without σ) in one :func:`resolvent_rows` call (the catalog's map rows as separate calls do;
+        one that verimono's own solver cannot verify: the points one by one, as :func:`point` takes them),
+        then the ratios as :func:`raw`, :func:`grow` and :func:`value` compute them."""
+        fams = list(which)
+        dists = [RAY_GROWTH[0] * r, RAY_GROWTH[1] * r] if sigma is None else [s_best]
+        rays_s = [(rays_t[f][0], rays_t[f][1], d) for f in fams for d in dists]
+        X = np.array([c + d * u for c, u, d in rays_s])
+        out = np.empty((len(ts), len(fams)))
+        for k, tt in enumerate(ts.tolist()):
+            try:
+                Z = resolvent_rows(op, X, lam, tt)
+                zs = [z if np.all(np.isfinite(z)) else None for z in Z]
+            except UnverifiedSolution:
+                zs = [point(c, u, d, tt) for c, u, d in rays_s]
+            for j in range(len(fams)):
+                if sigma is not None:
+                    z = zs[j]
+                    out[k, j] = -np.inf if z is None else _sigma_ratio(S, z, tt)[0]
+                    continue
+                za, zb = zs[2 * j], zs[2 * j + 1]
+                if za is None or zb is None:
+                    out[k, j] = -np.inf
+                    continue
+                a, b = raw(za, tt), raw(zb, tt)
+                out[k, j] = b / a if a > 1e-9 and np.isfinite(b) else 1.0
+        return out
+
+    t_values.many = t_many      # type: ignore[attr-defined]
+    if sigma is None:           # a growth ratio: its bound GROWTH_FLAG
+        t_many.bound = GROWTH_FLAG      # type: ignore[attr-defined]
     count = max(1, strata() // RAY_TIME_SHARE)
     over_t = search_time(t_values, 0.0, T, design=np.r_[S.times, t], seed=S.seed, families=2, count=count)
     if over_t.value > best:
