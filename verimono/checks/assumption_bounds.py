@@ -179,6 +179,8 @@ def _phi_sup(S, off: np.ndarray) -> tuple[Sup, dict]:
     # ties (a φ never approached at the design times) broken toward the points farthest from the domain,
     # whose projections move with it (the exposed boundary points first), the shortest windows first
     rank = np.concatenate([np.r_[off, np.full(len(dirs), 1e300)] + k for k in range(len(widths))])
+    # the coverage: every time's ratio by :func:`one`, without the engine's bookkeeping per time
+    values.many = lambda ss, which: np.array([[one(f, s) for f in which] for s in ss.tolist()])  # type: ignore
     sup = search_time(values, 0.0, hi, design=S.design(0.0, hi), seed=S.seed, rank=rank,
                       bounds=lambda f: (0.0, T - widths[int(f) // nP]))
     wi, pi = divmod(sup.family, nP)
@@ -343,6 +345,8 @@ def _sigma_sup(S) -> tuple[Sup, dict]:
             out.append(_sigma_ratio(S, resolvent_rows(op, P[pi:pi + 1], lams[li], t)[0], t)[0])
         return np.array(out)
 
+    # the coverage: every time's ratio as ``values`` computes it, without the engine's bookkeeping per time
+    values.many = lambda ts, which: np.array([values(t, which) for t in ts.tolist()])   # type: ignore
     sup = search_time(values, 0.0, S.T, design=S.design(), seed=S.seed)
     li, pi = divmod(sup.family, len(P))
     z = S.rows(P[pi:pi + 1], lams[li], sup.t)[0]
@@ -567,6 +571,8 @@ def _theta_sup(S, key: str) -> tuple[Sup, dict]:
         return np.array(out)
 
     hi = T - min(lams)
+    # the coverage: every time's ratio by :func:`one`, without the engine's bookkeeping per time
+    values.many = lambda ss, which: np.array([[one(f, s)[0] for f in which] for s in ss.tolist()])  # type: ignore
     sup = search_time(values, 0.0, hi, design=S.design(0.0, hi), seed=S.seed,
                       bounds=lambda f: (0.0, T - lams[f // nP]))
     _, c = one(sup.family, sup.t)
