@@ -20,6 +20,15 @@ over the **time design** of :func:`time_design`:
 * **refined at the worst windows**: DIRECT and the bounded Brent searches of
   :func:`verimono.checks.engine.supremum.maximise` (its ``cover`` phase is this design).
 
+A law whose ``values`` carries a vectorised form ``values.many(ts, which) -> (len(ts), len(which))`` has the
+coverage (every design time known in advance) evaluated through it, in blocks of :data:`MANY_BLOCK` times: the
+subject's calls as the law makes them, the law's arithmetic over all the times at once, and the engine's
+bookkeeping in one pass.  The engine takes a vectorised value only when it is ``-inf`` (a family undefined
+there) or finite and at most ``SUSPECT`` times the form's ``bound`` (default 1); any other row — NaN, ``inf``,
+near or above the bound, a block that met an unverified solve of verimono's own — is evaluated again by
+``values`` itself, which alone decides a failure (:meth:`verimono.checks.engine.supremum._Evaluator.many`).  The
+forms repeat their law's operations to the bit (tests/checks/test_time_vectorised.py compares them).
+
 What was searched goes in the record (``details["searched"]["t"]``): the points, the evaluations, the
 **resolution** (the largest gap between evaluated times, at most the promised one) and the finest bracket of
 the refinement.  ``ci`` resolves ``t`` to ``T/2048`` (better than the ``T/2000`` issue 42 asks), ``thorough``
