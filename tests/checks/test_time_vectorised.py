@@ -57,7 +57,8 @@ def _mismatches(values, lo: float, hi: float, accepted_rows: list | None = None)
             own = np.asarray(values(t, which), dtype=float)
             row = table[k]
             with np.errstate(invalid="ignore"):
-                accepted = np.all((row == -np.inf) | (np.isfinite(row) & (row <= SUSPECT * bound)))
+                accepted = (not np.isnan(row).any() if getattr(form, "own", False) else
+                            np.all((row == -np.inf) | (np.isfinite(row) & (row <= SUSPECT * bound))))
             if accepted and accepted_rows is not None:
                 accepted_rows.append(t)
             if accepted and not np.array_equal(row, own):
@@ -148,3 +149,26 @@ def test_an_accepted_form_that_hides_a_violation_is_what_the_bitwise_comparison_
                       points=60, seed=1, direct_points=0)
     assert hidden.value < 1.0 < _sup(law).value
     assert supremum.SUSPECT == SUSPECT
+
+
+def test_a_form_that_is_the_laws_own_values_is_taken_as_it_is_but_for_a_row_it_could_not_evaluate():
+    """``own = True``: the law's own values in a loop — a value above the bound is the law's (no second call),
+    a NaN row (a block that met an unverified solve) is evaluated again."""
+    calls = []
+
+    def law(t, which):
+        v = np.array([3.0 if abs(t - 0.5) < 0.05 else 0.1])
+        return v if which is None else v[list(which)]
+
+    def values(t, which):
+        calls.append(t)
+        return law(t, which)
+    cover = np.linspace(0.01, 0.99, 50)
+    values.many = lambda ts, which: np.array([np.nan if abs(t - 0.01) < 1e-12 else law(t, which)[0]
+                                              for t in ts])[:, None]
+    values.many.own = True
+    got = maximise(values, Space("t", 0.0, 1.0), design=[0.0, 1.0], cover=cover, points=60, seed=1,
+                   direct_points=0)
+    assert got.value == 3.0
+    assert sum(abs(t - 0.01) < 1e-12 for t in calls) >= 1          # the NaN row: the law itself
+    assert not any(abs(t - 0.5) < 0.05 and t in cover.tolist() for t in calls)     # 3.0 taken from the form

@@ -181,6 +181,7 @@ def _phi_sup(S, off: np.ndarray) -> tuple[Sup, dict]:
     rank = np.concatenate([np.r_[off, np.full(len(dirs), 1e300)] + k for k in range(len(widths))])
     # the coverage: every time's ratio by :func:`one`, without the engine's bookkeeping per time
     values.many = lambda ss, which: np.array([[one(f, s) for f in which] for s in ss.tolist()])  # type: ignore
+    values.many.own = True      # type: ignore[attr-defined]  # the law's own ratio: nothing to evaluate again
     sup = search_time(values, 0.0, hi, design=S.design(0.0, hi), seed=S.seed, rank=rank,
                       bounds=lambda f: (0.0, T - widths[int(f) // nP]))
     wi, pi = divmod(sup.family, nP)
@@ -347,6 +348,7 @@ def _sigma_sup(S) -> tuple[Sup, dict]:
 
     # the coverage: every time's ratio as ``values`` computes it, without the engine's bookkeeping per time
     values.many = lambda ts, which: np.array([values(t, which) for t in ts.tolist()])   # type: ignore
+    values.many.own = True      # type: ignore[attr-defined]
     sup = search_time(values, 0.0, S.T, design=S.design(), seed=S.seed)
     li, pi = divmod(sup.family, len(P))
     z = S.rows(P[pi:pi + 1], lams[li], sup.t)[0]
@@ -573,6 +575,7 @@ def _theta_sup(S, key: str) -> tuple[Sup, dict]:
     hi = T - min(lams)
     # the coverage: every time's ratio by :func:`one`, without the engine's bookkeeping per time
     values.many = lambda ss, which: np.array([[one(f, s)[0] for f in which] for s in ss.tolist()])  # type: ignore
+    values.many.own = True      # type: ignore[attr-defined]
     sup = search_time(values, 0.0, hi, design=S.design(0.0, hi), seed=S.seed,
                       bounds=lambda f: (0.0, T - lams[f // nP]))
     _, c = one(sup.family, sup.t)

@@ -284,12 +284,18 @@ class _Evaluator:
         only when it is ``-inf`` (the family undefined there) or finite and at most :data:`SUSPECT` times the
         form's ``bound`` (its attribute; default 1: every ratio's bound), a margin far beyond the rounding of
         a sum reduced in another order; a row with any other value (NaN, ``inf``, near or above the bound: what
-        decides a failure) is evaluated again by the law's own ``values``, through :meth:`some`'s path."""
+        decides a failure) is evaluated again by the law's own ``values``, through :meth:`some`'s path.  A form
+        that states ``own = True`` is the law's own ``values`` at each point (a loop without the engine's
+        bookkeeping per point): its values are the law's, only a NaN row (a block it could not evaluate) is
+        evaluated again."""
         which = list(which)
         bound = float(getattr(form, "bound", 1.0))
         table = np.asarray(form(xs, which), dtype=float).reshape(len(xs), len(which))
         with np.errstate(invalid="ignore"):
-            fine = (table == -np.inf) | (np.isfinite(table) & (table <= SUSPECT * bound))
+            if getattr(form, "own", False):     # the law's own values at each point, in a loop: nothing to redo
+                fine = ~np.isnan(table)         # (NaN: a block the form could not evaluate)
+            else:
+                fine = (table == -np.inf) | (np.isfinite(table) & (table <= SUSPECT * bound))
         redo = ~fine.all(axis=1)
         self.vectorised += int((~redo).sum())
         out = table.copy()

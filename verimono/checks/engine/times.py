@@ -143,6 +143,7 @@ def search_time(values: Callable[[float, Sequence[int] | None], np.ndarray], lo:
                 out.append(v)
             return np.vstack(out)
         many.bound = getattr(form, "bound", 1.0)     # type: ignore[attr-defined]
+        many.own = getattr(form, "own", False)       # type: ignore[attr-defined]
         tracked.many = many                          # type: ignore[attr-defined]
 
     return maximise(tracked, Space("t", lo, hi), design=own, cover=cover, points=points, seed=seed, bounds=bounds,
