@@ -179,6 +179,9 @@ def _phi_sup(S, off: np.ndarray) -> tuple[Sup, dict]:
     # ties (a φ never approached at the design times) broken toward the points farthest from the domain,
     # whose projections move with it (the exposed boundary points first), the shortest windows first
     rank = np.concatenate([np.r_[off, np.full(len(dirs), 1e300)] + k for k in range(len(widths))])
+    # the coverage: every time's ratio by :func:`one`, without the engine's bookkeeping per time
+    values.many = lambda ss, which: np.array([[one(f, s) for f in which] for s in ss.tolist()])  # type: ignore
+    values.many.own = True      # type: ignore[attr-defined]  # the law's own ratio: nothing to evaluate again
     sup = search_time(values, 0.0, hi, design=S.design(0.0, hi), seed=S.seed, rank=rank,
                       bounds=lambda f: (0.0, T - widths[int(f) // nP]))
     wi, pi = divmod(sup.family, nP)
@@ -343,6 +346,9 @@ def _sigma_sup(S) -> tuple[Sup, dict]:
             out.append(_sigma_ratio(S, resolvent_rows(op, P[pi:pi + 1], lams[li], t)[0], t)[0])
         return np.array(out)
 
+    # the coverage: every time's ratio as ``values`` computes it, without the engine's bookkeeping per time
+    values.many = lambda ts, which: np.array([values(t, which) for t in ts.tolist()])   # type: ignore
+    values.many.own = True      # type: ignore[attr-defined]
     sup = search_time(values, 0.0, S.T, design=S.design(), seed=S.seed)
     li, pi = divmod(sup.family, len(P))
     z = S.rows(P[pi:pi + 1], lams[li], sup.t)[0]
@@ -437,6 +443,38 @@ def _rays(S, t: float):
             return np.array([grow(*rays_t[f], tt) for f in fams])
         return np.array([value(*rays_t[f], s_best, tt) for f in fams])
 
+    def t_many(ts: np.ndarray, which) -> np.ndarray:
+        """``t_values(t, which)`` at every time of ``ts``: at each time the points of every family's ray (two
+        of each without σ) in one :func:`resolvent_rows` call (the catalog's map rows as separate calls do;
+        one that verimono's own solver cannot verify: the points one by one, as :func:`point` takes them),
+        then the ratios as :func:`raw`, :func:`grow` and :func:`value` compute them."""
+        fams = list(which)
+        dists = [RAY_GROWTH[0] * r, RAY_GROWTH[1] * r] if sigma is None else [s_best]
+        rays_s = [(rays_t[f][0], rays_t[f][1], d) for f in fams for d in dists]
+        X = np.array([c + d * u for c, u, d in rays_s])
+        out = np.empty((len(ts), len(fams)))
+        for k, tt in enumerate(ts.tolist()):
+            try:
+                Z = resolvent_rows(op, X, lam, tt)
+                zs = [z if np.all(np.isfinite(z)) else None for z in Z]
+            except UnverifiedSolution:
+                zs = [point(c, u, d, tt) for c, u, d in rays_s]
+            for j in range(len(fams)):
+                if sigma is not None:
+                    z = zs[j]
+                    out[k, j] = -np.inf if z is None else _sigma_ratio(S, z, tt)[0]
+                    continue
+                za, zb = zs[2 * j], zs[2 * j + 1]
+                if za is None or zb is None:
+                    out[k, j] = -np.inf
+                    continue
+                a, b = raw(za, tt), raw(zb, tt)
+                out[k, j] = b / a if a > 1e-9 and np.isfinite(b) else 1.0
+        return out
+
+    t_values.many = t_many      # type: ignore[attr-defined]
+    if sigma is None:           # a growth ratio: its bound GROWTH_FLAG
+        t_many.bound = GROWTH_FLAG      # type: ignore[attr-defined]
     count = max(1, strata() // RAY_TIME_SHARE)
     over_t = search_time(t_values, 0.0, T, design=np.r_[S.times, t], seed=S.seed, families=2, count=count)
     if over_t.value > best:
@@ -535,6 +573,9 @@ def _theta_sup(S, key: str) -> tuple[Sup, dict]:
         return np.array(out)
 
     hi = T - min(lams)
+    # the coverage: every time's ratio by :func:`one`, without the engine's bookkeeping per time
+    values.many = lambda ss, which: np.array([[one(f, s)[0] for f in which] for s in ss.tolist()])  # type: ignore
+    values.many.own = True      # type: ignore[attr-defined]
     sup = search_time(values, 0.0, hi, design=S.design(0.0, hi), seed=S.seed,
                       bounds=lambda f: (0.0, T - lams[f // nP]))
     _, c = one(sup.family, sup.t)

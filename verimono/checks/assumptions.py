@@ -40,6 +40,12 @@ from .subjects import require_problem
 from .engine.times import search_time, searched_t
 
 
+def _dots(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``a_i @ b_i`` of every row, by a stacked matmul: the same bits as the 1-D ``a_i @ b_i`` of the law's
+    evaluator of one time (``np.einsum`` and ``np.sum`` reduce in another order)."""
+    return (a[:, None, :] @ b[:, :, None])[:, 0, 0]
+
+
 def _non_monotone(Z: np.ndarray, Y: np.ndarray, P: np.ndarray):
     """``(ratio, inner, i, j)`` of every pair of graph points ``(Z_i, Y_i)``: ``-⟨Z_i − Z_j, Y_i − Y_j⟩`` in
     units of its rounding (``P``: the size of what each ``Y`` was computed from)."""
@@ -134,6 +140,27 @@ def _a1_sup(S):
         every = np.concatenate([pairs(t, li, np.arange(len(P)))[2] for li in range(len(lams))])
         return every if which is None else every[np.asarray(list(which), dtype=int)]
 
+    def many(ts: np.ndarray, which) -> np.ndarray:
+        """``values(t, which)`` at every time of ``ts`` (``which``: one or two pairs): the subject's calls as
+        :func:`one` makes them, the arithmetic over all times at once (NaN where a row is not finite for a
+        reason other than an unverified resolvent: the engine evaluates it again with :func:`one`)."""
+        out = np.empty((len(ts), len(which)))
+        for k, f in enumerate(which):
+            li, kk = divmod(int(f), per)
+            lam, p = lams[li], P[[ia[kk], ib[kk]]]
+            z = np.stack([S.rows(p, lam, t) for t in ts.tolist()])         # (times, 2, n)
+            y = (p - z) / lam
+            dz, dy = z[:, 0] - z[:, 1], y[:, 0] - y[:, 1]
+            size = np.abs(p).max(axis=1) / lam
+            tol = RTOL * (np.sqrt(_dots(dz, dz)) * (1.0 + max(size[0], size[1]))
+                          + np.sqrt(_dots(dy, dy)) * (1.0 + np.abs(z).max(axis=(1, 2))))
+            with np.errstate(invalid="ignore"):
+                r = -_dots(dz, dy) / (tol + 1e-300)
+            unverified = ~np.isfinite(z).all(axis=(1, 2))
+            out[:, k] = np.where(np.isnan(r) & unverified, -np.inf, r)
+        return out
+
+    values.many = many      # type: ignore[attr-defined]
     sup = search_time(values, 0.0, S.T, design=S.design(), seed=S.seed)
     li, k = divmod(sup.family, per)
     z, y, ratio, inner, _, _ = pairs(sup.t, li, np.array([ia[k], ib[k]]))

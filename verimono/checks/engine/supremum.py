@@ -63,6 +63,9 @@ REFINE_MAXITER = 40
 XATOL = 1e-6
 #: golden-section steps of the refinement (``refine=True``): from Brent's ``~1e-8`` to below one ulp
 REFINE_STEPS = 80
+#: a vectorised value above this fraction of its bound (or not finite) is evaluated again by the law's own
+#: ``values`` (:meth:`_Evaluator.many`; as :data:`verimono.checks.engine.batches.SUSPECT` for the operator laws)
+SUSPECT = 0.999
 #: the default budget (points of a space per search) when the active profile is not one of verimono's
 DEFAULT_BUDGET = {"time": 512, "coordinate": 27, "points": 100}
 
@@ -229,6 +232,8 @@ class _Evaluator:
         self.us: list[float] = []
         self.evaluations = 0
         self.limited = 0
+        #: points whose values came from the law's vectorised form (:meth:`many`)
+        self.vectorised = 0
 
     def note(self, x: float, vals: np.ndarray, which: Sequence[int]) -> None:
         self.us.append(self.space.unit(x))
@@ -240,6 +245,12 @@ class _Evaluator:
 
     def some(self, x: float, which: Sequence[int]) -> np.ndarray:
         """The values of the families ``which`` at ``x`` (``-inf`` where verimono's solver is unverified)."""
+        vals = self._some(x, which)
+        self.note(x, vals, which)
+        return vals
+
+    def _some(self, x: float, which: Sequence[int]) -> np.ndarray:
+        """:meth:`some`'s values, not noted."""
         try:
             vals = _finite(self.values(x, list(which)))
             if vals.size != len(which) and vals.size > max(which):     # a values() that returned every family
@@ -252,7 +263,6 @@ class _Evaluator:
                 except UnverifiedSolution:      # verimono's own solver, not the subject: no evidence here
                     self.limited += 1
                     vals[k] = -np.inf
-        self.note(x, vals, which)
         return vals
 
     def table(self, xs: np.ndarray, table: np.ndarray) -> None:
@@ -266,6 +276,42 @@ class _Evaluator:
             if table.flat[i] > self.best["value"]:
                 self.best.update(value=float(table.flat[i]), at=float(xs[i // table.shape[1]]),
                                  family=i % table.shape[1])
+
+    def many(self, xs: np.ndarray, which: Sequence[int], form: Callable) -> np.ndarray:
+        """The values of the families ``which`` at every point of ``xs`` (a list known in advance: the coverage),
+        from the law's vectorised form ``form(xs, which) -> (len(xs), len(which))`` where it is accepted, noted
+        in order as :meth:`some` notes them (the same points, counts and best).  A vectorised value is accepted
+        only when it is ``-inf`` (the family undefined there) or finite and at most :data:`SUSPECT` times the
+        form's ``bound`` (its attribute; default 1: every ratio's bound), a margin far beyond the rounding of
+        a sum reduced in another order; a row with any other value (NaN, ``inf``, near or above the bound: what
+        decides a failure) is evaluated again by the law's own ``values``, through :meth:`some`'s path.  A form
+        that states ``own = True`` is the law's own ``values`` at each point (a loop without the engine's
+        bookkeeping per point): its values are the law's, only a NaN row (a block it could not evaluate) is
+        evaluated again."""
+        which = list(which)
+        bound = float(getattr(form, "bound", 1.0))
+        table = np.asarray(form(xs, which), dtype=float).reshape(len(xs), len(which))
+        with np.errstate(invalid="ignore"):
+            if getattr(form, "own", False):     # the law's own values at each point, in a loop: nothing to redo
+                fine = ~np.isnan(table)         # (NaN: a block the form could not evaluate)
+            else:
+                fine = (table == -np.inf) | (np.isfinite(table) & (table <= SUSPECT * bound))
+        redo = ~fine.all(axis=1)
+        self.vectorised += int((~redo).sum())
+        out = table.copy()
+        for k in np.flatnonzero(redo).tolist():
+            out[k] = self._some(float(xs[k]), which)
+        # noted in one pass: the same points and counts, and the best as noting row by row finds it (the first
+        # largest value, in the order of the rows)
+        unit = self.space.unit
+        self.us += [unit(x) for x in xs.tolist()]
+        self.evaluations += out.size
+        if out.size:
+            i = int(np.argmax(out))
+            if out.flat[i] > self.best["value"]:
+                self.best.update(value=float(out.flat[i]), at=float(xs[i // out.shape[1]]),
+                                 family=int(which[i % out.shape[1]]))
+        return out
 
     def every(self, x: float) -> np.ndarray | None:
         """Every family's value at ``x`` (``None`` when an unverified solve prevents the whole row)."""
@@ -325,9 +371,15 @@ def maximise(values: Callable[[float, Sequence[int] | None], np.ndarray], space:
             count = max(0, int(points * COVER_SHARE) - len(xs))
             off = _offset(seed)
             cover = [space.value((i + off) / count) for i in range(count)]
-        for x in cover:
-            r = ev.some(float(x), chosen)
-            found.append((float(x), float(r.max()), r, chosen))
+        many = getattr(values, "many", None)     # the law's vectorised form over a list of points
+        if many is not None and len(cover):
+            xc = np.asarray(cover, dtype=float)
+            for x, r in zip(xc.tolist(), ev.many(xc, chosen, many)):
+                found.append((x, float(r.max()), r, chosen))
+        else:
+            for x in cover:
+                r = ev.some(float(x), chosen)
+                found.append((float(x), float(r.max()), r, chosen))
         maxfun = int(points * DIRECT_SHARE) if direct_points is None else int(direct_points)
         if maxfun >= 3:
             def neg(u: np.ndarray) -> float:

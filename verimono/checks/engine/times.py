@@ -20,6 +20,15 @@ over the **time design** of :func:`time_design`:
 * **refined at the worst windows**: DIRECT and the bounded Brent searches of
   :func:`verimono.checks.engine.supremum.maximise` (its ``cover`` phase is this design).
 
+A law whose ``values`` carries a vectorised form ``values.many(ts, which) -> (len(ts), len(which))`` has the
+coverage (every design time known in advance) evaluated through it, in blocks of :data:`MANY_BLOCK` times: the
+subject's calls as the law makes them, the law's arithmetic over all the times at once, and the engine's
+bookkeeping in one pass.  The engine takes a vectorised value only when it is ``-inf`` (a family undefined
+there) or finite and at most ``SUSPECT`` times the form's ``bound`` (default 1); any other row — NaN, ``inf``,
+near or above the bound, a block that met an unverified solve of verimono's own — is evaluated again by
+``values`` itself, which alone decides a failure (:meth:`verimono.checks.engine.supremum._Evaluator.many`).  The
+forms repeat their law's operations to the bit (tests/checks/test_time_vectorised.py compares them).
+
 What was searched goes in the record (``details["searched"]["t"]``): the points, the evaluations, the
 **resolution** (the largest gap between evaluated times, at most the promised one) and the finest bracket of
 the refinement.  ``ci`` resolves ``t`` to ``T/2048`` (better than the ``T/2000`` issue 42 asks), ``thorough``
@@ -32,6 +41,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 
+from ...core.errors import UnverifiedSolution
 from ...execution.timeouts import note_progress
 from .supremum import Space, Sup, budget, maximise
 
@@ -47,6 +57,10 @@ STRATA_PER_POINT = 6
 REFINE_PER = 48
 LOCAL_MIN_POINTS = 16
 
+
+#: times per block of a law's vectorised form (``values.many``) in the coverage: the unit's budget meets the
+#: search between blocks (:func:`verimono.execution.timeouts.note_progress`)
+MANY_BLOCK = 256
 
 #: the most strata of one design: ``thorough``'s, a little over ten times ``ci``'s (its stage budgets are ten
 #: times ``ci``'s; 6 x 8192 would be 16 times, and the LCS references' evaluations, one LP each, would outrun
@@ -111,6 +125,26 @@ def search_time(values: Callable[[float, Sequence[int] | None], np.ndarray], lo:
         # the resolution it had reached (the record's details["searched"])
         note_progress(len(seen), held[0], "times", searched=covered)
         return v
+
+    form = getattr(values, "many", None)
+    if form is not None:     # the law's vectorised form over a list of times: the coverage in blocks
+        def many(ts: np.ndarray, which) -> np.ndarray:
+            out = []
+            for a in range(0, len(ts), MANY_BLOCK):
+                block = ts[a:a + MANY_BLOCK]
+                try:
+                    v = np.asarray(form(block, which), dtype=float).reshape(len(block), len(which))
+                except UnverifiedSolution:      # verimono's own solver: the engine takes these times one by one
+                    v = np.full((len(block), len(which)), np.nan)
+                seen.extend(block.tolist())
+                with np.errstate(invalid="ignore"):
+                    held[0] = held[0] and not np.any(v > 1.0)
+                note_progress(len(seen), held[0], "times", searched=covered)
+                out.append(v)
+            return np.vstack(out)
+        many.bound = getattr(form, "bound", 1.0)     # type: ignore[attr-defined]
+        many.own = getattr(form, "own", False)       # type: ignore[attr-defined]
+        tracked.many = many                          # type: ignore[attr-defined]
 
     return maximise(tracked, Space("t", lo, hi), design=own, cover=cover, points=points, seed=seed, bounds=bounds,
                     rank=rank, families=families, refine=golden, direct_points=refine, **more)
