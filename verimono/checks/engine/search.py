@@ -81,7 +81,7 @@ from ..core import REGISTRY, Law, Outcome, classify, law, new_record, run, subje
 from .forms import CONTIGUOUS, cycled, form_note, form_search, forms_for, in_form
 from .samples import NUMPY_DIM, Sample, law_samples
 from .supremum import budget
-from .sweep import law_draws, shrink, sweep_count, sweep_samples
+from .sweep import edge_count, edge_draws, law_draws, shrink, sweep_count, sweep_samples
 
 #: examples per law when ``examples`` is not given and the run configuration's profile is not one of
 #: verimono's (a user's own); otherwise the profile's ``law_examples`` governs (:func:`default_examples`)
@@ -90,8 +90,10 @@ DEFAULT_EXAMPLES = 50
 BOUND = 1.0
 #: ratios handed to hypothesis.target are clipped to this (observations must be finite)
 TARGET_CAP = 1e12
-#: hypothesis searches with ``examples // HYPOTHESIS_SHARE`` examples (at least ``HYPOTHESIS_MIN``) after
-#: the NumPy draws found nothing, with all ``examples`` when a draw broke the law
+#: no longer used by the search (kept as public names): hypothesis searched ``max(HYPOTHESIS_MIN, examples //
+#: HYPOTHESIS_SHARE)`` examples after NumPy draws that found nothing; the edge samples
+#: (:func:`verimono.checks.engine.sweep.edge_draws`) cover what it contributed there, and hypothesis now runs
+#: (with all ``examples``) only when a draw broke the law, or above :data:`NUMPY_DIM` coordinates
 HYPOTHESIS_SHARE = 4
 HYPOTHESIS_MIN = 3
 #: the law that reports an operator whose resolvent raises on plain inputs (its statement: ``J_λ`` is
@@ -434,10 +436,13 @@ def _search(decl: Law, op: Any, seed: int, examples: int, horizon: float) -> tup
     try:
         with no_local_constants(), time_limit(current_budget(), f"{decl.name} on {subject_name(op)}"):
             if op.dim <= NUMPY_DIM:
-                drawn = state.first_violation(cycled(law_draws(op.dim, seed, horizon, examples, Sample), forms_for(op)))
-            full = drawn is not None or op.dim > NUMPY_DIM
-            _hypothesis_search(state, seed, horizon, examples if full else max(HYPOTHESIS_MIN,
-                                                                               examples // HYPOTHESIS_SHARE))
+                edges = edge_draws(op.dim, seed, horizon, edge_count(examples), Sample)
+                how["edge"] = len(edges)
+                drawn = state.first_violation(cycled(law_draws(op.dim, seed, horizon, examples, Sample), forms_for(op))
+                                              + edges)
+            if drawn is not None or op.dim > NUMPY_DIM:     # hypothesis where it pays: its climb and its shrinking
+                how["hypothesis"] = examples
+                _hypothesis_search(state, seed, horizon, examples)
     except _Violation:
         pass
     except UnitTimeout as exc:
@@ -657,6 +662,9 @@ def run_law(decl: Law | str, op: Any, *, seed: int | None = None, examples: int 
                                           "coordinate": how.get("coordinate", 0),
                                           "searched": {**searched(state.xs, state.lams, state.ts, horizon,
                                                                   state.coordinates), "forms": dict(state.forms),
+                                                 **({"edge_samples": how["edge"]} if how.get("edge") else {}),
+                                                 **({"hypothesis_examples": how["hypothesis"]}
+                                                    if how.get("hypothesis") else {}),
                                                  **({"budget": state.budget_note} if state.budget_note else {})}},
                        {"seed": seed, "examples": examples, "horizon": horizon, "operator": repr(op)})
         rec.duration = time.perf_counter() - start
