@@ -4,11 +4,18 @@ A law of an operator is an evaluator ``law(op, sample) -> Outcome`` (:mod:`verim
 search evaluates it, in order, on
 
 1. ``examples`` NumPy draws from the distribution of :func:`verimono.checks.samples.law_samples`
-   (:func:`verimono.checks.sweep.law_draws`, seeded by the record's seed);
-2. a hypothesis search (:func:`~verimono.checks.samples.law_samples`) that starts from the simplest samples,
-   climbs toward violations through :func:`hypothesis.target` on the ratio and shrinks a failing sample —
-   with ``examples // HYPOTHESIS_SHARE`` examples when the draws found nothing, with all ``examples`` when
-   one broke the law (a draw hypothesis does not meet again is shrunk greedily);
+   (:func:`verimono.checks.sweep.law_draws`, seeded by the record's seed), then the simplest sample alone
+   (``x1 = x2 = 0``, ``λ = μ = ν = 1``, ``t = 0``) and :func:`~verimono.checks.sweep.edge_count` ``- 1`` more
+   **edge samples** (:func:`verimono.checks.sweep.edge_draws`): the kinds of points hypothesis's generate phase
+   contributed beyond the draws — its simplest example, identical points, hypothesis's extreme floats (the
+   smallest normals of float64 and float32, epsilons, tiny ``10^-307 … 10^-10``) and subnormals beside ordinary
+   entries, ``-0.0``, values next to the simple ones, coordinates of ``x2`` equal to ``x1``'s, tiny times —
+   drawn by NumPy from the seed, the same on every machine (``details["searched"]["edge_samples"]``);
+2. hypothesis (:func:`~verimono.checks.samples.law_samples`), only where its targeting and shrinking pay: when a
+   draw or an edge sample broke the law, a search of all ``examples`` that climbs toward violations through
+   :func:`hypothesis.target` on the ratio and shrinks a failing sample (a draw hypothesis does not meet again is
+   shrunk greedily), and above :data:`NUMPY_DIM` coordinates, where the points are NumPy recipes that hypothesis
+   draws (``details["searched"]["hypothesis_examples"]``); draws that found nothing go on to the sweep;
 3. the scale sweep (:mod:`verimono.checks.sweep`), points from ``10^-9`` to ``10^6``, on and just outside
    the boundary of the domain;
 4. the coordinate search (:mod:`verimono.checks.coordinates`): each coordinate of the worst sample — the
@@ -25,8 +32,10 @@ Every record says what was searched (``details["searched"]``: the range of ``|x|
 the largest gap between the sampled times, each coordinate's range and resolution, the samples evaluated in
 each input form).
 
-Hypothesis's engine costs about 1.7 ms per example here against about 0.02 ms per NumPy draw, and a
-vectorised evaluation about 7 µs per sample (one batched call) to 25 µs (one call per distinct step size).  One given
+Hypothesis's engine costs about 1.7 ms per example here (and ~0.7 ms to start a search) against about 0.02 ms per
+NumPy draw, and a vectorised evaluation about 7 µs per sample (one batched call) to 25 µs (one call per distinct
+step size): the edge samples replaced a search of ``max(HYPOTHESIS_MIN, examples // HYPOTHESIS_SHARE)`` hypothesis
+examples on every law (docs/speed.md, "Edge samples in place of hypothesis's generate phase").  One given
 ``sample=`` (a :class:`~verimono.checks.samples.Sample` or its dict from a counterexample) is evaluated
 alone instead: that is how a failure is replayed and how outer ``@given`` tests drive the laws.
 
@@ -624,7 +633,8 @@ def _verdict(state: _Search, how: dict, base: dict, details: dict, cex_extra: di
 
 def run_law(decl: Law | str, op: Any, *, seed: int | None = None, examples: int | None = None,
             horizon: float = 1.0, sample: Sample | dict | None = None) -> CheckResult:
-    """One law on ``op``: NumPy draws, a hypothesis search and the scale sweep, or one given ``sample``.
+    """One law on ``op``: NumPy draws and edge samples (hypothesis after a violation), the scale sweep and the
+    coordinates, or one given ``sample``.
 
     ``seed`` makes the search reproducible (a fresh one is drawn and recorded when ``None``); ``examples``
     is the effort (default: the active profile's, :func:`default_examples`); times are sampled in
@@ -681,7 +691,7 @@ def run_law(decl: Law | str, op: Any, *, seed: int | None = None, examples: int 
     return rec
 
 
-#: what an operator law quantifies over unless it says otherwise: points (the draws, hypothesis, the sweep),
+#: what an operator law quantifies over unless it says otherwise: points (the draws, the edge samples, the sweep),
 #: the input's form and every coordinate of :func:`verimono.checks.engine.coordinates.coordinate_search`
 OPERATOR_DOMAIN = ("points", "form") + COORDINATES
 

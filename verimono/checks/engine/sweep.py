@@ -1,4 +1,5 @@
-"""The scale sweep: seeded samples at every scale, evaluated after the hypothesis search of each law.
+"""The scale sweep: seeded samples at every scale, evaluated after the draws and edge samples of each law
+(:func:`law_draws`, :func:`edge_draws`: NumPy's versions of what hypothesis's generate phase drew).
 
 Hypothesis draws points of moderate size and climbs toward large ratios; a bug confined to a thin region
 (a prox that crashes or takes a wrong branch only for ``|x| < 10^-6``, or only on the boundary of its
