@@ -446,12 +446,13 @@ def _search(decl: Law, op: Any, seed: int, examples: int, horizon: float) -> tup
         with no_local_constants(), time_limit(current_budget(), f"{decl.name} on {subject_name(op)}"):
             if op.dim <= NUMPY_DIM:
                 edges = edge_draws(op.dim, seed, horizon, edge_count(examples), Sample)
-                how["edge"] = len(edges)
                 # in hypothesis's order: the draws, the simplest sample alone (the worst so far when it ties the
                 # ratio 0 that pairs x1 = x2 give: the coordinates start from its pair), the other edge samples
-                for part in (cycled(law_draws(op.dim, seed, horizon, examples, Sample), forms_for(op)), edges[:1],
-                             edges[1:]):
+                parts = (cycled(law_draws(op.dim, seed, horizon, examples, Sample), forms_for(op)), edges[:1], edges[1:])
+                for i, part in enumerate(parts):
                     drawn = state.first_violation(part)
+                    if i:       # the edge samples searched (none when a draw broke the law)
+                        how["edge"] = how.get("edge", 0) + len(part)
                     if drawn is not None or state.unsupported is not None:
                         break
             if drawn is not None or op.dim > NUMPY_DIM:     # hypothesis where it pays: its climb and its shrinking
