@@ -346,23 +346,26 @@ def test_a_limit_of_verimonos_own_solvers_is_undecided_never_failed_nor_passed()
     assert rec.status == "failed" and "SolverFailure" in rec.message, str(rec)   # the root cause, as any raise
 
 
-def test_a_law_sees_the_numpy_draws_then_a_short_hypothesis_search_then_the_sweep_then_the_coordinates():
-    """examples NumPy draws, then examples // HYPOTHESIS_SHARE hypothesis examples (at least HYPOTHESIS_MIN),
-    then the scale sweep, then the coordinate search: every sample counted once in details["evaluations"]."""
-    from verimono.checks.engine import search as L
+def test_a_law_sees_the_numpy_draws_then_the_edge_samples_then_the_sweep_then_the_coordinates():
+    """examples NumPy draws, then edge_count(examples) edge samples (no hypothesis example: the draws found
+    nothing), then the scale sweep, then the coordinate search: every sample counted once in
+    details["evaluations"], the edge samples stated in details["searched"]."""
+    from verimono.checks.engine.sweep import edge_count
     from verimono.reference import get
 
     op = get("t|x| (n=3)").operator
     for examples in (4, 20, 40):
         r = run_law("resolvent_nonexpansive", op, seed=3, examples=examples)
-        hyp = max(L.HYPOTHESIS_MIN, examples // L.HYPOTHESIS_SHARE)
+        edges = edge_count(examples)
         assert r.status == "passed" and r.details["evaluations"] == \
-            examples + hyp + r.details["sweep"] + r.details["coordinate"], r.details
+            examples + edges + r.details["sweep"] + r.details["coordinate"], r.details
+        assert r.details["searched"]["edge_samples"] == edges and "hypothesis_examples" not in r.details["searched"]
 
 
 def test_a_violation_only_the_draws_meet_is_shrunk_and_replays(monkeypatch):
     """With hypothesis confined to one harmless sample (x1 = x2 = 0), the explicit step's violation comes from
-    the NumPy draws: recorded as theirs, shrunk greedily, and replayed by sample=."""
+    the NumPy draws: recorded as theirs, shrunk greedily, and replayed by sample=.  Without the draws, and the
+    edge samples only that harmless pair, nothing finds it."""
     from hypothesis import strategies as st
 
     from verimono.checks.engine import coordinates, samples, search as L
@@ -374,7 +377,7 @@ def test_a_violation_only_the_draws_meet_is_shrunk_and_replays(monkeypatch):
     assert r.status == "failed" and r.counterexample["found_by"] == "NumPy draws (shrunk greedily)", str(r)
     again = run_law("resolvent_nonexpansive", zoo.build("explicit_step"), sample=r.counterexample)
     assert again.status == "failed", str(again)
-    monkeypatch.setattr(L, "HYPOTHESIS_MIN", 0)
+    monkeypatch.setattr(L, "edge_draws", lambda *a, **k: [samples.Sample(np.zeros(2), np.zeros(2), 1.0, 1.0, 1.0, 0.0)] * 5)
     monkeypatch.setattr(L, "law_draws", lambda *a, **k: [])     # without the draws nothing finds it (but the
     monkeypatch.setattr(coordinates, "COORDINATES",                # direction search, from the pair x1 = x2)
                         tuple(c for c in coordinates.COORDINATES if c != "direction"))

@@ -1,7 +1,9 @@
 """Same seed → same records, whatever the user imported.  Hypothesis mixes numeric literals of imported
 "local" modules into generation; verimono's searches switch that off (verimono.core._reproducible), so a record's
 seed reproduces it in a fresh process.  Shown in fresh processes with and without an unrelated module of
-many constants, and — so the test is seen able to fail — without the guard the records differ."""
+many constants, and — so the test is seen able to fail — without the guard the samples hypothesis draws differ.
+Hypothesis searches only where it pays (a violation of the draws, or above NUMPY_DIM coordinates): the subjects
+are a lawful prox in R^65 and, in R^2, a prox whose value laws break."""
 
 from __future__ import annotations
 
@@ -21,10 +23,22 @@ SCRIPT = textwrap.dedent('''
         import contextlib, verimono.checks.engine.search as search
         search.no_local_constants = contextlib.nullcontext
     import verimono as vm
+    import verimono.checks.engine.search as engine
+    drawn, evaluate = [], engine._Search.evaluate
+    def logged(self, s, climb=False):     # the samples hypothesis draws (climb: inside hypothesis's search)
+        if climb:
+            drawn.append(s.to_dict())
+        return evaluate(self, s, climb)
+    engine._Search.evaluate = logged
     soft = lambda x, lam: np.sign(x) * np.maximum(np.abs(x) - lam, 0.0)
-    op = vm.operator_from_prox(soft, value=lambda x: float(np.abs(x).sum()), shape=2, name="soft")
-    rep = vm.check_operator(op, seed=7, examples=15, profile="dev")
-    print(json.dumps([[r.check, r.status, r.worst, r.details.get("worst_sample")] for r in rep]))
+    # above NUMPY_DIM = 64 coordinates hypothesis searches every law (draws and edge samples below: no hypothesis)
+    op = vm.operator_from_prox(soft, value=lambda x: float(np.abs(x).sum()), shape=65, name="soft")
+    # the prox of 2|x|_1 stated as |x|_1's: its value laws break at the draws, so hypothesis searches them
+    bad = vm.operator_from_prox(lambda x, lam: soft(x, 2 * lam), value=lambda x: float(np.abs(x).sum()), shape=2,
+                                name="soft at 2 lam")
+    reps = [vm.check_operator(o, seed=7, examples=15, profile="dev") for o in (op, bad)]
+    print(json.dumps([[r.check, r.status, r.worst, r.details.get("worst_sample"), r.counterexample]
+                      for rep in reps for r in rep] + [drawn]))
 ''')
 
 
@@ -85,8 +99,11 @@ def test_a_fresh_process_reproduces_the_records_of_this_one(tmp_path):
     import verimono as vm
 
     soft = lambda x, lam: np.sign(x) * np.maximum(np.abs(x) - lam, 0.0)   # noqa: E731
-    op = vm.operator_from_prox(soft, value=lambda x: float(np.abs(x).sum()), shape=2, name="soft")
-    rep = vm.check_operator(op, seed=7, examples=15, profile="dev")    # the fresh process's, whatever $CI says
-    here = json.loads(json.dumps([[r.check, r.status, r.worst, r.details.get("worst_sample")] for r in rep]))
+    op = vm.operator_from_prox(soft, value=lambda x: float(np.abs(x).sum()), shape=65, name="soft")
+    bad = vm.operator_from_prox(lambda x, lam: soft(x, 2 * lam), value=lambda x: float(np.abs(x).sum()), shape=2,
+                                name="soft at 2 lam")
+    reps = [vm.check_operator(o, seed=7, examples=15, profile="dev") for o in (op, bad)]   # whatever $CI says
+    here = json.loads(json.dumps([[r.check, r.status, r.worst, r.details.get("worst_sample"), r.counterexample]
+                                  for rep in reps for r in rep]))
     _constants_module(tmp_path)
-    assert here == _records(tmp_path, False)
+    assert here == _records(tmp_path, False)[:-1]      # (the fresh process's last entry: hypothesis's samples)

@@ -4,11 +4,18 @@ A law of an operator is an evaluator ``law(op, sample) -> Outcome`` (:mod:`verim
 search evaluates it, in order, on
 
 1. ``examples`` NumPy draws from the distribution of :func:`verimono.checks.samples.law_samples`
-   (:func:`verimono.checks.sweep.law_draws`, seeded by the record's seed);
-2. a hypothesis search (:func:`~verimono.checks.samples.law_samples`) that starts from the simplest samples,
-   climbs toward violations through :func:`hypothesis.target` on the ratio and shrinks a failing sample —
-   with ``examples // HYPOTHESIS_SHARE`` examples when the draws found nothing, with all ``examples`` when
-   one broke the law (a draw hypothesis does not meet again is shrunk greedily);
+   (:func:`verimono.checks.sweep.law_draws`, seeded by the record's seed), then the simplest sample alone
+   (``x1 = x2 = 0``, ``λ = μ = ν = 1``, ``t = 0``) and :func:`~verimono.checks.sweep.edge_count` ``- 1`` more
+   **edge samples** (:func:`verimono.checks.sweep.edge_draws`): the kinds of points hypothesis's generate phase
+   contributed beyond the draws — its simplest example, identical points, hypothesis's extreme floats (the
+   smallest normals of float64 and float32, epsilons, tiny ``10^-307 … 10^-10``) and subnormals beside ordinary
+   entries, ``-0.0``, values next to the simple ones, coordinates of ``x2`` equal to ``x1``'s, tiny times —
+   drawn by NumPy from the seed, the same on every machine (``details["searched"]["edge_samples"]``);
+2. hypothesis (:func:`~verimono.checks.samples.law_samples`), only where its targeting and shrinking pay: when a
+   draw or an edge sample broke the law, a search of all ``examples`` that climbs toward violations through
+   :func:`hypothesis.target` on the ratio and shrinks a failing sample (a draw hypothesis does not meet again is
+   shrunk greedily), and above :data:`NUMPY_DIM` coordinates, where the points are NumPy recipes that hypothesis
+   draws (``details["searched"]["hypothesis_examples"]``); draws that found nothing go on to the sweep;
 3. the scale sweep (:mod:`verimono.checks.sweep`), points from ``10^-9`` to ``10^6``, on and just outside
    the boundary of the domain;
 4. the coordinate search (:mod:`verimono.checks.coordinates`): each coordinate of the worst sample — the
@@ -25,8 +32,10 @@ Every record says what was searched (``details["searched"]``: the range of ``|x|
 the largest gap between the sampled times, each coordinate's range and resolution, the samples evaluated in
 each input form).
 
-Hypothesis's engine costs about 1.7 ms per example here against about 0.02 ms per NumPy draw, and a
-vectorised evaluation about 7 µs per sample (one batched call) to 25 µs (one call per distinct step size).  One given
+Hypothesis's engine costs about 1.7 ms per example here (and ~0.7 ms to start a search) against about 0.02 ms per
+NumPy draw, and a vectorised evaluation about 7 µs per sample (one batched call) to 25 µs (one call per distinct
+step size): the edge samples replaced a search of ``max(HYPOTHESIS_MIN, examples // HYPOTHESIS_SHARE)`` hypothesis
+examples on every law (docs/speed.md, "Edge samples in place of hypothesis's generate phase").  One given
 ``sample=`` (a :class:`~verimono.checks.samples.Sample` or its dict from a counterexample) is evaluated
 alone instead: that is how a failure is replayed and how outer ``@given`` tests drive the laws.
 
@@ -81,7 +90,7 @@ from ..core import REGISTRY, Law, Outcome, classify, law, new_record, run, subje
 from .forms import CONTIGUOUS, cycled, form_note, form_search, forms_for, in_form
 from .samples import NUMPY_DIM, Sample, law_samples
 from .supremum import budget
-from .sweep import law_draws, shrink, sweep_count, sweep_samples
+from .sweep import edge_count, edge_draws, law_draws, shrink, sweep_count, sweep_samples
 
 #: examples per law when ``examples`` is not given and the run configuration's profile is not one of
 #: verimono's (a user's own); otherwise the profile's ``law_examples`` governs (:func:`default_examples`)
@@ -90,8 +99,10 @@ DEFAULT_EXAMPLES = 50
 BOUND = 1.0
 #: ratios handed to hypothesis.target are clipped to this (observations must be finite)
 TARGET_CAP = 1e12
-#: hypothesis searches with ``examples // HYPOTHESIS_SHARE`` examples (at least ``HYPOTHESIS_MIN``) after
-#: the NumPy draws found nothing, with all ``examples`` when a draw broke the law
+#: no longer used by the search (kept as public names): hypothesis searched ``max(HYPOTHESIS_MIN, examples //
+#: HYPOTHESIS_SHARE)`` examples after NumPy draws that found nothing; the edge samples
+#: (:func:`verimono.checks.engine.sweep.edge_draws`) cover what it contributed there, and hypothesis now runs
+#: (with all ``examples``) only when a draw broke the law, or above :data:`NUMPY_DIM` coordinates
 HYPOTHESIS_SHARE = 4
 HYPOTHESIS_MIN = 3
 #: the law that reports an operator whose resolvent raises on plain inputs (its statement: ``J_λ`` is
@@ -434,10 +445,19 @@ def _search(decl: Law, op: Any, seed: int, examples: int, horizon: float) -> tup
     try:
         with no_local_constants(), time_limit(current_budget(), f"{decl.name} on {subject_name(op)}"):
             if op.dim <= NUMPY_DIM:
-                drawn = state.first_violation(cycled(law_draws(op.dim, seed, horizon, examples, Sample), forms_for(op)))
-            full = drawn is not None or op.dim > NUMPY_DIM
-            _hypothesis_search(state, seed, horizon, examples if full else max(HYPOTHESIS_MIN,
-                                                                               examples // HYPOTHESIS_SHARE))
+                edges = edge_draws(op.dim, seed, horizon, edge_count(examples), Sample)
+                # in hypothesis's order: the draws, the simplest sample alone (the worst so far when it ties the
+                # ratio 0 that pairs x1 = x2 give: the coordinates start from its pair), the other edge samples
+                parts = (cycled(law_draws(op.dim, seed, horizon, examples, Sample), forms_for(op)), edges[:1], edges[1:])
+                for i, part in enumerate(parts):
+                    drawn = state.first_violation(part)
+                    if i:       # the edge samples searched (none when a draw broke the law)
+                        how["edge"] = how.get("edge", 0) + len(part)
+                    if drawn is not None or state.unsupported is not None:
+                        break
+            if drawn is not None or op.dim > NUMPY_DIM:     # hypothesis where it pays: its climb and its shrinking
+                how["hypothesis"] = examples
+                _hypothesis_search(state, seed, horizon, examples)
     except _Violation:
         pass
     except UnitTimeout as exc:
@@ -614,7 +634,8 @@ def _verdict(state: _Search, how: dict, base: dict, details: dict, cex_extra: di
 
 def run_law(decl: Law | str, op: Any, *, seed: int | None = None, examples: int | None = None,
             horizon: float = 1.0, sample: Sample | dict | None = None) -> CheckResult:
-    """One law on ``op``: NumPy draws, a hypothesis search and the scale sweep, or one given ``sample``.
+    """One law on ``op``: NumPy draws and edge samples (hypothesis after a violation), the scale sweep and the
+    coordinates, or one given ``sample``.
 
     ``seed`` makes the search reproducible (a fresh one is drawn and recorded when ``None``); ``examples``
     is the effort (default: the active profile's, :func:`default_examples`); times are sampled in
@@ -657,6 +678,9 @@ def run_law(decl: Law | str, op: Any, *, seed: int | None = None, examples: int 
                                           "coordinate": how.get("coordinate", 0),
                                           "searched": {**searched(state.xs, state.lams, state.ts, horizon,
                                                                   state.coordinates), "forms": dict(state.forms),
+                                                 **({"edge_samples": how["edge"]} if how.get("edge") else {}),
+                                                 **({"hypothesis_examples": how["hypothesis"]}
+                                                    if how.get("hypothesis") else {}),
                                                  **({"budget": state.budget_note} if state.budget_note else {})}},
                        {"seed": seed, "examples": examples, "horizon": horizon, "operator": repr(op)})
         rec.duration = time.perf_counter() - start
@@ -668,7 +692,7 @@ def run_law(decl: Law | str, op: Any, *, seed: int | None = None, examples: int 
     return rec
 
 
-#: what an operator law quantifies over unless it says otherwise: points (the draws, hypothesis, the sweep),
+#: what an operator law quantifies over unless it says otherwise: points (the draws, the edge samples, the sweep),
 #: the input's form and every coordinate of :func:`verimono.checks.engine.coordinates.coordinate_search`
 OPERATOR_DOMAIN = ("points", "form") + COORDINATES
 

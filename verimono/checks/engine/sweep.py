@@ -1,4 +1,5 @@
-"""The scale sweep: seeded samples at every scale, evaluated after the hypothesis search of each law.
+"""The scale sweep: seeded samples at every scale, evaluated after the draws and edge samples of each law
+(:func:`law_draws`, :func:`edge_draws`: NumPy's versions of what hypothesis's generate phase drew).
 
 Hypothesis draws points of moderate size and climbs toward large ratios; a bug confined to a thin region
 (a prox that crashes or takes a wrong branch only for ``|x| < 10^-6``, or only on the boundary of its
@@ -132,6 +133,80 @@ def law_draws(n: int, seed: int, horizon: float, count: int, make: Callable, sca
     return out
 
 
+#: hypothesis's own favourites that :func:`law_draws` does not draw (printed from its generate phase on the catalog at
+#: ci, docs/speed.md "Edge samples"): the smallest normal float64, float32's smallest normal and smallest subnormal,
+#: float64's machine epsilon, float16's epsilon and smallest normal — as coordinates beside ordinary ones
+EDGE_CONSTANTS = (2.2250738585072014e-308, 1.1754943508222875e-38, 1.401298464324817e-45, 2.220446049250313e-16,
+                  5.960464477539063e-08, 6.103515625e-05)
+#: hypothesis's values next to the simple ones (1 - 2^-53 is the float below 1), and the ends of the range
+EDGE_NEAR_SIMPLE = (1.9, 1.1, 1.5, 1.0 / 3.0, 0.99999, 1.001, 2.00001, 1.0 - 2.0 ** -53, 10.0)
+#: step sizes of the edge samples: the strategies' simple ones and hypothesis's values next to them
+EDGE_STEPS = _SIMPLE_STEPS + (0.99999, 1.001, 2.00001, 1.9, 1.5, 1.0 - 2.0 ** -53)
+#: times of the edge samples, as fractions of the horizon: both ends, the middle, hypothesis's tiny times
+#: (``10^-98``, ``2^-24``, ``2^-14``) and the float below the horizon
+EDGE_TIMES = (0.0, 1.0, 0.5, 1e-98, 5.960464477539063e-08, 6.103515625e-05, 1.0 - 2.0 ** -53)
+#: the coordinate kinds of an edge sample and how often each is drawn: ordinary uniform, an :data:`EDGE_CONSTANTS`,
+#: tiny ``±10^u`` (``u`` uniform in ``[-307, -10]``: hypothesis draws floats by exponent), subnormal, ``±0.0``,
+#: an :data:`EDGE_NEAR_SIMPLE`, a small integer
+EDGE_KINDS = (0.30, 0.15, 0.15, 0.08, 0.12, 0.12, 0.08)
+#: edge samples per law: at least this many, ``examples // 2`` when more
+EDGE_MIN = 16
+
+
+def edge_count(examples: int) -> int:
+    """How many edge samples :func:`edge_draws` makes for a law searched with ``examples`` draws."""
+    return max(EDGE_MIN, int(examples) // 2)
+
+
+def edge_draws(n: int, seed: int, horizon: float, count: int, make: Callable, scale: float = 10.0) -> list:
+    """``count`` samples of the kinds hypothesis's generate phase contributed beyond :func:`law_draws` (its
+    simplest example, its extreme floats beside ordinary entries, repeated values), drawn by NumPy in one pass
+    from ``default_rng(seed)`` (the same on every machine):
+
+    * the simplest sample, ``x1 = x2 = 0``, ``λ = μ = ν = 1``, ``t = 0`` (hypothesis's first example), and a
+      pair of identical points ``x1 = x2``;
+    * coordinates of ``x1`` of the kinds :data:`EDGE_KINDS` — ordinary ones in ``[-scale, scale]`` beside
+      :data:`EDGE_CONSTANTS`, tiny ``±10^u`` (``10^-307`` to ``10^-10``), subnormals, ``±0.0`` and
+      :data:`EDGE_NEAR_SIMPLE` (times ``scale / 10``);
+    * ``x2`` within ``10^-2`` of ``x1`` (half the samples), with half its offsets exactly 0 (coordinates equal
+      to ``x1``'s: repeated values), or drawn like ``x1``;
+    * step sizes from :data:`EDGE_STEPS` half the time (else log-uniform in ``[10^-3, 10]``), times from
+      :data:`EDGE_TIMES` (times ``horizon``) half the time (else uniform in ``[0, horizon]``)."""
+    count, n = int(count), int(n)
+    rng = np.random.default_rng([int(seed) % (2 ** 63), n, count, 2])
+    kinds = np.cumsum(EDGE_KINDS) / np.sum(EDGE_KINDS)
+
+    def points(size: float) -> np.ndarray:
+        shape = (count, n)
+        kind = np.searchsorted(kinds, rng.random(shape), side="right")
+        sign = np.where(rng.random(shape) < 0.5, -1.0, 1.0)
+        choices = [
+            rng.uniform(-size, size, shape),
+            sign * np.array(EDGE_CONSTANTS)[rng.integers(len(EDGE_CONSTANTS), size=shape)],
+            sign * 10.0 ** rng.uniform(-307.0, -10.0, shape),
+            sign * 5e-324 * rng.integers(1, 2 ** 52, size=shape).astype(float),     # k · 2^-1074: subnormal
+            sign * 0.0,
+            sign * np.array(EDGE_NEAR_SIMPLE)[rng.integers(len(EDGE_NEAR_SIMPLE), size=shape)] * (size / 10.0),
+            np.rint(rng.uniform(-size, size, shape)),
+        ]
+        return np.choose(np.minimum(kind, len(choices) - 1), choices)
+
+    x1 = points(scale)
+    near = rng.random(count) < 0.5
+    offset = np.where(rng.random((count, n)) < 0.5, 0.0, points(1e-2))
+    x2 = np.where(near[:, None], x1 + offset, points(scale))
+    steps = np.where(rng.random((count, 3)) < 0.5, np.array(EDGE_STEPS)[rng.integers(len(EDGE_STEPS), size=(count, 3))],
+                     10.0 ** rng.uniform(-3.0, 1.0, (count, 3)))
+    t = float(horizon) * np.where(rng.random(count) < 0.5, np.array(EDGE_TIMES)[rng.integers(len(EDGE_TIMES), size=count)],
+                                  rng.random(count))
+    if count:
+        x1[0], x2[0], steps[0], t[0] = 0.0, 0.0, 1.0, 0.0      # hypothesis's simplest example
+    if count > 1:
+        x2[1] = x1[1]                                          # identical points
+    return [make(x1[i].copy(), x2[i].copy(), float(steps[i, 0]), float(steps[i, 1]), float(steps[i, 2]), float(t[i]))
+            for i in range(count)]
+
+
 def _simpler_floats(v: float) -> list[float]:
     if v == 0.0:
         return []
@@ -182,4 +257,5 @@ def shrink(sample, fails: Callable[[object], bool], replace: Callable, budget: i
     return sample, calls
 
 
-__all__ = ["SCALES", "SWEEP_BY_PROFILE", "SWEEP_CAP", "sweep_count", "sweep_samples", "law_draws", "shrink"]
+__all__ = ["SCALES", "SWEEP_BY_PROFILE", "SWEEP_CAP", "sweep_count", "sweep_samples", "law_draws", "edge_draws",
+           "edge_count", "EDGE_MIN", "shrink"]
