@@ -34,7 +34,7 @@ each input form).
 
 Hypothesis's engine costs about 1.7 ms per example here (and ~0.7 ms to start a search) against about 0.02 ms per
 NumPy draw, and a vectorised evaluation about 7 µs per sample (one batched call) to 25 µs (one call per distinct
-step size): the edge samples replaced a search of ``max(HYPOTHESIS_MIN, examples // HYPOTHESIS_SHARE)`` hypothesis
+step size): the edge samples replaced a search of ``max(3, examples // 4)`` hypothesis
 examples on every law (docs/speed.md, "Edge samples in place of hypothesis's generate phase").  One given
 ``sample=`` (a :class:`~verimono.checks.samples.Sample` or its dict from a counterexample) is evaluated
 alone instead: that is how a failure is replayed and how outer ``@given`` tests drive the laws.
@@ -99,12 +99,6 @@ DEFAULT_EXAMPLES = 50
 BOUND = 1.0
 #: ratios handed to hypothesis.target are clipped to this (observations must be finite)
 TARGET_CAP = 1e12
-#: no longer used by the search (kept as public names): hypothesis searched ``max(HYPOTHESIS_MIN, examples //
-#: HYPOTHESIS_SHARE)`` examples after NumPy draws that found nothing; the edge samples
-#: (:func:`verimono.checks.engine.sweep.edge_draws`) cover what it contributed there, and hypothesis now runs
-#: (with all ``examples``) only when a draw broke the law, or above :data:`NUMPY_DIM` coordinates
-HYPOTHESIS_SHARE = 4
-HYPOTHESIS_MIN = 3
 #: the law that reports an operator whose resolvent raises on plain inputs (its statement: ``J_λ`` is
 #: defined on all of ``R^n``); every other law is then not evaluated, so the cause is reported once
 ROOT_LAW = "resolvent_single_valued"
@@ -706,4 +700,4 @@ def operator_law(name: str, label: str, *requires: Any, over: tuple = OPERATOR_D
 
 __all__ = ["run_law", "operator_law", "evaluate_sample", "root_cause", "bounded_root_cause", "fresh_seed", "default_examples",
            "positive_examples", "valid_seed", "valid_horizon", "DEFAULT_EXAMPLES", "BOUND", "ROOT_LAW",
-           "HARNESS_LIMIT", "HYPOTHESIS_SHARE", "HYPOTHESIS_MIN", "OPERATOR_DOMAIN"]
+           "HARNESS_LIMIT", "OPERATOR_DOMAIN"]
