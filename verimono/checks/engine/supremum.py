@@ -265,17 +265,19 @@ class _Evaluator:
                     vals[k] = -np.inf
         return vals
 
-    def table(self, xs: np.ndarray, table: np.ndarray) -> None:
-        """:meth:`note` of every row of ``table`` (the values of every family at ``xs``, known before: a design the
-        caller evaluated as one list), in order: the same points, counts and best (the first largest value)."""
+    def table(self, xs: np.ndarray, table: np.ndarray, which: Sequence[int] | None = None) -> None:
+        """:meth:`note` of every row of ``table`` (the values of the families ``which`` — every family when
+        ``None`` — at ``xs``, known before: a design the caller evaluated as one list), in one pass: the same
+        points, counts and best as noting row by row (the first largest value, in the order of the rows)."""
         unit = self.space.unit
         self.us += [unit(x) for x in xs.tolist()]
         self.evaluations += table.size
         if table.size:
             i = int(np.argmax(table))
             if table.flat[i] > self.best["value"]:
+                k = i % table.shape[1]
                 self.best.update(value=float(table.flat[i]), at=float(xs[i // table.shape[1]]),
-                                 family=i % table.shape[1])
+                                 family=k if which is None else int(which[k]))
 
     def many(self, xs: np.ndarray, which: Sequence[int], form: Callable) -> np.ndarray:
         """The values of the families ``which`` at every point of ``xs`` (a list known in advance: the coverage),
@@ -301,16 +303,7 @@ class _Evaluator:
         out = table.copy()
         for k in np.flatnonzero(redo).tolist():
             out[k] = self._some(float(xs[k]), which)
-        # noted in one pass: the same points and counts, and the best as noting row by row finds it (the first
-        # largest value, in the order of the rows)
-        unit = self.space.unit
-        self.us += [unit(x) for x in xs.tolist()]
-        self.evaluations += out.size
-        if out.size:
-            i = int(np.argmax(out))
-            if out.flat[i] > self.best["value"]:
-                self.best.update(value=float(out.flat[i]), at=float(xs[i // out.shape[1]]),
-                                 family=int(which[i % out.shape[1]]))
+        self.table(xs, out, which)
         return out
 
     def every(self, x: float) -> np.ndarray | None:
