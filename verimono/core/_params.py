@@ -47,6 +47,15 @@ class Param:
             return np.asarray(v)
         return real_array(v, f"{self.name}({t!r})")
 
+    def at_times(self, ts: np.ndarray) -> np.ndarray:
+        """The parameter at every time of ``ts`` (shape ``(B,)``): a constant as it is (it broadcasts against
+        the rows), a moving one stacked row by row, ``(B, *shape)``, each row the value of a call at that time
+        alone (the user's callable is called once per time, with a Python float: no callable is assumed to
+        map an array of times)."""
+        if self._fn is None:
+            return self._value
+        return np.array([self(t) for t in np.asarray(ts, dtype=float).tolist()], dtype=float)
+
     def describe(self) -> str:
         if self._fn is None:
             return np.array2string(self._value, precision=4, threshold=6)

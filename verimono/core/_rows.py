@@ -40,4 +40,15 @@ def _norm(x: np.ndarray) -> np.ndarray:
 _INF = math.inf
 
 
+def times_of(t, x: np.ndarray, who: str) -> np.ndarray | None:
+    """``t`` as a time per row of ``x`` when it is an array of shape ``(B,)`` (``x`` then ``(B, n)``), else
+    ``None`` (one time for every row: the ordinary call)."""
+    if type(t) is not np.ndarray or t.ndim != 1:
+        return None
+    if np.ndim(x) != 2 or np.shape(x)[0] != t.shape[0]:
+        from .errors import InvalidProblem
+        raise InvalidProblem(f"{who}: a time per row needs points of shape ({t.shape[0]}, n), got {np.shape(x)}")
+    return t.astype(float, copy=False)
+
+
 __all__ = ["dot_rows"]

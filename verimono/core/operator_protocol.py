@@ -95,6 +95,14 @@ class Operator:
         calls (the catalog's own resolvents do; a user's, or a subclass override, is not assumed to)."""
         return False
 
+    def _accepts_times(self) -> bool:
+        """Whether :meth:`resolvent`, :meth:`yosida`, :meth:`min_norm` and :meth:`project_domain` take ``t`` of
+        shape ``(B,)`` beside ``x`` of shape ``(B, n)`` — row ``i`` at time ``t[i]`` — bit-identically to ``B``
+        separate calls (the catalog's own members do; a user's operator, or a subclass override, is not assumed
+        to: the assumption laws then call it once per time).  ``min_norm`` raises :class:`OutsideDomain` when
+        any row is outside the domain at its time."""
+        return False
+
     def _kernel(self, x0: np.ndarray) -> Callable | None:
         """A fast ``step(x, lam, t) = J_λ x`` for float arrays shaped like ``x0``, or ``None``.
 
@@ -123,11 +131,30 @@ def resolvent_kernel(op: "Operator", x0: np.ndarray) -> Callable:
 
 def resolvent_rows(op: "Operator", X: np.ndarray, lam: float, t: float = 0.0) -> np.ndarray:
     """``J_λ`` of every row of ``X`` ``(B, n)``: one vectorized call when the operator's resolvent maps
-    batches row by row (the catalog's), else one call per row — the same values either way."""
+    batches row by row (the catalog's), else one call per row — the same values either way.  ``t`` of shape
+    ``(B,)``: row ``i`` at ``t[i]``, in one call when the operator declares it takes a time per row
+    (:meth:`Operator._accepts_times`), else one call per row."""
     X = np.asarray(X, dtype=float)
+    if type(t) is np.ndarray and t.ndim == 1:
+        if accepts_times(op):
+            return np.asarray(op.resolvent(X, lam, t), dtype=float)
+        return np.array([np.asarray(op.resolvent(x, lam, tt), dtype=float)
+                         for x, tt in zip(X, t.tolist())]).reshape(X.shape)
     if op._accepts_batches():
         return np.asarray(op.resolvent(X, lam, t), dtype=float)
     return np.array([np.asarray(op.resolvent(x, lam, t), dtype=float) for x in X]).reshape(X.shape)
+
+
+def accepts_times(op: Any) -> bool:
+    """Whether ``op`` declares that its members take a time per row (:meth:`Operator._accepts_times`); an
+    object that does not say does not (never found out by calling it and catching what it raises)."""
+    says = getattr(op, "_accepts_times", None)
+    return bool(says()) if callable(says) else False
+
+
+def per_row(fn: Callable, x: np.ndarray, ts: np.ndarray) -> np.ndarray:
+    """``fn(x_i, t_i)`` of every row, stacked: what a member that does not take a time per row is called as."""
+    return np.array([np.asarray(fn(xi, ti), dtype=float) for xi, ti in zip(x, ts.tolist())]).reshape(np.shape(x))
 
 
 def provides(op: Any, member: str) -> bool:

@@ -27,16 +27,43 @@ from typing import Any, Callable
 import numpy as np
 
 from ._params import as_param
-from ._rows import _INF, _TINY, _mx, _norm, _sqrt, dot_rows
+from ._rows import _INF, _TINY, _mx, _norm, _sqrt, dot_rows, times_of
 from ._validate import bad_lam, bad_param, batch_column, check_lam, real_array
 from .errors import InvalidProblem, NotMonotone, OutsideDomain
 from .tolerances import tolerance
-from .operator_protocol import Operator, operator_from_resolvent, provides, resolvent_kernel, resolvent_rows
+from .operator_protocol import (Operator, accepts_times, operator_from_resolvent, per_row, provides, resolvent_kernel,
+                                resolvent_rows)
 
 
 def _own(obj: Any, cls: type, member: str = "resolvent") -> bool:
     """Whether ``obj`` uses ``cls``'s own ``member`` (a subclass override disables the fast kernel)."""
     return getattr(type(obj), member) is getattr(cls, member)
+
+
+#: the members that take a time per row (:meth:`Operator._accepts_times`)
+_TIMED = ("resolvent", "yosida", "min_norm", "project_domain")
+
+
+def _own_times(obj: Any, cls: type) -> bool:
+    """``obj`` uses ``cls``'s own members that take a time per row (no subclass override of any)."""
+    return all(_own(obj, cls, m) for m in _TIMED)
+
+
+def _column(p: np.ndarray) -> np.ndarray:
+    """A value per row ``(B,)`` as a column ``(B, 1)``; a scalar, or rows ``(B, n)``, as they are."""
+    return p[:, None] if np.ndim(p) == 1 else p
+
+
+def _weight_times(param, ts: np.ndarray, owner: str, what: str) -> np.ndarray:
+    """:func:`_weight_at` at every time of ``ts`` (a constant as it is, checked at construction; a moving one a row
+    per time, each time where it is not ``≥ 0`` going through :func:`_weight_at`: its error)."""
+    if param.constant:
+        return param(0.0)
+    c = param.at_times(ts)
+    if not (c >= 0).all():
+        for t in ts.tolist():
+            _weight_at(param, t, owner, what)
+    return c
 
 
 def _scalar_fn(param) -> Callable[[float], float]:
@@ -132,6 +159,11 @@ class Linear(_EverywhereDefined):
 
     def resolvent(self, x, lam, t=0.0):
         x = real_array(x)
+        ts = times_of(t, x, self.name)
+        if ts is not None:
+            if not self.static or not self._accepts_times():     # M(t) per row: its own inverse each
+                return per_row(lambda xi, ti: self.resolvent(xi, lam, ti), x, ts)
+            t = 0.0
         W = self._inverse(check_lam(lam, f"{self.name}.resolvent"), t)
         if x.ndim == 1:
             return x @ W
@@ -141,6 +173,9 @@ class Linear(_EverywhereDefined):
 
     def _accepts_batches(self):
         return _own(self, Linear)
+
+    def _accepts_times(self):
+        return _own_times(self, Linear)
 
     def _kernel(self, x0):
         if not _own(self, Linear) or not self.static or x0.ndim != 1:
@@ -154,6 +189,13 @@ class Linear(_EverywhereDefined):
         return step
 
     def min_norm(self, x, t=0.0):
+        ts = times_of(t, x, self.name)
+        if ts is not None:
+            x = real_array(x)
+            if not self.static or not self._accepts_times():
+                return per_row(lambda xi, ti: self.min_norm(xi, ti), x, ts)
+            # a stack of (1, n) @ (n, n) products: each row exactly as the single point's x @ Mᵀ
+            return (x[:, None, :] @ self._M(0.0).T)[:, 0, :]
         return real_array(x) @ (self._M(t) if self.static else self._M_at(t)).T
 
     def growth(self, t=0.0):
@@ -212,18 +254,27 @@ class NormSubdifferential(_EverywhereDefined):
         return _weight_at(self._c, t, self.name, "c(t)")
 
     def _col(self, t, x):
-        """``c(t)`` shaped to broadcast against the norms ``(..., 1)`` of ``x`` (a batch ``(B,)`` per row)."""
+        """``c(t)`` shaped to broadcast against the norms ``(..., 1)`` of ``x`` (a batch ``(B,)`` per row; with
+        ``t`` of shape ``(B,)``, ``c(t[i])`` for row ``i``)."""
+        ts = times_of(t, x, self.name)
+        if ts is not None:
+            return _column(_weight_times(self._c, ts, self.name, "c(t)"))
         return batch_column(self._c_at(t), x, "c")
 
     def resolvent(self, x, lam, t=0.0):
         # J x = x max(|x| - λc, 0)/|x|, written so that x = 0 gives 0 without a 0/0
         lam = check_lam(lam, f"{self.name}.resolvent")
         x = real_array(x)
+        if type(t) is np.ndarray and not self._accepts_times():
+            return per_row(lambda xi, ti: self.resolvent(xi, lam, ti), x, times_of(t, x, self.name))
         nrm = _norm(x)
         return x * (_mx(nrm - lam * self._col(t, x), 0.0) / _mx(nrm, _TINY))
 
     def _accepts_batches(self):
         return _own(self, NormSubdifferential)
+
+    def _accepts_times(self):
+        return _own_times(self, NormSubdifferential) and self._c(0.0).ndim == 0
 
     def _kernel(self, x0):
         if not _own(self, NormSubdifferential) or x0.ndim != 1 or self._c(0.0).ndim:
@@ -250,6 +301,8 @@ class NormSubdifferential(_EverywhereDefined):
 
     def min_norm(self, x, t=0.0):
         x = np.asarray(x, dtype=float)
+        if type(t) is np.ndarray and not self._accepts_times():
+            return per_row(lambda xi, ti: self.min_norm(xi, ti), x, times_of(t, x, self.name))
         nrm = _norm(x)
         # 0 where |x| is 0 or underflows (x·x < tiny): F^0(0) = 0; the max only avoids a 0/0 warning
         return np.where(nrm > 0.0, self._col(t, x) * x / _mx(nrm, _TINY), 0.0)
@@ -287,10 +340,20 @@ class L1Subdifferential(_EverywhereDefined):
     def resolvent(self, x, lam, t=0.0):
         lam = check_lam(lam, f"{self.name}.resolvent")
         x = real_array(x)
-        return np.sign(x) * _mx(np.abs(x) - lam * _weight_at(self._c, t, self.name, "c(t)"), 0.0)
+        return np.sign(x) * _mx(np.abs(x) - lam * self._c_rows(t, x), 0.0)
+
+    def _c_rows(self, t, x):
+        """``c(t)``, or with ``t`` of shape ``(B,)`` ``c(t[i])`` for row ``i`` of ``x``."""
+        ts = times_of(t, x, self.name)
+        if ts is None:
+            return _weight_at(self._c, t, self.name, "c(t)")
+        return _column(_weight_times(self._c, ts, self.name, "c(t)"))
 
     def _accepts_batches(self):
         return _own(self, L1Subdifferential)
+
+    def _accepts_times(self):
+        return _own_times(self, L1Subdifferential)
 
     def _kernel(self, x0):
         if not _own(self, L1Subdifferential):
@@ -319,7 +382,7 @@ class L1Subdifferential(_EverywhereDefined):
 
     def min_norm(self, x, t=0.0):
         x = real_array(x)
-        return np.sign(x) * _weight_at(self._c, t, self.name, "c(t)")
+        return np.sign(x) * self._c_rows(t, x)
 
     def growth(self, t=0.0):
         """``|F^0(t, x)| ≤ |c(t)|`` (Euclidean norm of the weights) for every ``x``."""
@@ -355,10 +418,15 @@ class NormalCone(Operator):
 
     def resolvent(self, x, lam, t=0.0):
         check_lam(lam, f"{self.name}.resolvent")  # J_λ = proj for every λ > 0, and only for those
+        if type(t) is np.ndarray and not accepts_times(self.S):     # a set that takes one time per call
+            return per_row(self.S.project, np.asarray(x, dtype=float), times_of(t, x, self.name))
         return self.S.project(x, t)
 
     def _accepts_batches(self):
         return _own(self, NormalCone) and getattr(self.S, "_accepts_batches", lambda: False)()
+
+    def _accepts_times(self):
+        return _own_times(self, NormalCone) and accepts_times(self.S)
 
     def _kernel(self, x0):
         if not _own(self, NormalCone):
@@ -377,11 +445,21 @@ class NormalCone(Operator):
 
     def min_norm(self, x, t=0.0):
         x = np.asarray(x, dtype=float)
+        ts = times_of(t, x, self.name)
+        if ts is not None:      # every row at its own time: outside at any, the first named
+            inside = self.S.contains(x, ts) if accepts_times(self.S) else \
+                np.array([self.S.contains(xi, ti) for xi, ti in zip(x, ts.tolist())], dtype=bool)
+            if not np.all(inside):
+                i = int(np.argmin(inside))
+                raise OutsideDomain(f"x = {x[i]} is not in S(t={ts[i]!r}); N_S(x) is empty there")
+            return np.zeros_like(x)
         if not self.S.contains(x, t):
             raise OutsideDomain(f"x = {x} is not in S(t={t}); N_S(x) is empty there")
         return np.zeros_like(x)
 
     def project_domain(self, x, t=0.0):
+        if type(t) is np.ndarray and not accepts_times(self.S):
+            return per_row(self.S.project, np.asarray(x, dtype=float), times_of(t, x, self.name))
         return self.S.project(x, t)
 
     def contains(self, x, y, t=0.0, tol=None):
@@ -408,13 +486,28 @@ class Shifted(Operator):
     def Phi(self, t: float = 0.0) -> np.ndarray:
         return self._Phi(t)
 
+    def _shift(self, t, x):
+        """``Φ(t)``, or with ``t`` of shape ``(B,)`` the rows ``Φ(t[i])``."""
+        ts = times_of(t, x, self.name)
+        if ts is None:
+            return self._Phi(t)
+        if not self._accepts_times():
+            raise InvalidProblem(f"{self.name}: its operator does not take a time per row")
+        return self._Phi(0.0) if self._Phi.constant else self._Phi.at_times(ts)
+
     def resolvent(self, x, lam, t=0.0):
         lam = check_lam(lam, f"{self.name}.resolvent")
-        p = self._Phi(t)
-        return self.F.resolvent(real_array(x) + p, lam, t) - p
+        x = real_array(x)
+        if type(t) is np.ndarray and not self._accepts_times():
+            return per_row(lambda xi, ti: self.resolvent(xi, lam, ti), x, times_of(t, x, self.name))
+        p = self._shift(t, x)
+        return self.F.resolvent(x + p, lam, t) - p
 
     def _accepts_batches(self):
         return _own(self, Shifted) and self.F._accepts_batches()
+
+    def _accepts_times(self):
+        return _own_times(self, Shifted) and accepts_times(self.F) and np.ndim(self._Phi(0.0)) <= 1
 
     def _kernel(self, x0):
         if not _own(self, Shifted):
@@ -437,11 +530,17 @@ class Shifted(Operator):
         return Operator.provides(self, member) and provides(self.F, member)
 
     def min_norm(self, x, t=0.0):
-        return self.F.min_norm(np.asarray(x, dtype=float) + self._Phi(t), t)
+        x = np.asarray(x, dtype=float)
+        if type(t) is np.ndarray and not self._accepts_times():
+            return per_row(lambda xi, ti: self.min_norm(xi, ti), x, times_of(t, x, self.name))
+        return self.F.min_norm(x + self._shift(t, x), t)
 
     def project_domain(self, x, t=0.0):
-        p = self._Phi(t)
-        return self.F.project_domain(np.asarray(x, dtype=float) + p, t) - p
+        x = np.asarray(x, dtype=float)
+        if type(t) is np.ndarray and not self._accepts_times():
+            return per_row(lambda xi, ti: self.project_domain(xi, ti), x, times_of(t, x, self.name))
+        p = self._shift(t, x)
+        return self.F.project_domain(x + p, t) - p
 
     def contains(self, x, y, t=0.0, tol=None):
         p = self._Phi(t)
@@ -473,8 +572,23 @@ class LogBarrier(Operator):
             raise bad_param(self.name, "c(t)", c, t, "must be > 0")
         return c
 
+    def _c_rows(self, t, x):
+        """``c(t)``, or with ``t`` of shape ``(B,)`` ``c(t[i])`` for row ``i`` of ``x`` (each checked as
+        :meth:`_c_at` checks it)."""
+        ts = times_of(t, x, self.name)
+        if ts is None:
+            return self._c_at(t)
+        if self._c.constant:
+            return self._c(0.0)
+        c = self._c.at_times(ts)
+        if not np.all(c > 0):
+            for tt in ts.tolist():
+                self._c_at(tt)
+        return _column(c)
+
     def resolvent(self, x, lam, t=0.0):
-        return self._resolve(real_array(x), check_lam(lam, f"{self.name}.resolvent"), self._c_at(t))
+        x = real_array(x)
+        return self._resolve(x, check_lam(lam, f"{self.name}.resolvent"), self._c_rows(t, x))
 
     @staticmethod
     def _resolve(x, lam, c):
@@ -486,6 +600,9 @@ class LogBarrier(Operator):
 
     def _accepts_batches(self):
         return _own(self, LogBarrier)
+
+    def _accepts_times(self):
+        return _own_times(self, LogBarrier)
 
     def _kernel(self, x0):
         if not _own(self, LogBarrier):
@@ -511,7 +628,8 @@ class LogBarrier(Operator):
         x = np.asarray(x, dtype=float)
         if np.any(x <= 0.0):
             raise OutsideDomain(f"LogBarrier is defined on (0, ∞)^n; got x = {x}")
-        return -self._c(t) / x
+        ts = times_of(t, x, self.name)
+        return -(self._c(t) if ts is None else self._c(0.0) if self._c.constant else _column(self._c.at_times(ts))) / x
 
     def project_domain(self, x, t=0.0):
         return np.maximum(np.asarray(x, dtype=float), 0.0)

@@ -8,6 +8,12 @@ Batches of sets: ``Ball(center, radius)`` with ``center`` of shape ``(B, n)`` an
 ``(B,)``, and ``Box(lower, upper)`` with bounds of shape ``(B, n)``, are ``B`` sets projecting the rows of
 a ``(B, n)`` batch of points one each (one vectorized call).
 
+Times per row: a catalog set whose :meth:`ConvexSet._accepts_times` says so takes ``t`` of shape ``(B,)`` beside
+``x`` of shape ``(B, n)`` in ``project`` and ``contains`` — row ``i`` at time ``t[i]``, bit-identical to ``B``
+separate calls (its moving parameters are called once per time; the arithmetic runs over all rows at once).
+``contains`` then answers per row, an array of ``B`` booleans.  The assumption laws' time designs use it
+(:mod:`verimono.checks.assumption_samples`); a set that does not declare it is called once per time.
+
 Performance: projections are written without ``np.errstate`` and with inner products by the BLAS
 ``dot`` of each row (:func:`verimono.core.operators.dot_rows`), so a batch ``(B, n)`` and its rows one by one
 give identical bits;
@@ -22,10 +28,10 @@ from typing import Any, Callable
 import numpy as np
 
 from ._params import as_param
-from ._rows import _INF, _TINY, _mn, _mx, _sqrt, dot_rows
+from ._rows import _INF, _TINY, _mn, _mx, _sqrt, dot_rows, times_of
 from ._validate import bad_lam, bad_param, batch_column, finite_point, real_array
 from .errors import InvalidProblem
-from .tolerances import tolerance
+from .tolerances import row_tolerances, tolerance
 
 
 class ConvexSet:
@@ -42,14 +48,28 @@ class ConvexSet:
         raise NotImplementedError
 
     def contains(self, x: np.ndarray, t: float = 0.0, tol: float | None = None) -> bool:
-        """Whether ``x ∈ S(t)`` up to ``tol`` (default scaled to ``|x|``)."""
+        """Whether ``x ∈ S(t)`` up to ``tol`` (default scaled to ``|x|``).  With ``t`` of shape ``(B,)`` and
+        ``x`` of shape ``(B, n)``: whether each row lies in ``S(t[i])`` (default tolerance of each row), an
+        array of ``B`` booleans, as ``B`` separate calls answer."""
         x = np.asarray(x, dtype=float)
+        ts = times_of(t, x, self.name)
+        if ts is not None:
+            if not self._accepts_times():
+                return np.array([self.contains(xi, ti, tol) for xi, ti in zip(x, ts.tolist())], dtype=bool)
+            tol = row_tolerances(x) if tol is None else tol
+            return np.max(np.abs(self.project(x, ts) - x), axis=-1, initial=0.0) <= tol
         tol = tolerance(x) if tol is None else tol
         return bool(np.max(np.abs(self.project(x, t) - x), initial=0.0) <= tol)
 
     def _accepts_batches(self) -> bool:
         """Whether :meth:`project` maps a batch ``(B, n)`` row by row, bit-identically (the catalog sets'
         own projections do; a user's set or override is not assumed to)."""
+        return False
+
+    def _accepts_times(self) -> bool:
+        """Whether :meth:`project` and :meth:`contains` take ``t`` of shape ``(B,)`` beside ``x`` of shape
+        ``(B, n)``, row ``i`` at ``t[i]``, bit-identically to ``B`` separate calls (the catalog sets' own members
+        do, unless they are a batch of sets; a user's set or override is not assumed to)."""
         return False
 
     def _kernel(self, x0: np.ndarray) -> Callable | None:
@@ -75,6 +95,21 @@ def _all_static(*params) -> bool:
 
 def _own(obj: Any, cls: type) -> bool:
     return type(obj).project is cls.project
+
+
+def _own_times(obj: Any, cls: type) -> bool:
+    """``obj`` uses ``cls``'s own ``project`` and ``contains`` (those that take a time per row)."""
+    return type(obj).project is cls.project and type(obj).contains is cls.contains
+
+
+def _at_times(param, ts: np.ndarray) -> np.ndarray:
+    """``param`` at every time of ``ts``: a constant as it is, a moving one ``(B, *shape)``, a row per time."""
+    return param(0.0) if param.constant else param.at_times(ts)
+
+
+def _column(p: np.ndarray) -> np.ndarray:
+    """A value per row ``(B,)`` as a column ``(B, 1)``; a scalar as it is."""
+    return p[:, None] if np.ndim(p) else p
 
 
 def _fast(param) -> Callable[[float], np.ndarray]:
@@ -120,6 +155,9 @@ class Ball(ConvexSet):
     def _accepts_batches(self):
         return _own(self, Ball)
 
+    def _accepts_times(self):
+        return _own_times(self, Ball) and self._c(0.0).ndim <= 1 and self._r(0.0).ndim == 0
+
     def _radius_at(self, t):
         """``radius(t)``, checked ``≥ 0`` (a nonempty ball) at this ``t`` when it moves; a radius below 0 by
         round-off (:func:`_past_roundoff`) is 0, the ball its centre."""
@@ -131,23 +169,40 @@ class Ball(ConvexSet):
         return r
 
     def project(self, x, t=0.0):
-        return self._project(finite_point(x, f"the point projected onto {self.name}"), t)
+        x = finite_point(x, f"the point projected onto {self.name}")
+        ts = times_of(t, x, self.name)
+        if ts is not None:
+            if not self._accepts_times():
+                return np.array([self.project(xi, ti) for xi, ti in zip(x, ts.tolist())]).reshape(x.shape)
+            return self._project(x, ts, times=True)
+        return self._project(x, t)
 
-    def _project(self, x, t):
-        """:meth:`project` of a finite float array (the solve loop checks finiteness per block instead)."""
+    def _project(self, x, t, times=False):
+        """:meth:`project` of a finite float array (the solve loop checks finiteness per block instead);
+        ``times``: ``t`` has a time per row of ``x`` (the same operations on each row)."""
         # points inside are returned unchanged (not as c + (x - c), which may differ in the last bit)
-        c = self._c(t)
+        c = _at_times(self._c, t) if times else self._c(t)
         d = x - c
         with np.errstate(over="ignore"):
             nrm = np.sqrt(dot_rows(d, d))[..., None]
         if np.isinf(nrm).any():          # |d| beyond 1.3e154: d·d overflows; the norm itself does not
             nrm = np.where(np.isinf(nrm), _scaled_norm(d), nrm)
-        r = batch_column(self._radius_at(t), x, "radius")
+        r = _column(self._radius_times(t)) if times else batch_column(self._radius_at(t), x, "radius")
         outside = nrm > r
         if not outside.any():  # the common case along a trajectory: nothing to project
             return x.copy()
         # where nrm > r (>= 0) the divisor is nrm; elsewhere it keeps r/divisor <= 1 (no inf*0 warnings)
         return np.where(outside, c + d * (r / _mx(nrm, _mx(r, _TINY))), x)
+
+    def _radius_times(self, ts):
+        """``radius`` at every time of ``ts`` (``(B,)``; a constant as it is), each checked as :meth:`_radius_at`
+        checks it (a time where it is below 0 goes through :meth:`_radius_at`: its error, or its round-off 0)."""
+        if self._r.constant:
+            return self._r(0.0)
+        r = self._r.at_times(ts)
+        if not np.all(r >= 0):
+            r = np.array([self._radius_at(t) for t in ts.tolist()], dtype=float)
+        return r
 
     def _kernel(self, x0):
         if not _own(self, Ball):
@@ -219,6 +274,9 @@ class Box(ConvexSet):
     def _accepts_batches(self):
         return _own(self, Box)
 
+    def _accepts_times(self):
+        return _own_times(self, Box) and np.ndim(self._lo(0.0)) <= 1 and np.ndim(self._hi(0.0)) <= 1
+
     def _bounds_at(self, t):
         """``(lower(t), upper(t))``, checked ``lower ≤ upper`` (a nonempty box) at this ``t`` when they move;
         bounds crossed by round-off (:func:`_past_roundoff`) are the point between them."""
@@ -234,8 +292,25 @@ class Box(ConvexSet):
         return lo, hi
 
     def project(self, x, t=0.0):
+        x = finite_point(x, f"the point projected onto {self.name}")
+        ts = times_of(t, x, self.name)
+        if ts is not None:
+            if not self._accepts_times():
+                return np.array([self.project(xi, ti) for xi, ti in zip(x, ts.tolist())]).reshape(x.shape)
+            lo, hi = self._bounds_times(ts)
+            return _mn(_mx(x, lo), hi)
         lo, hi = self._bounds_at(t)
-        return _mn(_mx(finite_point(x, f"the point projected onto {self.name}"), lo), hi)
+        return _mn(_mx(x, lo), hi)
+
+    def _bounds_times(self, ts):
+        """``(lower, upper)`` at every time of ``ts`` (rows ``(B, n)``; constants as they are), checked as
+        :meth:`_bounds_at` checks them (a time where they cross goes through it: its error or its midpoint)."""
+        lo, hi = _at_times(self._lo, ts), _at_times(self._hi, ts)
+        if not self.static and not np.all(lo <= hi):
+            pairs = [self._bounds_at(t) for t in ts.tolist()]
+            lo = np.array([np.broadcast_to(a, (self.dim,)) for a, _ in pairs], dtype=float)
+            hi = np.array([np.broadcast_to(b, (self.dim,)) for _, b in pairs], dtype=float)
+        return lo, hi
 
     def _kernel(self, x0):
         if not _own(self, Box):
@@ -296,6 +371,9 @@ class HalfSpace(ConvexSet):
     def _accepts_batches(self):
         return _own(self, HalfSpace)
 
+    def _accepts_times(self):
+        return _own_times(self, HalfSpace) and np.ndim(self._a(0.0)) == 1 and np.ndim(self._b(0.0)) == 0
+
     def _normal_at(self, t):
         a = self._a(t)
         if not self._a.constant and not (np.isfinite(a).all() and a.dot(a) > 0.0):
@@ -305,6 +383,21 @@ class HalfSpace(ConvexSet):
     def project(self, x, t=0.0):
         # inner products row by row (dot_rows, not x @ a): the same summation for a point and a batch row
         x = finite_point(x, f"the point projected onto {self.name}")
+        ts = times_of(t, x, self.name)
+        if ts is not None:
+            if not self._accepts_times():
+                return np.array([self.project(xi, ti) for xi, ti in zip(x, ts.tolist())]).reshape(x.shape)
+            a, b = _at_times(self._a, ts), _column(_at_times(self._b, ts))
+            if a.ndim == 1:
+                aa = a.dot(a)
+            else:      # moving: each row's a(t) checked as _normal_at checks it, aa the BLAS dot of each row
+                aa = dot_rows(a, a)
+                if not (np.isfinite(a).all() and np.all(aa > 0.0)):
+                    for ti in ts.tolist():
+                        self._normal_at(ti)
+                aa = aa[:, None]
+            excess = _mx(dot_rows(x, a)[..., None] - b, 0.0) / aa
+            return x - excess * a
         a, b = self._normal_at(t), self._b(t)
         excess = _mx(dot_rows(x, a)[..., None] - b, 0.0) / a.dot(a)
         return x - excess * a
@@ -365,6 +458,9 @@ class Polyhedron(ConvexSet):
 
     def contains(self, x, t=0.0, tol=None):
         x = np.asarray(x, dtype=float)
+        ts = times_of(t, x, self.name)
+        if ts is not None:      # one row at a time (its data at its time): the same as separate calls
+            return np.array([self.contains(xi, ti, tol) for xi, ti in zip(x, ts.tolist())], dtype=bool)
         G, h, A, b = self.data(t)
         tol = tolerance(x, h) if tol is None else tol
         ok = np.all(x @ G.T <= h + tol)
@@ -383,6 +479,9 @@ class Polyhedron(ConvexSet):
     def _accepts_batches(self):
         return _own(self, Polyhedron)
 
+    def _accepts_times(self):
+        return _own_times(self, Polyhedron)
+
     def project(self, x, t=0.0):
         """Points inside are returned as they are; the others by a KKT-verified QP each.
 
@@ -392,6 +491,9 @@ class Polyhedron(ConvexSet):
         from .qp import solve_qp
 
         x = finite_point(x, f"the point projected onto {self.name}")
+        ts = times_of(t, x, self.name)
+        if ts is not None:      # one row at a time (its data at its time): the same as separate calls
+            return np.array([self.project(xi, ti) for xi, ti in zip(x, ts.tolist())]).reshape(x.shape)
         G, h, A, b = self.data(t)
         inside = self._inside(x, G, h, A, b)
         if x.ndim == 1:
@@ -422,9 +524,20 @@ class Translated(ConvexSet):
     def _accepts_batches(self):
         return _own(self, Translated) and self.S._accepts_batches()
 
+    def _accepts_times(self):
+        return (_own_times(self, Translated) and bool(getattr(self.S, "_accepts_times", lambda: False)())
+                and np.ndim(self._c(0.0)) <= 1)
+
     def project(self, x, t=0.0):
+        x = np.asarray(x, dtype=float)
+        ts = times_of(t, x, self.name)
+        if ts is not None:
+            if not self._accepts_times():
+                return np.array([self.project(xi, ti) for xi, ti in zip(x, ts.tolist())]).reshape(x.shape)
+            c = _at_times(self._c, ts)
+            return self.S.project(x - c, ts) + c
         c = self._c(t)
-        return self.S.project(np.asarray(x, dtype=float) - c, t) + c
+        return self.S.project(x - c, t) + c
 
     def _kernel(self, x0):
         if not _own(self, Translated):
