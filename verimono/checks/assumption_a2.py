@@ -36,7 +36,8 @@ from ..core.errors import UnverifiedSolution
 from ..core.operators import resolvent_rows
 from ..core.tolerances import tolerance
 from ..records.results import UNDECIDED
-from .assumption_samples import A2_LAMBDAS, EVIDENCE, run_assumption, sampled
+from ..core.operator_protocol import accepts_times
+from .assumption_samples import A2_LAMBDAS, EVIDENCE, on_times, run_assumption, sampled
 from .core import Outcome, law
 from .jumps import jump_time
 from .engine.supremum import zoom
@@ -189,10 +190,13 @@ def _fastest(S, lam: float) -> tuple[list[float], int, dict]:
         return speed(t, list(range(len(P))) if which is None else list(which), A2_SPEED_STEP * T)
 
     def many(ts: np.ndarray, which) -> np.ndarray:
-        """``values(t, which)`` at every time of ``ts``: the subject's calls as :func:`speed` makes them, the
-        norms over all times at once (a time whose resolvent verimono's own solver cannot verify is NaN: the
+        """``values(t, which)`` at every time of ``ts``: the subject's calls as :func:`speed` makes them (all times
+        in one call when the operator takes a time per row), the norms over all times at once (a time whose resolvent verimono's own solver cannot verify is NaN: the
         engine evaluates it again with ``values``)."""
         rows, eps = list(which), A2_SPEED_STEP * T
+        if accepts_times(S.op):     # every time in one call, each row as a separate call gives it
+            D = on_times(S.op, P[rows], lam, np.minimum(ts + eps, T)) - on_times(S.op, P[rows], lam, ts)
+            return np.linalg.norm(D, axis=2) / size[rows]
         D = np.full((len(ts), len(rows), P.shape[1]), np.nan)
         for k, t in enumerate(ts.tolist()):
             try:

@@ -30,11 +30,14 @@ from typing import Any
 
 import numpy as np
 
-from ..core.errors import UnverifiedSolution
+from ..core.errors import OutsideDomain, UnverifiedSolution
 from ..core.operators import resolvent_rows
 from ..core.tolerances import GROWTH_FLAG, current_rtol, STALL_RATIO, STALL_WINDOW, quotient_tolerance, tolerance
 from ..records.results import FAILED, PASSED, SKIPPED
-from .assumption_samples import EVIDENCE, f0_norm, growth, min_norm_or_none, run_assumption, sampled
+from ..core.operator_protocol import accepts_times
+from ..core.tolerances import row_tolerances
+from .assumption_samples import (EVIDENCE, f0_norm, f0_norms, growth, min_norm_or_none, norms, on_times,
+                                 run_assumption, sampled)
 from .core import Outcome, law
 from .jumps import find_jumps, jump_time
 from .engine.supremum import Sup
@@ -143,6 +146,14 @@ def _phi_ratio(dist: float, phi_s: float, phi_t: float) -> float:
     return float(r)
 
 
+def _phi_ratios(dist: np.ndarray, phi_s: np.ndarray, phi_t: np.ndarray) -> np.ndarray:
+    """:func:`_phi_ratio` of every element (the same operations, elementwise)."""
+    rhs, rtol = phi_t - phi_s, current_rtol()
+    big = np.maximum(np.abs(phi_s), np.abs(phi_t))
+    r = dist / (np.maximum(rhs, 0.0) + rtol * (1.0 + np.maximum(np.abs(dist), big)))
+    return np.where(rhs < -rtol * (1.0 + big), np.maximum(r, 2.0), r)
+
+
 def _phi_sup(S, off: np.ndarray) -> tuple[Sup, dict]:
     """The stated φ against the domain motion on every window ``[s, s + w]``, ``w ∈`` :data:`A3_WINDOWS`
     ``·T``, searched over ``s`` (:func:`verimono.checks.engine.times.search_time`; families: the window's
@@ -179,8 +190,30 @@ def _phi_sup(S, off: np.ndarray) -> tuple[Sup, dict]:
     # ties (a φ never approached at the design times) broken toward the points farthest from the domain,
     # whose projections move with it (the exposed boundary points first), the shortest windows first
     rank = np.concatenate([np.r_[off, np.full(len(dirs), 1e300)] + k for k in range(len(widths))])
-    # the coverage: every time's ratio by :func:`one`, without the engine's bookkeeping per time
-    values.many = lambda ss, which: np.array([[one(f, s) for f in which] for s in ss.tolist()])  # type: ignore
+    def many(ss: np.ndarray, which) -> np.ndarray:
+        """:func:`one` at every time of ``ss``: each window's two projections of every time in one call (an
+        operator that takes a time per row: each row as a separate call gives it), φ once per time, the ratio's
+        operations elementwise."""
+        out = np.full((len(ss), len(which)), -np.inf)
+        phi_s = np.array([float(phi(s)) for s in ss.tolist()])
+        for k, f in enumerate(which):
+            wi, pi = divmod(int(f), nP)
+            w = widths[wi]
+            ok = ss + w <= T
+            if not ok.any():
+                continue
+            s_ok = ss[ok]
+            t_ok = np.minimum(s_ok + w, T)
+            Z = np.asarray(op.project_domain(np.tile(P[pi], (len(s_ok), 1)), s_ok), dtype=float)
+            Q = np.asarray(op.project_domain(Z, t_ok), dtype=float)
+            pt = np.array([float(phi(t)) for t in t_ok.tolist()])
+            out[ok, k] = _phi_ratios(norms(Z - Q), phi_s[ok], pt)
+        return out
+
+    if accepts_times(op):
+        values.many = many      # type: ignore[attr-defined]
+    else:   # the coverage: every time's ratio by :func:`one`, without the engine's bookkeeping per time
+        values.many = lambda ss, which: np.array([[one(f, s) for f in which] for s in ss.tolist()])  # type: ignore
     values.many.own = True      # type: ignore[attr-defined]  # the law's own ratio: nothing to evaluate again
     sup = search_time(values, 0.0, hi, design=S.design(0.0, hi), seed=S.seed, rank=rank,
                       bounds=lambda f: (0.0, T - widths[int(f) // nP]))
@@ -332,6 +365,17 @@ def _sigma_ratio(S, z: np.ndarray, t: float) -> tuple[float, dict | None]:
     return val / (rhs + tol), {"t": t, "z": z, "F0_norm": val, "sigma_t": sig}
 
 
+def _sigma_ratios(S, Z: np.ndarray, ts: np.ndarray) -> np.ndarray:
+    """:func:`_sigma_ratio` of every row ``z_i`` at ``t_i`` (the same operations elementwise; σ once per time)."""
+    val = f0_norms(S.op, Z, ts, 1e-6 * S.T)
+    sig = np.array([float(S.problem.sigma(t)) for t in ts.tolist()])
+    rhs = sig * (1.0 + norms(Z))
+    tol = current_rtol() * (1.0 + np.maximum(np.abs(rhs), np.abs(val)))
+    with np.errstate(invalid="ignore"):
+        r = val / (rhs + tol)
+    return np.where(np.isnan(val), -np.inf, r)
+
+
 def _sigma_sup(S) -> tuple[Sup, dict]:
     """The stated σ against ``|F^0(t, z)|/(1 + |z|)`` searched over ``t`` (families: the sampled ``z =
     J_λ(t) p``, one per point ``p`` around ``x0`` and step ``λ``)."""
@@ -346,8 +390,19 @@ def _sigma_sup(S) -> tuple[Sup, dict]:
             out.append(_sigma_ratio(S, resolvent_rows(op, P[pi:pi + 1], lams[li], t)[0], t)[0])
         return np.array(out)
 
-    # the coverage: every time's ratio as ``values`` computes it, without the engine's bookkeeping per time
-    values.many = lambda ts, which: np.array([values(t, which) for t in ts.tolist()])   # type: ignore
+    def many(ts: np.ndarray, which) -> np.ndarray:
+        """``values(t, which)`` at every time of ``ts``: each family's resolvents at every time in one call (an
+        operator that takes a time per row), then :func:`_sigma_ratios`."""
+        out = np.empty((len(ts), len(which)))
+        for k, f in enumerate(which):
+            li, pi = divmod(int(f), len(P))
+            out[:, k] = _sigma_ratios(S, on_times(op, P[pi:pi + 1], lams[li], ts)[:, 0], ts)
+        return out
+
+    if accepts_times(op):
+        values.many = many      # type: ignore[attr-defined]
+    else:   # the coverage: every time's ratio as ``values`` computes it, without the engine's bookkeeping per time
+        values.many = lambda ts, which: np.array([values(t, which) for t in ts.tolist()])   # type: ignore
     values.many.own = True      # type: ignore[attr-defined]
     sup = search_time(values, 0.0, S.T, design=S.design(), seed=S.seed)
     li, pi = divmod(sup.family, len(P))
@@ -453,6 +508,24 @@ def _rays(S, t: float):
         rays_s = [(rays_t[f][0], rays_t[f][1], d) for f in fams for d in dists]
         X = np.array([c + d * u for c, u, d in rays_s])
         out = np.empty((len(ts), len(fams)))
+        if accepts_times(op):       # every time in one call of each member, each row as a separate call gives it
+            Z = on_times(op, X, lam, ts)                              # (times, rays, n)
+            tt = np.repeat(ts, len(rays_s))
+            Zf = Z.reshape(-1, Z.shape[2])
+            ok = np.isfinite(Zf).all(axis=1)
+            if sigma is not None:
+                q = np.full(len(Zf), -np.inf)
+                q[ok] = _sigma_ratios(S, Zf[ok], tt[ok])
+                return q.reshape(len(ts), len(rays_s))
+            val = np.full(len(Zf), np.nan)
+            val[ok] = f0_norms(op, Zf[ok], tt[ok], 1e-6 * T)
+            with np.errstate(invalid="ignore"):
+                rho = np.where(np.isnan(val), -np.inf, val / (1.0 + norms(Zf)))    # raw(z, t)
+            a, b = rho.reshape(len(ts), len(fams), 2)[..., 0], rho.reshape(len(ts), len(fams), 2)[..., 1]
+            pair = ok.reshape(len(ts), len(fams), 2).all(axis=2)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                g = np.where((a > 1e-9) & np.isfinite(b), b / a, 1.0)
+            return np.where(pair, g, -np.inf)
         for k, tt in enumerate(ts.tolist()):
             try:
                 Z = resolvent_rows(op, X, lam, tt)
@@ -572,9 +645,46 @@ def _theta_sup(S, key: str) -> tuple[Sup, dict]:
                 out.append(increments(s, lam, z, f0)[0] if ok else -np.inf)
         return np.array(out)
 
+    def many(ss: np.ndarray, which) -> np.ndarray:
+        """:func:`one` at every time of ``ss``: each member's rows at every time in one call (an operator that
+        takes a time per row: each row as a separate call gives it), θ once per time, the increments' operations
+        elementwise."""
+        out = np.full((len(ss), len(which)), -np.inf)
+        for k, f in enumerate(which):
+            li, pi = divmod(int(f), nP)
+            lam = lams[li]
+            ok = ss + lam <= T + 1e-12
+            if not ok.any():
+                continue
+            s_ok = ss[ok]
+            Z = on_times(op, P[pi:pi + 1], 0.1 * T, s_ok)[:, 0]
+            y_next = norms(np.asarray(op.yosida(Z, lam, s_ok + lam), dtype=float))
+            if key == "YB":
+                f0 = f0_norms_or_nan(Z, s_ok)
+                d = y_next - f0
+            else:
+                d = y_next - norms(np.asarray(op.yosida(Z, lam, s_ok), dtype=float))
+            th = np.array([float(theta(s + lam)) - float(theta(s)) for s in s_ok.tolist()])
+            with np.errstate(invalid="ignore"):
+                q = np.where(d > 0, d / (np.maximum(th, 0.0) + row_tolerances(Z) / float(lam)), 0.0)
+            if key == "YB":
+                q = np.where(np.isnan(f0), -np.inf, q)
+            out[ok, k] = q
+        return out
+
+    def f0_norms_or_nan(Z: np.ndarray, ss: np.ndarray) -> np.ndarray:
+        """``|F^0(s_i, z_i)|`` of every row, NaN where :func:`f0_of` is ``None``."""
+        try:
+            return norms(np.asarray(op.min_norm(Z, ss), dtype=float))
+        except (OutsideDomain, UnverifiedSolution):
+            vals = [f0_of(z, s) for z, s in zip(Z, ss.tolist())]
+            return np.array([np.nan if v is None else v for v in vals], dtype=float)
+
     hi = T - min(lams)
-    # the coverage: every time's ratio by :func:`one`, without the engine's bookkeeping per time
-    values.many = lambda ss, which: np.array([[one(f, s)[0] for f in which] for s in ss.tolist()])  # type: ignore
+    if accepts_times(op):
+        values.many = many      # type: ignore[attr-defined]
+    else:   # the coverage: every time's ratio by :func:`one`, without the engine's bookkeeping per time
+        values.many = lambda ss, which: np.array([[one(f, s)[0] for f in which] for s in ss.tolist()])  # type: ignore
     values.many.own = True      # type: ignore[attr-defined]
     sup = search_time(values, 0.0, hi, design=S.design(0.0, hi), seed=S.seed,
                       bounds=lambda f: (0.0, T - lams[f // nP]))

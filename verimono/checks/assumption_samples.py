@@ -24,7 +24,8 @@ from typing import Any, Callable
 import numpy as np
 
 from ..core.errors import OutsideDomain, UnverifiedSolution
-from ..core.operators import resolvent_rows
+from ..core.operator_protocol import accepts_times
+from ..core.operators import dot_rows, resolvent_rows
 from ..core.problem import Problem
 from ..core.tolerances import GROWTH_FLAG
 from ..execution.timeouts import note_progress
@@ -90,6 +91,15 @@ class _Samples:
                 except UnverifiedSolution:
                     self.unverified += 1
             return out
+
+    def rows_at_times(self, P: np.ndarray, lam: float, ts: np.ndarray) -> np.ndarray:
+        """``J_λ(t) p`` of every row ``p`` of ``P`` at every time of ``ts``, ``(len(ts), len(P), n)``: one call
+        when the operator takes a time per row (:func:`verimono.core.operator_protocol.accepts_times`: the
+        catalog's, each row as a separate call gives it), else :meth:`rows` at each time."""
+        if accepts_times(self.op):
+            self.progress()
+            return on_times(self.op, P, lam, ts)
+        return np.stack([self.rows(P, lam, t) for t in ts.tolist()])
 
     def graph(self, t: float, lam: float, P: np.ndarray | None = None):
         """``(z, y, p)`` with ``z = J_λ p ∈ dom F(t)``, ``y = Y_λ p ∈ F(t, z)`` (rows of the points whose
@@ -174,6 +184,32 @@ def min_norm_or_none(op, z, t):
         return None
 
 
+def on_times(op, P: np.ndarray, lam: float, ts: np.ndarray) -> np.ndarray:
+    """``J_λ(t) p`` for every time of ``ts`` and row of ``P``, ``(len(ts), len(P), n)``, in one call of an
+    operator that takes a time per row (the rows time-major: ``P`` repeated at each time)."""
+    m = len(P)
+    X = np.tile(np.asarray(P, dtype=float), (len(ts), 1))
+    return resolvent_rows(op, X, lam, np.repeat(np.asarray(ts, dtype=float), m)).reshape(len(ts), m, -1)
+
+
+def norms(V: np.ndarray) -> np.ndarray:
+    """``|v|`` of every row: ``sqrt(v·v)`` with the BLAS dot of each row, the bits of ``float(np.linalg.norm(v))``
+    of the row alone."""
+    return np.sqrt(dot_rows(V, V))
+
+
+def f0_norms(op, Z: np.ndarray, ts: np.ndarray, mu: float) -> np.ndarray:
+    """:func:`f0_norm` of every row ``z_i`` at ``t_i`` of an operator that takes a time per row, NaN where it is
+    ``None`` (a row outside the domain: the rows then one by one, as :func:`f0_norm` takes them)."""
+    try:
+        return norms(op.min_norm(Z, ts))
+    except (OutsideDomain, UnverifiedSolution):
+        out = [f0_norm(op, z, t, mu)[0] for z, t in zip(Z, ts.tolist())]
+        return np.array([np.nan if v is None else v for v in out], dtype=float)
+    except NotImplementedError:
+        return norms(op.yosida(Z, mu, ts))
+
+
 def f0_norm(op, z, t, mu):
     """``|F^0(t, z)|``, or the lower estimate ``|Y_μ z|`` when the operator has no ``min_norm``."""
     try:
@@ -201,5 +237,5 @@ def growth(value: float, evidence: dict, details: dict, failed: str, passed: str
     return Outcome(None, status=PASSED, details=details, message=passed)
 
 
-__all__ = ["samples_for", "run_assumption", "EVIDENCE", "LAMBDAS", "FAR_DECADES", "KINK_DECADES", "AFTER_JUMP", "A2_LAMBDAS",
+__all__ = ["on_times", "norms", "f0_norms", "samples_for", "run_assumption", "EVIDENCE", "LAMBDAS", "FAR_DECADES", "KINK_DECADES", "AFTER_JUMP", "A2_LAMBDAS",
            "min_norm_or_none", "f0_norm", "sampled", "growth"]

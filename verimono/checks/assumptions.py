@@ -142,13 +142,13 @@ def _a1_sup(S):
 
     def many(ts: np.ndarray, which) -> np.ndarray:
         """``values(t, which)`` at every time of ``ts`` (``which``: one or two pairs): the subject's calls as
-        :func:`one` makes them, the arithmetic over all times at once (NaN where a row is not finite for a
+        :func:`one` makes them (all times in one call when the operator takes a time per row), the arithmetic over all times at once (NaN where a row is not finite for a
         reason other than an unverified resolvent: the engine evaluates it again with :func:`one`)."""
         out = np.empty((len(ts), len(which)))
         for k, f in enumerate(which):
             li, kk = divmod(int(f), per)
             lam, p = lams[li], P[[ia[kk], ib[kk]]]
-            z = np.stack([S.rows(p, lam, t) for t in ts.tolist()])         # (times, 2, n)
+            z = S.rows_at_times(p, lam, ts)         # (times, 2, n): one call when the operator takes a time per row
             y = (p - z) / lam
             dz, dy = z[:, 0] - z[:, 1], y[:, 0] - y[:, 1]
             size = np.abs(p).max(axis=1) / lam
