@@ -36,8 +36,8 @@ from ..core.tolerances import GROWTH_FLAG, current_rtol, STALL_RATIO, STALL_WIND
 from ..records.results import FAILED, PASSED, SKIPPED
 from ..core.operator_protocol import accepts_times
 from ..core.tolerances import row_tolerances
-from .assumption_samples import (EVIDENCE, f0_norm, f0_norms, growth, min_norm_or_none, norms, on_times,
-                                 run_assumption, sampled)
+from .assumption_samples import (EVIDENCE, f0_norm, f0_norms, growth, min_norm_or_none, min_norms, norms,
+                                 on_times, run_assumption, sampled)
 from .core import Outcome, law
 from .jumps import find_jumps, jump_time
 from .engine.supremum import Sup
@@ -78,16 +78,16 @@ def check_assumption_A3(S) -> Outcome:
     """(A3): ``sup_{z ∈ dom F(s)} dist(z, dom F(t)) ≤ φ(t) - φ(s)``: the least nondecreasing ``φ̂`` of the
     sampled domain motion, compared with a stated ``φ``; a jump of the domain fails it (φ must be absolutely
     continuous)."""
-    op, ts = S.op, S.times
+    ts = S.times
     n = len(ts)
     D = np.zeros((n, n))
     arg: dict[tuple[int, int], Any] = {}
     off = np.zeros(len(S.near))         # how far each point lies from the domain: ties of the φ search
     for a in range(n):
-        Z = np.array([op.project_domain(p, float(ts[a])) for p in S.near])
+        Z = _domain(S, S.near, float(ts[a]))
         off = np.maximum(off, np.linalg.norm(S.near - Z, axis=1))
         for b in range(a + 1, n):
-            Q = np.array([op.project_domain(z, float(ts[b])) for z in Z])
+            Q = _domain(S, Z, float(ts[b]))
             d = np.linalg.norm(Z - Q, axis=1)
             m = int(np.argmax(d))
             D[a, b], arg[(a, b)] = float(d[m]), Z[m]
@@ -134,6 +134,14 @@ def check_assumption_A3(S) -> Outcome:
                    f"exposed in every direction of {details['searched']['boundary']['sphere']} "
                    f"({details['searched']['boundary']['points']} directions); largest ratio {sup.value:.3g} at "
                    f"s = {sup.t:.4g} ({EVIDENCE})")
+
+
+def _domain(S, P: np.ndarray, t: float) -> np.ndarray:
+    """``proj_{dom F(t)} p`` of every row of ``P``: one call with the time on every row when the operator takes a
+    time per row (each row as its own call gives it), else one call per row."""
+    if accepts_times(S.op):
+        return np.asarray(S.op.project_domain(P, np.full(len(P), float(t))), dtype=float)
+    return np.array([S.op.project_domain(p, t) for p in P])
 
 
 def _phi_ratio(dist: float, phi_s: float, phi_t: float) -> float:
@@ -256,8 +264,8 @@ def _exposed_search(S, at, x0: np.ndarray, R: float, windows, w: float, start=()
 def _excess(S, a: float, b: float) -> tuple[float, np.ndarray, float]:
     """``max_z dist(z, dom F(b))`` over the sampled ``z = proj_{dom F(a)} p``, the maximiser, and the
     tolerance of its projections (of ``p``'s size: a far point's projection carries its rounding)."""
-    Z = np.array([S.op.project_domain(p, a) for p in S.near])
-    Q = np.array([S.op.project_domain(z, b) for z in Z])
+    Z = _domain(S, S.near, a)
+    Q = _domain(S, Z, b)
     d = np.linalg.norm(Z - Q, axis=1)
     m = int(np.argmax(d))
     return float(d[m]), Z[m], tolerance(S.near[m], Z[m], d[m])
@@ -269,7 +277,7 @@ def _a3_jump(S, details: dict) -> dict | None:
     ``dom F(a)`` over ``dom F(b)`` on the final bracket: still above tolerance and stalled (≥ ``STALL_RATIO``
     times its value ``STALL_WINDOW`` bisections earlier) means ``φ(b) − φ(a) ≥ excess`` on ever shorter
     ``[a, b]``: no absolutely continuous φ (a domain that only grows jumps without violating (A3))."""
-    jumps, searched = find_jumps(lambda t: np.array([S.op.project_domain(p, t) for p in S.near]), S.T)
+    jumps, searched = find_jumps(lambda t: _domain(S, S.near, t), S.T)
     details["jump_search"] = searched
     details["domain_jumps"] = []
     for j in jumps:
@@ -299,8 +307,16 @@ def check_assumption_LG(S) -> Outcome:
         best = 0.0
         for ti, t in enumerate(S.times):
             z_all, _, _ = S.graph(float(t), lam)
-            for z in z_all:
-                val, how = f0_norm(op, z, float(t), 1e-6 * S.T)
+            if accepts_times(op) and len(z_all):     # every row's |F^0| in one call, each as its own call gives it
+                vals, how = f0_norms(op, z_all, np.full(len(z_all), float(t)), 1e-6 * S.T, how=True)
+                f0s = [None if v != v else v for v in vals.tolist()]
+            else:
+                f0s = None
+            for k, z in enumerate(z_all):
+                if f0s is None:
+                    val, how = f0_norm(op, z, float(t), 1e-6 * S.T)
+                else:
+                    val = f0s[k]
                 if val is None:
                     continue
                 r = val / (1.0 + float(np.linalg.norm(z)))
@@ -709,18 +725,33 @@ def check_assumption_YB(S) -> Outcome:
             if s + lam > T + 1e-12:
                 continue
             Z = S.rows(S.points, 0.1 * T, s)  # z ∈ dom F(s)
-            for z in Z[np.all(np.isfinite(Z), axis=1)]:
-                try:
-                    y_next = float(np.linalg.norm(op.yosida(z, lam, s + lam)))
-                    y_now = float(np.linalg.norm(op.yosida(z, lam, s)))
-                except UnverifiedSolution:      # verimono's own solver: no evidence at this point
-                    S.unverified += 1
-                    continue
+            Zf = Z[np.all(np.isfinite(Z), axis=1)]
+            pre = None
+            if accepts_times(op) and len(Zf):   # each member once for every row, each as its own call gives it
+                y1 = norms(np.asarray(op.yosida(Zf, lam, np.full(len(Zf), s + lam)), dtype=float)).tolist()
+                y0 = norms(np.asarray(op.yosida(Zf, lam, np.full(len(Zf), s)), dtype=float)).tolist()
+                f0s = None
+                if has_f0:
+                    try:
+                        f0s = min_norms(op, Zf, s)
+                    except NotImplementedError:
+                        has_f0 = False
+                pre = (y1, y0, f0s)
+            for k, z in enumerate(Zf):
+                if pre is None:
+                    try:
+                        y_next = float(np.linalg.norm(op.yosida(z, lam, s + lam)))
+                        y_now = float(np.linalg.norm(op.yosida(z, lam, s)))
+                    except UnverifiedSolution:      # verimono's own solver: no evidence at this point
+                        S.unverified += 1
+                        continue
+                else:
+                    y_next, y_now = pre[0][k], pre[1][k]
                 tol = quotient_tolerance(lam, z)
                 cands = {"YB'": y_next - y_now}
                 if has_f0:
                     try:
-                        f0 = min_norm_or_none(op, z, s)
+                        f0 = min_norm_or_none(op, z, s) if pre is None else pre[2][k]
                         if f0 is not None:
                             cands["YB"] = y_next - float(np.linalg.norm(f0))
                     except NotImplementedError:

@@ -198,16 +198,30 @@ def norms(V: np.ndarray) -> np.ndarray:
     return np.sqrt(dot_rows(V, V))
 
 
-def f0_norms(op, Z: np.ndarray, ts: np.ndarray, mu: float) -> np.ndarray:
+def f0_norms(op, Z: np.ndarray, ts: np.ndarray, mu: float, how: bool = False):
     """:func:`f0_norm` of every row ``z_i`` at ``t_i`` of an operator that takes a time per row, NaN where it is
-    ``None`` (a row outside the domain: the rows then one by one, as :func:`f0_norm` takes them)."""
+    ``None`` (a row outside the domain: the rows then one by one, as :func:`f0_norm` takes them); ``how``: with
+    what it was computed too, as :func:`f0_norm` says it."""
     try:
-        return norms(op.min_norm(Z, ts))
+        out, by = norms(np.asarray(op.min_norm(Z, ts), dtype=float)), "min_norm"
     except (OutsideDomain, UnverifiedSolution):
-        out = [f0_norm(op, z, t, mu)[0] for z, t in zip(Z, ts.tolist())]
-        return np.array([np.nan if v is None else v for v in out], dtype=float)
+        vals = [f0_norm(op, z, t, mu)[0] for z, t in zip(Z, ts.tolist())]
+        out, by = np.array([np.nan if v is None else v for v in vals], dtype=float), "min_norm"
     except NotImplementedError:
-        return norms(op.yosida(Z, mu, ts))
+        out, by = norms(np.asarray(op.yosida(Z, mu, ts), dtype=float)), "yosida lower estimate"
+    return (out, by) if how else out
+
+
+def min_norms(op, Z: np.ndarray, t: float) -> list:
+    """:func:`min_norm_or_none` of every row of ``Z`` at ``t``: one call with the time on every row when the
+    operator takes a time per row (each row as its own call gives it; a row outside the domain: the rows one by
+    one), else one call per row."""
+    if accepts_times(op) and len(Z):
+        try:
+            return list(np.asarray(op.min_norm(Z, np.full(len(Z), t)), dtype=float))
+        except (OutsideDomain, UnverifiedSolution):
+            pass
+    return [min_norm_or_none(op, zi, t) for zi in Z]
 
 
 def f0_norm(op, z, t, mu):
@@ -237,5 +251,5 @@ def growth(value: float, evidence: dict, details: dict, failed: str, passed: str
     return Outcome(None, status=PASSED, details=details, message=passed)
 
 
-__all__ = ["on_times", "norms", "f0_norms", "samples_for", "run_assumption", "EVIDENCE", "LAMBDAS", "FAR_DECADES", "KINK_DECADES", "AFTER_JUMP", "A2_LAMBDAS",
+__all__ = ["on_times", "norms", "f0_norms", "min_norms", "samples_for", "run_assumption", "EVIDENCE", "LAMBDAS", "FAR_DECADES", "KINK_DECADES", "AFTER_JUMP", "A2_LAMBDAS",
            "min_norm_or_none", "f0_norm", "sampled", "growth"]

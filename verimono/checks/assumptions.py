@@ -33,8 +33,8 @@ from .arguments import valid_seed
 from .assumption_a2 import (A2_LEVELS, A2_RATIO, A2_SETTLED, A2_TAIL_SAFETY, UNDECIDED_SIDE,  # noqa: F401
                             check_assumption_A2)
 from .assumption_bounds import check_assumption_A3, check_assumption_LG, check_assumption_YB  # noqa: F401
-from .assumption_samples import (A2_LAMBDAS, EVIDENCE, LAMBDAS, min_norm_or_none, run_assumption,  # noqa: F401
-                                 sampled)
+from .assumption_samples import (A2_LAMBDAS, EVIDENCE, LAMBDAS, min_norm_or_none, min_norms,  # noqa: F401
+                                 run_assumption, sampled)
 from .core import Outcome, law, laws_of, run, subject_name
 from .subjects import require_problem
 from .engine.times import search_time, searched_t
@@ -75,7 +75,7 @@ def check_assumption_A1(S) -> Outcome:
             N.append(J[:nn][keep[:nn]])
         try:   # minimal sections at the domain points of x0 and the points around it
             z = np.vstack(N)
-            f0 = [min_norm_or_none(S.op, zi, float(t)) for zi in z]
+            f0 = min_norms(S.op, z, float(t))
             keep = [i for i, v in enumerate(f0) if v is not None]
             Z.append(z[keep]), Y.append(np.array([f0[i] for i in keep]).reshape(-1, S.problem.dim))
             P.append(np.abs(Y[-1]).max(axis=1) if keep else np.zeros(0))

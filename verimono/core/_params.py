@@ -51,10 +51,15 @@ class Param:
         """The parameter at every time of ``ts`` (shape ``(B,)``): a constant as it is (it broadcasts against
         the rows), a moving one stacked row by row, ``(B, *shape)``, each row the value of a call at that time
         alone (the user's callable is called once per time, with a Python float: no callable is assumed to
-        map an array of times)."""
+        map an array of times; a run of rows at the same time shares one call, as a batch at one time does)."""
         if self._fn is None:
             return self._value
-        return np.array([self(t) for t in np.asarray(ts, dtype=float).tolist()], dtype=float)
+        ts = np.asarray(ts, dtype=float)
+        if ts.size > 1 and np.any(ts[1:] == ts[:-1]):     # a time repeated (its rows together): one call each
+            first = np.r_[True, ts[1:] != ts[:-1]]
+            values = np.array([self(t) for t in ts[first].tolist()], dtype=float)
+            return values[np.cumsum(first) - 1]
+        return np.array([self(t) for t in ts.tolist()], dtype=float)
 
     def describe(self) -> str:
         if self._fn is None:
