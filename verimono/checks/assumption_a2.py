@@ -104,6 +104,8 @@ def _deep(S, p: np.ndarray, lam: float, t: float) -> tuple[np.ndarray, np.ndarra
     verified, and :data:`A2_WINDOW` levels in all, whose spread is read."""
     dd = (S.T - t) * A2_RATIO ** np.arange(A2_LEVELS + 1, A2_DEEP_LEVELS + 1)
     dd = dd[t + dd > t]
+    if accepts_times(S.op) and len(dd) >= A2_WINDOW:    # every level in one call, each as its own call gives it
+        return dd, on_times(S.op, p[None, :], lam, t + dd)[:, 0]
     kept, values = [], []
     for k, d in enumerate(dd):
         try:
@@ -125,7 +127,10 @@ def right_limit(S, t: float, lam: float, P: np.ndarray | None = None):
     ones before it is judged (a point ``10^-6`` from the kink of ``t|x|`` moves only once ``λδ < 10^-6``)."""
     P = S.near if P is None else P
     deltas = (S.T - t) * A2_RATIO ** np.arange(A2_LEVELS + 1)
-    Q = np.stack([resolvent_rows(S.op, P, lam, t + d) for d in deltas], axis=1)   # (P, D, n)
+    if accepts_times(S.op):     # every level in one call, each row as its own call gives it
+        Q = on_times(S.op, P, lam, t + deltas).transpose(1, 0, 2)
+    else:
+        Q = np.stack([resolvent_rows(S.op, P, lam, t + d) for d in deltas], axis=1)   # (P, D, n)
     AT = resolvent_rows(S.op, P, lam, t)
     worst, counter, sequences, unsettled, no_limit = 0.0, None, 0, 0, None
     for p, q, at_t in zip(P, Q, AT):
@@ -209,7 +214,17 @@ def _fastest(S, lam: float) -> tuple[list[float], int, dict]:
     many.bound = np.inf     # type: ignore[attr-defined]  # a speed, no bound: every finite value is the law's
     sup = search_time(values, 0.0, T, design=S.design(), seed=S.seed)
     f = sup.family
-    z = zoom(lambda t, w: float(speed(t, [f], max(1e-4 * w * w, floor))[0]), 0.0, T, sup.at,
+
+    def probe(t: float, w: float) -> float:
+        return float(speed(t, [f], max(1e-4 * w * w, floor))[0])
+
+    if accepts_times(S.op):     # a zoom level's probes in one call each side, as :func:`speed` computes each
+        def probes(ts: np.ndarray, w: float) -> np.ndarray:
+            eps, rows = max(1e-4 * w * w, floor), [f]
+            D = on_times(S.op, P[rows], lam, np.minimum(ts + eps, T)) - on_times(S.op, P[rows], lam, ts)
+            return (np.linalg.norm(D, axis=2) / size[rows])[:, 0]
+        probe.many = probes     # type: ignore[attr-defined]
+    z = zoom(probe, 0.0, T, sup.at,
              2 * sup.searched.resolution, scaled=True, probes=A2_ZOOM_PROBES, shrink=A2_ZOOM_SHRINK,
              levels=A2_ZOOM_LEVELS)
     return z.points[::-1], f, {"speed_search": sup.as_dict(), "searched_t": searched_t(sup),

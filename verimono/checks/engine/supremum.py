@@ -489,8 +489,10 @@ def zoom(f: Callable[..., float], lo: float, hi: float, at: float, width: float,
     at each level ``probes`` equally spaced points of the bracket (its ends included) and its centre, the
     bracket then centred on the largest (kept inside ``[lo, hi]``), until no float lies between two probes
     (or ``levels`` levels).  ``scaled=True``: ``f(x, w)`` is told the bracket's width ``w`` (a difference
-    quotient whose step shrinks with it)."""
+    quotient whose step shrinks with it).  ``f.many(xs, w)``, when ``f`` carries it, gives a level's values at
+    once (the same values as ``f`` at each probe, bit for bit; taken in the same order)."""
     call = (lambda x, w: float(f(x, w))) if scaled else (lambda x, w: float(f(x)))
+    many = getattr(f, "many", None)
     best_x = float(at)
     widths, vals, count, pts = [], [], 0, []
     w = float(width)
@@ -501,8 +503,9 @@ def zoom(f: Callable[..., float], lo: float, hi: float, at: float, width: float,
         if not np.all(np.diff(xs[:-1]) > 0):
             break
         level_best, level_x = -math.inf, best_x
-        for x in xs:
-            v = call(float(x), w)
+        level = None if many is None else np.asarray(many(xs, w), dtype=float).tolist()
+        for k, x in enumerate(xs):
+            v = call(float(x), w) if level is None else level[k]
             count += 1
             if v != v:
                 v = math.inf
