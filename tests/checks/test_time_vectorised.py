@@ -18,6 +18,7 @@ from verimono.checks import assumption_a2, assumption_bounds, assumptions
 from verimono.checks.assumptions import check_assumptions
 from verimono.checks.engine import supremum, times
 from verimono.checks.engine.supremum import SUSPECT, Space, budgets, maximise
+from verimono import reference
 from verimono.reference import catalog
 
 #: a small time budget: the searches' shapes, not their resolution, are under test (96 strata)
@@ -172,3 +173,56 @@ def test_a_form_that_is_the_laws_own_values_is_taken_as_it_is_but_for_a_row_it_c
     assert got.value == 3.0
     assert sum(abs(t - 0.01) < 1e-12 for t in calls) >= 1          # the NaN row: the law itself
     assert not any(abs(t - 0.5) < 0.05 and t in cover.tolist() for t in calls)     # 3.0 taken from the form
+
+
+# -- a time per row (issue 43): the catalog's operators called once per block of times ----------------------
+
+#: the modules whose laws ask ``accepts_times`` (each imported it by name)
+_ASKERS = ("verimono.checks.assumptions", "verimono.checks.assumption_a2", "verimono.checks.assumption_bounds",
+           "verimono.checks.assumption_samples")
+
+
+#: a tinier time budget for the records' comparison (24 strata): every path is taken, at a fraction of the cost
+TINY = 4
+
+
+def _records(name, monkeypatch, **patches):
+    """The five assumption records of reference ``name`` (tiny time budget) as dicts without ``duration``,
+    with ``patches`` (attribute → value) set on every module that asks ``accepts_times``."""
+    import importlib
+    import json
+
+    with monkeypatch.context() as m:
+        for mod in _ASKERS:
+            for attr, value in patches.items():
+                if hasattr(importlib.import_module(mod), attr):
+                    m.setattr(f"{mod}.{attr}", value)
+        with budgets(time=TINY, points=8):
+            report = check_assumptions(reference.get(name), composite=False)
+    out = []
+    for r in report:
+        d = json.loads(json.dumps(r.to_dict(), default=str))
+        d.pop("duration", None)
+        out.append(d)
+    return out
+
+
+@pytest.mark.parametrize("name", ["moving-box", "tnorm-3", pytest.param("translating-ball", marks=pytest.mark.slow),
+                                  pytest.param("play-piecewise-linear", marks=pytest.mark.slow),
+                                  pytest.param("c-over-x", marks=pytest.mark.slow)])
+def test_the_laws_give_the_same_records_with_a_time_per_row_as_time_by_time(name, monkeypatch):
+    """Every path that calls the operator once per block of times — the forms of the coverage, the sample-time
+    loops, (A2)'s levels and zoom — against the per-time path a user's operator takes (``accepts_times`` False):
+    the records are equal field by field (status, worst, counterexample, what was searched)."""
+    per_time = _records(name, monkeypatch, accepts_times=lambda op: False)
+    assert _records(name, monkeypatch) == per_time
+
+
+def test_a_time_per_row_taken_in_the_wrong_order_changes_the_records(monkeypatch):
+    """The comparison above is not vacuous: ``on_times`` with each block's times reversed (row ``i`` at
+    ``t[B−1−i]``) gives other records."""
+    from verimono.checks.assumption_samples import on_times
+
+    def reversed_times(op, P, lam, ts):
+        return on_times(op, P, lam, np.asarray(ts)[::-1])
+    assert _records("moving-box", monkeypatch, on_times=reversed_times) != _records("moving-box", monkeypatch)
