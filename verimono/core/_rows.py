@@ -11,6 +11,8 @@ import math
 
 import numpy as np
 
+from .errors import InvalidProblem
+
 _ar = np.add.reduce
 _mx, _mn = np.maximum, np.minimum
 _sqrt = math.sqrt
@@ -46,7 +48,6 @@ def times_of(t, x: np.ndarray, who: str) -> np.ndarray | None:
     if type(t) is not np.ndarray or t.ndim != 1:
         return None
     if np.ndim(x) != 2 or np.shape(x)[0] != t.shape[0]:
-        from .errors import InvalidProblem
         raise InvalidProblem(f"{who}: a time per row needs points of shape ({t.shape[0]}, n), got {np.shape(x)}")
     return t.astype(float, copy=False)
 
