@@ -11,6 +11,10 @@ Every catalog operator accepts points of shape ``(n,)`` or a batch of shape ``(B
 parameter may be a constant or a callable of ``t``.  Scalar and vector parameters may also carry a
 leading batch axis — ``NormSubdifferential(c)`` with ``c`` of shape ``(B,)`` is a batch of ``B`` operators
 applied row by row to points of shape ``(B, n)`` (likewise ``Ball`` and ``Box`` in :mod:`verimono.core.sets`).
+A time per row: ``resolvent``, ``yosida``, ``min_norm`` and ``project_domain`` of the catalog take ``t`` of shape
+``(B,)`` beside ``x`` of shape ``(B, n)`` — row ``i`` at ``t[i]``, bit-identical to ``B`` separate calls — as
+:meth:`Operator._accepts_times` declares (:func:`verimono.core.operator_protocol.accepts_times`); the assumption
+laws call such an operator once per block of times, any other once per time.
 
 Performance: the per-step work of :func:`verimono.solve` is the resolvent.  Catalog operators compute it
 without ``np.errstate``/``np.where`` (``x max(|x| - λc, 0)/max(|x|, tiny)`` has no ``0/0``), with sums of
