@@ -68,8 +68,8 @@ TINY = 5e-324
 #: the timed records' early look (:func:`verimono.execution.timing.look_plan`): at 6 interleaved rounds, with the
 #: error the planned looks (9 and 27 rounds, r_(2)/r_(8) and r_(8)/r_(20)) leave unspent, a record whose six
 #: per-round ratios all lie on one side of its target is decided there (6 is the fewest rounds with any bound at
-#: that level: 2**-6 = 1.56% <= 2.09%); the later looks are unchanged.  Measured at ci: every record of a quiet
-#: run but a straddling one is decided at 6 (docs/speed.md, branch perf8)
+#: that level: 2**-6 = 1.56% <= 2.09%); the later looks are unchanged.  Measured at ci in a whole run at load 8.7:
+#: 13 of the 14 timed records decided at 6 rounds, the other at 9 (docs/speed.md, branch perf8)
 EARLY_ROUNDS = 6
 
 #: ``runner(setup, target, rounds)``: calls ``setup(); target()`` ``rounds`` times (pytest-benchmark's
