@@ -765,3 +765,21 @@ def test_all_finite_reads_a_sum_and_decides_overflow_exactly():
     b = np.zeros((3, 3))
     b[1, 1] = -np.inf
     assert not all_finite(b) and all_finite(np.zeros((3, 3)))
+
+
+@pytest.mark.parametrize("block", [1, 3, 1 << 16])
+def test_velocity_rows_are_the_trajectorys_selections_bit_for_bit_in_any_block(monkeypatch, block):
+    """``velocity_rows`` (the input's increments a block of cells at a time) yields ``y_k = (z_k - x_{k+1})/h``,
+    the trajectory's own selections, bit for bit, with a Lipschitz field and an input, across block boundaries
+    (a block of 1 number is one cell per call, the old way), and ``velocity_row`` agrees row by row."""
+    from verimono import random_grid
+    from verimono.checks import trajectory_laws as tl
+
+    monkeypatch.setattr(tl, "_INCREMENT_BLOCK", block)
+    p = get("Lipschitz field and input")
+    t = random_grid(p.T, 40, seed=5)
+    tr = solve(p, t)
+    x = np.asarray(tr.x)
+    rows = np.array(list(tl.velocity_rows(p, t, x)))
+    assert np.array_equal(rows, np.asarray(tr.selections))
+    assert all(np.array_equal(rows[k], tl.velocity_row(p, t, x, k)) for k in range(len(t) - 1))

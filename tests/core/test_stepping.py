@@ -95,3 +95,21 @@ def test_solve_is_a_stepper():
     out = np.asarray(vm.solve(p, grid))
     assert out.shape == (len(grid), 1)
     assert np.all(np.abs(np.diff(out[:, 0])) <= 0.1 + tolerance(1.0))  # |x'| <= c = 1
+
+
+def test_input_increments_integrate_quintics_exactly_with_the_nodes_computed_once():
+    """3-point Gauss–Legendre is exact for polynomials of degree <= 5: the increments of u(t) = t^5 - 2t^2 are
+    ∫ u = [t^6/6 - 2t^3/3] over every cell, to rounding (relative 1e-13 of the cell's |u| h: the data are O(1)).
+    The nodes are computed once (``_GAUSS3``, read-only): a call cannot change another's."""
+    from verimono.core import problem as problem_module
+    from verimono.core.operators import Linear
+
+    p = vm.Problem(Linear([[1.0]]), [0.0], 2.0, u=lambda s: np.array([s ** 5 - 2 * s ** 2]))
+    t = np.array([0.0, 0.3, 0.35, 1.0, 1.7, 2.0])
+    prim = t ** 6 / 6 - 2 * t ** 3 / 3
+    for _ in range(2):
+        got = p.input_increments(t)[:, 0]
+        np.testing.assert_allclose(got, np.diff(prim), rtol=0, atol=1e-13 * 2.0 ** 5 * 2.0)
+    nodes, weights = problem_module._GAUSS3
+    assert not nodes.flags.writeable and not weights.flags.writeable
+    assert np.array_equal(nodes, np.polynomial.legendre.leggauss(3)[0])

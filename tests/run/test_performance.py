@@ -288,6 +288,63 @@ def test_a_ratio_on_the_target_is_wrongly_judged_at_most_alpha_of_the_time():
     assert on.count("failed") <= 2000 * timing.ALPHA and on.count("passed") <= 2000 * timing.ALPHA
 
 
+def test_the_early_look_spends_only_the_error_the_planned_looks_leave():
+    """``look_plan``: the planned looks keep their levels (r_(2)/r_(8) of 9, r_(8)/r_(20) of 27 at ALPHA/2); the
+    early look at 6 rounds gets ALPHA minus their attained levels and its bound is the min/max (rank 1); the
+    attained levels add up to at most ALPHA per side (1/64 + 10/512 + P(Bin(27, 1/2) <= 7) = 4.47%)."""
+    plan = timing.look_plan(9, 27, early=6)
+    assert [n for n, _ in plan] == [6, 9, 27] and plan[1:] == timing.look_plan(9, 27)
+    assert [timing.order_rank(n, a) for n, a in plan] == [1, 2, 8]
+    spent = [timing.attained(n, a) for n, a in plan]
+    assert spent[:2] == [2 ** -6, 10 / 512]
+    assert sum(spent) == pytest.approx(0.0447, abs=1e-4) and sum(spent) <= timing.ALPHA
+    for rounds, max_rounds in ((9, 27), (15, 27), (9, 9), (12, 36)):
+        p = timing.look_plan(rounds, max_rounds, early=6)
+        assert sum(timing.attained(n, a) for n, a in p) <= timing.ALPHA
+    assert timing.look_plan(9, 27, early=5) == timing.look_plan(9, 27)   # 2**-5 does not fit: no early look
+    assert timing.look_plan(6, 27, early=6) == timing.look_plan(6, 27)   # not before the planned rounds
+
+
+def test_six_rounds_on_one_side_decide_early_and_a_planted_3x_still_fails():
+    m = Machine(1.2)
+    j = timing.judge(m, target=1.5, rounds=9, max_rounds=27, early=6)
+    assert j.status == "passed" and m.asked == [6] and j.looks == 1 and j.high == max(j.per_round) <= 1.5
+    assert j.level == pytest.approx(1 - timing.look_plan(9, 27, early=6)[0][1])
+    slow = Machine(3 * 1.2)
+    j = timing.judge(slow, target=1.5, rounds=9, max_rounds=27, early=6)
+    assert j.status == "failed" and slow.asked == [6] and j.low == min(j.per_round) > 1.5
+
+
+def test_a_record_not_decided_early_gets_the_unchanged_looks():
+    """One spiked round among the first six: no early verdict; the same data then meets the same 9- and 27-round
+    bounds as without the early look (the rule is the old one from there on, on the same rounds)."""
+    went_on = 0
+    for seed in range(40):
+        kw = dict(spikes=0.3, seed=seed, side="subject")
+        a, b = Machine(1.3, **kw), Machine(1.3, **kw)
+        with_early = timing.judge(a, target=1.5, rounds=9, max_rounds=27, early=6)
+        without = timing.judge(b, target=1.5, rounds=9, max_rounds=27)
+        if with_early.looks == 1:
+            assert max(with_early.per_round) <= 1.5 and with_early.rounds == 6
+            continue
+        assert (with_early.status, with_early.low, with_early.high, with_early.rounds) == \
+            (without.status, without.low, without.high, without.rounds), seed
+        assert with_early.looks == without.looks + 1 and a.asked[0] == 6 and sum(a.asked) == sum(b.asked)
+        went_on += 1
+    assert 10 <= went_on <= 35          # both paths taken
+
+
+def test_with_the_early_look_a_ratio_on_the_target_is_still_wrongly_judged_at_most_alpha_of_the_time():
+    on = [timing.judge(Machine(1.0, jitter=0.2, seed=s), target=1.0, rounds=9, max_rounds=27, early=6).status
+          for s in range(2000)]
+    assert on.count("failed") <= 2000 * timing.ALPHA and on.count("passed") <= 2000 * timing.ALPHA
+    good = [timing.judge(Machine(1.2, spikes=0.15, seed=s), target=1.5, rounds=9, max_rounds=27, early=6).status
+            for s in range(200)]
+    slow = [timing.judge(Machine(3.6, spikes=0.15, seed=s), target=1.5, rounds=9, max_rounds=27, early=6).status
+            for s in range(200)]
+    assert "failed" not in good and "passed" not in slow and good.count("passed") >= 190
+
+
 def test_speed_up_targets_are_judged_on_baseline_over_subject():
     fast = timing.judge(Machine(0.01), target=30.0, speedup=True, rounds=9)     # 100x
     slow = timing.judge(Machine(0.1), target=30.0, speedup=True, rounds=9)      # 10x

@@ -256,7 +256,7 @@ class Problem:
             return np.diff(Ut, axis=0)
         if self.u is None:
             return None
-        nodes, weights = np.polynomial.legendre.leggauss(3)
+        nodes, weights = _GAUSS3
         h = np.diff(t)
         mid = 0.5 * (t[:-1] + t[1:])
         total = np.zeros((h.size, self.dim))
@@ -271,6 +271,13 @@ class Problem:
         return f"Problem({self.name!r}, n={self.dim}, T={self.T:g}, order={self.order})"
 
 
+
+#: 3-point Gauss–Legendre nodes and weights on [-1, 1], computed once (``leggauss`` solves an eigenproblem per call:
+#: ``input_increments`` called row by row by the trajectory laws spent 60% of their time there; the same arrays)
+_GAUSS3 = tuple(a.copy() for a in np.polynomial.legendre.leggauss(3))
+for _a in _GAUSS3:
+    _a.flags.writeable = False
+del _a
 
 #: where a problem was loaded from (``MODULE:OBJECT``), for reproduction lines; weak: it dies with the problem
 _ORIGINS: "weakref.WeakKeyDictionary[Problem, str]" = weakref.WeakKeyDictionary()

@@ -41,6 +41,17 @@ process waited for a CPU, the load average and the calibration before and after.
 verdict, pass or fail, has probability at most ``ALPHA`` = 5% when the true median sits on the target,
 and far less away from it.
 
+**An early look** (``judge(..., early=6)``, what :mod:`verimono.run.performance` asks for): before the
+planned rounds, the same rule looks once at ``early`` rounds with the error those two looks leave unspent.
+The union bound is over the looks' *attained* levels (the order statistics are discrete: at 9 rounds
+``r_(2)``/``r_(8)`` attain ``P(Bin(9, 1/2) <= 1)`` = 1.95%, at 27 ``r_(8)``/``r_(20)`` attain 0.96%, against
+the nominal 2.5% each), so the early look gets ``ALPHA`` minus those, 2.09%, and at 6 rounds its rank is 1: the
+minimum and maximum, attained ``2**-6`` = 1.56%.  In words: *all six per-round ratios on one side of the
+target decide the record at six rounds*; otherwise it goes on to the planned rounds and then the budget,
+where the bounds are the same order statistics at the same levels as without the early look.  A wrong verdict
+(pass or fail, per side) then has probability at most 1.56 + 1.95 + 0.96 = 4.47% ≤ ``ALPHA`` when the true
+median sits on the target (:func:`look_plan` computes it; a plan that cannot fit an early look drops it).
+
 **Calibration** (:mod:`verimono.execution.calibration`, re-exported here): a fixed NumPy-and-Python workload, best of
 ``repeats``; stage times are stated in its units (``verimono gate``), and so are the time budgets of
 :mod:`verimono.execution.timeouts` (:func:`calibration` measures it once per process and caches it);
@@ -287,28 +298,50 @@ def decide(subject: Sequence[float], baseline: Sequence[float], *, target: float
     return status, med, lo, hi
 
 
+def attained(n: int, alpha: float) -> float:
+    """The error one side of :func:`median_interval` at level ``alpha`` on ``n`` rounds actually attains,
+    ``P(Bin(n, 1/2) <= k - 1)`` for ``k = order_rank(n, alpha)`` (0 when there is no bound): at most ``alpha``."""
+    k = order_rank(n, alpha)
+    return _binom_cdf_half(n, k - 1) if k else 0.0
+
+
+def look_plan(rounds: int, max_rounds: int | None = None, *, early: int | None = None,
+              alpha: float = ALPHA) -> list[tuple[int, float]]:
+    """The looks of :func:`judge` as ``(rounds so far, per-side level)``: ``rounds`` at ``alpha / looks`` and,
+    when ``max_rounds > rounds``, ``max_rounds`` at the same level (Bonferroni, as without an early look); then,
+    when ``0 < early < rounds`` and the error those looks leave unspent by their attained levels
+    (:func:`attained`) gives ``early`` rounds an order-statistics bound, a first look at ``early`` rounds with that
+    error.  The attained levels of the plan add up to at most ``alpha`` per side."""
+    max_rounds = max(rounds, max_rounds or rounds)
+    looks = 1 if max_rounds == rounds else LOOKS
+    plan = [(rounds, alpha / looks)] + ([(max_rounds, alpha / looks)] if looks > 1 else [])
+    if early is not None and 0 < early < rounds:
+        rest = alpha - sum(attained(n, a) for n, a in plan)
+        if rest > 0 and order_rank(early, rest) >= 1:
+            plan.insert(0, (early, rest))
+    return plan
+
+
 def judge(more: Callable[[int], tuple[Sequence[float], Sequence[float]]], *, target: float, speedup: bool = False,
-          rounds: int, max_rounds: int | None = None, alpha: float = ALPHA) -> Judgement:
+          rounds: int, max_rounds: int | None = None, alpha: float = ALPHA, early: int | None = None) -> Judgement:
     """The sequential rule of the module docstring: ``more(k)`` runs ``k`` more interleaved rounds and returns
     their ``(subject_times, baseline_times)``.  Look at ``rounds`` rounds; when the interval straddles the
     target and ``max_rounds > rounds``, run up to ``max_rounds`` and look again; still straddling: undecided.
-    Each look uses ``alpha / looks`` per side (``looks`` = 2 when a second look is planned, else 1)."""
-    max_rounds = max(rounds, max_rounds or rounds)
-    looks_planned = 1 if max_rounds == rounds else LOOKS
-    a = alpha / looks_planned
+    Each look uses ``alpha / looks`` per side (``looks`` = 2 when a second look is planned, else 1).  ``early``:
+    a first look at that many rounds with the error left unspent (:func:`look_plan`; the module docstring)."""
+    plan = look_plan(rounds, max_rounds, early=early, alpha=alpha)
     subj: list[float] = []
     base: list[float] = []
     looks = 0
-    need = rounds
-    while True:
-        s, b = more(need - len(subj))
-        subj += [float(x) for x in s]
-        base += [float(x) for x in b]
+    for need, a in plan:
+        if need > len(subj):
+            s, b = more(need - len(subj))
+            subj += [float(x) for x in s]
+            base += [float(x) for x in b]
         looks += 1
         status, ratio, lo, hi = decide(subj, base, target=target, speedup=speedup, alpha=a)
-        if status != "straddles" or len(subj) >= max_rounds or looks >= looks_planned:
+        if status != "straddles":
             break
-        need = max_rounds
     return Judgement("undecided" if status == "straddles" else status, ratio, lo, hi, 1 - a, target, speedup,
                      subj, base, looks)
 
@@ -427,6 +460,6 @@ class MachineProbe:
 
 
 __all__ = ["cpu_now", "subject_cpu", "TimedStepper", "ALPHA", "LOOKS", "NOISE_REASON", "BUSY_WAITING", "BUSY_FOREIGN", "CLOCK", "CLOCK_DESCRIPTION", "Sample", "timed",
-           "order_rank", "median_interval", "Judgement", "decide", "judge", "is_noise_undecided", "calibrate",
+           "order_rank", "median_interval", "Judgement", "decide", "attained", "look_plan", "judge", "is_noise_undecided", "calibrate",
            "calibrate_both",
            "calibration", "set_calibration", "loadavg", "MachineProbe"]

@@ -65,6 +65,13 @@ MEMORY_TARGET = 1.0
 #: the smallest positive double (a norm of 0 divides to 0, as in the catalog's kernels)
 TINY = 5e-324
 
+#: the timed records' early look (:func:`verimono.execution.timing.look_plan`): at 6 interleaved rounds, with the
+#: error the planned looks (9 and 27 rounds, r_(2)/r_(8) and r_(8)/r_(20)) leave unspent, a record whose six
+#: per-round ratios all lie on one side of its target is decided there (6 is the fewest rounds with any bound at
+#: that level: 2**-6 = 1.56% <= 2.09%); the later looks are unchanged.  Measured at ci in a whole run at load 8.7:
+#: 13 of the 14 timed records decided at 6 rounds, the other at 9 (docs/speed.md, branch perf8)
+EARLY_ROUNDS = 6
+
 #: ``runner(setup, target, rounds)``: calls ``setup(); target()`` ``rounds`` times (pytest-benchmark's
 #: ``pedantic`` in the benchmark suite)
 Runner = Callable[[Callable[[], Any], Callable[[], Any], int], None]
@@ -281,13 +288,14 @@ def interleave(subject: Callable[[], Any], baseline: Callable[[], Any], rounds: 
 
 def measure(subject: Callable[[], Any], baseline: Callable[[], Any], *, target: float, speedup: bool = False,
             rounds: int, max_rounds: int | None = None, runner: Runner | None = None, subject_scale: float = 1.0,
-            baseline_scale: float = 1.0) -> tuple[timing.Judgement, Rounds]:
+            baseline_scale: float = 1.0, early: int | None = EARLY_ROUNDS) -> tuple[timing.Judgement, Rounds]:
     """Time ``subject`` against ``baseline`` and judge the ratio against ``target`` (:func:`verimono.execution.timing.judge`:
-    ``rounds`` rounds, then up to ``max_rounds`` when the interval straddles the target; one look with a
-    ``runner``)."""
+    a first look at ``early`` rounds (:data:`EARLY_ROUNDS`; ``None``: none), then ``rounds`` rounds, then up to
+    ``max_rounds`` when the interval straddles the target; one look with a ``runner``)."""
     r = Rounds(subject, baseline, runner=runner, subject_scale=subject_scale, baseline_scale=baseline_scale)
     j = timing.judge(r, target=target, speedup=speedup, rounds=rounds,
-                     max_rounds=rounds if runner is not None else max_rounds)
+                     max_rounds=rounds if runner is not None else max_rounds,
+                     early=early if runner is None else None)
     return j, r
 
 
@@ -557,6 +565,9 @@ def performance_report(sizes: Sizes, *, stepper: Callable | None = None,
     average — is recorded in every timed record's ``details["machine"]``: the evidence, beside each record's
     own, of why a speed could not be judged."""
     machine: dict[str, Any] = {"joined_threads": _quiet_process()}
+    # the memory record first: on the idle core it is the stage's longest single job (2.3 s at ci, quiet), and the
+    # timed records cut short by the early look no longer outlast it; the calibration runs beside it as they do
+    pending = aside(sizes.memory_steps, stepper) if aside is not None else None
     machine.update({"calibration_before": timing.calibrate_both(), "loadavg_before": timing.loadavg()})
     mr = sizes.max_rounds
     jobs: list[tuple[str, Callable[[], CheckResult]]] = []
@@ -572,7 +583,6 @@ def performance_report(sizes: Sizes, *, stepper: Callable | None = None,
         jobs.append((f"ensemble {kind}", ens))
     jobs.append(("DiodeBridge", lambda: check_lcs_step(steps=sizes.lcs_steps, rounds=sizes.lcs_rounds,
                                                        max_rounds=mr)))
-    pending = aside(sizes.memory_steps, stepper) if aside is not None else None
     memory: list[CheckResult] = []
 
     def memory_record() -> CheckResult:
@@ -607,7 +617,7 @@ def performance_report(sizes: Sizes, *, stepper: Callable | None = None,
     return report
 
 
-__all__ = ["PER_STEP_TARGET", "ENSEMBLE_TARGET", "LCS_TARGET", "LCS_BATCH_TARGET", "LCS_BATCH_TARGET_COMPILED", "LCS_AGREEMENT", "MEMORY_TARGET",
+__all__ = ["EARLY_ROUNDS", "PER_STEP_TARGET", "ENSEMBLE_TARGET", "LCS_TARGET", "LCS_BATCH_TARGET", "LCS_BATCH_TARGET_COMPILED", "LCS_AGREEMENT", "MEMORY_TARGET",
            "SIZES", "Sizes", "bare_t_norm", "bare_box", "bare_ball", "floor_loop", "minimal_lcs", "per_step_case", "ensemble_case",
            "interleave", "measure", "Rounds", "ratio_record", "check_per_step", "check_ensemble", "check_lcs_step", "check_lcs_batch",
            "check_memory", "peak_memory", "performance_report"]
