@@ -124,6 +124,10 @@ __all__ = ["prefetched", "batched", "batch_sizes", "_BatchFailure", "SMALL_BATCH
 
 #: law name → its vectorised form ``fn(op, rows) -> ratios (B,)`` (:func:`vectorised`)
 VECTORISED: dict[str, Any] = {}
+#: the laws whose vectorised form decides a row by the other rows of its pass (``yosida_limit``: the last row still
+#: open goes to the evaluator), so that its rows are decided only in a pass of their own list (never prefetched with
+#: other lists: :meth:`verimono.checks.engine.search._Search.prefetch`); every other form is computed row by row
+PER_PASS = {"yosida_limit"}
 #: a vectorised ratio above this (or not finite) is evaluated again by the law's evaluator of one sample
 SUSPECT = 0.999
 #: the most coordinates stacked in one vectorised evaluation (rows × n): bounds its memory at n = 10^6
@@ -426,7 +430,7 @@ def row_ratios(lhs: np.ndarray, rhs: np.ndarray, slack: np.ndarray) -> np.ndarra
     return np.where(bad, np.inf, r)
 
 
-__all__ += ["VECTORISED", "SUSPECT", "ROW_CELLS", "ROUNDING_SAFETY", "vectorised", "Rows", "rows_accepted", "rounding",
+__all__ += ["VECTORISED", "PER_PASS", "SUSPECT", "ROW_CELLS", "ROUNDING_SAFETY", "vectorised", "Rows", "rows_accepted", "rounding",
             "rounding_bound",
             "row_resolvents", "row_member", "row_contains", "row_values",
             "row_norms", "row_dots", "row_ratios"]
