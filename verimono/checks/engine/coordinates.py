@@ -79,6 +79,15 @@ def _replace(s: Sample, **changes: Any) -> Sample:
     return out
 
 
+def _with(s: Sample, name: str, value: float) -> Sample:
+    """:func:`_replace` of one field, without building keyword arguments (a step or time design: ~1 µs a sample)."""
+    out = object.__new__(Sample)
+    d = out.__dict__
+    d.update(s.__dict__)
+    d[name] = value
+    return out
+
+
 def _norm(v: np.ndarray) -> float:
     m = float(np.max(np.abs(v), initial=0.0))
     return 0.0 if m == 0.0 or not math.isfinite(m) else m * float(np.linalg.norm(v / m))
@@ -90,11 +99,11 @@ def _moves(s: Sample, name: str, op: Any, horizon: float) -> tuple[Space, Callab
     if name in ("lam", "mu", "nu"):
         lo, hi = current_step_range()
         space = Space(name, lo, hi, log=True)
-        return space, (lambda v: _replace(s, **{name: float(v)})), \
+        return space, (lambda v: _with(s, name, float(v))), \
             [10.0 ** k for k in range(-4, 2)] + [lo, hi, getattr(s, name)]
     if name == "t":
         space = Space("t", 0.0, float(horizon))
-        return space, (lambda v: _replace(s, t=float(v))), [0.0, horizon / 2, float(horizon), s.t]
+        return space, (lambda v: _with(s, "t", float(v))), [0.0, horizon / 2, float(horizon), s.t]
     if s.recipe is not None:
         return None
     if name == "scale":
