@@ -124,6 +124,10 @@ __all__ = ["prefetched", "batched", "batch_sizes", "_BatchFailure", "SMALL_BATCH
 
 #: law name → its vectorised form ``fn(op, rows) -> ratios (B,)`` (:func:`vectorised`)
 VECTORISED: dict[str, Any] = {}
+#: the laws whose vectorised form decides a row by the other rows of its pass (``yosida_limit``: the last row still
+#: open goes to the evaluator), so that its rows are decided only in a pass of their own list (never prefetched with
+#: other lists: :meth:`verimono.checks.engine.search._Search.prefetch`); every other form is computed row by row
+PER_PASS = {"yosida_limit"}
 #: a vectorised ratio above this (or not finite) is evaluated again by the law's evaluator of one sample
 SUSPECT = 0.999
 #: the most coordinates stacked in one vectorised evaluation (rows × n): bounds its memory at n = 10^6
@@ -147,8 +151,9 @@ class Rows:
     __slots__ = ("x1", "x2", "lam", "mu", "nu", "t", "ok", "err")
 
     def __init__(self, samples: Sequence[Any]) -> None:
-        self.x1 = np.stack([s.x1 for s in samples]).astype(float, copy=False)
-        self.x2 = np.stack([s.x2 for s in samples]).astype(float, copy=False)
+        # np.array of the points (not np.stack: ~4x its cost per row here, the same numbers; a ragged list raises alike)
+        self.x1 = np.array([s.x1 for s in samples], dtype=float)
+        self.x2 = np.array([s.x2 for s in samples], dtype=float)
         self.lam, self.mu, self.nu, self.t = (np.array([getattr(s, k) for s in samples], dtype=float)
                                               for k in ("lam", "mu", "nu", "t"))
         self.ok = np.ones(len(samples), dtype=bool)
@@ -218,17 +223,22 @@ def row_resolvents(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok:
     good = np.ones(B, dtype=bool)
     if B == 0:
         return np.zeros_like(X)
-    if rows_accepted(op):
+    st, perf = (CLOCK[-1] if CLOCK else None), time.perf_counter      # _call_starts, inlined: the loops below are
+    if rows_accepted(op):                                               # the engine's cost per row
         order, bounds = _groups(lams, ts)
         Xs = X.copy() if order is None else X[order]        # the subject's input: one private copy
         lam_l = (lams if order is None else lams[order]).tolist()
         t_l = (ts if order is None else ts[order]).tolist()
         Js, resolvent = np.empty_like(Xs), op.resolvent
         for lo, hi in zip(bounds[:-1], bounds[1:]):
-            _call_starts()
+            if st is not None:
+                now, f = perf(), st.in_flight
+                if f is not None and now - f > st.slowest:
+                    st.slowest = now - f
+                st.in_flight = now
             try:
                 P = resolvent(Xs if hi - lo == B else Xs[lo:hi], lam_l[lo], t_l[lo])
-                if type(P) is not np.ndarray or P.dtype != np.float64:
+                if type(P) is not np.ndarray or P.dtype is not _F64:
                     P = as_float64(P)
                 if P.shape != (hi - lo, n):
                     raise ValueError
@@ -251,10 +261,14 @@ def row_resolvents(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok:
     Xc = X.copy()       # row i is the subject's input of call i (a row of a private copy)
     lam_l, t_l, resolvent = lams.tolist(), ts.tolist(), op.resolvent
     for i in range(B):
-        _call_starts()
+        if st is not None:
+            now, f = perf(), st.in_flight
+            if f is not None and now - f > st.slowest:
+                st.slowest = now - f
+            st.in_flight = now
         try:
             p = resolvent(Xc[i], lam_l[i], t_l[i])
-            if type(p) is not np.ndarray or p.dtype != np.float64:
+            if type(p) is not np.ndarray or p.dtype is not _F64:
                 p = as_float64(p)
             if p.shape != (n,):
                 raise ValueError
@@ -269,6 +283,10 @@ def row_resolvents(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok:
     return J
 
 
+#: float64's dtype (``P.dtype is _F64``: NumPy's native float64 dtype is one object; any other goes through ``as_float64``)
+_F64 = np.dtype(np.float64)
+
+
 def row_member(member: Any, X: np.ndarray, ts: np.ndarray, ok: np.ndarray) -> np.ndarray:
     """``member(X_i, t_i)`` of every row, one call per row on a copy (a member other than the resolvent —
     ``min_norm``, ``project_domain`` — is no batch map the catalog promises); a row whose call raised (an
@@ -276,11 +294,16 @@ def row_member(member: Any, X: np.ndarray, ts: np.ndarray, ok: np.ndarray) -> np
     marked ``False`` in ``ok``.  Each call is timed as a call of its own (:func:`_call_starts`)."""
     out = np.zeros_like(X)
     t_l, n, bad = ts.tolist(), X.shape[1], []
+    st, perf = (CLOCK[-1] if CLOCK else None), time.perf_counter      # _call_starts, inlined
     for i in np.flatnonzero(ok).tolist():
-        _call_starts()
+        if st is not None:
+            now, f = perf(), st.in_flight
+            if f is not None and now - f > st.slowest:
+                st.slowest = now - f
+            st.in_flight = now
         try:
             p = member(X[i].copy(), t_l[i])
-            if type(p) is not np.ndarray or p.dtype != np.float64:
+            if type(p) is not np.ndarray or p.dtype is not _F64:
                 p = as_float64(p)
             if p.shape != (n,):
                 raise ValueError
@@ -301,8 +324,13 @@ def row_values(op: Any, Z: np.ndarray, ts: np.ndarray, ok: np.ndarray) -> np.nda
     (the law's evaluator judges a point outside ``dom g``)."""
     out = np.zeros(len(ok))
     t_l, value = ts.tolist(), op.value
+    st, perf = (CLOCK[-1] if CLOCK else None), time.perf_counter      # _call_starts, inlined
     for i in np.flatnonzero(ok).tolist():
-        _call_starts()
+        if st is not None:
+            now, f = perf(), st.in_flight
+            if f is not None and now - f > st.slowest:
+                st.slowest = now - f
+            st.in_flight = now
         try:
             v = value(np.array(Z[i], dtype=float), t_l[i])
             v = float(v if type(v) is float else as_float64(v))
@@ -326,8 +354,13 @@ def row_contains(op: Any, X: np.ndarray, Y: np.ndarray, ts: np.ndarray, tols: np
     can)."""
     got = np.zeros(len(ok), dtype=bool)
     t_l, tol_l, contains = ts.tolist(), np.broadcast_to(tols, ts.shape).tolist(), op.contains
+    st, perf = (CLOCK[-1] if CLOCK else None), time.perf_counter      # _call_starts, inlined
     for i in np.flatnonzero(ok).tolist():
-        _call_starts()
+        if st is not None:
+            now, f = perf(), st.in_flight
+            if f is not None and now - f > st.slowest:
+                st.slowest = now - f
+            st.in_flight = now
         try:
             v = contains(X[i].copy(), Y[i].copy(), t_l[i], tol_l[i])
         except NotImplementedError:
@@ -398,7 +431,7 @@ def row_ratios(lhs: np.ndarray, rhs: np.ndarray, slack: np.ndarray) -> np.ndarra
     return np.where(bad, np.inf, r)
 
 
-__all__ += ["VECTORISED", "SUSPECT", "ROW_CELLS", "ROUNDING_SAFETY", "vectorised", "Rows", "rows_accepted", "rounding",
+__all__ += ["VECTORISED", "PER_PASS", "SUSPECT", "ROW_CELLS", "ROUNDING_SAFETY", "vectorised", "Rows", "rows_accepted", "rounding",
             "rounding_bound",
             "row_resolvents", "row_member", "row_contains", "row_values",
             "row_norms", "row_dots", "row_ratios"]

@@ -79,6 +79,15 @@ def _replace(s: Sample, **changes: Any) -> Sample:
     return out
 
 
+def _with(s: Sample, name: str, value: float) -> Sample:
+    """:func:`_replace` of one field, without building keyword arguments (a step or time design: ~1 µs a sample)."""
+    out = object.__new__(Sample)
+    d = out.__dict__
+    d.update(s.__dict__)
+    d[name] = value
+    return out
+
+
 def _norm(v: np.ndarray) -> float:
     m = float(np.max(np.abs(v), initial=0.0))
     return 0.0 if m == 0.0 or not math.isfinite(m) else m * float(np.linalg.norm(v / m))
@@ -90,11 +99,11 @@ def _moves(s: Sample, name: str, op: Any, horizon: float) -> tuple[Space, Callab
     if name in ("lam", "mu", "nu"):
         lo, hi = current_step_range()
         space = Space(name, lo, hi, log=True)
-        return space, (lambda v: _replace(s, **{name: float(v)})), \
+        return space, (lambda v: _with(s, name, float(v))), \
             [10.0 ** k for k in range(-4, 2)] + [lo, hi, getattr(s, name)]
     if name == "t":
         space = Space("t", 0.0, float(horizon))
-        return space, (lambda v: _replace(s, t=float(v))), [0.0, horizon / 2, float(horizon), s.t]
+        return space, (lambda v: _with(s, "t", float(v))), [0.0, horizon / 2, float(horizon), s.t]
     if s.recipe is not None:
         return None
     if name == "scale":
@@ -126,7 +135,8 @@ def _moves(s: Sample, name: str, op: Any, horizon: float) -> tuple[Space, Callab
 def coordinate_search(evaluate: Callable[[Sample], float], op: Any, start: Sample, horizon: float, points: int,
                       seed: int, stop: Callable[[], bool],
                       many: Callable[[list[Sample]], list[float]] | None = None, dense: bool = False,
-                      rows: bool = False, over: tuple = COORDINATES) -> list[dict]:
+                      rows: bool = False, over: tuple = COORDINATES,
+                      prefetch: Callable[[list[list[Sample]]], None] | None = None) -> list[dict]:
     """Each coordinate of ``start`` maximised on its own (module docstring); ``evaluate(sample)`` returns the
     law's ratio (and raises to end the search, as on a violation); ``many(samples)`` the ratios of a list
     (default: ``evaluate`` of each; the search's evaluates a law's vectorised form over all of them at once —
@@ -134,6 +144,9 @@ def coordinate_search(evaluate: Callable[[Sample], float], op: Any, start: Sampl
     design is :func:`dense_count` points of its space (``rows``: the operator maps batches, so the points'
     coordinates are denser still); ``stop()`` ends it between coordinates; ``over``: the law's declared
     quantifiers (:attr:`verimono.checks.core.Law.over`) — a coordinate it does not declare is not searched.
+    ``prefetch(lists)`` (with ``dense``): told the designs of every coordinate after the direction before the
+    first is evaluated (they all start from the same sample), so that ``many`` evaluates them in one pass; each is
+    still searched in its turn, its design then its local search, as without it.
     Returns what each coordinate's search covered."""
     if many is None:
         many = lambda ss: [evaluate(s) for s in ss]     # noqa: E731
@@ -153,28 +166,47 @@ def coordinate_search(evaluate: Callable[[Sample], float], op: Any, start: Sampl
                 best[:] = [v, s]
         return vals
 
-    for name in (c for c in COORDINATES if c in over):
+    def plan(name: str) -> tuple | None:
+        """The coordinate's space, its sample at a point, its design and samples, and the step decades' (``None``:
+        it cannot move)."""
+        moved = _moves(here, name, op, horizon)
+        if moved is None:
+            return None
+        space, at, design = moved
+        decades = None
+        if name in ("lam", "mu", "nu"):
+            d_design, stride = _decade_design(space, points, dense)
+            decades = (space, d_design, stride, [at(v) for v in d_design])
+            space = Space(name, *STEPS, log=True)       # the steps the samples are drawn from, at full density
+        if dense:
+            design = design + _even(space, dense_count(points, name, rows))
+        design = [float(min(max(v, space.lo), space.hi)) for v in design]
+        return space, at, design, [at(v) for v in design], decades
+
+    names = [c for c in COORDINATES if c in over and not (c in _MORE and points < MORE_FROM)]
+    plans: dict = {}
+    for name in names:
         if stop():
             break
-        if name in _MORE and points < MORE_FROM:
-            continue
         if name == "direction":        # not one-dimensional: the sphere of directions of x2 - x1
             got = direction_search(ev, op, start, points, seed, evs)
             if got is not None:
                 done.append(got)
             here = best[1]             # the other coordinates from the worst direction (or the worst sample)
             continue
-        moved = _moves(here, name, op, horizon)
-        if moved is None:
+        if dense and prefetch is not None and not plans:     # every design from ``here``, known now: one pass
+            plans = {c: plan(c) for c in names if c != "direction"}
+            prefetch([ss for p in plans.values() if p is not None
+                      for ss in ((p[4][3], p[3]) if p[4] is not None else (p[3],))])
+        planned = plans[name] if name in plans else plan(name)
+        if planned is None:
             continue
-        space, at, design = moved
-        if name in ("lam", "mu", "nu"):
-            done.append(_decades(evaluate, space, at, points, seed, name, many, dense))
-            space = Space(name, *STEPS, log=True)       # the steps the samples are drawn from, at full density
-        if dense:
-            design = design + _even(space, dense_count(points, name, rows))
-        design = [float(min(max(v, space.lo), space.hi)) for v in design]
-        first = many([at(v) for v in design])
+        space, at, design, samples, decades = planned
+        if decades is not None:
+            d_space, d_design, stride, d_samples = decades
+            done.append(_decades(evaluate, d_space, at, points, seed, name, many, dense,
+                                 planned=(d_design, stride, d_samples)))
+        first = many(samples)
         if len(set(first)) <= 1 and not dense:     # flat at the design: covered by the budget's points
             more = [v for v in _covering(space, points, seed) if v not in set(design)]
             design, first = design + more, first + many([at(v) for v in more])
@@ -188,15 +220,8 @@ def coordinate_search(evaluate: Callable[[Sample], float], op: Any, start: Sampl
     return done
 
 
-def _decades(evaluate: Callable[[Sample], float], space: Space, at: Callable[[float], Sample], points: int,
-             seed: int, name: str, many: Callable[[list[Sample]], list[float]] | None = None,
-             dense: bool = False) -> dict:
-    """The step coordinate ``name`` over every decade the precision represents (``space``,
-    :func:`verimono.core.tolerances.current_step_range`): a design of every ``stride``-th decade, ``stride`` the
-    smallest that ``DECADE_SHARE · points`` evaluations pay (ci: every 3rd decade of float64's 160, dev every 6th,
-    thorough every one), then, unless the ratio is the same at every design point (a law that does not read the
-    step: ``"read": False``), the local search of :func:`maximise` around the largest design values (the design
-    is the coverage: its stride is the resolution promised)."""
+def _decade_design(space: Space, points: int, dense: bool) -> tuple[list[float], float]:
+    """The design of :func:`_decades` over ``space`` and its stride (decades between design points)."""
     lo, hi = math.ceil(math.log10(space.lo)), math.floor(math.log10(space.hi))
     stride: float = max(1, math.ceil((hi - lo) / (DECADE_SHARE * max(1, points))))
     design = [10.0 ** k for k in range(lo, hi + 1, int(stride))] + [space.hi]
@@ -205,7 +230,23 @@ def _decades(evaluate: Callable[[Sample], float], space: Space, at: Callable[[fl
         extra = _even(space, min(DENSE_MAX, DECADE_SHARE * (dense_count(points) if dense else points)))
         stride = min(float(stride), (math.log10(space.hi) - math.log10(space.lo)) / max(1, len(extra) - 1))
         design = sorted(set(design + extra))
-    first = many([at(v) for v in design]) if many is not None else [evaluate(at(v)) for v in design]
+    return design, stride
+
+
+def _decades(evaluate: Callable[[Sample], float], space: Space, at: Callable[[float], Sample], points: int,
+             seed: int, name: str, many: Callable[[list[Sample]], list[float]] | None = None,
+             dense: bool = False, planned: tuple | None = None) -> dict:
+    """The step coordinate ``name`` over every decade the precision represents (``space``,
+    :func:`verimono.core.tolerances.current_step_range`): a design of every ``stride``-th decade, ``stride`` the
+    smallest that ``DECADE_SHARE · points`` evaluations pay (ci: every 3rd decade of float64's 160, dev every 6th,
+    thorough every one), then, unless the ratio is the same at every design point (a law that does not read the
+    step: ``"read": False``), the local search of :func:`maximise` around the largest design values (the design
+    is the coverage: its stride is the resolution promised).  ``planned``: the design, its stride and its samples,
+    made before (:func:`_decade_design`)."""
+    design, stride, samples = planned if planned is not None else (*_decade_design(space, points, dense), None)
+    if samples is None:
+        samples = [at(v) for v in design]
+    first = many(samples) if many is not None else [evaluate(s) for s in samples]
     if len(set(first)) <= 1:
         return {"coordinate": f"{name} decades", "read": False, "stride": stride, "points": len(design),
                 "range": [space.lo, space.hi], "log": True}

@@ -50,12 +50,12 @@ def sweep_count(profile: str | None, law: str) -> int:
     return min(n, SWEEP_CAP.get(law, n))
 
 
-def sweep_samples(op, seed: int, horizon: float, count: int, make: Callable) -> list:
-    """``count`` samples (built by ``make(x1, x2, lam, mu, nu, t)``) for ``op`` on ``R^n``, seeded by ``seed``."""
-    n = int(op.dim)
+def _sweep_draws(n: int, seed: int, horizon: float, count: int, cap: float) -> tuple:
+    """The seeded part of :func:`sweep_samples` — every sample's ``x1, x2, λ, μ, ν, t`` before the points in the
+    range of the resolvent replace some (those consume no draw) — as ``(X1, X2, steps, t)``, read-only: the same
+    for every law of a battery (cached by :func:`_cached_draws`)."""
     rng = np.random.default_rng([int(seed) % (2 ** 63), n, count])
-    cap = current_largest() / 64.0           # a float16 subject cannot be given |x| = 1e6
-    out, boundary = [], None
+    X1, X2, steps, ts = np.empty((count, n)), np.empty((count, n)), np.empty((count, 3)), np.empty(count)
     for i in range(count):
         s1 = min(SCALES[i % len(SCALES)], cap)
         u = rng.uniform(-1.0, 1.0, n)
@@ -76,6 +76,41 @@ def sweep_samples(op, seed: int, horizon: float, count: int, make: Callable) -> 
             x2 = x1 + 1e-2 * np.abs(x1) * rng.uniform(-1.0, 1.0, n)
             lam, mu, nu = (float(10.0 ** rng.uniform(*MIXED)) for _ in range(3))
         t = float((0.0, float(horizon))[i % 2]) if i % 7 < 2 else float(rng.uniform(0.0, horizon))
+        X1[i], X2[i], steps[i], ts[i] = x1, x2, (lam, mu, nu), t
+    return X1, X2, steps, ts
+
+
+#: the seeded draws of the last few (function, arguments) — a battery's laws draw the same samples for the same
+#: seed, dimension and count: :func:`_cached_draws`
+_DRAWS: dict = {}
+#: how many draws :data:`_DRAWS` keeps (a battery's; a stage's operators of one dimension share theirs)
+DRAWS_KEPT = 16
+
+
+def _cached_draws(fn: Callable, *args) -> tuple:
+    """``fn(*args)`` (a pure function of its arguments: seeded NumPy draws), computed once for the last
+    :data:`DRAWS_KEPT` distinct calls; its arrays read-only (every sample made from them gets copies)."""
+    key = (fn.__name__,) + args
+    got = _DRAWS.get(key)
+    if got is None:
+        got = fn(*args)
+        for a in got:
+            a.flags.writeable = False
+        if len(_DRAWS) >= DRAWS_KEPT:
+            _DRAWS.pop(next(iter(_DRAWS)))
+        _DRAWS[key] = got
+    return got
+
+
+def sweep_samples(op, seed: int, horizon: float, count: int, make: Callable) -> list:
+    """``count`` samples (built by ``make(x1, x2, lam, mu, nu, t)``) for ``op`` on ``R^n``, seeded by ``seed``."""
+    n = int(op.dim)
+    cap = current_largest() / 64.0           # a float16 subject cannot be given |x| = 1e6
+    X1, X2, steps, ts = _cached_draws(_sweep_draws, n, int(seed), float(horizon), int(count), float(cap))
+    lams, mus, nus, tl = steps[:, 0].tolist(), steps[:, 1].tolist(), steps[:, 2].tolist(), ts.tolist()
+    out, boundary = [], None
+    for i in range(count):
+        x1, x2, lam, mu, nu, t = X1[i].copy(), X2[i].copy(), lams[i], mus[i], nus[i], tl[i]
         if i % 4 == 3:   # points in the range of J: J_ν x and J_ν(J_ν x), or just outside the boundary
             try:
                 a = np.asarray(op.resolvent(x1.copy(), nu, t), dtype=float)
@@ -108,6 +143,11 @@ def law_draws(n: int, seed: int, horizon: float, count: int, make: Callable, sca
     is one of 0, ±1/2, ±1, ±2, ±scale a quarter of the time, a small integer another eighth; half the step
     sizes and times are the strategies' simple ones), but drawn by NumPy from ``default_rng(seed)``, about a
     hundred times faster than hypothesis's engine draws a sample."""
+    return _samples(_cached_draws(_law_draws, int(n), int(seed), float(horizon), int(count), float(scale)), make)
+
+
+def _law_draws(n: int, seed: int, horizon: float, count: int, scale: float) -> tuple:
+    """The draws of :func:`law_draws` as ``(X1, X2, steps, t)``."""
     rng = np.random.default_rng([int(seed) % (2 ** 63), int(n), int(count), 1])
 
     def point(size: float) -> np.ndarray:
@@ -122,15 +162,22 @@ def law_draws(n: int, seed: int, horizon: float, count: int, make: Callable, sca
             return float(_SIMPLE_STEPS[rng.integers(len(_SIMPLE_STEPS))])
         return float(10.0 ** rng.uniform(-3.0, 1.0)) if rng.uniform() < 0.5 else float(rng.uniform(1e-3, 10.0))
 
-    out = []
-    for _ in range(count):
+    X1, X2, steps, ts = np.empty((count, n)), np.empty((count, n)), np.empty((count, 3)), np.empty(count)
+    for i in range(count):
         x1 = point(scale)
         x2 = x1 + point(1e-2) if rng.uniform() < 0.5 else point(scale)
         lam, mu, nu = step(), step(), step()
         t = (0.0, float(horizon), 0.5 * horizon)[rng.integers(3)] if rng.uniform() < 0.5 else \
             float(rng.uniform(0.0, horizon))
-        out.append(make(x1, x2, lam, mu, nu, float(t)))
-    return out
+        X1[i], X2[i], steps[i], ts[i] = x1, x2, (lam, mu, nu), float(t)
+    return X1, X2, steps, ts
+
+
+def _samples(draws: tuple, make: Callable) -> list:
+    """The samples of cached draws ``(X1, X2, steps, t)``, each with its own copies of the points."""
+    X1, X2, steps, ts = draws
+    return [make(X1[i].copy(), X2[i].copy(), lam, mu, nu, t)
+            for i, ((lam, mu, nu), t) in enumerate(zip(steps.tolist(), ts.tolist()))]
 
 
 #: hypothesis's own favourites that :func:`law_draws` does not draw (printed from its generate phase on the catalog at
@@ -172,6 +219,11 @@ def edge_draws(n: int, seed: int, horizon: float, count: int, make: Callable, sc
       to ``x1``'s: repeated values), or drawn like ``x1``;
     * step sizes from :data:`EDGE_STEPS` half the time (else log-uniform in ``[10^-3, 10]``), times from
       :data:`EDGE_TIMES` (times ``horizon``) half the time (else uniform in ``[0, horizon]``)."""
+    return _samples(_cached_draws(_edge_draws, int(n), int(seed), float(horizon), int(count), float(scale)), make)
+
+
+def _edge_draws(n: int, seed: int, horizon: float, count: int, scale: float) -> tuple:
+    """The draws of :func:`edge_draws` as ``(X1, X2, steps, t)``."""
     count, n = int(count), int(n)
     rng = np.random.default_rng([int(seed) % (2 ** 63), n, count, 2])
     kinds = np.cumsum(EDGE_KINDS) / np.sum(EDGE_KINDS)
@@ -203,8 +255,7 @@ def edge_draws(n: int, seed: int, horizon: float, count: int, make: Callable, sc
         x1[0], x2[0], steps[0], t[0] = 0.0, 0.0, 1.0, 0.0      # hypothesis's simplest example
     if count > 1:
         x2[1] = x1[1]                                          # identical points
-    return [make(x1[i].copy(), x2[i].copy(), float(steps[i, 0]), float(steps[i, 1]), float(steps[i, 2]), float(t[i]))
-            for i in range(count)]
+    return x1, x2, steps, t
 
 
 def _simpler_floats(v: float) -> list[float]:
