@@ -93,11 +93,12 @@ def test_rel_int_margin_and_shorter_solution_are_linprogs_bit_for_bit(monkeypatc
 
 
 def test_rel_int_memo_solves_each_lp_once_and_answers_the_lp(monkeypatch):
-    solved = []
+    solved, answers = [], []
 
     def margin(system, t):
         solved.append(t)
-        return hyp.rel_int_margin(system, t)
+        answers.append(hyp.rel_int_margin(system, t))
+        return answers[-1]
 
     monkeypatch.setattr(section7, "rel_int_margin", margin)
     system = example_system(lambda t: np.array([np.sin(3 * t) - 0.2, 0.0]))
@@ -105,7 +106,9 @@ def test_rel_int_memo_solves_each_lp_once_and_answers_the_lp(monkeypatch):
     assert len(solved) == len(set(solved))                          # each t's LP once
     assert set(np.linspace(0.0, 2.0, 17).tolist()) <= set(solved)   # the grid among them, and searched beyond
     assert len(solved) > 17
-    # what the law reports is what the LPs say: its grid margins, and its least margin the least of all solved
+    # what the law reports is what the LPs say: its grid margins, its search's least margin the LP's at the time
+    # the search names, and its worst the least of all solved
     assert out.details["margins"] == [hyp.rel_int_margin(system, t) for t in out.details["t"]]
-    least = min(hyp.rel_int_margin(system, t) for t in solved)
-    assert -out.worst == least
+    found = out.details["min_search"]
+    assert -found["sup"] == hyp.rel_int_margin(system, found["t"])
+    assert -out.worst == min(answers)
