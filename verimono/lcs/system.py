@@ -17,6 +17,8 @@ with ``γ = 1`` unless the θ-γ variant is asked for.  ``θ = 1`` is the paper'
 
 from __future__ import annotations
 
+import copy
+
 from typing import Any, Callable
 
 import numpy as np
@@ -68,6 +70,15 @@ class StepMatrices:
         self.M = sys.D + h * gamma * sys.C @ WiB
         self.step = sys.relation.stepper(self.M)
         self._relation = sys.relation
+
+    def fresh(self) -> "StepMatrices":
+        """What ``StepMatrices(sys, h, θ, γ)`` makes again — the same matrices (shared, never written) and a fresh
+        one-step solver (:meth:`verimono.lcs.relations._BoxStepper.fresh`: its pattern factorisations shared) —
+        without recomputing them."""
+        new = copy.copy(self)
+        fresh = getattr(self.step, "fresh", None)
+        new.step = fresh() if fresh is not None else self._relation.stepper(self.M)
+        return new
 
     def relation_step(self):
         """A fresh warm-started one-step solver ``(q, scale) ↦ (z, w)`` for ``M`` (:meth:`Relation.stepper`)."""
@@ -361,6 +372,8 @@ def _increments(u, t: np.ndarray, n: int, B: int | None) -> np.ndarray | None:
 
 #: entries of an operator's memo of ``H^0(t, x)`` and ``proj_dom H(t,·)(x)`` (:meth:`LCSOperator._memoised`)
 MEMO_SIZE = 8192
+#: step sizes whose matrices an operator keeps once made (:meth:`LCSOperator._sm`), forgotten all at once
+STEP_TEMPLATES = 4096
 
 
 class LCSOperator(Operator):
@@ -379,6 +392,7 @@ class LCSOperator(Operator):
         self.system = system
         self.static = system.v_constant
         self._mats: dict[float, StepMatrices] = {}
+        self._templates: dict[str, StepMatrices] = {}
         self._recent: StepMatrices | None = None
         # the active sets of the last selection and projection QPs (:mod:`verimono.lcs._warm_qp`)
         self._warm_select: dict = {}
@@ -404,7 +418,16 @@ class LCSOperator(Operator):
         if sm is None:
             if len(self._mats) > 16:
                 self._mats.clear()
-            sm = self._mats[lam] = self.system.step_matrices(lam, 1.0, None)
+            # the matrices of a step size are a function of it alone: made once (an operator law asks ~20,000
+            # resolvents over a few hundred λ, far more than the 16 live steppers), each live stepper made fresh
+            # from them as a new StepMatrices would be — the same answers, bit for bit, at a copy's cost
+            key = lam.hex()
+            tpl = self._templates.get(key)
+            if tpl is None:
+                if len(self._templates) >= STEP_TEMPLATES:
+                    self._templates.clear()
+                tpl = self._templates[key] = self.system.step_matrices(lam, 1.0, None)
+            sm = self._mats[lam] = tpl.fresh()
             warm = getattr(sm.step, "warm_from", None)
             if warm is not None and self._recent is not None:   # a new step size: the last one's pattern first
                 warm(self._recent.step)
