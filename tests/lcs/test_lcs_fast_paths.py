@@ -262,3 +262,31 @@ def test_step_matrices_made_once_answer_as_new_ones_bit_for_bit(monkeypatch):
         assert all(n > 0 for _, n in fast)                   # full solves happen, and are compared
         monkeypatch.setattr(_BoxStepper, "fresh", lambda self: _BoxStepper(self.rel, self.M))    # new each time
         assert [_resolvent_run(make().operator(), np.random.default_rng(1)) for make in systems] == fast
+
+
+def test_batched_resolvent_rows_are_the_point_resolvents_bit_for_bit():
+    """``LCSOperator.resolvent`` of a batch (``_rows``: the step matrices and ``v(t)`` looked up once) answers
+    each row as the one-point resolvent does, bit for bit, and leaves its stepper as the rows one by one would
+    (the same full solves, last and recent patterns): rows inside ``dom H``, at its edge and beyond, in runs."""
+    from verimono.execution.workers import blas_limited
+    from verimono.lcs import LinearRelationSystem, Relay
+    from verimono.reference.lcs_example import example_system
+
+    rng = np.random.default_rng(8)
+    S = rng.normal(size=(2, 2))
+    C = rng.normal(size=(2, 2))
+    makes = [lambda: example_system(lambda t: np.array([np.sin(t), 0.0])),
+             lambda: LinearRelationSystem(-np.eye(2), C.T, C, S - S.T, Relay(-1.0, 2.0),
+                                          v=lambda t: np.array([np.cos(t), t]))]
+    with blas_limited():
+        for make in makes:
+            batched, single = make().operator(), make().operator()
+            for k in range(30):
+                lam, t = float(10.0 ** rng.uniform(-4, 1)), float(rng.uniform(0, 2))
+                X = rng.normal(size=(int(rng.integers(1, 12)), batched.dim)) * 10.0 ** rng.uniform(-3, 1)
+                X[::3] = np.abs(X[::3]) * (k % 2)       # runs of the domain's edge and inside it
+                got = batched.resolvent(X, lam, t)
+                want = np.array([single.resolvent(x, lam, t) for x in X])
+                assert got.shape == want.shape and _bits(got) == _bits(want)
+                a, b = batched._mats[lam].step, single._mats[lam].step
+                assert (a.full_solves, a.last, a.recent) == (b.full_solves, b.last, b.recent)
