@@ -393,6 +393,7 @@ class LCSOperator(Operator):
         self.static = system.v_constant
         self._mats: dict[float, StepMatrices] = {}
         self._templates: dict[str, StepMatrices] = {}
+        self._proj_data: tuple | None = None
         self._recent: StepMatrices | None = None
         # the active sets of the last selection and projection QPs (:mod:`verimono.lcs._warm_qp`)
         self._warm_select: dict = {}
@@ -578,10 +579,14 @@ class LCSOperator(Operator):
         if not rel.is_lcp:
             raise NotImplementedError(f"{self.name}: projection onto dom H for mixed bounds")
         n, m = s.n, s.m
-        P = np.zeros((n + m, n + m))
-        P[:n, :n] = np.eye(n)
-        G = np.block([[np.zeros((m, n)), -np.eye(m)], [-s.C, -s.D]])
-        h = np.concatenate([np.zeros(m), s.v(t)])
+        if self._proj_data is None:     # P and G are the system's: made once (read only), as np.block made them
+            P = np.zeros((n + m, n + m))
+            P[:n, :n] = np.eye(n)
+            G = np.block([[np.zeros((m, n)), -np.eye(m)], [-s.C, -s.D]])
+            P.flags.writeable = G.flags.writeable = False
+            self._proj_data = (P, G)
+        P, G = self._proj_data
+        h = np.concatenate([np.zeros(m), v])        # v = v(t), looked up above
         return solve_qp_warm(self._warm_project, P, np.concatenate([-x, np.zeros(m)]), G, h)[:n]
 
 
