@@ -112,3 +112,20 @@ def test_rel_int_memo_solves_each_lp_once_and_answers_the_lp(monkeypatch):
     found = out.details["min_search"]
     assert -found["sup"] == hyp.rel_int_margin(system, found["t"])
     assert -out.worst == min(answers)
+
+
+def test_lcp_feasibility_and_infeasibility_certificate_are_linprogs(monkeypatch):
+    """``lcp._feasible`` and ``lcp._infeasibility_certificate`` (the LPs behind ``dom H`` and the infeasible-step
+    message) answer as through ``linprog``, bit for bit, on feasible and infeasible LCPs of PSD and skew ``M``."""
+    import verimono.lcs.lcp as lcp
+
+    rng = np.random.default_rng(3)
+    cases = []
+    for k in range(40):
+        R = rng.normal(size=(3, 3))
+        M = (R @ R.T * (rng.random((3, 3)) < 0.7), R - R.T, np.diag([1.0, 0.0, 0.0]))[k % 3]
+        cases.append((M, rng.normal(size=3) * 10.0 ** rng.uniform(-3, 3)))
+    fast = [(lcp._feasible(M, q), _bits(lcp._infeasibility_certificate(M, q))) for M, q in cases]
+    monkeypatch.setattr(lcp, "linprog_highs", _via_linprog)
+    assert fast == [(lcp._feasible(M, q), _bits(lcp._infeasibility_certificate(M, q))) for M, q in cases]
+    assert {f for f, _ in fast} == {True, False} and any(c is not None for _, c in fast)
