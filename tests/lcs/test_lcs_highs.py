@@ -129,3 +129,19 @@ def test_lcp_feasibility_and_infeasibility_certificate_are_linprogs(monkeypatch)
     monkeypatch.setattr(lcp, "linprog_highs", _via_linprog)
     assert fast == [(lcp._feasible(M, q), _bits(lcp._infeasibility_certificate(M, q))) for M, q in cases]
     assert {f for f, _ in fast} == {True, False} and any(c is not None for _, c in fast)
+
+
+def test_without_scipys_private_highs_modules_linprog_itself_answers(monkeypatch):
+    """Another SciPy, whose private HiGHS modules are not the ones ``_highs`` reads: ``linprog`` is called, and
+    answers as the direct path does."""
+    import verimono.lcs._highs as highs
+
+    rng = np.random.default_rng(4)
+    cases = []
+    for _ in range(30):
+        A, b = rng.normal(size=(4, 3)), rng.normal(size=4)
+        cases.append((rng.normal(size=3), A, b, None, None, np.full(3, -2.0), np.full(3, np.inf)))
+    direct = [_answer(linprog_highs(*case)) for case in cases]
+    monkeypatch.setattr(highs, "_state", {"h": None})
+    assert [_answer(linprog_highs(*case)) for case in cases] == direct
+    assert {s for s, _, _ in direct} >= {0}

@@ -27,11 +27,17 @@ _state: dict = {}
 
 
 def _core():
-    """HiGHS' bindings and the options object of ``linprog(method="highs")``'s defaults, made once."""
+    """HiGHS' bindings and the options object of ``linprog(method="highs")``'s defaults, made once; ``None``
+    when this SciPy's private HiGHS modules are not the ones read here (``linprog`` itself is then called)."""
     if not _state:
-        import scipy.optimize._highspy._core as h
-        from scipy.optimize._highspy import _highs_options as hopt
-        from scipy.optimize._highspy._highs_wrapper import check_option
+        try:
+            import scipy.optimize._highspy._core as h
+            from scipy.optimize._highspy import _highs_options as hopt
+            from scipy.optimize._highspy._highs_wrapper import check_option
+            h.HighsLp, h._Highs, h.HighsOptions, h.kHighsInf, h.MatrixFormat.kColwise   # noqa: B018 - present?
+        except (ImportError, AttributeError):                                   # pragma: no cover
+            _state["h"] = None
+            return None
 
         # the options _linprog_highs passes at its defaults, filtered and checked as _highs_wrapper does
         options = {"presolve": True, "highs_debug_level": h.HighsDebugLevel.kHighsDebugLevelNone,
@@ -71,6 +77,8 @@ def linprog_highs(c, A_ub, b_ub, A_eq=None, b_eq=None, lb=None, ub=None):
     refuses HiGHS' optimum; otherwise HiGHS' model status as ``linprog`` maps it); ``fun`` and ``x`` are
     ``None`` unless HiGHS found an optimum."""
     st = _core()
+    if st is None or st["h"] is None:
+        return _linprog(c, A_ub, b_ub, A_eq, b_eq, lb, ub)
     h, inf = st["h"], st["inf"]
     c = np.array(c, dtype=float)
     nv = c.size
@@ -133,6 +141,20 @@ def linprog_highs(c, A_ub, b_ub, A_eq=None, b_eq=None, lb=None, ub=None):
     ok = bool(np.all((x >= bounds[:, 0] - tol) & (x <= bounds[:, 1] + tol)))
     ok = ok and not (slack < -tol).any() and not (np.abs(con) > tol).any()
     return (0 if ok else 4), fun, x
+
+
+def _linprog(c, A_ub, b_ub, A_eq=None, b_eq=None, lb=None, ub=None):
+    """The same through ``scipy.optimize.linprog`` itself (another SciPy's private HiGHS modules)."""
+    from scipy.optimize import linprog
+
+    nv = len(c)
+    lb = np.zeros(nv) if lb is None else np.asarray(lb, dtype=float)
+    ub = np.full(nv, np.inf) if ub is None else np.asarray(ub, dtype=float)
+    bounds = [(None if np.isinf(lo) else lo, None if np.isinf(hi) else hi) for lo, hi in zip(lb.tolist(), ub.tolist())]
+    b_ub = np.asarray(b_ub, dtype=float).reshape(-1)
+    res = linprog(c, A_ub=A_ub if b_ub.size else None, b_ub=b_ub if b_ub.size else None, A_eq=A_eq, b_eq=b_eq,
+                  bounds=bounds, method="highs")
+    return res.status, (res.fun if res.x is not None else None), res.x
 
 
 def _status(h, model_status) -> int:
