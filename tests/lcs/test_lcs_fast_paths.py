@@ -211,3 +211,82 @@ def test_warm_qp_trial_memo_is_the_trial_bit_for_bit(monkeypatch):
     assert run(plant=True) == planted
     for (p, f0), t in zip(fast[::len(xs)], ts):      # x = 0: the edge, H^0 = −max(sin 3t, 0)
         assert np.frombuffer(f0)[0] == pytest.approx(-max(np.sin(3 * t), 0.0), abs=1e-12)
+
+
+def _resolvent_run(op, rng):
+    """Resolvents of ``op`` over 20 step sizes cycled (more than the 16 live steppers: each is made again) at
+    points inside ``dom H``, at its edge and beyond it, several times: their bits, and the full solves counted
+    by the relation."""
+    rel = op.system.relation
+    full = []
+    solve = rel.solve
+    rel.solve = lambda *a, **k: (full.append(1), solve(*a, **k))[1]
+    lams = 10.0 ** rng.uniform(-6, 2, 20)
+    out = []
+    for k in range(240):            # runs of 6 calls per λ (patterns alternate within a run), 20 λ cycled twice
+        lam = float(lams[(k // 6) % 20])
+        x = rng.normal(size=op.dim) * 10.0 ** rng.uniform(-3, 2)
+        out.append(op.resolvent(x, lam, float(rng.uniform(0, 2))).tobytes())
+    del rel.solve
+    return out, len(full)
+
+
+def test_step_matrices_made_once_answer_as_new_ones_bit_for_bit(monkeypatch):
+    """``LCSOperator._sm`` makes each step size's matrices once and a fresh stepper from them when a live one
+    was forgotten: the same resolvents, bit for bit, and the same full solves (a fresh stepper remembers no
+    pattern) as a new ``StepMatrices`` each time; and the kept matrices are bit for bit new ones."""
+    from verimono.lcs import Complementarity, LinearRelationSystem, Relay
+    from verimono.lcs.relations import _BoxStepper
+    from verimono.execution.workers import blas_limited
+    from verimono.reference.lcs_example import example_system
+
+    with blas_limited():    # one BLAS thread, as the run holds it: OpenBLAS's threads cost 5-15 ms a 1x1 solve here
+        rng = np.random.default_rng(5)
+        C = rng.normal(size=(2, 2))
+        S = rng.normal(size=(2, 2))
+        # B = Cᵀ, A = −I: M = D + λ/(1+λ) C Cᵀ, positive definite (complementarity) or PSD (a bounded box): solvable
+        systems = [lambda: example_system(lambda t: np.array([np.sin(t), 0.0])),
+                   lambda: LinearRelationSystem(-np.eye(2), C.T, C, S @ S.T + np.eye(2),
+                                                Complementarity(), v=lambda t: np.array([np.cos(t), -0.5])),
+                   lambda: LinearRelationSystem(-np.eye(2), C.T, C, S - S.T, Relay(-1.0, 2.0),
+                                                v=lambda t: np.array([np.cos(t), t]))]
+        fast = []
+        for make in systems:
+            op = make().operator()
+            fast.append(_resolvent_run(op, np.random.default_rng(1)))
+            assert len(op._templates) == 20
+            for key, tpl in op._templates.items():
+                new = op.system.step_matrices(float.fromhex(key), 1.0, None)
+                assert [_bits(a) for a in (tpl.E, tpl.G, tpl.M, *tpl.lu)] == \
+                    [_bits(a) for a in (new.E, new.G, new.M, *new.lu)]
+        assert all(n > 0 for _, n in fast)                   # full solves happen, and are compared
+        monkeypatch.setattr(_BoxStepper, "fresh", lambda self: _BoxStepper(self.rel, self.M))    # new each time
+        assert [_resolvent_run(make().operator(), np.random.default_rng(1)) for make in systems] == fast
+
+
+def test_batched_resolvent_rows_are_the_point_resolvents_bit_for_bit():
+    """``LCSOperator.resolvent`` of a batch (``_rows``: the step matrices and ``v(t)`` looked up once) answers
+    each row as the one-point resolvent does, bit for bit, and leaves its stepper as the rows one by one would
+    (the same full solves, last and recent patterns): rows inside ``dom H``, at its edge and beyond, in runs."""
+    from verimono.execution.workers import blas_limited
+    from verimono.lcs import LinearRelationSystem, Relay
+    from verimono.reference.lcs_example import example_system
+
+    rng = np.random.default_rng(8)
+    S = rng.normal(size=(2, 2))
+    C = rng.normal(size=(2, 2))
+    makes = [lambda: example_system(lambda t: np.array([np.sin(t), 0.0])),
+             lambda: LinearRelationSystem(-np.eye(2), C.T, C, S - S.T, Relay(-1.0, 2.0),
+                                          v=lambda t: np.array([np.cos(t), t]))]
+    with blas_limited():
+        for make in makes:
+            batched, single = make().operator(), make().operator()
+            for k in range(30):
+                lam, t = float(10.0 ** rng.uniform(-4, 1)), float(rng.uniform(0, 2))
+                X = rng.normal(size=(int(rng.integers(1, 12)), batched.dim)) * 10.0 ** rng.uniform(-3, 1)
+                X[::3] = np.abs(X[::3]) * (k % 2)       # runs of the domain's edge and inside it
+                got = batched.resolvent(X, lam, t)
+                want = np.array([single.resolvent(x, lam, t) for x in X])
+                assert got.shape == want.shape and _bits(got) == _bits(want)
+                a, b = batched._mats[lam].step, single._mats[lam].step
+                assert (a.full_solves, a.last, a.recent) == (b.full_solves, b.last, b.recent)

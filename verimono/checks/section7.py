@@ -165,14 +165,23 @@ def check_rel_int(system: Any, T: float, *, samples: int, seed: int) -> Outcome:
     adjacent floats: a margin that touches 0 at one time, ``v = |t − 0.4567|``, is 0.0036 at the nearest of
     64 samples)."""
     ts = _times(system, T, samples)
-    margins = [rel_int_margin(system, float(t)) for t in ts]
+    # the margin is a function of t alone: the search below starts on the same grid, each LP solved once
+    known: dict[float, float | None] = {}
+
+    def margin(t: float) -> float | None:
+        out = known.get(t)
+        if out is None:
+            out = known[t] = rel_int_margin(system, t)
+        return out
+
+    margins = [margin(float(t)) for t in ts]
     if any(mg is None for mg in margins):
         return Outcome(None, status=SKIPPED, message="im(𝓜 + D) is known as a polyhedron only for box relations "
                                                      "with D + Dᵀ ⪰ 0")
     details = {"evidence": True, "t": ts.tolist(), "margins": margins}
     worst_t, least = float(ts[int(np.argmin(margins))]), float(min(margins))
     if not system.v_constant:
-        sup = sup_over_time(lambda t, which: np.array([-rel_int_margin(system, float(t))]), 0.0, T, grid=ts,
+        sup = sup_over_time(lambda t, which: np.array([-margin(float(t))]), 0.0, T, grid=ts,
                             refine=True, seed=seed)
         details["searched"] = {"t": sup.searched.as_dict()}
         details["min_search"] = sup.as_dict()

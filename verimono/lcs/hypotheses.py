@@ -7,9 +7,9 @@ on them are in :mod:`verimono.checks.section7`.
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import linprog
 
 from ..core.tolerances import tolerance
+from ._highs import linprog_highs
 from .lcp import is_psd, lcp_residual, sol_polyhedron
 from .relations import BoxRelation
 
@@ -47,11 +47,12 @@ def rel_int_margin(system, t: float) -> float | None:
         r = np.zeros(nv); r[n + m + j] = -1.0; r[-1] = 1.0
         rows.append(r[None]); rhs.append(np.zeros(1))
     c = np.zeros(nv); c[-1] = -1.0
-    bounds = [(None, None)] * (n + m + f) + [(None, 1.0)]
-    res = linprog(c, A_ub=np.vstack(rows), b_ub=np.concatenate(rhs),
-                  A_eq=np.vstack(eq_rows) if eq_rows else None, b_eq=np.array(eq_rhs) if eq_rows else None,
-                  bounds=bounds, method="highs")
-    return float(-res.fun) if res.status == 0 else float("-inf")
+    ub = np.full(nv, np.inf); ub[-1] = 1.0
+    # linprog(method="highs")'s model, options and answer, without its wrapper (:mod:`verimono.lcs._highs`)
+    status, fun, _ = linprog_highs(c, np.vstack(rows), np.concatenate(rhs),
+                                   np.vstack(eq_rows) if eq_rows else None, np.array(eq_rhs) if eq_rows else None,
+                                   np.full(nv, -np.inf), ub)
+    return float(-fun) if status == 0 else float("-inf")
 
 
 def sample_unit_q(D: np.ndarray, rng) -> np.ndarray:
@@ -75,11 +76,11 @@ def shorter_solution(D, q, z):
     the LP ``min zᵀy`` over ``SOL`` (:func:`verimono.lcs.lcp.sol_polyhedron`) finds a violating ``y``, and
     the segment ``z + τ(y − z)`` its shortest point."""
     G, h, Aeq, beq = sol_polyhedron(D, q, z)
-    res = linprog(z, A_ub=G, b_ub=h, A_eq=Aeq if len(Aeq) else None, b_eq=beq if len(Aeq) else None,
-                  bounds=[(None, None)] * q.size, method="highs")
-    if res.status != 0:
+    status, _, y = linprog_highs(z, G, h, Aeq if len(Aeq) else None, beq if len(Aeq) else None,
+                                 np.full(q.size, -np.inf), np.full(q.size, np.inf))
+    if status != 0:
         return None
-    d = res.x - z
+    d = y - z
     dd = float(d @ d)
     if dd == 0.0 or z @ d >= 0:
         return None

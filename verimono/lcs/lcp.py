@@ -36,12 +36,12 @@ import itertools
 from typing import Callable
 
 import numpy as np
-from scipy.optimize import linprog
 
 from ..core.errors import InfeasibleStep, InvalidProblem, UnverifiedSolution, VerimonoError
 from ..core._linalg import absmax, lstsq_solution, singular_values, svd_reduced
 from ..core.qp import solve_qp
 from ..core.tolerances import POLISH_RTOL, QP_RTOL, RTOL
+from ._highs import linprog_highs
 
 #: largest n for which complementary pieces are enumerated (2^n pieces)
 ENUM_MAX = 12
@@ -333,8 +333,8 @@ GENERAL_BACKENDS = ("lemke", "enumerate")
 def _feasible(M, q) -> bool:
     """Whether ``FEA(q, M) = {z ≥ 0, Mz + q ≥ 0}`` is nonempty (linear programming)."""
     n = q.shape[0]
-    res = linprog(np.zeros(n), A_ub=-M, b_ub=q, bounds=[(0, None)] * n, method="highs")
-    return res.status != 2
+    status, _, _ = linprog_highs(np.zeros(n), -M, q)     # linprog(method="highs")'s answer (z ≥ 0 by default)
+    return status != 2
 
 
 def proved_solvable(M, q, scale: float | None = None) -> bool:
@@ -354,9 +354,9 @@ def _infeasibility_certificate(M, q) -> np.ndarray | None:
     n = q.shape[0]
     A_eq = np.vstack([M + M.T, np.ones((1, n))])
     b_eq = np.concatenate([np.zeros(n), [1.0]])
-    res = linprog(q, A_ub=-M, b_ub=np.zeros(n), A_eq=A_eq, b_eq=b_eq, bounds=[(0, None)] * n, method="highs")
-    if res.status == 0 and res.fun < 0:
-        return res.x
+    status, fun, x = linprog_highs(q, -M, np.zeros(n), A_eq, b_eq)      # z ≥ 0 by default, as linprog's
+    if status == 0 and fun < 0:
+        return x
     return None
 
 

@@ -186,6 +186,15 @@ class _BoxStepper:
             return None
         return lam, y
 
+    def fresh(self) -> "_BoxStepper":
+        """A new stepper of the same ``M``, as ``_BoxStepper(rel, M)`` makes it (no last or recent pattern, no
+        full solve counted), without recomputing what is a function of ``M`` and the bounds alone: ``‖M‖∞``,
+        whether ``M`` is PSD, and the patterns' factorisations (:meth:`_entry`), whose cache the two share."""
+        new = object.__new__(_BoxStepper)
+        new.rel, new.M, new.lo, new.hi, new.psd, new.m_norm = self.rel, self.M, self.lo, self.hi, self.psd, self.m_norm
+        new.cache, new.last, new.recent, new.full_solves = self.cache, None, [], 0
+        return new
+
     def warm_from(self, other: object) -> None:
         """Try ``other``'s last active pattern first (a nearby ``M``, e.g. the same system at another step
         size): a pattern is a guess that :meth:`_try` verifies for this ``M``, so a wrong one costs one

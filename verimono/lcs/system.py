@@ -17,6 +17,8 @@ with ``γ = 1`` unless the θ-γ variant is asked for.  ``θ = 1`` is the paper'
 
 from __future__ import annotations
 
+import copy
+
 from typing import Any, Callable
 
 import numpy as np
@@ -68,6 +70,15 @@ class StepMatrices:
         self.M = sys.D + h * gamma * sys.C @ WiB
         self.step = sys.relation.stepper(self.M)
         self._relation = sys.relation
+
+    def fresh(self) -> "StepMatrices":
+        """What ``StepMatrices(sys, h, θ, γ)`` makes again — the same matrices (shared, never written) and a fresh
+        one-step solver (:meth:`verimono.lcs.relations._BoxStepper.fresh`: its pattern factorisations shared) —
+        without recomputing them."""
+        new = copy.copy(self)
+        fresh = getattr(self.step, "fresh", None)
+        new.step = fresh() if fresh is not None else self._relation.stepper(self.M)
+        return new
 
     def relation_step(self):
         """A fresh warm-started one-step solver ``(q, scale) ↦ (z, w)`` for ``M`` (:meth:`Relation.stepper`)."""
@@ -361,6 +372,8 @@ def _increments(u, t: np.ndarray, n: int, B: int | None) -> np.ndarray | None:
 
 #: entries of an operator's memo of ``H^0(t, x)`` and ``proj_dom H(t,·)(x)`` (:meth:`LCSOperator._memoised`)
 MEMO_SIZE = 8192
+#: step sizes whose matrices an operator keeps once made (:meth:`LCSOperator._sm`), forgotten all at once
+STEP_TEMPLATES = 4096
 
 
 class LCSOperator(Operator):
@@ -379,6 +392,8 @@ class LCSOperator(Operator):
         self.system = system
         self.static = system.v_constant
         self._mats: dict[float, StepMatrices] = {}
+        self._templates: dict[str, StepMatrices] = {}
+        self._proj_data: tuple | None = None
         self._recent: StepMatrices | None = None
         # the active sets of the last selection and projection QPs (:mod:`verimono.lcs._warm_qp`)
         self._warm_select: dict = {}
@@ -404,7 +419,16 @@ class LCSOperator(Operator):
         if sm is None:
             if len(self._mats) > 16:
                 self._mats.clear()
-            sm = self._mats[lam] = self.system.step_matrices(lam, 1.0, None)
+            # the matrices of a step size are a function of it alone: made once (an operator law asks ~20,000
+            # resolvents over a few hundred λ, far more than the 16 live steppers), each live stepper made fresh
+            # from them as a new StepMatrices would be — the same answers, bit for bit, at a copy's cost
+            key = lam.hex()
+            tpl = self._templates.get(key)
+            if tpl is None:
+                if len(self._templates) >= STEP_TEMPLATES:
+                    self._templates.clear()
+                tpl = self._templates[key] = self.system.step_matrices(lam, 1.0, None)
+            sm = self._mats[lam] = tpl.fresh()
             warm = getattr(sm.step, "warm_from", None)
             if warm is not None and self._recent is not None:   # a new step size: the last one's pattern first
                 warm(self._recent.step)
@@ -417,6 +441,8 @@ class LCSOperator(Operator):
     def resolvent(self, x, lam, t=0.0):
         x = np.asarray(x, dtype=float)
         if x.ndim == 2:
+            if x.shape[0] and x.shape[1] == self.dim and type(self).resolvent is LCSOperator.resolvent:
+                return self._rows(x, float(lam), t)
             return np.array([self.resolvent(xi, lam, t) for xi in x])
         if x.shape != (self.dim,):
             raise InvalidProblem(f"{self.name} acts on R^{self.dim}; got a point of shape {x.shape}")
@@ -425,6 +451,22 @@ class LCSOperator(Operator):
         xE, v = sm.E @ x, s.v(t)
         z, _ = sm.step(s.C @ xE + v, s.q_scale(xE, v))
         return xE + sm.G @ z
+
+    def _rows(self, X: np.ndarray, lam: float, t) -> np.ndarray:
+        """The resolvent of every row of ``X``, each row's arithmetic exactly :meth:`resolvent`'s for one point
+        (the same products, the same stepper called in the same order), with what the rows share looked up
+        once: the step matrices of ``λ`` and ``v(t)``, a function of ``t`` (an assumption law's design asks
+        ~20 rows at one ``(λ, t)``; the paper's Example's operator laws ~100)."""
+        sm = self._sm(lam)
+        s = self.system
+        v = s.v(t)
+        E, G, C, step, q_scale = sm.E, sm.G, s.C, sm.step, s.q_scale
+        out = []
+        for x in X:
+            xE = E @ x
+            z, _ = step(C @ xE + v, q_scale(xE, v))
+            out.append(xE + G @ z)
+        return np.array(out)
 
     # -- the set-valued H(t, x) through the multipliers of (Cx + v, D) ----------------------------------
     def _box(self):
@@ -537,10 +579,14 @@ class LCSOperator(Operator):
         if not rel.is_lcp:
             raise NotImplementedError(f"{self.name}: projection onto dom H for mixed bounds")
         n, m = s.n, s.m
-        P = np.zeros((n + m, n + m))
-        P[:n, :n] = np.eye(n)
-        G = np.block([[np.zeros((m, n)), -np.eye(m)], [-s.C, -s.D]])
-        h = np.concatenate([np.zeros(m), s.v(t)])
+        if self._proj_data is None:     # P and G are the system's: made once (read only), as np.block made them
+            P = np.zeros((n + m, n + m))
+            P[:n, :n] = np.eye(n)
+            G = np.block([[np.zeros((m, n)), -np.eye(m)], [-s.C, -s.D]])
+            P.flags.writeable = G.flags.writeable = False
+            self._proj_data = (P, G)
+        P, G = self._proj_data
+        h = np.concatenate([np.zeros(m), v])        # v = v(t), looked up above
         return solve_qp_warm(self._warm_project, P, np.concatenate([-x, np.zeros(m)]), G, h)[:n]
 
 
