@@ -376,14 +376,17 @@ def test_an_operator_law_out_of_budget_after_samples_that_held_is_undecided():
     else:
         assert "before any sample was evaluated" in rec.message
 
-    def hangs_later(x, lam, t):                      # a few samples hold, then a call never returns (it sleeps: the
-        seen.append(1)                               # test takes no CPU from a busy machine)
-        if len(seen) > 20:
-            time.sleep(600)
+    def hangs_later(x, lam, t):                      # samples hold, then a call never returns (it sleeps: the
+        seen.append(1)                               # test takes no CPU from a busy machine); after 200 calls: past
+        if len(seen) == 201:                         # the first vectorised pass (the draws and edge samples, one
+            time.sleep(60)                           # evaluation counted when all its rows return), in the sweep
         return np.asarray(x, dtype=float) / (1.0 + lam)
 
     seen: list[int] = []
     op = vm.operator_from_resolvent(hangs_later, 2, name="hangs later")
     with timeouts.budget(1.5):                       # in flight > half the budget and 20x any sample, even when busy
         rec = run_law("resolvent_nonexpansive", op, seed=0, examples=50)
+    # the sweep had no limit of its own (the search and the coordinate phase each armed a whole budget): a law
+    # called outside run_unit slept the 60 s out, then passed
     assert rec.status == "failed" and "does not return" in rec.message and rec.details["evaluations"] >= 2, rec
+    assert "time budget of 1.5 s" in rec.message, rec.message

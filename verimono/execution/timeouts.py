@@ -162,10 +162,11 @@ class _Limit:
     :func:`verimono.execution.interrupts.safe_to_interrupt` stops reading the stack), whether its deadline has
     passed (``due``) and how many times its interrupt was raised into the block (``raised``)."""
 
-    __slots__ = ("seconds", "unit", "start", "boundary", "due", "raised", "closed", "stopped_at")
+    __slots__ = ("seconds", "unit", "start", "boundary", "due", "raised", "closed", "stopped_at", "stated")
 
-    def __init__(self, seconds: float, unit: str, boundary: Any) -> None:
+    def __init__(self, seconds: float, unit: str, boundary: Any, stated: float | None = None) -> None:
         self.seconds, self.unit, self.boundary = seconds, unit, boundary
+        self.stated = seconds if stated is None else stated     # the budget the block is a part of
         self.start, self.due, self.raised, self.closed = time.perf_counter(), False, 0, False
         self.stopped_at: float | None = None
 
@@ -177,9 +178,9 @@ class _Limit:
         elapsed = time.perf_counter() - self.start
         stopped_at = self.stopped_at if self.stopped_at is not None else time.perf_counter()
         note = f"; {evidence['harness_error']} after the interrupt" if evidence.get("harness_error") else ""
-        exc = UnitTimeout(f"{self.unit} exceeded its time budget of {self.seconds:g} s (stopped after "
+        exc = UnitTimeout(f"{self.unit} exceeded its time budget of {self.stated:g} s (stopped after "
                           f"{elapsed:.1f} s){note}")
-        exc.evidence = {"budget": self.seconds, "elapsed": elapsed, "in_flight": stopped_at - self.start,
+        exc.evidence = {"budget": self.stated, "elapsed": elapsed, "in_flight": stopped_at - self.start,
                         "stopped_at": stopped_at, **evidence}
         return exc
 
@@ -200,8 +201,10 @@ SWALLOWED_STEP = 0.05
 
 
 @contextmanager
-def time_limit(seconds: float | None, unit: str) -> Iterator[None]:
+def time_limit(seconds: float | None, unit: str, *, part_of: float | None = None) -> Iterator[None]:
     """Run the block for at most ``seconds``; :class:`UnitTimeout` naming ``unit`` when it takes longer.
+    ``part_of``: the whole budget of which ``seconds`` is what is left (a law's later phase), which the
+    timeout states and its verdict is judged against (:func:`verimono.records.verdicts.never_returned`).
 
     Nested limits keep the tighter one: an outer limit that expires first still fires (as the outer
     unit's timeout).  ``seconds=None``, ``inf``, a budget beyond the platform's timers (:data:`TIMER_LIMIT`)
@@ -223,7 +226,7 @@ def time_limit(seconds: float | None, unit: str) -> Iterator[None]:
     if outer_left and outer_left <= seconds:     # the outer unit's budget is the tighter one: leave it alone
         yield
         return
-    lim = _Limit(seconds, unit, sys._getframe(2))   # 2: past contextlib's __enter__, the `with` statement's frame
+    lim = _Limit(seconds, unit, sys._getframe(2), part_of)   # 2: past contextlib's __enter__, the `with` statement's frame
 
     def fire(signum, frame):
         if lim.closed:           # a signal that arrived as the limit closed: nothing to stop, nothing to re-arm

@@ -82,7 +82,7 @@ from ...execution.config import current as current_config
 from ...execution.profiles import LARGE_N, large_n_count
 from ...records.results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
 from ...execution.timeouts import (checkpoint, current_budget, interrupted, interruptible, note_progress,
-                                  time_limit)
+                                  time_limit, unlimited)
 from ...records.verdicts import timeout_verdict
 from .batches import CLOCK, PER_PASS, ROW_CELLS, VECTORISED, Rows, _BatchFailure, batched, prefetched, rows_accepted
 from .coordinates import COORDINATES, coordinate_search, searched
@@ -259,6 +259,8 @@ class _Search:
     pending: list = dataclasses.field(default_factory=list)
     pre: dict = dataclasses.field(default_factory=dict)
     pre_rows: tuple = ()
+    #: the law's budget and when it runs out (:func:`time.perf_counter`; ``None``: unlimited), shared by its phases
+    deadline: tuple[float, float] | None = None
 
     @interruptible   # the law's and the subject's code: the unit's budget may stop it even under hypothesis
     def evaluate(self, s: Sample, climb: bool = False) -> float | None:
@@ -504,8 +506,9 @@ def _search(decl: Law, op: Any, seed: int, examples: int, horizon: float) -> tup
     state, how = _Search(decl, op, horizon=horizon), {"timed_out": "", "harness": "", "flaky": "", "sweep": 0,
                                                       "minimum": min(MIN_EVALUATED, examples)}
     drawn = None
+    state.deadline = _deadline(current_budget())
     try:
-        with no_local_constants(), time_limit(current_budget(), f"{decl.name} on {subject_name(op)}"):
+        with no_local_constants(), _phase_limit(state, f"{decl.name} on {subject_name(op)}"):
             if op.dim <= NUMPY_DIM:
                 edges = edge_draws(op.dim, seed, horizon, edge_count(examples), Sample)
                 # in hypothesis's order: the draws, the simplest sample alone (the worst so far when it ties the
@@ -542,7 +545,12 @@ def _search(decl: Law, op: Any, seed: int, examples: int, horizon: float) -> tup
             state.shrunk_into(*drawn, "NumPy draws (shrunk greedily)")
     # the scale sweep spells out its points: for n > NUMPY_DIM the NumPy recipes cover the scales instead
     if state.failure is None and state.unsupported is None and not stopped and op.dim <= NUMPY_DIM:
-        how["sweep"] = _sweep(state, seed, horizon)
+        try:          # the sweep under what is left of the law's budget, as every phase
+            with _phase_limit(state, f"{decl.name} on {subject_name(op)}"):
+                how["sweep"] = _sweep(state, seed, horizon)
+        except UnitTimeout as exc:
+            _timed_out(how, exc, state)
+        stopped = how["timed_out"]
     if state.failure is None and state.unsupported is None and not stopped and state.worst_sample is not None \
             and COORDINATE_CAP.get(decl.name, 1):
         _coordinates(state, seed, horizon, how)
@@ -561,7 +569,7 @@ def _coordinates(state: _Search, seed: int, horizon: float, how: dict) -> None:
 
     start, before = dataclasses.replace(state.worst_sample, form=CONTIGUOUS), state.runs
     try:
-        with time_limit(current_budget(), f"{state.decl.name} on {subject_name(state.op)}"):
+        with _phase_limit(state, f"{state.decl.name} on {subject_name(state.op)}"):
             over = state.decl.over or OPERATOR_DOMAIN          # the law's declared quantifiers
             formed = form_search(ratio, start, forms_for(state.op)) if "form" in over else None   # a few samples
             points, n = budget("coordinate"), int(np.size(start.x1))
@@ -605,6 +613,24 @@ def _replay(decl: Law, op: Any, sample: Sample | dict) -> tuple[_Search, dict]:
     except UnitTimeout as exc:
         _timed_out(how, exc, state)
     return state, how
+
+
+def _deadline(seconds: float | None) -> tuple[float, float] | None:
+    """``(seconds, when it runs out)`` of a law's budget of ``seconds`` (:func:`current_budget`) started now;
+    ``None``: no limit."""
+    return None if unlimited(seconds) else (seconds, time.perf_counter() + seconds)
+
+
+def _phase_limit(state: _Search, unit: str):
+    """The time limit of a phase of the law's search: what is left of the law's budget.  The search, the sweep
+    and the coordinate phase share one budget (each armed a whole budget of its own before, and the sweep
+    none: a law called on its own, outside :func:`verimono.execution.timeouts.run_unit`, hung on a resolvent
+    that stopped returning in the sweep).  The timeout states, and is judged against, the whole budget; a spent
+    budget stops the phase at once (a millisecond)."""
+    if state.deadline is None:
+        return time_limit(None, unit)
+    seconds, end = state.deadline
+    return time_limit(max(end - time.perf_counter(), 1e-3), unit, part_of=seconds)
 
 
 def _timed_out(how: dict, exc: UnitTimeout, state: _Search) -> None:
