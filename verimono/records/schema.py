@@ -25,7 +25,7 @@ Layout (schema ``verimono.results``, version ``SCHEMA_VERSION`` = ``MAJOR.MINOR`
                     "cpu_waiting", "foreign_cpu", "loadavg"}],   # how busy the machine was
         "executor": "serial" | "process:2" | ...,      #   where the stages' units ran (stage times compare
                                                        #   only between runs on the same executor)
-        "calibrations": [0.012, 0.013],                #   the workload timed before and after the stages
+        "calibrations": [0.012, 0.013],                #   the workload timed before and after the stages (the start's alone: no record timed)
         "calibration": 0.012,                          #   the faster of the two: the unit of stage times
         "calibrations_cpu": [0.011, 0.011],            #   their CPU seconds (median of the repeats)
         "duration": 93.5,                              #   seconds of the whole run (or pytest session)
