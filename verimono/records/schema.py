@@ -223,7 +223,8 @@ def document(meta: dict[str, Any], counts: dict[str, int], results: list[dict[st
              trajectories: list[Any]) -> dict[str, Any]:
     """The schema document of a run; ``meta.environment`` and ``created`` are filled in when absent (and
     written back into ``meta``)."""
-    meta.setdefault("environment", environment())
+    if "environment" not in meta:     # not setdefault: that measured it again for a run that had (0.02 s)
+        meta["environment"] = environment()
     if not meta.get("created"):
         meta["created"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
     written = {k: v for k, v in meta.items() if k != "created"}
