@@ -2,8 +2,6 @@
 ``∫|u|`` and ``∫σ`` over every cell on the large side — the side on which lem:bndSeq's β and ψ only grow — and
 within ``QUAD_RTOL`` of the integral, against closed forms in exact rational arithmetic."""
 
-import subprocess
-import sys
 from fractions import Fraction
 
 import numpy as np
@@ -60,9 +58,3 @@ def test_smooth_integrands_to_round_off_and_the_input_total():
     assert np.all(got >= exact * (1 - 4e-16)) and np.all(got <= exact * (1 + 1e-13))
     lg = LGBounds(0.0, lambda s: 0.0, lambda s: 0.0, np.pi, absu=lambda s: abs(np.cos(s)))   # ∫_0^π |cos| = 2
     assert 2.0 * (1 - 4e-16) <= lg.u_total <= 2.0 * (1 + 1e-12)
-
-
-def test_the_bounds_do_not_import_scipy_integrate():
-    code = "import verimono.checks.bounds, sys; print('scipy.integrate' in sys.modules)"
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
-    assert out.strip() == "False"

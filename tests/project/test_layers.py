@@ -431,7 +431,9 @@ def test_a_problem_and_the_parser_load_none_of_the_heavy_modules():
             "build_parser().parse_args(['gate', '--baseline', 'b.json', '--results', 'r.json'])\n"
             "print(loaded() or '-')\n"
             "build_parser().parse_args(['run', '--stage', 'siconos'])\n"
-            "print('verimono.lcs' in sys.modules, 'scipy.optimize' in sys.modules)\n") % (NOT_FOR_A_PROBLEM,
-                                                                                          NOT_FOR_A_PROBLEM)
+            "print('verimono.lcs' in sys.modules, 'scipy.optimize' in sys.modules)\n"
+            # the stages without scipy.integrate: the a-priori bounds integrate by their own quadrature
+            "print('verimono.checks.bounds' in sys.modules, 'scipy.integrate' in sys.modules)\n") % (
+                NOT_FOR_A_PROBLEM, NOT_FOR_A_PROBLEM)
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
-    assert out.splitlines() == ["(9, 2) -", "-", "True True"], out
+    assert out.splitlines() == ["(9, 2) -", "-", "True True", "True False"], out
