@@ -253,3 +253,35 @@ def test_progress_is_quiet_and_line_oriented_off_a_terminal_or_under_ci(monkeypa
         assert len(within) == lines                         # at most one line per interval, none at 0 or total
         assert all(line.startswith("[2/7] operator_laws: ") for line in within)
     assert within == ["[2/7] operator_laws: 1/3 units done, at b", "[2/7] operator_laws: 2/3 units done, at c"]
+
+
+def test_a_check_with_no_timed_record_measures_no_end_calibration(good_check):
+    """`verimono check`'s records are not timed (no same-job timing ratio): the run keeps its start's
+    calibration alone (issue 43: no end calibration when nothing is timed), and the gate then leaves its stages'
+    wall growth unjudged (tests/run/test_gate_cpu.py)."""
+    rep = load(good_check / "results.json")
+    assert not any("timing_ratio" in r.details for r in rep.results)
+    assert len(rep.meta["calibrations"]) == 1 and len(rep.meta["calibrations_cpu"]) == 1
+    assert rep.meta["calibration"] == rep.meta["calibrations"][0] > 0
+
+
+@pytest.mark.parametrize("timed", [False, True])
+def test_the_end_calibration_is_measured_when_a_record_is_timed(monkeypatch, timed):
+    """The same run with a timed record (the performance stage's ``details["timing_ratio"]``) measures its end
+    calibration as before: the two ends, and their drift, are what the gate's wall verdicts read."""
+    import types
+
+    from verimono.records.results import CheckResult, Report
+    from verimono.run import execute as ex
+    from verimono.run import stages
+
+    details = {"timing_ratio": 1.1} if timed else {}
+    rep = Report([CheckResult("speed", "solve", "passed", worst=0.5, bound=1.0, details=details)])
+    monkeypatch.setattr(stages, "run_stages", lambda *a, **k: rep)
+    calls = []
+    monkeypatch.setattr(ex, "calibrate_times", lambda *a, **k: calls.append(k) or (0.07, [0.06, 0.07, 0.08]))
+    context = types.SimpleNamespace(progress=None, executor=None, seed=0, problems=None, data_dir=None)
+    out = ex.execute(command="run", profile_name="ci", stages=["performance"], context=context)
+    assert ex.has_timed_records(out) is timed
+    assert len(out.meta["calibrations"]) == len(out.meta["calibrations_cpu"]) == (2 if timed else 1)
+    assert [bool(k.get("agreeing_with")) for k in calls] == ([False, True] if timed else [False])

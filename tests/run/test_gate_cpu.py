@@ -118,6 +118,22 @@ def test_time_spent_off_the_cpu_regresses_by_wall_time_on_a_quiet_machine_only()
     assert comp.ok and any("off the CPU not judged" in c.message and "busy" in c.message for c in comp.others)
 
 
+@pytest.mark.parametrize("single", ["results", "baseline"])
+def test_wall_growth_of_a_run_with_one_calibration_is_not_judged(single):
+    """A run with no timed record measures no end calibration (`verimono check`): with one calibration its drift
+    is unknown, so the same sleepy stage as above (a regression between two-calibration runs on a quiet machine)
+    is listed as not judged, saying why — a CPU regression is still one."""
+    base, cur = run(stage(**IDLE)), run(stage(cpu=0.9, subject=0.45, slices=spread(0.065), wall=0.6 * 3))
+    one = cur if single == "results" else base
+    one.meta["calibrations"] = one.meta["calibrations"][:1]
+    comp = compare(base, cur)
+    assert comp.ok and any("off the CPU not judged" in c.message and "one calibration" in c.message
+                           for c in comp.others), [str(c) for c in comp.others]
+    slow = run(stage(cpu=5 * 0.9, subject=5 * 0.45, slices=spread(0.065), wall=3.0))
+    slow.meta["calibrations"] = slow.meta["calibrations"][:1]
+    assert [c for c in compare(run(stage(**IDLE)), slow).regressions if "CPU time" in c.message]
+
+
 def test_tiny_cpu_figures_are_not_judged():
     """Below 2 calibrations or 0.1 s of CPU a figure is start-up noise: not compared at all."""
     base = run(stage(cpu=0.06, subject=0.03, slices=spread(0.065), wall=0.1))

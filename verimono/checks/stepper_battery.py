@@ -25,6 +25,7 @@ from ..execution.executors import Unit
 from ..execution.workers import blas_limited
 from .core import laws_of, stepper_subject
 from .isolated import isolating, run_check, run_isolated
+from .own_steps import check_adaptive
 from .partitions import single
 from .generated_problems import generated_problems
 from .sample_problems import valid_count
@@ -155,8 +156,6 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
             return check_stepper(stepper, problems, scheme=scheme, order=order, seed=seed, executor=executor,
                                  laws=laws, generated=generated, orders=orders, step_range=step_range)
     if isinstance(stepper, Adaptive):    # it chooses its own steps: a grid's study would call it wrongly
-        from .own_steps import check_adaptive
-
         return check_adaptive(stepper, problems, laws=laws is not False)
     require_stepper(stepper)
     # every argument before the first call of the stepper: what the harness was given is never charged to it

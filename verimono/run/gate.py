@@ -51,7 +51,9 @@ So:
   with its CPU time unchanged that is time spent off the CPU (sleeping, waiting), which CPU time does not
   see.  On a busy machine — some task waited for a CPU more than ``BUSY_WAITING`` of the stage's time
   (Linux PSI) and processes outside the run used more than ``BUSY_FOREIGN`` of the machine's CPU — or
-  between calibrations that drift by more than ``CALIBRATION_DRIFT``, such growth is listed as not judged;
+  between calibrations that drift by more than ``CALIBRATION_DRIFT``, or where a run measured one calibration
+  (a run with no timed record — ``verimono check`` — measures none at its end), such growth is listed as not
+  judged;
 * a record's same-job ratio (``details["timing_ratio"]``, larger is worse) regresses when it grew by more than
   ``TIMING_GROWTH`` *with confidence*: the lower end of its interval (``details["timing_interval"]``, the
   order-statistics bound of the median per-round ratio, :mod:`verimono.execution.timing`) exceeds ``TIMING_GROWTH``
@@ -466,10 +468,26 @@ def _calibrations(meta: dict[str, Any]) -> list[float]:
     return [float(c) for c in cals if _number(c) and math.isfinite(c) and c > 0]
 
 
-def _stage_unjudged(cur_cals: list[float], stage: dict[str, Any]) -> str | None:
+def _start_only(meta: dict[str, Any]) -> bool:
+    """Whether a run measured its start's calibration alone (``meta.calibrations`` a list of one): a run with no
+    timed record measures none at its end (:func:`verimono.run.execute.has_timed_records`).  A document from
+    before ``meta.calibrations`` (``meta.calibration`` alone) is judged as it always was."""
+    cals = meta.get("calibrations")
+    return isinstance(cals, list) and len(_calibrations(meta)) == 1
+
+
+def _stage_unjudged(cur_cals: list[float], stage: dict[str, Any], start_only: tuple[bool, bool] = (False, False)
+                    ) -> str | None:
     """Why a stage's *wall* time in this run cannot support a regression (module docstring, *Timing*), or
-    ``None``: the calibrations at its ends drift, or the machine was busy during the stage."""
+    ``None``: the calibrations at its ends drift, or the machine was busy during the stage — or a run (this one,
+    the baseline: ``start_only``, :func:`_start_only`) measured one calibration: its drift is unknown and its one
+    figure, the start's (measured while the command line imports: up to 2x the end's), is no steadier unit than
+    the faster of two."""
     why = []
+    single = [who for who, one in zip(("this run", "the baseline"), start_only) if one]
+    if single:
+        why.append(f"{' and '.join(single)} measured one calibration (none at the end: no record of it is timed), "
+                   "so its drift is unknown")
     drift = max(cur_cals) / min(cur_cals)
     if drift > CALIBRATION_DRIFT:
         why.append(f"the calibrations at the run's start and end differ by {drift:.2f}x (> {CALIBRATION_DRIFT}x)")
@@ -582,11 +600,12 @@ def _compare_timings(base: Report, cur: Report, out: list[Change]) -> None:
         if subject_change is not None:
             out.append(subject_change)
         if verdict in ("ok", "untimed"):
-            _compare_wall(b, s, bcals, ccals, out, cpu_judged=verdict == "ok")
+            _compare_wall(b, s, bcals, ccals, out, cpu_judged=verdict == "ok",
+                          start_only=(_start_only(cur.meta), _start_only(base.meta)))
 
 
 def _compare_wall(b: dict[str, Any], s: dict[str, Any], bcals: list[float], ccals: list[float], out: list[Change],
-                  cpu_judged: bool) -> None:
+                  cpu_judged: bool, start_only: tuple[bool, bool] = (False, False)) -> None:
     """A stage's wall time in calibration units (taken at the run's slower calibration, the baseline's at its
     faster): growth beyond ``TIMING_GROWTH`` regresses only on a quiet machine (:func:`_stage_unjudged`) — where
     its CPU time did not grow, it is time spent off the CPU (sleeping, waiting on I/O or a lock), which CPU time
@@ -597,7 +616,7 @@ def _compare_wall(b: dict[str, Any], s: dict[str, Any], bcals: list[float], ccal
     rb, rc, rc_most = b["duration"] / min(bcals), s["duration"] / max(ccals), s["duration"] / min(ccals)
     if rc_most <= TIMING_GROWTH * rb:
         return
-    why = _stage_unjudged(ccals, s)
+    why = _stage_unjudged(ccals, s, start_only)
     if why is None and rc <= TIMING_GROWTH * rb:
         return
     if rc > TIMING_GROWTH * rb:

@@ -27,6 +27,7 @@ from ...core.stepping import solve
 from ...execution.timeouts import current_budget, run_unit, time_limit
 from ...checks.core import laws_of
 from ...checks.core import subject_name as _name
+from ...checks.own_steps import check_adaptive
 from ...checks.orders import check_convergence_order
 from ...checks.picard import check_picard
 from ...checks.pseudo_distance import check_pseudo_distance
@@ -113,8 +114,6 @@ def adaptive_stage(profile: Profile, context: RunContext) -> Report:
 
 
 def _adaptive_unit(stepper: Any, problem: Any) -> Report:
-    from ...checks.own_steps import check_adaptive
-
     return check_adaptive(stepper, [problem])
 
 

@@ -1,0 +1,60 @@
+"""The a-priori bounds' quadrature (``verimono.checks.bounds._cell_integrals``, in place of ``scipy.integrate.quad``):
+``∫|u|`` and ``∫σ`` over every cell on the large side — the side on which lem:bndSeq's β and ψ only grow — and
+within ``QUAD_RTOL`` of the integral, against closed forms in exact rational arithmetic."""
+
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+from verimono.checks import bounds
+from verimono.checks.bounds import LGBounds, QUAD_RTOL, _cell_integrals
+
+#: |u| of a piecewise-linear u: zeros (kinks) at 3/4 and 5/4, kinks where the two pieces cross (13/12, 7/4);
+#: each value is one rounded subtraction (relative error ≤ 2^-53), the doubling and the min exact
+KINKS = (Fraction(3, 4), Fraction(13, 12), Fraction(5, 4), Fraction(7, 4))
+#: the rounding of the nodes' positions, which the quadrature's estimate does not cover (the first test)
+ROUNDING = 32 * np.finfo(float).eps
+
+
+def _abs_u(s):
+    return min(abs(s - 0.75), 2.0 * abs(s - 1.25))
+
+
+def _exact(a: Fraction, b: Fraction) -> Fraction:
+    """∫_a^b |u| exactly: |u| is linear between its kinks, so the trapezoid rule on them is exact."""
+    def v(s):
+        return min(abs(s - KINKS[0]), 2 * abs(s - KINKS[2]))
+    pts = sorted({a, b} | {k for k in KINKS if a < k < b})
+    return sum(((v(p) + v(q)) * (q - p) / 2 for p, q in zip(pts, pts[1:])), Fraction(0))
+
+
+def _relative_excess(cells: int) -> list[Fraction]:
+    t = np.linspace(0.0, 2.0, cells + 1)
+    got = _cell_integrals(_abs_u, t)
+    return [Fraction(got[k]) / _exact(Fraction(t[k]), Fraction(t[k + 1])) - 1 for k in range(cells)]
+
+
+@pytest.mark.parametrize("cells", [7, 40])
+def test_cell_integrals_of_a_kinked_input_are_on_the_large_side_and_tight(cells):
+    excess = _relative_excess(cells)
+    # never below the integral (ψ and β only grow), but for the rounding of the nodes themselves: a node
+    # s = m + h x is within an ulp of s, |u| moves by |u'| ulp(s) there, a relative 4 ulps of the integral of
+    # the cell [5/4, 13/10] where |u| = 2(s − 5/4) starts from 0 (the quadrature's own rounding is covered)
+    assert min(excess) >= -ROUNDING, float(min(excess))
+    assert max(excess) <= QUAD_RTOL, float(max(excess))       # and above it by at most the stated tolerance
+
+
+def test_without_the_bisection_a_kink_is_missed(monkeypatch):
+    """The broken control: one Gauss–Kronrod pass per cell (no bisection) is off by far more than QUAD_RTOL on
+    the cells holding a kink — what the bisection is there for."""
+    monkeypatch.setattr(bounds, "QUAD_DEPTH", 0)
+    assert max(_relative_excess(40)) > 1e3 * QUAD_RTOL
+
+
+def test_smooth_integrands_to_round_off_and_the_input_total():
+    t = np.linspace(0.0, 3.0, 13)
+    got, exact = _cell_integrals(np.exp, t), np.diff(np.exp(t))          # ∫_a^b e^s = e^b − e^a
+    assert np.all(got >= exact * (1 - 4e-16)) and np.all(got <= exact * (1 + 1e-13))
+    lg = LGBounds(0.0, lambda s: 0.0, lambda s: 0.0, np.pi, absu=lambda s: abs(np.cos(s)))   # ∫_0^π |cos| = 2
+    assert 2.0 * (1 - 4e-16) <= lg.u_total <= 2.0 * (1 + 1e-12)
