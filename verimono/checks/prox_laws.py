@@ -38,11 +38,20 @@ from .members import value as _g
 from .engine.batches import rounding, row_dots, row_norms, row_ratios, row_resolvents, row_values, vectorised
 from .engine.search import operator_law
 from ..core.tolerances import row_tolerances
+from ..execution.profiles import LARGE_N
 
 #: the independent minimiser (scipy.optimize, derivative-free Powell) runs only on R^n with n ≤ this
 MINIMISER_MAX_DIM = 4
 #: relative perturbation sizes of the optimality law, times 1 + |p|_∞
 PERTURBATIONS = (1e-4, 1e-2, 1.0)
+#: above this many coordinates the optimality law reads ``|z - x|²`` of its perturbation ``z = p + c·d`` as
+#: ``|x - p|² - 2c⟨x - p, d⟩ + c²|d|²`` (two dots per direction, none per perturbation: at n = 10^6 the
+#: subtraction and dot were a third of the law's work).  Its rounding beyond the direct sum's, that of three
+#: dots — at most ``~n·eps·(|x - p| + |c|)²``, in practice ``~√n·eps`` times that — is set against a slack of at
+#: least ``0.8·RTOL·(|x - p| + |c|)²`` (``4·tolerance(Φ)``, ``Φ(p) ≥ |x - p|²/4`` or ``|λg(p)| ≥ |x - p|²/4``, and
+#: ``4τ|δ| ≥ 4·RTOL·c²``): a ratio moved by ``~1e-5`` at n = 10^6 (``0.1`` in the worst case of rounding).  At or
+#: below it the arithmetic is the direct one, and records there do not move.
+EXPANDED_N = LARGE_N
 
 
 def _tolf(*values: float) -> float:
@@ -219,20 +228,26 @@ def check_prox_optimal(op, s, p, gp):
     x, lam, t = s.x1, s.lam, s.t
     # x - p once: (p - x) @ (p - x) is the same number (p - x = -(x - p) exactly, and the same squares)
     xp = x - p
-    fp = lam * gp + 0.5 * float(xp @ xp)
+    a2 = float(xp @ xp)
+    fp = lam * gp + 0.5 * a2
     s0 = 1.0 + _amax(p)
     tau, dxp = tolerance(x, p), _nrm(xp)
     # per perturbation: z = p + c·d made once and handed to g uncopied (it is made for that call: the
-    # counterexample's z is made again from c and d, the same numbers), z - x into one buffer, one dot —
-    # the same elementwise operations and BLAS dot as λg(z) + |z - x|²/2 was, without four n-sized temporaries.
-    # A coordinate direction e_i changes one entry: z is p (p + 0.0 for the + sign: p + (+0.0)·e_j, signed zeros
-    # included) with entry i set, and z - x is x - p negated (the same squares) with entry i set, in a buffer of
-    # ours patched and restored — the same numbers, two passes over n where there were eight
+    # counterexample's z is made again from c and d, the same numbers).  For n <= EXPANDED_N, z - x into one
+    # buffer and one dot — the same elementwise operations and BLAS dot as λg(z) + |z - x|²/2 was, without four
+    # n-sized temporaries; a coordinate direction e_i changes one entry: z is p (p + 0.0 for the + sign:
+    # p + (+0.0)·e_j, signed zeros included) with entry i set, and z - x is x - p negated (the same squares) with
+    # entry i set, in a buffer of ours patched and restored — the same numbers, two passes over n where there
+    # were eight.  Above EXPANDED_N, |z - x|² = |x - p|² - 2c⟨x - p, d⟩ + c²|d|² from two dots per direction
+    # (:data:`EXPANDED_N`: the rounding this moves is far inside the slack)
+    expanded = x.size > EXPANDED_N
     w, cd, wi = np.empty_like(x), np.empty_like(x), None
     worst, at = -math.inf, None
     for d in _directions(x, p, x.size, x, xp, dxp):
         coordinate = type(d) is int
-        if coordinate and wi is None:
+        if expanded:
+            b, dd = (float(xp[d]), 1.0) if coordinate else (float(xp @ d), float(d @ d))
+        elif coordinate and wi is None:
             wi = xp.copy()
         for h in PERTURBATIONS:
             dz = h * s0
@@ -243,11 +258,15 @@ def check_prox_optimal(op, s, p, gp):
                 if coordinate:
                     z = np.add(p, 0.0) if sgn > 0 else p.copy()
                     z[d] = p[d] + c
+                else:
+                    z = np.add(p, cd) if sgn > 0 else np.subtract(p, cd)
+                if expanded:
+                    q = max(a2 - 2.0 * c * b + c * c * dd, 0.0)
+                elif coordinate:
                     wi[d] = z[d] - x[d]
                     q = float(wi @ wi)
                     wi[d] = xp[d]
                 else:
-                    z = np.add(p, cd) if sgn > 0 else np.subtract(p, cd)
                     np.subtract(z, x, out=w)
                     q = float(w @ w)
                 fz = lam * _owned_value(op, z, t) + 0.5 * q
