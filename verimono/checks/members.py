@@ -186,7 +186,11 @@ def listed(a: np.ndarray) -> Any:
     recipe replays it; a million coordinates per record would swamp the report)."""
     if a.size <= NUMPY_DIM:
         return a.tolist()
-    return f"<{a.size} values, |.|_inf = {float(np.max(np.abs(a))):.6g}>"
+    if a.dtype.kind == "f" and a.size > 4096:   # max(max a, -min a) + 0.0: the same number (and +0 for ±0), no |a| copy
+        m = float(max(a.max(), -a.min())) + 0.0
+    else:
+        m = float(np.max(np.abs(a)))
+    return f"<{a.size} values, |.|_inf = {m:.6g}>"
 
 
 __all__ = ["point", "resolvent", "min_norm", "within_roundoff_of_domain", "outside_by_roundoff_of_dom_g",

@@ -175,10 +175,10 @@ def check_prox_inequality(op, s, p, gp):
         if gz == math.inf:
             continue
         tau = _tol(rtol, ax, ap, ax if z is x else _amax(z))
-        zp = z - p
+        zp, nzp = (xp, nxp) if z is x else (z - p, None)     # z = x: z - p is x - p, the same numbers
         lhs = float(xp @ zp)
         rhs = lam * (gz - gp)
-        slack = 4 * tau * (nxp + _nrm(zp) + tau) + 4 * lam * tolerance(gp, gz)
+        slack = 4 * tau * (nxp + (_nrm(zp) if nzp is None else nzp) + tau) + 4 * lam * tolerance(gp, gz)
         q = _ratio(lhs - rhs, 0.0, slack)
         if worst is None or not q <= worst[0]:
             worst = (q, lab, z, gz, lhs - rhs, slack)
