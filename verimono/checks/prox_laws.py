@@ -230,8 +230,9 @@ def check_prox_optimal(op, s, p, gp):
     xp = x - p
     a2 = float(xp @ xp)
     fp = lam * gp + 0.5 * a2
-    s0 = 1.0 + _amax(p)
-    tau, dxp = tolerance(x, p), _nrm(xp)
+    ap = _amax(p)
+    s0 = 1.0 + ap
+    tau, dxp = _tol(current_rtol(), _amax(x), ap), _nrm(xp)      # tolerance(x, p), |p|_inf read once
     # per perturbation: z = p + c·d made once and handed to g uncopied (it is made for that call: the
     # counterexample's z is made again from c and d, the same numbers).  For n <= EXPANDED_N, z - x into one
     # buffer and one dot — the same elementwise operations and BLAS dot as λg(z) + |z - x|²/2 was, without four
