@@ -79,3 +79,24 @@ def test_the_battery_at_a_million_coordinates():
     failed = {r.check for r in broken.results if r.status == FAILED}
     assert {"resolvent_nonexpansive", "resolvent_firmly_nonexpansive"} <= failed, broken.summary()
     assert not [r for r in broken.results if r.status == UNDECIDED], broken.summary()
+
+
+def test_norm_unscaled_above_unscaled_n_only_where_safe():
+    """Above ``UNSCALED_N`` entries :func:`verimono.checks.members.norm` is ``sqrt(v·v)`` when ``|v|_inf`` lies in
+    ``SAFE_SQUARES``: within a few ulps of the scaled norm (the exact norm to ~n·eps) at every scale, never 0
+    for differences of 1e-250 nor inf for points of 1e300 (there it scales, as at or below ``UNSCALED_N``)."""
+    import math
+    import numpy as np
+    from verimono.checks.members import UNSCALED_N, norm
+    rng = np.random.default_rng(0)
+    for n in (UNSCALED_N, UNSCALED_N + 1):
+        v = rng.standard_normal(n)
+        for scale in (1e-300, 1e-250, 1e-120, 1.0, 1e120, 1e300):
+            w = scale * v
+            m = float(np.max(np.abs(w)))
+            scaled = m * float(np.linalg.norm(w / m))
+            got = norm(w)
+            assert math.isfinite(got) and got > 0, (n, scale, got)
+            assert abs(got - scaled) <= 8 * np.finfo(float).eps * scaled, (n, scale, got, scaled)
+            if n == UNSCALED_N or not 2.0 ** -400 < m < 2.0 ** 400:
+                assert got == scaled, (n, scale)        # at or below UNSCALED_N, or outside the safe range: scaled

@@ -159,3 +159,45 @@ def test_time_of_check_operator_on_a_closed_form_prox():
 def test_every_value_law_is_registered_with_its_requirement():
     for name in VALUE:
         assert name in LAWS and any(getattr(req, "name", None) == "value" for req in LAWS[name].requires)
+
+
+
+def _soft_weighted(n: int, k: float):
+    """The prox of ``2k|·|_1`` on R^n given with ``g = 2|·|_1``: lawful for ``k = 1``; for ``k = 1.02`` the weight
+    2% too large (``l1_weight`` of :mod:`zoo_prox` on R^n, 2% off instead of a factor 2)."""
+    val = lambda x: 2.0 * float(np.abs(x).sum())   # noqa: E731
+    return vm.operator_from_prox(lambda x, lam: zoo_prox.soft(x, 2.0 * k * lam), value=val, shape=n, name=f"soft_{k}")
+
+
+
+def _optimal_ratios(op, n: int, samples: int = 6) -> list[float]:
+    """``prox_optimal``'s ratio on seeded samples (points of scale 1 and 100, λ from 1e-3 to 10), the evaluator
+    called directly: one ratio per sample, no search."""
+    from verimono.checks.engine.samples import Sample
+    evaluate = LAWS["prox_optimal"].evaluate
+    rng = np.random.default_rng(1)
+    out = []
+    for k in range(samples):
+        scale, lam = (1.0, 100.0)[k % 2], 10.0 ** (k - 3)
+        s = Sample(scale * rng.standard_normal(n), scale * rng.standard_normal(n), lam, 0.5 * lam, 2.0 * lam, 0.0)
+        out.append(evaluate(op, s).worst)
+    return out
+
+
+def test_prox_optimal_expanded(monkeypatch):
+    """Above ``EXPANDED_N`` coordinates (2^14; lowered here to 49, the same code at n = 50 for speed)
+    ``prox_optimal`` reads ``|z - x|²`` as ``|x - p|² - 2c⟨x - p, d⟩ + c²|d|²``: a weight 2% too large (``l1_weight``
+    of the zoo on R^n, 2% off) fails, its lawful control holds, and every ratio is the direct arithmetic's (the
+    same evaluator at ``EXPANDED_N`` itself) within the rounding the expansion moves: 1e-6 of the ratio, or of the
+    slack for the control's ratios of pure rounding (~1e-8)."""
+    from verimono.checks import prox_laws
+    n = 50
+    bad, good = _soft_weighted(n, 1.02), _soft_weighted(n, 1.0)
+    direct = _optimal_ratios(bad, n), _optimal_ratios(good, n)
+    monkeypatch.setattr(prox_laws, "EXPANDED_N", n - 1)
+    expanded = _optimal_ratios(bad, n), _optimal_ratios(good, n)
+    for ratios in (direct, expanded):
+        assert max(ratios[0]) > 100 and max(ratios[1]) < 1e-3, ratios
+    for e, d in zip(expanded[0] + expanded[1], direct[0] + direct[1]):
+        assert abs(e - d) <= 1e-6 * max(1.0, abs(d)), (e, d)
+    assert expanded != direct        # the other arithmetic did run (its rounding differs somewhere)

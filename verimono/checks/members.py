@@ -171,14 +171,30 @@ def _finite_near(op: Any, p: np.ndarray, t: float, base: float, dirs: list[np.nd
     return False
 
 
+#: above this many entries :func:`norm` scales its vector only when ``|v|_inf`` leaves ``SAFE_SQUARES``
+UNSCALED_N = 1 << 14
+#: ``|v|_inf`` within which ``Σ v_i²`` neither overflows nor loses more than ``eps`` of itself to underflow, for any n
+#: below 2^100: each square ``<= 2^800 n``, and a square that underflows is ``< 2^-1074 < eps·2^-800``
+SAFE_SQUARES = (2.0 ** -400, 2.0 ** 400)
+
+
 def norm(v: Any) -> float:
-    """Euclidean norm without underflow: sampled points may differ by 1e-250, whose square is 0."""
+    """Euclidean norm without underflow: sampled points may differ by 1e-250, whose square is 0.
+
+    ``|v|_inf · |v / |v|_inf|``, the scaled sum of squares; above :data:`UNSCALED_N` entries (2^14, the
+    coordinates above which :mod:`verimono.execution.profiles` caps the search as well) ``sqrt(v·v)`` when
+    ``|v|_inf`` lies in :data:`SAFE_SQUARES`, where scaling changes nothing but the rounding (a few ulps):
+    the division was a third of a law's norm at n = 10^6.  At or below it the numbers are the scaled ones."""
     v = np.asarray(v, dtype=float)
     if v.size > 4096:       # max(max v, -min v): the same maximum without an n-sized |v| (a law calls this per point)
         m = float(max(v.max(), -v.min()))
     else:
         m = float(np.max(np.abs(v), initial=0.0))
-    return 0.0 if m == 0.0 or not math.isfinite(m) else m * float(np.linalg.norm(v / m))
+    if m == 0.0 or not math.isfinite(m):
+        return 0.0
+    if v.size > UNSCALED_N and SAFE_SQUARES[0] < m < SAFE_SQUARES[1]:
+        return float(np.linalg.norm(v))
+    return m * float(np.linalg.norm(v / m))
 
 
 def listed(a: np.ndarray) -> Any:
@@ -186,7 +202,11 @@ def listed(a: np.ndarray) -> Any:
     recipe replays it; a million coordinates per record would swamp the report)."""
     if a.size <= NUMPY_DIM:
         return a.tolist()
-    return f"<{a.size} values, |.|_inf = {float(np.max(np.abs(a))):.6g}>"
+    if a.dtype.kind == "f" and a.size > 4096:   # max(max a, -min a) + 0.0: the same number (and +0 for ±0), no |a| copy
+        m = float(max(a.max(), -a.min())) + 0.0
+    else:
+        m = float(np.max(np.abs(a)))
+    return f"<{a.size} values, |.|_inf = {m:.6g}>"
 
 
 __all__ = ["point", "resolvent", "min_norm", "within_roundoff_of_domain", "outside_by_roundoff_of_dom_g",

@@ -38,11 +38,20 @@ from .members import value as _g
 from .engine.batches import rounding, row_dots, row_norms, row_ratios, row_resolvents, row_values, vectorised
 from .engine.search import operator_law
 from ..core.tolerances import row_tolerances
+from ..execution.profiles import LARGE_N
 
 #: the independent minimiser (scipy.optimize, derivative-free Powell) runs only on R^n with n ≤ this
 MINIMISER_MAX_DIM = 4
 #: relative perturbation sizes of the optimality law, times 1 + |p|_∞
 PERTURBATIONS = (1e-4, 1e-2, 1.0)
+#: above this many coordinates the optimality law reads ``|z - x|²`` of its perturbation ``z = p + c·d`` as
+#: ``|x - p|² - 2c⟨x - p, d⟩ + c²|d|²`` (two dots per direction, none per perturbation: at n = 10^6 the
+#: subtraction and dot were a third of the law's work).  Its rounding beyond the direct sum's, that of three
+#: dots — at most ``~n·eps·(|x - p| + |c|)²``, in practice ``~√n·eps`` times that — is set against a slack of at
+#: least ``0.8·RTOL·(|x - p| + |c|)²`` (``4·tolerance(Φ)``, ``Φ(p) ≥ |x - p|²/4`` or ``|λg(p)| ≥ |x - p|²/4``, and
+#: ``4τ|δ| ≥ 4·RTOL·c²``): a ratio moved by ``~1e-5`` at n = 10^6 (``0.1`` in the worst case of rounding).  At or
+#: below it the arithmetic is the direct one, and records there do not move.
+EXPANDED_N = LARGE_N
 
 
 def _tolf(*values: float) -> float:
@@ -106,15 +115,13 @@ def _outside(op, p, gp, what, x, t) -> Outcome:
                             "resolvent_roundoff": tau, "precision": prec})
 
 
-def _directions(x, p, n, seed_like) -> list[np.ndarray]:
-    """Unit directions: the coordinates, ``x - p``, ``p`` and seeded random ones (deterministic in the sample)."""
-    dirs = []
-    for i in range(min(n, 3)):        # e_i without the n x n identity (3.2 GB at n = 20000)
-        e = np.zeros(n)
-        e[i] = 1.0
-        dirs.append(e)
-    for v in (x - p, p):
-        nv = _nrm(v)
+def _directions(x, p, n, seed_like, xp=None, nxp=None) -> list:
+    """Unit directions: the coordinates, ``x - p``, ``p`` and seeded random ones (deterministic in the sample).
+    A coordinate direction ``e_i`` is given as its index ``i`` (the optimality law perturbs one entry of ``p``;
+    :func:`_unit` makes the vector when a counterexample needs it); ``xp = x - p`` and its norm when known."""
+    dirs: list = list(range(min(n, 3)))    # e_i without the n x n identity (3.2 GB at n = 20000), nor n zeros each
+    for v, nv in ((x - p if xp is None else xp, nxp), (p, None)):
+        nv = _nrm(v) if nv is None else nv
         if nv > 0:
             dirs.append(v / nv)
     rng = np.random.default_rng(zlib.crc32(np.ascontiguousarray(seed_like, dtype=float)))   # its bytes, uncopied
@@ -122,6 +129,13 @@ def _directions(x, p, n, seed_like) -> list[np.ndarray]:
         v = rng.standard_normal(n)
         dirs.append(v / _nrm(v))
     return dirs
+
+
+def _unit(i: int, n: int) -> np.ndarray:
+    """The coordinate direction ``e_i`` of ``R^n``."""
+    e = np.zeros(n)
+    e[i] = 1.0
+    return e
 
 
 def _at_prox_point(what):
@@ -161,10 +175,10 @@ def check_prox_inequality(op, s, p, gp):
         if gz == math.inf:
             continue
         tau = _tol(rtol, ax, ap, ax if z is x else _amax(z))
-        zp = z - p
+        zp, nzp = (xp, nxp) if z is x else (z - p, None)     # z = x: z - p is x - p, the same numbers
         lhs = float(xp @ zp)
         rhs = lam * (gz - gp)
-        slack = 4 * tau * (nxp + _nrm(zp) + tau) + 4 * lam * tolerance(gp, gz)
+        slack = 4 * tau * (nxp + (_nrm(zp) if nzp is None else nzp) + tau) + 4 * lam * tolerance(gp, gz)
         q = _ratio(lhs - rhs, 0.0, slack)
         if worst is None or not q <= worst[0]:
             worst = (q, lab, z, gz, lhs - rhs, slack)
@@ -212,25 +226,53 @@ def check_prox_optimal(op, s, p, gp):
     ``Φ(p) + |δ|²/2 ≤ Φ(p + δ)`` for perturbations ``δ`` along coordinates, ``x - p``, ``p`` and seeded
     directions."""
     x, lam, t = s.x1, s.lam, s.t
-    fp = lam * gp + 0.5 * float((p - x) @ (p - x))
-    s0 = 1.0 + float(np.max(np.abs(p), initial=0.0))
-    tau, dxp = tolerance(x, p), _nrm(x - p)
+    # x - p once: (p - x) @ (p - x) is the same number (p - x = -(x - p) exactly, and the same squares)
+    xp = x - p
+    a2 = float(xp @ xp)
+    fp = lam * gp + 0.5 * a2
+    ap = _amax(p)
+    s0 = 1.0 + ap
+    tau, dxp = _tol(current_rtol(), _amax(x), ap), _nrm(xp)      # tolerance(x, p), |p|_inf read once
     # per perturbation: z = p + c·d made once and handed to g uncopied (it is made for that call: the
-    # counterexample's z is made again from c and d, the same numbers), z - x into one buffer, one dot —
-    # the same elementwise operations and BLAS dot as λg(z) + |z - x|²/2 was, without four n-sized temporaries
-    w, cd = np.empty_like(x), np.empty_like(x)
+    # counterexample's z is made again from c and d, the same numbers).  For n <= EXPANDED_N, z - x into one
+    # buffer and one dot — the same elementwise operations and BLAS dot as λg(z) + |z - x|²/2 was, without four
+    # n-sized temporaries; a coordinate direction e_i changes one entry: z is p (p + 0.0 for the + sign:
+    # p + (+0.0)·e_j, signed zeros included) with entry i set, and z - x is x - p negated (the same squares) with
+    # entry i set, in a buffer of ours patched and restored — the same numbers, two passes over n where there
+    # were eight.  Above EXPANDED_N, |z - x|² = |x - p|² - 2c⟨x - p, d⟩ + c²|d|² from two dots per direction
+    # (:data:`EXPANDED_N`: the rounding this moves is far inside the slack)
+    expanded = x.size > EXPANDED_N
+    w, cd, wi = np.empty_like(x), np.empty_like(x), None
     worst, at = -math.inf, None
-    for d in _directions(x, p, x.size, x):
+    for d in _directions(x, p, x.size, x, xp, dxp):
+        coordinate = type(d) is int
+        if expanded:
+            b, dd = (float(xp[d]), 1.0) if coordinate else (float(xp @ d), float(d @ d))
+        elif coordinate and wi is None:
+            wi = xp.copy()
         for h in PERTURBATIONS:
-            np.multiply(d, h * s0, out=cd)      # (-c)·d = -(c·d) and p + (-(c·d)) = p - c·d exactly: one product for both signs
+            dz = h * s0
+            if not coordinate:
+                np.multiply(d, dz, out=cd)      # (-c)·d = -(c·d) and p + (-(c·d)) = p - c·d exactly: one product for both signs
             for sgn in (1.0, -1.0):
                 c = sgn * h * s0
-                z = np.add(p, cd) if sgn > 0 else np.subtract(p, cd)
-                np.subtract(z, x, out=w)
-                fz = lam * _owned_value(op, z, t) + 0.5 * float(w @ w)
+                if coordinate:
+                    z = np.add(p, 0.0) if sgn > 0 else p.copy()
+                    z[d] = p[d] + c
+                else:
+                    z = np.add(p, cd) if sgn > 0 else np.subtract(p, cd)
+                if expanded:
+                    q = max(a2 - 2.0 * c * b + c * c * dd, 0.0)
+                elif coordinate:
+                    wi[d] = z[d] - x[d]
+                    q = float(wi @ wi)
+                    wi[d] = xp[d]
+                else:
+                    np.subtract(z, x, out=w)
+                    q = float(w @ w)
+                fz = lam * _owned_value(op, z, t) + 0.5 * q
                 if fz == math.inf:
                     continue
-                dz = h * s0
                 slack = 4 * _tolf(fp, fz, lam * gp) + 4 * tau * (dxp + dz + tau)
                 r = (fp + 0.5 * dz * dz - fz) / slack
                 if not r <= worst:
@@ -239,7 +281,7 @@ def check_prox_optimal(op, s, p, gp):
         return Outcome.compare(0.0, 0.0, 1.0, "optimality: every perturbation left dom g (sample inconclusive)", {},
                                inconclusive=True)
     d, c, fz, slack = at
-    z = np.multiply(d, c)
+    z = np.multiply(_unit(d, x.size) if type(d) is int else d, c)
     z += p
     dz2 = float((z - p) @ (z - p))
     return Outcome.compare(fp + 0.5 * dz2 - fz, 0.0, slack,
