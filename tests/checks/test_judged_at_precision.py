@@ -14,12 +14,12 @@ from verimono.checks.engine.samples import Sample
 from verimono.checks.engine.search import run_law
 from verimono.records.results import FAILED, PASSED
 
-pyproximal = pytest.importorskip("pyproximal", reason="PyProximal is in the test extra")
-
-
 def ball_prox(radius: float):
     """PyProximal's projection onto the unit ball (or, for the plant, onto the ball of ``radius``) with
-    PyProximal's own membership test as the indicator: ``g(x) = 0`` if ``|x| ≤ 1`` exactly, else ``+inf``."""
+    PyProximal's own membership test as the indicator: ``g(x) = 0`` if ``|x| ≤ 1`` exactly, else ``+inf``.
+    PyProximal is imported here, not at the module's top: importing it (PyLops, SciPy's signal module) costs
+    ≈ 1 s of CPU, which every pytest process and xdist worker paid at collection for five tests."""
+    pyproximal = pytest.importorskip("pyproximal", reason="PyProximal is in the test extra")
     inside = pyproximal.EuclideanBall(np.zeros(3), 1.0)
     proj = pyproximal.EuclideanBall(np.zeros(3), radius)
     return vm.operator_from_prox(lambda x, lam: proj.prox(x, lam), value=lambda x: 0.0 if inside(x) else np.inf,

@@ -8,11 +8,10 @@ import textwrap
 
 import numpy as np
 import pytest
-import qpsolvers
 from scipy.optimize import LinearConstraint, minimize
 
 from verimono import InfeasibleStep, SolverFailure
-from verimono.core.qp import equilibrate, kkt_residual, solve_qp
+from verimono.core.qp import _qpsolvers, equilibrate, kkt_residual, solve_qp
 
 # the triangle {z1 + z2 <= 1, z >= 0} and a slab cut by an equality, as (G, h, A, b)
 TRIANGLE = (np.array([[1.0, 1.0], [-1.0, 0.0], [0.0, -1.0]]), np.array([1.0, 0.0, 0.0]), None, None)
@@ -93,7 +92,10 @@ def test_zero_rows_are_dropped_or_prove_infeasibility():
 def test_a_back_end_reporting_a_wrong_answer_is_not_trusted(monkeypatch):
     """Every back-end 'solves' the projection of (2, 3) onto the triangle with an interior point (the answer
     is (0, 1)): the KKT check rejects it, and polishing on its (empty) active set does not rescue it."""
-    monkeypatch.setattr(qpsolvers, "solve_qp", lambda P, q, *args, **kwargs: np.full(q.shape, 0.1))
+    # the qpsolvers verimono calls: its private copy without the unused back-ends (or the shared package where
+    # one was imported before); this module does not import qpsolvers itself, which imports JAX where installed
+    # (≈ 1 s of CPU at collection in every pytest process) and would make verimono use the shared package
+    monkeypatch.setattr(_qpsolvers(), "solve_qp", lambda P, q, *args, **kwargs: np.full(q.shape, 0.1))
     G, h, _, _ = TRIANGLE
     with pytest.raises(SolverFailure, match="KKT check failed"):
         solve_qp(np.eye(2), -np.array([2.0, 3.0]), G, h)

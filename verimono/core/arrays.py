@@ -96,8 +96,16 @@ def as_float64(value: Any) -> np.ndarray:
     its precision reported to the judgement in progress (:func:`verimono.core.tolerances.observe`).  A float64
     NumPy array is returned as it is; complex or non-numeric values raise ``TypeError``/``ValueError``
     as ``np.asarray(value, dtype=float)`` does."""
-    if type(value) is np.ndarray and value.dtype == np.float64:
-        return value
+    kind = type(value)
+    if kind is np.ndarray:
+        if value.dtype == np.float64:
+            return value
+        if value.dtype == np.float32:   # a NumPy float32 subject's outputs: what the general path below does,
+            observe("float32")          # without its dtype-name lookups (a third of a float32 battery's CPU)
+            return value.astype(np.float64)
+    elif kind is np.float32:
+        observe("float32")
+        return np.asarray(value, dtype=float)
     p = precision_of(value)
     if p is not None and p != "float64":
         observe(p)
