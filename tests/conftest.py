@@ -30,10 +30,18 @@ def siconos_dir() -> Path:
     return siconos_root(PACKAGED_DATA)
 
 
+def _node_ids(name: str) -> set[str]:
+    """The node ids listed in ``tests/<name>`` (one a line; after '#', the measured seconds)."""
+    return {line.split("  #")[0].strip() for line in
+            (Path(__file__).resolve().parent / name).read_text(encoding="utf-8").splitlines()
+            if line.strip() and not line.startswith("#")}
+
+
 #: fast-tier tests measured at 2 s or more: marked ``slow`` here (tests/slow_tests.txt says when and how measured)
-_MEASURED_SLOW = {line.split("  #")[0].strip() for line in
-                  (Path(__file__).resolve().parent / "slow_tests.txt").read_text(encoding="utf-8").splitlines()
-                  if line.strip() and not line.startswith("#")}
+_MEASURED_SLOW = _node_ids("slow_tests.txt")
+#: fast-tier tests measured at 0.4 s or more: marked ``heavy``, the tier CI runs right after the default one
+#: (tests/heavy_tests.txt says when and how measured)
+_MEASURED_HEAVY = _node_ids("heavy_tests.txt")
 
 
 @pytest.hookimpl(tryfirst=True)       # before `-m` deselects: the marker must be there when it looks
@@ -41,3 +49,5 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         if item.nodeid in _MEASURED_SLOW:
             item.add_marker(pytest.mark.slow)
+        elif item.nodeid in _MEASURED_HEAVY:
+            item.add_marker(pytest.mark.heavy)
