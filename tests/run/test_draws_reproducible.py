@@ -15,8 +15,10 @@ from __future__ import annotations
 import hashlib
 import importlib
 import sys
+from pathlib import Path
 
 import numpy as np
+import pytest
 
 from verimono.checks.generated_problems import generated_problems
 from verimono.execution.profiles import get_profile
@@ -65,3 +67,68 @@ def test_generated_operators_depend_on_the_seed():
     profile = get_profile("ci")
     assert _fingerprint(op for _, op in _generated_operators(profile, 0)) != \
         _fingerprint(op for _, op in _generated_operators(profile, 1))
+
+
+_LOCATED = r'''
+import hashlib, json, sys
+import numpy as np
+import verimono
+from reference import catalog
+from verimono.checks.operator_battery import check_operator
+from verimono.execution.profiles import get_profile
+from verimono.run.stages.builtin import _generated_operators
+
+def fingerprints(ops):
+    out = []
+    for op in ops:
+        x = np.linspace(-2.0, 3.0, 5 * op.dim).reshape(5, op.dim)
+        vals = [np.asarray(op.resolvent(xi, lam, t), dtype=float) for xi in x for lam in (0.1, 1.0, 7.0)
+                for t in (0.0, 0.37, 1.0)]
+        out.append(hashlib.sha256(repr(op).encode() + np.concatenate(vals).tobytes()).hexdigest())
+    return out
+
+profile = get_profile("ci")
+H = [p.operator for p in catalog() if "Example" in p.name and "\u2212t" in p.name][0]
+rep = check_operator(H, seed=0, examples=profile.law_examples)
+print(json.dumps({"file": verimono.__file__,
+                  "operators": fingerprints(op for _, op in _generated_operators(profile, 0)),
+                  "records": [[r.check, r.status, repr(r.worst), r.details.get("evaluations"), r.counterexample]
+                              for r in rep.results]}))
+'''
+
+
+def _located_run(root) -> dict:
+    import json
+    import os
+    import subprocess
+
+    env = {**os.environ, "PYTHONPATH": str(root), "PYTHONHASHSEED": "random"}
+    out = subprocess.run([sys.executable, "-c", _LOCATED], cwd=root, env=env, capture_output=True, text=True,
+                         timeout=600)
+    assert out.returncode == 0, out.stderr[-3000:]
+    got = json.loads(out.stdout.strip().splitlines()[-1])
+    assert got["file"].startswith(str(root)), got["file"]      # the copy ran, not the installed package
+    return got
+
+
+@pytest.mark.slow
+def test_the_same_code_at_another_path_gives_the_same_records(tmp_path):
+    """A run is a function of (code, seed, profile): the package copied to two folders — one under a folder
+    named ``tests``, which hypothesis excludes when it collects local constants (``is_local_module_file``) —
+    draws the same six operators and gives the paper Example's ``H`` the same operator-law records
+    (evaluations, worst ratios to the bit), hash randomisation on.  Seen failing on 747bfae: the copy under
+    ``tests/`` drew other operators #2 and #3 (verimono's own literals no longer in hypothesis' pool)."""
+    import shutil
+
+    import verimono
+
+    src = Path(verimono.__file__).resolve().parent.parent
+    runs = []
+    for root in (tmp_path / "a", tmp_path / "tests" / "elsewhere_longer_name"):
+        for pkg in ("verimono", "reference"):
+            shutil.copytree(src / pkg, root / pkg, ignore=shutil.ignore_patterns("__pycache__"))
+        runs.append(_located_run(root))
+    a, b = runs
+    assert a["operators"] == b["operators"] and len(set(a["operators"])) == 6
+    assert a["records"] == b["records"]
+    assert sum(r[1] == "passed" for r in a["records"]) >= 10 and all(r[3] for r in a["records"][:15])
