@@ -33,7 +33,7 @@ from ...checks.picard import check_picard
 from ...checks.pseudo_distance import check_pseudo_distance
 from ...checks.shared_runs import note_partitions, shared_runs
 from ...checks.siconos import check_siconos_case, check_siconos_lcps
-from ...checks.generated_problems import generated_problems
+from ...checks.generated_problems import SEED_STRIDE, draw, generated_problems
 from ...checks.stepper_battery import stepper_checks
 from .registry import UNIT_TIME, RunContext, register_stage, timed_unit
 
@@ -140,7 +140,6 @@ def _generated_operators(profile: Profile, seed: int | None) -> list[tuple[str, 
     + k``."""
     import random
 
-    from ...checks.generated_problems import SEED_STRIDE, draw
     from ...strategies.operators import maximal_monotone_operators
 
     base = random.SystemRandom().randrange(2 ** 31) if seed is None else seed
