@@ -137,6 +137,31 @@ def test_a_member_that_does_not_declare_it_is_called_per_row():
     assert not accepts_times(NormSubdifferential(np.array([1.0, 2.0]), dim=2))     # a batch of operators
 
 
+def test_a_member_wrapped_on_the_object_is_called_per_row():
+    """A member replaced on the object itself (a user's instrumentation: ``op.resolvent = counting(op.resolvent)``,
+    ``ball.project = ...``) is not the catalog's own: it is called once per row with a float time, as a subclass
+    override is (found by the probe: the assumption laws called such a wrapper with an array of times)."""
+    def float_only(member):
+        def wrapped(x, *args):
+            assert isinstance(args[-1], float), f"{member} called with t of type {type(args[-1]).__name__}"
+            return getattr(type(member.__self__), member.__name__)(member.__self__, x, *args)
+        return wrapped
+    X, ts = _points(2)
+    ball = Ball(lambda t: np.array([t, 0.0]), 1.0)
+    ball.project = float_only(ball.project)
+    assert not accepts_times(ball)
+    op = NormalCone(ball)
+    assert not accepts_times(op)
+    assert np.array_equal(resolvent_rows(op, X, LAM, ts), np.array([op.resolvent(x, LAM, t) for x, t in zip(X, ts)]))
+    ns = NormSubdifferential(lambda t: 1.0 + t, dim=2)
+    ns.yosida = float_only(ns.yosida)
+    assert not accepts_times(ns)
+    nc = NormalCone(Box(-np.ones(2), lambda t: np.array([1.0 + t, 1.0])))
+    nc.resolvent = float_only(nc.resolvent)
+    assert not accepts_times(nc)
+    assert np.array_equal(resolvent_rows(nc, X, LAM, ts), np.array([nc.resolvent(x, LAM, t) for x, t in zip(X, ts)]))
+
+
 def test_a_parameter_invalid_at_one_time_raises_as_a_separate_call_does():
     """A radius, a weight, a box that goes wrong at one time of the block: the error names that time."""
     X, ts = _points(2)

@@ -60,6 +60,12 @@ _WEIGHTS_G[1::2] = np.concatenate([_WG[:-1], _WG[::-1]])           # the 7 Gauss
 #: the sums' own rounding (as text too: one string, longer than the 20 characters hypothesis keeps of a string literal)
 QUAD_RTOL, QUAD_ATOL, ROUNDING_ULPS = (float(x) for x in "1e-11 1e-14 16 (rtol atol ulps)".split()[:3])
 QUAD_DEPTH = 40
+#: the Lagrange weights that extrapolate the 15 nodes' values to the end x = 1 of [-1, 1] (reversed: to x = -1;
+#: Σ|L| = 3.84, so the extrapolation's rounding stays a few ulps), and the gap 1 − x_max between an end and its
+#: outermost node: a kink or a jump in that gap is seen by no node (K15 = G7 there), only by the end's value
+_TO_END = np.array([np.prod([(1.0 - xk) / (xj - xk) for k, xk in enumerate(_NODES) if k != j])
+                    for j, xj in enumerate(_NODES)])
+_GAP = 1.0 - _NODES[-1]
 
 
 def _cell_integrals(fn: Callable, t: np.ndarray) -> np.ndarray:
@@ -85,11 +91,18 @@ def _cell_integrals(fn: Callable, t: np.ndarray) -> np.ndarray:
     a, b, owner = t[:-1].copy(), t[1:].copy(), np.arange(n)
     for depth in range(QUAD_DEPTH + 1):
         half, mid = 0.5 * (b - a), 0.5 * (a + b)
-        pts = mid[:, None] + half[:, None] * _NODES[None, :]
-        vals = np.array([float(fn(s)) for s in pts.ravel().tolist()]).reshape(pts.shape)
-        kron = half * (vals @ _WEIGHTS_K)
-        # the estimate, and the sums' own rounding (a few ulps of Σ w|f|): the sum stays on the large side of it
-        err = np.abs(kron - half * (vals @ _WEIGHTS_G)) + ROUNDING_ULPS * np.finfo(float).eps * half * (np.abs(vals) @ _WEIGHTS_K)
+        pts = np.concatenate([a[:, None], mid[:, None] + half[:, None] * _NODES[None, :], b[:, None]], axis=1)
+        ends = np.array([float(fn(s)) for s in pts.ravel().tolist()]).reshape(pts.shape)
+        vals = ends[:, 1:-1]
+        with np.errstate(invalid="ignore", over="ignore"):
+            kron = half * (vals @ _WEIGHTS_K)
+            # the estimate, and the sums' own rounding (a few ulps of Σ w|f|): the sum stays on the large side of
+            # it; and what the gaps at the ends can hold that no node sees: the gap's width times how far the end's
+            # value is from the nodes' polynomial extrapolated there (≥ a jump's area in the gap, ≥ a kink's)
+            err = (np.abs(kron - half * (vals @ _WEIGHTS_G)) + ROUNDING_ULPS * np.finfo(float).eps * half * (np.abs(vals) @ _WEIGHTS_K)
+                   + _GAP * half * (np.abs(ends[:, -1] - vals @ _TO_END) + np.abs(ends[:, 0] - vals @ _TO_END[::-1])))
+        # a sum past the largest float: the integral is +inf on the large side (inf − inf is no estimate)
+        err[np.isnan(err) & ~np.isnan(ends).any(axis=1)] = np.inf
         done = ~(err > np.maximum(QUAD_RTOL * np.abs(kron), QUAD_ATOL)) | (depth == QUAD_DEPTH) | (half <= 0)
         np.add.at(total, owner[done], kron[done] + err[done])
         if done.all():

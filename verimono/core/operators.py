@@ -49,8 +49,10 @@ _TIMED = ("resolvent", "yosida", "min_norm", "project_domain")
 
 
 def _own_times(obj: Any, cls: type) -> bool:
-    """``obj`` uses ``cls``'s own members that take a time per row (no subclass override of any)."""
-    return all(_own(obj, cls, m) for m in _TIMED)
+    """``obj`` uses ``cls``'s own members that take a time per row: no subclass override of any, none replaced on
+    the object itself (a user's wrapper is not assumed to take an array of times)."""
+    mine = getattr(obj, "__dict__", {})
+    return all(_own(obj, cls, m) and m not in mine for m in _TIMED)
 
 
 def _column(p: np.ndarray) -> np.ndarray:

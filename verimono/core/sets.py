@@ -98,8 +98,11 @@ def _own(obj: Any, cls: type) -> bool:
 
 
 def _own_times(obj: Any, cls: type) -> bool:
-    """``obj`` uses ``cls``'s own ``project`` and ``contains`` (those that take a time per row)."""
-    return type(obj).project is cls.project and type(obj).contains is cls.contains
+    """``obj`` uses ``cls``'s own ``project`` and ``contains`` (those that take a time per row): neither overridden
+    by a subclass nor replaced on the object itself (a user's wrapper is not assumed to take an array of times)."""
+    mine = getattr(obj, "__dict__", {})
+    return (type(obj).project is cls.project and type(obj).contains is cls.contains
+            and "project" not in mine and "contains" not in mine)
 
 
 def _at_times(param, ts: np.ndarray) -> np.ndarray:
