@@ -81,3 +81,14 @@ def test_a_kink_or_a_jump_no_node_sees_is_still_on_the_large_side(c, kind):
 def test_an_integral_that_overflows_is_infinite_not_nan():
     got = _cell_integrals(lambda s: 1.7e308 * (1.0 + s), np.array([0.0, 1.0]))      # ∫ = 2.55e308 > max float
     assert got[0] == np.inf
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1e-150, 1.0, 1e150, 1e300])
+def test_a_jump_is_on_the_large_side_at_every_magnitude(scale):
+    """The acceptance floor scales with the whole integral: an absolute 1e-14 accepted the piece holding a jump of
+    |u| at scale 1e-300 on its first estimate, blind to it (7.7e-5 below the integral, found by a user's probe)."""
+    rng = np.random.default_rng(3)
+    for c in rng.uniform(0.0, 1.0, 40).tolist():
+        got = _cell_integrals(lambda s: scale * (2.0 if s >= c else 1.0), np.array([0.0, 1.0]))[0]
+        exact = Fraction(scale) * (Fraction(c) + 2 * (1 - Fraction(c)))
+        assert Fraction(got) >= exact and Fraction(got) / exact - 1 <= 1e-9, (scale, c, got)

@@ -55,9 +55,12 @@ _NODES = np.concatenate([-_XK[:-1], _XK[::-1]])                    # the 15 node
 _WEIGHTS_K = np.concatenate([_WK[:-1], _WK[::-1]])
 _WEIGHTS_G = np.zeros(15)
 _WEIGHTS_G[1::2] = np.concatenate([_WG[:-1], _WG[::-1]])           # the 7 Gauss nodes are the odd ones
-#: a piece is accepted once its error estimate |K15 − G7| is below QUAD_RTOL of its integral (or QUAD_ATOL);
-#: beyond QUAD_DEPTH bisections its estimate is kept, added like any other; ROUNDING_ULPS ulps of Σ w|f| cover
-#: the sums' own rounding (as text too: one string, longer than the 20 characters hypothesis keeps of a string literal)
+#: a piece is accepted once its error estimate |K15 − G7| is below QUAD_RTOL of its integral or QUAD_ATOL of the
+#: whole integral over all cells (the first pass's Σ|K15|, at least the smallest normal float): scaled so, |u| of any
+#: magnitude is integrated alike (an absolute 1e-14 accepted a piece of a jump at scale 1e-300 on its first, blind
+#: estimate: 1e-4 below the integral), and a piece that never settles (noise, a jump on every scale) stops once it
+#: is that small a part of the whole; beyond QUAD_DEPTH bisections its estimate is kept, added like any other;
+#: ROUNDING_ULPS ulps of Σ w|f| cover the sums' own rounding
 QUAD_RTOL, QUAD_ATOL, ROUNDING_ULPS = (float(x) for x in "1e-11 1e-14 16 (rtol atol ulps)".split()[:3])
 QUAD_DEPTH = 40
 #: the Lagrange weights that extrapolate the 15 nodes' values to the end x = 1 of [-1, 1] (reversed: to x = -1;
@@ -73,7 +76,7 @@ def _cell_integrals(fn: Callable, t: np.ndarray) -> np.ndarray:
 
     ``fn`` (``|u|``, ``σ``) is a scalar callable that may be non-smooth (``|u|`` has a kink where ``u``
     vanishes).  Every cell is integrated by the 15-point Gauss–Kronrod rule, all cells at once; a piece whose
-    estimate ``|K15 − G7|`` exceeds ``QUAD_RTOL`` of its value (``QUAD_ATOL`` absolute) is bisected, down to
+    estimate ``|K15 − G7|`` exceeds ``QUAD_RTOL`` of its value is bisected, down to
     ``QUAD_DEPTH`` times.  ``|K15 − G7|`` bounds the Kronrod rule's error by a wide margin where ``fn`` is smooth
     on the piece (it is the Gauss rule's error, of a rule 9 degrees lower) and the bisection shrinks the piece
     holding a kink until it is; the sum ``K15 + |K15 − G7|`` (and a few ulps of ``Σ w|fn|`` for the sums'
@@ -103,7 +106,9 @@ def _cell_integrals(fn: Callable, t: np.ndarray) -> np.ndarray:
                    + _GAP * half * (np.abs(ends[:, -1] - vals @ _TO_END) + np.abs(ends[:, 0] - vals @ _TO_END[::-1])))
         # a sum past the largest float: the integral is +inf on the large side (inf − inf is no estimate)
         err[np.isnan(err) & ~np.isnan(ends).any(axis=1)] = np.inf
-        done = ~(err > np.maximum(QUAD_RTOL * np.abs(kron), QUAD_ATOL)) | (depth == QUAD_DEPTH) | (half <= 0)
+        if depth == 0:
+            floor = QUAD_ATOL * max(float(np.sum(np.abs(kron))), float(np.finfo(float).tiny))
+        done = ~(err > np.maximum(QUAD_RTOL * np.abs(kron), floor)) | (depth == QUAD_DEPTH) | (half <= 0)
         np.add.at(total, owner[done], kron[done] + err[done])
         if done.all():
             break
