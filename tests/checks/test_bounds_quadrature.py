@@ -92,3 +92,17 @@ def test_a_jump_is_on_the_large_side_at_every_magnitude(scale):
         got = _cell_integrals(lambda s: scale * (2.0 if s >= c else 1.0), np.array([0.0, 1.0]))[0]
         exact = Fraction(scale) * (Fraction(c) + 2 * (1 - Fraction(c)))
         assert Fraction(got) >= exact and Fraction(got) / exact - 1 <= 1e-9, (scale, c, got)
+
+
+def test_an_input_that_never_settles_costs_calls_linear_in_the_cells():
+    """An |u| with a jump on every scale (values from the bits of s): the bisection stops at QUAD_PIECES open pieces a
+    cell, each estimate added — it doubled its pieces at every level before, 2^40 of them."""
+    calls = []
+
+    def noise(s):
+        calls.append(s)
+        return 1.0 + (hash(s) % 1000) / 1000.0
+
+    got = _cell_integrals(noise, np.linspace(0.0, 1.0, 11))
+    assert np.all(np.isfinite(got)) and 1.0 <= got.sum() <= 4.0, got       # 1 ≤ |u| < 2 on [0, 1], estimates added
+    assert len(calls) <= 17 * 2 * bounds.QUAD_PIECES * 10, len(calls)
