@@ -39,7 +39,7 @@ def _node_ids(name: str) -> set[str]:
 
 #: fast-tier tests measured at 2 s or more: marked ``slow`` here (tests/slow_tests.txt says when and how measured)
 _MEASURED_SLOW = _node_ids("slow_tests.txt")
-#: fast-tier tests measured at 0.4 s or more: marked ``heavy``, the tier CI runs right after the default one
+#: fast-tier tests measured at 0.3 s or more: marked ``heavy``, the tier CI runs right after the default one
 #: (tests/heavy_tests.txt says when and how measured)
 _MEASURED_HEAVY = _node_ids("heavy_tests.txt")
 
