@@ -52,4 +52,9 @@ def times_of(t, x: np.ndarray, who: str) -> np.ndarray | None:
     return t.astype(float, copy=False)
 
 
+def per_row(fn, x: np.ndarray, ts: np.ndarray) -> np.ndarray:
+    """``fn(x_i, t_i)`` of every row, stacked: what a member that does not take a time per row is called as."""
+    return np.array([np.asarray(fn(xi, ti), dtype=float) for xi, ti in zip(x, ts.tolist())]).reshape(np.shape(x))
+
+
 __all__ = ["dot_rows"]

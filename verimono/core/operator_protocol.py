@@ -152,11 +152,6 @@ def accepts_times(op: Any) -> bool:
     return bool(says()) if callable(says) else False
 
 
-def per_row(fn: Callable, x: np.ndarray, ts: np.ndarray) -> np.ndarray:
-    """``fn(x_i, t_i)`` of every row, stacked: what a member that does not take a time per row is called as."""
-    return np.array([np.asarray(fn(xi, ti), dtype=float) for xi, ti in zip(x, ts.tolist())]).reshape(np.shape(x))
-
-
 def provides(op: Any, member: str) -> bool:
     """``op.provides(member)`` for operators that say, else whether ``op`` has the member at all."""
     says = getattr(op, "provides", None)

@@ -31,11 +31,11 @@ from typing import Any, Callable
 import numpy as np
 
 from ._params import as_param
-from ._rows import _INF, _TINY, _mx, _norm, _sqrt, dot_rows, times_of
+from ._rows import _INF, _TINY, _mx, _norm, _sqrt, dot_rows, per_row, times_of
 from ._validate import bad_lam, bad_param, batch_column, check_lam, real_array
 from .errors import InvalidProblem, NotMonotone, OutsideDomain
 from .tolerances import tolerance
-from .operator_protocol import (Operator, accepts_times, operator_from_resolvent, per_row, provides, resolvent_kernel,
+from .operator_protocol import (Operator, accepts_times, operator_from_resolvent, provides, resolvent_kernel,
                                 resolvent_rows)
 
 

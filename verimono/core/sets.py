@@ -28,7 +28,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ._params import as_param
-from ._rows import _INF, _TINY, _mn, _mx, _sqrt, dot_rows, times_of
+from ._rows import _INF, _TINY, _mn, _mx, _sqrt, dot_rows, per_row, times_of
 from ._validate import bad_lam, bad_param, batch_column, finite_point, real_array
 from .errors import InvalidProblem
 from .tolerances import row_tolerances, tolerance
@@ -176,7 +176,7 @@ class Ball(ConvexSet):
         ts = times_of(t, x, self.name)
         if ts is not None:
             if not self._accepts_times():
-                return np.array([self.project(xi, ti) for xi, ti in zip(x, ts.tolist())]).reshape(x.shape)
+                return per_row(self.project, x, ts)
             return self._project(x, ts, times=True)
         return self._project(x, t)
 
@@ -299,7 +299,7 @@ class Box(ConvexSet):
         ts = times_of(t, x, self.name)
         if ts is not None:
             if not self._accepts_times():
-                return np.array([self.project(xi, ti) for xi, ti in zip(x, ts.tolist())]).reshape(x.shape)
+                return per_row(self.project, x, ts)
             lo, hi = self._bounds_times(ts)
             return _mn(_mx(x, lo), hi)
         lo, hi = self._bounds_at(t)
@@ -389,7 +389,7 @@ class HalfSpace(ConvexSet):
         ts = times_of(t, x, self.name)
         if ts is not None:
             if not self._accepts_times():
-                return np.array([self.project(xi, ti) for xi, ti in zip(x, ts.tolist())]).reshape(x.shape)
+                return per_row(self.project, x, ts)
             a, b = _at_times(self._a, ts), _column(_at_times(self._b, ts))
             if a.ndim == 1:
                 aa = a.dot(a)
@@ -496,7 +496,7 @@ class Polyhedron(ConvexSet):
         x = finite_point(x, f"the point projected onto {self.name}")
         ts = times_of(t, x, self.name)
         if ts is not None:      # one row at a time (its data at its time): the same as separate calls
-            return np.array([self.project(xi, ti) for xi, ti in zip(x, ts.tolist())]).reshape(x.shape)
+            return per_row(self.project, x, ts)
         G, h, A, b = self.data(t)
         inside = self._inside(x, G, h, A, b)
         if x.ndim == 1:
@@ -536,7 +536,7 @@ class Translated(ConvexSet):
         ts = times_of(t, x, self.name)
         if ts is not None:
             if not self._accepts_times():
-                return np.array([self.project(xi, ti) for xi, ti in zip(x, ts.tolist())]).reshape(x.shape)
+                return per_row(self.project, x, ts)
             c = _at_times(self._c, ts)
             return self.S.project(x - c, ts) + c
         c = self._c(t)
