@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 
+from ._validate import bad_lam
 from .errors import InvalidProblem
 
 _ar = np.add.reduce
@@ -55,6 +56,29 @@ def times_of(t, x: np.ndarray, who: str) -> np.ndarray | None:
 def per_row(fn, x: np.ndarray, ts: np.ndarray) -> np.ndarray:
     """``fn(x_i, t_i)`` of every row, stacked: what a member that does not take a time per row is called as."""
     return np.array([np.asarray(fn(xi, ti), dtype=float) for xi, ti in zip(x, ts.tolist())]).reshape(np.shape(x))
+
+
+def steps_of(lam, x: np.ndarray, who: str) -> np.ndarray | None:
+    """``lam`` as a step size per row of ``x`` when it is an array of shape ``(B,)`` (``x`` then ``(B, n)``), each
+    checked ``0 < λ < ∞`` as a separate call checks its own (the first bad one named, as that call would), else
+    ``None`` (one step for every row: the ordinary call)."""
+    if type(lam) is not np.ndarray or lam.ndim != 1:
+        return None
+    if np.ndim(x) != 2 or np.shape(x)[0] != lam.shape[0]:
+        raise InvalidProblem(f"{who}: a step size per row needs points of shape ({lam.shape[0]}, n), got {np.shape(x)}")
+    ls = lam.astype(float, copy=False)
+    good = (ls > 0.0) & (ls < _INF)        # NaN fails both
+    if not good.all():
+        raise bad_lam(ls.tolist()[int(np.argmin(good))], who)
+    return ls
+
+
+def per_row_steps(fn, x: np.ndarray, ls: np.ndarray, t) -> np.ndarray:
+    """``fn(x_i, λ_i, t_i)`` of every row (``t`` one time for all rows, or ``(B,)`` a time per row), stacked: what a
+    member that does not take a step size per row is called as (a float ``λ`` and a float ``t`` each call)."""
+    ts = t.tolist() if type(t) is np.ndarray and t.ndim == 1 else [t] * len(ls)
+    return np.array([np.asarray(fn(xi, li, ti), dtype=float)
+                     for xi, li, ti in zip(x, ls.tolist(), ts)]).reshape(np.shape(x))
 
 
 __all__ = ["dot_rows"]

@@ -19,6 +19,7 @@ import numpy as np
 
 from .arrays import Boundary, array_kind, as_float64, batch_chunks, given_as_is, take_prefetched
 from ._subgradients import checked_value, subgradient_contains
+from ._rows import per_row_steps, steps_of
 from ._validate import check_lam, real_array
 from .errors import InvalidProblem
 from .tolerances import tolerance
@@ -48,7 +49,14 @@ class Operator:
         raise NotImplementedError(f"{self.name} does not provide a resolvent")
 
     def yosida(self, x: np.ndarray, lam: float, t: float = 0.0) -> np.ndarray:
-        """Yosida approximation ``Y_λ x = (x - J_λ x)/λ``, an element of ``F(t, J_λ x)``."""
+        """Yosida approximation ``Y_λ x = (x - J_λ x)/λ``, an element of ``F(t, J_λ x)``.  ``lam`` of shape ``(B,)``
+        beside ``x`` of shape ``(B, n)``: row ``i`` at ``λ_i`` (one call when :meth:`_accepts_steps`, else per row)."""
+        if type(lam) is np.ndarray and lam.ndim == 1:
+            x = real_array(x)
+            ls = steps_of(lam, x, f"{self.name}.yosida")
+            if not self._accepts_steps():
+                return per_row_steps(self.yosida, x, ls, t)
+            return (x - self.resolvent(x, ls, t)) / ls[:, None]
         lam = check_lam(lam, f"{self.name}.yosida")
         x = real_array(x)
         return (x - self.resolvent(x, lam, t)) / lam
@@ -103,6 +111,14 @@ class Operator:
         any row is outside the domain at its time."""
         return False
 
+    def _accepts_steps(self) -> bool:
+        """Whether :meth:`resolvent` and :meth:`yosida` take ``lam`` of shape ``(B,)`` beside ``x`` of shape ``(B, n)``
+        — row ``i`` at step size ``λ_i`` (and, with ``t`` of shape ``(B,)`` too, at time ``t_i`` when
+        :meth:`_accepts_times` says so) — bit-identically to ``B`` separate calls with a float ``λ`` (the catalog's
+        own members do; a user's operator, or a subclass override, or a member replaced on the object is not
+        assumed to: the operator laws then call it once per step size)."""
+        return False
+
     def _kernel(self, x0: np.ndarray) -> Callable | None:
         """A fast ``step(x, lam, t) = J_λ x`` for float arrays shaped like ``x0``, or ``None``.
 
@@ -149,6 +165,13 @@ def accepts_times(op: Any) -> bool:
     """Whether ``op`` declares that its members take a time per row (:meth:`Operator._accepts_times`); an
     object that does not say does not (never found out by calling it and catching what it raises)."""
     says = getattr(op, "_accepts_times", None)
+    return bool(says()) if callable(says) else False
+
+
+def accepts_steps(op: Any) -> bool:
+    """Whether ``op`` declares that its ``resolvent`` and ``yosida`` take a step size per row
+    (:meth:`Operator._accepts_steps`); an object that does not say does not (never found out by calling it)."""
+    says = getattr(op, "_accepts_steps", None)
     return bool(says()) if callable(says) else False
 
 

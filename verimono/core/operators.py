@@ -31,12 +31,12 @@ from typing import Any, Callable
 import numpy as np
 
 from ._params import as_param
-from ._rows import _INF, _TINY, _mx, _norm, _sqrt, dot_rows, per_row, times_of
+from ._rows import _INF, _TINY, _mx, _norm, _sqrt, dot_rows, per_row, per_row_steps, steps_of, times_of
 from ._validate import bad_lam, bad_param, batch_column, check_lam, real_array
 from .errors import InvalidProblem, NotMonotone, OutsideDomain
 from .tolerances import tolerance
-from .operator_protocol import (Operator, accepts_times, operator_from_resolvent, provides, resolvent_kernel,
-                                resolvent_rows)
+from .operator_protocol import (Operator, accepts_steps, accepts_times, operator_from_resolvent, provides,
+                                resolvent_kernel, resolvent_rows)
 
 
 def _own(obj: Any, cls: type, member: str = "resolvent") -> bool:
@@ -53,6 +53,29 @@ def _own_times(obj: Any, cls: type) -> bool:
     the object itself (a user's wrapper is not assumed to take an array of times)."""
     mine = getattr(obj, "__dict__", {})
     return all(_own(obj, cls, m) and m not in mine for m in _TIMED)
+
+
+#: the members that take a step size per row (:meth:`Operator._accepts_steps`)
+_STEPPED = ("resolvent", "yosida")
+
+
+def _own_steps(obj: Any, cls: type) -> bool:
+    """``obj`` uses ``cls``'s own ``resolvent`` and ``yosida`` (those that take a step size per row): neither
+    overridden by a subclass nor replaced on the object itself (a user's wrapper is called with a float ``λ``)."""
+    mine = getattr(obj, "__dict__", {})
+    return all(_own(obj, cls, m) and m not in mine for m in _STEPPED)
+
+
+def _steps(op: Operator, x: np.ndarray, lam, t):
+    """``(λ, None)`` for one step size (checked), ``(λ column (B, 1), None)`` for a step size per row the operator
+    computes at once, or ``(None, J)`` with ``J`` the rows' resolvents called one by one (a float ``λ_i`` and ``t_i``
+    each) when it does not declare it, or the times per row with it (:meth:`Operator._accepts_steps`)."""
+    ls = steps_of(lam, x, f"{op.name}.resolvent")
+    if ls is None:
+        return check_lam(lam, f"{op.name}.resolvent"), None
+    if not op._accepts_steps() or (type(t) is np.ndarray and not op._accepts_times()):
+        return None, per_row_steps(op.resolvent, x, ls, t)
+    return ls[:, None], None
 
 
 def _column(p: np.ndarray) -> np.ndarray:
@@ -165,6 +188,17 @@ class Linear(_EverywhereDefined):
 
     def resolvent(self, x, lam, t=0.0):
         x = real_array(x)
+        if type(lam) is np.ndarray:
+            ls, J = _steps(self, x, lam, t)
+            if J is not None:
+                return J
+            if not self.static:     # M(t) per row: its own inverse each
+                return per_row_steps(self.resolvent, x, ls[:, 0], t)
+            # each row's (I + λ_i M)^{-T} (the same cached factor a separate call uses), and a stack of
+            # (1, n) @ (n, n) products: each row exactly as the single point's x @ W
+            inverse = self._inverse
+            W = np.array([inverse(li, 0.0) for li in ls[:, 0].tolist()])
+            return (x[:, None, :] @ W)[:, 0, :]
         ts = times_of(t, x, self.name)
         if ts is not None:
             if not self.static or not self._accepts_times():     # M(t) per row: its own inverse each
@@ -182,6 +216,9 @@ class Linear(_EverywhereDefined):
 
     def _accepts_times(self):
         return _own_times(self, Linear)
+
+    def _accepts_steps(self):
+        return _own_steps(self, Linear)
 
     def _kernel(self, x0):
         if not _own(self, Linear) or not self.static or x0.ndim != 1:
@@ -269,8 +306,10 @@ class NormSubdifferential(_EverywhereDefined):
 
     def resolvent(self, x, lam, t=0.0):
         # J x = x max(|x| - λc, 0)/|x|, written so that x = 0 gives 0 without a 0/0
-        lam = check_lam(lam, f"{self.name}.resolvent")
         x = real_array(x)
+        lam, J = _steps(self, x, lam, t)
+        if J is not None:
+            return J
         if type(t) is np.ndarray and not self._accepts_times():
             return per_row(lambda xi, ti: self.resolvent(xi, lam, ti), x, times_of(t, x, self.name))
         nrm = _norm(x)
@@ -281,6 +320,9 @@ class NormSubdifferential(_EverywhereDefined):
 
     def _accepts_times(self):
         return _own_times(self, NormSubdifferential) and self._c(0.0).ndim == 0
+
+    def _accepts_steps(self):
+        return _own_steps(self, NormSubdifferential) and self._c(0.0).ndim == 0
 
     def _kernel(self, x0):
         if not _own(self, NormSubdifferential) or x0.ndim != 1 or self._c(0.0).ndim:
@@ -344,8 +386,10 @@ class L1Subdifferential(_EverywhereDefined):
         _nonnegative(c0, "c(0)")
 
     def resolvent(self, x, lam, t=0.0):
-        lam = check_lam(lam, f"{self.name}.resolvent")
         x = real_array(x)
+        lam, J = _steps(self, x, lam, t)
+        if J is not None:
+            return J
         return np.sign(x) * _mx(np.abs(x) - lam * self._c_rows(t, x), 0.0)
 
     def _c_rows(self, t, x):
@@ -360,6 +404,9 @@ class L1Subdifferential(_EverywhereDefined):
 
     def _accepts_times(self):
         return _own_times(self, L1Subdifferential)
+
+    def _accepts_steps(self):
+        return _own_steps(self, L1Subdifferential)
 
     def _kernel(self, x0):
         if not _own(self, L1Subdifferential):
@@ -423,7 +470,12 @@ class NormalCone(Operator):
         return 0.0
 
     def resolvent(self, x, lam, t=0.0):
-        check_lam(lam, f"{self.name}.resolvent")  # J_λ = proj for every λ > 0, and only for those
+        if type(lam) is np.ndarray:     # J_λ = proj for every λ > 0, and only for those: each row's checked
+            lam, J = _steps(self, np.asarray(x, dtype=float), lam, t)
+            if J is not None:
+                return J
+        else:
+            check_lam(lam, f"{self.name}.resolvent")  # J_λ = proj for every λ > 0, and only for those
         if type(t) is np.ndarray and not accepts_times(self.S):     # a set that takes one time per call
             return per_row(self.S.project, np.asarray(x, dtype=float), times_of(t, x, self.name))
         return self.S.project(x, t)
@@ -433,6 +485,9 @@ class NormalCone(Operator):
 
     def _accepts_times(self):
         return _own_times(self, NormalCone) and accepts_times(self.S)
+
+    def _accepts_steps(self):
+        return _own_steps(self, NormalCone) and self._accepts_batches()
 
     def _kernel(self, x0):
         if not _own(self, NormalCone):
@@ -502,8 +557,14 @@ class Shifted(Operator):
         return self._Phi(0.0) if self._Phi.constant else self._Phi.at_times(ts)
 
     def resolvent(self, x, lam, t=0.0):
-        lam = check_lam(lam, f"{self.name}.resolvent")
         x = real_array(x)
+        if type(lam) is np.ndarray:
+            ls, J = _steps(self, x, lam, t)
+            if J is not None:
+                return J
+            lam = ls[:, 0]      # the inner operator takes the steps as they were given
+        else:
+            lam = check_lam(lam, f"{self.name}.resolvent")
         if type(t) is np.ndarray and not self._accepts_times():
             return per_row(lambda xi, ti: self.resolvent(xi, lam, ti), x, times_of(t, x, self.name))
         p = self._shift(t, x)
@@ -514,6 +575,9 @@ class Shifted(Operator):
 
     def _accepts_times(self):
         return _own_times(self, Shifted) and accepts_times(self.F) and np.ndim(self._Phi(0.0)) <= 1
+
+    def _accepts_steps(self):
+        return _own_steps(self, Shifted) and accepts_steps(self.F) and np.ndim(self._Phi(0.0)) <= 1
 
     def _kernel(self, x0):
         if not _own(self, Shifted):
@@ -594,7 +658,10 @@ class LogBarrier(Operator):
 
     def resolvent(self, x, lam, t=0.0):
         x = real_array(x)
-        return self._resolve(x, check_lam(lam, f"{self.name}.resolvent"), self._c_rows(t, x))
+        lam, J = _steps(self, x, lam, t)
+        if J is not None:
+            return J
+        return self._resolve(x, lam, self._c_rows(t, x))
 
     @staticmethod
     def _resolve(x, lam, c):
@@ -609,6 +676,9 @@ class LogBarrier(Operator):
 
     def _accepts_times(self):
         return _own_times(self, LogBarrier)
+
+    def _accepts_steps(self):
+        return _own_steps(self, LogBarrier) and np.shape(self._c(0.0)) in ((), (self.dim,))
 
     def _kernel(self, x0):
         if not _own(self, LogBarrier):
