@@ -177,3 +177,17 @@ def test_a_parameter_invalid_at_one_time_raises_as_a_separate_call_does():
         NormalCone(Ball([0.0, 0.0], 1.0)).min_norm(X, ts)
     with pytest.raises(InvalidProblem, match="a time per row"):
         ball.project(X[:3], ts)
+
+
+def test_a_one_point_call_with_a_length_1_array_is_the_ordinary_call():
+    """``x`` of shape ``(n,)`` with ``t`` or ``λ`` a length-1 array is not "a time (a step) per row": it is the
+    ordinary call with ``t`` (``λ``) as given, as before times per row existed.  A constant operator's resolvent
+    then equals the scalar call's; a time-dependent parameter of shape (1,) is, as always, a batch of one operator,
+    whose typed error names it."""
+    x = np.array([3.0, 0.5, -1.0])
+    op = Linear(np.array([[2.0, 1.0, 0.0], [-1.0, 1.0, 0.0], [0.0, 0.0, 3.0]]))
+    assert np.array_equal(op.resolvent(x, 0.3, np.array([0.5])), op.resolvent(x, 0.3, 0.5))
+    assert np.array_equal(op.yosida(x, 0.3, np.array([0.5])), op.yosida(x, 0.3, 0.5))
+    ball = NormalCone(Ball(center=np.zeros(3), radius=lambda t: 1.0 + t))
+    with pytest.raises(InvalidProblem, match="batch of 1 values"):
+        ball.resolvent(x, 0.3, np.array([0.5]))

@@ -45,8 +45,9 @@ _INF = math.inf
 
 def times_of(t, x: np.ndarray, who: str) -> np.ndarray | None:
     """``t`` as a time per row of ``x`` when it is an array of shape ``(B,)`` (``x`` then ``(B, n)``), else
-    ``None`` (one time for every row: the ordinary call)."""
-    if type(t) is not np.ndarray or t.ndim != 1:
+    ``None`` (one time for every row: the ordinary call).  A one-point call (``x`` of shape ``(n,)``) with a
+    length-1 array ``t`` is the ordinary call too, as it was before times per row existed (``t`` broadcasts)."""
+    if type(t) is not np.ndarray or t.ndim != 1 or (t.shape[0] == 1 and np.ndim(x) == 1):
         return None
     if np.ndim(x) != 2 or np.shape(x)[0] != t.shape[0]:
         raise InvalidProblem(f"{who}: a time per row needs points of shape ({t.shape[0]}, n), got {np.shape(x)}")
@@ -61,8 +62,9 @@ def per_row(fn, x: np.ndarray, ts: np.ndarray) -> np.ndarray:
 def steps_of(lam, x: np.ndarray, who: str) -> np.ndarray | None:
     """``lam`` as a step size per row of ``x`` when it is an array of shape ``(B,)`` (``x`` then ``(B, n)``), each
     checked ``0 < λ < ∞`` as a separate call checks its own (the first bad one named, as that call would), else
-    ``None`` (one step for every row: the ordinary call)."""
-    if type(lam) is not np.ndarray or lam.ndim != 1:
+    ``None`` (one step for every row: the ordinary call; so is a one-point call with a length-1 array ``lam``, as
+    for :func:`times_of`)."""
+    if type(lam) is not np.ndarray or lam.ndim != 1 or (lam.shape[0] == 1 and np.ndim(x) == 1):
         return None
     if np.ndim(x) != 2 or np.shape(x)[0] != lam.shape[0]:
         raise InvalidProblem(f"{who}: a step size per row needs points of shape ({lam.shape[0]}, n), got {np.shape(x)}")
