@@ -292,12 +292,22 @@ def check_prox_optimal(op, s, p, gp):
 @operator_law("prox_minimiser", "prox optimality (independent minimiser)", _VALUE)
 def check_prox_minimiser(op, s):
     """The prox optimality (independent minimiser): ``Φ(p) ≤ Φ(z*)`` for ``z*`` a minimiser of
-    ``Φ`` found by scipy's Powell from ``p``, ``x``, ``0`` (``n ≤ 4`` only: larger samples are
-    inconclusive)."""
+    ``Φ`` found by scipy's Powell from ``p`` and ``x`` (from ``p`` alone on ``R^1``: :func:`_starts`; ``n ≤ 4``
+    only: larger samples are inconclusive)."""
     if s.x1.size > MINIMISER_MAX_DIM:
         return Outcome.compare(0.0, 0.0, 1.0, f"independent minimiser runs only for n ≤ {MINIMISER_MAX_DIM} "
                                "(sample inconclusive)", {}, inconclusive=True)
     return _minimised(op, s)
+
+
+def _starts(p, x):
+    """Powell's start points: ``p`` and ``x``; on ``R^1`` ``p`` alone.  There Powell is a Brent line search along
+    the one direction, its bracket grown without bound from the start, and ``Φ`` is strongly convex: from ``p``
+    and from ``x`` it minimises the same function of one variable over the whole line, and the two results differ
+    by the line search's tolerance only (from ``x`` it cost 1.5–2× the evaluations of the start at ``p``).  On
+    ``R^n``, n ≥ 2, a start can stall at a kink of ``g`` (the coordinate directions none of them descending
+    while another is), and the start at ``x`` reaches the minimiser by another path: both stay."""
+    return (p,) if p.size == 1 else (p, x)
 
 
 @_at_prox_point("independent minimiser")
@@ -310,12 +320,18 @@ def _minimised(op, s, p, gp):
     big = 1e300
 
     def phi(z):
-        v = _phi(op, np.asarray(z, dtype=float), x, lam, t)
+        # λg(z) + |z - x|²/2 as _phi makes it, g read by _owned_value: Powell hands each call a point of its own
+        # (scipy's wrapper copies it) and |z - x|² is taken before g sees z, so members.value's protective copy
+        # is not needed: the same numbers
+        z = np.asarray(z, dtype=float)
+        w = z - x
+        q = 0.5 * float(w @ w)
+        v = lam * _owned_value(op, z, t) + q
         return v if v < big else big
     best, zbest = math.inf, None
     scale = 1.0 + float(np.max(np.abs(x), initial=0.0))
-    for z0 in (p, x):
-        if phi(z0) >= big:
+    for z0 in _starts(p, x):
+        if phi(z0.copy()) >= big:     # a copy: p and x are read after it
             continue
         res = minimize(phi, z0, method="Powell", options={"xtol": 1e-10 * scale, "ftol": 1e-14, "maxfev": 200 * n})
         if res.fun < best:
