@@ -232,7 +232,11 @@ def check_prox_optimal(op, s, p, gp):
     fp = lam * gp + 0.5 * a2
     ap = _amax(p)
     s0 = 1.0 + ap
-    tau, dxp = _tol(current_rtol(), _amax(x), ap), _nrm(xp)      # tolerance(x, p), |p|_inf read once
+    rtol = current_rtol()
+    tau, dxp = _tol(rtol, _amax(x), ap), _nrm(xp)      # tolerance(x, p), |p|_inf read once
+    # _tolf(fp, fz, λg(p)) per perturbation with rtol and the two fixed magnitudes read once: the same max of
+    # the same three numbers, the same products
+    afp, algp = abs(fp), abs(lam * gp)
     # per perturbation: z = p + c·d made once and handed to g uncopied (it is made for that call: the
     # counterexample's z is made again from c and d, the same numbers).  For n <= EXPANDED_N, z - x into one
     # buffer and one dot — the same elementwise operations and BLAS dot as λg(z) + |z - x|²/2 was, without four
@@ -273,7 +277,7 @@ def check_prox_optimal(op, s, p, gp):
                 fz = lam * _owned_value(op, z, t) + 0.5 * q
                 if fz == math.inf:
                     continue
-                slack = 4 * _tolf(fp, fz, lam * gp) + 4 * tau * (dxp + dz + tau)
+                slack = 4 * (rtol * (1.0 + max(afp, abs(fz), algp))) + 4 * tau * (dxp + dz + tau)
                 r = (fp + 0.5 * dz * dz - fz) / slack
                 if not r <= worst:
                     worst, at = r, (d, c, fz, slack)
