@@ -207,3 +207,33 @@ def test_prox_optimal_expanded(monkeypatch):
     for e, d in zip(expanded[0] + expanded[1], direct[0] + direct[1]):
         assert abs(e - d) <= 1e-6 * max(1.0, abs(d)), (e, d)
     assert expanded != direct        # the other arithmetic did run (its rounding differs somewhere)
+
+
+def _minimiser_ratios(op, n: int, samples: int = 6) -> list[float]:
+    """``prox_minimiser``'s ratio on the seeded samples of :func:`_optimal_ratios`, the evaluator called directly."""
+    from verimono.checks.engine.samples import Sample
+    evaluate = LAWS["prox_minimiser"].evaluate
+    rng = np.random.default_rng(1)
+    out = []
+    for k in range(samples):
+        scale, lam = (1.0, 100.0)[k % 2], 10.0 ** (k - 3)
+        s = Sample(scale * rng.standard_normal(n), scale * rng.standard_normal(n), lam, 0.5 * lam, 2.0 * lam, 0.0)
+        out.append(evaluate(op, s).worst)
+    return out
+
+
+def test_prox_minimiser_on_the_line_starts_at_p_alone(monkeypatch):
+    """On R^1 ``prox_minimiser`` runs Powell from ``p`` alone (``prox_laws._starts``): one strongly convex function
+    of one variable, minimised over the whole line from either start.  A weight 2% too large fails and its lawful
+    control holds with that start alone, and every ratio is that of both starts (``p`` and ``x``, as on R^n)
+    within the line search's tolerance: 1e-6 of the ratio, or of the slack for the control's ratios (~1e-9)."""
+    from verimono.checks import prox_laws
+    bad, good = _soft_weighted(1, 1.02), _soft_weighted(1, 1.0)
+    assert len(prox_laws._starts(np.zeros(1), np.ones(1))) == 1 and len(prox_laws._starts(np.zeros(2), np.ones(2))) == 2
+    alone = _minimiser_ratios(bad, 1), _minimiser_ratios(good, 1)
+    monkeypatch.setattr(prox_laws, "_starts", lambda p, x: (p, x))
+    both = _minimiser_ratios(bad, 1), _minimiser_ratios(good, 1)
+    for ratios in (alone, both):
+        assert max(ratios[0]) > 100 and max(ratios[1]) < 1e-3, ratios
+    for a, b in zip(alone[0] + alone[1], both[0] + both[1]):
+        assert abs(a - b) <= 1e-6 * max(1.0, abs(b)), (a, b)

@@ -232,7 +232,11 @@ def check_prox_optimal(op, s, p, gp):
     fp = lam * gp + 0.5 * a2
     ap = _amax(p)
     s0 = 1.0 + ap
-    tau, dxp = _tol(current_rtol(), _amax(x), ap), _nrm(xp)      # tolerance(x, p), |p|_inf read once
+    rtol = current_rtol()
+    tau, dxp = _tol(rtol, _amax(x), ap), _nrm(xp)      # tolerance(x, p), |p|_inf read once
+    # _tolf(fp, fz, λg(p)) per perturbation with rtol and the two fixed magnitudes read once: the same max of
+    # the same three numbers, the same products
+    afp, algp = abs(fp), abs(lam * gp)
     # per perturbation: z = p + c·d made once and handed to g uncopied (it is made for that call: the
     # counterexample's z is made again from c and d, the same numbers).  For n <= EXPANDED_N, z - x into one
     # buffer and one dot — the same elementwise operations and BLAS dot as λg(z) + |z - x|²/2 was, without four
@@ -273,7 +277,7 @@ def check_prox_optimal(op, s, p, gp):
                 fz = lam * _owned_value(op, z, t) + 0.5 * q
                 if fz == math.inf:
                     continue
-                slack = 4 * _tolf(fp, fz, lam * gp) + 4 * tau * (dxp + dz + tau)
+                slack = 4 * (rtol * (1.0 + max(afp, abs(fz), algp))) + 4 * tau * (dxp + dz + tau)
                 r = (fp + 0.5 * dz * dz - fz) / slack
                 if not r <= worst:
                     worst, at = r, (d, c, fz, slack)
@@ -292,12 +296,22 @@ def check_prox_optimal(op, s, p, gp):
 @operator_law("prox_minimiser", "prox optimality (independent minimiser)", _VALUE)
 def check_prox_minimiser(op, s):
     """The prox optimality (independent minimiser): ``Φ(p) ≤ Φ(z*)`` for ``z*`` a minimiser of
-    ``Φ`` found by scipy's Powell from ``p``, ``x``, ``0`` (``n ≤ 4`` only: larger samples are
-    inconclusive)."""
+    ``Φ`` found by scipy's Powell from ``p`` and ``x`` (from ``p`` alone on ``R^1``: :func:`_starts`; ``n ≤ 4``
+    only: larger samples are inconclusive)."""
     if s.x1.size > MINIMISER_MAX_DIM:
         return Outcome.compare(0.0, 0.0, 1.0, f"independent minimiser runs only for n ≤ {MINIMISER_MAX_DIM} "
                                "(sample inconclusive)", {}, inconclusive=True)
     return _minimised(op, s)
+
+
+def _starts(p, x):
+    """Powell's start points: ``p`` and ``x``; on ``R^1`` ``p`` alone.  There Powell is a Brent line search along
+    the one direction, its bracket grown without bound from the start, and ``Φ`` is strongly convex: from ``p``
+    and from ``x`` it minimises the same function of one variable over the whole line, and the two results differ
+    by the line search's tolerance only (from ``x`` it cost 1.5–2× the evaluations of the start at ``p``).  On
+    ``R^n``, n ≥ 2, a start can stall at a kink of ``g`` (the coordinate directions none of them descending
+    while another is), and the start at ``x`` reaches the minimiser by another path: both stay."""
+    return (p,) if p.size == 1 else (p, x)
 
 
 @_at_prox_point("independent minimiser")
@@ -310,12 +324,18 @@ def _minimised(op, s, p, gp):
     big = 1e300
 
     def phi(z):
-        v = _phi(op, np.asarray(z, dtype=float), x, lam, t)
+        # λg(z) + |z - x|²/2 as _phi makes it, g read by _owned_value: Powell hands each call a point of its own
+        # (scipy's wrapper copies it) and |z - x|² is taken before g sees z, so members.value's protective copy
+        # is not needed: the same numbers
+        z = np.asarray(z, dtype=float)
+        w = z - x
+        q = 0.5 * float(w @ w)
+        v = lam * _owned_value(op, z, t) + q
         return v if v < big else big
     best, zbest = math.inf, None
     scale = 1.0 + float(np.max(np.abs(x), initial=0.0))
-    for z0 in (p, x):
-        if phi(z0) >= big:
+    for z0 in _starts(p, x):
+        if phi(z0.copy()) >= big:     # a copy: p and x are read after it
             continue
         res = minimize(phi, z0, method="Powell", options={"xtol": 1e-10 * scale, "ftol": 1e-14, "maxfev": 200 * n})
         if res.fun < best:
