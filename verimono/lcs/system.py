@@ -438,8 +438,31 @@ class LCSOperator(Operator):
     def _accepts_batches(self):
         return type(self).resolvent is LCSOperator.resolvent
 
+    def _accepts_times(self):
+        """A time per row (:meth:`verimono.Operator._accepts_times`): ``resolvent``, ``yosida``, ``min_norm`` and
+        ``project_domain`` of rows ``(B, n)`` at times ``(B,)`` take each row as its own call would, in the rows'
+        order (the stateful stepper and the warm QPs see the same sequence of calls) — unless a subclass or the
+        object itself replaces one of them."""
+        mine = getattr(self, "__dict__", {})
+        return all(getattr(type(self), m) is getattr(LCSOperator, m) and m not in mine
+                   for m in ("resolvent", "yosida", "min_norm", "project_domain"))
+
+    def _times(self, x: np.ndarray, t) -> np.ndarray | None:
+        """``t`` as a time per row of ``x`` (:func:`verimono.core._rows.times_of`), else ``None``."""
+        if type(t) is not np.ndarray or t.ndim != 1:
+            return None
+        if x.ndim != 2 or x.shape[0] != t.shape[0]:
+            raise InvalidProblem(f"{self.name}: a time per row needs points of shape ({t.shape[0]}, n), "
+                                 f"got {x.shape}")
+        return t.astype(float, copy=False)
+
     def resolvent(self, x, lam, t=0.0):
         x = np.asarray(x, dtype=float)
+        ts = self._times(x, t)
+        if ts is not None:
+            if x.shape[0] and x.shape[1] == self.dim and self._accepts_times():
+                return self._rows(x, float(lam), ts.tolist())
+            return np.array([self.resolvent(xi, lam, ti) for xi, ti in zip(x, ts.tolist())]).reshape(x.shape)
         if x.ndim == 2:
             if x.shape[0] and x.shape[1] == self.dim and type(self).resolvent is LCSOperator.resolvent:
                 return self._rows(x, float(lam), t)
@@ -456,13 +479,18 @@ class LCSOperator(Operator):
         """The resolvent of every row of ``X``, each row's arithmetic exactly :meth:`resolvent`'s for one point
         (the same products, the same stepper called in the same order), with what the rows share looked up
         once: the step matrices of ``λ`` and ``v(t)``, a function of ``t`` (an assumption law's design asks
-        ~20 rows at one ``(λ, t)``; the paper's Example's operator laws ~100)."""
+        ~20 rows at one ``(λ, t)``; the paper's Example's operator laws ~100).  ``t`` a list: row ``i`` at
+        ``t[i]`` (``v`` looked up per row)."""
         sm = self._sm(lam)
         s = self.system
-        v = s.v(t)
         E, G, C, step, q_scale = sm.E, sm.G, s.C, sm.step, s.q_scale
         out = []
-        for x in X:
+        if type(t) is list:
+            vs = [s.v(ti) for ti in t]
+        else:
+            v = s.v(t)
+            vs = [v] * len(X)
+        for x, v in zip(X, vs):
             xE = E @ x
             z, _ = step(C @ xE + v, q_scale(xE, v))
             out.append(xE + G @ z)
@@ -519,6 +547,9 @@ class LCSOperator(Operator):
 
     def min_norm(self, x, t=0.0):
         x = np.asarray(x, dtype=float)
+        ts = self._times(x, t)
+        if ts is not None:      # row by row in order: OutsideDomain when any row is outside at its time
+            return np.array([self.min_norm(xi, ti) for xi, ti in zip(x, ts.tolist())]).reshape(x.shape)
         if x.ndim == 2:
             return np.array([self.min_norm(xi, t) for xi in x])
         return self._memoised("min_norm", x, t, lambda: self._min_norm(x, t))
@@ -560,6 +591,9 @@ class LCSOperator(Operator):
 
     def project_domain(self, x, t=0.0):
         x = np.asarray(x, dtype=float)
+        ts = self._times(x, t)
+        if ts is not None:
+            return np.array([self.project_domain(xi, ti) for xi, ti in zip(x, ts.tolist())]).reshape(x.shape)
         if x.ndim == 2:
             return np.array([self.project_domain(xi, t) for xi in x])
         return self._memoised("project_domain", x, t, lambda: self._project_domain(x, t))
