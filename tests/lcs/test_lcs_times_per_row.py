@@ -184,3 +184,90 @@ def _records(name, monkeypatch, **patches):
         d.pop("duration", None)
         out.append(d)
     return out
+
+
+# -- project_domain of a block: rows proved inside dom H(t_i) at once -------------------------------------------
+
+def _psd3(seed: int = 0):
+    """n = m = 3 with a random PSD, non-symmetric ``D`` (``S + K``, ``S`` PSD of rank 2, ``K`` skew): 8 patterns,
+    some of them singular."""
+    rng = np.random.default_rng(seed)
+    R = rng.normal(size=(3, 2))
+    K = rng.normal(size=(3, 3))
+    D = R @ R.T + (K - K.T)
+    C = rng.normal(size=(3, 3))
+    return LinearRelationSystem(-np.eye(3), C.T.copy(), C, D, Complementarity(),
+                                v=lambda t: np.array([np.sin(t), t - 1.0, 0.5 - t]), name="psd3").operator()
+
+
+def _exact_inside(op, x, t) -> bool:
+    """What :meth:`LCSOperator._project_domain` proves: ``x ∈ dom H(t)`` (no row infeasible, and Lemke's solution
+    or the linear program)."""
+    from verimono.lcs._warm_qp import row_infeasible
+    from verimono.lcs.lcp import _feasible, proved_solvable
+    s = op.system
+    q = s.C @ x + s.v(t)
+    return not row_infeasible(s.D, q) and (proved_solvable(s.D, q, s.q_scale(x, s.v(t))) or _feasible(s.D, q))
+
+
+def _edge_points(op, seed: int = 5):
+    """Points at every scale, and the Example's kind of degenerate ones: on the edge ``x = −v2`` exactly, and
+    ``1e-13``, ``1e-10`` and ``1e-7`` (relative) either side of it; times where ``v1`` vanishes (``t = 0``, ``π``)."""
+    rng = np.random.default_rng(seed)
+    n = op.dim
+    X = rng.normal(size=(60, n)) * np.repeat([1e-8, 1.0, 1e4], 20)[:, None]
+    ts = rng.uniform(0.0, 4.0, 60)
+    ts[:6] = [0.0, 0.0, np.pi, np.pi, 1.0, 2.0]
+    if n == 1:
+        X[:6, 0] = 0.0
+        X[40:60, 0] = np.repeat([0.0, 1e-13, -1e-13, 1e-10, -1e-10, 1e-7, -1e-7, 5e-9, -5e-9, 2.0], 2) * \
+            np.tile([1.0, 3.0], 10)
+    return X, ts
+
+
+@pytest.mark.parametrize("which", ["ramp", "sine", "psd2", "psd3"])
+def test_rows_proved_inside_are_inside_by_the_exact_proof(which):
+    """Every row the block proves inside, the row's own proof (Lemke or the linear program) proves inside too,
+    and the block proves a good share of the rows inside (the test is not vacuous; the two PSD systems have every
+    row inside, the Example leaves those outside and on its edge); the block's projections are
+    the separate calls' bit for bit."""
+    make = _psd3 if which == "psd3" else MAKERS[which]
+    op = make()
+    X, ts = _edge_points(op)
+    inside = op._inside_rows(X, ts)
+    assert inside is not None and inside.sum() >= 10
+    if which in ("ramp", "sine"):     # dom H(t) = [0, ∞): the points outside and on the edge are left
+        assert inside.sum() <= len(X) - 20
+    for x, t, ok in zip(X, ts.tolist(), inside.tolist()):
+        if ok:
+            assert _exact_inside(op, x, t), (x, t)
+    one = make()
+    assert _same(op.project_domain(X, ts), np.array([one.project_domain(x, t) for x, t in zip(X, ts.tolist())]))
+
+
+def test_rows_within_rounding_of_the_edge_are_left_to_their_own_call():
+    """The Example at ``v = (−t, 0)``: ``dom H(t) = [0, ∞)``; a row ``1e-13`` inside the edge, on it, or outside is
+    not proved inside by the block (the margin is 1e-9 of the data); ``1e-7`` inside is."""
+    op = _ramp()
+    X = np.array([[0.0], [1e-13], [-1e-13], [-1e-7], [1e-7], [3.0]])
+    ts = np.full(6, 0.5)
+    assert op._inside_rows(X, ts).tolist() == [False, False, False, False, True, True]
+    assert op._inside_rows(X, np.zeros(6)).tolist() == [False] * 6     # v1 = 0: no strict pattern
+
+
+def test_not_applicable_to_a_relay_or_a_broken_v():
+    """A relay (bounded box: ``dom H = R^n``, the row's own call answers at once) and a ``v`` that raises: no
+    block proof, each row its own call (which raises in its turn)."""
+    from verimono.lcs.relations import Relay
+    relay = LinearRelationSystem(np.zeros((1, 1)), np.array([[1.0]]), np.array([[1.0]]), np.array([[1.0]]),
+                                 Relay(), v=np.zeros(1), name="relay").operator()
+    assert relay._inside_rows(np.ones((3, 1)), np.zeros(3)) is None
+
+    def v(t):
+        if t > 1:
+            raise ZeroDivisionError("v")
+        return np.array([-t, 0.0])
+    bad = example_system(v).operator()
+    assert bad._inside_rows(np.ones((3, 1)), np.array([0.5, 2.0, 0.5])) is None
+    with pytest.raises(ZeroDivisionError):
+        bad.project_domain(np.ones((3, 1)), np.array([0.5, 2.0, 0.5]))
