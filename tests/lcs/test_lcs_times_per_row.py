@@ -271,3 +271,10 @@ def test_not_applicable_to_a_relay_or_a_broken_v():
     assert bad._inside_rows(np.ones((3, 1)), np.array([0.5, 2.0, 0.5])) is None
     with pytest.raises(ZeroDivisionError):
         bad.project_domain(np.ones((3, 1)), np.array([0.5, 2.0, 0.5]))
+
+
+def test_non_finite_rows_are_left_to_their_own_call():
+    """A NaN or infinite row is never proved inside (its own call says what it is)."""
+    op = _ramp()
+    X = np.array([[np.nan], [np.inf], [1.0], [-np.inf]])
+    assert op._inside_rows(X, np.full(4, 0.5)).tolist() == [False, False, True, False]
