@@ -105,7 +105,10 @@ def _deep(S, p: np.ndarray, lam: float, t: float) -> tuple[np.ndarray, np.ndarra
     dd = (S.T - t) * A2_RATIO ** np.arange(A2_LEVELS + 1, A2_DEEP_LEVELS + 1)
     dd = dd[t + dd > t]
     if accepts_times(S.op) and len(dd) >= A2_WINDOW:    # every level in one call, each as its own call gives it
-        return dd, on_times(S.op, p[None, :], lam, t + dd)[:, 0]
+        try:
+            return dd, on_times(S.op, p[None, :], lam, t + dd)[:, 0]
+        except UnverifiedSolution:      # a level verimono cannot verify: the levels one by one, as below
+            pass
     kept, values = [], []
     for k, d in enumerate(dd):
         try:

@@ -372,6 +372,9 @@ def _increments(u, t: np.ndarray, n: int, B: int | None) -> np.ndarray | None:
 
 #: entries of an operator's memo of ``H^0(t, x)`` and ``proj_dom H(t,·)(x)`` (:meth:`LCSOperator._memoised`)
 MEMO_SIZE = 8192
+#: the margin, relative to the data, by which :meth:`LCSOperator._inside_rows` wants a multiplier positive and its
+#: complement slack positive before it takes a row as inside ``dom H(t)`` (its own rounding: ``1e4·ε`` of the data)
+INSIDE_MARGIN = 1e-9
 #: step sizes whose matrices an operator keeps once made (:meth:`LCSOperator._sm`), forgotten all at once
 STEP_TEMPLATES = 4096
 
@@ -399,6 +402,7 @@ class LCSOperator(Operator):
         self._warm_select: dict = {}
         self._warm_project: dict = {}
         self._memo: dict = {}
+        self._patterns: list | None = None      # the multipliers' patterns of :meth:`_inside_rows`, made once
 
     def _memoised(self, kind: str, x: np.ndarray, t, compute):
         """``compute()`` once per ``(kind, t, x)``: an assumption law asks ``H^0`` and ``proj_dom H`` at the same
@@ -438,8 +442,31 @@ class LCSOperator(Operator):
     def _accepts_batches(self):
         return type(self).resolvent is LCSOperator.resolvent
 
+    def _accepts_times(self):
+        """A time per row (:meth:`verimono.Operator._accepts_times`): ``resolvent``, ``yosida``, ``min_norm`` and
+        ``project_domain`` of rows ``(B, n)`` at times ``(B,)`` take each row as its own call would, in the rows'
+        order (the stateful stepper and the warm QPs see the same sequence of calls) — unless a subclass or the
+        object itself replaces one of them."""
+        mine = getattr(self, "__dict__", {})
+        return all(getattr(type(self), m) is getattr(LCSOperator, m) and m not in mine
+                   for m in ("resolvent", "yosida", "min_norm", "project_domain"))
+
+    def _times(self, x: np.ndarray, t) -> np.ndarray | None:
+        """``t`` as a time per row of ``x`` (:func:`verimono.core._rows.times_of`), else ``None``."""
+        if type(t) is not np.ndarray or t.ndim != 1:
+            return None
+        if x.ndim != 2 or x.shape[0] != t.shape[0]:
+            raise InvalidProblem(f"{self.name}: a time per row needs points of shape ({t.shape[0]}, n), "
+                                 f"got {x.shape}")
+        return t.astype(float, copy=False)
+
     def resolvent(self, x, lam, t=0.0):
         x = np.asarray(x, dtype=float)
+        ts = self._times(x, t)
+        if ts is not None:
+            if x.shape[0] and x.shape[1] == self.dim and self._accepts_times():
+                return self._rows(x, float(lam), ts.tolist())
+            return np.array([self.resolvent(xi, lam, ti) for xi, ti in zip(x, ts.tolist())]).reshape(x.shape)
         if x.ndim == 2:
             if x.shape[0] and x.shape[1] == self.dim and type(self).resolvent is LCSOperator.resolvent:
                 return self._rows(x, float(lam), t)
@@ -456,13 +483,18 @@ class LCSOperator(Operator):
         """The resolvent of every row of ``X``, each row's arithmetic exactly :meth:`resolvent`'s for one point
         (the same products, the same stepper called in the same order), with what the rows share looked up
         once: the step matrices of ``λ`` and ``v(t)``, a function of ``t`` (an assumption law's design asks
-        ~20 rows at one ``(λ, t)``; the paper's Example's operator laws ~100)."""
+        ~20 rows at one ``(λ, t)``; the paper's Example's operator laws ~100).  ``t`` a list: row ``i`` at
+        ``t[i]`` (``v`` looked up per row)."""
         sm = self._sm(lam)
         s = self.system
-        v = s.v(t)
         E, G, C, step, q_scale = sm.E, sm.G, s.C, sm.step, s.q_scale
         out = []
-        for x in X:
+        if type(t) is list:
+            vs = [s.v(ti) for ti in t]
+        else:
+            v = s.v(t)
+            vs = [v] * len(X)
+        for x, v in zip(X, vs):
             xE = E @ x
             z, _ = step(C @ xE + v, q_scale(xE, v))
             out.append(xE + G @ z)
@@ -519,6 +551,9 @@ class LCSOperator(Operator):
 
     def min_norm(self, x, t=0.0):
         x = np.asarray(x, dtype=float)
+        ts = self._times(x, t)
+        if ts is not None:      # row by row in order: OutsideDomain when any row is outside at its time
+            return np.array([self.min_norm(xi, ti) for xi, ti in zip(x, ts.tolist())]).reshape(x.shape)
         if x.ndim == 2:
             return np.array([self.min_norm(xi, t) for xi in x])
         return self._memoised("min_norm", x, t, lambda: self._min_norm(x, t))
@@ -560,9 +595,66 @@ class LCSOperator(Operator):
 
     def project_domain(self, x, t=0.0):
         x = np.asarray(x, dtype=float)
+        ts = self._times(x, t)
+        if ts is not None:
+            inside = self._inside_rows(x, ts) if self._accepts_times() else None
+            if inside is None:
+                return np.array([self.project_domain(xi, ti) for xi, ti in zip(x, ts.tolist())]).reshape(x.shape)
+            out = []
+            for xi, ti, ok in zip(x, ts.tolist(), inside.tolist()):
+                # a row proved inside dom H(t_i) is its own projection, what _project_domain returns for it (its
+                # proof skipped, the memo kept as that call keeps it); the others as their own call
+                out.append(self._memoised("project_domain", xi, ti, xi.copy) if ok else self.project_domain(xi, ti))
+            return np.array(out).reshape(x.shape)
         if x.ndim == 2:
             return np.array([self.project_domain(xi, t) for xi in x])
         return self._memoised("project_domain", x, t, lambda: self._project_domain(x, t))
+
+    def _inside_rows(self, X: np.ndarray, ts: np.ndarray) -> np.ndarray | None:
+        """Which rows ``x_i`` are proved inside ``dom H(t_i)`` (complementarity, PSD ``D``) by a strictly complementary
+        solution of the multipliers' ``LCP(Cx_i + v(t_i), D)``, for the whole block at once: on a pattern ``I`` whose
+        ``D_II`` is well conditioned (``cond ≤ 1e4``), ``z_I = −D_II^{-1} q_I > τ`` and ``w_J = (Dz + q)_J > τ`` off it,
+        ``τ = INSIDE_MARGIN·(1 + |q|∞ + ‖C‖∞|x|∞ + |v|∞ + ‖D‖∞|z|∞)`` — far above the rounding of this computation
+        (``cond·ε`` of the data), so the exact solution of the pattern is a solution too and ``x_i ∈ dom H(t_i)``:
+        what the row's own call proves with Lemke or the linear program (:meth:`_project_domain`), which is then
+        spared.  A row not proved (on the domain's edge, outside it, a tie) is left to its own call.  ``None``:
+        not applicable here (another relation, or ``H`` as a set unavailable), every row its own call."""
+        s = self.system
+        try:
+            rel = self._box()
+            if not rel.is_lcp or not len(X):
+                return None
+            pats = self._patterns
+            if pats is None:
+                D, m = s.D, s.m
+                pats = []
+                for mask in range(1 << m):
+                    I = np.array([i for i in range(m) if mask >> i & 1], dtype=int)
+                    J = np.array([i for i in range(m) if not mask >> i & 1], dtype=int)
+                    inv = None
+                    if I.size:
+                        DII = D[np.ix_(I, I)]
+                        if not np.linalg.cond(DII) <= 1e4:
+                            continue
+                        inv = np.linalg.inv(DII)
+                    pats.append((I, J, inv))
+                self._patterns = pats
+            with np.errstate(all="ignore"):
+                V = np.array([np.asarray(s.v(ti), dtype=float) for ti in ts.tolist()])
+                Q = X @ s.C.T + V
+                size = 1.0 + np.abs(Q).max(axis=1) + s._c_norm * np.abs(X).max(axis=1) + np.abs(V).max(axis=1)
+                d_norm = float(np.abs(s.D).sum(axis=1).max(initial=0.0))
+                inside = np.zeros(len(X), dtype=bool)
+                for I, J, inv in pats:
+                    Z = np.zeros_like(Q)
+                    if inv is not None:
+                        Z[:, I] = -(Q[:, I] @ inv.T)
+                    W = Z @ s.D.T + Q
+                    tau = INSIDE_MARGIN * (size + d_norm * np.abs(Z).max(axis=1))
+                    inside |= (Z[:, I] > tau[:, None]).all(axis=1) & (W[:, J] > tau[:, None]).all(axis=1)
+            return inside & np.isfinite(size)
+        except Exception:   # noqa: BLE001 - whatever the block raises, each row's own call raises it in its turn
+            return None
 
     def _project_domain(self, x, t):
         rel, s = self._box(), self.system
