@@ -221,6 +221,28 @@ def test_a_hidden_per_step_leak_fails_the_memory_record_and_one_just_below_it_pa
 
 
 @pytest.mark.slow
+def test_a_streamed_solve_that_keeps_every_state_fails_the_memory_record(monkeypatch):
+    """O(K n) memory behind the stream: ``solve``'s kernel keeping each state it returns (a copy per step)
+    must fail, however the study streams (measured 3.82x)."""
+    from verimono.core import stepping
+
+    real, kept = stepping.resolvent_kernel, []
+
+    def kernel(op, x0):
+        step = real(op, x0)
+
+        def keeping(*args):
+            out = step(*args)
+            kept.append(out.copy())
+            return out
+        return keeping
+
+    monkeypatch.setattr(stepping, "resolvent_kernel", kernel)
+    rec = performance.check_memory(steps=performance.SIZES["ci"].memory_steps)
+    assert kept and rec.status == FAILED and rec.details["ratio"] > 2.0, rec
+
+
+@pytest.mark.slow
 def test_the_extrapolated_peak_is_the_traced_peak_within_a_percent():
     """The line through the peaks at about steps/8 and steps/4 against tracing the whole study at ``steps``
     (what the record did before): the lawful study and a leaking one within 1%, never below by more than 0.1%
