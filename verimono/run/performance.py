@@ -618,8 +618,9 @@ def performance_report(sizes: Sizes, *, stepper: Callable | None = None,
     average — is recorded in every timed record's ``details["machine"]``: the evidence, beside each record's
     own, of why a speed could not be judged."""
     machine: dict[str, Any] = {"joined_threads": _quiet_process()}
-    # the memory record first: on the idle core it is the stage's longest single job (2.3 s at ci, quiet), and the
-    # timed records cut short by the early look no longer outlast it; the calibration runs beside it as they do
+    # the memory record first, on the idle core: the stage's longest single job when it traced 10^5 steps (2.3 s
+    # at ci, quiet; since branch memunit ~0.7 s, two smaller studies), and the memory-bound batch record waits for
+    # it; the calibration runs beside it as the timed records do
     pending = aside(sizes.memory_steps, stepper) if aside is not None else None
     machine.update({"calibration_before": timing.calibrate_both(), "loadavg_before": timing.loadavg()})
     mr = sizes.max_rounds
