@@ -39,7 +39,7 @@ from ..execution import timing
 from ..records.results import FAILED, PASSED, UNDECIDED, CheckResult, Report
 from ..records.verdicts import new_record
 from ..core.sets import Ball, Box
-from ..core.stepping import solve
+from ..core.stepping import STREAM_BLOCK, solve
 
 #: per-step overhead: ``solve`` within 1.5x a bare NumPy loop doing the same arithmetic
 PER_STEP_TARGET = 1.5
@@ -502,13 +502,11 @@ def peak_memory(fn: Callable[[], Any]) -> tuple[int, float, Any]:
         tracemalloc.stop()
 
 
-def memory_sizes(steps: int, block: int | None = None) -> list[int]:
+def memory_sizes(steps: int, block: int = STREAM_BLOCK) -> list[int]:
     """The numbers of steps :func:`check_memory` traces its study at: the largest ``K <= steps/d`` for ``d`` in
     :data:`MEMORY_TRACED` with as many rows (``K + 1``) as ``steps`` modulo the stream's ``block``
     (:data:`verimono.core.stepping.STREAM_BLOCK`), at least one block and one apart; ``[steps]`` when they do not
     fit below ``steps``.  At ci (10^5 steps): 9 888 and 18 080."""
-    if block is None:
-        from ..core.stepping import STREAM_BLOCK as block
     rows = steps + 1
     rem = rows % block
     ms: list[int] = []
