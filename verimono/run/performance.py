@@ -531,7 +531,7 @@ def check_memory(*, steps: int, n: int = 10, stepper: Callable | None = None) ->
     affine function of ``K`` at all three (sizes picked otherwise, the peak of the smaller study fell in its
     first block and the line missed a planted leak by up to 19%).  Measured against tracing the study at
     ``steps`` itself (what this record did before): +0.45% on the lawful study at 10^5 steps, +0.36-0.38% with
-    a planted leak of 17-21 bytes a step (the leaks' list growth is the rest), for 28% of the traced steps
+    planted leaks adding 17-23 bytes a step (the leaks' list growth is the rest), for 28% of the traced steps
     (:mod:`tracemalloc` charges every allocation: the traced loop runs ~6x slower than untraced).  Growth
     faster than linear in ``K`` (a step keeping a copy of all the steps before it: quadratic time as well)
     is not what the line sees, nor memory of order ``K`` freed before the study's sink takes its first block:
