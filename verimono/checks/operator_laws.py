@@ -506,7 +506,8 @@ def _rows_resolvent_limit(op, r):
     return worst
 
 
-# the laws whose evaluator calls a member besides the resolvent (one call per row: row_member, row_contains) or
+# the laws whose evaluator calls a member besides the resolvent (row_member: one call per block where the operator
+# takes a time per row, else per row; row_contains: one call per row) or
 # decides by a truth value: a membership accepted at the law's own tolerance is the law's ratio 1 exactly (its
 # grade), so it is stated with no rounding bound (the tolerance is the same elementwise arithmetic, bit for bit);
 # a membership refused, a member that raised, a limit not closed at the first step: the law's evaluator decides

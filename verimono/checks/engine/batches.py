@@ -325,15 +325,67 @@ def _one_call(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok: np.n
 _F64 = np.dtype(np.float64)
 
 
+#: the members :func:`row_member` calls once for a block when their operator takes a time per row
+#: (:meth:`verimono.core.operator_protocol.Operator._accepts_times` declares these two besides the resolvent and yosida)
+_TIMED_MEMBERS = ("min_norm", "project_domain")
+
+
+def _member_takes_times(member: Any) -> bool:
+    """Whether ``member`` is the ``min_norm`` or ``project_domain`` its operator's class defines (a bound method, not
+    one replaced on the object) and the operator declares a time per row for it
+    (:func:`verimono.core.operator_protocol.accepts_times`, which is false where a member is replaced on the object
+    or overridden by a subclass of the catalog): then one call on ``(B, n)`` rows with ``t`` of shape ``(B,)`` is
+    bit-identical to the ``B`` calls per row."""
+    owner, fn = getattr(member, "__self__", None), getattr(member, "__func__", None)
+    if owner is None or fn is None or not accepts_times(owner):
+        return False
+    cls = type(owner)
+    return any(getattr(cls, m, None) is fn for m in _TIMED_MEMBERS)
+
+
+def _member_block(member: Any, X: np.ndarray, ts: np.ndarray, rows: np.ndarray, st, perf) -> np.ndarray | None:
+    """``member(X[rows], ts[rows])`` as one call (timed as one subject call, :func:`_call_starts`), or ``None`` when
+    it raised (an ``OutsideDomain`` at any row among them) or answered no array of the rows' shape: then the calls
+    per row say which rows are bad."""
+    if st is not None:
+        now, f = perf(), st.in_flight
+        if f is not None and now - f > st.slowest:
+            st.slowest = now - f
+        st.in_flight = now
+    try:
+        P = member(X[rows], ts[rows].astype(float))     # fancy indexing: the subject's input is a private copy
+        if type(P) is not np.ndarray or P.dtype is not _F64:
+            P = as_float64(P)
+        if P.shape != (rows.size, X.shape[1]):
+            return None
+    except Exception:   # noqa: BLE001 - the calls per row meet it, row by row, as before
+        if interrupted():
+            raise
+        return None
+    return P
+
+
 def row_member(member: Any, X: np.ndarray, ts: np.ndarray, ok: np.ndarray) -> np.ndarray:
-    """``member(X_i, t_i)`` of every row, one call per row on a copy (a member other than the resolvent —
-    ``min_norm``, ``project_domain`` — is no batch map the catalog promises); a row whose call raised (an
-    ``OutsideDomain`` among them: the law's evaluator judges it) or returned no finite point of its shape is
-    marked ``False`` in ``ok``.  Each call is timed as a call of its own (:func:`_call_starts`)."""
+    """``member(X_i, t_i)`` of every row still ``ok``, on copies; a row whose call raised (an ``OutsideDomain``
+    among them: the law's evaluator judges it) or returned no finite point of its shape is marked ``False`` in
+    ``ok``.  Each call is timed as a call of its own (:func:`_call_starts`).
+
+    Where ``member`` is a catalog operator's own ``min_norm`` or ``project_domain`` and the operator takes a time
+    per row (:func:`_member_takes_times`), the rows are one call (bit-identical to the calls per row, as the
+    operator declares); if that call raises (one row outside the domain) or answers no ``(B, n)`` array, the calls
+    per row run as before and judge the rows one by one.  Any other member (a user's, one replaced on the object)
+    is called once per row."""
     out = np.zeros_like(X)
     t_l, n, bad = ts.tolist(), X.shape[1], []
     st, perf = (CLOCK[-1] if CLOCK else None), time.perf_counter      # _call_starts, inlined
-    for i in np.flatnonzero(ok).tolist():
+    rows = np.flatnonzero(ok)
+    if rows.size >= 2 and _member_takes_times(member):
+        P = _member_block(member, X, ts, rows, st, perf)
+        if P is not None:
+            out[rows] = P
+            ok &= np.isfinite(out).all(axis=1)
+            return out
+    for i in rows.tolist():
         if st is not None:
             now, f = perf(), st.in_flight
             if f is not None and now - f > st.slowest:
