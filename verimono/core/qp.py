@@ -53,9 +53,11 @@ _ROUTINES = None
 
 
 def load_optimizers() -> None:
-    """Import what a QP solve needs from SciPy now (``scipy.optimize``): called where an object that solves QPs
-    is built (:class:`verimono.lcs.LinearRelationSystem`) and by the stages whose units solve them, before the
-    workers fork (``verimono.run.stages``), so that no law's time budget pays the import."""
+    """Import what a QP solve needs from SciPy now (``scipy.optimize``): the stages whose units use it import it
+    before the workers fork (``verimono.run.stages``), to be inherited.  No law's time budget pays the import
+    where it is not: the batteries that search under a budget (the operator, assumption, Section 7 and Hoffman
+    laws) load ``scipy.optimize`` with their modules (the search engine's ``direct``); the stepper battery, which
+    does not, solves its QPs (the paper's Example's a-priori bounds) under no search budget."""
     _nnls_routines()
 
 

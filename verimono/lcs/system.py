@@ -31,7 +31,6 @@ from ..core.problem import Problem
 from ..core.stepping import Trajectory
 from ..core.tolerances import tolerance
 from ..core._linalg import absmax
-from ..core.qp import load_optimizers
 from ._lu import lu_factor, lu_solve
 from .kernel import BatchStepError
 from ._warm_qp import row_infeasible, solve_qp_warm
@@ -96,7 +95,6 @@ class LinearRelationSystem:
 
     def __init__(self, A, B, C, D, relation, *, u: Callable | None = None, v: Any = None,
                  name: str | None = None) -> None:
-        load_optimizers()        # its steps and bounds solve QPs: SciPy's optimizers now, not in a law's budget
         A = np.array(A, dtype=float, ndmin=2)
         n = A.shape[0]
         self.A = _matrix(A, (n, n), "A")

@@ -89,10 +89,10 @@ def _merged(reports: Iterable[Report]) -> Report:
 
 def _load_optimizers(profile: Profile, context: RunContext) -> None:
     """SciPy's optimizers (``scipy.optimize``: the laws' searches, the QPs of the paper's Example and of
-    Section 7), imported before the workers fork (:func:`prepare_stages`) for the stages whose units use them
-    under a law's time budget: inherited by both workers, as when the checks imported them.  A stepper's
-    ``verimono check`` (convergence, trajectory laws) does not ask for them: the one worker that builds the
-    paper's Example imports them there (:class:`verimono.lcs.LinearRelationSystem`), off this process's path."""
+    Section 7), imported before the workers fork (:func:`prepare_stages`) for the stages whose units use them:
+    inherited by both workers, as when the checks imported them at their top.  A stepper's ``verimono check``
+    (convergence, trajectory laws) does not ask for them: the worker whose unit solves the paper's Example's
+    QPs (its a-priori bounds) imports them there, off this process's path (0.15-0.5 s)."""
     load_optimizers()
 
 
