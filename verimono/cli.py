@@ -298,6 +298,8 @@ def _finish(report: Report, out: Path, baseline: Report | None, run_id: str | No
     if changes is not None:
         for ln in changes.regression_lines(getattr(baseline, "source", None), paths["json"]):
             print(ln)
+        if changes.wall_unjudged_line():
+            print(f"verimono: {changes.wall_unjudged_line()}")
         line += f"; against the baseline: {changes.summary()}"
     print(line)
     print(f"verimono: wrote {paths['html']} and {paths['json']}")
@@ -546,6 +548,8 @@ def _cmd_gate(args: argparse.Namespace) -> int:
     if args.verbose:
         for c in comparison.others:
             print(f"  {c}")
+    elif comparison.wall_unjudged_line():
+        print(f"verimono gate: {comparison.wall_unjudged_line()}")
     print(f"verimono gate: {comparison.summary()} against {args.baseline}")
     return EXIT_OK if comparison.ok else EXIT_FAILED
 

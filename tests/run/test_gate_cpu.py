@@ -212,3 +212,23 @@ def test_the_subject_over_the_whole_run_pools_its_stages():
     assert "of 20 samples" in pooled[0].message
     alone = [c for c in changes if "in stage" in c.key]
     assert len(alone) == 2 and all(not c.regression and "not judged" in c.message for c in alone)
+
+
+def test_wall_growth_not_judged_is_said_in_one_line():
+    """The sleepy stage of a run with one calibration (`verimono check`: no end calibration) is no regression and
+    was listed only by `verimono gate -v`: the comparison says it in one line, with the growth and the reason,
+    which the commands print in their normal output; a change that is judged (or none) gives no such line."""
+    base, cur = run(stage(**IDLE)), run(stage(cpu=0.9, subject=0.45, slices=spread(0.065), wall=0.6 * 3),
+                                        stage("trajectory_laws", cpu=0.9, slices=spread(0.065), wall=0.6 * 3))
+    base.meta["stages"].append(stage("trajectory_laws", cpu=0.9, slices=spread(0.065), wall=0.6))
+    cur.meta["calibrations"] = cur.meta["calibrations"][:1]
+    comp = compare(base, cur)
+    line = comp.wall_unjudged_line()
+    assert comp.ok and line is not None and "\n" not in line
+    assert "stage convergence" in line and "stage trajectory_laws" in line and "3.0x" in line
+    assert "one calibration" in line and "not judged" in line
+    # the same growth on a quiet machine with two calibrations is a regression, judged: no such line
+    assert not compare(base, run(stage(cpu=0.9, subject=0.45, slices=spread(0.065), wall=0.6 * 3))).ok
+    assert compare(base, run(stage(cpu=0.9, subject=0.45, slices=spread(0.065), wall=0.6 * 3))
+                   ).wall_unjudged_line() is None
+    assert compare(base, base).wall_unjudged_line() is None

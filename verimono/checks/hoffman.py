@@ -27,6 +27,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ..core.errors import UnverifiedSolution
+from ..core.qp import ACTIVE_RTOL
 from ..lcs.hoffman import hoffman_constant
 from ..records.results import CheckResult
 from ..core.sets import Polyhedron
@@ -121,8 +122,6 @@ class ActiveSetProjector:
 
     def _learn(self, z: np.ndarray) -> None:
         """Cache the active set of the verified projection ``z`` (rows within the QP check's active tolerance)."""
-        from ..core.qp import ACTIVE_RTOL
-
         scale = 1.0 + float(np.abs(z).max(initial=0.0))
         rows = np.flatnonzero(self.Q @ z - self.q >= -ACTIVE_RTOL * scale)
         if any(np.array_equal(rows, s[0]) for s in self.sets):

@@ -17,10 +17,15 @@ from typing import Mapping
 class _MovedModules(importlib.abc.MetaPathFinder, importlib.abc.Loader):
     def __init__(self, package: str, moved: Mapping[str, str]):
         self.targets = {f"{package}.{old}": f"{package}.{new}" for old, new in moved.items()}
+        # every import after ``import verimono`` asks this finder first (SciPy's, hypothesis's: ~630 on the
+        # check path): one C-level prefix test answers the others (the loop below cost 0.03-0.05 s of them)
+        self._packages = tuple(old + "." for old in self.targets)
 
     def _target(self, name: str) -> str | None:
         if name in self.targets:
             return self.targets[name]
+        if not name.startswith(self._packages):
+            return None
         for old, new in self.targets.items():   # a submodule of a moved package
             if name.startswith(old + "."):
                 return new + name[len(old):]

@@ -25,24 +25,47 @@ import warnings
 from typing import Any
 
 import numpy as np
-from scipy.optimize import nnls
 
 from ._linalg import absmax, lstsq_solution
 from .errors import InfeasibleStep, UnverifiedSolution
 from .tolerances import QP_RTOL
 
-try:    # SciPy's own routine behind ``scipy.optimize.nnls`` (its wrapper's argument handling costs more than the solve)
-    from scipy.optimize._slsqplib import nnls as _nnls_routine
-except ImportError:     # pragma: no cover - another SciPy layout: the public function
-    _nnls_routine = None
-
 _EMPTY = np.zeros(0)
+
+
+def _nnls_routines():
+    """``scipy.optimize.nnls`` and SciPy's own routine behind it (``None`` in another SciPy layout), imported on
+    the first KKT check: ``scipy.optimize`` (its ``linprog`` pulls in ``scipy.fft``, ``special``, ``sparse``,
+    ``spatial``: 0.3-0.5 s) is not imported with the checks, where most runs — a stepper's ``verimono check``
+    on the ball or the box — solve no QP."""
+    global _ROUTINES
+    if _ROUTINES is None:
+        from scipy.optimize import nnls
+        try:    # SciPy's routine behind ``nnls`` (its wrapper's argument handling costs more than the solve)
+            from scipy.optimize._slsqplib import nnls as routine
+        except ImportError:     # pragma: no cover - another SciPy layout: the public function
+            routine = None
+        _ROUTINES = (nnls, routine)
+    return _ROUTINES
+
+
+_ROUTINES = None
+
+
+def load_optimizers() -> None:
+    """Import what a QP solve needs from SciPy now (``scipy.optimize``): the stages whose units use it import it
+    before the workers fork (``verimono.run.stages``), to be inherited.  No law's time budget pays the import
+    where it is not: the batteries that search under a budget (the operator, assumption, Section 7 and Hoffman
+    laws) load ``scipy.optimize`` with their modules (the search engine's ``direct``); the stepper battery, which
+    does not, solves its QPs (the paper's Example's a-priori bounds) under no search budget."""
+    _nnls_routines()
 
 
 def _nnls(A, b, maxiter):
     """``scipy.optimize.nnls(A, b, maxiter=maxiter)``: the same routine with the same arguments (``A`` C-ordered
     ``float64``, finite, ``b`` of matching length), without the wrapper's argument checks, which cost more than
     the solve on these small matrices; the same answer bit for bit, the same errors."""
+    nnls, _nnls_routine = _nnls_routines()
     if _nnls_routine is None:
         return nnls(A, b, maxiter=maxiter)
     A = np.asarray_chkfinite(A, dtype=np.float64, order="C")

@@ -31,6 +31,7 @@ from ._params import as_param
 from ._rows import _INF, _TINY, _mn, _mx, _sqrt, dot_rows, per_row, times_of
 from ._validate import bad_lam, bad_param, batch_column, finite_point, real_array
 from .errors import InvalidProblem
+from .qp import solve_qp
 from .tolerances import row_tolerances, tolerance
 
 
@@ -491,8 +492,6 @@ class Polyhedron(ConvexSet):
         A batch ``(B, n)`` tests membership for all rows at once and solves QPs only for the rows
         outside, each exactly as for the point alone (identical results).
         """
-        from .qp import solve_qp
-
         x = finite_point(x, f"the point projected onto {self.name}")
         ts = times_of(t, x, self.name)
         if ts is not None:      # one row at a time (its data at its time): the same as separate calls

@@ -180,6 +180,19 @@ class Comparison:
             f" ({self.compared} baseline records compared, {len(self.others)} other changes)"
         return head
 
+    def wall_unjudged_line(self) -> str | None:
+        """One line for the stages whose wall time grew beyond ``TIMING_GROWTH`` while the gate could not judge
+        it (:func:`_compare_wall`: one calibration — a `verimono check` — a busy machine, drifting calibrations):
+        no regression, but a subject that sleeps or waits shows nowhere else, so the commands print this in
+        their normal output (the full changes stay under ``verimono gate -v``); ``None`` when there is none."""
+        hits = [(c, c.wall_unjudged) for c in self.others if getattr(c, "wall_unjudged", None)]
+        if not hits:
+            return None
+        grown = ", ".join(f"{c.key} up to {growth:.1f}x" for c, (growth, _) in hits)
+        whys = "; ".join(dict.fromkeys(why for _, (_, why) in hits))
+        return (f"wall time grew beyond {TIMING_GROWTH:g}x the baseline's (time off the CPU: sleeping, waiting) "
+                f"but was not judged: {grown} — {whys}")
+
     def to_dict(self) -> dict[str, Any]:
         return {"ok": self.ok, "compared": self.compared, "changes": [dataclasses.asdict(c) for c in self.changes]}
 
@@ -630,8 +643,9 @@ def _compare_wall(b: dict[str, Any], s: dict[str, Any], bcals: list[float], ccal
         out.append(Change("timing", f"stage {s['name']}", f"{what}{cpu}, on a quiet machine: time spent off the "
                           "CPU (sleeping, waiting)", True))
     else:
-        out.append(Change("timing", f"stage {s['name']}", f"{what}{cpu}: time off the CPU not judged ({why})",
-                          False))
+        change = Change("timing", f"stage {s['name']}", f"{what}{cpu}: time off the CPU not judged ({why})", False)
+        change.wall_unjudged = (rc_most / rb, why)   # not a field: the documents' changes keep their keys
+        out.append(change)
 
 
 def compare(baseline: Report, current: Report) -> Comparison:

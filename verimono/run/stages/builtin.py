@@ -18,6 +18,7 @@ from ...core._jsonable import to_jsonable
 from ...core.adaptive import Adaptive
 from ...core.adaptive_proximal import solve_adaptive
 from ...core.errors import StageUnavailable
+from ...core.qp import load_optimizers
 from ...execution.executors import Unit
 from ...core.grids import uniform_grid
 from ...execution.profiles import Profile
@@ -84,6 +85,15 @@ def _merged(reports: Iterable[Report]) -> Report:
     for rep in reports:
         out.extend(rep)
     return out
+
+
+def _load_optimizers(profile: Profile, context: RunContext) -> None:
+    """SciPy's optimizers (``scipy.optimize``: the laws' searches, the QPs of the paper's Example and of
+    Section 7), imported before the workers fork (:func:`prepare_stages`) for the stages whose units use them:
+    inherited by both workers, as when the checks imported them at their top.  A stepper's ``verimono check``
+    (convergence, trajectory laws) does not ask for them: the worker whose unit solves the paper's Example's
+    QPs (its a-priori bounds) imports them there, off this process's path (0.15-0.5 s)."""
+    load_optimizers()
 
 
 @register_stage("convergence", "every analytic reference's convergence study against its expected order")
@@ -157,7 +167,8 @@ def _generated_operators(profile: Profile, seed: int | None) -> list[tuple[str, 
     return [(f"generated #{i} (n={n}, seed {seed})", op) for i, (n, op) in enumerate(drawn)]
 
 
-@register_stage("operator_laws", "resolvent and Yosida laws on the catalog operators and generated families")
+@register_stage("operator_laws", "resolvent and Yosida laws on the catalog operators and generated families",
+                prepare=_load_optimizers)
 def operator_laws_stage(profile: Profile, context: RunContext) -> Report:
     """``check_operator`` on each catalog operator (or the user's) and on generated families.
 
@@ -251,7 +262,8 @@ def _checks_unit(checks: list[tuple[str, Callable]], subject: Any,
     return report
 
 
-@register_stage("assumptions", "sampled evidence for (A1), (A2), (A3), (LG), (YB) on every reference")
+@register_stage("assumptions", "sampled evidence for (A1), (A2), (A3), (LG), (YB) on every reference",
+                prepare=_load_optimizers)
 def assumptions_stage(profile: Profile, context: RunContext) -> Report:
     """``check_assumptions(problem)`` on every reference (evidence, never proof).
 
@@ -278,7 +290,8 @@ def _assumptions_unit(check_assumptions: Callable, p: Any, seed: int | None) -> 
     return report
 
 
-@register_stage("section7", "the paper's complementarity example: orders, trajectories, hypotheses")
+@register_stage("section7", "the paper's complementarity example: orders, trajectories, hypotheses",
+                prepare=_load_optimizers)
 def section7_stage(profile: Profile, context: RunContext) -> Report:
     """The complementarity systems of the paper (``verimono.reference.lcs_example``): convergence order
     of the stepper under test on each, a trajectory sample, and the evidence for the hypotheses of the
@@ -341,7 +354,8 @@ def _hypotheses_unit(label: str, seed: int) -> Report:
     return rep
 
 
-@register_stage("siconos", "agreement with the Siconos reference trajectories shipped in verimono/data")
+@register_stage("siconos", "agreement with the Siconos reference trajectories shipped in verimono/data",
+                prepare=_load_optimizers)
 def siconos_stage(profile: Profile, context: RunContext) -> Report:
     """Agreement with the Siconos reference trajectories (the packaged data, or ``--data DIR``)."""
     from ...lcs import siconos_cases as cases
@@ -359,7 +373,7 @@ def _siconos_unit(check: Callable, *args: Any) -> Report:
 
 
 @register_stage("performance", "verimono against bare baselines, as same-job ratios: per-step overhead, "
-                "ensembles, DiodeBridge, memory")
+                "ensembles, DiodeBridge, memory", prepare=_load_optimizers)
 def performance_stage(profile: Profile, context: RunContext) -> Report:
     """The speed targets as records (:mod:`verimono.run.performance`), at the sizes of ``profile``; each
     record's ``details["timing_ratio"]`` is gated against the baseline by ratio, never by seconds."""
