@@ -232,3 +232,18 @@ def test_wall_growth_not_judged_is_said_in_one_line():
     assert compare(base, run(stage(cpu=0.9, subject=0.45, slices=spread(0.065), wall=0.6 * 3))
                    ).wall_unjudged_line() is None
     assert compare(base, base).wall_unjudged_line() is None
+
+
+def test_the_reasons_not_to_judge_are_said_once_each():
+    """Four stages of one busy run give the same reasons in their own figures: the line says each kind of reason
+    once, with how many more stages gave it, not four times (a run on a loaded machine printed 1,100 characters)."""
+    from verimono.run.gate import _one_reason_each
+
+    cal = "the calibrations at the run's start and end differ by 6.08x (> 1.25x)"
+    whys = [f"{cal}; the machine was busy: some task waited for a CPU 100% of the stage's time and processes "
+            f"outside the run used {p}% of the machine's CPU" for p in (70, 74, 73, 66)]
+    parts = _one_reason_each(whys)
+    assert parts == [f"{cal} (3 more stages likewise)",
+                     "the machine was busy: some task waited for a CPU 100% of the stage's time and processes "
+                     "outside the run used 70% of the machine's CPU (3 more stages likewise)"]
+    assert _one_reason_each(["this run measured one calibration"]) == ["this run measured one calibration"]

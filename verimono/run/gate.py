@@ -189,12 +189,28 @@ class Comparison:
         if not hits:
             return None
         grown = ", ".join(f"{c.key} up to {growth:.1f}x" for c, (growth, _) in hits)
-        whys = "; ".join(dict.fromkeys(why for _, (_, why) in hits))
+        whys = "; ".join(_one_reason_each(why for _, (_, why) in hits))
         return (f"wall time grew beyond {TIMING_GROWTH:g}x the baseline's (time off the CPU: sleeping, waiting) "
                 f"but was not judged: {grown} — {whys}")
 
     def to_dict(self) -> dict[str, Any]:
         return {"ok": self.ok, "compared": self.compared, "changes": [dataclasses.asdict(c) for c in self.changes]}
+
+
+def _one_reason_each(whys: Any) -> list[str]:
+    """The stages' reasons for not judging, each kind said once: a reason is ``"; "``-separated parts, and a part's
+    kind is what precedes its first ``":"`` (the same busy machine measured per stage differs only in its
+    percentages); the first stage's wording of each kind is kept, and how many more stages gave that kind."""
+    kinds: dict[str, list[Any]] = {}
+    for why in whys:
+        for part in str(why).split("; "):
+            kind = part.split(":", 1)[0]
+            if kind in kinds:
+                kinds[kind][1] += 1
+            else:
+                kinds[kind] = [part, 0]
+    return [part + (f" ({more} more stage{'s' if more != 1 else ''} likewise)" if more else "")
+            for part, more in kinds.values()]
 
     def regression_lines(self, baseline: str | Path | None = None, results: str | Path | None = None,
                          limit: int = LISTED_REGRESSIONS) -> list[str]:
