@@ -23,6 +23,8 @@ import ctypes
 import threading
 from typing import Iterator
 
+from .profiles import LARGE_N
+
 #: glibc's ``mallopt`` parameters (``malloc.h``)
 M_TRIM_THRESHOLD, M_MMAP_THRESHOLD = -1, -3
 #: the mmap threshold during a battery: glibc's largest (``DEFAULT_MMAP_THRESHOLD_MAX`` on 64-bit; an 8 MB
@@ -53,7 +55,6 @@ def heap_kept(n: int) -> Iterator[bool]:
     """Freed blocks kept by glibc's allocator while a battery on a subject of ``n`` coordinates runs (yields
     whether it did: only above ``LARGE_N`` and with glibc).  Nested and concurrent batteries share one setting;
     the last to end gives the free memory back."""
-    from .profiles import LARGE_N
     global _depth
     calls = _glibc() if n > LARGE_N else None
     if calls is None:
