@@ -85,3 +85,29 @@ def test_nested_batteries_share_one_setting(monkeypatch):
             pass
         assert calls == [(heap.M_MMAP_THRESHOLD, heap.KEPT_MMAP), (heap.M_TRIM_THRESHOLD, heap.KEPT_TRIM)]
     assert calls[2:] == [(heap.M_TRIM_THRESHOLD, heap.AFTER_TRIM), (heap.M_MMAP_THRESHOLD, heap.AFTER_MMAP), ("trim", 0)]
+
+
+class _Entered(Exception):
+    pass
+
+
+def _refuse(n):
+    raise _Entered(n)
+
+
+def test_both_batteries_keep_the_heap_for_their_largest_subject(monkeypatch):
+    """``check_operator`` and ``check_stepper`` (in this process) enter ``heap_kept`` with the subject's number of
+    coordinates — the operator's ``dim``, the largest problem's initial state — before any law runs."""
+    import numpy as np
+
+    import verimono as vm
+    from verimono.checks import operator_battery, stepper_battery
+    monkeypatch.setattr(operator_battery, "heap_kept", _refuse)
+    monkeypatch.setattr(stepper_battery, "heap_kept", _refuse)
+    with pytest.raises(_Entered) as got:
+        vm.check_operator(vm.NormSubdifferential(1.0, 7), seed=0)
+    assert got.value.args == (7,)
+    problems = [vm.Problem(vm.NormSubdifferential(1.0, dim=n), np.linspace(-1.0, 1.0, n), 1.0) for n in (3, 11)]
+    with pytest.raises(_Entered) as got:
+        vm.check_stepper(vm.solve, problems, orders=False, generated=0)
+    assert got.value.args == (11,)
