@@ -13,6 +13,7 @@ from ..execution import watchdog
 from ..core.errors import InvalidCheckArgument
 from ..execution.config import chosen
 from ..execution.executors import Unit
+from ..execution.heap import heap_kept
 from ..execution.workers import blas_limited
 from ..records.results import Report
 from . import operator_laws, prox_laws  # noqa: F401 - the laws join the registry on import
@@ -57,7 +58,9 @@ def check_operator(op: Any, *, seed: int | None = None, examples: int | None = N
     interpreter on such a call: it warns once and waits for it to return (:mod:`verimono.execution.watchdog`).
 
     The BLAS libraries loaded when it begins run on one thread for the battery, as under ``verimono run`` and
-    ``verimono check``, and get the caller's limits back after (:func:`verimono.execution.workers.blas_limited`)."""
+    ``verimono check``, and get the caller's limits back after (:func:`verimono.execution.workers.blas_limited`).
+    Above ``LARGE_N`` coordinates glibc's allocator keeps the blocks the laws free for the battery's length
+    (:func:`verimono.execution.heap.heap_kept`: no page faults for every sample's fresh arrays)."""
     if profile is not None:
         with chosen(profile):
             return check_operator(op, seed=seed, examples=examples, horizon=horizon, executor=executor)
@@ -77,10 +80,18 @@ def check_operator(op: Any, *, seed: int | None = None, examples: int | None = N
         return report
     if executor not in (None, "serial"):
         raise InvalidCheckArgument(f"check_operator: executor must be None, 'serial' or 'process:N', got {executor!r}")
-    with blas_limited():                                # as under the command line (BLAS_THREADS)
+    with blas_limited(), heap_kept(_dim(op)):           # as under the command line (BLAS_THREADS); freed blocks kept
         for _, check in operator_checks(op, seed=seed, examples=examples, horizon=horizon):
             watchdog.finished(report.add(check(op)))    # kept should a later law block in native code
     return report
+
+
+def _dim(op: Any) -> int:
+    """The operator's number of coordinates (0 when it does not say: then nothing is kept)."""
+    try:
+        return int(getattr(op, "dim", 0) or 0)
+    except (TypeError, ValueError):
+        return 0
 
 
 def _battery(op: Any, seed: int, examples: int, horizon: float) -> Report:

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import functools
 import math
+import sys
 import zlib
 
 import numpy as np
@@ -91,6 +92,38 @@ def _owned_value(op, z: np.ndarray, t: float) -> float:
     if type(v) is not float:
         v = as_float64(v)
     return float(v)
+
+
+class _Scratch:
+    """One n-vector handed to ``g`` per perturbation, written whole before each call and reused while ``g`` keeps
+    no reference to it.
+
+    A fresh n-vector per perturbation was 42 allocations of 8 MB per sample at n = 10^6, each freed to the system
+    and faulted in again page by page (a fifth of the battery's CPU was the kernel's).  A ``g`` that writes into
+    its argument changes nothing: every entry is written again before the next call.  A ``g`` that keeps its
+    argument (a memo of the last point, a view of it) raises its reference count: the buffer is then left to it and
+    the next perturbation gets a fresh one, as before."""
+
+    __slots__ = ("like", "buf", "refs")
+
+    def __init__(self, like: np.ndarray) -> None:
+        self.like, self.buf, self.refs = like, None, 0
+
+    def take(self) -> np.ndarray:
+        """The buffer to write the next point into (``empty_like`` the sample's ``p``: its layout, as a fresh result
+        of ``np.add(p, ·)`` has)."""
+        if self.buf is None:
+            self.buf = np.empty_like(self.like)
+        return self.buf
+
+    def value(self, op, z: np.ndarray, t: float) -> float:
+        """``g(t, z)`` for ``z`` the buffer (:func:`_owned_value`), the buffer given up if ``g`` kept it."""
+        refs = sys.getrefcount(z)
+        try:
+            return _owned_value(op, z, t)
+        finally:
+            if sys.getrefcount(z) != refs:
+                self.buf = None
 
 
 def _outside(op, p, gp, what, x, t) -> Outcome:
@@ -247,6 +280,7 @@ def check_prox_optimal(op, s, p, gp):
     # (:data:`EXPANDED_N`: the rounding this moves is far inside the slack)
     expanded = x.size > EXPANDED_N
     w, cd, wi = np.empty_like(x), np.empty_like(x), None
+    scratch = _Scratch(p)                # z, one buffer for the 42 perturbations while g keeps none
     worst, at = -math.inf, None
     for d in _directions(x, p, x.size, x, xp, dxp):
         coordinate = type(d) is int
@@ -260,11 +294,15 @@ def check_prox_optimal(op, s, p, gp):
                 np.multiply(d, dz, out=cd)      # (-c)·d = -(c·d) and p + (-(c·d)) = p - c·d exactly: one product for both signs
             for sgn in (1.0, -1.0):
                 c = sgn * h * s0
+                z = scratch.take()
                 if coordinate:
-                    z = np.add(p, 0.0) if sgn > 0 else p.copy()
+                    if sgn > 0:
+                        np.add(p, 0.0, out=z)
+                    else:
+                        np.copyto(z, p)
                     z[d] = p[d] + c
                 else:
-                    z = np.add(p, cd) if sgn > 0 else np.subtract(p, cd)
+                    (np.add if sgn > 0 else np.subtract)(p, cd, out=z)
                 if expanded:
                     q = max(a2 - 2.0 * c * b + c * c * dd, 0.0)
                 elif coordinate:
@@ -274,7 +312,7 @@ def check_prox_optimal(op, s, p, gp):
                 else:
                     np.subtract(z, x, out=w)
                     q = float(w @ w)
-                fz = lam * _owned_value(op, z, t) + 0.5 * q
+                fz = lam * scratch.value(op, z, t) + 0.5 * q
                 if fz == math.inf:
                     continue
                 slack = 4 * (rtol * (1.0 + max(afp, abs(fz), algp))) + 4 * tau * (dxp + dz + tau)

@@ -22,6 +22,7 @@ from . import bounds, limits, picard, trajectory_laws  # noqa: F401 - the laws j
 from . import orders as _order_law  # noqa: F401 - convergence_order joins the registry on import
 from ..execution.config import chosen, current
 from ..execution.executors import Unit
+from ..execution.heap import heap_kept
 from ..execution.workers import blas_limited
 from .core import laws_of, stepper_subject
 from .isolated import isolating, run_check, run_isolated
@@ -115,6 +116,14 @@ def stepper_checks(stepper: Callable | None = None, problems: Iterable[Problem] 
     yield from law_checks(list(refs) + list(extra), laws, seed)
 
 
+def _largest_dim(problems: Iterable[Any]) -> int:
+    """The largest number of coordinates of the problems' initial states (0 for none, or the catalog's: small)."""
+    try:
+        return max((int(np.size(getattr(p, "x0", ()))) for p in problems or ()), default=0)
+    except Exception:   # noqa: BLE001 - an initial state without a size: nothing is kept
+        return 0
+
+
 def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, *, scheme: str | None = None,
                   order: float | None = None, seed: int | None = None, executor: Any = None,
                   laws: bool | Iterable[str] = True, generated: int | None = None, orders: bool = True,
@@ -181,7 +190,8 @@ def check_stepper(stepper: Callable, problems: Iterable[Problem] | None = None, 
         records = [rec for rep in run_isolated(executor, units, given) for rec in rep.results]
     else:
         # the laws judge the same runs of the stepper: each is made once; BLAS as under the command line
-        with shared_runs(), blas_limited():
+        # above LARGE_N coordinates glibc keeps the blocks the laws free (execution.heap: no page faults again)
+        with shared_runs(), blas_limited(), heap_kept(_largest_dim(problems)):
             # a stepper that never returns: a failed record naming the unit, and the battery goes on
             records = [run_unit(lambda: check(stepper), check=name.partition("[")[0],
                                 subject=stepper_subject(stepper, name.partition("[")[2][:-1]))
