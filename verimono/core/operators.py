@@ -120,6 +120,28 @@ def _weight_at(param, t: float, owner: str, what: str) -> np.ndarray:
     return c
 
 
+def _weight_value(param, t, owner: str, what: str):
+    """:func:`_weight_at`'s ``c(t)`` as a Python float when it is a scalar ``≥ 0``, else what :func:`_weight_at`
+    returns or raises (an array: a batch of weights; its error: a negative or NaN weight).
+
+    The same number either way: a constant's 0-d float64 read once; a callable's ``float`` or ``np.float64``
+    taken as it is (``Param`` would wrap it as a 0-d float64 array of the same value).  The callable is called
+    once, as :func:`_weight_at` calls it: a value off the fast path is converted as ``Param`` converts it
+    (:meth:`verimono.core._params.Param.of`) and checked as :func:`_weight_at` checks it."""
+    fn = param._fn
+    if fn is None:
+        v = param._value
+        return float(v) if v.ndim == 0 else v       # a constant was checked at construction
+    v = fn(t)
+    if (type(v) is float or type(v) is np.float64) and v >= 0.0:
+        return float(v)
+    c = param.of(v, t)
+    if not (float(c) >= 0.0 if c.ndim == 0 else (c >= 0).all()):
+        raise bad_param(owner, what, c, t, "must be >= 0 (a negative weight makes the operator non-monotone)",
+                        NotMonotone)
+    return c
+
+
 def _check_dim(op: Operator, x: np.ndarray) -> np.ndarray:
     x = np.asarray(x, dtype=float)
     if x.shape[-1:] != (op.dim,):
@@ -307,6 +329,19 @@ class NormSubdifferential(_EverywhereDefined):
     def resolvent(self, x, lam, t=0.0):
         # J x = x max(|x| - λc, 0)/|x|, written so that x = 0 gives 0 without a 0/0
         x = real_array(x)
+        if x.ndim == 1 and type(lam) is not np.ndarray and type(t) is not np.ndarray:
+            # one point, one λ, one t: the same checks in the same order, and the scalar arithmetic in Python
+            # floats (the same IEEE operations on the same |x|², hence the same bits)
+            lam = check_lam(lam, f"{self.name}.resolvent")
+            s = dot_rows(x, x)      # before c(t), as below: an overflow warns before a bad weight raises
+            c = _weight_value(self._c, t, self.name, "c(t)")
+            if type(c) is float:
+                nrm = _sqrt(s)
+                lc = lam * c
+                if nrm < _INF and lc < _INF:    # else NumPy's arithmetic below: its overflow warnings
+                    return x * (max(nrm - lc, 0.0) / max(nrm, _TINY))
+            nrm = np.sqrt(s)[..., None]         # _norm(x)
+            return x * (_mx(nrm - lam * batch_column(np.asarray(c), x, "c"), 0.0) / _mx(nrm, _TINY))
         lam, J = _steps(self, x, lam, t)
         if J is not None:
             return J
@@ -342,10 +377,14 @@ class NormSubdifferential(_EverywhereDefined):
 
     def value(self, x, t=0.0):
         """``g(t, x) = c(t)|x|`` (``F(t,·) = ∂g(t,·)``): the value laws check the resolvent is its prox."""
-        c = np.asarray(self._c_at(t), dtype=float)
-        if c.ndim:
-            raise NotImplementedError(f"{self.name}: a value needs one weight c(t), not a batch of them")
-        return float(c) * float(np.linalg.norm(np.asarray(x, dtype=float)))
+        c = _weight_value(self._c, t, self.name, "c(t)")
+        if type(c) is not float:
+            if c.ndim:
+                raise NotImplementedError(f"{self.name}: a value needs one weight c(t), not a batch of them")
+            c = float(c)
+        # np.linalg.norm's own default path (any shape: the flattened array's sqrt(x·x)) without its dispatch
+        x = np.asarray(x, dtype=float).ravel(order="K")
+        return c * _sqrt(x.dot(x))
 
     def min_norm(self, x, t=0.0):
         x = np.asarray(x, dtype=float)
