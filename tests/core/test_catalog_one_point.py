@@ -32,9 +32,15 @@ def _outcome(fn, *args):
 
 
 def _row(fn):
-    """``fn`` evaluated as row 0 of a batch of one: the general (NumPy row) path."""
+    """``fn`` evaluated as row 0 of a batch of one: the general (NumPy row) path (an error's message names the
+    point as the one-point call would: ``[[..]]`` as ``[..]``, the shape ``(1, n)`` as ``(n,)``)."""
     def call(x, *args):
-        got = fn(np.asarray(x, dtype=float)[None, :], *args)
+        x = np.asarray(x, dtype=float)
+        try:
+            got = fn(x[None, :], *args)
+        except Exception as exc:
+            msg = str(exc).replace("[[", "[").replace("]]", "]").replace(f"(1, {x.shape[-1]})", f"({x.shape[-1]},)")
+            raise type(exc)(msg) from None
         return got[0]
     return call
 
@@ -126,3 +132,60 @@ def test_a_batch_weight_is_refused_by_value_and_a_one_point_resolvent():
     # the batch (B, n) applies c_i to row i: J x = max(1 - λc_i/|x|, 0) x with |x| = √2
     np.testing.assert_allclose(op.resolvent(np.ones((2, 2)), 0.5),
                                [[1 - 0.25 / 2 ** 0.5] * 2, [1 - 0.5 / 2 ** 0.5] * 2], rtol=4 * np.finfo(float).eps)
+
+
+def _sets():
+    """Catalog sets whose one-point projection has a fast path, with the cases it declines: a radius
+    per row (refused for one point), a normal whose |a|² underflows or overflows, a centre where d·d overflows, a
+    moving radius below 0 (an error, or 0 within round-off)."""
+    from verimono.core.sets import Ball, Box, HalfSpace
+
+    return [Ball([0.5, -1.0, 2.0], 1.5), Ball([0.0, 0.0, 0.0], 0.0), Ball([1e300, -1e300, 0.0], 1e300),
+            Ball(lambda t: np.array([math.sin(t), 0.0, 1.0]), lambda t: 1.0 - t),
+            Ball(np.zeros(3), np.array([0.5, 1.0])),
+            HalfSpace([1.0, 2.0, -1.0], 0.5), HalfSpace([1e-170, 1e-170, 0.0], 0.0), HalfSpace([1e200, 1.0, 0.0], -1e300),
+            HalfSpace(lambda t: np.array([math.cos(t), math.sin(t), 0.0]), lambda t: t),
+            Box(lambda t: np.array([math.sin(t) - 1, -1.0, -np.inf]), lambda t: np.array([math.sin(t) + 1, 1 - t, 2.0]))]
+
+
+def _set_differences() -> list:
+    rng = np.random.default_rng(7)
+    out = []
+    for S in _sets():
+        for i, x in enumerate(_points(3, rng)):
+            for t in _TIMES:
+                for what, one, row in (("project", S.project, _row(S.project)),
+                                       ("contains", S.contains, lambda x, t, S=S: bool(
+                                           np.max(np.abs(S.project(x, t) - np.asarray(x, dtype=float)), initial=0.0)
+                                           <= operators.tolerance(np.asarray(x, dtype=float))))):
+                    a, b = _outcome(one, x, t), _outcome(row, x, t)
+                    if a != b:
+                        out.append((S.name, i, t, what, a, b))
+    return out
+
+
+def test_catalog_sets_one_point_projection_is_the_row_path():
+    assert _set_differences() == []
+
+
+def test_the_set_comparison_sees_a_planted_last_bit_error(monkeypatch):
+    import verimono.core.sets as sets
+
+    monkeypatch.setattr(sets, "_sqrt", lambda s: math.nextafter(math.sqrt(s), math.inf))
+    monkeypatch.setattr(sets, "_INF", 1e300)        # and the half-space's guard moved: its overflow warnings go
+    assert len(_set_differences()) > 50
+
+
+def test_tolerance_of_a_python_float_is_that_of_the_same_double():
+    """``tolerance(c)`` of a Python float (a weight ``c(t)``) takes ``abs`` directly: the number NumPy's path gives
+    for the same double (``np.float64`` goes through ``np.max(np.abs(.))``); -0, NaN, ±inf, subnormals included."""
+    from verimono.core.tolerances import tolerance
+
+    values = [0.0, -0.0, 5e-324, -1e-300, 1.0, -2.5, 1e308, -1e308, math.inf, -math.inf, math.nan]
+    values += list(np.random.default_rng(3).standard_normal(50) * 10.0 ** np.arange(-25, 25))
+    for v in values:
+        for other in ((), (np.array([0.5, -3.0]),), (7.0,)):
+            a = tolerance(float(v), *other)
+            b = tolerance(np.float64(v), *other)
+            assert np.float64(a).tobytes() == np.float64(b).tobytes(), (v, other, a, b)
+            assert a == a and a >= 1e-16 or math.isnan(v)      # rtol·(1 + max|s|) ≥ rtol > 0 unless NaN won

@@ -142,6 +142,13 @@ def _weight_value(param, t, owner: str, what: str):
     return c
 
 
+def _frobenius(x: np.ndarray) -> float:
+    """``float(np.linalg.norm(x))`` of a float array: NumPy's own default path (the flattened array's
+    ``sqrt(x·x)``, the same dot and its warnings) without its dispatch."""
+    x = x.ravel(order="K")
+    return _sqrt(x.dot(x))
+
+
 def _check_dim(op: Operator, x: np.ndarray) -> np.ndarray:
     x = np.asarray(x, dtype=float)
     if x.shape[-1:] != (op.dim,):
@@ -382,14 +389,23 @@ class NormSubdifferential(_EverywhereDefined):
             if c.ndim:
                 raise NotImplementedError(f"{self.name}: a value needs one weight c(t), not a batch of them")
             c = float(c)
-        # np.linalg.norm's own default path (any shape: the flattened array's sqrt(x·x)) without its dispatch
-        x = np.asarray(x, dtype=float).ravel(order="K")
-        return c * _sqrt(x.dot(x))
+        return c * _frobenius(np.asarray(x, dtype=float))
 
     def min_norm(self, x, t=0.0):
         x = np.asarray(x, dtype=float)
         if type(t) is np.ndarray and not self._accepts_times():
             return per_row(lambda xi, ti: self.min_norm(xi, ti), x, times_of(t, x, self.name))
+        if x.ndim == 1 and type(t) is not np.ndarray:
+            # one point at one t: the same operations in the same order (|x|², then c(t), then the array's
+            # c·x/|x|, computed whatever |x| as np.where computes it: its warnings), the norm a Python float
+            s = dot_rows(x, x)
+            c = _weight_value(self._c, t, self.name, "c(t)")
+            if type(c) is float:
+                nrm = _sqrt(s)
+                v = c * x / max(nrm, _TINY)
+                return v if nrm > 0.0 else np.zeros(x.shape)
+            nrm = np.sqrt(s)[..., None]
+            return np.where(nrm > 0.0, batch_column(c, x, "c") * x / _mx(nrm, _TINY), 0.0)
         nrm = _norm(x)
         # 0 where |x| is 0 or underflows (x·x < tiny): F^0(0) = 0; the max only avoids a 0/0 warning
         return np.where(nrm > 0.0, self._col(t, x) * x / _mx(nrm, _TINY), 0.0)
@@ -400,12 +416,13 @@ class NormSubdifferential(_EverywhereDefined):
 
     def contains(self, x, y, t=0.0, tol=None):
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
-        c = float(self._c_at(t))
+        c = _weight_value(self._c, t, self.name, "c(t)")
+        c = c if type(c) is float else float(c)
         tol = tolerance(c, y) if tol is None else tol
-        nx = float(np.linalg.norm(x))
-        if nx <= tol and np.linalg.norm(y) <= c + tol:  # x within tol of 0, where F = the ball cB
+        nx = _frobenius(x)
+        if nx <= tol and _frobenius(y) <= c + tol:  # x within tol of 0, where F = the ball cB
             return True
-        return bool(nx > 0.0 and np.linalg.norm(y - c * x / nx) <= tol)
+        return bool(nx > 0.0 and _frobenius(y - c * x / nx) <= tol)
 
 
 class L1Subdifferential(_EverywhereDefined):
@@ -567,7 +584,9 @@ class NormalCone(Operator):
         tol = tolerance(x, y) if tol is None else tol
         if not self.S.contains(x, t, tol):
             return False
-        return bool(np.max(np.abs(self.S.project(x + y, t) - x)) <= tol)
+        d = np.abs(self.S.project(x + y, t) - x)
+        # the ndarray's own max (np.max's dispatch is most of a small point's cost): the same reduction
+        return bool((d.max() if type(d) is np.ndarray else np.max(d)) <= tol)
 
 
 class Shifted(Operator):
