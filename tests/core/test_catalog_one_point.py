@@ -189,3 +189,18 @@ def test_tolerance_of_a_python_float_is_that_of_the_same_double():
             b = tolerance(np.float64(v), *other)
             assert np.float64(a).tobytes() == np.float64(b).tobytes(), (v, other, a, b)
             assert a == a and a >= 1e-16 or math.isnan(v)      # rtol·(1 + max|s|) ≥ rtol > 0 unless NaN won
+
+
+def test_a_subclass_overriding_c_at_is_called_through_it():
+    """The one-point paths read ``c(t)`` themselves only while ``_c_at`` and ``_col`` are the class's own: a subclass
+    that overrides ``_c_at`` (here: doubling the weight) gets it in value, resolvent, min_norm and contains."""
+    class Doubled(NormSubdifferential):
+        def _c_at(self, t):
+            return 2.0 * super()._c_at(t)
+
+    op, plain = Doubled(lambda t: t, dim=2), NormSubdifferential(lambda t: 2.0 * t, dim=2)
+    x = np.array([3.0, 4.0])
+    assert op.value(x, 0.5) == plain.value(x, 0.5) == 5.0
+    assert np.array_equal(op.resolvent(x, 1.0, 0.5), plain.resolvent(x, 1.0, 0.5))     # (1 - 1/5) x
+    assert np.array_equal(op.min_norm(x, 0.5), plain.min_norm(x, 0.5))                  # x/5
+    assert op.contains(x, x / 5.0, 0.5) and not NormSubdifferential(lambda t: t, dim=2).contains(x, x / 5.0, 0.5)

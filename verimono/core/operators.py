@@ -308,6 +308,13 @@ class NormSubdifferential(_EverywhereDefined):
     """
 
     static = False
+    #: the one-point paths read c(t) by :func:`_weight_value` (the same number and checks as :meth:`_c_at`): only
+    #: while :meth:`_c_at` and :meth:`_col` are this class's own (a subclass overriding either is called through them)
+    _fast_c = True
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        cls._fast_c = cls._c_at is NormSubdifferential._c_at and cls._col is NormSubdifferential._col
 
     def __init__(self, c: Any, dim: int = 1, name: str | None = None) -> None:
         super().__init__(dim, name or "NormSubdifferential")
@@ -336,7 +343,7 @@ class NormSubdifferential(_EverywhereDefined):
     def resolvent(self, x, lam, t=0.0):
         # J x = x max(|x| - λc, 0)/|x|, written so that x = 0 gives 0 without a 0/0
         x = real_array(x)
-        if x.ndim == 1 and type(lam) is not np.ndarray and type(t) is not np.ndarray:
+        if x.ndim == 1 and type(lam) is not np.ndarray and type(t) is not np.ndarray and self._fast_c:
             # one point, one λ, one t: the same checks in the same order, and the scalar arithmetic in Python
             # floats (the same IEEE operations on the same |x|², hence the same bits)
             lam = check_lam(lam, f"{self.name}.resolvent")
@@ -384,8 +391,9 @@ class NormSubdifferential(_EverywhereDefined):
 
     def value(self, x, t=0.0):
         """``g(t, x) = c(t)|x|`` (``F(t,·) = ∂g(t,·)``): the value laws check the resolvent is its prox."""
-        c = _weight_value(self._c, t, self.name, "c(t)")
+        c = _weight_value(self._c, t, self.name, "c(t)") if self._fast_c else self._c_at(t)
         if type(c) is not float:
+            c = np.asarray(c, dtype=float)
             if c.ndim:
                 raise NotImplementedError(f"{self.name}: a value needs one weight c(t), not a batch of them")
             c = float(c)
@@ -395,7 +403,7 @@ class NormSubdifferential(_EverywhereDefined):
         x = np.asarray(x, dtype=float)
         if type(t) is np.ndarray and not self._accepts_times():
             return per_row(lambda xi, ti: self.min_norm(xi, ti), x, times_of(t, x, self.name))
-        if x.ndim == 1 and type(t) is not np.ndarray:
+        if x.ndim == 1 and type(t) is not np.ndarray and self._fast_c:
             # one point at one t: the same operations in the same order (|x|², then c(t), then the array's
             # c·x/|x|, computed whatever |x| as np.where computes it: its warnings), the norm a Python float
             s = dot_rows(x, x)
@@ -416,7 +424,7 @@ class NormSubdifferential(_EverywhereDefined):
 
     def contains(self, x, y, t=0.0, tol=None):
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
-        c = _weight_value(self._c, t, self.name, "c(t)")
+        c = _weight_value(self._c, t, self.name, "c(t)") if self._fast_c else self._c_at(t)
         c = c if type(c) is float else float(c)
         tol = tolerance(c, y) if tol is None else tol
         nx = _frobenius(x)
