@@ -204,3 +204,32 @@ def test_a_subclass_overriding_c_at_is_called_through_it():
     assert np.array_equal(op.resolvent(x, 1.0, 0.5), plain.resolvent(x, 1.0, 0.5))     # (1 - 1/5) x
     assert np.array_equal(op.min_norm(x, 0.5), plain.min_norm(x, 0.5))                  # x/5
     assert op.contains(x, x / 5.0, 0.5) and not NormSubdifferential(lambda t: t, dim=2).contains(x, x / 5.0, 0.5)
+
+
+def _log_barrier_reference(op, x, y, t):
+    """``LogBarrier.contains`` as written with ``np.any``/``np.all`` (b19eba1): some ``x'`` within tol of ``x`` with
+    ``F(x') = -c/x'`` within tol of ``y``."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    if np.any(x <= 0.0):
+        return False
+    c = op._c(t)
+    tol = operators.tolerance(-c / x, y)
+    with np.errstate(divide="ignore", over="ignore"):
+        lo = np.where(x - tol > 0.0, -c / np.maximum(x - tol, operators._TINY), -np.inf)
+    return bool(np.all((y >= lo - tol) & (y <= -c / (x + tol) + tol)))
+
+
+def test_log_barrier_contains_and_min_norm_on_mixed_signs():
+    """Points with some coordinates ≤ 0 (outside: ``min_norm`` raises, ``contains`` is False), inside, and ``y`` on,
+    near and off ``-c/x``: the ndarray's own ``any``/``all`` decide as ``np.any``/``np.all`` did."""
+    op = operators.LogBarrier(0.7, dim=3)
+    rng = np.random.default_rng(5)
+    for _ in range(200):
+        x = rng.standard_normal(3) + 0.8
+        for y in (-0.7 / x, -0.7 / x * (1 + 1e-9), -0.7 / x + rng.standard_normal(3) * 1e-3):
+            assert op.contains(x, y, 0.0) == _log_barrier_reference(op, x, y, 0.0)
+        if (x <= 0.0).any():
+            with pytest.raises(operators.OutsideDomain):
+                op.min_norm(x)
+        else:
+            assert np.array_equal(op.min_norm(x), -0.7 / x)

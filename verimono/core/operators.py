@@ -768,7 +768,7 @@ class LogBarrier(Operator):
 
     def min_norm(self, x, t=0.0):
         x = np.asarray(x, dtype=float)
-        if np.any(x <= 0.0):
+        if (x <= 0.0).any():       # the ndarray's own any: np.any's dispatch is most of a small point's cost
             raise OutsideDomain(f"LogBarrier is defined on (0, ∞)^n; got x = {x}")
         ts = times_of(t, x, self.name)
         return -(self._c(t) if ts is None else self._c(0.0) if self._c.constant else _column(self._c.at_times(ts))) / x
@@ -778,7 +778,7 @@ class LogBarrier(Operator):
 
     def contains(self, x, y, t=0.0, tol=None):
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
-        if np.any(x <= 0.0):
+        if (x <= 0.0).any():
             return False
         c = self._c(t)
         expected = -c / x
@@ -790,7 +790,7 @@ class LogBarrier(Operator):
         with np.errstate(divide="ignore", over="ignore"):
             lo = np.where(x - tol > 0.0, -c / np.maximum(x - tol, _TINY), -np.inf)
         hi = -c / (x + tol)
-        return bool(np.all((y >= lo - tol) & (y <= hi + tol)))
+        return bool(((y >= lo - tol) & (y <= hi + tol)).all())
 
 
 __all__ = [
