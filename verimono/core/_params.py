@@ -47,6 +47,15 @@ class Param:
             return np.asarray(v)
         return real_array(v, f"{self.name}({t!r})")
 
+    def of(self, v: Any, t: float) -> np.ndarray:
+        """What ``self(t)`` returns when the callable returned ``v`` at ``t`` (for a caller that called it
+        itself, to take a scalar's fast path: the callable is called once either way)."""
+        if type(v) is np.ndarray and v.dtype == np.float64:
+            return v
+        if type(v) is float:
+            return np.asarray(v)
+        return real_array(v, f"{self.name}({t!r})")
+
     def at_times(self, ts: np.ndarray) -> np.ndarray:
         """The parameter at every time of ``ts`` (shape ``(B,)``): a constant as it is (it broadcasts against
         the rows), a moving one stacked row by row, ``(B, *shape)``, each row the value of a call at that time

@@ -120,6 +120,35 @@ def _weight_at(param, t: float, owner: str, what: str) -> np.ndarray:
     return c
 
 
+def _weight_value(param, t, owner: str, what: str):
+    """:func:`_weight_at`'s ``c(t)`` as a Python float when it is a scalar ``≥ 0``, else what :func:`_weight_at`
+    returns or raises (an array: a batch of weights; its error: a negative or NaN weight).
+
+    The same number either way: a constant's 0-d float64 read once; a callable's ``float`` or ``np.float64``
+    taken as it is (``Param`` would wrap it as a 0-d float64 array of the same value).  The callable is called
+    once, as :func:`_weight_at` calls it: a value off the fast path is converted as ``Param`` converts it
+    (:meth:`verimono.core._params.Param.of`) and checked as :func:`_weight_at` checks it."""
+    fn = param._fn
+    if fn is None:
+        v = param._value
+        return float(v) if v.ndim == 0 else v       # a constant was checked at construction
+    v = fn(t)
+    if (type(v) is float or type(v) is np.float64) and v >= 0.0:
+        return float(v)
+    c = param.of(v, t)
+    if not (float(c) >= 0.0 if c.ndim == 0 else (c >= 0).all()):
+        raise bad_param(owner, what, c, t, "must be >= 0 (a negative weight makes the operator non-monotone)",
+                        NotMonotone)
+    return c
+
+
+def _frobenius(x: np.ndarray) -> float:
+    """``float(np.linalg.norm(x))`` of a float array: NumPy's own default path (the flattened array's
+    ``sqrt(x·x)``, the same dot and its warnings) without its dispatch."""
+    x = x.ravel(order="K")
+    return _sqrt(x.dot(x))
+
+
 def _check_dim(op: Operator, x: np.ndarray) -> np.ndarray:
     x = np.asarray(x, dtype=float)
     if x.shape[-1:] != (op.dim,):
@@ -279,6 +308,13 @@ class NormSubdifferential(_EverywhereDefined):
     """
 
     static = False
+    #: the one-point paths read c(t) by :func:`_weight_value` (the same number and checks as :meth:`_c_at`): only
+    #: while :meth:`_c_at` and :meth:`_col` are this class's own (a subclass overriding either is called through them)
+    _fast_c = True
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        cls._fast_c = cls._c_at is NormSubdifferential._c_at and cls._col is NormSubdifferential._col
 
     def __init__(self, c: Any, dim: int = 1, name: str | None = None) -> None:
         super().__init__(dim, name or "NormSubdifferential")
@@ -307,6 +343,19 @@ class NormSubdifferential(_EverywhereDefined):
     def resolvent(self, x, lam, t=0.0):
         # J x = x max(|x| - λc, 0)/|x|, written so that x = 0 gives 0 without a 0/0
         x = real_array(x)
+        if x.ndim == 1 and type(lam) is not np.ndarray and type(t) is not np.ndarray and self._fast_c:
+            # one point, one λ, one t: the same checks in the same order, and the scalar arithmetic in Python
+            # floats (the same IEEE operations on the same |x|², hence the same bits)
+            lam = check_lam(lam, f"{self.name}.resolvent")
+            s = dot_rows(x, x)      # before c(t), as below: an overflow warns before a bad weight raises
+            c = _weight_value(self._c, t, self.name, "c(t)")
+            if type(c) is float:
+                nrm = _sqrt(s)
+                lc = lam * c
+                if nrm < _INF and lc < _INF:    # else NumPy's arithmetic below: its overflow warnings
+                    return x * (max(nrm - lc, 0.0) / max(nrm, _TINY))
+            nrm = np.sqrt(s)[..., None]         # _norm(x)
+            return x * (_mx(nrm - lam * batch_column(np.asarray(c), x, "c"), 0.0) / _mx(nrm, _TINY))
         lam, J = _steps(self, x, lam, t)
         if J is not None:
             return J
@@ -342,15 +391,29 @@ class NormSubdifferential(_EverywhereDefined):
 
     def value(self, x, t=0.0):
         """``g(t, x) = c(t)|x|`` (``F(t,·) = ∂g(t,·)``): the value laws check the resolvent is its prox."""
-        c = np.asarray(self._c_at(t), dtype=float)
-        if c.ndim:
-            raise NotImplementedError(f"{self.name}: a value needs one weight c(t), not a batch of them")
-        return float(c) * float(np.linalg.norm(np.asarray(x, dtype=float)))
+        c = _weight_value(self._c, t, self.name, "c(t)") if self._fast_c else self._c_at(t)
+        if type(c) is not float:
+            c = np.asarray(c, dtype=float)
+            if c.ndim:
+                raise NotImplementedError(f"{self.name}: a value needs one weight c(t), not a batch of them")
+            c = float(c)
+        return c * _frobenius(np.asarray(x, dtype=float))
 
     def min_norm(self, x, t=0.0):
         x = np.asarray(x, dtype=float)
         if type(t) is np.ndarray and not self._accepts_times():
             return per_row(lambda xi, ti: self.min_norm(xi, ti), x, times_of(t, x, self.name))
+        if x.ndim == 1 and type(t) is not np.ndarray and self._fast_c:
+            # one point at one t: the same operations in the same order (|x|², then c(t), then the array's
+            # c·x/|x|, computed whatever |x| as np.where computes it: its warnings), the norm a Python float
+            s = dot_rows(x, x)
+            c = _weight_value(self._c, t, self.name, "c(t)")
+            if type(c) is float:
+                nrm = _sqrt(s)
+                v = c * x / max(nrm, _TINY)
+                return v if nrm > 0.0 else np.zeros(x.shape)
+            nrm = np.sqrt(s)[..., None]
+            return np.where(nrm > 0.0, batch_column(c, x, "c") * x / _mx(nrm, _TINY), 0.0)
         nrm = _norm(x)
         # 0 where |x| is 0 or underflows (x·x < tiny): F^0(0) = 0; the max only avoids a 0/0 warning
         return np.where(nrm > 0.0, self._col(t, x) * x / _mx(nrm, _TINY), 0.0)
@@ -361,12 +424,13 @@ class NormSubdifferential(_EverywhereDefined):
 
     def contains(self, x, y, t=0.0, tol=None):
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
-        c = float(self._c_at(t))
+        c = _weight_value(self._c, t, self.name, "c(t)") if self._fast_c else self._c_at(t)
+        c = c if type(c) is float else float(c)
         tol = tolerance(c, y) if tol is None else tol
-        nx = float(np.linalg.norm(x))
-        if nx <= tol and np.linalg.norm(y) <= c + tol:  # x within tol of 0, where F = the ball cB
+        nx = _frobenius(x)
+        if nx <= tol and _frobenius(y) <= c + tol:  # x within tol of 0, where F = the ball cB
             return True
-        return bool(nx > 0.0 and np.linalg.norm(y - c * x / nx) <= tol)
+        return bool(nx > 0.0 and _frobenius(y - c * x / nx) <= tol)
 
 
 class L1Subdifferential(_EverywhereDefined):
@@ -528,7 +592,9 @@ class NormalCone(Operator):
         tol = tolerance(x, y) if tol is None else tol
         if not self.S.contains(x, t, tol):
             return False
-        return bool(np.max(np.abs(self.S.project(x + y, t) - x)) <= tol)
+        d = np.abs(self.S.project(x + y, t) - x)
+        # the ndarray's own max (np.max's dispatch is most of a small point's cost): the same reduction
+        return bool((d.max() if type(d) is np.ndarray else np.max(d)) <= tol)
 
 
 class Shifted(Operator):
@@ -702,7 +768,7 @@ class LogBarrier(Operator):
 
     def min_norm(self, x, t=0.0):
         x = np.asarray(x, dtype=float)
-        if np.any(x <= 0.0):
+        if (x <= 0.0).any():       # the ndarray's own any: np.any's dispatch is most of a small point's cost
             raise OutsideDomain(f"LogBarrier is defined on (0, ∞)^n; got x = {x}")
         ts = times_of(t, x, self.name)
         return -(self._c(t) if ts is None else self._c(0.0) if self._c.constant else _column(self._c.at_times(ts))) / x
@@ -712,7 +778,7 @@ class LogBarrier(Operator):
 
     def contains(self, x, y, t=0.0, tol=None):
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
-        if np.any(x <= 0.0):
+        if (x <= 0.0).any():
             return False
         c = self._c(t)
         expected = -c / x
@@ -724,7 +790,7 @@ class LogBarrier(Operator):
         with np.errstate(divide="ignore", over="ignore"):
             lo = np.where(x - tol > 0.0, -c / np.maximum(x - tol, _TINY), -np.inf)
         hi = -c / (x + tol)
-        return bool(np.all((y >= lo - tol) & (y <= hi + tol)))
+        return bool(((y >= lo - tol) & (y <= hi + tol)).all())
 
 
 __all__ = [

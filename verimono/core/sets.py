@@ -60,7 +60,9 @@ class ConvexSet:
             tol = row_tolerances(x) if tol is None else tol
             return np.max(np.abs(self.project(x, ts) - x), axis=-1, initial=0.0) <= tol
         tol = tolerance(x) if tol is None else tol
-        return bool(np.max(np.abs(self.project(x, t) - x), initial=0.0) <= tol)
+        d = np.abs(self.project(x, t) - x)
+        # the ndarray's own max (np.max's dispatch is most of a small point's cost): the same reduction
+        return bool((d.max(initial=0.0) if type(d) is np.ndarray else np.max(d, initial=0.0)) <= tol)
 
     def _accepts_batches(self) -> bool:
         """Whether :meth:`project` maps a batch ``(B, n)`` row by row, bit-identically (the catalog sets'
@@ -188,10 +190,26 @@ class Ball(ConvexSet):
         c = _at_times(self._c, t) if times else self._c(t)
         d = x - c
         with np.errstate(over="ignore"):
-            nrm = np.sqrt(dot_rows(d, d))[..., None]
+            dd = dot_rows(d, d)
+        r = None
+        if d.ndim == 1 and not times:
+            # one point, one ball: the norm and the test in Python floats (the same IEEE operations on the same
+            # d·d, hence the same bits), the radius read once as below
+            nrm = _sqrt(dd)
+            if nrm < _INF:
+                r = self._radius_at(t)
+                if r.ndim == 0:
+                    rf = float(r)
+                    if not nrm > rf:
+                        return x.copy()
+                    return c + d * (rf / nrm)       # nrm > r ≥ 0: the divisor below is nrm
+        nrm = np.sqrt(dd)[..., None]
         if np.isinf(nrm).any():          # |d| beyond 1.3e154: d·d overflows; the norm itself does not
             nrm = np.where(np.isinf(nrm), _scaled_norm(d), nrm)
-        r = _column(self._radius_times(t)) if times else batch_column(self._radius_at(t), x, "radius")
+        if times:
+            r = _column(self._radius_times(t))
+        else:
+            r = batch_column(self._radius_at(t) if r is None else r, x, "radius")
         outside = nrm > r
         if not outside.any():  # the common case along a trajectory: nothing to project
             return x.copy()
@@ -285,7 +303,7 @@ class Box(ConvexSet):
         """``(lower(t), upper(t))``, checked ``lower ≤ upper`` (a nonempty box) at this ``t`` when they move;
         bounds crossed by round-off (:func:`_past_roundoff`) are the point between them."""
         lo, hi = self._lo(t), self._hi(t)
-        if not self.static and not np.all(lo <= hi):
+        if not self.static and not (lo <= hi).all():
             lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
             gap = lo - hi
             finite = np.concatenate([np.ravel(lo[np.isfinite(lo)]), np.ravel(hi[np.isfinite(hi)])])
@@ -403,7 +421,17 @@ class HalfSpace(ConvexSet):
             excess = _mx(dot_rows(x, a)[..., None] - b, 0.0) / aa
             return x - excess * a
         a, b = self._normal_at(t), self._b(t)
-        excess = _mx(dot_rows(x, a)[..., None] - b, 0.0) / a.dot(a)
+        s, aa = dot_rows(x, a), a.dot(a)
+        if x.ndim == 1 and a.ndim == 1 and b.ndim == 0:
+            # one point, one half-space: the excess in Python floats (the same IEEE operations, hence the same
+            # bits) where none of them overflows, divides by 0 or meets a NaN (NumPy's arithmetic below then:
+            # its warnings)
+            e = float(s) - float(b)
+            if -_INF < e < _INF and 0.0 < aa < _INF:
+                e = max(e, 0.0) / float(aa)
+                if e < _INF:
+                    return x - e * a
+        excess = _mx(s[..., None] - b, 0.0) / aa
         return x - excess * a
 
     def _kernel(self, x0):

@@ -232,6 +232,8 @@ def tolerance(*scales: float, rtol: float | None = None) -> float:
                 a = float(max(s.max(), -s.min()))
             else:
                 a = float(np.abs(s).max()) if s.size else 0.0
+        elif type(s) is float:             # a weight c(t): abs is np.abs of one double, without its dispatch
+            a = abs(s)
         else:
             a = float(np.max(np.abs(s))) if np.size(s) else 0.0
         if a > m:
