@@ -196,6 +196,17 @@ class Comparison:
     def to_dict(self) -> dict[str, Any]:
         return {"ok": self.ok, "compared": self.compared, "changes": [dataclasses.asdict(c) for c in self.changes]}
 
+    def regression_lines(self, baseline: str | Path | None = None, results: str | Path | None = None,
+                         limit: int = LISTED_REGRESSIONS) -> list[str]:
+        """The first ``limit`` regressions as ``verimono gate`` prints them, then how many more and the
+        ``verimono gate`` command that lists them all (``baseline``, ``results``: the two documents' paths)."""
+        regs = self.regressions
+        lines = [f"  {c}" for c in regs[:limit]]
+        if len(regs) > limit:
+            lines.append(f"  … and {len(regs) - limit} more; `verimono gate --baseline {baseline or 'BASELINE'} "
+                         f"--results {results or 'RESULTS'}` lists all")
+        return lines
+
 
 def _one_reason_each(whys: Any) -> list[str]:
     """The stages' reasons for not judging, each kind said once: a reason is ``"; "``-separated parts, and a part's
@@ -211,17 +222,6 @@ def _one_reason_each(whys: Any) -> list[str]:
                 kinds[kind] = [part, 0]
     return [part + (f" ({more} more stage{'s' if more != 1 else ''} likewise)" if more else "")
             for part, more in kinds.values()]
-
-    def regression_lines(self, baseline: str | Path | None = None, results: str | Path | None = None,
-                         limit: int = LISTED_REGRESSIONS) -> list[str]:
-        """The first ``limit`` regressions as ``verimono gate`` prints them, then how many more and the
-        ``verimono gate`` command that lists them all (``baseline``, ``results``: the two documents' paths)."""
-        regs = self.regressions
-        lines = [f"  {c}" for c in regs[:limit]]
-        if len(regs) > limit:
-            lines.append(f"  … and {len(regs) - limit} more; `verimono gate --baseline {baseline or 'BASELINE'} "
-                         f"--results {results or 'RESULTS'}` lists all")
-        return lines
 
 
 def check_unique_keys(report: Report, what: str = "the results") -> None:
