@@ -36,6 +36,7 @@ from .kernel import BatchStepError
 from ._warm_qp import row_infeasible, solve_qp_warm
 from .lcp import _box_lcp, _feasible, is_psd, proved_solvable, sol_polyhedron, solve_lcp
 from .relations import BoxRelation, as_relation
+from ._select_rows import MAX_FACES_K, Faces, select_rows
 
 
 def _matrix(value, shape, what):
@@ -403,6 +404,7 @@ class LCSOperator(Operator):
         self._warm_project: dict = {}
         self._memo: dict = {}
         self._patterns: list | None = None      # the multipliers' patterns of :meth:`_inside_rows`, made once
+        self._faces = None                      # the faces of H^0's block selection (:meth:`_row_faces`), made once
 
     def _memoised(self, kind: str, x: np.ndarray, t, compute):
         """``compute()`` once per ``(kind, t, x)``: an assumption law asks ``H^0`` and ``proj_dom H`` at the same
@@ -553,10 +555,92 @@ class LCSOperator(Operator):
         x = np.asarray(x, dtype=float)
         ts = self._times(x, t)
         if ts is not None:      # row by row in order: OutsideDomain when any row is outside at its time
+            if x.shape[0] and x.shape[1] == self.dim and self._selects_rows():
+                return self._min_norm_rows(x, ts.tolist())
             return np.array([self.min_norm(xi, ti) for xi, ti in zip(x, ts.tolist())]).reshape(x.shape)
         if x.ndim == 2:
+            if x.shape[0] and x.shape[1] == self.dim and self._selects_rows():
+                return self._min_norm_rows(x, [t] * x.shape[0])
             return np.array([self.min_norm(xi, t) for xi in x])
         return self._memoised("min_norm", x, t, lambda: self._min_norm(x, t))
+
+    def _selects_rows(self) -> bool:
+        """Whether ``min_norm`` of a block may select the rows' multipliers together (:meth:`_min_norm_rows`):
+        none of the members it stands for replaced by a subclass or the instance."""
+        mine = getattr(self, "__dict__", {})
+        return self._accepts_times() and all(getattr(type(self), m) is getattr(LCSOperator, m) and m not in mine
+                                             for m in ("_min_norm", "_select"))
+
+    def _row_faces(self):
+        """:class:`verimono.lcs._select_rows.Faces` of the multipliers' box LCP and ``H^0``'s selection, made once;
+        ``False`` where the block selection does not apply (not a box relation with PSD ``D``, or more than
+        :data:`~verimono.lcs._select_rows.MAX_FACES_K` multipliers)."""
+        F = self._faces
+        if F is None:
+            F = False
+            try:
+                rel, s = self._box(), self.system
+                lo, hi = rel.bounds(s.m)
+                big, _, _ = _box_lcp(s.D, np.zeros(s.m), lo, hi)
+                if big.shape[0] <= MAX_FACES_K and np.isfinite(s.A).all() and np.isfinite(s.B).all():
+                    k = big.shape[0]
+                    P = np.zeros((k, k))
+                    P[:s.m, :s.m] = s.B.T @ s.B
+                    F = Faces(big, P)
+            except NotImplementedError:
+                F = False
+            self._faces = F
+        return F
+
+    def _min_norm_rows(self, X: np.ndarray, ts: list) -> np.ndarray:
+        """``min_norm`` of every row ``x_i`` at ``t_i``: the rows not remembered selected together
+        (:func:`verimono.lcs._select_rows.select_rows`: every row's candidate accepted only by the per-row path's
+        own LCP residual and KKT checks), each row it does not accept taken as its own call, in the rows' order
+        (``OutsideDomain`` when a row is outside at its time, as row by row).  The answers agree with the
+        per-row path's to the selection QP's verification tolerance: ``H^0 = −Ax − Bλ*`` is unique even where
+        the multipliers ``λ*`` are not (the edge of ``dom H(t)``)."""
+        out = np.empty(X.shape)
+        keys = [("min_norm", float(ti), xi.tobytes()) for xi, ti in zip(X, ts)]
+        memo = self._memo
+        miss = []
+        for i, key in enumerate(keys):
+            hit = memo.get(key)
+            if hit is None:
+                miss.append(i)
+            else:
+                out[i] = hit
+        ok = np.zeros(len(miss), dtype=bool)
+        F = self._row_faces() if miss else False
+        if F:
+            s = self.system
+            try:
+                rel = self.system.relation
+                lo, hi = rel.bounds(s.m)
+                fin = np.flatnonzero(np.isfinite(hi))
+                Xm = X[miss]
+                with np.errstate(all="ignore"):
+                    V = np.array([np.asarray(s.v(ts[i]), dtype=float) for i in miss]).reshape(len(miss), s.m)
+                    Q = Xm @ s.C.T + V
+                    scales = s._c_norm * np.abs(Xm).max(axis=1) + np.abs(V).max(axis=1)
+                    QQ = np.concatenate([Q + s.D @ lo, np.broadcast_to((hi - lo)[fin], (len(miss), fin.size))],
+                                        axis=1)
+                    AX = Xm @ s.A.T
+                    Cc = np.zeros((len(miss), F.k))
+                    Cc[:, :s.m] = AX @ s.B + (s.B.T @ s.B) @ lo
+                    Z, ok = select_rows(F, QQ, Cc, scales)
+                    H0 = -AX - (lo + Z[:, :s.m]) @ s.B.T
+                ok &= np.isfinite(H0).all(axis=1)
+            except Exception:   # noqa: BLE001 - whatever the block raises, each row's own call raises it in its turn
+                ok = np.zeros(len(miss), dtype=bool)
+        for j, i in enumerate(miss):
+            if ok[j]:
+                out[i] = H0[j]
+                if len(memo) >= MEMO_SIZE:
+                    memo.clear()
+                memo[keys[i]] = H0[j].copy()
+            else:
+                out[i] = self.min_norm(X[i], ts[i])
+        return out
 
     def _min_norm(self, x, t):
         s = self.system

@@ -1,0 +1,152 @@
+"""``H^0`` of a block of rows selected together (:mod:`verimono.lcs._select_rows`, branch example6) against each
+row's own call (:meth:`LCSOperator._select`: Lemke, the rank certificate, the warm selection QP).
+
+Tolerance: both answers are minimisers of the selection QP verified by ``kkt_residual`` to ``QP_RTOL`` in the
+QP's equilibrated units, whose size is that of the data ``q = Cx + v`` and of ``c = BᵀAx``; ``H^0 = −Ax − Bλ*`` is
+unique even where ``λ*`` is not, so the two agree to ``QP_RTOL`` times that size, times ``‖B‖∞`` (the map
+from multipliers to ``H^0``) and a margin of 100 for the conditioning of these small systems:
+``TOL_FACTOR·QP_RTOL·(1 + ‖C‖∞|x|∞ + |v|∞ + ‖A‖∞|x|∞)·(1 + ‖B‖∞)``.  Measured: at most 6e-6 of it on the random
+systems below (3.7e-12 absolute on a rank-1 3×3 ``D`` at |x| ≈ 10, last bits elsewhere); a wrong face or a dropped
+check gives errors of the data's size.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import verimono.lcs._select_rows as sr
+from verimono.core.errors import OutsideDomain
+from verimono.core.tolerances import QP_RTOL
+from verimono.lcs.relations import Complementarity, Relay
+from verimono.lcs.system import LinearRelationSystem
+from verimono.reference import lcs_example as ex
+
+TOL_FACTOR = 100.0
+
+
+def _tol(op, X, ts):
+    s = op.system
+    V = np.array([s.v(t) for t in ts])
+    size = (1.0 + s._c_norm * np.abs(X).max(axis=1) + np.abs(V).max(axis=1)
+            + np.abs(s.A).sum(axis=1).max() * np.abs(X).max(axis=1))
+    return TOL_FACTOR * QP_RTOL * size * (1.0 + np.abs(s.B).sum(axis=1).max())
+
+
+def _accepted(monkeypatch):
+    """Count the rows the block selection accepts (so a test cannot pass with every row taken row by row)."""
+    seen = [0, 0]
+    orig = sr.select_rows
+
+    def counting(*a):
+        Z, ok = orig(*a)
+        seen[0] += ok.size
+        seen[1] += int(ok.sum())
+        return Z, ok
+    monkeypatch.setattr("verimono.lcs.system.select_rows", counting)
+    return seen
+
+
+def _psd_system(seed, n, m, relay=False, rank=None):
+    """A passive LCS (``C = Bᵀ``, ``D = SᵀS + K``: ``S`` of rank ``rank``, ``K`` skew), ``v`` moving with ``t``."""
+    rng = np.random.default_rng(seed)
+    r = m if rank is None else rank
+    S = rng.normal(size=(r, m))
+    K = rng.normal(size=(m, m))
+    D = S.T @ S + (K - K.T)
+    A = rng.normal(size=(n, n)) * 0.5
+    B = rng.normal(size=(n, m))
+    w = rng.normal(size=m)
+    return LinearRelationSystem(A, B, B.T.copy(), D, Relay() if relay else Complementarity(),
+                                v=lambda t: w * np.sin(t + np.arange(m)), name=f"psd{seed}").operator()
+
+
+def _domain_rows(op, seed, B=40):
+    """Points of ``dom H(t_i)``: resolvents of random points at several scales (many land on the domain's
+    faces, where the multipliers are not unique), and a few repeated rows and times."""
+    rng = np.random.default_rng(seed)
+    X = rng.normal(size=(B, op.dim)) * np.repeat([1e-6, 0.1, 1.0, 10.0], B // 4)[:, None]
+    ts = rng.uniform(0.0, 6.0, B)
+    ts[1], X[1] = ts[0], X[0]
+    return op.resolvent(X, 0.7, ts), ts
+
+
+def _both(make, X, ts):
+    """``min_norm`` of the block on one operator and row by row on a fresh one."""
+    one, many = make(), make()
+    rows = np.array([one.min_norm(x, t) for x, t in zip(X, ts.tolist())])
+    return many.min_norm(X, ts), rows, many
+
+
+SYSTEMS = [(0, 1, 1, False, None), (1, 2, 2, False, None), (2, 3, 2, False, 1), (3, 2, 3, False, None),
+           (4, 3, 3, False, 1), (5, 1, 2, True, None), (6, 2, 2, True, 1)]
+
+
+@pytest.mark.parametrize("seed,n,m,relay,rank", SYSTEMS)
+def test_block_selection_agrees_with_each_rows_own_on_random_psd_systems(seed, n, m, relay, rank, monkeypatch):
+    """Random monotone LCSs (complementarity and relay, ``D`` of full and deficient rank): the block's ``H^0``
+    against each row's own call, within the stated tolerance; most rows are the block's own answers."""
+    seen = _accepted(monkeypatch)
+    make = lambda: _psd_system(seed, n, m, relay, rank)       # noqa: E731
+    X, ts = _domain_rows(make(), seed)
+    got, want, _ = _both(make, X, ts)
+    tol = _tol(make(), X, ts)
+    assert (np.abs(got - want).max(axis=1) <= tol).all(), np.abs(got - want).max(axis=1) / tol
+    assert seen[1] >= 0.75 * seen[0] > 0, seen
+
+
+def _example(v):
+    return ex.example_system(v).operator()
+
+
+SINE = lambda t: np.array([np.sin(t), 0.0])       # noqa: E731
+RAMP = lambda t: np.array([-t, 0.0])              # noqa: E731
+
+
+@pytest.mark.parametrize("v", [SINE, RAMP], ids=["sine", "ramp"])
+def test_example_edge_rows_against_each_rows_own_and_the_closed_form(v, monkeypatch):
+    """The Example's inputs on the edge ``x = −v2 = 0`` of ``dom H(t)`` (the multipliers a ray), rounding either
+    side of it (``±1e-16``: the resolvent's outputs), at ``v1 = 0`` (a tie: ``max(−v1, 0)`` at its kink) and inside:
+    ``H^0 = −max(−v1(t), 0)`` (the closed form), and each row's own call, within the stated tolerance."""
+    seen = _accepted(monkeypatch)
+    rng = np.random.default_rng(7)
+    ts = np.concatenate([rng.uniform(0.0, 10.0, 30), [0.0, np.pi, 2 * np.pi, 1e-12, 2.0 ** -23]])
+    X = np.zeros((ts.size, 1))
+    X[10:15, 0] = 1e-16 * rng.random(5)
+    X[15:20, 0] = rng.exponential(1.0, 5)
+    X[20:23, 0] = [1e-300, 5e-324, 1e-9]
+    got, want, _ = _both(lambda: _example(v), X, ts)
+    closed = -np.maximum(-np.array([v(t)[0] for t in ts]), 0.0)
+    tol = _tol(_example(v), X, ts)
+    assert (np.abs(got[:, 0] - closed) <= tol).all()
+    assert (np.abs(got - want).max(axis=1) <= tol).all()
+    assert seen[1] >= 0.9 * seen[0] > 0, seen
+
+
+def test_rows_outside_the_domain_and_non_finite_are_their_own_calls(monkeypatch):
+    """A row outside ``dom H(t)`` raises :class:`OutsideDomain` from the block as from its own call (the block
+    never accepts it); a row just outside by rounding (``−4e-16``) has an answer, as its own call does."""
+    seen = _accepted(monkeypatch)
+    op = _example(RAMP)
+    with pytest.raises(OutsideDomain):
+        op.min_norm(np.array([[1.0], [0.5], [-1.0], [2.0]]), np.array([0.1, 0.2, 0.3, 0.4]))
+    got = op.min_norm(np.array([[-4e-16], [0.0]]), np.array([0.5, 0.25]))
+    np.testing.assert_allclose(got, [[-0.5], [-0.25]], rtol=0, atol=_tol(op, np.zeros((2, 1)), [0.5, 0.25]).max())
+    assert seen[1] >= 2
+
+
+def test_block_selection_module_alone_accepts_only_minimisers():
+    """:func:`select_rows` on the Example's ``LCP(q, D)`` with ``P = diag(0, 1)``: on the edge (``q2 = 0``)
+    ``SOL = {0} × [max(−q1, 0), ∞)`` and the minimiser is ``(0, max(−q1, 0))``; inside (``q2 > 0``) it is the
+    unique solution; the rows outside (``q2 < 0`` by a margin) are never accepted."""
+    D = ex.D
+    P = np.diag([0.0, 1.0])
+    F = sr.Faces(D, P)
+    q1 = np.array([-2.0, -0.5, 0.0, 0.3, 1e-9, -1e-9, -3.0, 2.0])
+    q2 = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.5, -1.0])
+    Q = np.stack([q1, q2], axis=1)
+    Z, ok = sr.select_rows(F, Q, np.zeros((8, 2)), np.abs(Q).max(axis=1))
+    assert ok[:7].all() and not ok[7]
+    np.testing.assert_allclose(Z[:7, 1], np.maximum(-q1[:7], 0.0), rtol=0, atol=10 * QP_RTOL)
+    np.testing.assert_allclose(Z[:6, 0], 0.0, rtol=0, atol=10 * QP_RTOL)     # w2 = q2 − z1 = −z1 ≥ 0 on the edge
+    np.testing.assert_allclose(Z[6, 0], 1.5, rtol=0, atol=10 * QP_RTOL)      # z2 > 0 forces w2 = 1.5 − z1 = 0
