@@ -150,3 +150,22 @@ def test_block_selection_module_alone_accepts_only_minimisers():
     np.testing.assert_allclose(Z[:7, 1], np.maximum(-q1[:7], 0.0), rtol=0, atol=10 * QP_RTOL)
     np.testing.assert_allclose(Z[:6, 0], 0.0, rtol=0, atol=10 * QP_RTOL)     # w2 = q2 − z1 = −z1 ≥ 0 on the edge
     np.testing.assert_allclose(Z[6, 0], 1.5, rtol=0, atol=10 * QP_RTOL)      # z2 > 0 forces w2 = 1.5 − z1 = 0
+
+
+def test_block_selection_checks_optimality_not_only_membership():
+    """Rows where a face's candidate lies in ``SOL`` but is not the minimiser: the Example's ``LCP(q, D)`` at
+    ``q = (0, 1)`` has ``SOL = [0, 1] × {0}``; with ``P = I`` the minimiser is ``0`` and the vertex ``(1, 0)`` (the
+    face ``w2 = 0``) is a member of higher objective.  With ``P = 0``, ``c = (0, −1)`` on the edge ``q = (−2, 0)``
+    the objective is unbounded below over ``SOL = {0} × [2, ∞)``: no candidate may be accepted (the vertex
+    ``(0, 2)`` is in ``SOL`` and passes the residual check; only the KKT check's multiplier sign rejects it),
+    while ``c = (0, 1)`` makes it the minimiser."""
+    D = ex.D
+    Z, ok = sr.select_rows(sr.Faces(D, np.eye(2)), np.array([[0.0, 1.0], [0.0, 3.0]]), np.zeros((2, 2)),
+                           np.array([1.0, 3.0]))
+    assert ok.all()
+    np.testing.assert_allclose(Z, 0.0, rtol=0, atol=10 * QP_RTOL)
+    F0 = sr.Faces(D, np.zeros((2, 2)))
+    Q = np.array([[-2.0, 0.0], [-2.0, 0.0]])
+    Z, ok = sr.select_rows(F0, Q, np.array([[0.0, -1.0], [0.0, 1.0]]), np.array([2.0, 2.0]))
+    assert not ok[0] and ok[1]
+    np.testing.assert_allclose(Z[1], [0.0, 2.0], rtol=0, atol=10 * QP_RTOL)
