@@ -169,3 +169,49 @@ def test_block_selection_checks_optimality_not_only_membership():
     Z, ok = sr.select_rows(F0, Q, np.array([[0.0, -1.0], [0.0, 1.0]]), np.array([2.0, 2.0]))
     assert not ok[0] and ok[1]
     np.testing.assert_allclose(Z[1], [0.0, 2.0], rtol=0, atol=10 * QP_RTOL)
+
+
+def _edge_and_outside_rows(op, seed, B=40):
+    """Resolvent outputs (on the domain's faces), the same nudged by ±1e-16·scale, and random points (many outside
+    the domain), at random times."""
+    rng = np.random.default_rng(seed)
+    X, ts = _domain_rows(op, seed, B)
+    X[::4] += 1e-16 * rng.normal(size=X[::4].shape) * (1.0 + np.abs(X[::4]))
+    X[1::4] = rng.normal(size=X[1::4].shape) * 2.0
+    return X, ts
+
+
+@pytest.mark.parametrize("seed,n,m,relay,rank", SYSTEMS[:5])
+def test_block_projection_is_each_rows_own_bit_for_bit(seed, n, m, relay, rank):
+    """``project_domain`` of a block, whose rows on the domain's edge are proved inside by a face's verified
+    multiplier (:func:`verimono.lcs._select_rows.solvable_rows`), against each row's own call: bit for bit (a
+    row proved inside is its own projection, what its own call returns after Lemke's proof; the others are their
+    own calls), on random passive LCSs and the Example's two inputs, with rows outside the domain among them."""
+    for make in (lambda: _psd_system(seed, n, m, relay, rank), lambda: _example(SINE), lambda: _example(RAMP)):
+        X, ts = _edge_and_outside_rows(make(), seed)
+        one, many = make(), make()
+        rows = np.array([one.project_domain(x, t) for x, t in zip(X, ts.tolist())])
+        got = many.project_domain(X, ts)
+        assert got.shape == rows.shape and np.array_equal(got, rows)
+
+
+def test_block_projection_proves_the_example_edge_rows(monkeypatch):
+    """The Example's edge rows ``x = −v2(t) = 0`` (and 1e-16 either side) are proved inside by the block, not left
+    to Lemke one row at a time; rows outside by more than rounding are not."""
+    calls = []
+    orig = sr.solvable_rows
+
+    def counting(F, Q, scales):
+        got = orig(F, Q, scales)
+        calls.append((Q.copy(), got.copy()))
+        return got
+    monkeypatch.setattr("verimono.lcs.system.solvable_rows", counting)
+    op = _example(SINE)
+    ts = np.linspace(0.1, 9.0, 12)
+    X = np.array([[0.0], [1e-16], [-1e-16], [-1e-3]] * 3)
+    got = op.project_domain(X, ts)
+    Q, proved = calls[-1]
+    assert proved[:3].all() and proved[4:7].all() and proved[8:11].all()
+    assert not proved[[3, 7, 11]].any()
+    np.testing.assert_array_equal(got[[0, 1, 2]], X[[0, 1, 2]])
+    np.testing.assert_allclose(got[[3, 7, 11]], 0.0, rtol=0, atol=10 * QP_RTOL)

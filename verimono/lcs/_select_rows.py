@@ -71,16 +71,14 @@ class Faces:
         self.p = float(np.abs(P).max(initial=0.0)) or 1.0
 
 
-def select_rows(F: Faces, Q: np.ndarray, Cc: np.ndarray, scales: np.ndarray):
-    """Minimisers ``z_i`` of ``½zᵀPz + c_iᵀz`` over ``SOL(q_i, M)`` for the rows ``q_i`` of ``Q`` (``c_i`` of ``Cc``),
-    ``scales`` the size of the numbers each ``q_i`` was computed from (``_select``'s ``scale``).  Returns
-    ``(Z, ok)``: ``Z[i]`` is the accepted minimiser where ``ok[i]`` (see the module docstring), else undefined."""
+def _candidates(F: Faces, Q: np.ndarray, Cc: np.ndarray, scales: np.ndarray):
+    """Every face's candidate for every row; ``(Z, f, usable)``: per row the candidate of least objective among
+    those that pass ``solve_lcp``'s residual check (a verified solution of ``LCP(q_i, M)``), its objective (``inf``
+    when none passes), and whether the row may be decided here (finite, and not proved outside by
+    :func:`verimono.lcs._warm_qp.row_infeasible`'s margin: such a row is its own call, which raises)."""
     B, k = Q.shape
     M, P = F.M, F.P
-    ok = np.zeros(B, dtype=bool)
     Zbest = np.zeros((B, k))
-    if F.G_zero or B == 0:
-        return Zbest, ok
     with np.errstate(all="ignore"):
         finite = np.isfinite(Q).all(axis=1) & np.isfinite(Cc).all(axis=1) & np.isfinite(scales)
         # row_infeasible's proof of x ∉ dom H: left to the row's own call, which raises OutsideDomain
@@ -90,6 +88,7 @@ def select_rows(F: Faces, Q: np.ndarray, Cc: np.ndarray, scales: np.ndarray):
         # solve_lcp's units: q / s with s = max(|q|∞, scale), M / β
         s_lcp = np.maximum(qmax, scales)
         s_lcp = np.where(s_lcp > 0.0, s_lcp, 1.0)
+        qu_max = np.abs(Q / s_lcp[:, None]).max(axis=1)
         best_f = np.full(B, np.inf)
         for W, nz, pinvk in F.faces:
             rhs = np.zeros((B, pinvk.shape[1]))
@@ -100,14 +99,38 @@ def select_rows(F: Faces, Q: np.ndarray, Cc: np.ndarray, scales: np.ndarray):
             zu = Zc * (F.beta / s_lcp)[:, None]
             wu = Wc / s_lcp[:, None]
             res = np.abs(np.minimum(zu, wu)).max(axis=1)
-            lscale = 1.0 + np.maximum(np.abs(Q / s_lcp[:, None]).max(axis=1), F.row_norm_unit * np.abs(zu).max(axis=1))
+            lscale = 1.0 + np.maximum(qu_max, F.row_norm_unit * np.abs(zu).max(axis=1))
             good = res <= QP_RTOL * lscale
             f = 0.5 * np.einsum("bi,ij,bj->b", Zc, P, Zc) + np.einsum("bi,bi->b", Cc, Zc)
             take = good & (f < best_f)
             if take.any():
                 Zbest[take] = Zc[take]
                 best_f[take] = f[take]
-        cand = finite & ~outside & np.isfinite(best_f)
+    return Zbest, best_f, finite & ~outside
+
+
+def solvable_rows(F: Faces, Q: np.ndarray, scales: np.ndarray) -> np.ndarray:
+    """Rows ``q_i`` for which some face's candidate is a solution of ``LCP(q_i, M)`` verified as
+    :func:`verimono.lcs.lcp.proved_solvable` verifies Lemke's point (the same scaling, the same residual check):
+    the proof that ``x_i ∈ dom H(t_i)`` which :meth:`LCSOperator._project_domain` makes row by row."""
+    if F.G_zero or not len(Q):
+        return np.zeros(len(Q), dtype=bool)
+    _, f, usable = _candidates(F, Q, np.zeros(Q.shape), scales)
+    return usable & np.isfinite(f)
+
+
+def select_rows(F: Faces, Q: np.ndarray, Cc: np.ndarray, scales: np.ndarray):
+    """Minimisers ``z_i`` of ``½zᵀPz + c_iᵀz`` over ``SOL(q_i, M)`` for the rows ``q_i`` of ``Q`` (``c_i`` of ``Cc``),
+    ``scales`` the size of the numbers each ``q_i`` was computed from (``_select``'s ``scale``).  Returns
+    ``(Z, ok)``: ``Z[i]`` is the accepted minimiser where ``ok[i]`` (see the module docstring), else undefined."""
+    B, k = Q.shape
+    P = F.P
+    ok = np.zeros(B, dtype=bool)
+    if F.G_zero or B == 0:
+        return np.zeros((B, k)), ok
+    Zbest, best_f, usable = _candidates(F, Q, Cc, scales)
+    with np.errstate(all="ignore"):
+        cand = usable & np.isfinite(best_f)
         idx = np.flatnonzero(cand)
         if not idx.size:
             return Zbest, ok
@@ -150,4 +173,4 @@ def select_rows(F: Faces, Q: np.ndarray, Cc: np.ndarray, scales: np.ndarray):
     return Zbest, ok
 
 
-__all__ = ["Faces", "select_rows", "MAX_FACES_K"]
+__all__ = ["Faces", "select_rows", "solvable_rows", "MAX_FACES_K"]

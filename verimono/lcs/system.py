@@ -36,7 +36,7 @@ from .kernel import BatchStepError
 from ._warm_qp import row_infeasible, solve_qp_warm
 from .lcp import _box_lcp, _feasible, is_psd, proved_solvable, sol_polyhedron, solve_lcp
 from .relations import BoxRelation, as_relation
-from ._select_rows import MAX_FACES_K, Faces, select_rows
+from ._select_rows import MAX_FACES_K, Faces, select_rows, solvable_rows
 
 
 def _matrix(value, shape, what):
@@ -684,6 +684,8 @@ class LCSOperator(Operator):
             inside = self._inside_rows(x, ts) if self._accepts_times() else None
             if inside is None:
                 return np.array([self.project_domain(xi, ti) for xi, ti in zip(x, ts.tolist())]).reshape(x.shape)
+            if not inside.all() and self._selects_rows():
+                inside = inside | self._solvable_rows(x, ts, ~inside)
             out = []
             for xi, ti, ok in zip(x, ts.tolist(), inside.tolist()):
                 # a row proved inside dom H(t_i) is its own projection, what _project_domain returns for it (its
@@ -693,6 +695,31 @@ class LCSOperator(Operator):
         if x.ndim == 2:
             return np.array([self.project_domain(xi, t) for xi in x])
         return self._memoised("project_domain", x, t, lambda: self._project_domain(x, t))
+
+    def _solvable_rows(self, X: np.ndarray, ts: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        """Which of ``rows`` (a mask) are proved inside ``dom H(t_i)`` by a face's solution of the multipliers'
+        LCP that passes the residual check Lemke's point passes in :meth:`_project_domain`
+        (:func:`verimono.lcs._select_rows.solvable_rows`): the rows on the domain's edge, which
+        :meth:`_inside_rows`' margin leaves to their own call.  A row not proved is its own call."""
+        proved = np.zeros(len(X), dtype=bool)
+        F = self._row_faces()
+        idx = np.flatnonzero(rows)
+        if not F or not idx.size:
+            return proved
+        s = self.system
+        try:
+            lo, hi = s.relation.bounds(s.m)
+            fin = np.flatnonzero(np.isfinite(hi))
+            Xm = X[idx]
+            with np.errstate(all="ignore"):
+                V = np.array([np.asarray(s.v(t), dtype=float) for t in ts[idx].tolist()]).reshape(len(idx), s.m)
+                scales = s._c_norm * np.abs(Xm).max(axis=1) + np.abs(V).max(axis=1)
+                QQ = np.concatenate([Xm @ s.C.T + V + s.D @ lo,
+                                     np.broadcast_to((hi - lo)[fin], (len(idx), fin.size))], axis=1)
+                proved[idx] = solvable_rows(F, QQ, scales) & np.isfinite(Xm).all(axis=1)
+        except Exception:   # noqa: BLE001 - whatever the block raises, each row's own call raises it in its turn
+            proved[:] = False
+        return proved
 
     def _inside_rows(self, X: np.ndarray, ts: np.ndarray) -> np.ndarray | None:
         """Which rows ``x_i`` are proved inside ``dom H(t_i)`` (complementarity, PSD ``D``) by a strictly complementary
