@@ -215,3 +215,16 @@ def test_block_projection_proves_the_example_edge_rows(monkeypatch):
     assert not proved[[3, 7, 11]].any()
     np.testing.assert_array_equal(got[[0, 1, 2]], X[[0, 1, 2]])
     np.testing.assert_allclose(got[[3, 7, 11]], 0.0, rtol=0, atol=10 * QP_RTOL)
+
+
+def test_block_projection_at_each_rows_own_time_on_a_moving_domain():
+    """``v = (−1, t − 1)``: ``dom H(t) = [1 − t, ∞)`` moves; rows on and 1e-3 below their own time's edge, the times
+    decreasing (each row inside at the first row's time): each row's own projection, ``max(x, 1 − t_i)``."""
+    make = lambda: ex.example_system(lambda t: np.array([-1.0, t - 1.0])).operator()     # noqa: E731
+    ts = np.linspace(2.0, 0.0, 9)
+    X = (1.0 - ts - np.tile([0.0, 1e-3, 0.0], 3))[:, None]
+    one, many = make(), make()
+    rows = np.array([one.project_domain(x, t) for x, t in zip(X, ts.tolist())])
+    got = many.project_domain(X, ts)
+    np.testing.assert_array_equal(got, rows)
+    np.testing.assert_allclose(got[:, 0], 1.0 - ts, rtol=0, atol=10 * QP_RTOL)
