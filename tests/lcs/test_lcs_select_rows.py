@@ -182,17 +182,32 @@ def _edge_and_outside_rows(op, seed, B=40):
 
 
 @pytest.mark.parametrize("seed,n,m,relay,rank", SYSTEMS[:5])
-def test_block_projection_is_each_rows_own_bit_for_bit(seed, n, m, relay, rank):
+def test_block_projection_is_each_rows_own(seed, n, m, relay, rank, monkeypatch):
     """``project_domain`` of a block, whose rows on the domain's edge are proved inside by a face's verified
-    multiplier (:func:`verimono.lcs._select_rows.solvable_rows`), against each row's own call: bit for bit (a
-    row proved inside is its own projection, what its own call returns after Lemke's proof; the others are their
-    own calls), on random passive LCSs and the Example's two inputs, with rows outside the domain among them."""
+    multiplier (:func:`verimono.lcs._select_rows.solvable_rows`) and whose rows proved outside are projected
+    together (:func:`verimono.lcs._select_rows.project_rows`), against each row's own call, on random passive LCSs
+    and the Example's two inputs: the rows inside bit for bit (a row proved inside is its own projection, what
+    its own call returns after Lemke's proof), the projections within ``TOL_FACTOR·QP_RTOL`` of the data's size
+    (both sides are QP minimisers verified to ``QP_RTOL``; measured ≤ 0.006·QP_RTOL)."""
+    seen = []
+    orig = sr.project_rows
+
+    def counting(F, c, h):
+        Y, ok = orig(F, c, h)
+        seen.append(int(ok.sum()))
+        return Y, ok
+    monkeypatch.setattr("verimono.lcs.system.project_rows", counting)
     for make in (lambda: _psd_system(seed, n, m, relay, rank), lambda: _example(SINE), lambda: _example(RAMP)):
         X, ts = _edge_and_outside_rows(make(), seed)
         one, many = make(), make()
         rows = np.array([one.project_domain(x, t) for x, t in zip(X, ts.tolist())])
         got = many.project_domain(X, ts)
-        assert got.shape == rows.shape and np.array_equal(got, rows)
+        assert got.shape == rows.shape
+        size = 1.0 + np.abs(X).max(axis=1) + np.abs(rows).max(axis=1)
+        assert (np.abs(got - rows).max(axis=1) <= TOL_FACTOR * QP_RTOL * size).all()
+        inside = (rows == X).all(axis=1)
+        assert np.array_equal(got[inside], rows[inside])
+    assert sum(seen) >= 8       # the Example's rows outside by a margin: projected by the block
 
 
 def test_block_projection_proves_the_example_edge_rows(monkeypatch):
@@ -219,12 +234,13 @@ def test_block_projection_proves_the_example_edge_rows(monkeypatch):
 
 def test_block_projection_at_each_rows_own_time_on_a_moving_domain():
     """``v = (−1, t − 1)``: ``dom H(t) = [1 − t, ∞)`` moves; rows on and 1e-3 below their own time's edge, the times
-    decreasing (each row inside at the first row's time): each row's own projection, ``max(x, 1 − t_i)``."""
+    decreasing (each row inside at the first row's time): each row's own projection, ``max(x, 1 − t_i)`` (data of
+    size ≤ 2: the tolerance ``TOL_FACTOR·QP_RTOL·3``)."""
     make = lambda: ex.example_system(lambda t: np.array([-1.0, t - 1.0])).operator()     # noqa: E731
     ts = np.linspace(2.0, 0.0, 9)
     X = (1.0 - ts - np.tile([0.0, 1e-3, 0.0], 3))[:, None]
     one, many = make(), make()
     rows = np.array([one.project_domain(x, t) for x, t in zip(X, ts.tolist())])
     got = many.project_domain(X, ts)
-    np.testing.assert_array_equal(got, rows)
-    np.testing.assert_allclose(got[:, 0], 1.0 - ts, rtol=0, atol=10 * QP_RTOL)
+    np.testing.assert_allclose(got, rows, rtol=0, atol=TOL_FACTOR * QP_RTOL * 3.0)
+    np.testing.assert_allclose(got[:, 0], 1.0 - ts, rtol=0, atol=TOL_FACTOR * QP_RTOL * 3.0)

@@ -173,4 +173,73 @@ def select_rows(F: Faces, Q: np.ndarray, Cc: np.ndarray, scales: np.ndarray):
     return Zbest, ok
 
 
-__all__ = ["Faces", "select_rows", "solvable_rows", "MAX_FACES_K"]
+
+
+class ProjectionFaces:
+    """The projection onto ``dom H(t,·)`` of a complementarity LCS (:meth:`LCSOperator._project_domain`'s QP):
+    ``min ½|x' − x|²`` over ``(x', z)`` with ``z ≥ 0``, ``Cx' + Dz + v ≥ 0``, i.e. ``P = diag(I, 0)``,
+    ``c = (−x, 0)``, ``G = [[0, −I], [−C, −D]]``, ``h = (0, v)``: ``G`` and ``P`` are the system's, so each of the
+    ``2^{2m}`` active sets' KKT pseudo-inverse is made once, and every row's candidates are stack products."""
+
+    def __init__(self, P: np.ndarray, G: np.ndarray) -> None:
+        nv, r = P.shape[0], G.shape[0]
+        self.P, self.G, self.nv = P, G, nv
+        gn = np.sqrt(np.add.reduce(G * G, axis=1))
+        self.G_zero = bool((gn == 0.0).any())
+        self.g_norms = gn
+        self.G_unit = None if self.G_zero else G / gn[:, None]
+        self.sets = []
+        for mask in range(1 << r):
+            act = np.array([i for i in range(r) if mask >> i & 1], dtype=int)
+            e = act.size
+            K = np.zeros((nv + e, nv + e))
+            K[:nv, :nv] = P
+            if e:
+                K[:nv, nv:], K[nv:, :nv] = G[act].T, G[act]
+            self.sets.append((act, np.linalg.pinv(K)))
+
+
+def project_rows(F: ProjectionFaces, c: np.ndarray, h: np.ndarray):
+    """Minimisers ``y_i`` of ``½yᵀPy + c_iᵀy`` over ``Gy ≤ h_i`` for the rows ``c_i``, ``h_i``; ``(Y, ok)``.  A row's
+    candidate (the first active set, in order, whose KKT solution is feasible with nonnegative multipliers to
+    ``QP_RTOL`` of the data) is accepted only by :func:`verimono.core.qp.kkt_residual` at ``QP_RTOL`` on the QP
+    equilibrated as :func:`verimono.core.qp.equilibrate` does (``solve_qp``'s own acceptance); a row with a far
+    half-space, a non-finite row or one no candidate reaches is left to its own call."""
+    B, nv = c.shape
+    ok = np.zeros(B, dtype=bool)
+    Y = np.zeros((B, nv))
+    if F.G_zero or B == 0:
+        return Y, ok
+    with np.errstate(all="ignore"):
+        finite = np.isfinite(c).all(axis=1) & np.isfinite(h).all(axis=1)
+        size = 1.0 + np.maximum(np.abs(c).max(axis=1), np.abs(h).max(axis=1))
+        found = ~finite
+        for act, pk in F.sets:
+            rhs = np.concatenate([-c, h[:, act]], axis=1)
+            sol = rhs @ pk.T
+            y, mu = sol[:, :nv], sol[:, nv:]
+            tol = QP_RTOL * size * (1.0 + np.abs(y).max(axis=1))
+            good = ~found & ((y @ F.G.T - h).max(axis=1) <= tol)
+            if act.size:
+                good &= (mu.min(axis=1) >= -tol)
+            if good.any():
+                Y[good] = y[good]
+                found |= good
+        idx = np.flatnonzero(found & finite)
+        hu = h[idx] / F.g_norms
+        cmax = np.abs(c[idx]).max(axis=1) / (float(np.abs(F.P).max()) or 1.0)
+    p = float(np.abs(F.P).max()) or 1.0
+    Pu = F.P / p
+    for j, i in enumerate(idx.tolist()):
+        core = float(cmax[j])
+        hmax = float(np.abs(hu[j]).max())
+        if hmax > FAR * core:
+            continue
+        s = max(core, hmax)
+        if not (np.isfinite(s) and s > 0.0):
+            s = 1.0
+        ok[i] = kkt_residual(Pu, c[i] / (p * s), F.G_unit, hu[j] / s, None, None, Y[i] / s).ok
+    return Y, ok
+
+
+__all__ = ["Faces", "select_rows", "solvable_rows", "ProjectionFaces", "project_rows", "MAX_FACES_K"]

@@ -33,10 +33,10 @@ from ..core.tolerances import tolerance
 from ..core._linalg import absmax
 from ._lu import lu_factor, lu_solve
 from .kernel import BatchStepError
-from ._warm_qp import row_infeasible, solve_qp_warm
+from ._warm_qp import INFEASIBLE_MARGIN, row_infeasible, solve_qp_warm
 from .lcp import _box_lcp, _feasible, is_psd, proved_solvable, sol_polyhedron, solve_lcp
 from .relations import BoxRelation, as_relation
-from ._select_rows import MAX_FACES_K, Faces, select_rows, solvable_rows
+from ._select_rows import MAX_FACES_K, Faces, ProjectionFaces, project_rows, select_rows, solvable_rows
 
 
 def _matrix(value, shape, what):
@@ -405,6 +405,7 @@ class LCSOperator(Operator):
         self._memo: dict = {}
         self._patterns: list | None = None      # the multipliers' patterns of :meth:`_inside_rows`, made once
         self._faces = None                      # the faces of H^0's block selection (:meth:`_row_faces`), made once
+        self._proj_faces = None                 # the active sets of the block projection (:meth:`_projected_rows`)
 
     def _memoised(self, kind: str, x: np.ndarray, t, compute):
         """``compute()`` once per ``(kind, t, x)``: an assumption law asks ``H^0`` and ``proj_dom H`` at the same
@@ -684,13 +685,22 @@ class LCSOperator(Operator):
             inside = self._inside_rows(x, ts) if self._accepts_times() else None
             if inside is None:
                 return np.array([self.project_domain(xi, ti) for xi, ti in zip(x, ts.tolist())]).reshape(x.shape)
+            projected = {}
             if not inside.all() and self._selects_rows():
                 inside = inside | self._solvable_rows(x, ts, ~inside)
+                if not inside.all():
+                    projected = self._projected_rows(x, ts, ~inside)
             out = []
-            for xi, ti, ok in zip(x, ts.tolist(), inside.tolist()):
+            for i, (xi, ti, ok) in enumerate(zip(x, ts.tolist(), inside.tolist())):
                 # a row proved inside dom H(t_i) is its own projection, what _project_domain returns for it (its
-                # proof skipped, the memo kept as that call keeps it); the others as their own call
-                out.append(self._memoised("project_domain", xi, ti, xi.copy) if ok else self.project_domain(xi, ti))
+                # proof skipped, the memo kept as that call keeps it); a row the block projected, its verified
+                # projection (remembered as its own call would be); the others as their own call
+                if ok:
+                    out.append(self._memoised("project_domain", xi, ti, xi.copy))
+                elif i in projected:
+                    out.append(self._memoised("project_domain", xi, ti, projected[i].copy))
+                else:
+                    out.append(self.project_domain(xi, ti))
             return np.array(out).reshape(x.shape)
         if x.ndim == 2:
             return np.array([self.project_domain(xi, t) for xi in x])
@@ -720,6 +730,45 @@ class LCSOperator(Operator):
         except Exception:   # noqa: BLE001 - whatever the block raises, each row's own call raises it in its turn
             proved[:] = False
         return proved
+
+    def _projected_rows(self, X: np.ndarray, ts: np.ndarray, rows: np.ndarray) -> dict:
+        """The projections onto ``dom H(t_i)`` of ``rows`` (a mask) that the block verifies
+        (:func:`verimono.lcs._select_rows.project_rows`: :meth:`_project_domain`'s QP for the rows together, each
+        row's candidate accepted by ``kkt_residual`` at ``QP_RTOL`` in ``solve_qp``'s units), by row index;
+        complementarity only (a bounded box is the whole space, mixed bounds are the rows' own call's error)."""
+        s = self.system
+        idx = np.flatnonzero(rows)
+        if not idx.size or not self._row_faces():
+            return {}
+        try:
+            rel = self._box()
+            if not rel.is_lcp or 2 * s.m > 2 * MAX_FACES_K:
+                return {}
+            F = self._proj_faces
+            if F is None:
+                n, m = s.n, s.m
+                P = np.zeros((n + m, n + m))
+                P[:n, :n] = np.eye(n)
+                G = np.block([[np.zeros((m, n)), -np.eye(m)], [-s.C, -s.D]])
+                F = self._proj_faces = ProjectionFaces(P, G)
+            with np.errstate(all="ignore"):
+                V = np.array([np.asarray(s.v(t), dtype=float) for t in ts[idx].tolist()]).reshape(len(idx), s.m)
+                # only rows row_infeasible proves outside (what _project_domain takes to its QP with no linear
+                # program: a row within the program's tolerance of the domain is its own projection there)
+                Q = X[idx] @ s.C.T + V
+                tol = INFEASIBLE_MARGIN * (1.0 + np.abs(Q).max(axis=1) + self._row_faces().m_max)
+                far_out = (self._row_faces().nonpos[None, :] & (Q < -tol[:, None])).any(axis=1)
+                idx, V = idx[far_out], V[far_out]
+                if not idx.size:
+                    return {}
+                Xm = X[idx]
+                c = np.concatenate([-Xm, np.zeros((len(idx), s.m))], axis=1)
+                h = np.concatenate([np.zeros((len(idx), s.m)), V], axis=1)
+                Y, ok = project_rows(F, c, h)
+                ok &= np.isfinite(Y).all(axis=1)
+        except Exception:   # noqa: BLE001 - whatever the block raises, each row's own call raises it in its turn
+            return {}
+        return {int(i): Y[j, :s.n] for j, i in enumerate(idx.tolist()) if ok[j]}
 
     def _inside_rows(self, X: np.ndarray, ts: np.ndarray) -> np.ndarray | None:
         """Which rows ``x_i`` are proved inside ``dom H(t_i)`` (complementarity, PSD ``D``) by a strictly complementary
