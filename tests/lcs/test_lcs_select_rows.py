@@ -234,13 +234,27 @@ def test_block_projection_proves_the_example_edge_rows(monkeypatch):
 
 def test_block_projection_at_each_rows_own_time_on_a_moving_domain():
     """``v = (−1, t − 1)``: ``dom H(t) = [1 − t, ∞)`` moves; rows on and 1e-3 below their own time's edge, the times
-    decreasing (each row inside at the first row's time): each row's own projection, ``max(x, 1 − t_i)`` (data of
+    decreasing (each row inside at the first row's time), and rows at ``−3`` (outside at every time): each row's own
+    projection, ``max(x, 1 − t_i)`` (data of
     size ≤ 2: the tolerance ``TOL_FACTOR·QP_RTOL·3``)."""
     make = lambda: ex.example_system(lambda t: np.array([-1.0, t - 1.0])).operator()     # noqa: E731
     ts = np.linspace(2.0, 0.0, 9)
     X = (1.0 - ts - np.tile([0.0, 1e-3, 0.0], 3))[:, None]
+    X[2::3] = -3.0      # outside at every time: each row's projection its own time's edge
     one, many = make(), make()
     rows = np.array([one.project_domain(x, t) for x, t in zip(X, ts.tolist())])
     got = many.project_domain(X, ts)
     np.testing.assert_allclose(got, rows, rtol=0, atol=TOL_FACTOR * QP_RTOL * 3.0)
     np.testing.assert_allclose(got[:, 0], 1.0 - ts, rtol=0, atol=TOL_FACTOR * QP_RTOL * 3.0)
+
+
+def test_block_projection_module_alone_takes_the_minimiser():
+    """:func:`project_rows` on ``min ½|y − x|²`` over ``y ∈ [−1, 1]`` (``G = (1, −1)ᵀ``, ``h = (1, 1)``): ``x = −2``
+    projects to ``−1`` — the active set ``{y ≤ 1}`` comes first in the enumeration and its point ``y = 1`` is
+    feasible, but its multiplier is ``−3``: never accepted; ``x = 0.5`` is its own projection, ``x = 5`` goes to 1.
+    ``x = 0`` (``c = 0``: every half-space *far* by ``equilibrate``'s rule) is left to its own call."""
+    F = sr.ProjectionFaces(np.eye(1), np.array([[1.0], [-1.0]]))
+    x = np.array([[-2.0], [0.5], [5.0], [0.0]])
+    Y, ok = sr.project_rows(F, -x, np.ones((4, 2)))
+    assert ok[:3].all() and not ok[3]
+    np.testing.assert_allclose(Y[:3, 0], [-1.0, 0.5, 1.0], rtol=0, atol=10 * QP_RTOL)
