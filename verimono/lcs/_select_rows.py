@@ -37,6 +37,9 @@ from ..core.qp import FAR, kkt_residual
 from ..core.tolerances import QP_RTOL, RTOL
 from ._warm_qp import INFEASIBLE_MARGIN
 
+#: entries of a :class:`Faces`' memory of KKT verdicts (forgotten all at once when full)
+KKT_MEMO_SIZE = 4096
+
 #: the largest LCP size (``m`` plus the box's finite upper bounds) whose ``3^k`` faces are enumerated
 MAX_FACES_K = 5
 
@@ -69,6 +72,7 @@ class Faces:
         self.row_norm_unit = float(np.abs(M / self.beta).sum(axis=1).max(initial=0.0))
         self.nonpos = np.all(M <= 0.0, axis=1)
         self.p = float(np.abs(P).max(initial=0.0)) or 1.0
+        self.kkt_memo: dict = {}        # kkt_residual's verdicts on the equilibrated selection QPs, by their bytes
 
 
 def _candidates(F: Faces, Q: np.ndarray, Cc: np.ndarray, scales: np.ndarray):
@@ -168,8 +172,18 @@ def select_rows(F: Faces, Q: np.ndarray, Cc: np.ndarray, scales: np.ndarray):
         s = max(core, hmax)
         if not (np.isfinite(s) and s > 0.0):
             s = 1.0
-        rep = kkt_residual(Pu, Cs[j] / (F.p * s), F.G_unit, h / s, A, None if b is None else b / s, z / s)
-        ok[i] = rep.ok
+        q_s, h_s, b_s, y = Cs[j] / (F.p * s), h / s, None if b is None else b / s, z / s
+        # kkt_residual is a function of its arrays alone: remembered by their exact bytes (the Example's rows on the
+        # edge x = 0 are the same problem at every t once equilibrated: q/s = (±1, 0), y = (0, 1) or 0)
+        key = (q_s.tobytes(), h_s.tobytes(), None if A is None else (A.shape, A.tobytes()),
+               None if b_s is None else b_s.tobytes(), y.tobytes())
+        hit = F.kkt_memo.get(key)
+        if hit is None:
+            hit = kkt_residual(Pu, q_s, F.G_unit, h_s, A, b_s, y).ok
+            if len(F.kkt_memo) >= KKT_MEMO_SIZE:
+                F.kkt_memo.clear()
+            F.kkt_memo[key] = hit
+        ok[i] = hit
     return Zbest, ok
 
 
@@ -188,6 +202,7 @@ class ProjectionFaces:
         self.G_zero = bool((gn == 0.0).any())
         self.g_norms = gn
         self.G_unit = None if self.G_zero else G / gn[:, None]
+        self.kkt_memo: dict = {}        # kkt_residual's verdicts on the equilibrated projection QPs, by their bytes
         self.sets = []
         for mask in range(1 << r):
             act = np.array([i for i in range(r) if mask >> i & 1], dtype=int)
@@ -238,7 +253,15 @@ def project_rows(F: ProjectionFaces, c: np.ndarray, h: np.ndarray):
         s = max(core, hmax)
         if not (np.isfinite(s) and s > 0.0):
             s = 1.0
-        ok[i] = kkt_residual(Pu, c[i] / (p * s), F.G_unit, hu[j] / s, None, None, Y[i] / s).ok
+        q_s, h_s, y = c[i] / (p * s), hu[j] / s, Y[i] / s
+        key = (q_s.tobytes(), h_s.tobytes(), y.tobytes())       # as in select_rows: the verdict by its arrays' bytes
+        hit = F.kkt_memo.get(key)
+        if hit is None:
+            hit = kkt_residual(Pu, q_s, F.G_unit, h_s, None, None, y).ok
+            if len(F.kkt_memo) >= KKT_MEMO_SIZE:
+                F.kkt_memo.clear()
+            F.kkt_memo[key] = hit
+        ok[i] = hit
     return Y, ok
 
 
