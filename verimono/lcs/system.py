@@ -379,6 +379,11 @@ INSIDE_MARGIN = 1e-9
 #: step sizes whose matrices an operator keeps once made (:meth:`LCSOperator._sm`), forgotten all at once
 STEP_TEMPLATES = 4096
 
+#: the block projection onto dom H (:meth:`LCSOperator._projected_rows`) for at most this many multipliers (2^{2m}
+#: active sets) and n + m at most PROJECT_MAX_SIZE (each active set's KKT pseudo-inverse is made once, dense)
+PROJECT_MAX_M = 3
+PROJECT_MAX_SIZE = 64
+
 
 class LCSOperator(Operator):
     """``H(t, x) = −Ax + B(𝓜 + D)^{-1}(Cx + v(t))`` (``e:defht``); its resolvent is the one-step problem
@@ -742,7 +747,8 @@ class LCSOperator(Operator):
             return {}
         try:
             rel = self._box()
-            if not rel.is_lcp or 2 * s.m > 2 * MAX_FACES_K:
+            # 2^{2m} active sets of KKT systems of size n + m + |active|: kept small (the Section 7 systems, n ≤ 2)
+            if not rel.is_lcp or s.m > PROJECT_MAX_M or s.n + s.m > PROJECT_MAX_SIZE:
                 return {}
             F = self._proj_faces
             if F is None:
