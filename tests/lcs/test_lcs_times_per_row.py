@@ -64,14 +64,26 @@ def test_members_with_a_time_per_row_are_separate_calls_bit_for_bit(which):
     assert accepts_times(many)
     X, ts = _points(one.dim)
     for name, call in (("resolvent", lambda op, x, t: op.resolvent(x, LAM, t)),
-                       ("yosida", lambda op, x, t: op.yosida(x, LAM, t)),
-                       ("project_domain", lambda op, x, t: op.project_domain(x, t))):
+                       ("yosida", lambda op, x, t: op.yosida(x, LAM, t))):
         rows = np.array([call(one, x, t) for x, t in zip(X, ts.tolist())])
         assert _same(call(many, X, ts), rows), name
+    # project_domain of a block projects the rows proved outside together (branch example6,
+    # tests/lcs/test_lcs_select_rows.py): the same projections to the QP's verification tolerance, QP_RTOL relative to
+    # the data, and the rows inside the domain their own projection bit for bit
+    rows = np.array([one.project_domain(x, t) for x, t in zip(X, ts.tolist())])
+    got = many.project_domain(X, ts)
+    assert got.shape == rows.shape
+    np.testing.assert_allclose(got, rows, rtol=0, atol=100 * QP_RTOL * (1.0 + np.abs(X).max() + np.abs(rows).max()))
+    same = (rows == X).all(axis=1)
+    assert np.array_equal(got[same], rows[same])
     Z = one.resolvent(X, LAM, ts)      # in dom H(t_i): the minimal section exists at every row
     many.resolvent(X, LAM, ts)
     rows = np.array([one.min_norm(z, t) for z, t in zip(Z, ts.tolist())])
-    assert _same(many.min_norm(Z, ts), rows)
+    # min_norm of a block selects the rows' multipliers together (branch example6, tests/lcs/test_lcs_select_rows.py):
+    # the same H^0 to the selection QP's verification tolerance, QP_RTOL relative to the data, not bit for bit
+    got = many.min_norm(Z, ts)
+    assert got.shape == rows.shape
+    np.testing.assert_allclose(got, rows, rtol=0, atol=100 * QP_RTOL * (1.0 + np.abs(Z).max() + np.abs(rows).max()))
     x, t = X[9] * 0.5, 1.25
     assert _same(one.resolvent(x, LAM, t), many.resolvent(x, LAM, t))   # the steppers left in the same state
 
@@ -156,8 +168,18 @@ def test_a2_deep_levels_fall_back_to_one_call_per_level():
 @pytest.mark.parametrize("name", ["example-ramp", "example-sine"])
 def test_the_example_records_with_a_time_per_row_equal_time_by_time(name, monkeypatch):
     """The Example's five assumption records (a tiny time budget, every path taken) with the operator called
-    once per block of times against the per-time path: equal field by field (~1.7 s each)."""
-    assert _records(name, monkeypatch) == _records(name, monkeypatch, accepts_times=lambda op: False)
+    once per block of times against the per-time path (~1.7 s each): equal field by field but for what the
+    block selection of ``H^0`` moves (branch example6: the same ``H^0`` to the selection QP's verification
+    tolerance, not bit for bit) — the worst ratio to 1e-9 relative (RTOL/10) and the details the searches steer."""
+    got = _records(name, monkeypatch)
+    want = _records(name, monkeypatch, accepts_times=lambda op: False)
+    assert len(got) == len(want)
+    for g, w in zip(got, want):
+        assert {k: v for k, v in g.items() if k not in ("worst", "details", "message")} == \
+            {k: v for k, v in w.items() if k not in ("worst", "details", "message")}
+        assert (g["worst"] is None) == (w["worst"] is None)
+        if g["worst"] is not None:
+            assert abs(g["worst"] - w["worst"]) <= 1e-9 * (1.0 + abs(w["worst"]))
 
 
 def _records(name, monkeypatch, **patches):
@@ -242,7 +264,12 @@ def test_rows_proved_inside_are_inside_by_the_exact_proof(which):
         if ok:
             assert _exact_inside(op, x, t), (x, t)
     one = make()
-    assert _same(op.project_domain(X, ts), np.array([one.project_domain(x, t) for x, t in zip(X, ts.tolist())]))
+    rows = np.array([one.project_domain(x, t) for x, t in zip(X, ts.tolist())])
+    got = op.project_domain(X, ts)
+    # the rows proved outside are projected together (branch example6): to QP_RTOL of the data, not bit for bit
+    np.testing.assert_allclose(got, rows, rtol=0, atol=100 * QP_RTOL * (1.0 + np.abs(X).max() + np.abs(rows).max()))
+    same = (rows == X).all(axis=1)
+    assert np.array_equal(got[same], rows[same])
 
 
 def test_rows_within_rounding_of_the_edge_are_left_to_their_own_call():

@@ -33,9 +33,10 @@ from ..core.tolerances import tolerance
 from ..core._linalg import absmax
 from ._lu import lu_factor, lu_solve
 from .kernel import BatchStepError
-from ._warm_qp import row_infeasible, solve_qp_warm
+from ._warm_qp import INFEASIBLE_MARGIN, row_infeasible, solve_qp_warm
 from .lcp import _box_lcp, _feasible, is_psd, proved_solvable, sol_polyhedron, solve_lcp
 from .relations import BoxRelation, as_relation
+from ._select_rows import MAX_FACES_K, Faces, ProjectionFaces, project_rows, select_rows, solvable_rows
 
 
 def _matrix(value, shape, what):
@@ -378,6 +379,11 @@ INSIDE_MARGIN = 1e-9
 #: step sizes whose matrices an operator keeps once made (:meth:`LCSOperator._sm`), forgotten all at once
 STEP_TEMPLATES = 4096
 
+#: the block projection onto dom H (:meth:`LCSOperator._projected_rows`) for at most this many multipliers (2^{2m}
+#: active sets) and n + m at most PROJECT_MAX_SIZE (each active set's KKT pseudo-inverse is made once, dense)
+PROJECT_MAX_M = 3
+PROJECT_MAX_SIZE = 64
+
 
 class LCSOperator(Operator):
     """``H(t, x) = −Ax + B(𝓜 + D)^{-1}(Cx + v(t))`` (``e:defht``); its resolvent is the one-step problem
@@ -403,6 +409,8 @@ class LCSOperator(Operator):
         self._warm_project: dict = {}
         self._memo: dict = {}
         self._patterns: list | None = None      # the multipliers' patterns of :meth:`_inside_rows`, made once
+        self._faces = None                      # the faces of H^0's block selection (:meth:`_row_faces`), made once
+        self._proj_faces = None                 # the active sets of the block projection (:meth:`_projected_rows`)
 
     def _memoised(self, kind: str, x: np.ndarray, t, compute):
         """``compute()`` once per ``(kind, t, x)``: an assumption law asks ``H^0`` and ``proj_dom H`` at the same
@@ -553,10 +561,92 @@ class LCSOperator(Operator):
         x = np.asarray(x, dtype=float)
         ts = self._times(x, t)
         if ts is not None:      # row by row in order: OutsideDomain when any row is outside at its time
+            if x.shape[0] and x.shape[1] == self.dim and self._selects_rows():
+                return self._min_norm_rows(x, ts.tolist())
             return np.array([self.min_norm(xi, ti) for xi, ti in zip(x, ts.tolist())]).reshape(x.shape)
         if x.ndim == 2:
+            if x.shape[0] and x.shape[1] == self.dim and self._selects_rows():
+                return self._min_norm_rows(x, [t] * x.shape[0])
             return np.array([self.min_norm(xi, t) for xi in x])
         return self._memoised("min_norm", x, t, lambda: self._min_norm(x, t))
+
+    def _selects_rows(self) -> bool:
+        """Whether ``min_norm`` of a block may select the rows' multipliers together (:meth:`_min_norm_rows`):
+        none of the members it stands for replaced by a subclass or the instance."""
+        mine = getattr(self, "__dict__", {})
+        return self._accepts_times() and all(getattr(type(self), m) is getattr(LCSOperator, m) and m not in mine
+                                             for m in ("_min_norm", "_select"))
+
+    def _row_faces(self):
+        """:class:`verimono.lcs._select_rows.Faces` of the multipliers' box LCP and ``H^0``'s selection, made once;
+        ``False`` where the block selection does not apply (not a box relation with PSD ``D``, or more than
+        :data:`~verimono.lcs._select_rows.MAX_FACES_K` multipliers)."""
+        F = self._faces
+        if F is None:
+            F = False
+            try:
+                rel, s = self._box(), self.system
+                lo, hi = rel.bounds(s.m)
+                big, _, _ = _box_lcp(s.D, np.zeros(s.m), lo, hi)
+                if big.shape[0] <= MAX_FACES_K and np.isfinite(s.A).all() and np.isfinite(s.B).all():
+                    k = big.shape[0]
+                    P = np.zeros((k, k))
+                    P[:s.m, :s.m] = s.B.T @ s.B
+                    F = Faces(big, P)
+            except NotImplementedError:
+                F = False
+            self._faces = F
+        return F
+
+    def _min_norm_rows(self, X: np.ndarray, ts: list) -> np.ndarray:
+        """``min_norm`` of every row ``x_i`` at ``t_i``: the rows not remembered selected together
+        (:func:`verimono.lcs._select_rows.select_rows`: every row's candidate accepted only by the per-row path's
+        own LCP residual and KKT checks), each row it does not accept taken as its own call, in the rows' order
+        (``OutsideDomain`` when a row is outside at its time, as row by row).  The answers agree with the
+        per-row path's to the selection QP's verification tolerance: ``H^0 = −Ax − Bλ*`` is unique even where
+        the multipliers ``λ*`` are not (the edge of ``dom H(t)``)."""
+        out = np.empty(X.shape)
+        keys = [("min_norm", float(ti), xi.tobytes()) for xi, ti in zip(X, ts)]
+        memo = self._memo
+        miss = []
+        for i, key in enumerate(keys):
+            hit = memo.get(key)
+            if hit is None:
+                miss.append(i)
+            else:
+                out[i] = hit
+        ok = np.zeros(len(miss), dtype=bool)
+        F = self._row_faces() if miss else False
+        if F:
+            s = self.system
+            try:
+                rel = self.system.relation
+                lo, hi = rel.bounds(s.m)
+                fin = np.flatnonzero(np.isfinite(hi))
+                Xm = X[miss]
+                with np.errstate(all="ignore"):
+                    V = np.array([np.asarray(s.v(ts[i]), dtype=float) for i in miss]).reshape(len(miss), s.m)
+                    Q = Xm @ s.C.T + V
+                    scales = s._c_norm * np.abs(Xm).max(axis=1) + np.abs(V).max(axis=1)
+                    QQ = np.concatenate([Q + s.D @ lo, np.broadcast_to((hi - lo)[fin], (len(miss), fin.size))],
+                                        axis=1)
+                    AX = Xm @ s.A.T
+                    Cc = np.zeros((len(miss), F.k))
+                    Cc[:, :s.m] = AX @ s.B + (s.B.T @ s.B) @ lo
+                    Z, ok = select_rows(F, QQ, Cc, scales)
+                    H0 = -AX - (lo + Z[:, :s.m]) @ s.B.T
+                ok &= np.isfinite(H0).all(axis=1)
+            except Exception:   # noqa: BLE001 - whatever the block raises, each row's own call raises it in its turn
+                ok = np.zeros(len(miss), dtype=bool)
+        for j, i in enumerate(miss):
+            if ok[j]:
+                out[i] = H0[j]
+                if len(memo) >= MEMO_SIZE:
+                    memo.clear()
+                memo[keys[i]] = H0[j].copy()
+            else:
+                out[i] = self.min_norm(X[i], ts[i])
+        return out
 
     def _min_norm(self, x, t):
         s = self.system
@@ -600,15 +690,91 @@ class LCSOperator(Operator):
             inside = self._inside_rows(x, ts) if self._accepts_times() else None
             if inside is None:
                 return np.array([self.project_domain(xi, ti) for xi, ti in zip(x, ts.tolist())]).reshape(x.shape)
+            projected = {}
+            if not inside.all() and self._selects_rows():
+                inside = inside | self._solvable_rows(x, ts, ~inside)
+                if not inside.all():
+                    projected = self._projected_rows(x, ts, ~inside)
             out = []
-            for xi, ti, ok in zip(x, ts.tolist(), inside.tolist()):
+            for i, (xi, ti, ok) in enumerate(zip(x, ts.tolist(), inside.tolist())):
                 # a row proved inside dom H(t_i) is its own projection, what _project_domain returns for it (its
-                # proof skipped, the memo kept as that call keeps it); the others as their own call
-                out.append(self._memoised("project_domain", xi, ti, xi.copy) if ok else self.project_domain(xi, ti))
+                # proof skipped, the memo kept as that call keeps it); a row the block projected, its verified
+                # projection (remembered as its own call would be); the others as their own call
+                if ok:
+                    out.append(self._memoised("project_domain", xi, ti, xi.copy))
+                elif i in projected:
+                    out.append(self._memoised("project_domain", xi, ti, projected[i].copy))
+                else:
+                    out.append(self.project_domain(xi, ti))
             return np.array(out).reshape(x.shape)
         if x.ndim == 2:
             return np.array([self.project_domain(xi, t) for xi in x])
         return self._memoised("project_domain", x, t, lambda: self._project_domain(x, t))
+
+    def _solvable_rows(self, X: np.ndarray, ts: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        """Which of ``rows`` (a mask) are proved inside ``dom H(t_i)`` by a face's solution of the multipliers'
+        LCP that passes the residual check Lemke's point passes in :meth:`_project_domain`
+        (:func:`verimono.lcs._select_rows.solvable_rows`): the rows on the domain's edge, which
+        :meth:`_inside_rows`' margin leaves to their own call.  A row not proved is its own call."""
+        proved = np.zeros(len(X), dtype=bool)
+        F = self._row_faces()
+        idx = np.flatnonzero(rows)
+        if not F or not idx.size:
+            return proved
+        s = self.system
+        try:
+            lo, hi = s.relation.bounds(s.m)
+            fin = np.flatnonzero(np.isfinite(hi))
+            Xm = X[idx]
+            with np.errstate(all="ignore"):
+                V = np.array([np.asarray(s.v(t), dtype=float) for t in ts[idx].tolist()]).reshape(len(idx), s.m)
+                scales = s._c_norm * np.abs(Xm).max(axis=1) + np.abs(V).max(axis=1)
+                QQ = np.concatenate([Xm @ s.C.T + V + s.D @ lo,
+                                     np.broadcast_to((hi - lo)[fin], (len(idx), fin.size))], axis=1)
+                proved[idx] = solvable_rows(F, QQ, scales) & np.isfinite(Xm).all(axis=1)
+        except Exception:   # noqa: BLE001 - whatever the block raises, each row's own call raises it in its turn
+            proved[:] = False
+        return proved
+
+    def _projected_rows(self, X: np.ndarray, ts: np.ndarray, rows: np.ndarray) -> dict:
+        """The projections onto ``dom H(t_i)`` of ``rows`` (a mask) that the block verifies
+        (:func:`verimono.lcs._select_rows.project_rows`: :meth:`_project_domain`'s QP for the rows together, each
+        row's candidate accepted by ``kkt_residual`` at ``QP_RTOL`` in ``solve_qp``'s units), by row index;
+        complementarity only (a bounded box is the whole space, mixed bounds are the rows' own call's error)."""
+        s = self.system
+        idx = np.flatnonzero(rows)
+        if not idx.size or not self._row_faces():
+            return {}
+        try:
+            rel = self._box()
+            # 2^{2m} active sets of KKT systems of size n + m + |active|: kept small (the Section 7 systems, n ≤ 2)
+            if not rel.is_lcp or s.m > PROJECT_MAX_M or s.n + s.m > PROJECT_MAX_SIZE:
+                return {}
+            F = self._proj_faces
+            if F is None:
+                n, m = s.n, s.m
+                P = np.zeros((n + m, n + m))
+                P[:n, :n] = np.eye(n)
+                G = np.block([[np.zeros((m, n)), -np.eye(m)], [-s.C, -s.D]])
+                F = self._proj_faces = ProjectionFaces(P, G)
+            with np.errstate(all="ignore"):
+                V = np.array([np.asarray(s.v(t), dtype=float) for t in ts[idx].tolist()]).reshape(len(idx), s.m)
+                # only rows row_infeasible proves outside (what _project_domain takes to its QP with no linear
+                # program: a row within the program's tolerance of the domain is its own projection there)
+                Q = X[idx] @ s.C.T + V
+                tol = INFEASIBLE_MARGIN * (1.0 + np.abs(Q).max(axis=1) + self._row_faces().m_max)
+                far_out = (self._row_faces().nonpos[None, :] & (Q < -tol[:, None])).any(axis=1)
+                idx, V = idx[far_out], V[far_out]
+                if not idx.size:
+                    return {}
+                Xm = X[idx]
+                c = np.concatenate([-Xm, np.zeros((len(idx), s.m))], axis=1)
+                h = np.concatenate([np.zeros((len(idx), s.m)), V], axis=1)
+                Y, ok = project_rows(F, c, h)
+                ok &= np.isfinite(Y).all(axis=1)
+        except Exception:   # noqa: BLE001 - whatever the block raises, each row's own call raises it in its turn
+            return {}
+        return {int(i): Y[j, :s.n] for j, i in enumerate(idx.tolist()) if ok[j]}
 
     def _inside_rows(self, X: np.ndarray, ts: np.ndarray) -> np.ndarray | None:
         """Which rows ``x_i`` are proved inside ``dom H(t_i)`` (complementarity, PSD ``D``) by a strictly complementary
