@@ -216,3 +216,22 @@ def test_a_subclass_reading_its_weight_its_own_way_is_called_per_row():
             nrm = np.linalg.norm(X, axis=1)
             assert np.allclose(sep, X * np.maximum(1 - LAM * c2 / nrm, 0.0)[:, None], rtol=1e-14, atol=0.0)
             assert np.array_equal(op.min_norm(sep, ts), np.array([op.min_norm(z, t) for z, t in zip(sep, ts.tolist())]))
+
+
+def test_a_subclass_reading_its_weight_its_own_way_gets_no_fast_kernel():
+    """The steppers' kernel (:func:`resolvent_kernel`) of such a subclass is its resolvent, not the catalog's
+    kernel reading ``c`` from the parameter (probe2: ``solve`` stepped ∂(c|·|) where the subclass states ∂(2c|·|))."""
+    from verimono.core.operator_protocol import resolvent_kernel
+
+    class TwiceNorm(NormSubdifferential):
+        def _c_at(self, t):
+            return 2.0 * super()._c_at(t)
+
+    class TwiceBarrier(LogBarrier):
+        def _c_at(self, t):
+            return 2.0 * super()._c_at(t)
+    x = np.array([3.0, 4.0])
+    for op in (TwiceNorm(lambda t: 1.0 + t, dim=2), TwiceNorm(1.5, dim=2), TwiceBarrier(1.5, dim=2)):
+        assert np.array_equal(resolvent_kernel(op, x)(x, LAM, 0.5), op.resolvent(x, LAM, 0.5)), op.name
+    # ∂(2·1.5|·|) at |x| = 5: J x = (1 - 0.3·3/5) x
+    assert np.allclose(TwiceNorm(1.5, dim=2).resolvent(x, LAM, 0.5), 0.82 * x, rtol=1e-15)

@@ -375,7 +375,7 @@ class NormSubdifferential(_EverywhereDefined):
         return _own_steps(self, NormSubdifferential) and self._c(0.0).ndim == 0
 
     def _kernel(self, x0):
-        if not _own(self, NormSubdifferential) or x0.ndim != 1 or self._c(0.0).ndim:
+        if not _own(self, NormSubdifferential) or not self._fast_c or x0.ndim != 1 or self._c(0.0).ndim:
             return None
         c, name = _scalar_fn(self._c), self.name
 
@@ -751,7 +751,7 @@ class LogBarrier(Operator):
         return _own_steps(self, LogBarrier) and np.shape(self._c(0.0)) in ((), (self.dim,))
 
     def _kernel(self, x0):
-        if not _own(self, LogBarrier):
+        if not _own(self, LogBarrier) or not _own(self, LogBarrier, "_c_at"):     # a subclass's c(t): its resolvent
             return None
         resolve, name = self._resolve, self.name
         if self._c.constant:
