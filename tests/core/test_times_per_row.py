@@ -191,3 +191,47 @@ def test_a_one_point_call_with_a_length_1_array_is_the_ordinary_call():
     ball = NormalCone(Ball(center=np.zeros(3), radius=lambda t: 1.0 + t))
     with pytest.raises(InvalidProblem, match="batch of 1 values"):
         ball.resolvent(x, 0.3, np.array([0.5]))
+
+
+def test_a_subclass_reading_its_weight_its_own_way_is_called_per_row():
+    """A subclass overriding the weight's read ``_c_at`` (NormSubdifferential's and LogBarrier's documented hook:
+    here ``c(t)`` doubled) is not the catalog's own: a block with a time per row equals its separate calls, which
+    read ``c`` through the override (found by probe2: the block read ``c`` from the parameter directly, the
+    separate calls through ``_c_at``, so the engine's block pass judged an operator half as strong)."""
+    class TwiceNorm(NormSubdifferential):
+        def _c_at(self, t):
+            return 2.0 * super()._c_at(t)
+
+    class TwiceBarrier(LogBarrier):
+        def _c_at(self, t):
+            return 2.0 * super()._c_at(t)
+    X, ts = _points(2)
+    for op in (TwiceNorm(lambda t: 1.0 + t, dim=2), TwiceBarrier(lambda t: 1.0 + t, dim=2)):
+        sep = np.array([op.resolvent(x, LAM, t) for x, t in zip(X, ts.tolist())])
+        assert np.array_equal(resolvent_rows(op, X, LAM, ts), sep), op.name
+        assert np.array_equal(op.resolvent(X, LAM, ts), sep), op.name
+        # against the weight written out: J x = max(1 - 2λc/|x|, 0) x for ∂(2c|·|)
+        if isinstance(op, NormSubdifferential):
+            c2 = 2.0 * (1.0 + ts)
+            nrm = np.linalg.norm(X, axis=1)
+            assert np.allclose(sep, X * np.maximum(1 - LAM * c2 / nrm, 0.0)[:, None], rtol=1e-14, atol=0.0)
+            assert np.array_equal(op.min_norm(sep, ts), np.array([op.min_norm(z, t) for z, t in zip(sep, ts.tolist())]))
+
+
+def test_a_subclass_reading_its_weight_its_own_way_gets_no_fast_kernel():
+    """The steppers' kernel (:func:`resolvent_kernel`) of such a subclass is its resolvent, not the catalog's
+    kernel reading ``c`` from the parameter (probe2: ``solve`` stepped ∂(c|·|) where the subclass states ∂(2c|·|))."""
+    from verimono.core.operator_protocol import resolvent_kernel
+
+    class TwiceNorm(NormSubdifferential):
+        def _c_at(self, t):
+            return 2.0 * super()._c_at(t)
+
+    class TwiceBarrier(LogBarrier):
+        def _c_at(self, t):
+            return 2.0 * super()._c_at(t)
+    x = np.array([3.0, 4.0])
+    for op in (TwiceNorm(lambda t: 1.0 + t, dim=2), TwiceNorm(1.5, dim=2), TwiceBarrier(1.5, dim=2)):
+        assert np.array_equal(resolvent_kernel(op, x)(x, LAM, 0.5), op.resolvent(x, LAM, 0.5)), op.name
+    # ∂(2·1.5|·|) at |x| = 5: J x = (1 - 0.3·3/5) x
+    assert np.allclose(TwiceNorm(1.5, dim=2).resolvent(x, LAM, 0.5), 0.82 * x, rtol=1e-15)

@@ -111,3 +111,15 @@ def test_both_batteries_keep_the_heap_for_their_largest_subject(monkeypatch):
     with pytest.raises(_Entered) as got:
         vm.check_stepper(vm.solve, problems, orders=False, generated=0)
     assert got.value.args == (11,)
+
+
+def test_a_c_library_ctypes_cannot_open_by_none_keeps_nothing(monkeypatch):
+    """Where ``ctypes.CDLL(None)`` cannot open the process's own C library (Windows: ``LoadLibrary`` needs a name
+    and raises ``TypeError``), the battery runs with nothing changed, as on any other non-glibc C library (probe2:
+    the ``TypeError`` escaped ``heap_kept`` and a battery above ``LARGE_N`` raised before its first law)."""
+    def no_handle(name, *args, **kwargs):
+        raise TypeError("LoadLibrary() argument 1 must be str, not None")
+    monkeypatch.setattr(heap.ctypes, "CDLL", no_handle)
+    assert heap._glibc() is None
+    with heap_kept(LARGE_N + 1) as kept:
+        assert kept is False

@@ -368,13 +368,14 @@ class NormSubdifferential(_EverywhereDefined):
         return _own(self, NormSubdifferential)
 
     def _accepts_times(self):
-        return _own_times(self, NormSubdifferential) and self._c(0.0).ndim == 0
+        # a block of times reads c by _weight_times, not through a subclass's _c_at or _col (then: per row)
+        return self._fast_c and _own_times(self, NormSubdifferential) and self._c(0.0).ndim == 0
 
     def _accepts_steps(self):
         return _own_steps(self, NormSubdifferential) and self._c(0.0).ndim == 0
 
     def _kernel(self, x0):
-        if not _own(self, NormSubdifferential) or x0.ndim != 1 or self._c(0.0).ndim:
+        if not _own(self, NormSubdifferential) or not self._fast_c or x0.ndim != 1 or self._c(0.0).ndim:
             return None
         c, name = _scalar_fn(self._c), self.name
 
@@ -727,6 +728,8 @@ class LogBarrier(Operator):
         lam, J = _steps(self, x, lam, t)
         if J is not None:
             return J
+        if type(t) is np.ndarray and not self._accepts_times():
+            return per_row(lambda xi, ti: self.resolvent(xi, lam, ti), x, times_of(t, x, self.name))
         return self._resolve(x, lam, self._c_rows(t, x))
 
     @staticmethod
@@ -741,13 +744,14 @@ class LogBarrier(Operator):
         return _own(self, LogBarrier)
 
     def _accepts_times(self):
-        return _own_times(self, LogBarrier)
+        # a block of times reads c from the parameter, not through a subclass's _c_at (then: per row)
+        return _own(self, LogBarrier, "_c_at") and _own_times(self, LogBarrier)
 
     def _accepts_steps(self):
         return _own_steps(self, LogBarrier) and np.shape(self._c(0.0)) in ((), (self.dim,))
 
     def _kernel(self, x0):
-        if not _own(self, LogBarrier):
+        if not _own(self, LogBarrier) or not _own(self, LogBarrier, "_c_at"):     # a subclass's c(t): its resolvent
             return None
         resolve, name = self._resolve, self.name
         if self._c.constant:

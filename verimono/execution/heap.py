@@ -46,7 +46,7 @@ def _glibc():
         libc = ctypes.CDLL(None)
         libc.gnu_get_libc_version          # glibc only
         return libc.mallopt, libc.malloc_trim
-    except (OSError, AttributeError):
+    except (OSError, AttributeError, TypeError):     # TypeError: Windows' LoadLibrary needs a name
         return None
 
 
