@@ -39,7 +39,7 @@ from ..execution import timing
 from ..records.results import FAILED, PASSED, UNDECIDED, CheckResult, Report
 from ..records.verdicts import new_record
 from ..core.sets import Ball, Box
-from ..core.stepping import STREAM_BLOCK, solve
+from ..core.stepping import solve
 
 #: per-step overhead: ``solve`` within 1.5x a bare NumPy loop doing the same arithmetic
 PER_STEP_TARGET = 1.5
@@ -62,9 +62,6 @@ LCS_BATCH_TARGET_COMPILED = 0.05
 LCS_AGREEMENT = 1e-12
 #: memory: a streamed study holds at most one trajectory's bytes
 MEMORY_TARGET = 1.0
-#: the memory record traces its study at about ``steps/8`` and ``steps/4`` steps and extrapolates the peak to
-#: ``steps`` (:func:`memory_sizes`, :func:`check_memory`: a fixed part and a part per step)
-MEMORY_TRACED = (8, 4)
 #: the smallest positive double (a norm of 0 divides to 0, as in the catalog's kernels)
 TINY = 5e-324
 
@@ -502,53 +499,17 @@ def peak_memory(fn: Callable[[], Any]) -> tuple[int, float, Any]:
         tracemalloc.stop()
 
 
-def memory_sizes(steps: int, block: int = STREAM_BLOCK) -> list[int]:
-    """The numbers of steps :func:`check_memory` traces its study at: the largest ``K <= steps/d`` for ``d`` in
-    :data:`MEMORY_TRACED` with as many rows (``K + 1``) as ``steps`` modulo the stream's ``block``
-    (:data:`verimono.core.stepping.STREAM_BLOCK`), at least one block and one apart; ``[steps]`` when they do not
-    fit below ``steps``.  At ci (10^5 steps): 9 888 and 18 080."""
-    rows = steps + 1
-    rem = rows % block
-    ms: list[int] = []
-    for d in MEMORY_TRACED:
-        ms.append(max((rows // d - rem) // block, ms[-1] + 1 if ms else 1))
-    out = [m * block + rem - 1 for m in ms]
-    return out if out[-1] < steps else [steps]
-
-
 def check_memory(*, steps: int, n: int = 10, stepper: Callable | None = None) -> CheckResult:
-    """Target 6: peak traced memory of a serial convergence study on t|x| (grids of ``K/16``, ``K/8`` and ``K``
-    steps, streamed errors) at ``K = steps``, against allocating one trajectory of ``steps``.
-
-    The study is traced at two sizes near ``steps/8`` and ``steps/4`` (:func:`memory_sizes`) and its peak at
-    ``steps`` is the straight line through the two, extrapolated.  What a streamed study holds is a part fixed
-    by the stream's blocks (:data:`verimono.core.stepping.STREAM_BLOCK` rows and their per-block temporaries)
-    and a part proportional to ``K`` (the grids' nodes, 25.5 bytes per step at n = 10); a stepper holding its
-    trajectories (8n bytes per step and grid) or keeping anything per step adds to the slope, which the line
-    charges in full at ``steps`` (a negative slope counts as 0: the larger traced peak is never discounted).
-    The peak is reached in the largest grid's last full block or in its last, partial one; the two sizes have
-    as many rows as ``steps`` modulo the block, so both end on the same partial block and the peak is the same
-    affine function of ``K`` at all three (sizes picked otherwise, the peak of the smaller study fell in its
-    first block and the line missed a planted leak by up to 19%).  Measured against tracing the study at
-    ``steps`` itself (what this record did before): +0.45% on the lawful study at 10^5 steps, +0.36-0.38% with
-    planted leaks adding 17-23 bytes a step (the leaks' list growth is the rest), for 28% of the traced steps
-    (:mod:`tracemalloc` charges every allocation: the traced loop runs ~6x slower than untraced).  Growth
-    faster than linear in ``K`` (a step keeping a copy of all the steps before it: quadratic time as well)
-    is not what the line sees, nor memory of order ``K`` freed before the study's sink takes its first block:
-    below the stream's fixed part at the traced sizes, it would show only at ``steps``.  Anything kept while
-    the sink sums a block is seen — a streamed ``solve``'s leaks, and the whole trajectory of any stepper that
-    returns one (with the fixed part, such a stepper exceeds one trajectory at every size: the planted one
-    reads 1.38x, where tracing ``steps`` itself read 2.32x, its in-call copies of the steps as Python floats
-    being freed before the sink runs).  When the two sizes do not fit below ``steps`` (fewer than 3 blocks),
-    ``steps`` itself is traced."""
+    """Target 6: peak traced memory of a serial convergence study on t|x| (grids of ``steps/16``, ``steps/8``
+    and ``steps`` steps, streamed errors) against allocating one trajectory of ``steps``.  The peak is the
+    largest grid's: coarse grids below it keep the study a study (three points for the fit) at 68% of the
+    steps of ``steps/4, steps/2, steps`` (:mod:`tracemalloc` slows the stepping loop about threefold)."""
     from ..reference import subdifferential  # the catalog package loads the LCS tools (SciPy's optimizers)
 
     stepper = _default_stepper(stepper)
     x0 = np.linspace(0.1, 1.0, n)
     p = subdifferential.t_norm(x0 / np.linalg.norm(x0) * 0.5, T=1.0)
-
-    def study(k: int):
-        return convergence_study(stepper, p, [1.0 / (k // 16), 1.0 / (k // 8), 1.0 / k], executor="serial")
+    grids = [1.0 / (steps // 16), 1.0 / (steps // 8), 1.0 / steps]
 
     def one_trajectory():
         x = np.empty((steps + 1, n))
@@ -558,30 +519,18 @@ def check_memory(*, steps: int, n: int = 10, stepper: Callable | None = None) ->
     # fresh process), which are not the study's memory — a run whose earlier stages ran elsewhere (process:N
     # workers, `--stage performance` alone) failed this record at 2.2x without it
     convergence_study(stepper, p, [1.0 / 64, 1.0 / 128], executor="serial")
-    sizes = memory_sizes(steps)
-    traced = [peak_memory(lambda k=k: study(k)) for k in sizes]
-    peaks = [pk for pk, _, _ in traced]
-    s_sec = sum(sec for _, sec, _ in traced)
-    study_ok = all(bool(out.verdict()[0]) for _, _, out in traced)
-    if len(sizes) == 2:
-        slope = max((peaks[1] - peaks[0]) / (sizes[1] - sizes[0]), 0.0)
-        s_peak = int(math.ceil(peaks[1] + slope * (steps - sizes[1])))
-        how = f" (extrapolated from {sizes[0]} and {sizes[1]} steps: {slope:.1f} B/step)"
-    else:
-        slope, s_peak, how = None, peaks[0], ""
+    s_peak, s_sec, study = peak_memory(lambda: convergence_study(stepper, p, grids, executor="serial"))
     b_peak, b_sec, _ = peak_memory(one_trajectory)
     ratio = s_peak / b_peak
+    study_ok = bool(study.verdict()[0])
     status = PASSED if ratio <= MEMORY_TARGET else FAILED
     return new_record(
         "performance_memory", f"t|x| n={n} {steps} steps", status, worst=ratio / MEMORY_TARGET, bound=1.0,
-        message=f"study peak {s_peak / 2**20:.2f} MiB{how} = {ratio:.3f}x one trajectory "
+        message=f"study peak {s_peak / 2**20:.2f} MiB = {ratio:.3f}x one trajectory "
                 f"({b_peak / 2**20:.2f} MiB; target ≤ {MEMORY_TARGET:g}x)",
-        counterexample=None if status == PASSED else {"case": p.name, "steps": steps, "ratio": ratio,
-                                                      "traced_steps": sizes, "traced_bytes": peaks,
-                                                      "bytes_per_step": slope},
+        counterexample=None if status == PASSED else {"case": p.name, "steps": steps, "ratio": ratio},
         details={"timing_ratio": ratio, "ratio": ratio, "target": MEMORY_TARGET, "direction": "<=", "rounds": 1,
                  "subject_s": [s_sec], "baseline_s": [b_sec], "subject_bytes": s_peak, "baseline_bytes": b_peak,
-                 "traced_steps": sizes, "traced_bytes": peaks, "bytes_per_step": slope,
                  "steps": steps, "n": n, "study_ok": study_ok},
         duration=s_sec + b_sec)
 
@@ -616,9 +565,8 @@ def performance_report(sizes: Sizes, *, stepper: Callable | None = None,
     average — is recorded in every timed record's ``details["machine"]``: the evidence, beside each record's
     own, of why a speed could not be judged."""
     machine: dict[str, Any] = {"joined_threads": _quiet_process()}
-    # the memory record first, on the idle core: the stage's longest single job when it traced 10^5 steps (2.3 s
-    # at ci, quiet; since branch memunit ~0.7 s, two smaller studies), and the memory-bound batch record waits for
-    # it; the calibration runs beside it as the timed records do
+    # the memory record first: on the idle core it is the stage's longest single job (2.3 s at ci, quiet), and the
+    # timed records cut short by the early look no longer outlast it; the calibration runs beside it as they do
     pending = aside(sizes.memory_steps, stepper) if aside is not None else None
     machine.update({"calibration_before": timing.calibrate_both(), "loadavg_before": timing.loadavg()})
     mr = sizes.max_rounds
@@ -669,7 +617,7 @@ def performance_report(sizes: Sizes, *, stepper: Callable | None = None,
     return report
 
 
-__all__ = ["EARLY_ROUNDS", "PER_STEP_TARGET", "ENSEMBLE_TARGET", "LCS_TARGET", "LCS_BATCH_TARGET", "LCS_BATCH_TARGET_COMPILED", "LCS_AGREEMENT", "MEMORY_TARGET", "MEMORY_TRACED", "memory_sizes",
+__all__ = ["EARLY_ROUNDS", "PER_STEP_TARGET", "ENSEMBLE_TARGET", "LCS_TARGET", "LCS_BATCH_TARGET", "LCS_BATCH_TARGET_COMPILED", "LCS_AGREEMENT", "MEMORY_TARGET",
            "SIZES", "Sizes", "bare_t_norm", "bare_box", "bare_ball", "floor_loop", "minimal_lcs", "per_step_case", "ensemble_case",
            "interleave", "measure", "Rounds", "ratio_record", "check_per_step", "check_ensemble", "check_lcs_step", "check_lcs_batch",
            "check_memory", "peak_memory", "performance_report"]
