@@ -176,11 +176,11 @@ def _soft_weighted(n: int, k: float):
 
 
 
-def _optimal_ratios(op, n: int, samples: int = 6) -> list[float]:
-    """``prox_optimal``'s ratio on seeded samples (points of scale 1 and 100, λ from 1e-3 to 10), the evaluator
-    called directly: one ratio per sample, no search."""
+def _law_ratios(law: str, op, n: int, samples: int = 6) -> list[float]:
+    """``law``'s ratio on seeded samples (points of scale 1 and 100, λ from 1e-3 to 10), the evaluator called
+    directly: one ratio per sample, no search."""
     from verimono.checks.engine.samples import Sample
-    evaluate = LAWS["prox_optimal"].evaluate
+    evaluate = LAWS[law].evaluate
     rng = np.random.default_rng(1)
     out = []
     for k in range(samples):
@@ -188,6 +188,10 @@ def _optimal_ratios(op, n: int, samples: int = 6) -> list[float]:
         s = Sample(scale * rng.standard_normal(n), scale * rng.standard_normal(n), lam, 0.5 * lam, 2.0 * lam, 0.0)
         out.append(evaluate(op, s).worst)
     return out
+
+
+def _optimal_ratios(op, n: int) -> list[float]:
+    return _law_ratios("prox_optimal", op, n)
 
 
 def test_prox_optimal_expanded(monkeypatch):
@@ -209,17 +213,8 @@ def test_prox_optimal_expanded(monkeypatch):
     assert expanded != direct        # the other arithmetic did run (its rounding differs somewhere)
 
 
-def _minimiser_ratios(op, n: int, samples: int = 6) -> list[float]:
-    """``prox_minimiser``'s ratio on the seeded samples of :func:`_optimal_ratios`, the evaluator called directly."""
-    from verimono.checks.engine.samples import Sample
-    evaluate = LAWS["prox_minimiser"].evaluate
-    rng = np.random.default_rng(1)
-    out = []
-    for k in range(samples):
-        scale, lam = (1.0, 100.0)[k % 2], 10.0 ** (k - 3)
-        s = Sample(scale * rng.standard_normal(n), scale * rng.standard_normal(n), lam, 0.5 * lam, 2.0 * lam, 0.0)
-        out.append(evaluate(op, s).worst)
-    return out
+def _minimiser_ratios(op, n: int) -> list[float]:
+    return _law_ratios("prox_minimiser", op, n)
 
 
 def test_prox_minimiser_on_the_line_starts_at_p_alone(monkeypatch):

@@ -193,18 +193,25 @@ def test_a_one_point_call_with_a_length_1_array_is_the_ordinary_call():
         ball.resolvent(x, 0.3, np.array([0.5]))
 
 
+class TwiceNorm(NormSubdifferential):
+    """∂(2c|·|) stated through the weight's read ``_c_at`` (NormSubdifferential's documented hook)."""
+
+    def _c_at(self, t):
+        return 2.0 * super()._c_at(t)
+
+
+class TwiceBarrier(LogBarrier):
+    """The log barrier of weight 2c stated through ``_c_at``."""
+
+    def _c_at(self, t):
+        return 2.0 * super()._c_at(t)
+
+
 def test_a_subclass_reading_its_weight_its_own_way_is_called_per_row():
     """A subclass overriding the weight's read ``_c_at`` (NormSubdifferential's and LogBarrier's documented hook:
     here ``c(t)`` doubled) is not the catalog's own: a block with a time per row equals its separate calls, which
     read ``c`` through the override (found by probe2: the block read ``c`` from the parameter directly, the
     separate calls through ``_c_at``, so the engine's block pass judged an operator half as strong)."""
-    class TwiceNorm(NormSubdifferential):
-        def _c_at(self, t):
-            return 2.0 * super()._c_at(t)
-
-    class TwiceBarrier(LogBarrier):
-        def _c_at(self, t):
-            return 2.0 * super()._c_at(t)
     X, ts = _points(2)
     for op in (TwiceNorm(lambda t: 1.0 + t, dim=2), TwiceBarrier(lambda t: 1.0 + t, dim=2)):
         sep = np.array([op.resolvent(x, LAM, t) for x, t in zip(X, ts.tolist())])
@@ -223,13 +230,6 @@ def test_a_subclass_reading_its_weight_its_own_way_gets_no_fast_kernel():
     kernel reading ``c`` from the parameter (probe2: ``solve`` stepped ∂(c|·|) where the subclass states ∂(2c|·|))."""
     from verimono.core.operator_protocol import resolvent_kernel
 
-    class TwiceNorm(NormSubdifferential):
-        def _c_at(self, t):
-            return 2.0 * super()._c_at(t)
-
-    class TwiceBarrier(LogBarrier):
-        def _c_at(self, t):
-            return 2.0 * super()._c_at(t)
     x = np.array([3.0, 4.0])
     for op in (TwiceNorm(lambda t: 1.0 + t, dim=2), TwiceNorm(1.5, dim=2), TwiceBarrier(1.5, dim=2)):
         assert np.array_equal(resolvent_kernel(op, x)(x, LAM, 0.5), op.resolvent(x, LAM, 0.5)), op.name

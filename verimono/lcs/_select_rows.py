@@ -44,6 +44,20 @@ KKT_MEMO_SIZE = 4096
 MAX_FACES_K = 5
 
 
+def _kkt_ok(memo: dict, P, q, G, h, A, b, y) -> bool:
+    """``kkt_residual(P, q, G, h, A, b, y).ok``, remembered in ``memo`` by its arrays' exact bytes (a function of
+    them alone; ``P`` and ``G`` are the memo owner's, fixed); the memo is forgotten all at once when full."""
+    key = (q.tobytes(), h.tobytes(), None if A is None else (A.shape, A.tobytes()),
+           None if b is None else b.tobytes(), y.tobytes())
+    hit = memo.get(key)
+    if hit is None:
+        hit = kkt_residual(P, q, G, h, A, b, y).ok
+        if len(memo) >= KKT_MEMO_SIZE:
+            memo.clear()
+        memo[key] = hit
+    return hit
+
+
 class Faces:
     """What depends on ``(M, P)`` alone: the faces' KKT pseudo-inverses and ``sol_polyhedron``'s fixed rows."""
 
@@ -175,15 +189,7 @@ def select_rows(F: Faces, Q: np.ndarray, Cc: np.ndarray, scales: np.ndarray):
         q_s, h_s, b_s, y = Cs[j] / (F.p * s), h / s, None if b is None else b / s, z / s
         # kkt_residual is a function of its arrays alone: remembered by their exact bytes (the Example's rows on the
         # edge x = 0 are the same problem at every t once equilibrated: q/s = (±1, 0), y = (0, 1) or 0)
-        key = (q_s.tobytes(), h_s.tobytes(), None if A is None else (A.shape, A.tobytes()),
-               None if b_s is None else b_s.tobytes(), y.tobytes())
-        hit = F.kkt_memo.get(key)
-        if hit is None:
-            hit = kkt_residual(Pu, q_s, F.G_unit, h_s, A, b_s, y).ok
-            if len(F.kkt_memo) >= KKT_MEMO_SIZE:
-                F.kkt_memo.clear()
-            F.kkt_memo[key] = hit
-        ok[i] = hit
+        ok[i] = _kkt_ok(F.kkt_memo, Pu, q_s, F.G_unit, h_s, A, b_s, y)
     return Zbest, ok
 
 
@@ -254,14 +260,7 @@ def project_rows(F: ProjectionFaces, c: np.ndarray, h: np.ndarray):
         if not (np.isfinite(s) and s > 0.0):
             s = 1.0
         q_s, h_s, y = c[i] / (p * s), hu[j] / s, Y[i] / s
-        key = (q_s.tobytes(), h_s.tobytes(), y.tobytes())       # as in select_rows: the verdict by its arrays' bytes
-        hit = F.kkt_memo.get(key)
-        if hit is None:
-            hit = kkt_residual(Pu, q_s, F.G_unit, h_s, None, None, y).ok
-            if len(F.kkt_memo) >= KKT_MEMO_SIZE:
-                F.kkt_memo.clear()
-            F.kkt_memo[key] = hit
-        ok[i] = hit
+        ok[i] = _kkt_ok(F.kkt_memo, Pu, q_s, F.G_unit, h_s, None, None, y)
     return Y, ok
 
 

@@ -226,7 +226,7 @@ def row_resolvents(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok:
         return np.zeros_like(X)
     st, perf = (CLOCK[-1] if CLOCK else None), time.perf_counter      # _call_starts, inlined: the loops below are
     if rows_accepted(op):                                               # the engine's cost per row
-        J = _one_call(op, X, lams, ts, ok, st, perf)
+        J = _one_call(op, X, lams, ts, ok)
         if J is not None:
             return J
         order, bounds = _groups(lams, ts)
@@ -287,7 +287,7 @@ def row_resolvents(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok:
     return J
 
 
-def _one_call(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok: np.ndarray, st, perf) -> np.ndarray | None:
+def _one_call(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok: np.ndarray) -> np.ndarray | None:
     """:func:`row_resolvents` of rows whose ``(λ, t)`` differ, as one call when the operator takes them so — a step
     size per row (:func:`verimono.core.operator_protocol.accepts_steps`) where the ``λ`` differ, a time per row
     (``accepts_times``) where the ``t`` differ — bit-identical to its calls per ``(λ, t)`` (what the catalog
@@ -302,11 +302,7 @@ def _one_call(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok: np.n
     if (one_lam and one_t) or (not one_lam and not accepts_steps(op)) or (not one_t and not accepts_times(op)):
         return None
     Xs = X.copy()       # the subject's input: one private copy
-    if st is not None:
-        now, f = perf(), st.in_flight
-        if f is not None and now - f > st.slowest:
-            st.slowest = now - f
-        st.in_flight = now
+    _call_starts()      # one call, timed as one
     try:
         J = op.resolvent(Xs, lams[0].item() if one_lam else lams.copy(), ts[0].item() if one_t else ts.copy())
         if type(J) is not np.ndarray or J.dtype is not _F64:
@@ -343,15 +339,11 @@ def _member_takes_times(member: Any) -> bool:
     return any(getattr(cls, m, None) is fn for m in _TIMED_MEMBERS)
 
 
-def _member_block(member: Any, X: np.ndarray, ts: np.ndarray, rows: np.ndarray, st, perf) -> np.ndarray | None:
+def _member_block(member: Any, X: np.ndarray, ts: np.ndarray, rows: np.ndarray) -> np.ndarray | None:
     """``member(X[rows], ts[rows])`` as one call (timed as one subject call, :func:`_call_starts`), or ``None`` when
     it raised (an ``OutsideDomain`` at any row among them) or answered no array of the rows' shape: then the calls
     per row say which rows are bad."""
-    if st is not None:
-        now, f = perf(), st.in_flight
-        if f is not None and now - f > st.slowest:
-            st.slowest = now - f
-        st.in_flight = now
+    _call_starts()
     try:
         P = member(X[rows], ts[rows].astype(float))     # fancy indexing: the subject's input is a private copy
         if type(P) is not np.ndarray or P.dtype is not _F64:
@@ -380,7 +372,7 @@ def row_member(member: Any, X: np.ndarray, ts: np.ndarray, ok: np.ndarray) -> np
     st, perf = (CLOCK[-1] if CLOCK else None), time.perf_counter      # _call_starts, inlined
     rows = np.flatnonzero(ok)
     if rows.size >= 2 and _member_takes_times(member):
-        P = _member_block(member, X, ts, rows, st, perf)
+        P = _member_block(member, X, ts, rows)
         if P is not None:
             out[rows] = P
             ok &= np.isfinite(out).all(axis=1)
