@@ -236,7 +236,7 @@ def test_wall_growth_not_judged_is_said_in_one_line():
 
 def test_the_reasons_not_to_judge_are_said_once_each():
     """Four stages of one busy run give the same reasons in their own figures: the line says each kind of reason
-    once, with how many more stages gave it, not four times (a run on a loaded machine printed 1,100 characters)."""
+    once, with how many more stages gave it, not four times (a run on a loaded machine printed 1,057 characters)."""
     from verimono.run.gate import _one_reason_each
 
     cal = "the calibrations at the run's start and end differ by 6.08x (> 1.25x)"
