@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import importlib.metadata
 import re
+from pathlib import Path
 
 import pytest
 
@@ -321,7 +322,7 @@ def test_a_command_started_in_a_deleted_folder_is_a_clear_error(command, tmp_pat
             "sys.exit(main(sys.argv[2:]))")
     proc = subprocess.run([sys.executable, "-c", code, str(gone), *command, "--out", str(tmp_path / "out")],
                           capture_output=True, text=True, timeout=300,
-                          env=dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path)))
+                          env=dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[2])))
     assert proc.returncode == 2, proc.stderr[-2000:]
     assert "working directory no longer exists" in proc.stderr and "Traceback" not in proc.stderr
     assert not (tmp_path / "out").exists()
