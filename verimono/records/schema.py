@@ -220,9 +220,10 @@ def check_meta(meta: dict[str, Any]) -> None:
 
 
 def document(meta: dict[str, Any], counts: dict[str, int], results: list[dict[str, Any]], studies: list[Any],
-             trajectories: list[Any]) -> dict[str, Any]:
+             trajectories: list[Any], *, converted: bool = False) -> dict[str, Any]:
     """The schema document of a run; ``meta.environment`` and ``created`` are filled in when absent (and
-    written back into ``meta``)."""
+    written back into ``meta``).  ``converted``: ``studies`` and ``trajectories`` are JSON values already
+    (:func:`verimono.core._jsonable.to_jsonable`'s), taken as they are."""
     if "environment" not in meta:     # not setdefault: that measured it again for a run that had (0.02 s)
         meta["environment"] = environment()
     if not meta.get("created"):
@@ -235,8 +236,8 @@ def document(meta: dict[str, Any], counts: dict[str, int], results: list[dict[st
         "summary": counts,
         "meta": to_jsonable(written),
         "results": results,
-        "studies": to_jsonable(studies),
-        "trajectories": to_jsonable(trajectories),
+        "studies": studies if converted else to_jsonable(studies),
+        "trajectories": trajectories if converted else to_jsonable(trajectories),
     }
 
 

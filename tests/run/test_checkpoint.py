@@ -1,0 +1,53 @@
+"""The run's checkpoint (``results.json.partial``) made from pieces written once per stage
+(:class:`verimono.run.execute._Checkpoint`) is the document the whole partial report writes."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from verimono.records.results import CheckResult, Report, load
+from verimono.run.execute import _Checkpoint
+
+BASELINE = Path(__file__).resolve().parents[2] / "reports" / "baseline.json"
+
+
+def _numpy_record() -> CheckResult:
+    """A record whose fields hold what a check's do before they are saved: NumPy scalars and arrays, non-finite
+    floats (written as strings), a nested tuple."""
+    return CheckResult("resolvent_nonexpansive", "planted", "failed", worst=np.float64(1.5), bound=1.0,
+                       message="x", details={"x": np.array([1.0, np.nan]), "k": np.int64(3), "inf": np.inf,
+                                             "flag": np.bool_(True), "pair": (np.float32(0.5), None)})
+
+
+def _document(text: str) -> dict:
+    doc = json.loads(text)
+    doc.pop("created")
+    doc["meta"].pop("created", None)
+    return doc
+
+
+def test_the_pieces_joined_are_the_partial_reports_document():
+    base = load(BASELINE)
+    stages = [Report(base.results[:40], base.studies[:3], {}, base.trajectories[:2]),
+              Report([_numpy_record()]),                                   # no study, no trajectory: empty pieces
+              Report(base.results[40:90], base.studies[3:5], {}, base.trajectories[2:4])]
+    previous = Report(base.results[90:95], base.studies[5:6], {"stages": [{"name": "before"}]}, [])
+    saved, partial = _Checkpoint(previous), Report(meta={"run_id": "r", "stages": [{"name": "s"}]}).extend(previous)
+    for rep in stages:
+        saved.add(rep)
+        partial.extend(rep)
+        meta = {"run_id": "r", "stages": [{"name": "s"}]}
+        assert _document(saved.text(dict(meta))) == _document(Report(partial.results, partial.studies, dict(meta),
+                                                                      partial.trajectories).to_json())
+    text = saved.text({"run_id": "r"})
+    assert list(json.loads(text)) == list(json.loads(partial.to_json()))   # the keys in the schema's order
+    back = Report.from_json(text)
+    assert back.counts == partial.counts and back.counts["failed"] == 1 and len(back.studies) == 6
+
+
+def test_an_empty_checkpoint_is_a_readable_document():
+    back = Report.from_json(_Checkpoint(None).text({"run_id": "r"}))
+    assert len(back) == 0 and back.studies == [] and back.trajectories == []
