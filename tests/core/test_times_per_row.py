@@ -235,3 +235,22 @@ def test_a_subclass_reading_its_weight_its_own_way_gets_no_fast_kernel():
         assert np.array_equal(resolvent_kernel(op, x)(x, LAM, 0.5), op.resolvent(x, LAM, 0.5)), op.name
     # ∂(2·1.5|·|) at |x| = 5: J x = (1 - 0.3·3/5) x
     assert np.allclose(TwiceNorm(1.5, dim=2).resolvent(x, LAM, 0.5), 0.82 * x, rtol=1e-15)
+
+
+def test_a_barrier_subclass_reading_its_weight_its_own_way_gets_its_own_min_norm():
+    """``LogBarrier.min_norm`` (and ``contains``) read ``c`` through ``_c_at`` as its resolvent does: ``TwiceBarrier``
+    states ``F(x) = -2c/x``, so ``F^0(t, x) = -2c(t)/x`` at one point and per row, and ``y ∈ F(x)`` holds for that
+    ``y`` only (probe2: the parent's ``-c/x`` was returned; the resolvent's fixed point ``J x = x - λ F^0(J x)``
+    ties the two together: ``J x + λ F^0(J x) = x`` within a few roundings)."""
+    X, ts = _points(2)
+    X = np.abs(X) + 0.5                                    # inside the orthant
+    for c in (lambda t: 1.0 + t, 1.5):
+        op, parent = TwiceBarrier(c, dim=2), LogBarrier(c, dim=2)
+        for x, t in zip(X, ts.tolist()):
+            want = -2.0 * parent._c_at(t) / x              # -2c(t)/x: the weight doubled, the same division
+            assert np.array_equal(op.min_norm(x, t), want), (x, t)
+            assert op.contains(x, want, t) and not op.contains(x, parent.min_norm(x, t), t), (x, t)
+            p = op.resolvent(x, LAM, t)                    # J x + λ F^0(J x) = x
+            assert np.allclose(p + LAM * op.min_norm(p, t), x, rtol=1e-13, atol=0.0), (x, t)   # a few roundings
+        rows = np.array([op.min_norm(x, t) for x, t in zip(X, ts.tolist())])
+        assert np.array_equal(op.min_norm(X, ts), rows)

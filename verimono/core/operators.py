@@ -774,8 +774,11 @@ class LogBarrier(Operator):
         x = np.asarray(x, dtype=float)
         if (x <= 0.0).any():       # the ndarray's own any: np.any's dispatch is most of a small point's cost
             raise OutsideDomain(f"LogBarrier is defined on (0, ∞)^n; got x = {x}")
-        ts = times_of(t, x, self.name)
-        return -(self._c(t) if ts is None else self._c(0.0) if self._c.constant else _column(self._c.at_times(ts))) / x
+        if type(t) is np.ndarray and not self._accepts_times():     # a subclass's _c_at: per row, through it
+            return per_row(lambda xi, ti: self.min_norm(xi, ti), x, times_of(t, x, self.name))
+        # c(t) through _c_at (a subclass's own read of its weight, as the resolvent reads it; checked > 0 when it
+        # moves), per row by _c_rows: the same numbers as the parameter's for the class itself
+        return -self._c_rows(t, x) / x
 
     def project_domain(self, x, t=0.0):
         return np.maximum(np.asarray(x, dtype=float), 0.0)
@@ -784,7 +787,7 @@ class LogBarrier(Operator):
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
         if (x <= 0.0).any():
             return False
-        c = self._c(t)
+        c = self._c_at(t)          # a subclass's own read of its weight, as min_norm and the resolvent
         expected = -c / x
         tol = tolerance(expected, y) if tol is None else tol
         # the contract: some x' within tol of x (coordinatewise) with |F(x') - y| ≤ tol.  F = -c/x' is
