@@ -18,8 +18,9 @@ from verimono.checks import assumption_a2, assumption_bounds, assumptions
 from verimono.checks.assumptions import check_assumptions
 from verimono.checks.engine import supremum, times
 from verimono.checks.engine.supremum import SUSPECT, Space, budgets, maximise
-from verimono import reference
 from verimono.reference import catalog
+
+from assumption_records import assumption_records
 
 #: a small time budget: the searches' shapes, not their resolution, are under test (96 strata)
 SMALL = 16
@@ -177,34 +178,14 @@ def test_a_form_that_is_the_laws_own_values_is_taken_as_it_is_but_for_a_row_it_c
 
 # -- a time per row (issue 43): the catalog's operators called once per block of times ----------------------
 
-#: the modules whose laws ask ``accepts_times`` (each imported it by name)
-_ASKERS = ("verimono.checks.assumptions", "verimono.checks.assumption_a2", "verimono.checks.assumption_bounds",
-           "verimono.checks.assumption_samples")
-
-
 #: a tinier time budget for the records' comparison (24 strata): every path is taken, at a fraction of the cost
 TINY = 4
 
 
 def _records(name, monkeypatch, **patches):
     """The five assumption records of reference ``name`` (tiny time budget) as dicts without ``duration``,
-    with ``patches`` (attribute → value) set on every module that asks ``accepts_times``."""
-    import importlib
-    import json
-
-    with monkeypatch.context() as m:
-        for mod in _ASKERS:
-            for attr, value in patches.items():
-                if hasattr(importlib.import_module(mod), attr):
-                    m.setattr(f"{mod}.{attr}", value)
-        with budgets(time=TINY, points=8):
-            report = check_assumptions(reference.get(name), composite=False)
-    out = []
-    for r in report:
-        d = json.loads(json.dumps(r.to_dict(), default=str))
-        d.pop("duration", None)
-        out.append(d)
-    return out
+    with ``patches`` set on every module that asks ``accepts_times`` (tests/assumption_records.py)."""
+    return assumption_records(name, monkeypatch, TINY, **patches)
 
 
 @pytest.mark.parametrize("name", ["moving-box", "tnorm-3", pytest.param("translating-ball", marks=pytest.mark.slow),

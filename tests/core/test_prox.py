@@ -232,3 +232,29 @@ def test_prox_minimiser_on_the_line_starts_at_p_alone(monkeypatch):
         assert max(ratios[0]) > 100 and max(ratios[1]) < 1e-3, ratios
     for a, b in zip(alone[0] + alone[1], both[0] + both[1]):
         assert abs(a - b) <= 1e-6 * max(1.0, abs(b)), (a, b)
+
+
+def _soft_wrong_far(n: int, k: float, far: float = 20.0):
+    """The prox of ``2|·|_1`` on R^n given with ``g = 2|·|_1``, its weight ``k`` times too large only in the
+    coordinates with ``|x_i| > far``: lawful for ``k = 1``; for ``k = 1.02`` wrong only far out."""
+    def prox(x, lam):
+        x = np.asarray(x, dtype=float)
+        w = np.where(np.abs(x) > far, 2.0 * k * lam, 2.0 * lam)
+        return np.sign(x) * np.maximum(np.abs(x) - w, 0.0)
+    return vm.operator_from_prox(prox, value=lambda x: 2.0 * float(np.abs(x).sum()), shape=n, name=f"soft_far_{k}")
+
+
+@pytest.mark.parametrize("n", [1, pytest.param(3, marks=pytest.mark.slow)])     # n = 3: 1.4 s
+def test_prox_minimiser_searches_the_scales_its_siblings_search(n):
+    """``prox_minimiser`` sees the scale sweep's points at every scale of ``SCALES`` (to ``10^6``), as
+    ``prox_inequality``, ``prox_optimal`` and ``moreau_envelope`` do, not only its draws' ``|x| ≤ 10``: a soft
+    threshold whose weight is 2% too large only for ``|x_i| > 20`` fails it at every seed (the prox inequality
+    ``Φ(p) ≤ Φ(z*)`` broken by 10–100 slacks at ``|x| ~ 10^3``), and its lawful control (``k = 1``, the same
+    code) passes at the same seeds with every sample's ratio below 1e-6."""
+    for seed in range(3):
+        bad = run_law("prox_minimiser", _soft_wrong_far(n, 1.02), seed=seed)
+        assert bad.status == "failed", f"seed {seed}: {bad}"
+        assert np.abs(bad.counterexample["x1"]).max() > 20.0, bad.counterexample
+        good = run_law("prox_minimiser", _soft_wrong_far(n, 1.0), seed=seed)
+        assert good.status == "passed" and good.worst < 1e-6, f"seed {seed}: {good}"
+        assert good.details["searched"]["x_range"][1] >= 1e3, good.details["searched"]

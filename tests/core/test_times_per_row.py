@@ -235,3 +235,58 @@ def test_a_subclass_reading_its_weight_its_own_way_gets_no_fast_kernel():
         assert np.array_equal(resolvent_kernel(op, x)(x, LAM, 0.5), op.resolvent(x, LAM, 0.5)), op.name
     # ∂(2·1.5|·|) at |x| = 5: J x = (1 - 0.3·3/5) x
     assert np.allclose(TwiceNorm(1.5, dim=2).resolvent(x, LAM, 0.5), 0.82 * x, rtol=1e-15)
+
+
+def test_a_barrier_subclass_reading_its_weight_its_own_way_gets_its_own_min_norm():
+    """``LogBarrier.min_norm`` (and ``contains``) read ``c`` through ``_c_at`` as its resolvent does: ``TwiceBarrier``
+    states ``F(x) = -2c/x``, so ``F^0(t, x) = -2c(t)/x`` at one point and per row, and ``y ∈ F(x)`` holds for that
+    ``y`` only (probe2: the parent's ``-c/x`` was returned; the resolvent's fixed point ``J x = x - λ F^0(J x)``
+    ties the two together: ``J x + λ F^0(J x) = x`` within a few roundings)."""
+    X, ts = _points(2)
+    X = np.abs(X) + 0.5                                    # inside the orthant
+    for c in (lambda t: 1.0 + t, 1.5):
+        op, parent = TwiceBarrier(c, dim=2), LogBarrier(c, dim=2)
+        for x, t in zip(X, ts.tolist()):
+            want = -2.0 * parent._c_at(t) / x              # -2c(t)/x: the weight doubled, the same division
+            assert np.array_equal(op.min_norm(x, t), want), (x, t)
+            assert op.contains(x, want, t) and not op.contains(x, parent.min_norm(x, t), t), (x, t)
+            p = op.resolvent(x, LAM, t)                    # J x + λ F^0(J x) = x
+            assert np.allclose(p + LAM * op.min_norm(p, t), x, rtol=1e-13, atol=0.0), (x, t)   # a few roundings
+        rows = np.array([op.min_norm(x, t) for x, t in zip(X, ts.tolist())])
+        assert np.array_equal(op.min_norm(X, ts), rows)
+
+
+def _twice_on_the_object(op):
+    """``op`` with its weight's read ``_c_at`` doubled on the object itself (an instance attribute, not a subclass)."""
+    cls = type(op)
+    op._c_at = lambda t: 2.0 * cls._c_at(op, t)
+    return op
+
+
+@pytest.mark.parametrize("c", [lambda t: 1.0 + t, 1.5], ids=["moving", "constant"])
+def test_a_weight_read_replaced_on_the_object_is_the_subclass_s(c):
+    """An ``_c_at`` replaced on one object is honoured as a subclass's override is: every member of ∂(c|·|) (the
+    one-point fast paths of catfast included), its steppers' kernel and a block with a time per row give, bit for
+    bit, what ``TwiceNorm`` (the same operator written as a subclass) gives — and so for ``LogBarrier``.  Found by
+    probe2: the one-point paths read ``c`` from the parameter when ``_c_at`` was the class's own, whatever the
+    object said."""
+    from verimono.core.operator_protocol import resolvent_kernel
+
+    X, ts = _points(2)
+    pairs = ((_twice_on_the_object(NormSubdifferential(c, dim=2)), TwiceNorm(c, dim=2), X),
+             (_twice_on_the_object(LogBarrier(c, dim=2)), TwiceBarrier(c, dim=2), np.abs(X) + 0.5))
+    for mine, sub, pts in pairs:
+        for x, t in zip(pts[:8], ts[:8].tolist()):
+            assert np.array_equal(mine.resolvent(x, LAM, t), sub.resolvent(x, LAM, t)), (mine.name, x, t)
+            assert np.array_equal(mine.min_norm(x, t), sub.min_norm(x, t)), (mine.name, x, t)
+            assert np.array_equal(resolvent_kernel(mine, x)(x, LAM, t), sub.resolvent(x, LAM, t)), (mine.name, x, t)
+            y = sub.min_norm(x, t)
+            assert mine.contains(x, y, t) and sub.contains(x, y, t), (mine.name, x, t)
+            if isinstance(mine, NormSubdifferential):
+                assert mine.value(x, t) == sub.value(x, t), (mine.name, x, t)
+        assert np.array_equal(resolvent_rows(mine, pts, LAM, ts), resolvent_rows(sub, pts, LAM, ts)), mine.name
+        assert np.array_equal(mine.resolvent(pts, LAM, ts), sub.resolvent(pts, LAM, ts)), mine.name
+        assert np.array_equal(mine.min_norm(pts, ts), sub.min_norm(pts, ts)), mine.name
+    # against the weight written out, at one point: ∂(2·c|·|) at |x| = 5, t = 0.5
+    x = np.array([3.0, 4.0])
+    assert np.allclose(pairs[0][0].resolvent(x, LAM, 0.5), (1 - LAM * 3.0 / 5.0) * x, rtol=1e-15)   # 2c(0.5) = 3

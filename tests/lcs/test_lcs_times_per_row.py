@@ -18,6 +18,8 @@ from verimono.lcs.relations import Complementarity
 from verimono.lcs.system import LinearRelationSystem
 from verimono.reference.lcs_example import example_system
 
+from assumption_records import assumption_records
+
 LAM = 0.3
 
 
@@ -184,28 +186,8 @@ def test_the_example_records_with_a_time_per_row_equal_time_by_time(name, monkey
 
 def _records(name, monkeypatch, **patches):
     """The five assumption records of reference ``name`` (time budget 4, 8 points) as dicts without ``duration``,
-    with ``patches`` set on every module that asks ``accepts_times`` (as tests/checks/test_time_vectorised.py)."""
-    import importlib
-    import json
-
-    from verimono import reference
-    from verimono.checks.assumptions import check_assumptions
-    from verimono.checks.engine.supremum import budgets
-
-    with monkeypatch.context() as m:
-        for mod in ("verimono.checks.assumptions", "verimono.checks.assumption_a2",
-                    "verimono.checks.assumption_bounds", "verimono.checks.assumption_samples"):
-            for attr, value in patches.items():
-                if hasattr(importlib.import_module(mod), attr):
-                    m.setattr(f"{mod}.{attr}", value)
-        with budgets(time=4, points=8):
-            report = check_assumptions(reference.get(name), composite=False)
-    out = []
-    for r in report:
-        d = json.loads(json.dumps(r.to_dict(), default=str))
-        d.pop("duration", None)
-        out.append(d)
-    return out
+    with ``patches`` set on every module that asks ``accepts_times`` (tests/assumption_records.py)."""
+    return assumption_records(name, monkeypatch, 4, **patches)
 
 
 # -- project_domain of a block: rows proved inside dom H(t_i) at once -------------------------------------------

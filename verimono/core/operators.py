@@ -44,6 +44,12 @@ def _own(obj: Any, cls: type, member: str = "resolvent") -> bool:
     return getattr(type(obj), member) is getattr(cls, member)
 
 
+def _own_read(obj: Any, cls: type, member: str = "_c_at") -> bool:
+    """Whether ``obj`` reads its parameter by ``cls``'s own ``member``: neither overridden in a subclass nor
+    replaced on the object itself."""
+    return _own(obj, cls, member) and member not in getattr(obj, "__dict__", {})
+
+
 #: the members that take a time per row (:meth:`Operator._accepts_times`)
 _TIMED = ("resolvent", "yosida", "min_norm", "project_domain")
 
@@ -300,6 +306,10 @@ def _nonnegative(value: np.ndarray, what: str) -> None:
                           "a negative weight makes the operator non-monotone")
 
 
+#: NormSubdifferential's reads of its weight: replaced on an object, its fast paths step aside (``_fast_c``)
+_WEIGHT_READS = ("_c_at", "_col")
+
+
 class NormSubdifferential(_EverywhereDefined):
     """``F(t, ·) = ∂(c(t)‖·‖₂)``: ``F(t, x) = c x/|x|`` for ``x ≠ 0`` and the ball ``c B`` at 0.
 
@@ -315,6 +325,19 @@ class NormSubdifferential(_EverywhereDefined):
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
         cls._fast_c = cls._c_at is NormSubdifferential._c_at and cls._col is NormSubdifferential._col
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        # an _c_at or _col replaced on the object itself (not in a subclass) is honoured as a subclass's is: the
+        # object's _fast_c is then false (the one-point paths, the kernel and the blocks of times go through it);
+        # a flag set here, not a dictionary look-up on every call (catfast's one-point paths stay as fast)
+        super().__setattr__(name, value)
+        if name in _WEIGHT_READS:
+            super().__setattr__("_fast_c", False)
+
+    def __delattr__(self, name: str) -> None:
+        super().__delattr__(name)
+        if name in _WEIGHT_READS and not any(m in self.__dict__ for m in _WEIGHT_READS):
+            self.__dict__.pop("_fast_c", None)      # the class's own reads again: the class's flag
 
     def __init__(self, c: Any, dim: int = 1, name: str | None = None) -> None:
         super().__init__(dim, name or "NormSubdifferential")
@@ -744,14 +767,14 @@ class LogBarrier(Operator):
         return _own(self, LogBarrier)
 
     def _accepts_times(self):
-        # a block of times reads c from the parameter, not through a subclass's _c_at (then: per row)
-        return _own(self, LogBarrier, "_c_at") and _own_times(self, LogBarrier)
+        # a block of times reads c from the parameter, not through a subclass's or the object's _c_at (then: per row)
+        return _own_read(self, LogBarrier) and _own_times(self, LogBarrier)
 
     def _accepts_steps(self):
         return _own_steps(self, LogBarrier) and np.shape(self._c(0.0)) in ((), (self.dim,))
 
     def _kernel(self, x0):
-        if not _own(self, LogBarrier) or not _own(self, LogBarrier, "_c_at"):     # a subclass's c(t): its resolvent
+        if not _own(self, LogBarrier) or not _own_read(self, LogBarrier):     # a subclass's c(t): its resolvent
             return None
         resolve, name = self._resolve, self.name
         if self._c.constant:
@@ -774,8 +797,11 @@ class LogBarrier(Operator):
         x = np.asarray(x, dtype=float)
         if (x <= 0.0).any():       # the ndarray's own any: np.any's dispatch is most of a small point's cost
             raise OutsideDomain(f"LogBarrier is defined on (0, ∞)^n; got x = {x}")
-        ts = times_of(t, x, self.name)
-        return -(self._c(t) if ts is None else self._c(0.0) if self._c.constant else _column(self._c.at_times(ts))) / x
+        if type(t) is np.ndarray and not self._accepts_times():     # a subclass's _c_at: per row, through it
+            return per_row(lambda xi, ti: self.min_norm(xi, ti), x, times_of(t, x, self.name))
+        # c(t) through _c_at (a subclass's own read of its weight, as the resolvent reads it; checked > 0 when it
+        # moves), per row by _c_rows: the same numbers as the parameter's for the class itself
+        return -self._c_rows(t, x) / x
 
     def project_domain(self, x, t=0.0):
         return np.maximum(np.asarray(x, dtype=float), 0.0)
@@ -784,7 +810,7 @@ class LogBarrier(Operator):
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
         if (x <= 0.0).any():
             return False
-        c = self._c(t)
+        c = self._c_at(t)          # a subclass's own read of its weight, as min_norm and the resolvent
         expected = -c / x
         tol = tolerance(expected, y) if tol is None else tol
         # the contract: some x' within tol of x (coordinatewise) with |F(x') - y| ≤ tol.  F = -c/x' is
