@@ -115,6 +115,7 @@ class Relay(BoxRelation):
 
 #: active patterns a stepper of a PSD ``M`` tries after its last one, before a full solve
 RECENT_PATTERNS = 8
+_INF = float("inf")
 
 
 class _BoxStepper:
@@ -161,7 +162,9 @@ class _BoxStepper:
             hiI = self.hi[I]
             # which checks of :meth:`_try` can fire: an upper bound +∞ is never within τ of a multiplier, an empty
             # set of rows at a bound has nothing to check (skipping them changes no answer)
-            e = (I, fixed, lu, self.M @ fixed, self.lo[I], hiI, np.flatnonzero(s == 0), np.flatnonzero(s == 2),
+            Mfixed = self.M @ fixed
+            # ``(M·fixed)_I`` indexed once here, not at every try: the same numbers
+            e = (I, fixed, lu, Mfixed[I], self.lo[I], hiI, np.flatnonzero(s == 0), np.flatnonzero(s == 2),
                  bool(I.size), not bool(np.all(hiI == np.inf)), bool(np.any(s == 0)), bool(np.any(s == 2)))
             self.cache[pat] = e
         return e
@@ -169,12 +172,12 @@ class _BoxStepper:
     def _try(self, pat: bytes, q: np.ndarray, qmax: float):
         """The pattern's solution for ``q`` if it is strictly complementary (margin ``RTOL`` of
         :func:`verimono.lcs.lcp.lcp_scale`), else ``None``; ``q`` finite, ``qmax = |q|∞``."""
-        I, fixed, lu, Mfixed, loI, hiI, at_lo, at_hi, inner, upper, lower_rows, upper_rows = self._entry(pat)
+        I, fixed, lu, MfixedI, loI, hiI, at_lo, at_hi, inner, upper, lower_rows, upper_rows = self._entry(pat)
         if lu is False:
             return None
         lam = fixed.copy()
         if inner:
-            lam[I] = lu_solve(lu, -(q[I] + Mfixed[I]))
+            lam[I] = lu_solve(lu, -(q[I] + MfixedI))
         y = self.M @ lam + q
         # lcp_scale(M, q, lam), with ‖M‖∞ computed once
         tau = RTOL * (1.0 + max(qmax, self.m_norm * absmax(lam)))
@@ -204,8 +207,9 @@ class _BoxStepper:
 
     def __call__(self, q, scale=None):
         # non-finite data: no pattern is tried, the full solve says what is wrong
-        if self.last is not None and np.isfinite(q).all():
-            qmax = absmax(q)
+        # |q|∞ is finite exactly when q is (absmax is NaN with a NaN entry, inf with an infinite one): one
+        # reduction where np.isfinite(q).all() and absmax(q) were two
+        if self.last is not None and (qmax := absmax(q)) < _INF:
             out = self._try(self.last, q, qmax)
             if out is not None:
                 return out
