@@ -123,3 +123,36 @@ def test_the_norm_comparison_sees_a_pairwise_sum():
         w = v / m
         return m * float(np.sqrt(np.sum(w * w)))
     assert any(pairwise(v) != _norm_before(v) for v in _vectors())
+
+
+def _conditioned_cases() -> list:
+    """Square matrices around the stepper's threshold ``cond = 1e12`` (rotated ``diag(1, 1e-12·(1 + k·eps))``),
+    random ones over 400 decades, 1×1 ones with 0, ±0, tiny, huge and non-finite entries, and singular ones."""
+    rng = np.random.default_rng(6)
+    out = []
+    for k in range(-3, 4):
+        Q = np.linalg.qr(rng.normal(size=(2, 2)))[0]
+        out += [np.diag([1.0, 1e-12 * (1 + k * 2.2e-16)]), Q @ np.diag([1.0, 1e-12 * (1 + k * 2.2e-16)]) @ Q.T]
+    out += [rng.normal(size=(n, n)) * 10.0 ** rng.uniform(-200, 200) for n in (1, 2, 3) for _ in range(30)]
+    out += [np.array([[v]]) for v in (0.0, -0.0, 5e-324, 1e308, np.inf, -np.inf, np.nan)]
+    return out + [np.zeros((2, 2)), np.ones((2, 2)), np.array([[np.nan, 1.0], [1.0, 1.0]])]
+
+
+def _verdict(f, A):
+    try:
+        with np.errstate(all="ignore"):
+            return bool(f(A))
+    except np.linalg.LinAlgError:
+        return "raises"
+
+
+def test_the_stepper_judges_a_pattern_matrix_as_cond_did():
+    from verimono.lcs.relations import _well_conditioned
+    for A in _conditioned_cases():
+        assert _verdict(_well_conditioned, A) == _verdict(lambda a: np.linalg.cond(a) < 1e12, A), A
+
+
+def test_the_conditioning_comparison_sees_the_threshold_moved():
+    """``cond ≤ 1e12`` where the stepper had ``cond < 1e12``: ``diag(1, 1e-12)`` is judged otherwise."""
+    assert any(_verdict(lambda a: np.linalg.cond(a) <= 1e12, A) != _verdict(lambda a: np.linalg.cond(a) < 1e12, A)
+               for A in _conditioned_cases())

@@ -20,7 +20,7 @@ import numpy as np
 from ..core.errors import InvalidProblem, NotMonotone, UnverifiedSolution
 from ..core.operators import Operator
 from ..core.tolerances import QP_RTOL, RTOL, tolerance
-from ..core._linalg import absmax
+from ..core._linalg import absmax, singular_values
 from ._lu import lu_factor, lu_solve
 from .lcp import LCPResult, is_psd, lcp_scale, solve_box, solve_lcp
 
@@ -115,6 +115,21 @@ class Relay(BoxRelation):
 
 #: active patterns a stepper of a PSD ``M`` tries after its last one, before a full solve
 RECENT_PATTERNS = 8
+
+
+def _well_conditioned(A: np.ndarray) -> bool:
+    """``np.linalg.cond(A) < 1e12`` for a square float64 ``A`` without its dispatch: the same ratio of the same
+    singular values (:func:`verimono.core._linalg.singular_values`, ``np.linalg.svd``'s bit for bit), a NaN ratio
+    (``cond`` makes it ``inf`` or keeps it NaN) as not below.  A 1×1 ``[[a]]``: its one singular value is ``|a|``,
+    so the ratio is exactly 1 for a finite nonzero ``a`` and NaN for ``a = 0`` (a non-finite ``a`` goes the general
+    way, raising where ``cond`` raises)."""
+    if A.shape == (1, 1):
+        a = abs(float(A[0, 0]))
+        if a < _INF:
+            return a > 0.0
+    sv = singular_values(A)
+    with np.errstate(all="ignore"):
+        return bool(sv[0] / sv[-1] < 1e12)
 _INF = float("inf")
 
 
@@ -154,11 +169,8 @@ class _BoxStepper:
             fixed[I] = 0.0
             lu = None
             if I.size:
-                MII = self.M[np.ix_(I, I)]
-                if np.linalg.cond(MII) < 1e12:
-                    lu = lu_factor(MII)
-                else:
-                    lu = False
+                MII = self.M[I[:, None], I]        # what np.ix_(I, I) indexes
+                lu = lu_factor(MII) if _well_conditioned(MII) else False
             hiI = self.hi[I]
             # which checks of :meth:`_try` can fire: an upper bound +∞ is never within τ of a multiplier, an empty
             # set of rows at a bound has nothing to check (skipping them changes no answer)
