@@ -212,6 +212,29 @@ class Linear(_EverywhereDefined):
             return self._cache_inv
         return np.linalg.inv(np.eye(self.dim) + lam * self._M_at(t)).T
 
+    def _inverses(self, lams: list) -> np.ndarray:
+        """``[_inverse(λ, 0) for λ in lams]`` stacked (constant ``M``): the factors not cached are inverted in one
+        call of the stacked ``I + λ_k M`` (NumPy's ``inv`` solves each matrix of a stack as it solves one alone: the
+        same numbers), then cached in the order a call per row would cache them."""
+        cache = self._inv_cache
+        new = [lam for lam in dict.fromkeys(lams) if lam not in cache]
+        if len(new) > 1:
+            M = self._M(0.0)
+            made = np.linalg.inv(np.eye(self.dim) + np.array(new)[:, None, None] * M).transpose(0, 2, 1).copy()
+            fresh = dict(zip(new, made))
+            out = []
+            for lam in lams:
+                inv = cache.get(lam)
+                if inv is None:
+                    if len(cache) >= 256:
+                        cache.clear()
+                    inv = cache[lam] = fresh[lam]
+                out.append(inv)
+            self._cache_lam, self._cache_inv = lams[-1], out[-1]
+            return np.array(out)
+        inverse = self._inverse
+        return np.array([inverse(lam, 0.0) for lam in lams])
+
     def _M_at(self, t: float) -> np.ndarray:
         """``M(t)``, checked at this ``t``: square of the operator's size, finite, ``M + Mᵀ ⪰ 0`` (a moving
         ``M`` validated at ``t = 0`` only once gave ``x(1) = -11197`` for ``M(t) = 1 - 20t``)."""
@@ -231,8 +254,7 @@ class Linear(_EverywhereDefined):
                 return per_row_steps(self.resolvent, x, ls[:, 0], t)
             # each row's (I + λ_i M)^{-T} (the same cached factor a separate call uses), and a stack of
             # (1, n) @ (n, n) products: each row exactly as the single point's x @ W
-            inverse = self._inverse
-            W = np.array([inverse(li, 0.0) for li in ls[:, 0].tolist()])
+            W = self._inverses(ls[:, 0].tolist())
             return (x[:, None, :] @ W)[:, 0, :]
         ts = times_of(t, x, self.name)
         if ts is not None:
@@ -519,7 +541,7 @@ class L1Subdifferential(_EverywhereDefined):
     def value(self, x, t=0.0):
         """``g(t, x) = Σ c_i(t)|x_i|`` (``F(t,·) = ∂g(t,·)``): the value laws check the resolvent is its prox."""
         c = np.asarray(_weight_at(self._c, t, self.name, "c(t)"), dtype=float)
-        return float(np.sum(c * np.abs(np.asarray(x, dtype=float))))
+        return float(np.add.reduce(c * np.abs(np.asarray(x, dtype=float)), axis=None))   # np.sum without its dispatch
 
     def min_norm(self, x, t=0.0):
         x = real_array(x)

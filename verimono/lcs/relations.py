@@ -20,7 +20,7 @@ import numpy as np
 from ..core.errors import InvalidProblem, NotMonotone, UnverifiedSolution
 from ..core.operators import Operator
 from ..core.tolerances import QP_RTOL, RTOL, tolerance
-from ..core._linalg import absmax
+from ..core._linalg import absmax, singular_values
 from ._lu import lu_factor, lu_solve
 from .lcp import LCPResult, is_psd, lcp_scale, solve_box, solve_lcp
 
@@ -117,6 +117,22 @@ class Relay(BoxRelation):
 RECENT_PATTERNS = 8
 
 
+def _well_conditioned(A: np.ndarray) -> bool:
+    """``np.linalg.cond(A) < 1e12`` for a square float64 ``A`` without its dispatch: the same ratio of the same
+    singular values (:func:`verimono.core._linalg.singular_values`, ``np.linalg.svd``'s bit for bit), a NaN ratio
+    (``cond`` makes it ``inf`` or keeps it NaN) as not below.  A 1×1 ``[[a]]``: its one singular value is ``|a|``,
+    so the ratio is exactly 1 for a finite nonzero ``a`` and NaN for ``a = 0`` (a non-finite ``a`` goes the general
+    way, raising where ``cond`` raises)."""
+    if A.shape == (1, 1):
+        a = abs(float(A[0, 0]))
+        if a < _INF:
+            return a > 0.0
+    sv = singular_values(A)
+    with np.errstate(all="ignore"):
+        return bool(sv[0] / sv[-1] < 1e12)
+_INF = float("inf")
+
+
 class _BoxStepper:
     """``q ↦ (z, w)`` for a constant ``M``: the last pattern's factorisation first, then (PSD ``M``) the
     :data:`RECENT_PATTERNS` patterns that solved before it, a full solve otherwise.
@@ -153,15 +169,14 @@ class _BoxStepper:
             fixed[I] = 0.0
             lu = None
             if I.size:
-                MII = self.M[np.ix_(I, I)]
-                if np.linalg.cond(MII) < 1e12:
-                    lu = lu_factor(MII)
-                else:
-                    lu = False
+                MII = self.M[I[:, None], I]        # what np.ix_(I, I) indexes
+                lu = lu_factor(MII) if _well_conditioned(MII) else False
             hiI = self.hi[I]
             # which checks of :meth:`_try` can fire: an upper bound +∞ is never within τ of a multiplier, an empty
             # set of rows at a bound has nothing to check (skipping them changes no answer)
-            e = (I, fixed, lu, self.M @ fixed, self.lo[I], hiI, np.flatnonzero(s == 0), np.flatnonzero(s == 2),
+            Mfixed = self.M @ fixed
+            # ``(M·fixed)_I`` indexed once here, not at every try: the same numbers
+            e = (I, fixed, lu, Mfixed[I], self.lo[I], hiI, np.flatnonzero(s == 0), np.flatnonzero(s == 2),
                  bool(I.size), not bool(np.all(hiI == np.inf)), bool(np.any(s == 0)), bool(np.any(s == 2)))
             self.cache[pat] = e
         return e
@@ -169,12 +184,12 @@ class _BoxStepper:
     def _try(self, pat: bytes, q: np.ndarray, qmax: float):
         """The pattern's solution for ``q`` if it is strictly complementary (margin ``RTOL`` of
         :func:`verimono.lcs.lcp.lcp_scale`), else ``None``; ``q`` finite, ``qmax = |q|∞``."""
-        I, fixed, lu, Mfixed, loI, hiI, at_lo, at_hi, inner, upper, lower_rows, upper_rows = self._entry(pat)
+        I, fixed, lu, MfixedI, loI, hiI, at_lo, at_hi, inner, upper, lower_rows, upper_rows = self._entry(pat)
         if lu is False:
             return None
         lam = fixed.copy()
         if inner:
-            lam[I] = lu_solve(lu, -(q[I] + Mfixed[I]))
+            lam[I] = lu_solve(lu, -(q[I] + MfixedI))
         y = self.M @ lam + q
         # lcp_scale(M, q, lam), with ‖M‖∞ computed once
         tau = RTOL * (1.0 + max(qmax, self.m_norm * absmax(lam)))
@@ -204,8 +219,9 @@ class _BoxStepper:
 
     def __call__(self, q, scale=None):
         # non-finite data: no pattern is tried, the full solve says what is wrong
-        if self.last is not None and np.isfinite(q).all():
-            qmax = absmax(q)
+        # |q|∞ is finite exactly when q is (absmax is NaN with a NaN entry, inf with an infinite one): one
+        # reduction where np.isfinite(q).all() and absmax(q) were two
+        if self.last is not None and (qmax := absmax(q)) < _INF:
             out = self._try(self.last, q, qmax)
             if out is not None:
                 return out

@@ -17,8 +17,6 @@ with ``γ = 1`` unless the θ-γ variant is asked for.  ``θ = 1`` is the paper'
 
 from __future__ import annotations
 
-import copy
-
 from typing import Any, Callable
 
 import numpy as np
@@ -76,7 +74,8 @@ class StepMatrices:
         """What ``StepMatrices(sys, h, θ, γ)`` makes again — the same matrices (shared, never written) and a fresh
         one-step solver (:meth:`verimono.lcs.relations._BoxStepper.fresh`: its pattern factorisations shared) —
         without recomputing them."""
-        new = copy.copy(self)
+        new = object.__new__(type(self))       # copy.copy's shallow copy, without its reduce protocol
+        new.__dict__.update(self.__dict__)
         fresh = getattr(self.step, "fresh", None)
         new.step = fresh() if fresh is not None else self._relation.stepper(self.M)
         return new
@@ -501,6 +500,14 @@ class LCSOperator(Operator):
             vs = [s.v(ti) for ti in t]
         else:
             v = s.v(t)
+            if type(s).q_scale is LinearRelationSystem.q_scale:
+                # one v for every row: q_scale's ‖C‖∞|xE|∞ + |v|∞ with |v|∞ read once (the same sum)
+                cn, vmax = s._c_norm, absmax(v)
+                for x in X:
+                    xE = E @ x
+                    z, _ = step(C @ xE + v, cn * absmax(xE) + vmax)
+                    out.append(xE + G @ z)
+                return np.array(out)
             vs = [v] * len(X)
         for x, v in zip(X, vs):
             xE = E @ x

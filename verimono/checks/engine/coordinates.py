@@ -111,8 +111,10 @@ def _moves(s: Sample, name: str, op: Any, horizon: float) -> tuple[Space, Callab
         if r == 0.0:
             return None
         space = Space("|x1|", SCALE[0], min(SCALE[1], current_largest() / 64.0), log=True)
-        return space, (lambda v: _replace(s, x1=s.x1 * (v / r), x2=s.x2 * (v / r))), \
-            [10.0 ** k for k in range(-9, 7, 3)] + [min(max(r, SCALE[0]), SCALE[1])]
+        at = lambda v: _replace(s, x1=s.x1 * (v / r), x2=s.x2 * (v / r))      # noqa: E731
+        at.many = lambda vs: _rows_of(s, vs, lambda f: f[:, None] * s.x1, lambda f: f[:, None] * s.x2,
+                                      (np.array(vs) / r))
+        return space, at, [10.0 ** k for k in range(-9, 7, 3)] + [min(max(r, SCALE[0]), SCALE[1])]
     # offset from the boundary: x1 = b + s n
     try:
         b = np.asarray(op.resolvent(s.x1.copy(), s.nu, s.t), dtype=float)
@@ -128,8 +130,40 @@ def _moves(s: Sample, name: str, op: Any, horizon: float) -> tuple[Space, Callab
     if not OFFSET[0] * size < hi:
         return None
     space = Space("offset", OFFSET[0] * size, hi, log=True)
-    return space, (lambda v: _replace(s, x1=b + v * n, x2=b + 1e3 * v * n)), \
-        [10.0 ** k * size for k in range(-12, 4, 3)]
+    at = lambda v: _replace(s, x1=b + v * n, x2=b + 1e3 * v * n)      # noqa: E731
+    at.many = lambda vs: _rows_of(s, vs, lambda V: b + V[:, None] * n, lambda V: b + (1e3 * V)[:, None] * n,
+                                  np.array(vs))
+    return space, at, [10.0 ** k * size for k in range(-12, 4, 3)]
+
+
+#: points of at most this many coordinates get a design's samples as rows of one array (:func:`_rows_of`)
+ROWS_OF_N = 64
+
+
+def _rows_of(s: Sample, vs: list, x1: Callable, x2: Callable, V: np.ndarray) -> list[Sample] | None:
+    """The samples of a points' design at ``vs`` in one broadcast pass: ``x1(V)``, ``x2(V)`` are ``(len(vs), n)``
+    arrays whose row ``i`` is, element by element, the one-point lambda's arithmetic at ``vs[i]`` (a product and a
+    sum of float64 numbers, the same whether one scalar or a column multiplies: the same numbers).  Each sample
+    holds a row of its own (no two share one).  ``None`` above :data:`ROWS_OF_N` coordinates: a kept worst sample
+    would hold the whole design's array alive."""
+    if s.x1.size > ROWS_OF_N:
+        return None
+    X1, X2 = x1(V), x2(V)
+    out = []
+    for a, c in zip(X1, X2):
+        new = object.__new__(Sample)
+        d = new.__dict__
+        d.update(s.__dict__)
+        d["x1"], d["x2"] = a, c
+        out.append(new)
+    return out
+
+
+def _samples(at: Callable[[float], Sample], design: list[float]) -> list[Sample]:
+    """``[at(v) for v in design]``, in one pass where ``at`` has one (:func:`_rows_of`)."""
+    many = getattr(at, "many", None)
+    out = many(design) if many is not None and design else None
+    return out if out is not None else [at(v) for v in design]
 
 
 def coordinate_search(evaluate: Callable[[Sample], float], op: Any, start: Sample, horizon: float, points: int,
@@ -181,7 +215,7 @@ def coordinate_search(evaluate: Callable[[Sample], float], op: Any, start: Sampl
         if dense:
             design = design + _even(space, dense_count(points, name, rows))
         design = [float(min(max(v, space.lo), space.hi)) for v in design]
-        return space, at, design, [at(v) for v in design], decades
+        return space, at, design, _samples(at, design), decades
 
     names = [c for c in COORDINATES if c in over and not (c in _MORE and points < MORE_FROM)]
     plans: dict = {}

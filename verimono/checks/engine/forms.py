@@ -135,7 +135,8 @@ class _Formed:
             return
         n = x.size
         if form == INTEGER:
-            exact = x.dtype.kind in "iu" or (np.all(np.abs(x) < EXACT_INT) and np.array_equal(x, np.rint(x)))
+            # np.all and np.array_equal's tests as the arrays' own (the same shape: rint keeps it), without the dispatch
+            exact = x.dtype.kind in "iu" or bool((np.abs(x) < EXACT_INT).all() and (x == np.rint(x)).all())
             a = buf = x.astype(np.int64) if exact else np.array(x, dtype=float)
         elif form == STRIDED:
             buf = _garbage(2 * n + 1, dt)
