@@ -10,6 +10,7 @@ finished stages marked incomplete; :func:`merge_resumed` completes such a run.  
 
 from __future__ import annotations
 
+import json
 import sys
 import time
 from pathlib import Path
@@ -26,7 +27,8 @@ from ..execution.timeouts import budget_source
 from .progress import Progress
 from ..records.report import write
 from ..records.report.plots import draw_ahead, drawing_elsewhere, warm_up
-from ..records.results import Report, to_jsonable
+from ..records import schema
+from ..records.results import STATUSES, Report, to_jsonable
 from ..execution.calibration import PendingCalibration, calibrate_times, cpu_seconds, set_calibration
 from ..execution.timing import MachineProbe, is_noise_undecided
 
@@ -281,8 +283,6 @@ class _Checkpoint:
             self.add(previous)
 
     def add(self, rep: Report) -> None:
-        import json
-
         for key, values in (("results", [r.to_dict() for r in rep.results]),
                             ("studies", to_jsonable(rep.studies)), ("trajectories", to_jsonable(rep.trajectories))):
             if values:
@@ -291,11 +291,6 @@ class _Checkpoint:
             self.counts[r.status] = self.counts.get(r.status, 0) + 1
 
     def text(self, meta: dict) -> str:
-        import json
-
-        from ..records import schema
-        from ..records.results import STATUSES
-
         if self.environment is not None:
             meta.setdefault("environment", self.environment)
         doc = schema.document(meta, {s: self.counts.get(s, 0) for s in STATUSES}, [], [], [], converted=True)
