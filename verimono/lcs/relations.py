@@ -273,6 +273,12 @@ class _BoxStepper:
         fin = np.isfinite(Q).all(axis=1)
         qmax = np.abs(Q).max(axis=1)
         tried: dict[bytes, tuple] = {}
+        # rows with q ≥ 0 that no pattern answers strictly (a zero component: a point on the domain's edge): the
+        # full solve is solve_lcp's first branch, z = 0, whose pattern is every multiplier at its bound 0 (0 ≤ τ)
+        trivial = np.zeros(B, dtype=bool)
+        if type(self.rel).solve is BoxRelation.solve and self.rel.is_lcp and np.isfinite(self.M).all():
+            trivial = fin & (Q >= 0.0).all(axis=1)
+        zero = bytes(self.M.shape[0])
         for i in range(B):
             if self.last is not None and fin[i]:
                 pats = [self.last]
@@ -288,10 +294,17 @@ class _BoxStepper:
                         out[i] = hit[1][i]
                         break
                 else:
-                    out[i] = self._full(Q[i], scales[i])[0]
+                    out[i] = self._full(Q[i], scales[i])[0] if not trivial[i] else self._zero(zero)
                 continue
-            out[i] = self._full(Q[i], scales[i])[0]
+            out[i] = self._full(Q[i], scales[i])[0] if not trivial[i] else self._zero(zero)
         return out
+
+    def _zero(self, zero: bytes) -> float:
+        """:meth:`_full` of finite data ``q ≥ 0`` of an LCP: ``z = 0`` (:func:`verimono.lcs.solve_lcp`'s trivial
+        answer), its pattern remembered, the full solve counted."""
+        self.full_solves += 1
+        self._remember(zero)
+        return 0.0
 
 
 class OperatorRelation(Relation):
