@@ -21,7 +21,7 @@ from ..core.errors import InvalidProblem, NotMonotone, UnverifiedSolution
 from ..core.operators import Operator
 from ..core.tolerances import QP_RTOL, RTOL, tolerance
 from ..core._linalg import absmax, singular_values
-from ._lu import lu_factor, lu_solve
+from ._lu import _GETRS, lu_factor, lu_solve
 from .lcp import LCPResult, is_psd, lcp_scale, solve_box, solve_lcp
 
 
@@ -232,6 +232,10 @@ class _BoxStepper:
                         if out is not None:
                             self._remember(pat)
                             return out
+        return self._full(q, scale)
+
+    def _full(self, q, scale):
+        """The full solve of :meth:`__call__` (no pattern answered), remembering its pattern."""
         r = self.rel.solve(self.M, q, scale)
         self.full_solves += 1
         lam = r.z
@@ -239,6 +243,84 @@ class _BoxStepper:
         s = np.where(lam - self.lo <= tau, 0, np.where(self.hi - lam <= tau, 2, 1)).astype(np.int8)
         self._remember(s.tobytes())
         return r.z, r.w
+
+    def _try_rows(self, pat: bytes, Q: np.ndarray, qmax: np.ndarray, fin: np.ndarray):
+        """:meth:`_try` of every row of ``Q`` at once: ``(ok, lam)``, ``ok[i]`` whether the pattern answers row ``i``
+        and ``lam[i]`` its answer then — each row's arithmetic :meth:`_try`'s for that row alone (the pattern's
+        ``M_II`` solved per row by the same LAPACK call; ``M @ lam`` a stacked product, the same BLAS call per row as
+        the 1-D one; ``abs``, ``max``, ``+`` and the comparisons round alike elementwise; Python's
+        ``max(qmax, x)``, which keeps ``qmax`` when ``x`` is NaN, by ``where(x > qmax, x, qmax)``).  Rows not
+        ``fin`` (non-finite data, which :meth:`__call__` never tries) are not answered."""
+        I, fixed, lu, MfixedI, loI, hiI, at_lo, at_hi, inner, upper, lower_rows, upper_rows = self._entry(pat)
+        B = Q.shape[0]
+        if lu is False:
+            return np.zeros(B, dtype=bool), None
+        lam = np.repeat(fixed[None, :], B, axis=0)
+        with np.errstate(all="ignore"):
+            if inner:
+                rhs = -(Q[:, I] + MfixedI)
+                lu_, piv = lu
+                sol = np.full((B, I.size), np.nan)
+                for i in np.flatnonzero(fin).tolist():
+                    sol[i] = _GETRS(lu_, piv, rhs[i])[0]
+                lam[:, I] = sol
+            y = (self.M @ lam[:, :, None])[:, :, 0] + Q
+            a = self.m_norm * np.abs(lam).max(axis=1)
+            tau = RTOL * (1.0 + np.where(a > qmax, a, qmax))
+            bad = ~fin
+            if inner:
+                lamI = lam[:, I]
+                bad |= (lamI - loI <= tau[:, None]).any(axis=1)
+                if upper:
+                    bad |= (hiI - lamI <= tau[:, None]).any(axis=1)
+            if lower_rows:
+                bad |= (y[:, at_lo] <= tau[:, None]).any(axis=1)
+            if upper_rows:
+                bad |= (y[:, at_hi] >= -tau[:, None]).any(axis=1)
+        return ~bad, lam
+
+    def rows(self, Q: np.ndarray, scales) -> np.ndarray:
+        """``z`` of :meth:`__call__` for every row of ``Q`` (``scales[i]`` the ``scale`` of row ``i``), called in the
+        rows' order: the same answers, the same last and recent patterns and full solves at the end.  Which
+        pattern answers each row is decided as :meth:`__call__` decides it, row after row; a pattern's candidate
+        answers are computed for the whole block (:meth:`_try_rows`) the first time a row tries it."""
+        B = Q.shape[0]
+        out = np.empty((B, self.M.shape[0]))
+        fin = np.isfinite(Q).all(axis=1)
+        qmax = np.abs(Q).max(axis=1)
+        tried: dict[bytes, tuple] = {}
+        # rows with q ≥ 0 that no pattern answers strictly (a zero component: a point on the domain's edge): the
+        # full solve is solve_lcp's first branch, z = 0, whose pattern is every multiplier at its bound 0 (0 ≤ τ)
+        trivial = np.zeros(B, dtype=bool)
+        if type(self.rel).solve is BoxRelation.solve and self.rel.is_lcp and np.isfinite(self.M).all():
+            trivial = fin & (Q >= 0.0).all(axis=1)
+        zero = bytes(self.M.shape[0])
+        for i in range(B):
+            if self.last is not None and fin[i]:
+                pats = [self.last]
+                if self.psd:
+                    pats += [p for p in self.recent if p != self.last]
+                for k, pat in enumerate(pats):
+                    hit = tried.get(pat)
+                    if hit is None:
+                        hit = tried[pat] = self._try_rows(pat, Q, qmax, fin)
+                    if hit[0][i]:
+                        if k:
+                            self._remember(pat)
+                        out[i] = hit[1][i]
+                        break
+                else:
+                    out[i] = self._full(Q[i], scales[i])[0] if not trivial[i] else self._zero(zero)
+                continue
+            out[i] = self._full(Q[i], scales[i])[0] if not trivial[i] else self._zero(zero)
+        return out
+
+    def _zero(self, zero: bytes) -> float:
+        """:meth:`_full` of finite data ``q ≥ 0`` of an LCP: ``z = 0`` (:func:`verimono.lcs.solve_lcp`'s trivial
+        answer), its pattern remembered, the full solve counted."""
+        self.full_solves += 1
+        self._remember(zero)
+        return 0.0
 
 
 class OperatorRelation(Relation):

@@ -509,6 +509,16 @@ class LCSOperator(Operator):
                     out.append(xE + G @ z)
                 return np.array(out)
             vs = [v] * len(X)
+        rows = getattr(step, "rows", None)
+        if rows is not None and type(s).q_scale is LinearRelationSystem.q_scale and len(X) > 1:
+            # the same arithmetic for the whole block: each product a stacked matmul (the same BLAS call per row
+            # as the 1-D one), ``q_scale``'s two |·|∞ and its sum elementwise, the stepper's rows in order
+            V = np.array(vs, dtype=float).reshape(len(X), -1)
+            xE = (E @ X[:, :, None])[:, :, 0]
+            Q = (C @ xE[:, :, None])[:, :, 0] + V
+            scales = (s._c_norm * np.abs(xE).max(axis=1) + np.abs(V).max(axis=1)).tolist()
+            Z = rows(Q, scales)
+            return xE + (G @ Z[:, :, None])[:, :, 0]
         for x, v in zip(X, vs):
             xE = E @ x
             z, _ = step(C @ xE + v, q_scale(xE, v))
