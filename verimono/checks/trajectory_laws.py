@@ -556,6 +556,8 @@ def witness_rows(stepper: Callable, p: Problem, t: np.ndarray, x: np.ndarray) ->
         h = np.diff(t)
         step = resolvent_kernel(p.operator, np.asarray(p.x0, dtype=float))
         K = len(mu)
+        if x.ndim == 2 and x.dtype == np.float64 and x.shape[1] > 0:
+            return _witness_blocks(p, t, x, mu, h, step)
         dist, back_max, muy_max, hy_max = np.empty(K), np.empty(K), np.empty(K), np.empty(K)
         for k, yk in enumerate(velocity_rows(p, t, x)):
             # |μ y|_∞ and |h y|_∞ from |y|_∞: rounding is monotone and symmetric, so max_i |fl(c y_i)| =
@@ -577,6 +579,51 @@ def witness_rows(stepper: Callable, p: Problem, t: np.ndarray, x: np.ndarray) ->
         key = ("witness_rows", id(stepper), id(p), float(p.T), fingerprint(np.asarray(p.x0)), fingerprint(t), serial)
         value = remembered_value(key, (stepper, p), compute)
     return dict(zip(("distance", "back_max", "muy_max", "hy_max", "x_max"), value))
+
+
+def _witness_blocks(p: Problem, t: np.ndarray, x: np.ndarray, mu: np.ndarray, h: np.ndarray,
+                    step: Callable) -> tuple[np.ndarray, ...]:
+    """:func:`witness_rows`' numbers for float64 states ``(K+1, n)``, formed a block of rows at a time (at most
+    :data:`_INCREMENT_BLOCK` numbers, the blocks :func:`velocity_rows` asks the input's increments for): the
+    same element-wise operations on the same rows as :func:`velocity_rows` and the loop of :func:`witness_rows`
+    (``x_k + h f(x_k) + ∫u - x_{k+1}``, then ``/ h``, ``· μ``, ``+ x_{k+1}``), ``f`` and the resolvent called row
+    by row in the same order, the maxima by :func:`row_absmax` (``max(max, -min, 0)`` of each row, the same
+    number as :func:`_absmax`) and the distances by :func:`norms` of the block (``einsum`` reduces each row
+    of a block as it reduces the row alone: checked bit for bit at n = 1..4097).  One Python pass per row
+    less than the row loop: the trajectory laws' witnesses were a third of their stage's CPU."""
+    K = len(mu)
+    dist, back_max, muy_max, hy_max = np.empty(K), np.empty(K), np.empty(K), np.empty(K)
+    f = p.f
+    plain = f is None and p.input_increments(t[:2]) is None     # velocity_rows' own test, its call kept
+    rows = max(1, _INCREMENT_BLOCK // max(int(np.prod(np.shape(p.x0))), 1))
+    for a in range(0, K, rows):
+        b = min(K, a + rows)
+        hb = h[a:b, None]
+        if plain:
+            Y = np.subtract(x[a:b], x[a + 1:b + 1])
+        else:
+            dU = p.input_increments(t[a:a + rows + 1])
+            Y = x[a:b].copy()
+            if f is not None:
+                F = np.empty_like(Y)
+                for i in range(b - a):
+                    F[i] = as_float64(f(x[a + i]))
+                Y += hb * F
+            if dU is not None:
+                Y += np.asarray(dU[:b - a], dtype=float)
+            Y -= x[a + 1:b + 1]
+        Y /= hb
+        ymax = row_absmax(Y)
+        muy_max[a:b], hy_max[a:b] = mu[a:b] * ymax, h[a:b] * ymax
+        Y *= mu[a:b, None]
+        Y += x[a + 1:b + 1]
+        back = np.empty_like(Y)
+        for i, (yi, mi, ti) in enumerate(zip(Y, mu[a:b].tolist(), t[a + 1:b + 1].tolist())):
+            back[i] = np.reshape(as_float64(step(yi, mi, ti)), yi.shape)
+        back_max[a:b] = row_absmax(back)
+        back -= x[a + 1:b + 1]
+        dist[a:b] = norms(back)
+    return dist, back_max, muy_max, hy_max, row_absmax(x)
 
 
 def _absmax(a: np.ndarray) -> float:
