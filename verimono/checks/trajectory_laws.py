@@ -386,13 +386,12 @@ def check_selections(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int 
     if contains_available:
         # row_tolerances(x[:-1], x[1:], h y) / h, the discrete velocities formed one at a time
         tols = rtol * (1.0 + np.maximum(np.maximum(xm[:-1], xm[1:]), w["hy_max"])) / h
-        for k, yk in enumerate(velocity_rows(p, t, x)):
-            try:
+        try:
+            for k, yk in _velocities(p, t, x, h):
                 member[k] = op.contains(x[k + 1], yk, float(t[k + 1]), tol=float(tols[k]))
-            except NotImplementedError:
-                contains_available = False
-                member[:] = True
-                break
+        except NotImplementedError:
+            contains_available = False
+            member[:] = True
     worst = float(np.max(ratios))
     if contains_available and not member.all():
         worst = max(worst, 1.0 + float(np.sum(~member)))   # membership is boolean: count the misses
@@ -584,7 +583,7 @@ def witness_rows(stepper: Callable, p: Problem, t: np.ndarray, x: np.ndarray) ->
 def _witness_blocks(p: Problem, t: np.ndarray, x: np.ndarray, mu: np.ndarray, h: np.ndarray,
                     step: Callable) -> tuple[np.ndarray, ...]:
     """:func:`witness_rows`' numbers for float64 states ``(K+1, n)``, formed a block of rows at a time (at most
-    :data:`_INCREMENT_BLOCK` numbers, the blocks :func:`velocity_rows` asks the input's increments for): the
+    :func:`_velocity_blocks`' blocks): the
     same element-wise operations on the same rows as :func:`velocity_rows` and the loop of :func:`witness_rows`
     (``x_k + h f(x_k) + ∫u - x_{k+1}``, then ``/ h``, ``· μ``, ``+ x_{k+1}``), ``f`` and the resolvent called row
     by row in the same order, the maxima by :func:`row_absmax` (``max(max, -min, 0)`` of each row, the same
@@ -593,26 +592,7 @@ def _witness_blocks(p: Problem, t: np.ndarray, x: np.ndarray, mu: np.ndarray, h:
     less than the row loop: the trajectory laws' witnesses were a third of their stage's CPU."""
     K = len(mu)
     dist, back_max, muy_max, hy_max = np.empty(K), np.empty(K), np.empty(K), np.empty(K)
-    f = p.f
-    plain = f is None and p.input_increments(t[:2]) is None     # velocity_rows' own test, its call kept
-    rows = max(1, _INCREMENT_BLOCK // max(int(np.prod(np.shape(p.x0))), 1))
-    for a in range(0, K, rows):
-        b = min(K, a + rows)
-        hb = h[a:b, None]
-        if plain:
-            Y = np.subtract(x[a:b], x[a + 1:b + 1])
-        else:
-            dU = p.input_increments(t[a:a + rows + 1])
-            Y = x[a:b].copy()
-            if f is not None:
-                F = np.empty_like(Y)
-                for i in range(b - a):
-                    F[i] = as_float64(f(x[a + i]))
-                Y += hb * F
-            if dU is not None:
-                Y += np.asarray(dU[:b - a], dtype=float)
-            Y -= x[a + 1:b + 1]
-        Y /= hb
+    for a, b, Y in _velocity_blocks(p, t, x, h):
         ymax = row_absmax(Y)
         muy_max[a:b], hy_max[a:b] = mu[a:b] * ymax, h[a:b] * ymax
         Y *= mu[a:b, None]
@@ -624,6 +604,53 @@ def _witness_blocks(p: Problem, t: np.ndarray, x: np.ndarray, mu: np.ndarray, h:
         back -= x[a + 1:b + 1]
         dist[a:b] = norms(back)
     return dist, back_max, muy_max, hy_max, row_absmax(x)
+
+
+def _velocities(p: Problem, t: np.ndarray, x: np.ndarray, h: np.ndarray):
+    """``(k, y_k)`` for every step: :func:`_velocity_blocks`' rows for float64 states ``(K+1, n)``, else
+    :func:`velocity_rows`' (the same numbers)."""
+    if x.ndim == 2 and x.dtype == np.float64 and x.shape[1] > 0:
+        for a, _, Y in _velocity_blocks(p, t, x, h):
+            yield from enumerate(Y, a)
+    else:
+        yield from enumerate(velocity_rows(p, t, x))
+
+
+def _velocity_blocks(p: Problem, t: np.ndarray, x: np.ndarray, h: np.ndarray):
+    """``(a, b, Y)``: the discrete velocities ``y_a .. y_{b-1}`` of float64 states ``(K+1, n)`` as a block ``Y`` of at
+    most :data:`_VELOCITY_BLOCK` numbers (one row when a row is longer: a few rows of memory at any n), the
+    input's increments asked for in :func:`velocity_rows`' blocks (the same calls): the same numbers as
+    :func:`velocity_rows`, by the same element-wise operations on each row (``x_k + h f(x_k) + ∫u - x_{k+1}``,
+    then ``/ h``), ``f`` called row by row in order."""
+    K = len(h)
+    f = p.f
+    plain = f is None and p.input_increments(t[:2]) is None     # velocity_rows' own test, its call kept
+    size = max(int(np.prod(np.shape(p.x0))), 1)
+    rows, sub = max(1, _INCREMENT_BLOCK // size), max(1, _VELOCITY_BLOCK // size)
+    for base in range(0, K, rows):
+        dU = None if plain else p.input_increments(t[base:base + rows + 1])
+        for a in range(base, min(K, base + rows), sub):
+            b = min(K, base + rows, a + sub)
+            hb = h[a:b, None]
+            if plain:
+                Y = np.subtract(x[a:b], x[a + 1:b + 1])
+            else:
+                Y = x[a:b].copy()
+                if f is not None:
+                    F = np.empty_like(Y)
+                    for i in range(b - a):
+                        F[i] = as_float64(f(x[a + i]))
+                    Y += hb * F
+                if dU is not None:
+                    Y += np.asarray(dU[a - base:b - base], dtype=float)
+                Y -= x[a + 1:b + 1]
+            Y /= hb
+            yield a, b, Y
+
+
+#: the most numbers of :func:`_velocity_blocks`' block (its arrays a few times this): rows enough at small n to
+#: leave Python's per-row work behind, one row at large n
+_VELOCITY_BLOCK = 1 << 12
 
 
 def _absmax(a: np.ndarray) -> float:
