@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.tolerances import tolerance
-from ._highs import linprog_highs
+from ..core._highs import linprog_highs
 from .lcp import is_psd, lcp_residual, sol_polyhedron
 from .relations import BoxRelation
 
