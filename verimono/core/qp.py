@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from ._highs import linprog_highs
 from ._linalg import absmax, lstsq_solution
 from .errors import InfeasibleStep, UnverifiedSolution
 from .tolerances import QP_RTOL
@@ -402,8 +403,6 @@ def _feasible(G, h, A, b, n: int) -> bool | None:
     ``None`` when it could not tell.  Asked through :func:`verimono.core._highs.linprog_highs`, ``linprog``'s
     model, options and status without its wrapper (2.5-3 ms of Python a call, a third of the Siconos LCP files'
     unit: 128 calls there)."""
-    from ._highs import linprog_highs
-
     try:
         status, _, _ = linprog_highs(np.zeros(n), np.zeros((0, n)) if G is None else G,
                                      np.zeros(0) if h is None else h, A, b,
