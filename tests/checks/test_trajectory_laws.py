@@ -814,3 +814,30 @@ def test_witness_blocks_are_the_row_loops_numbers_bit_for_bit(name):
         back = np.reshape(step(y * mu[k] + x[k + 1], float(mu[k]), float(t[k + 1])), y.shape)
         assert back_max[k] == laws._absmax(back) and dist[k] == float(laws.norms(back - x[k + 1]))
     np.testing.assert_array_equal(x_max, laws.row_absmax(x))
+
+
+@pytest.mark.parametrize("name", ["translating ball", "moving box", "moving half-space", "play operator, u = sin t"])
+def test_normal_cone_members_of_a_block_are_contains_row_by_row(name):
+    """``selections`` asks a catalog normal cone about a block of rows at once (``_cone_members``): the same
+    booleans as ``NormalCone.contains`` row by row at each row's time and tolerance — on the scheme's own
+    velocities (members), on velocities turned away (not), and on states pushed off the set (not)."""
+    from verimono.checks import trajectory_laws as laws
+
+    p = get(name)
+    op = p.operator
+    assert laws._cone_rows(op)
+    t = np.sort(np.r_[0.0, np.random.default_rng(6).uniform(0, p.T, 40), p.T])
+    x = solve(p, t).x
+    h = np.diff(t)
+    Y = np.array([y for _, y in laws._velocities(p, t, x, h)])
+    rng = np.random.default_rng(7)
+    X1 = x[1:].copy()
+    cases = [(X1, Y), (X1, Y + rng.normal(size=Y.shape)), (X1 + rng.normal(size=X1.shape), Y)]
+    tols = 1e-9 * (1.0 + np.abs(x[1:]).max(axis=1)) / h
+    seen = set()
+    for X, V in cases:
+        got = laws._cone_members(op.S, X, V, t[1:], tols)
+        want = [op.contains(X[k], V[k], float(t[k + 1]), tol=float(tols[k])) for k in range(len(h))]
+        assert got.tolist() == want
+        seen |= set(want)
+    assert seen == {True, False}
