@@ -783,3 +783,61 @@ def test_velocity_rows_are_the_trajectorys_selections_bit_for_bit_in_any_block(m
     rows = np.array(list(tl.velocity_rows(p, t, x)))
     assert np.array_equal(rows, np.asarray(tr.selections))
     assert all(np.array_equal(rows[k], tl.velocity_row(p, t, x, k)) for k in range(len(t) - 1))
+
+
+@pytest.mark.parametrize("name", ["Lipschitz field and input", "play operator, piecewise-linear u",
+                                  "Example ex, v = (sin t, 0)", "t|x| (n=3)"])
+def test_witness_blocks_are_the_row_loops_numbers_bit_for_bit(name):
+    """``witness_rows`` and ``selections``' velocities formed a block of rows at a time (``_witness_blocks``,
+    ``_velocities``) are the row-by-row loop's numbers bit for bit — with a field ``f``, an input (``U`` and
+    ``u``), a complementarity system's stateful resolvent and neither — on a grid of unequal steps (a uniform one
+    for the Example: a step size each would be a factorisation each): the same velocities, ``|J_k - x_{k+1}|``
+    and row maxima the laws' tolerances are made of."""
+    from verimono.checks import trajectory_laws as laws
+    from verimono.core.operator_protocol import resolvent_kernel
+
+    p = get(name)
+    t = (uniform_grid(p.T, steps=58) if name.startswith("Example") else
+         np.sort(np.r_[0.0, np.random.default_rng(5).uniform(0, p.T, 57), p.T]))
+    x = solve(p, t).x
+    h, mu = np.diff(t), laws.witness_steps(t)
+    rows = list(laws.velocity_rows(p, t, x))
+    blocks = list(laws._velocities(p, t, x, h))
+    assert [k for k, _ in blocks] == list(range(len(h)))
+    np.testing.assert_array_equal(np.array([y for _, y in blocks]), np.array(rows))
+    step = resolvent_kernel(p.operator, np.asarray(p.x0, dtype=float))
+    dist, back_max, muy_max, hy_max, x_max = laws._witness_blocks(p, t, x, mu, h, step)
+    step = resolvent_kernel(p.operator, np.asarray(p.x0, dtype=float))
+    for k, y in enumerate(rows):          # the row loop witness_rows ran before the blocks
+        ymax = laws._absmax(y)
+        assert (muy_max[k], hy_max[k]) == (mu[k] * ymax, h[k] * ymax)
+        back = np.reshape(step(y * mu[k] + x[k + 1], float(mu[k]), float(t[k + 1])), y.shape)
+        assert back_max[k] == laws._absmax(back) and dist[k] == float(laws.norms(back - x[k + 1]))
+    np.testing.assert_array_equal(x_max, laws.row_absmax(x))
+
+
+@pytest.mark.parametrize("name", ["translating ball", "moving box", "moving half-space", "play operator, u = sin t"])
+def test_normal_cone_members_of_a_block_are_contains_row_by_row(name):
+    """``selections`` asks a catalog normal cone about a block of rows at once (``_cone_members``): the same
+    booleans as ``NormalCone.contains`` row by row at each row's time and tolerance — on the scheme's own
+    velocities (members), on velocities turned away (not), and on states pushed off the set (not)."""
+    from verimono.checks import trajectory_laws as laws
+
+    p = get(name)
+    op = p.operator
+    assert laws._cone_rows(op)
+    t = np.sort(np.r_[0.0, np.random.default_rng(6).uniform(0, p.T, 40), p.T])
+    x = solve(p, t).x
+    h = np.diff(t)
+    Y = np.array([y for _, y in laws._velocities(p, t, x, h)])
+    rng = np.random.default_rng(7)
+    X1 = x[1:].copy()
+    cases = [(X1, Y), (X1, Y + rng.normal(size=Y.shape)), (X1 + rng.normal(size=X1.shape), Y)]
+    tols = 1e-9 * (1.0 + np.abs(x[1:]).max(axis=1)) / h
+    seen = set()
+    for X, V in cases:
+        got = laws._cone_members(op.S, X, V, t[1:], tols)
+        want = [op.contains(X[k], V[k], float(t[k + 1]), tol=float(tols[k])) for k in range(len(h))]
+        assert got.tolist() == want
+        seen |= set(want)
+    assert seen == {True, False}

@@ -166,3 +166,29 @@ def test_no_point_from_any_back_end_is_infeasible_only_when_certified():
         solve_qp(np.eye(2), np.zeros(2), G, [1.0], A, [5.0], backends=("no such back-end",))
     with pytest.raises(UnverifiedSolution):
         solve_qp(np.eye(2), np.zeros(2), G, [10.0], A, [5.0], backends=("no such back-end",))
+
+
+def test_feasibility_certificate_is_linprogs_answer_on_feasible_and_infeasible_systems():
+    """``_feasible`` asks HiGHS through ``linprog_highs`` (no ``linprog`` wrapper): the same answer as ``linprog``
+    itself with free variables — ``False`` on its certificate of infeasibility, ``True`` on a point — on random
+    systems with and without equalities, infeasible ones (a row and its negation shifted apart) among them."""
+    from scipy.optimize import linprog
+
+    from verimono.core.qp import _feasible
+
+    def reference(G, h, A, b, n):
+        res = linprog(np.zeros(n), A_ub=G, b_ub=h, A_eq=A, b_eq=b, bounds=[(None, None)] * n, method="highs")
+        return False if res.status == 2 else (True if res.status == 0 else None)
+
+    rng = np.random.default_rng(11)
+    answers = []
+    for k in range(60):
+        n, m = int(rng.integers(1, 6)), int(rng.integers(1, 8))
+        G, h = rng.normal(size=(m, n)), rng.normal(size=m)
+        if k % 3 == 0:                       # x·g <= c and -x·g <= -c - 1: no point
+            G, h = np.vstack([G, -G[:1]]), np.r_[h, -h[0] - 1.0]
+        A, b = (rng.normal(size=(1, n)), rng.normal(size=1)) if k % 2 else (None, None)
+        got = _feasible(G, h, A, b, n)
+        assert got == reference(G, h, A, b, n), k
+        answers.append(got)
+    assert {True, False} <= set(answers)

@@ -12,7 +12,7 @@ from scipy.optimize import linprog
 import verimono.checks.section7 as section7
 import verimono.lcs.hypotheses as hyp
 from verimono.lcs import Complementarity, LinearRelationSystem, Relay
-from verimono.lcs._highs import linprog_highs
+from verimono.core._highs import linprog_highs
 from verimono.reference.lcs_example import example_system
 
 
@@ -134,7 +134,7 @@ def test_lcp_feasibility_and_infeasibility_certificate_are_linprogs(monkeypatch)
 def test_without_scipys_private_highs_modules_linprog_itself_answers(monkeypatch):
     """Another SciPy, whose private HiGHS modules are not the ones ``_highs`` reads: ``linprog`` is called, and
     answers as the direct path does."""
-    import verimono.lcs._highs as highs
+    import verimono.core._highs as highs
 
     rng = np.random.default_rng(4)
     cases = []

@@ -281,3 +281,23 @@ def test_direct_lapack_lu_is_scipys_bit_for_bit(n):
     assert lu_solve((lu, piv), np.empty((n, 0))).shape == (n, 0)
     with pytest.raises(ValueError, match="incompatible"):
         lu_solve((lu, piv), np.ones(n + 1))
+
+
+def test_enumerated_patterns_are_all_patterns_looked_up_in_order():
+    """``StepKernel.enumerated`` (the patterns' keys made once per kernel) gives what a loop of ``pattern(s)`` over
+    ``all_patterns()`` gives — the same maps, ``None`` where a map fails — and builds them in the same order, so
+    the patterns' ids (``by_id``) are those of the loop it replaces; a second pass builds nothing."""
+    M = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])   # singular principal blocks: some None
+    sys = LinearRelationSystem([[0.0]], np.zeros((1, 3)), np.zeros((3, 1)), M, Complementarity(),
+                               v=np.array([0.0, -1.0, 1.0]))
+    make = lambda: K.StepKernel(sys, sys.step_matrices(0.2, 1.0), exo_u=False, exo_v=True, v_const=None)  # noqa: E731
+    a, b = make(), make()
+    a.pattern(np.array([0, 1, 0]))            # one built before: the others keep the loop's order after it
+    b.pattern(np.array([0, 1, 0]))
+    got = list(a.enumerated())
+    want = [b.pattern(s) for s in b.all_patterns()]
+    assert [None if p is None else (p.key, p.s.tolist()) for p in got] == \
+           [None if p is None else (p.key, p.s.tolist()) for p in want]
+    assert None in got and len(got) == 8
+    built = len(a.by_id)
+    assert list(a.enumerated()) == got and len(a.by_id) == built

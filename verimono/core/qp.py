@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from ._highs import linprog_highs
 from ._linalg import absmax, lstsq_solution
 from .errors import InfeasibleStep, UnverifiedSolution
 from .tolerances import QP_RTOL
@@ -399,11 +400,13 @@ def solve_qp(P, q, G=None, h=None, A=None, b=None, *, backends=None, scale: floa
 def _feasible(G, h, A, b, n: int) -> bool | None:
     """Whether ``{y : Gy ≤ h, Ay = b}`` has a point, by HiGHS' phase one (``scipy.optimize.linprog`` with a zero
     objective): ``False`` only on its certificate of infeasibility (status 2), ``True`` when it found a point,
-    ``None`` when it could not tell."""
-    from scipy.optimize import linprog
-
+    ``None`` when it could not tell.  Asked through :func:`verimono.core._highs.linprog_highs`, ``linprog``'s
+    model, options and status without its wrapper (2.5-3 ms of Python a call, a third of the Siconos LCP files'
+    unit: 128 calls there)."""
     try:
-        res = linprog(np.zeros(n), A_ub=G, b_ub=h, A_eq=A, b_eq=b, bounds=[(None, None)] * n, method="highs")
+        status, _, _ = linprog_highs(np.zeros(n), np.zeros((0, n)) if G is None else G,
+                                     np.zeros(0) if h is None else h, A, b,
+                                     np.full(n, -np.inf), np.full(n, np.inf))
     except Exception:       # noqa: BLE001 - no certificate either way
         return None
-    return False if res.status == 2 else (True if res.status == 0 else None)
+    return False if status == 2 else (True if status == 0 else None)

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.tolerances import tolerance
-from ._highs import linprog_highs
+from ..core._highs import linprog_highs
 from .lcp import is_psd, lcp_residual, sol_polyhedron
 from .relations import BoxRelation
 
@@ -17,42 +17,71 @@ from .relations import BoxRelation
 def rel_int_margin(system, t: float) -> float | None:
     """``max τ`` of the LP above (``> 0`` iff ``im C ∩ ri(im(𝓜 + D) − v(t)) ≠ ∅``), or None if undecidable."""
     rel = system.relation
-    if not isinstance(rel, BoxRelation) or not is_psd(system.D):
+    if not isinstance(rel, BoxRelation):
         return None
+    lp = _margin_lp(system, rel)
+    if lp is None:
+        return None
+    c, A_ub, head, tail, A_eq, b_eq, lb, ub = lp
+    # linprog(method="highs")'s model, options and answer, without its wrapper (:mod:`verimono.core._highs`)
+    status, fun, _ = linprog_highs(c, A_ub, np.concatenate([head + system.v(t), tail]), A_eq, b_eq, lb, ub)
+    return float(-fun) if status == 0 else float("-inf")
+
+
+#: the margin LPs made, by their system's data (:func:`_margin_lp`); emptied past :data:`_MARGIN_LPS` entries
+_margin_lps: dict = {}
+_MARGIN_LPS = 64
+
+
+def _margin_lp(system, rel) -> tuple | None:
+    """Everything of :func:`rel_int_margin`'s LP but ``v(t)``: ``(c, A_ub, D l, the other rows' right-hand sides,
+    A_eq, b_eq, lb, ub)`` — the same arrays, made once per system's ``C``, ``D`` and bounds (a search over ``t``
+    asks ~500 margins of one system: the rows, ``D ⪰ 0``'s eigenvalues and the loops were half of each
+    call's Python) — or ``None`` when ``D`` is not positive semidefinite (undecidable)."""
     n, m = system.n, system.m
     lo, hi = rel.bounds(m)
-    fin = np.flatnonzero(np.isfinite(hi))
-    f = fin.size
-    E = np.eye(m)[:, fin]
-    # variables y = (x, z, s, τ); rows "expr ≥ τ" written as −expr + τ ≤ 0
-    nv = n + m + f + 1
-    rows, rhs, eq_rows, eq_rhs = [], [], [], []
-    v = system.v(t)
-    # D z + E s + D l + C x + v ≥ τ
-    G = np.hstack([-system.C, -system.D, -E, np.ones((m, 1))])
-    rows.append(G); rhs.append(system.D @ lo + v)
-    degenerate = np.zeros(m, bool)
-    degenerate[fin] = (hi - lo)[fin] <= 0
-    for i in range(m):  # z_i ≥ τ, unless the bound is degenerate (then z_i = 0 is an implicit equality)
-        r = np.zeros(nv)
-        if degenerate[i]:
-            r[n + i] = 1.0; eq_rows.append(r); eq_rhs.append(0.0)
-        else:
-            r[n + i] = -1.0; r[-1] = 1.0; rows.append(r[None]); rhs.append(np.zeros(1))
-    for j, i in enumerate(fin):  # (u − l)_i − z_i ≥ τ and s_j ≥ τ
-        if degenerate[i]:
-            continue
-        r = np.zeros(nv); r[n + i] = 1.0; r[-1] = 1.0
-        rows.append(r[None]); rhs.append(np.array([(hi - lo)[i]]))
-        r = np.zeros(nv); r[n + m + j] = -1.0; r[-1] = 1.0
-        rows.append(r[None]); rhs.append(np.zeros(1))
-    c = np.zeros(nv); c[-1] = -1.0
-    ub = np.full(nv, np.inf); ub[-1] = 1.0
-    # linprog(method="highs")'s model, options and answer, without its wrapper (:mod:`verimono.lcs._highs`)
-    status, fun, _ = linprog_highs(c, np.vstack(rows), np.concatenate(rhs),
-                                   np.vstack(eq_rows) if eq_rows else None, np.array(eq_rhs) if eq_rows else None,
-                                   np.full(nv, -np.inf), ub)
-    return float(-fun) if status == 0 else float("-inf")
+    C, D = np.asarray(system.C, dtype=float), np.asarray(system.D, dtype=float)
+    key = (n, m, C.shape, C.tobytes(), D.shape, D.tobytes(), np.asarray(lo, float).tobytes(),
+           np.asarray(hi, float).tobytes())
+    got = _margin_lps.get(key)
+    if got is not None:
+        return got[0]
+    if not is_psd(system.D):
+        lp = None
+    else:
+        fin = np.flatnonzero(np.isfinite(hi))
+        f = fin.size
+        E = np.eye(m)[:, fin]
+        # variables y = (x, z, s, τ); rows "expr ≥ τ" written as −expr + τ ≤ 0
+        nv = n + m + f + 1
+        rows, rhs, eq_rows, eq_rhs = [], [], [], []
+        # D z + E s + D l + C x + v ≥ τ
+        G = np.hstack([-system.C, -system.D, -E, np.ones((m, 1))])
+        rows.append(G)
+        head = system.D @ lo          # + v(t), per call
+        degenerate = np.zeros(m, bool)
+        degenerate[fin] = (hi - lo)[fin] <= 0
+        for i in range(m):  # z_i ≥ τ, unless the bound is degenerate (then z_i = 0 is an implicit equality)
+            r = np.zeros(nv)
+            if degenerate[i]:
+                r[n + i] = 1.0; eq_rows.append(r); eq_rhs.append(0.0)
+            else:
+                r[n + i] = -1.0; r[-1] = 1.0; rows.append(r[None]); rhs.append(np.zeros(1))
+        for j, i in enumerate(fin):  # (u − l)_i − z_i ≥ τ and s_j ≥ τ
+            if degenerate[i]:
+                continue
+            r = np.zeros(nv); r[n + i] = 1.0; r[-1] = 1.0
+            rows.append(r[None]); rhs.append(np.array([(hi - lo)[i]]))
+            r = np.zeros(nv); r[n + m + j] = -1.0; r[-1] = 1.0
+            rows.append(r[None]); rhs.append(np.zeros(1))
+        c = np.zeros(nv); c[-1] = -1.0
+        ub = np.full(nv, np.inf); ub[-1] = 1.0
+        lp = (c, np.vstack(rows), head, np.concatenate(rhs) if rhs else np.zeros(0),
+              np.vstack(eq_rows) if eq_rows else None, np.array(eq_rhs) if eq_rows else None, np.full(nv, -np.inf), ub)
+    if len(_margin_lps) >= _MARGIN_LPS:
+        _margin_lps.clear()
+    _margin_lps[key] = (lp,)
+    return lp
 
 
 def sample_unit_q(D: np.ndarray, rng) -> np.ndarray:

@@ -41,7 +41,7 @@ from ..core.errors import InfeasibleStep, InvalidProblem, UnverifiedSolution, Ve
 from ..core._linalg import absmax, lstsq_solution, singular_values, svd_reduced
 from ..core.qp import solve_qp
 from ..core.tolerances import POLISH_RTOL, QP_RTOL, RTOL
-from ._highs import linprog_highs
+from ..core._highs import linprog_highs
 
 #: largest n for which complementary pieces are enumerated (2^n pieces)
 ENUM_MAX = 12

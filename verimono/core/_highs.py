@@ -1,0 +1,167 @@
+"""``scipy.optimize.linprog(..., method="highs")`` for small dense LPs, without its wrapper.
+
+For the LPs of Section 7 (4–20 variables) ``linprog``'s Python costs ~8× HiGHS' own solve: it re-validates its
+inputs, converts the matrix through ``scipy.sparse``, and builds an options manager for each of five option
+checks on every call (profiled on the Example's ``lcs.rel_int``: 3.4 ms a call, 0.36 ms of it in HiGHS).
+:func:`linprog_highs` hands HiGHS the **same model with the same options** — the options object made once by
+the checks SciPy's ``_highs_wrapper`` makes, the matrix in the same compressed-column form, infinite bounds as
+``kHighsInf`` — on a fresh solver instance per call as SciPy does, and applies SciPy's own acceptance test
+(``_check_result``: an optimal point within ``√tol·10`` of its bounds and rows).  Its status, objective and
+point are bit for bit ``linprog``'s (``tests/lcs/test_lcs_highs.py`` compares them on random, degenerate,
+infeasible and unbounded LPs).  Only the default options of ``linprog(method="highs")`` are reproduced.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+
+#: SciPy's ``linprog`` default ``tol`` (``_parse_linprog``), and the acceptance tolerance ``_check_result``
+#: derives from it
+_TOL = 1e-9
+_CHECK_TOL = float(np.sqrt(_TOL) * 10)
+
+_state: dict = {}
+
+
+def _core():
+    """HiGHS' bindings and the options object of ``linprog(method="highs")``'s defaults, made once; ``None``
+    when this SciPy's private HiGHS modules are not the ones read here (``linprog`` itself is then called)."""
+    if not _state:
+        try:
+            import scipy.optimize._highspy._core as h
+            from scipy.optimize._highspy import _highs_options as hopt
+            from scipy.optimize._highspy._highs_wrapper import check_option
+            h.HighsLp, h._Highs, h.HighsOptions, h.kHighsInf, h.MatrixFormat.kColwise   # noqa: B018 - present?
+        except (ImportError, AttributeError):                                   # pragma: no cover
+            _state["h"] = None
+            return None
+
+        # the options _linprog_highs passes at its defaults, filtered and checked as _highs_wrapper does
+        options = {"presolve": True, "highs_debug_level": h.HighsDebugLevel.kHighsDebugLevelNone,
+                   "log_to_console": False, "output_flag": False,
+                   "simplex_strategy": h.simplex_constants.SimplexStrategy.kSimplexStrategyDual}
+        manager, probe, opts = hopt.HighsOptionsManager(), h._Highs(), h.HighsOptions()
+        for key, val in options.items():
+            if manager.get_option_type(key) == -1:
+                raise RuntimeError(f"HiGHS does not know the option {key!r}")    # pragma: no cover
+            if key == "presolve":
+                val = "on" if val else "off"
+            opt_type = h.HighsOptionType(manager.get_option_type(key))
+            status, msg = check_option(probe, key, val)
+            if opt_type == h.HighsOptionType.kBool and not isinstance(val, bool):
+                continue                                                       # pragma: no cover
+            if status != 0:
+                warnings.warn(msg, stacklevel=2)                              # pragma: no cover
+                continue                                                       # pragma: no cover
+            setattr(opts, key, val)
+        _state.update(h=h, options=opts, inf=h.kHighsInf)
+    return _state
+
+
+def _replace_inf(x: np.ndarray, inf: float) -> np.ndarray:
+    infs = np.isinf(x)
+    if infs.any():
+        with np.errstate(invalid="ignore"):
+            x[infs] = np.sign(x[infs]) * inf
+    return x
+
+
+def linprog_highs(c, A_ub, b_ub, A_eq=None, b_eq=None, lb=None, ub=None):
+    """``linprog(c, A_ub, b_ub, A_eq, b_eq, bounds=zip(lb, ub), method="highs")``'s ``(status, fun, x)``.
+
+    ``A_ub``, ``A_eq`` dense; ``lb``/``ub`` arrays (``±inf`` for none; default ``0`` and ``+inf`` as
+    ``linprog``'s); ``status`` is ``linprog``'s (0 optimal and accepted; 4 when SciPy's acceptance test
+    refuses HiGHS' optimum; otherwise HiGHS' model status as ``linprog`` maps it); ``fun`` and ``x`` are
+    ``None`` unless HiGHS found an optimum."""
+    st = _core()
+    if st is None or st["h"] is None:
+        return _linprog(c, A_ub, b_ub, A_eq, b_eq, lb, ub)
+    h, inf = st["h"], st["inf"]
+    c = np.array(c, dtype=float)
+    nv = c.size
+    A_ub = np.array(A_ub, dtype=float).reshape(-1, nv)
+    b_ub = np.array(b_ub, dtype=float).reshape(-1)
+    A_eq = np.zeros((0, nv)) if A_eq is None else np.array(A_eq, dtype=float).reshape(-1, nv)
+    b_eq = np.zeros(0) if b_eq is None else np.array(b_eq, dtype=float).reshape(-1)
+    lb = np.zeros(nv) if lb is None else np.array(lb, dtype=float).reshape(nv)
+    ub = np.full(nv, np.inf) if ub is None else np.array(ub, dtype=float).reshape(nv)
+    bounds = np.column_stack([lb, ub])                  # as _clean_inputs makes them, for _check_result
+    with np.errstate(invalid="ignore"):
+        lhs = np.concatenate((-np.ones_like(b_ub) * np.inf, b_eq))
+    rhs = np.concatenate((b_ub, b_eq))
+    # the compressed columns scipy.sparse.csc_array makes of the dense matrix (its nonzeros, column by
+    # column, rows ascending)
+    At = np.vstack((A_ub, A_eq)).T
+    cols, rows = np.nonzero(At)
+    data = At[cols, rows]
+    indptr = np.zeros(nv + 1, dtype=np.int32)
+    np.cumsum(np.bincount(cols, minlength=nv), out=indptr[1:])
+    rhs, lhs = _replace_inf(rhs, inf), _replace_inf(lhs, inf)
+    lb, ub = _replace_inf(lb.copy(), inf), _replace_inf(ub.copy(), inf)
+
+    numrow = rhs.size
+    lp = h.HighsLp()
+    lp.num_col_ = nv
+    lp.num_row_ = numrow
+    lp.a_matrix_.num_col_ = nv
+    lp.a_matrix_.num_row_ = numrow
+    lp.a_matrix_.format_ = h.MatrixFormat.kColwise
+    lp.col_cost_ = c
+    lp.col_lower_ = lb
+    lp.col_upper_ = ub
+    lp.row_lower_ = lhs
+    lp.row_upper_ = rhs
+    lp.a_matrix_.start_ = indptr
+    lp.a_matrix_.index_ = rows.astype(np.int32)
+    lp.a_matrix_.value_ = data
+
+    highs = h._Highs()
+    if highs.passOptions(st["options"]) == h.HighsStatus.kError:
+        return 4, None, None                                                   # pragma: no cover
+    if highs.passModel(lp) == h.HighsStatus.kError:
+        return 2, None, None                                                   # pragma: no cover (kModelError)
+    if highs.run() == h.HighsStatus.kError:
+        return _status(h, highs.getModelStatus()), None, None
+    model_status = highs.getModelStatus()
+    if model_status != h.HighsModelStatus.kOptimal:
+        return _status(h, model_status), None, None
+    info = highs.getInfo()
+    solution = highs.getSolution()
+    x = np.array(solution.col_value)
+    fun = info.objective_function_value
+    slack_all = rhs - solution.row_value
+    slack, con = np.array(slack_all[:b_ub.size]), np.array(slack_all[b_ub.size:])
+    # _check_result
+    tol = _CHECK_TOL
+    if np.isnan(x).any() or math.isnan(fun) or np.isnan(slack).any() or np.isnan(con).any():
+        return 4, fun, x
+    ok = bool(np.all((x >= bounds[:, 0] - tol) & (x <= bounds[:, 1] + tol)))
+    ok = ok and not (slack < -tol).any() and not (np.abs(con) > tol).any()
+    return (0 if ok else 4), fun, x
+
+
+def _linprog(c, A_ub, b_ub, A_eq=None, b_eq=None, lb=None, ub=None):
+    """The same through ``scipy.optimize.linprog`` itself (another SciPy's private HiGHS modules)."""
+    from scipy.optimize import linprog
+
+    nv = len(c)
+    lb = np.zeros(nv) if lb is None else np.asarray(lb, dtype=float)
+    ub = np.full(nv, np.inf) if ub is None else np.asarray(ub, dtype=float)
+    bounds = [(None if np.isinf(lo) else lo, None if np.isinf(hi) else hi) for lo, hi in zip(lb.tolist(), ub.tolist())]
+    b_ub = np.asarray(b_ub, dtype=float).reshape(-1)
+    res = linprog(c, A_ub=A_ub if b_ub.size else None, b_ub=b_ub if b_ub.size else None, A_eq=A_eq, b_eq=b_eq,
+                  bounds=bounds, method="highs")
+    return res.status, (res.fun if res.x is not None else None), res.x
+
+
+def _status(h, model_status) -> int:
+    """``linprog``'s status for a HiGHS model status that is not optimal (``_highs_to_scipy_status_message``)."""
+    M = h.HighsModelStatus
+    return {M.kModelError: 2, M.kTimeLimit: 1, M.kIterationLimit: 1, M.kInfeasible: 2,
+            M.kUnbounded: 3}.get(model_status, 4)
+
+
+__all__ = ["linprog_highs"]
