@@ -86,7 +86,8 @@ def _merged(reports: Iterable[Report]) -> Report:
     return out
 
 
-@register_stage("convergence", "every analytic reference's convergence study against its expected order")
+@register_stage("convergence", "every analytic reference's convergence study against its expected order",
+                overlap=True)
 def convergence_stage(profile: Profile, context: RunContext) -> Report:
     """Every analytic reference's convergence study, plus a trajectory sample for the report's plots;
     one unit per reference."""
@@ -102,7 +103,7 @@ def convergence_stage(profile: Profile, context: RunContext) -> Report:
 
 
 @register_stage("adaptive", "a stepper choosing its own steps (verimono.Adaptive): its rate in the tolerance, the "
-                "laws local to steps on its own partitions, located switching times", default=False)
+                "laws local to steps on its own partitions, located switching times", default=False, overlap=True)
 def adaptive_stage(profile: Profile, context: RunContext) -> Report:
     """:func:`verimono.checks.own_steps.check_adaptive` on every reference, one unit per reference: the stepper
     under test when it is a :class:`verimono.Adaptive` (``verimono check`` chooses this stage for one), else
@@ -157,7 +158,8 @@ def _generated_operators(profile: Profile, seed: int | None) -> list[tuple[str, 
     return [(f"generated #{i} (n={n}, seed {seed})", op) for i, (n, op) in enumerate(drawn)]
 
 
-@register_stage("operator_laws", "resolvent and Yosida laws on the catalog operators and generated families")
+@register_stage("operator_laws", "resolvent and Yosida laws on the catalog operators and generated families",
+                overlap=True)
 def operator_laws_stage(profile: Profile, context: RunContext) -> Report:
     """``check_operator`` on each catalog operator (or the user's) and on generated families.
 
@@ -198,7 +200,7 @@ def _draw_generated(profile: Profile, context: RunContext) -> None:
 
 
 @register_stage("trajectory_laws", "contraction, uniqueness of the limit, domain, a-priori bounds, selections",
-                prepare=_draw_generated)
+                prepare=_draw_generated, overlap=True, after=("convergence",))   # its costs and partitions
 def trajectory_laws_stage(profile: Profile, context: RunContext) -> Report:
     """The trajectory laws of the stepper under test on every reference (and, without a user-given
     problem list, on ``profile.generated_subjects`` sampled problems)."""
@@ -251,7 +253,7 @@ def _checks_unit(checks: list[tuple[str, Callable]], subject: Any,
     return report
 
 
-@register_stage("assumptions", "sampled evidence for (A1), (A2), (A3), (LG), (YB) on every reference")
+@register_stage("assumptions", "sampled evidence for (A1), (A2), (A3), (LG), (YB) on every reference", overlap=True)
 def assumptions_stage(profile: Profile, context: RunContext) -> Report:
     """``check_assumptions(problem)`` on every reference (evidence, never proof).
 
@@ -278,7 +280,8 @@ def _assumptions_unit(check_assumptions: Callable, p: Any, seed: int | None) -> 
     return report
 
 
-@register_stage("section7", "the paper's complementarity example: orders, trajectories, hypotheses")
+@register_stage("section7", "the paper's complementarity example: orders, trajectories, hypotheses",
+                overlap=True)
 def section7_stage(profile: Profile, context: RunContext) -> Report:
     """The complementarity systems of the paper (``verimono.reference.lcs_example``): convergence order
     of the stepper under test on each, a trajectory sample, and the evidence for the hypotheses of the
@@ -341,7 +344,8 @@ def _hypotheses_unit(label: str, seed: int) -> Report:
     return rep
 
 
-@register_stage("siconos", "agreement with the Siconos reference trajectories shipped in verimono/data")
+@register_stage("siconos", "agreement with the Siconos reference trajectories shipped in verimono/data",
+                overlap=True)
 def siconos_stage(profile: Profile, context: RunContext) -> Report:
     """Agreement with the Siconos reference trajectories (the packaged data, or ``--data DIR``)."""
     from ...lcs import siconos_cases as cases
