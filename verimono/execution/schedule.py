@@ -111,10 +111,13 @@ class SharedQueue:
         pass              # the workers are the runner's; execute() closes it
 
     def _wake(self) -> None:
-        try:
-            os.write(self._wake_w, b"x")
-        except OSError:
-            pass
+        with self._cond:                  # never a write to a closed descriptor's number, reused since
+            if self._wake_w < 0:
+                return
+            try:
+                os.write(self._wake_w, b"x")
+            except OSError:
+                pass
 
     # -- the main thread's side --------------------------------------------------------------------------
 
@@ -174,11 +177,13 @@ class SharedQueue:
             self._break(exc)
             raise
         finally:
-            for fd in (self._wake_r, self._wake_w):
-                try:
-                    os.close(fd)
-                except OSError:
-                    pass
+            with self._cond:
+                for fd in (self._wake_r, self._wake_w):
+                    try:
+                        os.close(fd)
+                    except OSError:
+                        pass
+                self._wake_r = self._wake_w = -1
 
     def _assign(self, idle: list, busy: dict, queued: list[tuple[_Job, int]]) -> None:
         # a stage others wait for first; then the longest expected first; ties in the order the stages asked

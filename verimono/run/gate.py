@@ -623,12 +623,18 @@ def _overlapped(stage: dict[str, Any]) -> bool:
 def _group_wall(group: tuple[str, ...], stages: dict[str, dict[str, Any]]) -> dict[str, Any] | None:
     """The stages ``group``, which ran at once in one run, as one stage of the gate's wall comparison: the wall
     of the group (``"group_duration"`` where they overlapped, else the sum of their walls, one after another)
-    and the busy signs of the busiest of them; ``None`` when a stage of the group is missing."""
+    and the busy signs of the busiest of them; ``None`` when a stage of the group is missing, or when they
+    overlapped without one wall of them all (a resumed run's: its stages came from two runs)."""
     if not all(n in stages for n in group):
         return None
     members = [stages[n] for n in group]
-    spans = [m["group_duration"] for m in members if _number(m.get("group_duration"))]
-    wall = max(spans) if spans else sum(float(m.get("duration") or 0.0) for m in members)
+    spans = {m.get("group_duration") for m in members}
+    if not any(_overlapped(m) for m in members):
+        wall = sum(float(m.get("duration") or 0.0) for m in members)
+    elif len(spans) == 1 and _number(next(iter(spans))):
+        wall = float(next(iter(spans)))
+    else:
+        return None
     out: dict[str, Any] = {"name": " + ".join(group), "duration": wall}
     for key in ("cpu_waiting", "foreign_cpu"):
         xs = [m[key] for m in members if _number(m.get(key))]
