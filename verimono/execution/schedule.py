@@ -29,6 +29,7 @@ from multiprocessing.connection import wait as _wait
 from typing import Any, Callable, Sequence
 
 from ..records.results import Report
+from .executors import unpicklable
 from .units import Unit, config_for, unit_failure
 from .workers import _decode_answer, _ship, start_method
 
@@ -251,8 +252,6 @@ class SharedQueue:
         self._progress(job, job.units[i].label)
 
     def _run_here(self, job: _Job) -> None:
-        from .executors import unpicklable
-
         for i in unpicklable(job.units, job.here, job.why, forked=start_method() == "fork"):
             self._give(job, i, self.runner._run_unpicklable(job.units[i], job.cfg))
         job.here.clear()
