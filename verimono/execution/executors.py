@@ -174,6 +174,23 @@ class ProcessRunner:
             proc.join()
         conn.close()
 
+    def start_all(self) -> bool:
+        """Every worker started and ready (:class:`verimono.execution.schedule.SharedQueue` hands units to them
+        itself); ``False`` when they run serially instead (``auto`` whose workers cannot start, as :meth:`map`
+        falls back)."""
+        if self._serial is not None:
+            return False
+        try:
+            self._pool += self._start(self.workers - len(self._pool))
+        except BadExecutor as exc:
+            if not self.fallback:
+                raise
+            print(f"verimono: {exc}; running the units serially", file=sys.stderr)
+            self.close(kill=True)
+            self.workers, self.spec, self._serial = 1, "serial", SerialRunner()
+            return False
+        return True
+
     def map(self, units: Sequence[Unit], profile: RunConfig | str | None, progress: Progress) -> list[Report]:
         results: list[Report | None] = [None] * len(units)
         pending = deque(range(len(units)))
