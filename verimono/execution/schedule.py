@@ -18,24 +18,42 @@ another; only their units, in the workers, overlap.
 A worker that dies, a unit past the timeout, a unit that cannot be pickled and a unit answered for after a
 native hang are handled as :meth:`ProcessRunner.map` handles them (one failed record each, the other units'
 records kept).
+
+**Processes started while the stage threads live** (a worker replacing one that died, timed out or answered for a
+native hang; a worker forked for a unit that cannot be pickled) are started under :meth:`SharedQueue.fork_guard`:
+the main thread takes the turn, so no stage's code runs in this process — every stage thread is parked, waiting
+for the turn, for its units or for a stage it reads — and forks only if, besides those parked stage threads, the
+process has no thread it did not have when its workers were forked before the stages started (no Python thread
+of anyone else's, no new native thread: a HiGHS, XLA or OpenMP pool a stage's code started) and none of
+:data:`~verimono.execution.workers.FORK_UNSAFE` is imported.  A fork then copies no lock held by a running
+thread (a module's import lock, a lock of a C library: a copy would wait on it forever and time out, a false
+failed record).  Otherwise a replacement is spawned (a fresh interpreter: nothing of this process is copied;
+0.55-0.9 s to ready on the 2-core machine against 0.01 s for a fork) and a unit that cannot be pickled runs in
+this process, holding the turn, as :func:`~verimono.execution.executors.run_here` runs it wherever forking is not
+safe.  OpenBLAS's own threads, present before the workers were forked, are stopped around a fork by OpenBLAS
+(``pthread_atfork``).
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
+import sys
 import threading
 import time
 from multiprocessing.connection import wait as _wait
-from typing import Any, Callable, Sequence
+from typing import Any, Callable, Iterator, Sequence
 
 from ..records.results import Report
-from .executors import unpicklable
+from .executors import run_forked, run_here, unpicklable
 from .units import Unit, config_for, unit_failure
-from .workers import _decode_answer, _ship, start_method
+from .workers import FORK_UNSAFE, _decode_answer, _ship
 
 #: seconds the queue waits, with a worker idle, for the stages that have not yet asked for their units, so
 #: that the longest of them goes first (a stage's code builds its units in milliseconds)
 GATHER_SECONDS = 0.05
+#: seconds :meth:`SharedQueue.fork_guard` waits for a stage thread that has just ended to be gone before it forks
+EXIT_WAIT = 0.05
 
 
 class _Job:
@@ -74,6 +92,10 @@ class SharedQueue:
         #: ``(stage, label, worker pid, sent, answered)`` of every unit, ``time.monotonic()`` seconds of this
         #: process: what the run reports of each stage's span on the shared workers
         self.timeline: list[tuple[str | None, str, int | None, float, float]] = []
+        #: the stage threads (:meth:`serve`'s), and this process's threads that are not Python's (OpenBLAS's) when
+        #: the queue was made, its workers already forked: what :meth:`fork_guard` allows besides the main thread
+        self._stage_threads: frozenset[int] = frozenset()
+        self._native0 = _native_threads()
 
     # -- the stage threads' side -------------------------------------------------------------------------
 
@@ -111,6 +133,39 @@ class SharedQueue:
     def close(self) -> None:
         pass              # the workers are the runner's; execute() closes it
 
+    @contextlib.contextmanager
+    def fork_guard(self) -> Iterator[bool]:
+        """Hold the turn (no stage's code runs in this process meanwhile) and say whether a fork of this process
+        is safe now: called from the main thread, every other thread a parked stage thread, no native thread
+        started since the workers were forked, Linux, none of ``FORK_UNSAFE`` imported and
+        ``$VERIMONO_START_METHOD`` not ``spawn`` (see the module docstring).  ``False``: spawn instead, or run
+        here (still holding the turn)."""
+        with self.turn:
+            yield self._fork_safe()
+
+    def _fork_safe(self) -> bool:
+        if os.environ.get("VERIMONO_START_METHOD", "").strip().lower() == "spawn":
+            return False
+        if not sys.platform.startswith("linux") or any(name in sys.modules for name in FORK_UNSAFE):
+            return False
+        main = threading.main_thread()
+        if threading.current_thread() is not main:
+            return False
+        if any(t is not main and t.ident not in self._stage_threads for t in threading.enumerate()):
+            return False
+        deadline = time.monotonic() + EXIT_WAIT
+        while True:
+            native = _native_threads()
+            if native is None or self._native0 is None:
+                return False
+            if native <= self._native0:
+                return True
+            # a stage thread that has just ended may still be leaving (its C thread-local destructors): wait
+            # briefly for it to be gone; a thread still there then is one this process did not have: no fork
+            if time.monotonic() > deadline:
+                return False
+            time.sleep(0.002)
+
     def _wake(self) -> None:
         with self._cond:                  # never a write to a closed descriptor's number, reused since
             if self._wake_w < 0:
@@ -126,6 +181,7 @@ class SharedQueue:
         """Hand the queued units to the workers until every thread of ``threads`` (the stages) has ended;
         ``on_idle()`` between events (the run releases finished stages there, in their order)."""
         runner = self.runner
+        self._stage_threads = frozenset(t.ident for t in threads if t.ident is not None)
         busy: dict[Any, tuple[Any, _Job, int, float]] = {}      # conn -> (worker, job, unit index, start)
         idle = list(runner._pool)
         idle_since: float | None = None
@@ -237,9 +293,11 @@ class SharedQueue:
         return worker
 
     def _replace(self, worker: Any) -> Any:
+        """A new worker in ``worker``'s place: forked under :meth:`fork_guard` where that is safe, else spawned."""
         runner = self.runner
         runner._pool.remove(worker)
-        (new,) = runner._start()
+        with self.fork_guard() as fork:
+            (new,) = runner._start(method="fork" if fork else "spawn")
         runner._pool.append(new)
         return new
 
@@ -252,8 +310,12 @@ class SharedQueue:
         self._progress(job, job.units[i].label)
 
     def _run_here(self, job: _Job) -> None:
-        for i in unpicklable(job.units, job.here, job.why, forked=start_method() == "fork"):
-            self._give(job, i, self.runner._run_unpicklable(job.units[i], job.cfg))
+        """``job``'s units that cannot be pickled: each in a worker forked for it under :meth:`fork_guard` where
+        that is safe, else in this process holding the turn (no stage's code runs meanwhile)."""
+        with self.fork_guard() as fork:
+            for i in unpicklable(job.units, job.here, job.why, forked=fork):
+                unit = job.units[i]
+                self._give(job, i, run_forked(unit, job.cfg, self.timeout) if fork else run_here(unit, job.cfg))
         job.here.clear()
 
     def _complete(self, jobs: list[_Job]) -> None:
@@ -270,6 +332,16 @@ class SharedQueue:
                 if not j.finished.is_set():
                     j.error = exc
                     j.finished.set()
+
+
+def _native_threads() -> int | None:
+    """Threads of this process that are not running Python threads (OpenBLAS's, a C library's pool, a Python thread
+    still leaving after its end); ``None`` where ``/proc`` cannot tell."""
+    try:
+        tids = {int(t) for t in os.listdir("/proc/self/task")}
+    except (OSError, ValueError):
+        return None
+    return len(tids - {t.native_id for t in threading.enumerate()})
 
 
 __all__ = ["SharedQueue", "GATHER_SECONDS"]

@@ -316,8 +316,9 @@ def _run_together(group: list[str], first: int, count: int, profile: Profile, co
                 _HERE.stage = n
                 slots[n] = _run_stage(n, profile, context, overlapped=[m for m in group if m != n])
         except BaseException as exc:  # noqa: BLE001 - the queue closed under it (an interrupt): the run ends
-            slots[n] = _stage_failure(n, exc, 0.0)[0], {"name": n, "status": "error", "records": 1,
-                                                         "duration": 0.0, "cpu": 0.0, "message": str(exc)}
+            with queue.turn:          # a stage's code in this process runs holding the turn, even this (fork_guard)
+                slots[n] = _stage_failure(n, exc, 0.0)[0], {"name": n, "status": "error", "records": 1,
+                                                             "duration": 0.0, "cpu": 0.0, "message": str(exc)}
         finally:
             ended[n].set()
             queue._wake()
