@@ -15,6 +15,7 @@ import contextlib
 import importlib
 import os
 import signal
+import subprocess
 import sys
 import threading
 import time
@@ -177,6 +178,104 @@ def test_the_unsafe_fork_of_an_unpicklable_unit_deadlocks_it(slow_module, cleanu
     assert got["sf_b #6"].status == "passed"
     importer = [r for r in got.values() if "importer" in r.subject]
     assert importer and importer[0].status == "failed", got
+
+
+# -- no stage thread outlives the run: an interrupt while a stage's code is in HiGHS --------------------------------
+
+INTERRUPTED = '''"""A run of two overlapping stages interrupted (SIGINT at 0.3 s) while one stage's code loops on HiGHS."""
+import os, signal, sys, threading, time
+
+import numpy as np
+
+from verimono.execution.executors import ProcessRunner, Unit
+from verimono.execution.profiles import get_profile
+from verimono.lcs._highs import linprog_highs
+from verimono.records.results import CheckResult, Report
+from verimono.run.stages import RunContext, register_stage, run_stages
+import verimono.run.stages.registry as registry
+
+if sys.argv[1:] == ["unsafe"]:           # the pipeline branch's stage threads: daemons, not joined on the way out
+    class _Unsafe(threading.Thread):
+        def __init__(self, *a, **k):
+            super().__init__(*a, **{**k, "daemon": True})
+
+        def join(self, timeout=None):
+            return None
+
+    class _Shim:
+        Thread, Event, Lock, local = _Unsafe, threading.Event, threading.Lock, threading.local
+    registry.threading = _Shim
+
+
+def _sleepy(seconds):
+    time.sleep(seconds)
+    return Report([CheckResult("sleepy", "x", "passed", worst=0.0, bound=1.0)])
+
+
+@register_stage("native_loop", overlap=True)
+def native_loop(profile, context):
+    import scipy.optimize._highspy._core as h
+
+    linprog_highs(np.array([1.0, 1.0]), np.array([[-1.0, -1.0]]), np.array([-1.0]))   # verimono's own call, once
+    lp = h.HighsLp()
+    lp.num_col_, lp.num_row_ = 2, 1
+    lp.col_cost_, lp.col_lower_, lp.col_upper_ = np.ones(2), np.zeros(2), np.full(2, h.kHighsInf)
+    lp.row_lower_, lp.row_upper_ = np.array([1.0]), np.array([h.kHighsInf])
+    lp.a_matrix_.format_ = h.MatrixFormat.kColwise
+    lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = np.array([0, 1, 2]), np.zeros(2, int), np.ones(2)
+    solver = h._Highs()
+    solver.setOptionValue("output_flag", False)
+    solver.passModel(lp)
+    end = time.monotonic() + 2.0
+    signal.setitimer(signal.ITIMER_REAL, 0.3)     # the run is interrupted 0.3 s into this loop
+    while time.monotonic() < end:          # this stage's own code, in this process: HiGHS (pybind11) again and again
+        solver.run()
+    return Report([r for rep in context.run_units(profile, [Unit("native_loop", "u", _sleepy, (0.1,))])
+                   for r in rep.results])
+
+
+@register_stage("waits", overlap=True)
+def waits(profile, context):
+    return Report([r for rep in context.run_units(profile, [Unit("waits", "u", _sleepy, (5.0,))]) for r in rep.results])
+
+
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt
+
+
+if __name__ == "__main__":
+    signal.signal(signal.SIGALRM, _interrupt)
+    runner = ProcessRunner(2)
+    try:
+        run_stages(["waits", "native_loop"], get_profile("ci"), RunContext(executor=runner, schedule="shared"))
+    except KeyboardInterrupt:
+        print("interrupted", flush=True)
+        runner.close(kill=True)
+        sys.exit(3)
+    print("not interrupted", flush=True)
+'''
+
+
+@pytest.mark.slow   # a fresh interpreter importing verimono, and 2 s of HiGHS: ~4 s each
+@pytest.mark.parametrize("threads", ["joined", "daemons"])
+def test_an_interrupted_run_never_aborts_at_exit(threads, tmp_path):
+    """The run is interrupted while one stage's code calls HiGHS (a pybind11 extension releasing the GIL) again
+    and again.  Its stage threads are joined on the way out: the script exits with its own status, 3.  The
+    pipeline branch's daemon threads, not joined ("daemons"): the interpreter finalizes while one is in HiGHS, its
+    return to Python ends it by pthread_exit, whose unwinding aborts the process — "terminate called without an
+    active exception", status 134 (SIGABRT) — seen failing so."""
+    script = tmp_path / "interrupted.py"
+    script.write_text(INTERRUPTED)
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
+    env.pop("VERIMONO_START_METHOD", None)
+    proc = subprocess.run([sys.executable, str(script), *(["unsafe"] if threads == "daemons" else [])],
+                          capture_output=True, text=True, timeout=120, env=env)
+    assert "interrupted" in proc.stdout, proc.stderr[-2000:]
+    if threads == "joined":
+        assert proc.returncode == 3 and "terminate called" not in proc.stderr, (proc.returncode, proc.stderr[-2000:])
+    else:
+        assert proc.returncode == -signal.SIGABRT and "terminate called without an active exception" in proc.stderr, \
+            (proc.returncode, proc.stderr[-2000:])
 
 
 # -- the guard's decision, without processes (default tier) -----------------------------------------------------

@@ -323,7 +323,10 @@ def _run_together(group: list[str], first: int, count: int, profile: Profile, co
             ended[n].set()
             queue._wake()
 
-    threads = [threading.Thread(target=body, args=(n,), name=f"verimono-stage-{n}", daemon=True) for n in group]
+    # not daemons, and joined below even when serving raises: a daemon thread alive at the interpreter's exit that
+    # re-enters a C++ extension releasing the GIL (pybind11's: HiGHS, ProxQP) is ended by pthread_exit, whose
+    # unwinding aborts the process ("terminate called without an active exception", status 134; docs/speed.md)
+    threads = [threading.Thread(target=body, args=(n,), name=f"verimono-stage-{n}") for n in group]
     released = [0]
 
     def release() -> None:
@@ -340,10 +343,16 @@ def _run_together(group: list[str], first: int, count: int, profile: Profile, co
         for t in threads:
             t.start()
         queue.serve(threads, on_idle=release)
-        for t in threads:
-            t.join()
+    except BaseException as exc:
+        queue._break(exc)          # (serve did already, unless a thread failed to start) every waiting stage released
+        raise
     finally:
-        context.executor = outer
+        try:
+            for t in threads:      # each ends at its next unit (the queue closed) or at its end: none outlives the run
+                if t.ident is not None:
+                    t.join()
+        finally:
+            context.executor = outer
     wall = time.perf_counter() - start
     for n in group:      # the group's wall, what the gate compares (a stage's own is the span it shared)
         if slots[n] is not None:
