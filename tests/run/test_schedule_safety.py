@@ -105,6 +105,11 @@ def cleanup_stages():
         STAGES.pop(n, None)
 
 
+def _fork_possible() -> bool:
+    """No thread of pytest's own (xdist's) and nothing FORK_UNSAFE imported by another test: the guard may fork."""
+    return threading.active_count() == 1 and not any(m in sys.modules for m in schedule.FORK_UNSAFE)
+
+
 def _unsafe_guard(self):
     """The safety removed: a fork whenever asked, whatever the stage threads do."""
     return contextlib.nullcontext(True)
@@ -136,7 +141,7 @@ def test_a_lost_worker_is_replaced_safely_and_later_units_pass(how, slow_module,
         return start(self, count, method)
 
     monkeypatch.setattr(ProcessRunner, "_start", spy)
-    alone = threading.active_count() == 1        # no thread of pytest's own (xdist's): the guard may fork
+    alone = _fork_possible()
     rep = _run(_stages(slow_module, how))
     # the two first workers (start_all, no method given), then the replacement: forked under the guard where
     # only the parked stage threads live, spawned where another thread of this process runs
@@ -161,7 +166,7 @@ def test_the_unsafe_fork_of_a_replacement_deadlocks_the_later_unit(slow_module, 
 
 @pytest.mark.slow
 def test_an_unpicklable_unit_runs_forked_under_the_guard(slow_module, cleanup_stages, capfd):
-    alone = threading.active_count() == 1
+    alone = _fork_possible()
     rep = _run(_stages(slow_module, None, unpicklable=True))
     got = _by_subject(rep)
     assert got["sf_a #3"].status == "passed" and got["sf_a #3"].details["value"] == 9, got
@@ -298,9 +303,14 @@ def test_fork_guard_holds_the_turn_and_refuses_a_thread_it_does_not_know(monkeyp
             assert q.turn.locked()
             assert fork is False                        # a Python thread that is not a parked stage thread
         q._stage_threads = frozenset(t.ident for t in threading.enumerate() if t is not threading.main_thread())
+        monkeypatch.setattr(schedule, "FORK_UNSAFE", ("verimono_no_such_module",))   # (JAX imported by another test)
         with q.fork_guard() as fork:
             assert fork is True                         # only stage threads, parked: the fork is safe
         assert not q.turn.locked()
+        monkeypatch.setitem(sys.modules, "verimono_no_such_module", sys.modules[__name__])
+        with q.fork_guard() as fork:
+            assert fork is False                        # a module whose threads do not survive a fork (JAX, torch)
+        monkeypatch.delitem(sys.modules, "verimono_no_such_module")
         monkeypatch.setattr(schedule, "_native_threads", lambda: q._native0 + 1)
         with q.fork_guard() as fork:
             assert fork is False                        # a native thread started since (a HiGHS or XLA pool)
