@@ -140,7 +140,8 @@ class ProcessRunner:
         """``count`` new workers (those :meth:`prestart` launched first), returned once each is ready; ``method``
         as :meth:`_launch`'s (the shared queue chooses it: :meth:`verimono.execution.schedule.SharedQueue.fork_guard`)."""
         started, self._launched = self._launched[:max(0, count)], self._launched[max(0, count):]
-        started += self._launch(count - len(started), method)
+        n = count - len(started)
+        started += self._launch(n) if method is None else self._launch(n, method)
         return self._ready(started)
 
     def _ready(self, started: list[tuple[Any, Any]]) -> list[tuple[Any, Any]]:
