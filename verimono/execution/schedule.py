@@ -23,14 +23,15 @@ records kept).
 native hang; a worker forked for a unit that cannot be pickled) are started under :meth:`SharedQueue.fork_guard`:
 the main thread takes the turn, so no stage's code runs in this process — every stage thread is parked, waiting
 for the turn, for its units or for a stage it reads — and forks only if, besides those parked stage threads, the
-process has no thread it did not have when its workers were forked before the stages started (no Python thread
-of anyone else's, no new native thread: a HiGHS, XLA or OpenMP pool a stage's code started) and none of
+process has no thread it did not have when the stages started (no Python thread of anyone else's, no new native
+thread: a HiGHS, XLA or OpenMP pool a stage's code started; those already there are the ones a run of one stage
+after another forks its replacements beside) and none of
 :data:`~verimono.execution.workers.FORK_UNSAFE` is imported.  A fork then copies no lock held by a running
 thread (a module's import lock, a lock of a C library: a copy would wait on it forever and time out, a false
 failed record).  Otherwise a replacement is spawned (a fresh interpreter: nothing of this process is copied;
 0.55-0.9 s to ready on the 2-core machine against 0.01 s for a fork) and a unit that cannot be pickled runs in
 this process, holding the turn, as :func:`~verimono.execution.executors.run_here` runs it wherever forking is not
-safe.  OpenBLAS's own threads, present before the workers were forked, are stopped around a fork by OpenBLAS
+safe.  OpenBLAS's own threads, there before the workers were forked, are stopped around a fork by OpenBLAS
 (``pthread_atfork``).
 """
 
@@ -93,7 +94,7 @@ class SharedQueue:
         #: process: what the run reports of each stage's span on the shared workers
         self.timeline: list[tuple[str | None, str, int | None, float, float]] = []
         #: the stage threads (:meth:`serve`'s), and this process's threads that are not Python's (OpenBLAS's) when
-        #: the queue was made, its workers already forked: what :meth:`fork_guard` allows besides the main thread
+        #: the queue was made, before the stages start: what :meth:`fork_guard` allows besides the main thread
         self._stage_threads: frozenset[int] = frozenset()
         self._native0 = _native_threads()
 
