@@ -185,6 +185,78 @@ def test_the_unsafe_fork_of_an_unpicklable_unit_deadlocks_it(slow_module, cleanu
     assert importer and importer[0].status == "failed", got
 
 
+# -- a unit is pickled when its stage asks for it, not while another stage's code runs ----------------------------
+
+class _Reduced:
+    """Pickled through Python code (``__reduce__``): the pickler gives up the GIL between a dict's values."""
+
+    def __init__(self, k: int) -> None:
+        self.k = k
+
+    def __reduce__(self):
+        return (_Reduced, (self.k,))
+
+
+SHARED_SIZE = 20_000
+
+
+def _count(shared: dict, tag: str, k: int) -> Report:
+    return Report([CheckResult("count", f"{tag} #{k}", "passed", worst=0.0, bound=1.0, details={"value": len(shared)})])
+
+
+@pytest.fixture
+def sharing_stages(monkeypatch):
+    """``sp_a``: two 0.5 s units, then four that carry a dict of 20,000 entries and count them; ``sp_b``: one short
+    unit, then 1.5 s of its own code adding and removing an entry of that same dict (as stages share the catalog's
+    problems).  Run one after another, every count is 20,000."""
+    shared = {i: _Reduced(i) for i in range(SHARED_SIZE)}
+    monkeypatch.setattr(schedule, "GATHER_SECONDS", 1.0)
+
+    @register_stage("sp_a", overlap=True)
+    def sp_a(profile, context):
+        units = [Unit("sp_a", f"slow{k}", _after, (0.5, "sp_a", k)) for k in (1, 2)]
+        units += [Unit("sp_a", f"count{k}", _count, (shared, "sp_a", k)) for k in range(3, 7)]
+        reps = context.run_units(profile, units, costs=[5.0, 5.0, 0.0, 0.0, 0.0, 0.0])
+        return Report([r for rep in reps for r in rep.results])
+
+    @register_stage("sp_b", overlap=True)
+    def sp_b(profile, context):
+        reps = context.run_units(profile, [Unit("sp_b", "short", _square, ("sp_b", 5))], costs=[9.0])
+        end = time.monotonic() + 1.5
+        while time.monotonic() < end:      # its own code, holding the turn, changes what sp_a's units carry
+            shared[-1] = _Reduced(-1)
+            sum(range(2000))
+            del shared[-1]
+            sum(range(2000))
+        return Report([r for rep in reps for r in rep.results])
+
+    yield ["sp_a", "sp_b"]
+    for n in ("sp_a", "sp_b"):
+        STAGES.pop(n, None)
+
+
+def _counts(rep: Report) -> list:
+    return [r.details.get("value") for r in rep.results if r.check == "count"]
+
+
+@pytest.mark.slow   # two workers, 0.5 s units, 1.5 s of the other stage's code: ~3 s
+def test_units_are_pickled_as_their_stage_asks_not_beside_another_stages_code(sharing_stages, capfd):
+    rep = _run(sharing_stages)
+    assert _counts(rep) == [SHARED_SIZE] * 4 and all(r.status == "passed" for r in rep.results), _counts(rep)
+    assert "cannot be sent" not in capfd.readouterr().err
+
+
+@pytest.mark.slow
+def test_units_pickled_by_the_main_thread_beside_another_stages_code_see_it_change(sharing_stages, monkeypatch,
+                                                                                   capfd):
+    """Seen failing: pickled when a worker frees (the branch's way), while sp_b's code changes the dict — the pickler
+    sees it change size (three times: the unit leaves the workers) or sends a state with sp_b's extra entry."""
+    monkeypatch.setattr(SharedQueue, "_ship_now", lambda self, job: None)
+    rep = _run(sharing_stages)
+    err = capfd.readouterr().err
+    assert "cannot be sent" in err or _counts(rep) != [SHARED_SIZE] * 4, (_counts(rep), err[-1000:])
+
+
 # -- no stage thread outlives the run: an interrupt while a stage's code is in HiGHS --------------------------------
 
 INTERRUPTED = '''"""A run of two overlapping stages interrupted (SIGINT at 0.3 s) while one stage's code loops on HiGHS."""

@@ -68,6 +68,8 @@ class _Job:
         self.pending = list(range(len(self.units)))
         self.here: list[int] = []          # units that cannot be pickled: run once the others are done
         self.why: list[str] = []
+        #: each unit pickled when its stage asked for it (:meth:`SharedQueue._ship_now`), ``None`` until sent
+        self.payloads: list[bytes | None] = [None] * len(self.units)
         self.done = 0
         self.finished = threading.Event()
         self.error: BaseException | None = None
@@ -108,16 +110,19 @@ class SharedQueue:
         if not units:
             progress(0, 0, "")
             return []
+        held = self.turn.locked()
+        job = _Job(-1, units, config_for(profile), progress,
+                   list(costs) if costs is not None else [0.0] * len(units), stage)
+        if held:
+            self._ship_now(job)
         with self._cond:
             if self._broken is not None:
                 raise RuntimeError("the run's shared queue is closed") from self._broken
-            job = _Job(self._seq, units, config_for(profile), progress,
-                       list(costs) if costs is not None else [0.0] * len(units), stage)
+            job.seq = self._seq
             self._seq += 1
             self._jobs.append(job)
             self._waiting += 1
         self._wake()
-        held = self.turn.locked()
         if held:
             self.turn.release()
         try:
@@ -130,6 +135,20 @@ class SharedQueue:
         if job.error is not None:
             raise RuntimeError("the run's shared queue is closed") from job.error
         return [r for r in job.results]  # type: ignore[misc]
+
+    def _ship_now(self, job: _Job) -> None:
+        """Pickle ``job``'s units now, in the stage's thread holding the turn, as one stage after another pickles
+        them with nothing else running: pickled later by the main thread, a unit's arguments were walked while
+        another stage's code changed what they share (the catalog's problems, a registry): "dictionary changed
+        size during iteration" three times over (the unit then ran outside the workers), or worse, a state of
+        them no run of one stage after another sends.  A unit that cannot be pickled runs where nothing is."""
+        for i, u in enumerate(job.units):
+            try:
+                job.payloads[i] = _ship(u, job.cfg)
+            except Exception as exc:  # noqa: BLE001 - it cannot travel: run where nothing is pickled
+                job.here.append(i)
+                job.why.append(f"{type(exc).__name__}: {exc}")
+        job.pending = [i for i in job.pending if i not in job.here]
 
     def close(self) -> None:
         pass              # the workers are the runner's; execute() closes it
@@ -251,12 +270,14 @@ class SharedQueue:
             if not idle:
                 break
             job.pending.remove(i)
-            try:
-                payload = _ship(job.units[i], job.cfg)
-            except Exception as exc:  # noqa: BLE001 - it cannot travel: run where nothing is pickled
-                job.here.append(i)
-                job.why.append(f"{type(exc).__name__}: {exc}")
-                continue
+            payload, job.payloads[i] = job.payloads[i], None
+            if payload is None:          # asked from a thread without the turn: pickled here, as before
+                try:
+                    payload = _ship(job.units[i], job.cfg)
+                except Exception as exc:  # noqa: BLE001 - it cannot travel: run where nothing is pickled
+                    job.here.append(i)
+                    job.why.append(f"{type(exc).__name__}: {exc}")
+                    continue
             worker = idle.pop()
             worker[1].send_bytes(payload)
             busy[worker[1]] = (worker, job, i, time.monotonic())
