@@ -148,3 +148,21 @@ def test_the_gate_judges_stages_that_ran_at_once_by_their_groups_wall():
     assert compare(base, busy).ok
     # the new schedule as the baseline too: group against group
     assert compare(copy.deepcopy(fast), slow).regressions and compare(fast, fast).ok
+
+
+def test_a_group_whose_stages_all_read_each_other_runs_one_after_another():
+    """``verimono check``'s convergence and trajectory_laws (the second reads the first): nothing could overlap, so
+    no thread and no queue; a stage that reads neither may overlap; a chain through a third stage is a chain."""
+    from verimono.run.stages.registry import _some_run_at_once
+
+    made = {"ch_a": (), "ch_b": ("ch_a",), "ch_c": ("ch_b",), "ch_d": ()}
+    for name, after in made.items():
+        register_stage(name, overlap=True, after=after)(lambda profile, context: Report())
+    try:
+        assert not _some_run_at_once(["ch_a", "ch_b"])
+        assert not _some_run_at_once(["ch_a", "ch_b", "ch_c"])        # ch_c reads ch_a through ch_b
+        assert _some_run_at_once(["ch_a", "ch_b", "ch_d"])            # ch_d reads neither
+        assert _some_run_at_once(["ch_a", "ch_d"])
+    finally:
+        for name in made:
+            STAGES.pop(name, None)

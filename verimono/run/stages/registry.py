@@ -279,7 +279,7 @@ def run_stages(names: Iterable[str] | None, profile: Profile, context: RunContex
         while shared and STAGES[group[0]].overlap and i + len(group) < len(names) \
                 and STAGES[names[i + len(group)]].overlap:
             group.append(names[i + len(group)])
-        if len(group) > 1 and context.executor.start_all():
+        if len(group) > 1 and _some_run_at_once(group) and context.executor.start_all():
             _run_together(group, i, len(names), profile, context, on_start, finish)
         else:
             for k, n in enumerate(group):
@@ -288,6 +288,22 @@ def run_stages(names: Iterable[str] | None, profile: Profile, context: RunContex
                 finish(n, *_run_stage(n, profile, context))
         i += len(group)
     return total
+
+
+def _some_run_at_once(group: list[str]) -> bool:
+    """Whether two stages of ``group`` may run at once: neither reads the other's results, even through a third
+    (``verimono check``'s convergence and trajectory_laws, the second after the first, run one after the other
+    as before, without a thread or a queue's gathering wait)."""
+    reads = {n: {d for d in STAGES[n].after if d in group} for n in group}
+    changed = True
+    while changed:                     # what each reads, directly or through another stage of the group
+        changed = False
+        for n in group:
+            more = set().union(*(reads[d] for d in reads[n])) - reads[n]
+            if more:
+                reads[n] |= more
+                changed = True
+    return any(a not in reads[b] and b not in reads[a] for i, a in enumerate(group) for b in group[i + 1:])
 
 
 def _can_share(context: RunContext) -> bool:
