@@ -170,6 +170,18 @@ def _baseline_for(args: argparse.Namespace) -> Report | None:
     return None
 
 
+def _expected_costs(baseline: Report | None, profile: str) -> dict:
+    """Each unit's wall seconds in the baseline, when it was made under ``profile``: the order of the run's
+    shared queue of units, longest first (:attr:`verimono.run.stages.RunContext.expected`).  The baseline is
+    the run's committed record of the same work (CI has it; a previous ``results.json`` may be another
+    machine's or another profile's); a unit it lacks, or a figure gone stale, costs speed only."""
+    if baseline is None or baseline.meta.get("profile") != profile:
+        return {}
+    from .run.stages.registry import expected_costs
+
+    return expected_costs(baseline)
+
+
 def _changes(baseline: Report | None, report: Report) -> Any:
     if baseline is None:
         return None
@@ -350,6 +362,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     run_id = run_id or (_start(out, "run", resumes=resumes) if (out / "results.json").exists() else None)
     baseline = _baseline_for(args)
     ctx = _context(args)
+    ctx.expected = _expected_costs(baseline, args.profile)
     run_id = run_id or _start(out, "run", resumes=resumes)
 
     def run(on_done):

@@ -24,7 +24,8 @@ RUN = ["run", "--profile", "ci", "--stage", "convergence", "--stage", "assumptio
 TIMING_KEYS = {"duration", "timings", "calibration", "calibrations", "created", "run_id", "executor",
                "cpu_waiting", "foreign_cpu", "loadavg",   # how busy the machine was during each stage
                "unit_budget",                             # the unit budget in seconds: units x the calibration
-               "cpu", "calibration_cpu", "calibrations_cpu", "units"}   # CPU times: the stages', the units', the calibrations'
+               "cpu", "calibration_cpu", "calibrations_cpu", "units",   # CPU times: the stages', the units', the calibrations'
+               "overlapped", "group_duration"}   # on workers, the stages that ran at once and their wall together
 
 STEPPERS = '''
 import multiprocessing, os, signal, time

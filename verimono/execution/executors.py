@@ -121,9 +121,10 @@ class ProcessRunner:
         :meth:`map` then finds them ready, or waits for them as for any start."""
         self._launched += self._launch(self.workers - len(self._pool) - len(self._launched))
 
-    def _launch(self, count: int) -> list[tuple[Any, Any]]:
+    def _launch(self, count: int, method: str | None = None) -> list[tuple[Any, Any]]:
+        """``count`` workers started (not yet ready), by ``method`` (``fork``/``spawn``; ``None``: :func:`start_method`)."""
         started = []
-        ctx = multiprocessing.get_context(start_method())
+        ctx = multiprocessing.get_context(method or start_method())
         sys.stdout.flush(), sys.stderr.flush()       # a forked copy must not write this process's buffers again
         for _ in range(max(0, count)):
             parent, child = ctx.Pipe(duplex=True)
@@ -135,10 +136,12 @@ class ProcessRunner:
             started.append((proc, parent))
         return started
 
-    def _start(self, count: int = 1) -> list[tuple[Any, Any]]:
-        """``count`` new workers (those :meth:`prestart` launched first), returned once each is ready."""
+    def _start(self, count: int = 1, method: str | None = None) -> list[tuple[Any, Any]]:
+        """``count`` new workers (those :meth:`prestart` launched first), returned once each is ready; ``method``
+        as :meth:`_launch`'s (the shared queue chooses it: :meth:`verimono.execution.schedule.SharedQueue.fork_guard`)."""
         started, self._launched = self._launched[:max(0, count)], self._launched[max(0, count):]
-        started += self._launch(count - len(started))
+        n = count - len(started)
+        started += self._launch(n) if method is None else self._launch(n, method)
         return self._ready(started)
 
     def _ready(self, started: list[tuple[Any, Any]]) -> list[tuple[Any, Any]]:
@@ -173,6 +176,23 @@ class ProcessRunner:
             proc.kill()
             proc.join()
         conn.close()
+
+    def start_all(self) -> bool:
+        """Every worker started and ready (:class:`verimono.execution.schedule.SharedQueue` hands units to them
+        itself); ``False`` when they run serially instead (``auto`` whose workers cannot start, as :meth:`map`
+        falls back)."""
+        if self._serial is not None:
+            return False
+        try:
+            self._pool += self._start(self.workers - len(self._pool))
+        except BadExecutor as exc:
+            if not self.fallback:
+                raise
+            print(f"verimono: {exc}; running the units serially", file=sys.stderr)
+            self.close(kill=True)
+            self.workers, self.spec, self._serial = 1, "serial", SerialRunner()
+            return False
+        return True
 
     def map(self, units: Sequence[Unit], profile: RunConfig | str | None, progress: Progress) -> list[Report]:
         results: list[Report | None] = [None] * len(units)

@@ -5,7 +5,7 @@ Layout (schema ``verimono.results``, version ``SCHEMA_VERSION`` = ``MAJOR.MINOR`
 
     {
       "schema": "verimono.results",
-      "schema_version": "1.3",
+      "schema_version": "1.4",
       "created": "2025-01-01T12:00:00+00:00",          # UTC, when the document was first written
       "summary": {"passed": 12, "failed": 0, "skipped": 0, "xfail": 0},   # derived, for humans
       "meta": {                                        # free-form facts about the run; keys verimono writes:
@@ -22,6 +22,9 @@ Layout (schema ``verimono.results``, version ``SCHEMA_VERSION`` = ``MAJOR.MINOR`
                     "calibration_cpu": [0.07, ...],    #   the calibration's CPU seconds, sampled beside it
                     "subject_cpu", "subject_calls",    #   the part in the subject's calls (verimono check)
                     "units": [{"label", "cpu", "wall"}],   # each unit's times
+                    "overlapped": [...], "group_duration",  #   ran at once with these stages (their units in
+                                                       #   one queue): "duration" is then its span among them,
+                                                       #   "group_duration" their wall together
                     "cpu_waiting", "foreign_cpu", "loadavg"}],   # how busy the machine was
         "executor": "serial" | "process:2" | ...,      #   where the stages' units ran (stage times compare
                                                        #   only between runs on the same executor)
@@ -53,7 +56,8 @@ numbers) and read back as floats where the field is numeric; ``null`` in a numer
 reads as ``nan``.  Compatibility: a reader accepts the same MAJOR version and any MINOR (minor versions only
 add optional keys; 1.1 added ``environment.blas`` and the optional solvers' versions, 1.2 a study's
 ``floors`` and ``solve_tol``, 1.3 the stages' CPU times: the gate refuses a baseline with stage times
-but without them, :func:`verimono.run.gate.baseline_uncalibrated`); anything else, and
+but without them, :func:`verimono.run.gate.baseline_uncalibrated`; 1.4 a stage's ``overlapped`` and
+``group_duration``, the stages that ran at once, whose walls the gate compares together); anything else, and
 any malformed field, is a :class:`SchemaError`, which the gate turns into exit status 2.  Writing and
 reading whole reports: :mod:`verimono.records.results` (``Report.save``, ``load``).
 """
@@ -74,7 +78,7 @@ from .environment import environment
 from ..core.errors import SchemaError
 
 SCHEMA_NAME = "verimono.results"
-SCHEMA_VERSION = "1.3"
+SCHEMA_VERSION = "1.4"
 _NON_FINITE = ("nan", "inf", "-inf", "+inf", "infinity", "-infinity")
 #: the fields of a result record
 RECORD_FIELDS = frozenset({"check", "subject", "status", "worst", "bound", "counterexample", "message", "seed",

@@ -53,7 +53,10 @@ So:
   (Linux PSI) and processes outside the run used more than ``BUSY_FOREIGN`` of the machine's CPU — or
   between calibrations that drift by more than ``CALIBRATION_DRIFT``, or where a run measured one calibration
   (a run with no timed record — ``verimono check`` — measures none at its end), such growth is listed as not
-  judged;
+  judged.  Stages that ran at once (``"overlapped"``: their units in one queue, :mod:`verimono.execution.schedule`)
+  have no wall time of their own: they are judged together, by the wall time of their group
+  (``"group_duration"``; a baseline run one stage after another: the sum of the same stages' walls), and the
+  busy signs of the busiest of them;
 * a record's same-job ratio (``details["timing_ratio"]``, larger is worse) regresses when it grew by more than
   ``TIMING_GROWTH`` *with confidence*: the lower end of its interval (``details["timing_interval"]``, the
   order-statistics bound of the median per-round ratio, :mod:`verimono.execution.timing`) exceeds ``TIMING_GROWTH``
@@ -620,6 +623,7 @@ def _compare_timings(base: Report, cur: Report, out: list[Change]) -> None:
                                 "subject_cpu")
         if change is not None:
             out.append(change)
+    groups: dict[tuple[str, ...], list[bool]] = {}
     for b, s in both:
         verdict, change = _cpu_change("CPU time", f"stage {s['name']}", b, s, "cpu")
         if change is not None:
@@ -628,9 +632,44 @@ def _compare_timings(base: Report, cur: Report, out: list[Change]) -> None:
                                         "subject_cpu")
         if subject_change is not None:
             out.append(subject_change)
-        if verdict in ("ok", "untimed"):
+        if _overlapped(b) or _overlapped(s):   # no wall of its own: its group's, below
+            group = tuple(sorted({s["name"], *(s.get("overlapped") or b.get("overlapped") or [])}))
+            groups.setdefault(group, []).append(verdict in ("ok", "untimed") and verdict)
+        elif verdict in ("ok", "untimed"):
             _compare_wall(b, s, bcals, ccals, out, cpu_judged=verdict == "ok",
                           start_only=(_start_only(cur.meta), _start_only(base.meta)))
+    for group, verdicts in groups.items():
+        sides = [_group_wall(group, side) for side in (before, {s["name"]: s for _, s in both})]
+        if None not in sides and all(verdicts):
+            _compare_wall(sides[0], sides[1], bcals, ccals, out, cpu_judged=all(v == "ok" for v in verdicts),
+                          start_only=(_start_only(cur.meta), _start_only(base.meta)))
+
+
+def _overlapped(stage: dict[str, Any]) -> bool:
+    return bool(stage.get("overlapped"))
+
+
+def _group_wall(group: tuple[str, ...], stages: dict[str, dict[str, Any]]) -> dict[str, Any] | None:
+    """The stages ``group``, which ran at once in one run, as one stage of the gate's wall comparison: the wall
+    of the group (``"group_duration"`` where they overlapped, else the sum of their walls, one after another)
+    and the busy signs of the busiest of them; ``None`` when a stage of the group is missing, or when they
+    overlapped without one wall of them all (a resumed run's: its stages came from two runs)."""
+    if not all(n in stages for n in group):
+        return None
+    members = [stages[n] for n in group]
+    spans = {m.get("group_duration") for m in members}
+    if not any(_overlapped(m) for m in members):
+        wall = sum(float(m.get("duration") or 0.0) for m in members)
+    elif len(spans) == 1 and _number(next(iter(spans))):
+        wall = float(next(iter(spans)))
+    else:
+        return None
+    out: dict[str, Any] = {"name": " + ".join(group), "duration": wall}
+    for key in ("cpu_waiting", "foreign_cpu"):
+        xs = [m[key] for m in members if _number(m.get(key))]
+        if xs:
+            out[key] = max(xs)
+    return out
 
 
 def _compare_wall(b: dict[str, Any], s: dict[str, Any], bcals: list[float], ccals: list[float], out: list[Change],

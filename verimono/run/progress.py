@@ -22,14 +22,30 @@ class Progress:
             enabled = self.stream.isatty() and not _ci()
         self.tty = enabled
         self.stage, self.index, self.total = "", 0, 1
+        self.running: dict[str, int] = {}     # the stages started and not yet done (several run at once)
+        self._span = 1
         self.width = min(shutil.get_terminal_size((100, 20)).columns, 120)
         self.interval = interval
         self._last_line = time.monotonic()
 
     def start(self, stage: Any, index: int, total: int) -> None:
-        self.stage, self.index, self.total = stage.name, index, total
+        self.running[stage.name] = index
+        self.total = total
+        self._running()
         self._last_line = time.monotonic()
         self.within(0, 1, "")
+
+    def _running(self) -> None:
+        """The stage(s) the line names: one, or ``"stages i-j"`` while several run at once (their units in one
+        queue: the counts within are then over all of them)."""
+        if not self.running:
+            self._span = 1
+            return
+        first, last = min(self.running.values()), max(self.running.values())
+        self.index = first
+        self.stage = (next(iter(self.running)) if len(self.running) == 1 else
+                      f"{', '.join(self.running)} at once")
+        self._span = last - first + 1
 
     def within(self, done: int, total: int, label: str) -> None:
         if not self.tty:
@@ -40,7 +56,7 @@ class Progress:
                                   + (f", at {label}" if label else "") + "\n")
                 self.stream.flush()
             return
-        frac = (self.index + (done / total if total else 1.0)) / self.total
+        frac = (self.index + self._span * (done / total if total else 1.0)) / self.total
         bar_w = 24
         fill = int(round(frac * bar_w))
         text = (f"\r[{'#' * fill}{'-' * (bar_w - fill)}] {frac * 100:3.0f}%  stage {self.index + 1}/{self.total} "
@@ -49,7 +65,9 @@ class Progress:
         self.stream.flush()
 
     def done(self, stage: Any, report: Report, info: dict) -> None:
-        line = (f"[{self.index + 1}/{self.total}] {stage.name}: {info['status']} — "
+        index = self.running.pop(stage.name, self.index)
+        self._running()
+        line = (f"[{index + 1}/{self.total}] {stage.name}: {info['status']} — "
                 f"{info['records']} records, {info['duration']:.1f} s"
                 + (f" ({info['message']})" if info["status"] in ("skipped", "error") else f" ({report.summary()})"))
         if self.tty:

@@ -96,7 +96,8 @@ def _load_optimizers(profile: Profile, context: RunContext) -> None:
     load_optimizers()
 
 
-@register_stage("convergence", "every analytic reference's convergence study against its expected order")
+@register_stage("convergence", "every analytic reference's convergence study against its expected order",
+                overlap=True)
 def convergence_stage(profile: Profile, context: RunContext) -> Report:
     """Every analytic reference's convergence study, plus a trajectory sample for the report's plots;
     one unit per reference."""
@@ -112,7 +113,7 @@ def convergence_stage(profile: Profile, context: RunContext) -> Report:
 
 
 @register_stage("adaptive", "a stepper choosing its own steps (verimono.Adaptive): its rate in the tolerance, the "
-                "laws local to steps on its own partitions, located switching times", default=False)
+                "laws local to steps on its own partitions, located switching times", default=False, overlap=True)
 def adaptive_stage(profile: Profile, context: RunContext) -> Report:
     """:func:`verimono.checks.own_steps.check_adaptive` on every reference, one unit per reference: the stepper
     under test when it is a :class:`verimono.Adaptive` (``verimono check`` chooses this stage for one), else
@@ -168,7 +169,7 @@ def _generated_operators(profile: Profile, seed: int | None) -> list[tuple[str, 
 
 
 @register_stage("operator_laws", "resolvent and Yosida laws on the catalog operators and generated families",
-                prepare=_load_optimizers)
+                prepare=_load_optimizers, overlap=True)
 def operator_laws_stage(profile: Profile, context: RunContext) -> Report:
     """``check_operator`` on each catalog operator (or the user's) and on generated families.
 
@@ -209,7 +210,7 @@ def _draw_generated(profile: Profile, context: RunContext) -> None:
 
 
 @register_stage("trajectory_laws", "contraction, uniqueness of the limit, domain, a-priori bounds, selections",
-                prepare=_draw_generated)
+                prepare=_draw_generated, overlap=True, after=("convergence",))   # its costs and partitions
 def trajectory_laws_stage(profile: Profile, context: RunContext) -> Report:
     """The trajectory laws of the stepper under test on every reference (and, without a user-given
     problem list, on ``profile.generated_subjects`` sampled problems)."""
@@ -263,7 +264,7 @@ def _checks_unit(checks: list[tuple[str, Callable]], subject: Any,
 
 
 @register_stage("assumptions", "sampled evidence for (A1), (A2), (A3), (LG), (YB) on every reference",
-                prepare=_load_optimizers)
+                prepare=_load_optimizers, overlap=True)
 def assumptions_stage(profile: Profile, context: RunContext) -> Report:
     """``check_assumptions(problem)`` on every reference (evidence, never proof).
 
@@ -291,7 +292,7 @@ def _assumptions_unit(check_assumptions: Callable, p: Any, seed: int | None) -> 
 
 
 @register_stage("section7", "the paper's complementarity example: orders, trajectories, hypotheses",
-                prepare=_load_optimizers)
+                prepare=_load_optimizers, overlap=True)
 def section7_stage(profile: Profile, context: RunContext) -> Report:
     """The complementarity systems of the paper (``verimono.reference.lcs_example``): convergence order
     of the stepper under test on each, a trajectory sample, and the evidence for the hypotheses of the
@@ -355,7 +356,7 @@ def _hypotheses_unit(label: str, seed: int) -> Report:
 
 
 @register_stage("siconos", "agreement with the Siconos reference trajectories shipped in verimono/data",
-                prepare=_load_optimizers)
+                prepare=_load_optimizers, overlap=True)
 def siconos_stage(profile: Profile, context: RunContext) -> Report:
     """Agreement with the Siconos reference trajectories (the packaged data, or ``--data DIR``)."""
     from ...lcs import siconos_cases as cases

@@ -21,6 +21,8 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import statistics
+import threading
 import time
 import traceback
 from pathlib import Path
@@ -28,7 +30,8 @@ from typing import Any, Callable, Iterable
 
 from ...checks.core import classify
 from ...core.errors import StageUnavailable, UnknownStage
-from ...execution.executors import SerialRunner
+from ...execution.executors import ProcessRunner, SerialRunner
+from ...execution.schedule import SharedQueue
 from ...execution.calibration import slices_after
 from ...execution.timing import cpu_now, subject_cpu
 from ...lcs.siconos import PACKAGED_DATA, siconos_root
@@ -65,6 +68,13 @@ class RunContext:
     partitions: dict[str, tuple[float, list[int]]] = dataclasses.field(default_factory=dict)
     #: ``(h_min, h_max)``: every convergence study on uniform grids with steps in that range only
     step_range: tuple[float, float] | None = None
+    #: how the stages run on a worker pool of 2 or more processes: ``"shared"``, the stages that may overlap
+    #: (:attr:`Stage.overlap`) at once, their units in one queue over the workers, longest expected first
+    #: (:mod:`verimono.execution.schedule`); ``"stages"``, one stage after another, as before
+    schedule: str = "shared"
+    #: the expected seconds of a unit by ``(stage, label)``, e.g. the baseline's (:func:`expected_costs`): the
+    #: order of the shared queue only (a wrong or missing figure costs speed, never a record)
+    expected: dict[tuple[str, str], float] = dataclasses.field(default_factory=dict)
 
     _catalog: list[Any] | None = dataclasses.field(default=None, repr=False)
 
@@ -72,10 +82,11 @@ class RunContext:
         """``problems`` if given, else the reference catalog (built once per run); then ``extra_problems``."""
         if self.problems is not None:
             return list(self.problems) + list(self.extra_problems)
-        if self._catalog is None:
-            from verimono.reference import catalog
+        with _CATALOG_LOCK:          # stages running at once build it once
+            if self._catalog is None:
+                from verimono.reference import catalog
 
-            self._catalog = catalog()
+                self._catalog = catalog()
         return self._catalog + list(self.extra_problems)
 
     def run_units(self, profile: Profile, units: list[Any], costs: list[float] | None = None) -> list[Report]:
@@ -88,7 +99,10 @@ class RunContext:
         back in the units' order all the same."""
         runner = self.executor if self.executor is not None else SerialRunner()
         timed = [dataclasses.replace(u, fn=timed_unit, args=(u.fn, u.args)) for u in units]
-        if costs is None or isinstance(runner, SerialRunner):
+        if isinstance(runner, SharedQueue):     # one queue with the other stages' units, longest expected first
+            out = runner.map(timed, profile.name, self.progress, costs=self._expected(units, costs),
+                             stage=_running_stage())
+        elif costs is None or isinstance(runner, SerialRunner):
             out = runner.map(timed, profile.name, self.progress)
         else:
             order = sorted(range(len(units)), key=lambda i: -costs[i])
@@ -99,7 +113,22 @@ class RunContext:
         for u, rep in zip(units, out):
             t = rep.meta.pop(UNIT_TIME, None)     # absent: a unit that died or timed out (its record says so)
             if isinstance(t, dict):
-                self.unit_times.append({"stage": u.stage, "label": u.label, **t})
+                self.unit_times.append({"stage": u.stage, "label": u.label, "run_stage": _running_stage(), **t})
+        return out
+
+    def _expected(self, units: list[Any], costs: list[float] | None) -> list[float]:
+        """Each unit's expected seconds in the shared queue: its figure in :attr:`expected`, else the median of
+        its stage's figures there, else its ``costs`` guess (another scale: it only orders a stage without
+        figures), else 0 (the units then go in their stages' and their own order)."""
+        by_stage: dict[str, list[float]] = {}
+        for (stage, _), sec in self.expected.items():
+            by_stage.setdefault(stage, []).append(sec)
+        out = []
+        for i, u in enumerate(units):
+            sec = self.expected.get((u.stage, u.label))
+            if sec is None and by_stage.get(u.stage):
+                sec = statistics.median(by_stage[u.stage])
+            out.append(float(sec) if sec is not None else float(costs[i]) if costs is not None else 0.0)
         return out
 
     def seed_for(self, profile: Profile) -> int | None:
@@ -112,6 +141,28 @@ class RunContext:
 
 #: ``Report.meta`` key under which :func:`timed_unit` hands a unit's times back (popped by ``run_units``)
 UNIT_TIME = "unit_time"
+
+_CATALOG_LOCK = threading.Lock()
+#: the stage the current thread runs (:func:`run_stages`), which ``run_units`` tags each unit's times with
+_HERE = threading.local()
+
+
+def _running_stage() -> str | None:
+    return getattr(_HERE, "stage", None)
+
+
+def expected_costs(report: Report | None) -> dict[tuple[str, str], float]:
+    """The wall seconds of every unit of ``report`` (a baseline, or a previous run's results:
+    ``meta["stages"][k]["units"]``) by ``(stage, label)``: the expected costs that order the shared queue
+    (:attr:`RunContext.expected`).  Empty for ``None`` or a document without unit figures."""
+    out: dict[tuple[str, str], float] = {}
+    for stage in (report.meta.get("stages") or []) if report is not None else []:
+        if not isinstance(stage, dict):
+            continue
+        for u in stage.get("units") or []:
+            if isinstance(u, dict) and isinstance(u.get("wall"), (int, float)) and isinstance(u.get("label"), str):
+                out[(str(stage.get("name")), u["label"])] = float(u["wall"])
+    return out
 
 
 def timed_unit(fn: Callable[..., Report], args: tuple) -> Report:
@@ -143,6 +194,13 @@ class Stage:
     #: ``prepare(profile, context)``, run in this process before the worker processes start (:func:`prepare_stages`):
     #: what the stage's units will unpickle is then imported once, here, and inherited by forked workers
     prepare: Callable[[Profile, RunContext], None] | None = None
+    #: the stage may run at once with the other such stages next to it in the run, its units in one queue with
+    #: theirs (:attr:`RunContext.schedule`): its work is in its units and none of its records measures time.  A
+    #: timed stage (performance), and a stage registered without saying so, runs alone, as before
+    overlap: bool = False
+    #: stages whose results this one reads (``context.costs``, ``context.partitions``): when they run in the
+    #: same run, it starts once they have ended
+    after: tuple[str, ...] = ()
 
 
 STAGES: dict[str, Stage] = {}
@@ -166,12 +224,15 @@ def default_stages() -> list[str]:
 
 
 def register_stage(name: str, description: str = "", *, default: bool = True,
-                   prepare: Callable[[Profile, RunContext], None] | None = None) -> Callable:
+                   prepare: Callable[[Profile, RunContext], None] | None = None, overlap: bool = False,
+                   after: Iterable[str] = ()) -> Callable:
     """Decorator registering ``fn(profile, context) -> Report`` as the stage ``name`` (replaces same name);
-    ``default=False``: a stage on request; ``prepare``: run before the workers start (:class:`Stage`)."""
+    ``default=False``: a stage on request; ``prepare``: run before the workers start; ``overlap``: may run at
+    once with other such stages; ``after``: the stages it reads the results of (:class:`Stage`)."""
 
     def deco(fn: Callable[[Profile, RunContext], Report]) -> Callable:
-        STAGES[name] = Stage(name, fn, description or (fn.__doc__ or "").strip().split("\n")[0], default, prepare)
+        STAGES[name] = Stage(name, fn, description or (fn.__doc__ or "").strip().split("\n")[0], default, prepare,
+                             overlap, tuple(after))
         return fn
 
     return deco
@@ -190,58 +251,177 @@ def _stage_failure(name: str, exc: BaseException, duration: float) -> tuple[Repo
 def run_stages(names: Iterable[str] | None, profile: Profile, context: RunContext,
                on_start: Callable[[Stage, int, int], None] | None = None,
                on_done: Callable[[Stage, Report, dict], None] | None = None) -> Report:
-    """Run the stages ``names`` (``None``: the default ones, in registration order) and merge their reports."""
+    """Run the stages ``names`` (``None``: the default ones, in registration order) and merge their reports.
+
+    On worker processes (2 or more, :attr:`RunContext.schedule` ``"shared"``) the stages next to each other in
+    ``names`` that may overlap (:attr:`Stage.overlap`) run at once, their units in one queue over the workers
+    (:mod:`verimono.execution.schedule`); the report is the same as one stage after another gives — each
+    stage's records in its units' order, the stages in ``names``' order, ``on_done`` called in that order as
+    each stage and those before it have ended — but a stage's ``duration`` is then the wall time from its start
+    to its end while it shared the workers (``info["overlapped"]``: the stages it ran with); its ``cpu`` is its
+    units' CPU seconds plus its own thread's, as before."""
     names = default_stages() if names is None else list(names)
     for n in names:
         if n not in STAGES:
             raise UnknownStage(f"unknown stage {n!r}; registered stages: {', '.join(STAGES)}")
     total = Report(meta={"stages": []})
-    for i, n in enumerate(names):
-        stage = STAGES[n]
-        if on_start:
-            on_start(stage, i, len(names))
-        start = time.perf_counter()
-        serial = context.executor is None or isinstance(context.executor, SerialRunner)
-        # this process's part: all of it when the units run here; else this thread's (it hands out the units
-        # and merges what comes back; a report warm-up thread of this process is not the stage's)
-        own_cpu = cpu_now if serial else time.thread_time
-        cpu0, (subj0, calls0), n_units = own_cpu(), subject_cpu(), len(context.unit_times)
-        try:
-            rep = stage.fn(profile, context)
-            if not isinstance(rep, Report):
-                raise TypeError(f"stage {n} returned {type(rep).__name__}, expected a verimono.Report")
-            status = "failed" if rep.failures else ("undecided" if not rep.ok else "passed")
-            message = rep.summary()
-        except (Exception, *SUBJECT_EXITS) as exc:  # noqa: BLE001 - a crash is a failure of the run, recorded
-            rep, status, message = _stage_failure(n, exc, time.perf_counter() - start)
-        duration = time.perf_counter() - start
-        units = context.unit_times[n_units:]
-        elsewhere = [u for u in units if u.get("pid") != os.getpid()]
-        cpu = own_cpu() - cpu0 + sum(u["cpu"] for u in elsewhere)
-        subj1, calls1 = subject_cpu()
-        subj = subj1 - subj0 + sum(u.get("subject_cpu", 0.0) for u in elsewhere)
-        calls = calls1 - calls0 + sum(u.get("subject_calls", 0) for u in elsewhere)
-        info = {"name": n, "status": status, "records": len(rep), "duration": duration, "cpu": cpu,
-                "message": message}
-        if calls:
-            info.update({"subject_cpu": subj, "subject_calls": calls})
-        slices = [c for u in units for c in u.get("calibration_cpu") or []]
-        if not slices or sum(u["cpu"] for u in units) < 0.5 * cpu:   # the stage's work is mostly not its units'
-            slices += slices_after(cpu)
-        info["calibration_cpu"] = [round(c, 5) for c in slices]
-        if units:
-            info["units"] = [{"label": u["label"], "cpu": round(u["cpu"], 4), "wall": round(u["wall"], 4)}
-                             for u in units]
-        for r in rep.results:
-            r.details.setdefault("stage", n)
-            cx = r.counterexample if isinstance(r.counterexample, dict) else {}
-            if isinstance(cx.get("problem"), str) and cx["problem"] in _reference_names():
-                r.details.setdefault("reference", cx["problem"])  # `--reference NAME` reproduces it
+
+    def finish(n: str, rep: Report, info: dict) -> None:
         total.extend(rep)
         total.meta["stages"].append(info)
         if on_done:
-            on_done(stage, rep, info)
+            on_done(STAGES[n], rep, info)
+
+    shared = _can_share(context)
+    i = 0
+    while i < len(names):
+        group = [names[i]]
+        while shared and STAGES[group[0]].overlap and i + len(group) < len(names) \
+                and STAGES[names[i + len(group)]].overlap:
+            group.append(names[i + len(group)])
+        if len(group) > 1 and _some_run_at_once(group) and context.executor.start_all():
+            _run_together(group, i, len(names), profile, context, on_start, finish)
+        else:
+            for k, n in enumerate(group):
+                if on_start:
+                    on_start(STAGES[n], i + k, len(names))
+                finish(n, *_run_stage(n, profile, context))
+        i += len(group)
     return total
+
+
+def _some_run_at_once(group: list[str]) -> bool:
+    """Whether two stages of ``group`` may run at once: neither reads the other's results, even through a third
+    (``verimono check``'s convergence and trajectory_laws, the second after the first, run one after the other
+    as before, without a thread or a queue's gathering wait)."""
+    reads = {n: {d for d in STAGES[n].after if d in group} for n in group}
+    changed = True
+    while changed:                     # what each reads, directly or through another stage of the group
+        changed = False
+        for n in group:
+            more = set().union(*(reads[d] for d in reads[n])) - reads[n]
+            if more:
+                reads[n] |= more
+                changed = True
+    return any(a not in reads[b] and b not in reads[a] for i, a in enumerate(group) for b in group[i + 1:])
+
+
+def _can_share(context: RunContext) -> bool:
+    """Whether stages may overlap: ``schedule == "shared"`` on a pool of 2 or more worker processes."""
+    return (context.schedule == "shared" and isinstance(context.executor, ProcessRunner)
+            and context.executor.workers >= 2)
+
+
+def _run_together(group: list[str], first: int, count: int, profile: Profile, context: RunContext,
+                  on_start: Callable[[Stage, int, int], None] | None, finish: Callable[[str, Report, dict], None]
+                  ) -> None:
+    """The stages ``group`` at once, each in a thread of its own (taking turns in this process: the queue's
+    ``turn``), their units in one :class:`SharedQueue` served from this thread; ``finish`` in ``group``'s order,
+    each stage as soon as it and those before it have ended."""
+    queue = SharedQueue(context.executor, first=[d for n in group for d in STAGES[n].after if d in group])
+    outer, context.executor = context.executor, queue
+    slots: dict[str, tuple[Report, dict] | None] = {n: None for n in group}
+    ended = {n: threading.Event() for n in group}
+
+    def body(n: str) -> None:
+        try:
+            for dep in STAGES[n].after:
+                if dep in ended:
+                    ended[dep].wait()
+            with queue.turn:
+                _HERE.stage = n
+                slots[n] = _run_stage(n, profile, context, overlapped=[m for m in group if m != n])
+        except BaseException as exc:  # noqa: BLE001 - the queue closed under it (an interrupt): the run ends
+            with queue.turn:          # a stage's code in this process runs holding the turn, even this (fork_guard)
+                slots[n] = _stage_failure(n, exc, 0.0)[0], {"name": n, "status": "error", "records": 1,
+                                                             "duration": 0.0, "cpu": 0.0, "message": str(exc)}
+        finally:
+            ended[n].set()
+            queue._wake()
+
+    # not daemons, and joined below even when serving raises: a daemon thread alive at the interpreter's exit that
+    # re-enters a C++ extension releasing the GIL (pybind11's: HiGHS, ProxQP) is ended by pthread_exit, whose
+    # unwinding aborts the process ("terminate called without an active exception", status 134; docs/speed.md)
+    threads = [threading.Thread(target=body, args=(n,), name=f"verimono-stage-{n}") for n in group]
+    released = [0]
+
+    def release() -> None:
+        while released[0] < len(group) and ended[group[released[0]]].is_set():
+            n = group[released[0]]
+            released[0] += 1
+            finish(n, *slots[n])
+
+    for k, n in enumerate(group):
+        if on_start:
+            on_start(STAGES[n], first + k, count)
+    start = time.perf_counter()
+    try:
+        for t in threads:
+            t.start()
+        queue.serve(threads, on_idle=release)
+    except BaseException as exc:
+        queue._break(exc)          # (serve did already, unless a thread failed to start) every waiting stage released
+        raise
+    finally:
+        try:
+            for t in threads:      # each ends at its next unit (the queue closed) or at its end: none outlives the run
+                if t.ident is not None:
+                    t.join()
+        finally:
+            context.executor = outer
+    wall = time.perf_counter() - start
+    for n in group:      # the group's wall, what the gate compares (a stage's own is the span it shared)
+        if slots[n] is not None:
+            slots[n][1]["group_duration"] = wall
+    release()
+
+
+def _run_stage(n: str, profile: Profile, context: RunContext, overlapped: list[str] | None = None
+               ) -> tuple[Report, dict]:
+    """One stage's report and its ``meta["stages"]`` entry (:func:`run_stages`)."""
+    stage = STAGES[n]
+    start = time.perf_counter()
+    serial = context.executor is None or isinstance(context.executor, SerialRunner)
+    # this process's part: all of it when the units run here; else this thread's (it hands out the units
+    # and merges what comes back; a report warm-up thread of this process is not the stage's)
+    own_cpu = cpu_now if serial else time.thread_time
+    cpu0, (subj0, calls0), n_units = own_cpu(), subject_cpu(), len(context.unit_times)
+    try:
+        rep = stage.fn(profile, context)
+        if not isinstance(rep, Report):
+            raise TypeError(f"stage {n} returned {type(rep).__name__}, expected a verimono.Report")
+        status = "failed" if rep.failures else ("undecided" if not rep.ok else "passed")
+        message = rep.summary()
+    except (Exception, *SUBJECT_EXITS) as exc:  # noqa: BLE001 - a crash is a failure of the run, recorded
+        rep, status, message = _stage_failure(n, exc, time.perf_counter() - start)
+    duration = time.perf_counter() - start
+    units = context.unit_times[n_units:]
+    if overlapped is not None:      # the other stages' units came back in between: this stage's only
+        units = [u for u in units if u.get("run_stage") == n]
+    elsewhere = [u for u in units if u.get("pid") != os.getpid()]
+    cpu = own_cpu() - cpu0 + sum(u["cpu"] for u in elsewhere)
+    subj1, calls1 = subject_cpu()
+    subj = subj1 - subj0 + sum(u.get("subject_cpu", 0.0) for u in elsewhere)
+    calls = calls1 - calls0 + sum(u.get("subject_calls", 0) for u in elsewhere)
+    info = {"name": n, "status": status, "records": len(rep), "duration": duration, "cpu": cpu,
+            "message": message}
+    if overlapped is not None:
+        info["overlapped"] = list(overlapped)
+    if calls:
+        info.update({"subject_cpu": subj, "subject_calls": calls})
+    slices = [c for u in units for c in u.get("calibration_cpu") or []]
+    if not slices or sum(u["cpu"] for u in units) < 0.5 * cpu:   # the stage's work is mostly not its units'
+        slices += slices_after(cpu)
+    info["calibration_cpu"] = [round(c, 5) for c in slices]
+    if units:
+        info["units"] = [{"label": u["label"], "cpu": round(u["cpu"], 4), "wall": round(u["wall"], 4)}
+                         for u in units]
+    for r in rep.results:
+        r.details.setdefault("stage", n)
+        cx = r.counterexample if isinstance(r.counterexample, dict) else {}
+        if isinstance(cx.get("problem"), str) and cx["problem"] in _reference_names():
+            r.details.setdefault("reference", cx["problem"])  # `--reference NAME` reproduces it
+    return rep, info
 
 
 def _reference_names() -> frozenset[str]:
@@ -268,4 +448,4 @@ def locate_data(explicit: str | os.PathLike | None = None) -> Path:
     return path
 
 
-__all__ = ["STAGES", "Stage", "default_stages", "RunContext", "register_stage", "run_stages", "prepare_stages", "locate_data", "timed_unit", "UNIT_TIME"]
+__all__ = ["STAGES", "Stage", "default_stages", "RunContext", "register_stage", "run_stages", "prepare_stages", "locate_data", "timed_unit", "UNIT_TIME", "expected_costs"]
