@@ -393,3 +393,34 @@ def test_fork_guard_holds_the_turn_and_refuses_a_thread_it_does_not_know(monkeyp
     finally:
         stop.set()
         stranger.join(), known.join()
+
+
+def test_fork_guard_waits_for_verimonos_own_report_threads_instead_of_spawning(monkeypatch):
+    """The Python API (``execute`` with no drawer process) starts its own daemon threads: the matplotlib warm-up
+    (an import, ~0.5 s) and the plots drawn after each stage.  A worker lost while one of them ran was *spawned*
+    (0.5-0.9 s, and a script without ``if __name__ == "__main__"`` lost the whole run to a BadExecutor); the guard
+    now waits for such a thread, which ends by itself, and forks — but never for a stranger's thread, and not
+    past OWN_THREAD_WAIT."""
+    from verimono.records.report.plots import PLOTS_THREAD, WARM_UP_THREAD
+
+    monkeypatch.delenv("VERIMONO_START_METHOD", raising=False)
+    monkeypatch.setattr(schedule, "FORK_UNSAFE", ("verimono_no_such_module",))
+    q = SharedQueue(_FakeRunner())
+    monkeypatch.setattr(schedule, "_native_threads", lambda: q._native0)
+    for name in (WARM_UP_THREAD, PLOTS_THREAD):
+        own = threading.Thread(target=time.sleep, args=(0.2,), name=name, daemon=True)
+        own.start()
+        with q.fork_guard() as fork:
+            assert fork is True and not own.is_alive()   # waited for, then forked
+    stop = threading.Event()
+    stuck = threading.Thread(target=stop.wait, name=WARM_UP_THREAD, daemon=True)
+    stuck.start()
+    monkeypatch.setattr(schedule, "OWN_THREAD_WAIT", 0.1)
+    try:
+        t0 = time.monotonic()
+        with q.fork_guard() as fork:
+            assert fork is False and stuck.is_alive()    # not ended within the wait: spawn, as before
+        assert time.monotonic() - t0 < 2.0
+    finally:
+        stop.set()
+        stuck.join()

@@ -45,6 +45,7 @@ import time
 from multiprocessing.connection import wait as _wait
 from typing import Any, Callable, Iterator, Sequence
 
+from ..records.report.plots import PLOTS_THREAD, WARM_UP_THREAD
 from ..records.results import Report
 from .executors import run_forked, run_here, unpicklable
 from .units import Unit, config_for, unit_failure
@@ -55,6 +56,12 @@ from .workers import FORK_UNSAFE, _decode_answer, _ship
 GATHER_SECONDS = 0.05
 #: seconds :meth:`SharedQueue.fork_guard` waits for a stage thread that has just ended to be gone before it forks
 EXIT_WAIT = 0.05
+#: verimono's own background threads of this process, which end by themselves (matplotlib's import, ~0.5 s; the
+#: plots of a finished stage, when no drawer process was forked: the Python API): :meth:`SharedQueue.fork_guard`
+#: waits for them, up to this many seconds in all, and forks, rather than spawning a replacement (0.5-0.9 s, and
+#: a user's script without ``if __name__ == "__main__":`` cannot spawn at all)
+OWN_THREAD_WAIT = 5.0
+OWN_THREADS = frozenset({WARM_UP_THREAD, PLOTS_THREAD})
 
 
 class _Job:
@@ -171,6 +178,10 @@ class SharedQueue:
         main = threading.main_thread()
         if threading.current_thread() is not main:
             return False
+        wait_until = time.monotonic() + OWN_THREAD_WAIT
+        for t in threading.enumerate():
+            if t.name in OWN_THREADS and t is not main and t.ident not in self._stage_threads:
+                t.join(max(0.0, wait_until - time.monotonic()))
         if any(t is not main and t.ident not in self._stage_threads for t in threading.enumerate()):
             return False
         deadline = time.monotonic() + EXIT_WAIT

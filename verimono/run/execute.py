@@ -26,7 +26,7 @@ from ..execution.profiles import get_profile, load_hypothesis_profile
 from ..execution.timeouts import budget_source
 from .progress import Progress
 from ..records.report import write
-from ..records.report.plots import draw_ahead, drawing_elsewhere, warm_up
+from ..records.report.plots import WARM_UP_THREAD, draw_ahead, drawing_elsewhere, warm_up
 from ..records import schema
 from ..records.results import STATUSES, Report, to_jsonable
 from ..execution.calibration import PendingCalibration, calibrate_times, cpu_seconds, set_calibration
@@ -77,7 +77,7 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
     elif waits_on_workers and not drawing_elsewhere():   # this process waits on the workers and draws the
         import threading                                 # plots itself: matplotlib's import and font cache now
 
-        threading.Thread(target=warm_up, name="verimono-report-warm-up", daemon=True).start()
+        threading.Thread(target=warm_up, name=WARM_UP_THREAD, daemon=True).start()
     start = time.perf_counter()
     probe = MachineProbe()
 

@@ -78,6 +78,11 @@ def _reused_axes(kind: str) -> Any:
     return ax
 
 
+#: the names of this process's own background threads (:func:`warm_up`'s, :func:`draw_ahead`'s): they end by
+#: themselves, so a fork guard waits for them rather than spawning (:meth:`verimono.execution.schedule.SharedQueue.fork_guard`)
+WARM_UP_THREAD, PLOTS_THREAD = "verimono-report-warm-up", "verimono-report-plots"
+
+
 def warm_up() -> None:
     """Import matplotlib's figure and Agg canvas: about 0.4 s that the drawer (or a run on worker processes, in a
     background thread of its otherwise waiting process) spends before the first plot is asked for.  Nothing is
@@ -148,7 +153,7 @@ def draw_ahead(studies: Any = (), samples: Any = ()) -> threading.Thread | None:
         except Exception:  # noqa: BLE001 - the report draws it again and reports the error there
             pass
 
-    thread = threading.Thread(target=draw, name="verimono-report-plots", daemon=True)
+    thread = threading.Thread(target=draw, name=PLOTS_THREAD, daemon=True)
     thread.start()
     return thread
 
