@@ -363,6 +363,10 @@ def _cmd_run(args: argparse.Namespace) -> int:
     baseline = _baseline_for(args)
     ctx = _context(args)
     ctx.expected = _expected_costs(baseline, args.profile)
+    if previous is not None:     # the finished convergence stage's grids and costs, which later stages read
+        from .run.stages.builtin import restore_convergence
+
+        restore_convergence(previous, ctx)
     run_id = run_id or _start(out, "run", resumes=resumes)
 
     def run(on_done):

@@ -112,6 +112,26 @@ def convergence_stage(profile: Profile, context: RunContext) -> Report:
     return _merged(reports)
 
 
+def restore_convergence(previous: Report, context: RunContext) -> None:
+    """What the convergence stage leaves in ``context`` for the later stages (:attr:`RunContext.partitions`,
+    which the trajectory laws judge the stepper on too, and :attr:`RunContext.costs`), rebuilt from ``previous``,
+    an interrupted run whose convergence stage finished (``verimono run --resume``): its studies, read back from
+    the results file, give the same grids (without them a resumed run's trajectory_laws records differed from an
+    uninterrupted run's, 21 worst ratios in a ci run).  The costs, which only order units, are its units' walls."""
+    labels: set[str] = set()
+    for stage in previous.meta.get("stages") or []:
+        if isinstance(stage, dict) and stage.get("name") == "convergence":
+            for u in stage.get("units") or []:
+                if isinstance(u, dict) and isinstance(u.get("label"), str):
+                    labels.add(u["label"])
+                    if isinstance(u.get("wall"), (int, float)):
+                        context.costs.setdefault(u["label"], float(u["wall"]))
+    for study in previous.studies:        # the convergence stage's own: one per reference it studied
+        name, T = getattr(study, "problem", None), getattr(study, "T", None)
+        if name in labels and T is not None and name not in context.partitions:
+            context.partitions[name] = (float(T), [len(g) - 1 for g in study.step_law_grids()])
+
+
 @register_stage("adaptive", "a stepper choosing its own steps (verimono.Adaptive): its rate in the tolerance, the "
                 "laws local to steps on its own partitions, located switching times", default=False, overlap=True)
 def adaptive_stage(profile: Profile, context: RunContext) -> Report:
@@ -406,4 +426,4 @@ def _memory_unit(steps: int, stepper: Any) -> Report:
     return Report([performance.check_memory(steps=steps, stepper=stepper)])
 
 
-__all__ = ["sample_trajectory", "TRAJECTORY_SAMPLES"]
+__all__ = ["sample_trajectory", "TRAJECTORY_SAMPLES", "restore_convergence"]
