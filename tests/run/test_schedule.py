@@ -166,3 +166,27 @@ def test_a_group_whose_stages_all_read_each_other_runs_one_after_another():
     finally:
         for name in made:
             STAGES.pop(name, None)
+
+
+def test_a_stage_named_twice_never_runs_at_once_with_itself(monkeypatch):
+    """``verimono run --stage siconos --stage siconos``: the two were one group, two threads of the same stage
+    keyed by one name (one slot, one end event): the same report given twice, each entry listing both threads'
+    units and ``overlapped`` empty.  A name already in a group now starts the next group, as one stage after
+    another runs it twice."""
+    from verimono.run.stages import registry
+
+    for name in ("dup_a", "dup_b"):
+        register_stage(name, overlap=True)(lambda profile, context: Report())
+    groups = []
+    monkeypatch.setattr(registry, "_can_share", lambda context: True)
+    monkeypatch.setattr(registry, "_run_together", lambda group, *a: groups.append(list(group)))
+
+    class _Started:
+        def start_all(self):
+            return True
+    try:
+        run_stages(["dup_a", "dup_a", "dup_b", "dup_a"], get_profile("ci"), RunContext(executor=_Started()))
+    finally:
+        for name in ("dup_a", "dup_b"):
+            STAGES.pop(name, None)
+    assert groups == [["dup_a", "dup_b"]]     # dup_a alone, then dup_a with dup_b, then dup_a alone

@@ -275,9 +275,9 @@ def run_stages(names: Iterable[str] | None, profile: Profile, context: RunContex
     shared = _can_share(context)
     i = 0
     while i < len(names):
-        group = [names[i]]
+        group = [names[i]]     # a stage named twice runs twice, one run after the other (a group keys by name)
         while shared and STAGES[group[0]].overlap and i + len(group) < len(names) \
-                and STAGES[names[i + len(group)]].overlap:
+                and STAGES[names[i + len(group)]].overlap and names[i + len(group)] not in group:
             group.append(names[i + len(group)])
         if len(group) > 1 and _some_run_at_once(group) and context.executor.start_all():
             _run_together(group, i, len(names), profile, context, on_start, finish)
