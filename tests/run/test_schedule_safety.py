@@ -424,3 +424,32 @@ def test_fork_guard_waits_for_verimonos_own_report_threads_instead_of_spawning(m
     finally:
         stop.set()
         stuck.join()
+
+
+RETURNS_AND_EXITS = '''
+from verimono.reference import catalog
+from verimono.run.execute import execute
+from verimono.run.stages import RunContext
+
+if __name__ == "__main__":
+    names = ("moving half-space", "moving box", "linear x' = -Mx", "t|x| (n=1)")
+    execute(command="run", profile_name="ci", stages=["convergence", "trajectory_laws"], executor="process:2",
+            context=RunContext(problems=[p for p in catalog() if p.name in names], seed=0))
+'''
+
+
+@pytest.mark.slow   # three fresh interpreters, each a small run on 2 worker processes: ~2 s each
+def test_a_script_that_exits_as_execute_returns_never_aborts(tmp_path):
+    """The Python API (``execute`` on worker processes, no drawer process) draws each stage's plots in a thread of
+    the user's process (:func:`verimono.records.report.plots.draw_ahead`).  That thread was a daemon: a script
+    exiting as ``execute`` returned finalized the interpreter under it while it was in matplotlib's Agg
+    (pybind11) — "terminate called without an active exception", status 134 (2 of 3 runs here, 6 of 6 of a
+    whole trajectory_laws + convergence run, on 5a13165 as on a2761d7).  Not a daemon now: the exit waits for the
+    plots being drawn."""
+    script = tmp_path / "returns_and_exits.py"
+    script.write_text(RETURNS_AND_EXITS)
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
+    env.pop("VERIMONO_START_METHOD", None)
+    for _ in range(3):
+        proc = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120, env=env)
+        assert proc.returncode == 0 and "terminate called" not in proc.stderr, (proc.returncode, proc.stderr[-2000:])

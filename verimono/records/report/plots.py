@@ -153,7 +153,10 @@ def draw_ahead(studies: Any = (), samples: Any = ()) -> threading.Thread | None:
         except Exception:  # noqa: BLE001 - the report draws it again and reports the error there
             pass
 
-    thread = threading.Thread(target=draw, name=PLOTS_THREAD, daemon=True)
+    # not a daemon: a script exiting as ``execute`` returns would finalize the interpreter under it while it is in
+    # matplotlib's Agg (pybind11), which aborts the process ("terminate called without an active exception",
+    # status 134); the exit now waits for the plots being drawn (tests/run/test_schedule_safety.py)
+    thread = threading.Thread(target=draw, name=PLOTS_THREAD, daemon=False)
     thread.start()
     return thread
 
