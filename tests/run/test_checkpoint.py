@@ -76,3 +76,34 @@ def test_a_resumed_run_has_the_finished_convergence_stages_grids_and_costs(tmp_p
     nothing = RunContext(problems=problems, seed=0)      # a run that had not finished its convergence stage
     restore_convergence(Report(meta={"stages": [{"name": "operator_laws", "units": []}]}), nothing)
     assert nothing.partitions == {} and nothing.costs == {}
+
+
+def test_a_stage_is_saved_before_the_console_says_it_finished():
+    """``[2/7] operator_laws: passed`` was printed before that stage's checkpoint was written: a run killed
+    (SIGKILL) in between — seen in a SIGKILL 10 s into a ci run — showed the stage finished, and ``--resume`` ran it again
+    ("finished: convergence").  The checkpoint (``on_done``) now comes first."""
+    from verimono.records.verdicts import new_record
+    from verimono.run.execute import execute
+    from verimono.run.progress import Progress
+    from verimono.run.stages import STAGES, RunContext, register_stage
+
+    events = []
+
+    class _Line(Progress):
+        def done(self, stage, report, info):
+            events.append(("line", stage.name))
+
+    class _Calibrated:
+        def times(self):
+            return 0.1, [0.1]
+
+    for name in ("ck_a", "ck_b"):
+        register_stage(name)(lambda profile, context, name=name: Report([new_record("square", name, "passed")]))
+    try:
+        execute(command="run", profile_name="ci", stages=["ck_a", "ck_b"], context=RunContext(seed=0),
+                progress=_Line(enabled=False), calibration=_Calibrated(),
+                on_done=lambda stage, rep, info: events.append(("saved", stage.name)))
+    finally:
+        for name in ("ck_a", "ck_b"):
+            STAGES.pop(name, None)
+    assert events == [("saved", "ck_a"), ("line", "ck_a"), ("saved", "ck_b"), ("line", "ck_b")]

@@ -407,6 +407,8 @@ def test_fork_guard_waits_for_verimonos_own_report_threads_instead_of_spawning(m
     monkeypatch.setattr(schedule, "FORK_UNSAFE", ("verimono_no_such_module",))
     q = SharedQueue(_FakeRunner())
     monkeypatch.setattr(schedule, "_native_threads", lambda: q._native0)
+    # threads other tests left alive count as this queue's parked stage threads (as in the test above)
+    q._stage_threads = frozenset(t.ident for t in threading.enumerate() if t is not threading.main_thread())
     for name in (WARM_UP_THREAD, PLOTS_THREAD):
         own = threading.Thread(target=time.sleep, args=(0.2,), name=name, daemon=True)
         own.start()

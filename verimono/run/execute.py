@@ -88,9 +88,9 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
         # the README stepper's check on a 2-core machine)
         if (waits_on_workers or drawing_elsewhere()) and (rep.studies or rep.trajectories):
             draw_ahead(rep.studies, rep.trajectories)
-        progress.done(stage, rep, info)
-        if on_done is not None:
+        if on_done is not None:       # saved (the checkpoint) before the console says the stage finished
             on_done(stage, rep, info)
+        progress.done(stage, rep, info)
 
     try:
         # BLAS_THREADS for the BLAS libraries the checks loaded too (SciPy's OpenBLAS is not NumPy's): the command
