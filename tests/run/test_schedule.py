@@ -190,3 +190,23 @@ def test_a_stage_named_twice_never_runs_at_once_with_itself(monkeypatch):
         for name in ("dup_a", "dup_b"):
             STAGES.pop(name, None)
     assert groups == [["dup_a", "dup_b"]]     # dup_a alone, then dup_a with dup_b, then dup_a alone
+
+
+def test_the_console_line_of_a_stage_that_shared_the_workers_says_so():
+    """``[6/7] siconos: passed — 29 records, 19.8 s``: siconos' units took 1.9 s of that span; the rest was the
+    other five stages' units on the same workers.  The line says the span was shared (docs/run.md: ``duration``
+    is the span, ``overlapped`` the stages it ran with); a stage that ran alone is told as before."""
+    import io
+
+    from verimono.run.progress import Progress
+
+    out = io.StringIO()
+    progress, rep = Progress(out, enabled=False), Report([CheckResult("square", "x", "passed", worst=0.5, bound=1.0)])
+    progress.total = 7
+    info = {"name": "siconos", "status": "passed", "records": 29, "duration": 19.8, "message": ""}
+    progress.done(STAGES["siconos"], rep, {**info, "overlapped": ["convergence", "operator_laws", "trajectory_laws",
+                                                                  "assumptions", "section7"]})
+    progress.done(STAGES["siconos"], rep, info)
+    shared, alone = out.getvalue().splitlines()
+    assert "29 records, 19.8 s at once with 5 other stages (" in shared
+    assert "29 records, 19.8 s (" in alone

@@ -69,6 +69,9 @@ class Progress:
         self._running()
         line = (f"[{index + 1}/{self.total}] {stage.name}: {info['status']} — "
                 f"{info['records']} records, {info['duration']:.1f} s"
+                # a span shared with other stages' units (docs/run.md: `overlapped`), not this stage's own time
+                + (f" at once with {len(info['overlapped'])} other stage{'s' * (len(info['overlapped']) > 1)}"
+                   if info.get("overlapped") else "")
                 + (f" ({info['message']})" if info["status"] in ("skipped", "error") else f" ({report.summary()})"))
         if self.tty:
             self.stream.write("\r" + " " * (self.width - 1) + "\r")
