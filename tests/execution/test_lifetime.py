@@ -162,12 +162,15 @@ def _loaded(pid: int, library: str) -> bool:
 def test_a_signal_while_the_command_imports_is_one_line(sig, tmp_path):
     """Ctrl-C in the first ~2 s of `verimono` (its imports) printed a raw KeyboardInterrupt traceback (SIGTERM
     a bare "Terminated"): now one line and status 130, at two moments of the start: NumPy loaded (verimono's
-    package is importing its core), SciPy loaded (the checks are being imported)."""
+    package is importing its core), SciPy loaded (the user's target is being imported: since `scipy.optimize` is
+    imported on the first QP, a target that cannot be found ends the command before SciPy is loaded at all, so the
+    target here is a module that imports SciPy and then takes its time)."""
     script = Path(sys.executable).with_name("verimono")
     if not script.exists():
         pytest.skip("the verimono console script is not installed next to this interpreter")
-    for moment in ("numpy", "scipy"):
-        proc = subprocess.Popen([str(script), "check", "nowhere:op", "--out", str(tmp_path / "out")], env=_env(),
+    (tmp_path / "slow_target.py").write_text("import time\nimport scipy.linalg\ntime.sleep(60)\nop = None\n")
+    for moment, target in (("numpy", "nowhere:op"), ("scipy", "slow_target:op")):
+        proc = subprocess.Popen([str(script), "check", target, "--out", str(tmp_path / "out")], env=_env(),
                                 cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         assert _wait_until(lambda: _loaded(proc.pid, f"/{moment}") or proc.poll() is not None, step=0.005)
         proc.send_signal(sig)
