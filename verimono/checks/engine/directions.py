@@ -80,11 +80,19 @@ def sketch_directions(op: Any, s: Sample, r: float, rng: np.random.Generator) ->
     m = ((np.array(cols) - j0) / r).T @ q.T            # M = D Qᵀ, D's columns the differences along q_i
     if not np.all(np.isfinite(m)):
         return []
-    sym, gram, res = 0.5 * (m + m.T), m.T @ m, np.eye(n) - m
+    with np.errstate(over="ignore", invalid="ignore"):
+        sym, gram, res = 0.5 * (m + m.T), m.T @ m, np.eye(n) - m
+        forms = (sym, gram, gram - sym, res.T @ res)
     out = []
-    for a in (sym, gram, gram - sym, res.T @ res):
+    for a in forms:
+        # a finite M whose squares overflow (a resolvent with differences ~1e160: LogBarrier near 0 at a large
+        # step) has no eigenvectors to read: eigh of inf gave NaN directions, and the search then handed the
+        # subject x2 = x1 + r·NaN and blamed it for the NaN it returned (a correct operator failed yosida_monotone
+        # in the dev profile, seed 2853691650)
+        if not np.all(np.isfinite(a)):
+            continue
         _, v = np.linalg.eigh(0.5 * (a + a.T))
-        out += [v[:, 0], v[:, -1]]
+        out += [d for d in (v[:, 0], v[:, -1]) if np.all(np.isfinite(d))]
     return out
 
 
