@@ -181,10 +181,13 @@ class ProcessRunner:
         """Every worker started and ready (:class:`verimono.execution.schedule.SharedQueue` hands units to them
         itself); ``False`` when they run serially instead (``auto`` whose workers cannot start, as :meth:`map`
         falls back)."""
-        if self._serial is not None:
-            return False
+        return self._serial is None and self._fill(self.workers)
+
+    def _fill(self, count: int) -> bool:
+        """The pool started up to ``count`` workers; ``False`` when they cannot start and ``auto`` falls back to
+        running serially from now on (said once on standard error); without the fallback the error is raised."""
         try:
-            self._pool += self._start(self.workers - len(self._pool))
+            self._pool += self._start(count - len(self._pool))
         except BadExecutor as exc:
             if not self.fallback:
                 raise
@@ -199,16 +202,7 @@ class ProcessRunner:
         pending = deque(range(len(units)))
         busy: dict[Any, tuple[tuple[Any, Any], int, float]] = {}   # conn -> (worker, unit index, start)
         arrived: list[Report] = []                                  # answered, not yet given to on_report
-        if self._serial is not None:
-            return self._serial.map(units, profile, progress)
-        try:
-            self._pool += self._start(min(self.workers, len(units)) - len(self._pool))
-        except BadExecutor as exc:
-            if not self.fallback:
-                raise
-            print(f"verimono: {exc}; running the units serially", file=sys.stderr)
-            self.close(kill=True)
-            self.workers, self.spec, self._serial = 1, "serial", SerialRunner()
+        if self._serial is not None or not self._fill(min(self.workers, len(units))):
             return self._serial.map(units, profile, progress)
         idle = list(self._pool)
         done = 0
