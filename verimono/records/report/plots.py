@@ -233,6 +233,8 @@ def convergence_figure(study: Any, ax: Any = None, *, legend: bool = True) -> An
     fig = ax.figure
     h = np.asarray(study.mesh, float)
     floor = float(study.floor)
+    ax.set_xscale("log")        # once, before the lines: ``loglog`` would set both scales (and their locators)
+    ax.set_yscale("log")        # again for every line
     positive = []
     for (norm, errs), color, marker in zip(study.errors.items(), COLORS, "osd"):
         e = np.asarray([_num(v) for v in errs])
@@ -241,7 +243,7 @@ def convergence_figure(study: Any, ax: Any = None, *, legend: bool = True) -> An
             continue
         positive.append(e[e > 0])
         shown = np.where(e > 0, e, np.nan)  # exact zeros cannot be drawn on a log axis
-        ax.loglog(h, shown, marker=marker, color=color, lw=1.0 if norm == "sup" else 0.8,
+        ax.plot(h, shown, marker=marker, color=color, lw=1.0 if norm == "sup" else 0.8,
                   alpha=1.0 if norm == "sup" else 0.55, ms=5 if norm == "sup" else 4, label=f"{norm} error")
     fit = study.fits["sup"]
     e = np.asarray([_num(v) for v in study.errors["sup"]])
@@ -258,10 +260,10 @@ def convergence_figure(study: Any, ax: Any = None, *, legend: bool = True) -> An
             hi = np.exp(ce + fit.high * (np.log(hh) - ch))
             ax.fill_between(hh, np.minimum(lo, hi), np.maximum(lo, hi), color=COLORS[0], alpha=0.15, lw=0,
                             label="95% interval")
-        ax.loglog(hh, line, color="black", lw=1.2, label=label)
+        ax.plot(hh, line, color="black", lw=1.2, label=label)
         exp = study.expected
         if exp is not None and exp.value is not None and not exp.exact:
-            ax.loglog(hh, np.exp(ce + exp.value * (np.log(hh) - ch)), color="#555555", ls="--", lw=1.2,
+            ax.plot(hh, np.exp(ce + exp.value * (np.log(hh) - ch)), color="#555555", ls="--", lw=1.2,
                       label=f"expected slope {exp.value:g}")
     elif fit.exact:
         ax.text(0.04, 0.9, "exact at the nodes: every error at round-off", transform=ax.transAxes,
@@ -271,8 +273,6 @@ def convergence_figure(study: Any, ax: Any = None, *, legend: bool = True) -> An
     if fit.exact or floor >= lo / 10:  # the floor matters here: show it
         ax.axhline(floor, color="#888888", ls=":", lw=1.0, label=f"round-off floor {floor:.1e}")
         lo, hi = min(lo, floor / 3), max(hi, floor * 3)
-    ax.set_xscale("log")
-    ax.set_yscale("log")
     ax.yaxis.set_major_formatter(FuncFormatter(_decade))   # plain text: mathtext costs most of the drawing
     ax.yaxis.set_minor_locator(NullLocator())
     ax.set_ylim(lo, hi)
