@@ -388,3 +388,104 @@ drawer.disconnect(); pending.close()
     assert out.returncode == 0, out.stderr
     n = len(small_report.studies) + len(small_report.trajectories)
     assert out.stdout.split() == [str(n), "True", "True", "True"]
+
+
+# -- the report's plots: thinned for drawing, each segment's extrema kept ------------------------------------------
+
+def _segments_missing_extrema(y, kept, count):
+    """The segments ``[a, b]`` between evenly spaced neighbours (every ``ceil((n-1)/count)``-th point, and the
+    last) whose lowest or highest value is not among ``kept``: what a decimation for a plot must never do."""
+    y, kept = np.asarray(y, float), np.asarray(kept)
+    n = len(y)
+    every = max(1, -(-(n - 1) // count))
+    base = sorted({*range(0, n, every), n - 1})
+    bad = []
+    for a, b in zip(base, base[1:]):
+        seg, mine = y[a:b + 1], y[kept[(kept >= a) & (kept <= b)]]
+        if np.all(np.isnan(seg)):
+            continue
+        if not (mine.size and np.nanmax(mine) == np.nanmax(seg) and np.nanmin(mine) == np.nanmin(seg)):
+            bad.append((a, b))
+    return bad
+
+
+@pytest.mark.parametrize("n, count", [(2, 60), (61, 60), (62, 60), (201, 60), (1000, 60), (10_007, 342), (400, 342)])
+def test_keep_extrema_keeps_each_segments_min_and_max(n, count):
+    """``plots.keep_extrema``: about ``count`` evenly spaced points, and between two of them the segment's lowest
+    and highest point: every segment's extremes are drawn (a random walk with one-point spikes and NaN gaps)."""
+    from verimono.records.report.plots import keep_extrema
+
+    rng = np.random.default_rng(n)
+    y = np.cumsum(rng.normal(size=n))
+    for i in rng.integers(0, n, size=3):
+        y[i] += rng.choice([-1, 1]) * 40.0                      # spikes, most of them between even points
+    if n > 100:
+        y[n // 3: n // 3 + 5] = np.nan                          # a gap in the line
+    kept = keep_extrema(y, count)
+    assert list(kept) == sorted(set(kept.tolist())) and kept[0] == 0 and kept[-1] == n - 1
+    assert len(kept) <= 3 * count + 2
+    assert _segments_missing_extrema(y, kept, count) == []
+    if n > 2 * count:                                           # it thins: fewer points than given
+        assert len(kept) < n
+
+
+def test_a_stride_decimation_drops_a_spike_the_extrema_check_sees():
+    """The check above, seen failing: every k-th point (the trajectory plot's markers before) steps over a spike."""
+    from verimono.records.report.plots import keep_extrema
+
+    y = np.sin(np.linspace(0, 3, 1000))
+    y[501] = 9.0                                                # between two of every 17th point
+    stride = np.arange(0, 1000, 17)
+    assert _segments_missing_extrema(y, stride, 60) != []
+    assert _segments_missing_extrema(y, keep_extrema(y, 60), 60) == []
+
+
+def test_a_trajectory_plot_of_a_long_sample_draws_its_spike_at_the_axes_resolution():
+    """A sample of 10^4 points: the exact line is drawn at about one point per pixel column (the figure needs
+    no more) and the markers at about 60, both through the one-point spike between evenly spaced points."""
+    from verimono.records.report import plots
+
+    t = np.linspace(0.0, 1.0, 10_001)
+    x = np.column_stack([np.cos(3 * t), np.sin(3 * t)])
+    x[5_003, 1] = 4.0
+    sample = {"problem": "spike", "h": 1e-4, "t": t.tolist(), "x": x.tolist(), "t_exact": t.tolist(),
+              "exact": x.tolist()}
+    ax = plots.trajectory_figure(sample, legend=False).axes[0]
+    exact, marks = [ln for ln in ax.lines if ln.get_marker() in ("None", "", None)], \
+        [ln for ln in ax.lines if ln.get_marker() == "o"]
+    assert len(exact) == len(marks) == 2
+    for ln, most in ((exact[1], 3 * plots.LINE_POINTS + 2), (marks[1], 3 * plots.MARKERS + 2)):
+        assert ln.get_ydata().max() == 4.0 and len(ln.get_ydata()) <= most
+    assert exact[0].get_ydata().min() == x[:, 0].min() and exact[0].get_ydata().max() == x[:, 0].max()
+
+
+def test_a_report_with_many_plots_has_unique_element_ids(small_report):
+    """Every id in the document once (the grid's line collections too: ``_svg`` salts them per figure)."""
+    from verimono.records.report import plots
+
+    plots.forget()
+    ids = re.findall(r'\bid="([^"]+)"', render(small_report))
+    assert len(ids) == len(set(ids)) > 0
+    plots.forget()
+
+
+def test_a_runs_trajectory_sample_keeps_a_spike_of_a_long_trajectory():
+    """``sample_trajectory`` thins a long trajectory for the report (400 evenly spaced points before): a one-step
+    spike of the stepper's is kept among them, as each segment's extremes are; a short one is kept whole."""
+    import verimono as vm
+    from verimono.reference import get
+    from verimono.run.stages.builtin import TRAJECTORY_SAMPLES, sample_trajectory
+
+    problem = get("t|x| (n=1)")
+
+    def spiky(problem, t):
+        x = np.array(vm.solve(problem, t), dtype=float)
+        x[1001] += 5.0                                      # between two of 400 evenly spaced nodes of 2001
+        return x
+
+    sample = sample_trajectory(spiky, problem, h=problem.T / 2000)
+    x, full = np.asarray(sample["x"], float), spiky(problem, np.linspace(0.0, problem.T, 2001))
+    assert np.max(x) == np.max(full) and np.min(x) == np.min(full)
+    assert TRAJECTORY_SAMPLES // 2 <= len(x) <= 3 * TRAJECTORY_SAMPLES
+    short = sample_trajectory(vm.solve, problem, h=problem.T / 50)
+    assert len(short["t"]) == 51

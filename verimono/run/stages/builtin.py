@@ -23,6 +23,7 @@ from ...execution.executors import Unit
 from ...core.grids import uniform_grid
 from ...execution.profiles import Profile
 from ...records.results import SKIPPED, CheckResult, Report
+from ...records.report.plots import keep_extrema
 from ...records.verdicts import new_record
 from ...core.stepping import solve
 from ...execution.timeouts import current_budget, run_unit, time_limit
@@ -38,22 +39,27 @@ from ...checks.generated_problems import SEED_STRIDE, draw, generated_problems
 from ...checks.stepper_battery import stepper_checks
 from .registry import UNIT_TIME, RunContext, register_stage, timed_unit
 
-#: how many points of a trajectory the report keeps for its plot (enough for a smooth curve)
+#: at most how many evenly spaced points of a long trajectory the report keeps for its plot (enough for a smooth
+#: curve: its markers are fewer), besides the extremes between them
 TRAJECTORY_SAMPLES = 400
 
 
 def sample_trajectory(stepper: Callable, problem: Any, h: float | None = None) -> dict[str, Any]:
     """A plot sample: ``stepper`` on a uniform grid of step ``h`` (default: the problem's coarsest
-    recommended step) next to the exact solution, thinned to :data:`TRAJECTORY_SAMPLES` points."""
+    recommended step) next to the exact solution, thinned to every k-th point (at most :data:`TRAJECTORY_SAMPLES`) and
+    the highest and lowest point of each plotted component between two of them."""
     h = h or (max(problem.steps) if problem.steps else problem.T / 50)
     t = uniform_grid(problem.T, h)
     x = np.asarray(stepper(problem, t), dtype=float)
-    keep = np.unique(np.linspace(0, len(t) - 1, min(len(t), TRAJECTORY_SAMPLES)).round().astype(int))
+    first = (lambda a: a[:, 0] if a.ndim == 3 else a)  # a batch: plot its first member
+    # evenly spaced, and each segment's extremes (records.report.plots.keep_extrema): a spike is kept, not stepped over
+    cols = first(x).reshape(len(t), -1)[:, :4].T if len(t) > TRAJECTORY_SAMPLES and x.shape[:1] == t.shape else []
+    keep = (np.unique(np.concatenate([keep_extrema(c, TRAJECTORY_SAMPLES - 1) for c in cols])) if len(cols)
+            else np.unique(np.linspace(0, len(t) - 1, min(len(t), TRAJECTORY_SAMPLES)).round().astype(int)))
     fine = np.linspace(0.0, problem.T, TRAJECTORY_SAMPLES)
     exact = None
     if problem.exact is not None:
         exact = np.array([np.asarray(problem.exact(s), dtype=float) for s in fine])
-    first = (lambda a: a[:, 0] if a.ndim == 3 else a)  # a batch: plot its first member
     return to_jsonable({"problem": problem.name, "stepper": _name(stepper), "h": float(h),
                         "t": t[keep], "x": first(x)[keep],
                         "t_exact": fine if exact is not None else None,
