@@ -496,11 +496,13 @@ class LCSOperator(Operator):
         s = self.system
         E, G, C, step, q_scale = sm.E, sm.G, s.C, sm.step, s.q_scale
         out = []
+        rows = getattr(step, "rows", None)
+        own_scale = type(s).q_scale is LinearRelationSystem.q_scale
         if type(t) is list:
             vs = [s.v(ti) for ti in t]
         else:
             v = s.v(t)
-            if type(s).q_scale is LinearRelationSystem.q_scale:
+            if own_scale and (rows is None or len(X) < 2):
                 # one v for every row: q_scale's ‖C‖∞|xE|∞ + |v|∞ with |v|∞ read once (the same sum)
                 cn, vmax = s._c_norm, absmax(v)
                 for x in X:
@@ -508,12 +510,13 @@ class LCSOperator(Operator):
                     z, _ = step(C @ xE + v, cn * absmax(xE) + vmax)
                     out.append(xE + G @ z)
                 return np.array(out)
-            vs = [v] * len(X)
-        rows = getattr(step, "rows", None)
-        if rows is not None and type(s).q_scale is LinearRelationSystem.q_scale and len(X) > 1:
+            vs = None if own_scale else [v] * len(X)
+        if rows is not None and own_scale and len(X) > 1:
             # the same arithmetic for the whole block: each product a stacked matmul (the same BLAS call per row
-            # as the 1-D one), ``q_scale``'s two |·|∞ and its sum elementwise, the stepper's rows in order
-            V = np.array(vs, dtype=float).reshape(len(X), -1)
+            # as the 1-D one), ``q_scale``'s two |·|∞ and its sum elementwise, the stepper's rows in order; one
+            # ``v`` for every row (a single time) broadcast over the block (the same sums)
+            V = np.array(vs, dtype=float).reshape(len(X), -1) if vs is not None else \
+                np.broadcast_to(np.asarray(v, dtype=float).reshape(1, -1), (len(X), np.size(v)))
             xE = (E @ X[:, :, None])[:, :, 0]
             Q = (C @ xE[:, :, None])[:, :, 0] + V
             scales = (s._c_norm * np.abs(xE).max(axis=1) + np.abs(V).max(axis=1)).tolist()
