@@ -32,7 +32,7 @@ from ..core._linalg import absmax
 from ._lu import lu_factor, lu_solve
 from .kernel import BatchStepError
 from ._warm_qp import INFEASIBLE_MARGIN, row_infeasible, solve_qp_warm
-from .lcp import _box_lcp, _feasible, is_psd, proved_solvable, sol_polyhedron, solve_lcp
+from .lcp import _box_lcp, _eye, _feasible, is_psd, proved_solvable, sol_polyhedron, solve_lcp
 from .relations import BoxRelation, as_relation
 from ._select_rows import MAX_FACES_K, Faces, ProjectionFaces, project_rows, select_rows, solvable_rows
 
@@ -56,14 +56,17 @@ class StepMatrices:
     def __init__(self, sys: "LinearRelationSystem", h: float, theta: float, gamma: float) -> None:
         n = sys.n
         self.h, self.theta, self.gamma = h, theta, gamma
-        W = np.eye(n) - h * theta * sys.A
+        # the identity made once per n (read only: every expression here makes a new array); the reductions
+        # through the arrays' own methods (what np.all, np.min and np.diag call: the same values)
+        eye = _eye(n)
+        W = eye - h * theta * sys.A
         try:
             self.lu = lu_factor(W)
         except (ValueError, np.linalg.LinAlgError):
             raise InvalidProblem(f"I − hθA is singular for h = {h:g}, θ = {theta:g}") from None
-        if not np.all(np.isfinite(self.lu[0])) or np.min(np.abs(np.diag(self.lu[0]))) == 0.0:
+        if not np.isfinite(self.lu[0]).all() or np.abs(self.lu[0].diagonal()).min() == 0.0:
             raise InvalidProblem(f"I − hθA is singular for h = {h:g}, θ = {theta:g}")
-        self.E = lu_solve(self.lu, np.eye(n) + h * (1.0 - theta) * sys.A)
+        self.E = lu_solve(self.lu, eye + h * (1.0 - theta) * sys.A)
         WiB = lu_solve(self.lu, sys.B)
         self.G = h * WiB
         self.M = sys.D + h * gamma * sys.C @ WiB
