@@ -305,3 +305,25 @@ def test_batched_resolvent_rows_are_the_point_resolvents_bit_for_bit():
                 assert got.shape == want.shape and _bits(got) == _bits(want)
                 a, b = batched._mats[lam].step, single._mats[lam].step
                 assert (a.full_solves, a.last, a.recent) == (b.full_solves, b.last, b.recent)
+
+
+def test_pattern_sets_are_each_patterns_own_index_sets_and_read_only():
+    """``relations._pattern_sets`` (branch units9: a pattern's index sets made once, shared by the steppers of every
+    step size): for every pattern of ``m ≤ 4`` multipliers, the sets ``_BoxStepper._entry`` made per stepper —
+    rows at the upper bound, inner, at the lower bound — and whether each is nonempty; asked again, the same
+    arrays, which refuse writes."""
+    import itertools
+
+    from verimono.lcs.relations import _pattern_sets
+
+    for m in range(1, 5):
+        for labels in itertools.product((0, 1, 2), repeat=m):
+            s = np.array(labels, dtype=np.int8)
+            pat = s.tobytes()
+            two, I, lo, hi, inner, lower, upper = _pattern_sets(pat)
+            assert two.tolist() == (s == 2).tolist()
+            assert (I.tolist(), lo.tolist(), hi.tolist()) == tuple(np.flatnonzero(s == k).tolist() for k in (1, 0, 2))
+            assert (inner, lower, upper) == (bool((s == 1).any()), bool((s == 0).any()), bool((s == 2).any()))
+            assert _pattern_sets(pat)[1] is I
+            with pytest.raises(ValueError):
+                I[...] = 0
