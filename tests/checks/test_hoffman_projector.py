@@ -51,3 +51,16 @@ def test_a_wrong_active_set_is_refused_by_its_certificate():
     # the vertex's cone does hold a point beyond it, and the cached set then answers without a QP
     z = proj.project(np.array([-1.0, -2.0]))
     assert proj.hits == 1 and proj.solves == 1 and z == pytest.approx([0.0, 0.0], abs=1e-12)
+
+
+def test_norm_is_numpys_norm_bit_for_bit():
+    """``hoffman._norm`` (the law's distances and residuals, branch units9) is ``float(np.linalg.norm(v))`` bit for
+    bit on real vectors of every length and scale, strided ones too (their own path: ``w·w`` of the raveled copy)."""
+    from verimono.checks.hoffman import _norm
+
+    rng = np.random.default_rng(3)
+    for k in range(400):
+        n = int(rng.integers(0, 300))
+        v = rng.standard_normal(2 * n) * 10.0 ** rng.uniform(-150, 150)
+        for w in (v[:n], v[::2], -v[1::2]):
+            assert _norm(w).hex() == float(np.linalg.norm(w)).hex(), (k, n)

@@ -10,7 +10,7 @@ import pytest
 
 import verimono.core.qp as qp
 import verimono.lcs.lcp as lcp
-from verimono.core._linalg import SMALL, absmax, lstsq_solution, singular_values, svd_reduced
+from verimono.core._linalg import SMALL, absmax, eigvalsh_values, lstsq_solution, singular_values, svd_reduced
 from verimono.lcs.relations import Complementarity, Relay
 
 
@@ -59,6 +59,21 @@ def test_linalg_gufuncs_are_numpys_functions_bit_for_bit():
     for f in (lambda: lstsq_solution(bad, np.ones(2)), lambda: svd_reduced(bad), lambda: singular_values(bad)):
         with pytest.raises(np.linalg.LinAlgError):
             f()
+
+
+def test_eigvalsh_values_is_numpys_eigvalsh_bit_for_bit():
+    """``eigvalsh_values`` (``is_psd``'s eigenvalues, branch units9): ``np.linalg.eigvalsh``'s answer bit for bit on
+    symmetric and non-symmetric matrices (only the lower triangle is read: ``UPLO="L"``), PSD ones on the edge, all
+    scales, non-finite ones (NumPy's NaNs); NumPy's own function for other dtypes and empty matrices."""
+    rng = np.random.default_rng(5)
+    for k in range(1500):
+        n = int(rng.integers(1, 9))
+        a = rng.normal(size=(n, n)) * 10.0 ** int(rng.integers(-8, 9))
+        a = (a + a.T, a @ a.T, a - a.T, a)[k % 4]                      # symmetric, PSD, skew, neither
+        assert _bits(eigvalsh_values(a)) == _bits(np.linalg.eigvalsh(a)), k
+    for a in (np.eye(3, dtype=int), np.zeros((0, 0)), np.eye(2, dtype=np.float32), np.full((2, 2), np.nan),
+              np.array([[np.inf, 0.0], [0.0, 1.0]]), np.array([[1.0, np.nan], [0.0, 1.0]])):
+        assert _bits(eigvalsh_values(a)) == _bits(np.linalg.eigvalsh(a))
 
 
 @pytest.mark.parametrize("values", [[], [0.0], [-0.0, 0.0], [1.0, -3.0, 2.0], [np.inf, 1.0], [-np.inf],
@@ -290,3 +305,25 @@ def test_batched_resolvent_rows_are_the_point_resolvents_bit_for_bit():
                 assert got.shape == want.shape and _bits(got) == _bits(want)
                 a, b = batched._mats[lam].step, single._mats[lam].step
                 assert (a.full_solves, a.last, a.recent) == (b.full_solves, b.last, b.recent)
+
+
+def test_pattern_sets_are_each_patterns_own_index_sets_and_read_only():
+    """``relations._pattern_sets`` (branch units9: a pattern's index sets made once, shared by the steppers of every
+    step size): for every pattern of ``m ≤ 4`` multipliers, the sets ``_BoxStepper._entry`` made per stepper —
+    rows at the upper bound, inner, at the lower bound — and whether each is nonempty; asked again, the same
+    arrays, which refuse writes."""
+    import itertools
+
+    from verimono.lcs.relations import _pattern_sets
+
+    for m in range(1, 5):
+        for labels in itertools.product((0, 1, 2), repeat=m):
+            s = np.array(labels, dtype=np.int8)
+            pat = s.tobytes()
+            two, I, lo, hi, inner, lower, upper = _pattern_sets(pat)
+            assert two.tolist() == (s == 2).tolist()
+            assert (I.tolist(), lo.tolist(), hi.tolist()) == tuple(np.flatnonzero(s == k).tolist() for k in (1, 0, 2))
+            assert (inner, lower, upper) == (bool((s == 1).any()), bool((s == 0).any()), bool((s == 2).any()))
+            assert _pattern_sets(pat)[1] is I
+            with pytest.raises(ValueError):
+                I[...] = 0

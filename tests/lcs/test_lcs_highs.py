@@ -145,3 +145,27 @@ def test_without_scipys_private_highs_modules_linprog_itself_answers(monkeypatch
     monkeypatch.setattr(highs, "_state", {"h": None})
     assert [_answer(linprog_highs(*case)) for case in cases] == direct
     assert {s for s, _, _ in direct} >= {0}
+
+
+def test_models_kept_by_their_fixed_arrays_answer_each_lp_as_linprog():
+    """``linprog_highs`` keeps each model's part that does not depend on ``b_ub`` (branch units9): LPs that differ
+    from a kept one in any one other array (``c``, ``A_ub``, ``A_eq``, ``b_eq``, ``lb``, ``ub``, the rows' count) or
+    in ``b_ub`` alone, asked one after the other, each get ``linprog``'s own answer bit for bit — each change
+    chosen to move the optimum, so a model kept under a key that misses it answers another LP."""
+    base = dict(c=np.array([1.0, -1.0, 0.5]), A_ub=np.array([[1.0, 1.0, 0.0], [-1.0, 2.0, 1.0]]),
+                b_ub=np.array([4.0, 3.0]), A_eq=np.array([[1.0, -1.0, 1.0]]), b_eq=np.array([0.5]),
+                lb=np.array([-1.0, -2.0, -np.inf]), ub=np.array([3.0, np.inf, 2.0]))
+    moved = {"c": (0, 0.25), "A_ub": (3, 0.25), "b_ub": (1, 0.25), "A_eq": (0, 0.25), "b_eq": (0, 0.25),
+             "lb": (0, 0.25), "ub": (2, -0.5)}                 # (flat index, change) of one entry
+    variants = [dict(base)]
+    for k, (i, d) in moved.items():
+        w = base[k].copy()
+        w.flat[i] += d
+        variants.append(dict(base, **{k: w}))
+    variants.append(dict(base, A_ub=np.vstack([base["A_ub"], [0.0, 1.0, 1.0]]), b_ub=np.array([4.0, 3.0, 1.0])))
+    first = _answer(_via_linprog(**base))
+    for _ in range(2):                                      # the second pass reads every kept model
+        for k, v in enumerate(variants):
+            want = _answer(_via_linprog(**v))
+            assert want[0] == 0 and (k == 0 or want != first), k    # optimal, and another optimum than base's
+            assert _answer(linprog_highs(**v)) == want, k

@@ -22,6 +22,7 @@ sample), its first population the largest sampled ratios, then a Nelder–Mead p
 
 from __future__ import annotations
 
+import math
 from typing import Any, Callable
 
 import numpy as np
@@ -59,6 +60,13 @@ DECADES = (-6, 5)
 EXPOSED_RADIUS = 10.0
 
 
+def _norm(v: np.ndarray) -> float:
+    """``float(np.linalg.norm(v))`` of a real vector, bit for bit: its own path (``sqrt(w·w)`` of ``w =
+    v.ravel(order="K")``) without the wrapper's dispatch (a correctly rounded square root either way)."""
+    w = v.ravel(order="K")
+    return math.sqrt(float(w.dot(w)))
+
+
 #: active sets (with their factorizations) a polyhedron's projector keeps, most recently verified first
 ACTIVE_SETS = 8
 
@@ -84,20 +92,23 @@ class ActiveSetProjector:
         self.P, self.Q, self.q = P, np.asarray(Q, float), np.asarray(q, float)
         self.R = None if R is None else np.atleast_2d(np.asarray(R, float))
         self.sets: list[tuple] = []          # (rows of Q, M, c, (MMᵀ)⁻¹, number of R rows)
+        self._q_max = float(np.abs(self.q).max(initial=0.0))      # |q|∞, of every projection's scale
         self.hits = self.solves = 0
 
     def project(self, x: np.ndarray) -> np.ndarray:
         x = np.asarray(x, dtype=float)
         Q, q, R = self.Q, self.q, self.R
         Qx = Q @ x
-        if np.all(Qx <= q) and (R is None or np.all(R @ x == 0.0)):
+        # NumPy's reductions through the arrays' own methods (what np.all, np.any and np.max call: the same
+        # values; their wrappers cost more than the reductions on these few coordinates)
+        if (Qx <= q).all() and (R is None or (R @ x == 0.0).all()):
             return x.copy()                  # Polyhedron.project's own test, the same arithmetic
-        scale = 1.0 + max(float(np.abs(x).max(initial=0.0)), float(np.abs(q).max(initial=0.0)))
+        scale = 1.0 + max(float(np.abs(x).max(initial=0.0)), self._q_max)
         tol = QP_RTOL * scale
         for i, (rows, M, c, C, k, vertex) in enumerate(self.sets):
             if vertex is None:
                 y = C @ (M @ x - c)
-                if np.any(y[k:] < 0.0):
+                if (y[k:] < 0.0).any():
                     continue
                 z = x - M.T @ y
             else:      # a vertex: x − v must lie in the cone of its active rows (the R rows' both signs)
@@ -108,8 +119,8 @@ class ActiveSetProjector:
                     continue
                 z = vertex.copy()
             slack = Q @ z - q
-            if (float(np.max(slack, initial=0.0)) > tol or float(np.max(np.abs(slack[rows]), initial=0.0)) > tol
-                    or (R is not None and float(np.max(np.abs(R @ z))) > tol)):
+            if (float(slack.max(initial=0.0)) > tol or float(np.abs(slack[rows]).max(initial=0.0)) > tol
+                    or (R is not None and float(np.abs(R @ z).max()) > tol)):
                 continue
             if i:
                 self.sets.insert(0, self.sets.pop(i))
@@ -295,8 +306,8 @@ def check_hoffman(est: Callable, *, seed: int = 0) -> Outcome:
         n = Q.shape[1]
 
         def measure(x: np.ndarray) -> tuple[float, float, float]:
-            d = float(np.linalg.norm(x - P.project(x)))
-            res = (0.0 if R is None else float(np.linalg.norm(R @ x))) + float(np.linalg.norm(np.maximum(0.0, Q @ x - q)))
+            d = _norm(x - P.project(x))
+            res = (0.0 if R is None else _norm(R @ x)) + _norm(np.maximum(0.0, Q @ x - q))
             return d / (alpha * res + tolerance(x, q)), d, res
 
         u = rng.standard_normal((HOFFMAN_POINTS, n))

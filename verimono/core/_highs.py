@@ -69,29 +69,20 @@ def _replace_inf(x: np.ndarray, inf: float) -> np.ndarray:
     return x
 
 
-def linprog_highs(c, A_ub, b_ub, A_eq=None, b_eq=None, lb=None, ub=None):
-    """``linprog(c, A_ub, b_ub, A_eq, b_eq, bounds=zip(lb, ub), method="highs")``'s ``(status, fun, x)``.
+#: the fixed part of the models :func:`linprog_highs` built (everything but the rows' upper bounds ``b_ub``), by the
+#: exact bytes of the arrays it is made of: a search asks hundreds of LPs of one system that differ in ``b_ub``
+#: alone (Section 7's margin LP at each time ``t``); emptied past :data:`_MODELS_MAX` entries
+_MODELS: dict = {}
+_MODELS_MAX = 64
 
-    ``A_ub``, ``A_eq`` dense; ``lb``/``ub`` arrays (``±inf`` for none; default ``0`` and ``+inf`` as
-    ``linprog``'s); ``status`` is ``linprog``'s (0 optimal and accepted; 4 when SciPy's acceptance test
-    refuses HiGHS' optimum; otherwise HiGHS' model status as ``linprog`` maps it); ``fun`` and ``x`` are
-    ``None`` unless HiGHS found an optimum."""
-    st = _core()
-    if st is None or st["h"] is None:
-        return _linprog(c, A_ub, b_ub, A_eq, b_eq, lb, ub)
-    h, inf = st["h"], st["inf"]
-    c = np.array(c, dtype=float)
+
+def _fixed_part(inf, c, A_ub, n_ub, A_eq, b_eq, lb, ub) -> tuple:
+    """What of :func:`linprog_highs`'s model does not depend on ``b_ub``, the arrays as the one-call path made
+    them: ``(bounds, b_eq, lower rows, column starts, row indices, values, lb, ub)`` (read only)."""
     nv = c.size
-    A_ub = np.array(A_ub, dtype=float).reshape(-1, nv)
-    b_ub = np.array(b_ub, dtype=float).reshape(-1)
-    A_eq = np.zeros((0, nv)) if A_eq is None else np.array(A_eq, dtype=float).reshape(-1, nv)
-    b_eq = np.zeros(0) if b_eq is None else np.array(b_eq, dtype=float).reshape(-1)
-    lb = np.zeros(nv) if lb is None else np.array(lb, dtype=float).reshape(nv)
-    ub = np.full(nv, np.inf) if ub is None else np.array(ub, dtype=float).reshape(nv)
     bounds = np.column_stack([lb, ub])                  # as _clean_inputs makes them, for _check_result
     with np.errstate(invalid="ignore"):
-        lhs = np.concatenate((-np.ones_like(b_ub) * np.inf, b_eq))
-    rhs = np.concatenate((b_ub, b_eq))
+        lhs = np.concatenate((-np.ones(n_ub) * np.inf, b_eq))
     # the compressed columns scipy.sparse.csc_array makes of the dense matrix (its nonzeros, column by
     # column, rows ascending)
     At = np.vstack((A_ub, A_eq)).T
@@ -99,8 +90,47 @@ def linprog_highs(c, A_ub, b_ub, A_eq=None, b_eq=None, lb=None, ub=None):
     data = At[cols, rows]
     indptr = np.zeros(nv + 1, dtype=np.int32)
     np.cumsum(np.bincount(cols, minlength=nv), out=indptr[1:])
-    rhs, lhs = _replace_inf(rhs, inf), _replace_inf(lhs, inf)
+    lhs = _replace_inf(lhs, inf)
     lb, ub = _replace_inf(lb.copy(), inf), _replace_inf(ub.copy(), inf)
+    out = (bounds, b_eq, lhs, indptr, rows.astype(np.int32), data, lb, ub)
+    for a in out:
+        a.flags.writeable = False
+    return out
+
+
+def linprog_highs(c, A_ub, b_ub, A_eq=None, b_eq=None, lb=None, ub=None):
+    """``linprog(c, A_ub, b_ub, A_eq, b_eq, bounds=zip(lb, ub), method="highs")``'s ``(status, fun, x)``.
+
+    ``A_ub``, ``A_eq`` dense; ``lb``/``ub`` arrays (``±inf`` for none; default ``0`` and ``+inf`` as
+    ``linprog``'s); ``status`` is ``linprog``'s (0 optimal and accepted; 4 when SciPy's acceptance test
+    refuses HiGHS' optimum; otherwise HiGHS' model status as ``linprog`` maps it); ``fun`` and ``x`` are
+    ``None`` unless HiGHS found an optimum.
+
+    The model's part that does not depend on ``b_ub`` is made once per ``(c, A_ub, A_eq, b_eq, lb, ub)``
+    (:data:`_MODELS`, by their bytes; the same arrays the one-call path makes, so HiGHS is handed the same
+    model); each call builds its own ``HighsLp`` from them and a fresh solver, as SciPy does."""
+    st = _core()
+    if st is None or st["h"] is None:
+        return _linprog(c, A_ub, b_ub, A_eq, b_eq, lb, ub)
+    h, inf = st["h"], st["inf"]
+    c = np.asarray(c, dtype=float).reshape(-1)
+    nv = c.size
+    A_ub = np.asarray(A_ub, dtype=float).reshape(-1, nv)
+    b_ub = np.array(b_ub, dtype=float).reshape(-1)
+    A_eq = np.zeros((0, nv)) if A_eq is None else np.asarray(A_eq, dtype=float).reshape(-1, nv)
+    b_eq = np.zeros(0) if b_eq is None else np.asarray(b_eq, dtype=float).reshape(-1)
+    lb = np.zeros(nv) if lb is None else np.asarray(lb, dtype=float).reshape(nv)
+    ub = np.full(nv, np.inf) if ub is None else np.asarray(ub, dtype=float).reshape(nv)
+    key = (nv, A_ub.shape[0], b_ub.size, A_eq.shape[0], c.tobytes(), A_ub.tobytes(), A_eq.tobytes(), b_eq.tobytes(),
+           lb.tobytes(), ub.tobytes())
+    fixed = _MODELS.get(key)
+    if fixed is None:
+        fixed = _fixed_part(inf, c, A_ub, b_ub.size, A_eq, b_eq, lb, ub)
+        if len(_MODELS) >= _MODELS_MAX:
+            _MODELS.clear()
+        _MODELS[key] = fixed
+    bounds, b_eq, lhs, indptr, rows, data, lb, ub = fixed
+    rhs = _replace_inf(np.concatenate((b_ub, b_eq)), inf)
 
     numrow = rhs.size
     lp = h.HighsLp()
@@ -115,7 +145,7 @@ def linprog_highs(c, A_ub, b_ub, A_eq=None, b_eq=None, lb=None, ub=None):
     lp.row_lower_ = lhs
     lp.row_upper_ = rhs
     lp.a_matrix_.start_ = indptr
-    lp.a_matrix_.index_ = rows.astype(np.int32)
+    lp.a_matrix_.index_ = rows
     lp.a_matrix_.value_ = data
 
     highs = h._Highs()
@@ -138,7 +168,7 @@ def linprog_highs(c, A_ub, b_ub, A_eq=None, b_eq=None, lb=None, ub=None):
     tol = _CHECK_TOL
     if np.isnan(x).any() or math.isnan(fun) or np.isnan(slack).any() or np.isnan(con).any():
         return 4, fun, x
-    ok = bool(np.all((x >= bounds[:, 0] - tol) & (x <= bounds[:, 1] + tol)))
+    ok = bool(((x >= bounds[:, 0] - tol) & (x <= bounds[:, 1] + tol)).all())
     ok = ok and not (slack < -tol).any() and not (np.abs(con) > tol).any()
     return (0 if ok else 4), fun, x
 

@@ -14,10 +14,12 @@ import numpy as np
 try:    # the gufuncs np.linalg.lstsq / np.linalg.svd call after their argument handling (NumPy 1.x and 2.x)
     try:
         from numpy.linalg import _umath_linalg
-        from numpy.linalg._linalg import _raise_linalgerror_lstsq, _raise_linalgerror_svd_nonconvergence
+        from numpy.linalg._linalg import (_raise_linalgerror_eigenvalues_nonconvergence, _raise_linalgerror_lstsq,
+                                          _raise_linalgerror_svd_nonconvergence)
     except ImportError:     # pragma: no cover - NumPy 1.x layout
         from numpy.linalg import _umath_linalg
-        from numpy.linalg.linalg import _raise_linalgerror_lstsq, _raise_linalgerror_svd_nonconvergence
+        from numpy.linalg.linalg import (_raise_linalgerror_eigenvalues_nonconvergence, _raise_linalgerror_lstsq,
+                                         _raise_linalgerror_svd_nonconvergence)
 except ImportError:     # pragma: no cover - another NumPy layout: the public functions
     _umath_linalg = None
 
@@ -56,6 +58,16 @@ def singular_values(a: np.ndarray) -> np.ndarray:
     with np.errstate(call=_raise_linalgerror_svd_nonconvergence, invalid="call", over="ignore", divide="ignore",
                      under="ignore"):
         return _umath_linalg.svd(a, signature="d->d")
+
+
+def eigvalsh_values(a: np.ndarray) -> np.ndarray:
+    """``np.linalg.eigvalsh(a)`` (``UPLO="L"``) for a square ``float64`` matrix: the same gufunc under the same error
+    state, without the wrapper (its checks cost more than LAPACK's work on a 2×2; branch units9)."""
+    if not (_plain(a) and a.ndim == 2 and a.shape[0] == a.shape[1] and a.size):
+        return np.linalg.eigvalsh(a)
+    with np.errstate(call=_raise_linalgerror_eigenvalues_nonconvergence, invalid="call", over="ignore",
+                     divide="ignore", under="ignore"):
+        return _umath_linalg.eigvalsh_lo(a, signature="d->d")
 
 
 def absmax(a) -> float:

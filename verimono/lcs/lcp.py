@@ -38,7 +38,7 @@ from typing import Callable
 import numpy as np
 
 from ..core.errors import InfeasibleStep, InvalidProblem, UnverifiedSolution, VerimonoError
-from ..core._linalg import absmax, lstsq_solution, singular_values, svd_reduced
+from ..core._linalg import absmax, eigvalsh_values, lstsq_solution, singular_values, svd_reduced
 from ..core.qp import solve_qp
 from ..core.tolerances import POLISH_RTOL, QP_RTOL, RTOL
 from ..core._highs import linprog_highs
@@ -129,7 +129,7 @@ def is_psd(M: np.ndarray, rtol: float = RTOL) -> bool:
     seen = _PSD_SEEN.get(key) if key is not None else None
     if seen is not None:
         return seen
-    answer = bool(np.linalg.eigvalsh(M + M.T)[0] >= -rtol * (1.0 + np.abs(M).max()))
+    answer = bool(eigvalsh_values(M + M.T)[0] >= -rtol * (1.0 + np.abs(M).max()))   # np.linalg.eigvalsh's
     if key is not None:
         if len(_PSD_SEEN) >= _PSD_SEEN_MAX:
             _PSD_SEEN.clear()

@@ -133,6 +133,30 @@ def _well_conditioned(A: np.ndarray) -> bool:
 _INF = float("inf")
 
 
+#: :func:`_pattern_sets`' answers, by a pattern's bytes (emptied past :data:`_PATTERN_SETS_MAX` entries): a pattern
+#: recurs over the step sizes of one system, each with its own ``M`` (an operator law sweeps hundreds of ``λ``)
+_PATTERN_SETS: dict[bytes, tuple] = {}
+_PATTERN_SETS_MAX = 1024
+
+
+def _pattern_sets(pat: bytes) -> tuple:
+    """What an active pattern's bytes (``int8``: 0 at the lower bound, 1 inner, 2 at the upper bound) say alone:
+    ``(at the upper bound (bool mask), inner rows, rows at the lower bound, rows at the upper bound, whether each of
+    the three is nonempty)`` — the index arrays :meth:`_BoxStepper._entry` made for each stepper, made once per
+    pattern and shared read only (they only index)."""
+    got = _PATTERN_SETS.get(pat)
+    if got is None:
+        s = np.frombuffer(pat, dtype=np.int8)
+        two, I, at_lo, at_hi = s == 2, np.flatnonzero(s == 1), np.flatnonzero(s == 0), np.flatnonzero(s == 2)
+        for a in (two, I, at_lo, at_hi):
+            a.flags.writeable = False
+        got = (two, I, at_lo, at_hi, bool(I.size), bool(at_lo.size), bool(at_hi.size))
+        if len(_PATTERN_SETS) >= _PATTERN_SETS_MAX:
+            _PATTERN_SETS.clear()
+        _PATTERN_SETS[pat] = got
+    return got
+
+
 class _BoxStepper:
     """``q ↦ (z, w)`` for a constant ``M``: the last pattern's factorisation first, then (PSD ``M``) the
     :data:`RECENT_PATTERNS` patterns that solved before it, a full solve otherwise.
@@ -163,12 +187,12 @@ class _BoxStepper:
     def _entry(self, pat: bytes):
         e = self.cache.get(pat)
         if e is None:
-            s = np.frombuffer(pat, dtype=np.int8)
-            I = np.flatnonzero(s == 1)
-            fixed = np.where(s == 2, self.hi, self.lo)
+            # the pattern's index sets, a function of its bytes alone (:func:`_pattern_sets`, shared read only)
+            two, I, at_lo, at_hi, inner, lower_rows, upper_rows = _pattern_sets(pat)
+            fixed = np.where(two, self.hi, self.lo)
             fixed[I] = 0.0
             lu = None
-            if I.size:
+            if inner:
                 MII = self.M[I[:, None], I]        # what np.ix_(I, I) indexes
                 lu = lu_factor(MII) if _well_conditioned(MII) else False
             hiI = self.hi[I]
@@ -176,8 +200,8 @@ class _BoxStepper:
             # set of rows at a bound has nothing to check (skipping them changes no answer)
             Mfixed = self.M @ fixed
             # ``(M·fixed)_I`` indexed once here, not at every try: the same numbers
-            e = (I, fixed, lu, Mfixed[I], self.lo[I], hiI, np.flatnonzero(s == 0), np.flatnonzero(s == 2),
-                 bool(I.size), not bool(np.all(hiI == np.inf)), bool(np.any(s == 0)), bool(np.any(s == 2)))
+            e = (I, fixed, lu, Mfixed[I], self.lo[I], hiI, at_lo, at_hi,
+                 inner, not bool((hiI == np.inf).all()), lower_rows, upper_rows)
             self.cache[pat] = e
         return e
 

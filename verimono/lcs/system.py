@@ -32,7 +32,7 @@ from ..core._linalg import absmax
 from ._lu import lu_factor, lu_solve
 from .kernel import BatchStepError
 from ._warm_qp import INFEASIBLE_MARGIN, row_infeasible, solve_qp_warm
-from .lcp import _box_lcp, _feasible, is_psd, proved_solvable, sol_polyhedron, solve_lcp
+from .lcp import _box_lcp, _eye, _feasible, is_psd, proved_solvable, sol_polyhedron, solve_lcp
 from .relations import BoxRelation, as_relation
 from ._select_rows import MAX_FACES_K, Faces, ProjectionFaces, project_rows, select_rows, solvable_rows
 
@@ -56,14 +56,17 @@ class StepMatrices:
     def __init__(self, sys: "LinearRelationSystem", h: float, theta: float, gamma: float) -> None:
         n = sys.n
         self.h, self.theta, self.gamma = h, theta, gamma
-        W = np.eye(n) - h * theta * sys.A
+        # the identity made once per n (read only: every expression here makes a new array); the reductions
+        # through the arrays' own methods (what np.all, np.min and np.diag call: the same values)
+        eye = _eye(n)
+        W = eye - h * theta * sys.A
         try:
             self.lu = lu_factor(W)
         except (ValueError, np.linalg.LinAlgError):
             raise InvalidProblem(f"I − hθA is singular for h = {h:g}, θ = {theta:g}") from None
-        if not np.all(np.isfinite(self.lu[0])) or np.min(np.abs(np.diag(self.lu[0]))) == 0.0:
+        if not np.isfinite(self.lu[0]).all() or np.abs(self.lu[0].diagonal()).min() == 0.0:
             raise InvalidProblem(f"I − hθA is singular for h = {h:g}, θ = {theta:g}")
-        self.E = lu_solve(self.lu, np.eye(n) + h * (1.0 - theta) * sys.A)
+        self.E = lu_solve(self.lu, eye + h * (1.0 - theta) * sys.A)
         WiB = lu_solve(self.lu, sys.B)
         self.G = h * WiB
         self.M = sys.D + h * gamma * sys.C @ WiB
@@ -496,11 +499,13 @@ class LCSOperator(Operator):
         s = self.system
         E, G, C, step, q_scale = sm.E, sm.G, s.C, sm.step, s.q_scale
         out = []
+        rows = getattr(step, "rows", None)
+        own_scale = type(s).q_scale is LinearRelationSystem.q_scale
         if type(t) is list:
             vs = [s.v(ti) for ti in t]
         else:
             v = s.v(t)
-            if type(s).q_scale is LinearRelationSystem.q_scale:
+            if own_scale and (rows is None or len(X) < 2):
                 # one v for every row: q_scale's ‖C‖∞|xE|∞ + |v|∞ with |v|∞ read once (the same sum)
                 cn, vmax = s._c_norm, absmax(v)
                 for x in X:
@@ -508,12 +513,13 @@ class LCSOperator(Operator):
                     z, _ = step(C @ xE + v, cn * absmax(xE) + vmax)
                     out.append(xE + G @ z)
                 return np.array(out)
-            vs = [v] * len(X)
-        rows = getattr(step, "rows", None)
-        if rows is not None and type(s).q_scale is LinearRelationSystem.q_scale and len(X) > 1:
+            vs = None if own_scale else [v] * len(X)
+        if rows is not None and own_scale and len(X) > 1:
             # the same arithmetic for the whole block: each product a stacked matmul (the same BLAS call per row
-            # as the 1-D one), ``q_scale``'s two |·|∞ and its sum elementwise, the stepper's rows in order
-            V = np.array(vs, dtype=float).reshape(len(X), -1)
+            # as the 1-D one), ``q_scale``'s two |·|∞ and its sum elementwise, the stepper's rows in order; one
+            # ``v`` for every row (a single time) broadcast over the block (the same sums)
+            V = np.array(vs, dtype=float).reshape(len(X), -1) if vs is not None else \
+                np.broadcast_to(np.asarray(v, dtype=float).reshape(1, -1), (len(X), np.size(v)))
             xE = (E @ X[:, :, None])[:, :, 0]
             Q = (C @ xE[:, :, None])[:, :, 0] + V
             scales = (s._c_norm * np.abs(xE).max(axis=1) + np.abs(V).max(axis=1)).tolist()
