@@ -31,6 +31,7 @@ import numpy as np
 from ..core.arrays import as_float64
 from ..core.tolerances import current_eps, current_precision, current_rtol, tolerance
 from .core import Member, Outcome, ratio as _ratio
+from ._powell import powell
 from ..core.errors import NotApplicable
 from .members import ROUNDOFF_ULPS, outside_by_roundoff_of_dom_g
 from .members import listed, norm as _nrm
@@ -354,7 +355,6 @@ def _starts(p, x):
 
 @_at_prox_point("independent minimiser")
 def _minimised(op, s, p, gp):
-    from scipy.optimize import minimize
 
     x, lam, t = s.x1, s.lam, s.t
     n = x.size
@@ -375,9 +375,11 @@ def _minimised(op, s, p, gp):
     for z0 in _starts(p, x):
         if phi(z0.copy()) >= big:     # a copy: p and x are read after it
             continue
-        res = minimize(phi, z0, method="Powell", options={"xtol": 1e-10 * scale, "ftol": 1e-14, "maxfev": 200 * n})
-        if res.fun < best:
-            best, zbest = float(res.fun), np.asarray(res.x, dtype=float)
+        # scipy's minimize(phi, z0, method="Powell", options={"xtol": 1e-10·scale, "ftol": 1e-14, "maxfev": 200n})
+        # without its wrappers (verimono.checks._powell): the same points evaluated, the same result
+        fun, zmin = powell(phi, z0, 1e-10 * scale, 1e-14, 200 * n)
+        if fun < best:
+            best, zbest = float(fun), np.asarray(zmin, dtype=float)
     if zbest is None:
         return Outcome.compare(0.0, 0.0, 1.0, "independent minimiser: no start point in dom g (sample inconclusive)",
                                {}, inconclusive=True)
