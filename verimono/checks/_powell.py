@@ -3,8 +3,11 @@ independent minimiser: the same points evaluated in the same order and the same 
 
 A line-for-line copy of SciPy 1.17.1's unbounded ``_minimize_powell`` (``_linesearch_powell``,
 ``_recover_from_bracket_error``, ``_minimize_scalar_brent``, ``Brent.optimize``, ``bracket``): the same float
-operations on the same operands (NumPy scalars where SciPy has them: ``bracket`` starts from ``np.asarray([0.0,
-1.0])``), the same stopping rules, the same ``maxfev`` count.  What is left out is what costs per call and changes
+operations on the same operands, the same stopping rules, the same ``maxfev`` count.  The line search's step
+lengths are Python floats where SciPy's ``bracket`` makes NumPy scalars (``np.asarray([0.0, 1.0])``): the same
+IEEE double operations (``+ - * /``, ``abs``, comparisons; no division here can be by zero: ``bracket``'s
+denominator is at least ``2e-21`` in magnitude or NaN, Brent's parabolic step divides by ``tmp2 > 0`` only), so
+the same numbers, without NumPy's scalar dispatch and its overflow warnings.  What is left out is what costs per call and changes
 no number: the wrapper's copy of each point (every point handed to ``func`` here is a fresh array or a copy), its
 ``np.isscalar`` test of a float, the closures ``myfunc``/``function_wrapper``, an ``OptimizeResult`` and a success
 message per line search, the option checks, callbacks and bounds (not used).  On the operator-law units it was
@@ -218,7 +221,7 @@ def _brent(func, tol: float):
 
 def _bracket(func):
     """SciPy's ``bracket(func)`` (``xa = 0``, ``xb = 1``, ``grow_limit = 110``, ``maxiter = 1000``)."""
-    xa, xb = np.asarray([0.0, 1.0])
+    xa, xb = 0.0, 1.0
     fa = func(xa)
     fb = func(xb)
     if fa < fb:
@@ -278,7 +281,7 @@ def _bracket(func):
         fc = fw
     cond1 = (fb < fc and fb <= fa) or (fb < fa and fb <= fc)
     cond2 = (xa < xb < xc or xc < xb < xa)
-    cond3 = np.isfinite(xa) and np.isfinite(xb) and np.isfinite(xc)
+    cond3 = math.isfinite(xa) and math.isfinite(xb) and math.isfinite(xc)
     if not (cond1 and cond2 and cond3):
         raise _NoBracket((xa, xb, xc, fa, fb, fc))
     return xa, xb, xc, fa, fb, fc
