@@ -29,6 +29,7 @@ import zlib
 import numpy as np
 
 from ..core.arrays import as_float64
+from ..core._small import abs_max
 from ..core.tolerances import current_eps, current_precision, current_rtol, tolerance
 from .core import Member, Outcome, ratio as _ratio
 from ._powell import powell
@@ -72,7 +73,7 @@ def _amax(v: np.ndarray) -> float:
         return 0.0
     if v.size > 4096 and v.dtype.kind == "f":
         return float(max(v.max(), -v.min()))
-    return float(np.abs(v).max())
+    return abs_max(v)
 
 
 def _tol(rtol: float, *maxima: float) -> float:
