@@ -336,8 +336,8 @@ def check_prox_optimal(op, s, p, gp):
 @operator_law("prox_minimiser", "prox optimality (independent minimiser)", _VALUE)
 def check_prox_minimiser(op, s):
     """The prox optimality (independent minimiser): ``Φ(p) ≤ Φ(z*)`` for ``z*`` a minimiser of
-    ``Φ`` found by scipy's Powell from ``p`` and ``x`` (from ``p`` alone on ``R^1``: :func:`_starts`; ``n ≤ 4``
-    only: larger samples are inconclusive)."""
+    ``Φ`` found by scipy's Powell (its arithmetic without its wrappers: :mod:`verimono.checks._powell`) from ``p``
+    and ``x`` (from ``p`` alone on ``R^1``: :func:`_starts`; ``n ≤ 4`` only: larger samples are inconclusive)."""
     if s.x1.size > MINIMISER_MAX_DIM:
         return Outcome.compare(0.0, 0.0, 1.0, f"independent minimiser runs only for n ≤ {MINIMISER_MAX_DIM} "
                                "(sample inconclusive)", {}, inconclusive=True)
