@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from ..core.arrays import as_float64
+from ..core._small import abs_max, all_finite
 from ..core.errors import NotApplicable, OutsideDomain
 from ..core.tolerances import current_eps, tolerance
 from .engine.samples import NUMPY_DIM
@@ -28,7 +29,7 @@ def point(value: Any, like: np.ndarray, member: str) -> np.ndarray:
     y = as_float64(value)
     if y.shape != like.shape:
         raise _BadOutput(f"{member} returned shape {y.shape} for a point of shape {like.shape}")
-    if not np.isfinite(y).all():      # the ndarray method: np.all's dispatch wrapper costs more than the test
+    if not all_finite(y):      # np.isfinite(y).all() (core._small: Python floats at R^1-R^8)
         raise _BadOutput(f"{member} returned non-finite values {y}")
     return y
 
@@ -189,7 +190,7 @@ def norm(v: Any) -> float:
     if v.size > 4096:       # max(max v, -min v): the same maximum without an n-sized |v| (a law calls this per point)
         m = float(max(v.max(), -v.min()))
     else:
-        m = float(np.abs(v).max(initial=0.0))
+        m = abs_max(v) if v.size else 0.0       # np.abs(v).max(initial=0.0)'s number (core._small)
     if m == 0.0 or not math.isfinite(m):
         return 0.0
     if v.size > UNSCALED_N and SAFE_SQUARES[0] < m < SAFE_SQUARES[1]:

@@ -29,8 +29,10 @@ import zlib
 import numpy as np
 
 from ..core.arrays import as_float64
+from ..core._small import abs_max
 from ..core.tolerances import current_eps, current_precision, current_rtol, tolerance
 from .core import Member, Outcome, ratio as _ratio
+from ._powell import powell
 from ..core.errors import NotApplicable
 from .members import ROUNDOFF_ULPS, outside_by_roundoff_of_dom_g
 from .members import listed, norm as _nrm
@@ -71,7 +73,7 @@ def _amax(v: np.ndarray) -> float:
         return 0.0
     if v.size > 4096 and v.dtype.kind == "f":
         return float(max(v.max(), -v.min()))
-    return float(np.abs(v).max())
+    return abs_max(v)
 
 
 def _tol(rtol: float, *maxima: float) -> float:
@@ -334,8 +336,8 @@ def check_prox_optimal(op, s, p, gp):
 @operator_law("prox_minimiser", "prox optimality (independent minimiser)", _VALUE)
 def check_prox_minimiser(op, s):
     """The prox optimality (independent minimiser): ``Φ(p) ≤ Φ(z*)`` for ``z*`` a minimiser of
-    ``Φ`` found by scipy's Powell from ``p`` and ``x`` (from ``p`` alone on ``R^1``: :func:`_starts`; ``n ≤ 4``
-    only: larger samples are inconclusive)."""
+    ``Φ`` found by scipy's Powell (its arithmetic without its wrappers: :mod:`verimono.checks._powell`) from ``p``
+    and ``x`` (from ``p`` alone on ``R^1``: :func:`_starts`; ``n ≤ 4`` only: larger samples are inconclusive)."""
     if s.x1.size > MINIMISER_MAX_DIM:
         return Outcome.compare(0.0, 0.0, 1.0, f"independent minimiser runs only for n ≤ {MINIMISER_MAX_DIM} "
                                "(sample inconclusive)", {}, inconclusive=True)
@@ -354,7 +356,6 @@ def _starts(p, x):
 
 @_at_prox_point("independent minimiser")
 def _minimised(op, s, p, gp):
-    from scipy.optimize import minimize
 
     x, lam, t = s.x1, s.lam, s.t
     n = x.size
@@ -375,9 +376,11 @@ def _minimised(op, s, p, gp):
     for z0 in _starts(p, x):
         if phi(z0.copy()) >= big:     # a copy: p and x are read after it
             continue
-        res = minimize(phi, z0, method="Powell", options={"xtol": 1e-10 * scale, "ftol": 1e-14, "maxfev": 200 * n})
-        if res.fun < best:
-            best, zbest = float(res.fun), np.asarray(res.x, dtype=float)
+        # scipy's minimize(phi, z0, method="Powell", options={"xtol": 1e-10·scale, "ftol": 1e-14, "maxfev": 200n})
+        # without its wrappers (verimono.checks._powell): the same points evaluated, the same result
+        fun, zmin = powell(phi, z0, 1e-10 * scale, 1e-14, 200 * n)
+        if fun < best:
+            best, zbest = float(fun), np.asarray(zmin, dtype=float)
     if zbest is None:
         return Outcome.compare(0.0, 0.0, 1.0, "independent minimiser: no start point in dom g (sample inconclusive)",
                                {}, inconclusive=True)

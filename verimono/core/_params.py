@@ -43,7 +43,7 @@ class Param:
         v = self._fn(t)
         if type(v) is np.ndarray and v.dtype == np.float64:   # the common case, before any message is built
             return v
-        if type(v) is float:
+        if type(v) is float or type(v) is np.float64:       # real_array's own 0-d float64 array of it
             return np.asarray(v)
         return real_array(v, f"{self.name}({t!r})")
 
@@ -52,7 +52,7 @@ class Param:
         itself, to take a scalar's fast path: the callable is called once either way)."""
         if type(v) is np.ndarray and v.dtype == np.float64:
             return v
-        if type(v) is float:
+        if type(v) is float or type(v) is np.float64:
             return np.asarray(v)
         return real_array(v, f"{self.name}({t!r})")
 

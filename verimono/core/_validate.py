@@ -7,6 +7,7 @@ import numbers
 
 import numpy as np
 
+from ._small import all_finite
 from .errors import InvalidProblem
 
 _INF = float("inf")
@@ -49,7 +50,7 @@ def real_array(x: object, what: str = "point") -> np.ndarray:
 def finite_point(x: object, what: str) -> np.ndarray:
     """:func:`real_array` and every entry finite (a projection of a NaN point has no meaning)."""
     a = real_array(x, what)
-    if not np.isfinite(a).all():
+    if not all_finite(a):
         raise InvalidProblem(f"{what} must be finite, got {np.array2string(a, threshold=8)}")
     return a
 

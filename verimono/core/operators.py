@@ -497,13 +497,18 @@ class L1Subdifferential(_EverywhereDefined):
 
     def resolvent(self, x, lam, t=0.0):
         x = real_array(x)
-        lam, J = _steps(self, x, lam, t)
-        if J is not None:
-            return J
+        if type(lam) is not np.ndarray:     # one λ: _steps' own path (steps_of is None), without the call
+            lam = check_lam(lam, f"{self.name}.resolvent")
+        else:
+            lam, J = _steps(self, x, lam, t)
+            if J is not None:
+                return J
         return np.sign(x) * _mx(np.abs(x) - lam * self._c_rows(t, x), 0.0)
 
     def _c_rows(self, t, x):
         """``c(t)``, or with ``t`` of shape ``(B,)`` ``c(t[i])`` for row ``i`` of ``x``."""
+        if type(t) is not np.ndarray:       # times_of's None, without the call
+            return _weight_at(self._c, t, self.name, "c(t)")
         ts = times_of(t, x, self.name)
         if ts is None:
             return _weight_at(self._c, t, self.name, "c(t)")
@@ -540,8 +545,12 @@ class L1Subdifferential(_EverywhereDefined):
 
     def value(self, x, t=0.0):
         """``g(t, x) = Σ c_i(t)|x_i|`` (``F(t,·) = ∂g(t,·)``): the value laws check the resolvent is its prox."""
-        c = np.asarray(_weight_at(self._c, t, self.name, "c(t)"), dtype=float)
-        return float(np.add.reduce(c * np.abs(np.asarray(x, dtype=float)), axis=None))   # np.sum without its dispatch
+        p = self._c
+        # a constant's read-only float64 array is what _weight_at returns for it and np.asarray(·, float) keeps
+        c = p._value if p._fn is None else np.asarray(_weight_at(p, t, self.name, "c(t)"), dtype=float)
+        if type(x) is not np.ndarray or x.dtype != np.float64:
+            x = np.asarray(x, dtype=float)
+        return float(np.add.reduce(c * np.abs(x), axis=None))   # np.sum without its dispatch
 
     def min_norm(self, x, t=0.0):
         x = real_array(x)

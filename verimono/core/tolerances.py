@@ -55,6 +55,8 @@ from typing import Any, Iterator
 
 import numpy as np
 
+from ._small import abs_max
+
 #: relative tolerance of exact identities computed in floating point (see module docstring)
 RTOL = 1e-8
 #: relative KKT residual below which a QP/LCP solution from a back-end is accepted
@@ -231,7 +233,7 @@ def tolerance(*scales: float, rtol: float | None = None) -> float:
             if s.dtype.kind == "f" and s.size > 4096:    # no |s| copy of a large array: max(max, -min), the same number
                 a = float(max(s.max(), -s.min()))
             else:
-                a = float(np.abs(s).max()) if s.size else 0.0
+                a = abs_max(s) if s.size else 0.0       # NumPy's number (core._small)
         elif type(s) is float:             # a weight c(t): abs is np.abs of one double, without its dispatch
             a = abs(s)
         else:

@@ -339,10 +339,18 @@ def searched(xs: list[float], lams: list[float], ts: list[float], horizon: float
     between its times in ``[0, horizon]``, and the coordinate searches."""
     if not xs:
         return {"samples": 0}
-    tt = np.unique(np.r_[0.0, np.clip(ts, 0.0, horizon), horizon])
+    # np.unique(np.r_[0.0, np.clip(ts, 0.0, horizon), horizon])'s largest gap without np.r_, the list's own clip and
+    # the unique: the sorted times with their repeats have the same gaps and zeros (the largest gap is >= 0, NaN
+    # sorted last as unique sorts it), and more than one distinct time exactly when the first and last differ
+    tt = np.empty(len(ts) + 2)
+    tt[0], tt[-1] = 0.0, horizon
+    inner = tt[1:-1]
+    inner[...] = ts
+    np.clip(inner, 0.0, horizon, out=inner)
+    tt.sort()
     return {"samples": len(ts), "x_range": [float(min(xs)), float(max(xs))],
             "lambda_range": [float(min(lams)), float(max(lams))],
-            "t_resolution": float(np.max(np.diff(tt))) if tt.size > 1 else float(horizon),
+            "t_resolution": float(np.diff(tt).max()) if tt[-1] != tt[0] else float(horizon),
             "coordinates": coordinates}
 
 

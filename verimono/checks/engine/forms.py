@@ -60,7 +60,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from ...core.arrays import as_given
+from ...core.arrays import _AS_GIVEN, as_given
 from ...core.errors import InputModified
 
 CONTIGUOUS, INTEGER, STRIDED, SLICE, READONLY, DECLARED = (
@@ -181,6 +181,15 @@ class InForm:
         return getattr(self._op, name)
 
     def _call(self, member: str, points: Sequence[Any], *rest: Any, **kw: Any) -> Any:
+        if len(points) == 1:        # one point (all members but contains): as below, without the list and generator
+            f = _Formed(points[0], self.form, self._dtype)
+            token = _AS_GIVEN.set(True)         # as_given(), without the context manager's object
+            try:
+                out = getattr(self._op, member)(f.array, *rest, **kw)
+            finally:
+                _AS_GIVEN.reset(token)
+            f.unchanged(member, self.form)
+            return out
         formed = [_Formed(x, self.form, self._dtype) for x in points]
         with as_given():
             out = getattr(self._op, member)(*(f.array for f in formed), *rest, **kw)

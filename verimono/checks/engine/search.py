@@ -75,6 +75,7 @@ import numpy as np
 from hypothesis import HealthCheck, Phase, Verbosity, given, settings
 
 from ...core.arrays import library_hint
+from ...core._small import abs_max
 from ...core._reproducible import no_local_constants
 from ..arguments import valid_horizon, valid_seed
 from ...core.errors import InvalidCheckArgument, UnitTimeout
@@ -214,7 +215,7 @@ def _row_amax(X: np.ndarray) -> np.ndarray:
 
 def _amax(x: np.ndarray) -> float:
     """``max |x_i|`` (0 for an empty point), without ``np.max``'s dispatch (once per point of every sample)."""
-    return float(np.abs(x).max()) if x.size else 0.0
+    return abs_max(x) if x.size else 0.0
 
 
 class _Violation(Exception):
