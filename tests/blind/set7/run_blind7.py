@@ -45,6 +45,7 @@ def run_one(name: str, seed: int, profile: str) -> dict:
     import verimono as vm
 
     entry = subjects().BY_NAME[name]
+    profile = None if profile == "default" else profile      # "default": no profile given (the run configuration's)
     t0 = time.perf_counter()
     subject = entry.build()
     if entry.kind == "operator":
@@ -103,7 +104,7 @@ def verdict(entry, res) -> tuple[bool, str]:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--profile", default="ci")
+    ap.add_argument("--profile", default="ci", help="dev, ci, thorough, or default (no profile argument)")
     ap.add_argument("--seeds", type=int, nargs="+", default=[0])
     ap.add_argument("--cap", type=float, default=600.0, help="seconds per (entry, seed)")
     ap.add_argument("--only", nargs="*", default=None)
