@@ -397,6 +397,8 @@ def _lcp_factory(broken):
             w = A @ z - x
             if np.all(z >= -tol) and np.all(w >= -tol):
                 return np.maximum(z, 0.0)
+        if broken:                                    # "no pattern fits: fall back to the careful solver", which
+            return _lcp_factory(False)(x, lam, t)     # hides the broken pattern wherever its candidate is infeasible
         raise RuntimeError("no complementarity pattern fits")
     return lcp_resolvent
 
@@ -863,7 +865,7 @@ ENTRIES = [
           "x = (1, 0, 0)", "ctrl_l1_min_norm_sign"),
     Entry("lcp_pattern_0_forgets_M", "operator", f"{PROP} v (Y_λx ∈ F(J_λx)) for F = Mx + N_R+^2 (e:lcp)", False,
           _lcp_build(True, "LCP resolvent, pattern {0} wrong"), _w_lcp(True),
-          "enumerated LCP: in the pattern z0 > 0, z1 = 0 it takes z0 = x0 (λM_00 forgotten)",
+          "enumerated LCP: in the pattern z0 > 0, z1 = 0 it takes z0 = x0 (λM_00 forgotten); where that candidate is infeasible a correct fallback answers, so it is wrong exactly on x0 > 0, x1 ≤ -λx0, and never raises",
           "x = (1, -5), λ = 1", "ctrl_lcp_enumerated"),
     Entry("soft_threshold_skips_tiny_steps", "operator", f"{PROP} v/vi (Y_λx ∈ F(J_λx), |Y_λx| → |F^0x|)", False,
           lambda: _op(tiny_step_soft, 3, "soft threshold, identity for λ < 1e-12", min_norm=_l1_min_norm,
