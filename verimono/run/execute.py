@@ -19,7 +19,7 @@ from typing import Any, Callable
 from ..execution import watchdog
 from ..records.atomic import partial_path, write_text
 from ..records.environment import environment
-from ..execution.executors import BLAS_THREADS, make_runner
+from ..execution.executors import BLAS_THREADS, ProcessRunner, make_runner
 from ..execution.config import RunConfig
 from ..execution.config import using as using_config
 from ..execution.profiles import get_profile, load_hypothesis_profile
@@ -99,7 +99,13 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
                 using_config(config, profile=profile_name, seed=context.seed, executor=executor) as cfg:
             unit_budget = budget_source()
             report = run_stages(stages, profile, context, on_start=progress.start, on_done=done)
-    finally:
+    except BaseException:
+        # interrupted (or failed): the workers are killed, not asked to finish their units — a worker busy with
+        # one answered the polite request only at that unit's end, and ``close`` waited up to 5 s for each
+        # (:meth:`ProcessRunner._stop`) before the user's script got its KeyboardInterrupt
+        _close(runner, kill=True)
+        raise
+    else:
         runner.close()
     duration = time.perf_counter() - start
     # once more at the end, when a record of the run is timed (:func:`has_timed_records`): one calibration
@@ -127,6 +133,14 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
                         "data_dir": None if context.data_dir is None else str(context.data_dir),
                         "environment": environment()})
     return report
+
+
+def _close(runner: Any, kill: bool) -> None:
+    """``runner.close(kill=kill)`` where the runner takes ``kill`` (:class:`ProcessRunner`), else ``close()``."""
+    if isinstance(runner, ProcessRunner):
+        runner.close(kill=kill)
+    else:
+        runner.close()
 
 
 def has_timed_records(report: Report) -> bool:

@@ -19,6 +19,7 @@ To add a battery::
 
 from __future__ import annotations
 
+import ctypes
 import dataclasses
 import os
 import statistics
@@ -323,21 +324,33 @@ def _run_together(group: list[str], first: int, count: int, profile: Profile, co
     slots: dict[str, tuple[Report, dict] | None] = {n: None for n in group}
     ended = {n: threading.Event() for n in group}
 
+    stopper = _Stopper()
+
     def body(n: str) -> None:
+        me = ctypes.c_ulong(threading.get_ident())
         try:
-            for dep in STAGES[n].after:
-                if dep in ended:
-                    ended[dep].wait()
-            with queue.turn:
-                _HERE.stage = n
-                slots[n] = _run_stage(n, profile, context, overlapped=[m for m in group if m != n])
-        except BaseException as exc:  # noqa: BLE001 - the queue closed under it (an interrupt): the run ends
-            with queue.turn:          # a stage's code in this process runs holding the turn, even this (fork_guard)
-                slots[n] = _stage_failure(n, exc, 0.0)[0], {"name": n, "status": "error", "records": 1,
-                                                             "duration": 0.0, "cpu": 0.0, "message": str(exc)}
+            stopper.enter()
+            try:
+                for dep in STAGES[n].after:
+                    if dep in ended:
+                        ended[dep].wait()
+                with queue.turn:
+                    _HERE.stage = n
+                    slots[n] = _run_stage(n, profile, context, overlapped=[m for m in group if m != n])
+            except BaseException as exc:  # noqa: BLE001 - the queue closed under it (an interrupt): the run ends
+                with queue.turn:          # a stage's code in this process runs holding the turn, even this (fork_guard)
+                    slots[n] = _stage_failure(n, exc, 0.0)[0], {"name": n, "status": "error", "records": 1,
+                                                                 "duration": 0.0, "cpu": 0.0, "message": str(exc)}
+            finally:
+                ended[n].set()
+                queue._wake()
+        except BaseException:  # noqa: BLE001 - a stop (:class:`_Stopper`) delivered late: the run is ending anyway
+            pass
         finally:
-            ended[n].set()
-            queue._wake()
+            # inline, no Python call: a call's first bytecode would deliver a pending stop here, outside every catch
+            with stopper.lock:
+                _SET_ASYNC_EXC(me, None)      # NULL: a stop sent and not yet delivered is cleared
+                stopper.running.discard(me.value)
 
     # not daemons, and joined below even when serving raises: a daemon thread alive at the interpreter's exit that
     # re-enters a C++ extension releasing the GIL (pybind11's: HiGHS, ProxQP) is ended by pthread_exit, whose
@@ -355,18 +368,19 @@ def _run_together(group: list[str], first: int, count: int, profile: Profile, co
         if on_start:
             on_start(STAGES[n], first + k, count)
     start = time.perf_counter()
+    raising = False
     try:
         for t in threads:
             t.start()
         queue.serve(threads, on_idle=release)
     except BaseException as exc:
+        raising = True
         queue._break(exc)          # (serve did already, unless a thread failed to start) every waiting stage released
+        stopper.stop()             # a stage's own code in this process stops at its next bytecode, not its next unit
         raise
     finally:
         try:
-            for t in threads:      # each ends at its next unit (the queue closed) or at its end: none outlives the run
-                if t.ident is not None:
-                    t.join()
+            _join_all([t for t in threads if t.ident is not None], stopper, raising=raising)
         finally:
             context.executor = outer
     wall = time.perf_counter() - start
@@ -374,6 +388,59 @@ def _run_together(group: list[str], first: int, count: int, profile: Profile, co
         if slots[n] is not None:
             slots[n][1]["group_duration"] = wall
     release()
+
+
+#: ``PyThreadState_SetAsyncExc(thread id, exception or NULL)`` (:class:`_Stopper`)
+_SET_ASYNC_EXC = ctypes.pythonapi.PyThreadState_SetAsyncExc
+
+
+class _Stopper:
+    """Stops the stage threads of :func:`_run_together` when the run is interrupted.
+
+    Ctrl-C reaches the main thread only (serving the queue).  Closing the queue releases a stage thread waiting
+    for its units, but one running its own code in this process (building units, drawing operators, merging
+    reports; a user's stage, for as long as it likes) ran on until its next unit: the interrupted ``execute``
+    waited for it (1-3 s of the built-in stages; forever for a stage that never asks for a unit), a second
+    Ctrl-C then broke that wait, and the still-running thread used the run's closed worker pool again — it
+    started new workers, and the user's script hung at its exit joining them (seen with two Ctrl-C's 0.3 s
+    apart).  :meth:`stop` raises ``KeyboardInterrupt`` in each stage thread at its next bytecode (what Ctrl-C
+    does to a serial run's stage in the main thread; a thread inside a C call sees it when the call returns).
+    A thread's end clears a stop not yet delivered, under the lock :meth:`stop` sends under (``body`` in
+    :func:`_run_together`), so a stop never lands outside the thread's catch-all: no "Exception in thread"."""
+
+    def __init__(self) -> None:
+        self.lock = threading.Lock()
+        self.running: set[int] = set()
+        self._stopping = False
+
+    def enter(self) -> None:
+        with self.lock:
+            self.running.add(threading.get_ident())
+            if self._stopping:
+                raise KeyboardInterrupt
+
+    def stop(self) -> None:
+        with self.lock:
+            self._stopping = True
+            for ident in self.running:
+                _SET_ASYNC_EXC(ctypes.c_ulong(ident), ctypes.py_object(KeyboardInterrupt))
+
+
+def _join_all(threads: list[threading.Thread], stopper: _Stopper, raising: bool = False) -> None:
+    """Join ``threads`` however often Ctrl-C is pressed meanwhile (each press stops them again): a stage thread
+    left running would use the run's pool after it was closed.  The first such press is raised once they have
+    ended, unless an exception (the first Ctrl-C) is already on its way (``raising``): that one is the user's."""
+    interrupt: BaseException | None = None
+    for t in threads:
+        while True:
+            try:
+                t.join()
+                break
+            except KeyboardInterrupt as exc:
+                interrupt = interrupt or exc
+                stopper.stop()
+    if interrupt is not None and not raising:
+        raise interrupt
 
 
 def _run_stage(n: str, profile: Profile, context: RunContext, overlapped: list[str] | None = None

@@ -1,0 +1,129 @@
+"""Ctrl-C while the Python API (:func:`verimono.run.execute.execute`) runs stages at once on the shared queue
+(issue 43, the fourth probe's item 1).
+
+The interrupt reaches the main thread, which serves the queue; a stage thread running its own code in this
+process went on until its next unit.  The interrupted ``execute`` waited for it (forever, for a stage that never
+asks for a unit again), a second Ctrl-C broke that wait and the script got its KeyboardInterrupt with the stage
+threads still running — they then used the closed worker pool (new workers started) and the script's exit waited
+on them forever.  Seen failing on 9e58e7d: caught 5.3 s after the first Ctrl-C, both stage threads alive.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import threading
+import time
+
+import pytest
+
+from verimono.run.stages.registry import _join_all, _Stopper
+
+CTRL_C_TWICE = r'''
+"""Ctrl-C twice, 0.3 s apart, while `execute` runs two overlapping stages; one stage's own code never returns
+to the queue (it sleeps 1 s, again and again: a stop reaches it only when a sleep returns)."""
+import multiprocessing, os, signal, sys, threading, time
+
+from verimono.execution.executors import Unit
+from verimono.records.results import CheckResult, Report
+from verimono.run.execute import execute
+from verimono.run.stages import RunContext, register_stage
+
+T0 = [0.0]
+
+
+def _unit(seconds):
+    time.sleep(seconds)
+    return Report([CheckResult("unit", "u", "passed", worst=0.5, bound=1.0)])
+
+
+def _press_ctrl_c():                     # the terminal's Ctrl-C, twice
+    time.sleep(0.5)
+    T0[0] = time.monotonic()
+    os.kill(os.getpid(), signal.SIGINT)
+    time.sleep(0.3)
+    os.kill(os.getpid(), signal.SIGINT)
+
+
+@register_stage("spins", overlap=True)
+def spins(profile, context):
+    reps = context.run_units(profile, [Unit("spins", "u", _unit, (0.01,))])
+    threading.Thread(target=_press_ctrl_c, name="user-presses-ctrl-c", daemon=True).start()
+    while True:                          # this stage's own code, in this process: never asks for a unit again
+        time.sleep(1.0)
+    return Report([r for rep in reps for r in rep.results])
+
+
+@register_stage("waits", overlap=True)
+def waits(profile, context):
+    return Report([r for rep in context.run_units(profile, [Unit("waits", "u", _unit, (30.0,))]) for r in rep.results])
+
+
+if __name__ == "__main__":
+    signal.signal(signal.SIGINT, signal.default_int_handler)   # (a background job inherits SIGINT ignored)
+    try:
+        execute(command="run", profile_name="ci", stages=["spins", "waits"], executor="process:2",
+                context=RunContext(seed=0))
+    except KeyboardInterrupt:
+        left = [t.name for t in threading.enumerate() if t.name.startswith("verimono-stage-")]
+        children = multiprocessing.active_children()
+        print(f"caught KeyboardInterrupt {time.monotonic() - T0[0]:.2f} s after Ctrl-C; stage threads alive: {left}; "
+              f"processes left: {len(children)}", flush=True)
+        if left or children:
+            sys.stdout.flush(), sys.stderr.flush()
+            os._exit(5)                  # (else the exit would wait for them forever)
+        sys.exit(0)
+    print("not interrupted", flush=True)
+    sys.exit(6)
+'''
+
+
+@pytest.mark.slow   # a fresh interpreter importing verimono, two workers: ~4 s
+def test_ctrl_c_twice_during_execute_gives_the_script_its_interrupt_and_leaves_nothing_running(tmp_path):
+    script = tmp_path / "ctrl_c_twice.py"
+    script.write_text(CTRL_C_TWICE)
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
+    env.pop("VERIMONO_START_METHOD", None)
+    proc = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120, env=env)
+    assert proc.returncode == 0, (proc.returncode, proc.stdout, proc.stderr[-2000:])
+    assert "stage threads alive: []; processes left: 0" in proc.stdout
+    assert "Traceback" not in proc.stderr and "Exception in thread" not in proc.stderr, proc.stderr[-2000:]
+
+
+def _stage_like(stopper: _Stopper, looped: list[int], ended: threading.Event) -> None:
+    """What ``_run_together``'s stage thread does around its stage: registered, its code, a catch-all, cleared."""
+    import ctypes
+
+    from verimono.run.stages import registry
+
+    me = ctypes.c_ulong(threading.get_ident())
+    try:
+        stopper.enter()
+        try:
+            while True:                  # a stage's own Python code, never returning
+                looped[0] += 1
+        except KeyboardInterrupt:
+            ended.set()
+    except BaseException:  # noqa: BLE001
+        pass
+    finally:
+        with stopper.lock:
+            registry._SET_ASYNC_EXC(me, None)
+            stopper.running.discard(me.value)
+
+
+def test_the_stopper_ends_a_stage_thread_in_its_own_code_and_join_survives_more_ctrl_c():
+    stopper, looped, ended = _Stopper(), [0], threading.Event()
+    t = threading.Thread(target=_stage_like, args=(stopper, looped, ended))
+    t.start()
+    while looped[0] == 0:
+        time.sleep(0.001)
+    stopper.stop()
+    _join_all([t], stopper, raising=True)
+    assert not t.is_alive() and ended.is_set() and not stopper.running
+    stopper.stop()                       # a stop after the thread's end reaches nobody
+    late = _Stopper()
+    late.stop()
+    with pytest.raises(KeyboardInterrupt):
+        late.enter()                     # a thread registering after the stop is stopped at once
