@@ -77,7 +77,10 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
     elif waits_on_workers and not drawing_elsewhere():   # this process waits on the workers and draws the
         import threading                                 # plots itself: matplotlib's import and font cache now
 
-        threading.Thread(target=warm_up, name=WARM_UP_THREAD, daemon=True).start()
+        # not a daemon: a script whose ``execute`` ends within the import (a short run) exited with the thread in
+        # matplotlib's C extensions, finalized under it (the abort a daemon thread in a C++ extension risks at
+        # exit, "terminate called ..."; tests/run/test_api_interrupt.py); its exit now waits for the import's end
+        threading.Thread(target=warm_up, name=WARM_UP_THREAD, daemon=False).start()
     start = time.perf_counter()
     probe = MachineProbe()
 
