@@ -26,11 +26,12 @@ import statistics
 import threading
 import time
 import traceback
+from threading import get_ident as _get_ident   # (a test replaces this module's `threading` by a shim)
 from pathlib import Path
 from typing import Any, Callable, Iterable
 
 from ...checks.core import classify
-from ...core.errors import StageUnavailable, UnknownStage
+from ...core.errors import StageUnavailable, UndeclaredStageRead, UnknownStage
 from ...execution.executors import ProcessRunner, SerialRunner
 from ...execution.schedule import SharedQueue
 from ...execution.calibration import slices_after
@@ -78,6 +79,11 @@ class RunContext:
     expected: dict[tuple[str, str], float] = dataclasses.field(default_factory=dict)
 
     _catalog: list[Any] | None = dataclasses.field(default=None, repr=False)
+
+    def __post_init__(self) -> None:
+        # what one stage writes for the later ones: a read by a stage that did not declare the writer is an error
+        self.costs = StageResults("costs", self.costs)
+        self.partitions = StageResults("partitions", self.partitions)
 
     def catalog(self) -> list[Any]:
         """``problems`` if given, else the reference catalog (built once per run); then ``extra_problems``."""
@@ -140,6 +146,100 @@ class RunContext:
         return 0 if profile.derandomize else None
 
 
+class StageResults(dict):
+    """A :class:`RunContext` field one stage writes and later stages read (``costs``, ``partitions``: the
+    convergence stage's, :attr:`Stage.writes`).  A stage that reads it must name the stages writing it in
+    ``after=``: on worker processes it otherwise runs at once with them and reads whatever is there — maybe
+    nothing, maybe part of it (the shared queue, :func:`run_stages`) — while one stage after another gives it
+    everything: a silent difference between executors.  So, during :func:`run_stages`, a read (``[]``, ``get``,
+    ``in``, iteration, ``len``) by a stage of a field that another stage of the same run writes (by its
+    ``writes``, or seen writing it) and that the reader did not declare (directly or through another stage) raises
+    :class:`verimono.core.errors.UndeclaredStageRead` — under every executor alike, so the missing ``after=``
+    shows on the first serial run.  Outside a stage (before the run, ``restore_convergence``) nothing is checked."""
+
+    def __init__(self, field: str, data: Any = ()) -> None:
+        super().__init__(data)
+        self.field = field
+        #: the stages of the run under way (:func:`run_stages`), ``()`` outside one
+        self.run: tuple[str, ...] = ()
+        #: stages seen writing it (besides those whose :attr:`Stage.writes` names it)
+        self.writers: set[str] = set()
+
+    def _read(self) -> None:
+        reader = _running_stage()
+        if reader is None or not self.run or reader not in STAGES:
+            return
+        declared = _reads(reader)
+        for w in self.run:
+            if w == reader or w in declared or w not in STAGES:
+                continue
+            if self.field in STAGES[w].writes or w in self.writers:
+                raise UndeclaredStageRead(
+                    f"stage {reader!r} reads context.{self.field}, which stage {w!r} of this run writes, without "
+                    f"declaring it: register it with register_stage(..., after=({w!r},)) — undeclared, it runs at "
+                    f"once with {w!r} on worker processes and reads whatever is there (maybe nothing)")
+
+    def _wrote(self) -> None:
+        writer = _running_stage()
+        if writer is not None:
+            self.writers.add(writer)
+
+    def __getitem__(self, key: Any) -> Any:
+        self._read()
+        return super().__getitem__(key)
+
+    def get(self, key: Any, default: Any = None) -> Any:
+        self._read()
+        return super().get(key, default)
+
+    def __contains__(self, key: object) -> bool:
+        self._read()
+        return super().__contains__(key)
+
+    def __iter__(self):
+        self._read()
+        return super().__iter__()
+
+    def __len__(self) -> int:
+        self._read()
+        return super().__len__()
+
+    def keys(self):
+        self._read()
+        return super().keys()
+
+    def values(self):
+        self._read()
+        return super().values()
+
+    def items(self):
+        self._read()
+        return super().items()
+
+    def __setitem__(self, key: Any, value: Any) -> None:
+        self._wrote()
+        super().__setitem__(key, value)
+
+    def setdefault(self, key: Any, default: Any = None) -> Any:
+        self._wrote()
+        return super().setdefault(key, default)
+
+    def __reduce__(self):       # pickled as a plain dict (a unit's arguments): the checks are this process's
+        return dict, (dict(self),)
+
+
+def _reads(name: str) -> set[str]:
+    """The stages ``name`` declares it reads (``after``), directly or through those stages' own."""
+    seen: set[str] = set()
+    todo = list(STAGES[name].after) if name in STAGES else []
+    while todo:
+        d = todo.pop()
+        if d not in seen:
+            seen.add(d)
+            todo.extend(STAGES[d].after if d in STAGES else ())
+    return seen
+
+
 #: ``Report.meta`` key under which :func:`timed_unit` hands a unit's times back (popped by ``run_units``)
 UNIT_TIME = "unit_time"
 
@@ -200,8 +300,10 @@ class Stage:
     #: timed stage (performance), and a stage registered without saying so, runs alone, as before
     overlap: bool = False
     #: stages whose results this one reads (``context.costs``, ``context.partitions``): when they run in the
-    #: same run, it starts once they have ended
+    #: same run, it starts once they have ended (reading one not declared: :class:`StageResults`)
     after: tuple[str, ...] = ()
+    #: the :class:`RunContext` fields this stage writes for later stages (``"costs"``, ``"partitions"``)
+    writes: tuple[str, ...] = ()
 
 
 STAGES: dict[str, Stage] = {}
@@ -226,14 +328,17 @@ def default_stages() -> list[str]:
 
 def register_stage(name: str, description: str = "", *, default: bool = True,
                    prepare: Callable[[Profile, RunContext], None] | None = None, overlap: bool = False,
-                   after: Iterable[str] = ()) -> Callable:
+                   after: Iterable[str] = (), writes: Iterable[str] = ()) -> Callable:
     """Decorator registering ``fn(profile, context) -> Report`` as the stage ``name`` (replaces same name);
     ``default=False``: a stage on request; ``prepare``: run before the workers start; ``overlap``: may run at
-    once with other such stages; ``after``: the stages it reads the results of (:class:`Stage`)."""
+    once with other such stages; ``after``: the stages it reads the results of — reading a result of a stage of
+    the same run that is not declared there raises :class:`verimono.core.errors.UndeclaredStageRead` (a failed
+    ``stage[name]`` record); ``writes``: the :class:`RunContext` results it writes (``"costs"``,
+    ``"partitions"``) (:class:`Stage`)."""
 
     def deco(fn: Callable[[Profile, RunContext], Report]) -> Callable:
         STAGES[name] = Stage(name, fn, description or (fn.__doc__ or "").strip().split("\n")[0], default, prepare,
-                             overlap, tuple(after))
+                             overlap, tuple(after), tuple(writes))
         return fn
 
     return deco
@@ -274,6 +379,21 @@ def run_stages(names: Iterable[str] | None, profile: Profile, context: RunContex
             on_done(STAGES[n], rep, info)
 
     shared = _can_share(context)
+    results = [f for f in (context.costs, context.partitions) if isinstance(f, StageResults)]
+    for f in results:
+        f.run = tuple(names)
+    try:
+        _run_groups(names, shared, profile, context, on_start, finish)
+    finally:
+        for f in results:
+            f.run = ()
+    return total
+
+
+def _run_groups(names: list[str], shared: bool, profile: Profile, context: RunContext,
+                on_start: Callable[[Stage, int, int], None] | None, finish: Callable[[str, Report, dict], None]
+                ) -> None:
+    """:func:`run_stages`'s loop: each group of stages that may overlap at once, else one after another."""
     i = 0
     while i < len(names):
         group = [names[i]]     # a stage named twice runs twice, one run after the other (a group keys by name)
@@ -288,7 +408,6 @@ def run_stages(names: Iterable[str] | None, profile: Profile, context: RunContex
                     on_start(STAGES[n], i + k, len(names))
                 finish(n, *_run_stage(n, profile, context))
         i += len(group)
-    return total
 
 
 def _some_run_at_once(group: list[str]) -> bool:
@@ -327,7 +446,7 @@ def _run_together(group: list[str], first: int, count: int, profile: Profile, co
     stopper = _Stopper()
 
     def body(n: str) -> None:
-        me = ctypes.c_ulong(threading.get_ident())
+        me = ctypes.c_ulong(_get_ident())
         try:
             stopper.enter()
             try:
@@ -415,7 +534,7 @@ class _Stopper:
 
     def enter(self) -> None:
         with self.lock:
-            self.running.add(threading.get_ident())
+            self.running.add(_get_ident())
             if self._stopping:
                 raise KeyboardInterrupt
 
@@ -453,6 +572,7 @@ def _run_stage(n: str, profile: Profile, context: RunContext, overlapped: list[s
     # and merges what comes back; a report warm-up thread of this process is not the stage's)
     own_cpu = cpu_now if serial else time.thread_time
     cpu0, (subj0, calls0), n_units = own_cpu(), subject_cpu(), len(context.unit_times)
+    outer, _HERE.stage = _running_stage(), n      # which stage reads (StageResults) and runs units (run_units)
     try:
         rep = stage.fn(profile, context)
         if not isinstance(rep, Report):
@@ -461,6 +581,8 @@ def _run_stage(n: str, profile: Profile, context: RunContext, overlapped: list[s
         message = rep.summary()
     except (Exception, *SUBJECT_EXITS) as exc:  # noqa: BLE001 - a crash is a failure of the run, recorded
         rep, status, message = _stage_failure(n, exc, time.perf_counter() - start)
+    finally:
+        _HERE.stage = outer
     duration = time.perf_counter() - start
     units = context.unit_times[n_units:]
     if overlapped is not None:      # the other stages' units came back in between: this stage's only
@@ -515,4 +637,4 @@ def locate_data(explicit: str | os.PathLike | None = None) -> Path:
     return path
 
 
-__all__ = ["STAGES", "Stage", "default_stages", "RunContext", "register_stage", "run_stages", "prepare_stages", "locate_data", "timed_unit", "UNIT_TIME", "expected_costs"]
+__all__ = ["STAGES", "Stage", "StageResults", "default_stages", "RunContext", "register_stage", "run_stages", "prepare_stages", "locate_data", "timed_unit", "UNIT_TIME", "expected_costs"]
