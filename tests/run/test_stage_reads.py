@@ -65,3 +65,13 @@ def test_the_error_is_a_verimono_error():
     from verimono.core.errors import VerimonoError
 
     assert issubclass(UndeclaredStageRead, VerimonoError)
+
+
+def test_a_stage_named_before_the_stage_it_reads_runs_after_it(user_stages):
+    """``after`` promises the reader starts once the writer has ended; named first (``--stage trajectory_laws
+    --stage convergence``) it ran first and read nothing — on 9e58e7d trajectory_laws so judged 21 worst ratios
+    other than a whole run's (the convergence studies' grids missing)."""
+    register_stage("probe4_reader", overlap=True, after=("probe4_writer",))(user_stages)
+    rep = run_stages(["probe4_reader", "probe4_writer", "probe4_reader"], get_profile("ci"), RunContext(seed=0))
+    assert [s["name"] for s in rep.meta["stages"]] == ["probe4_writer", "probe4_reader", "probe4_reader"]
+    assert [(r.check, r.status) for r in rep.results] == [("wrote", "passed"), ("read", "passed"), ("read", "passed")]

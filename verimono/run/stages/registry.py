@@ -373,6 +373,7 @@ def run_stages(names: Iterable[str] | None, profile: Profile, context: RunContex
     for n in names:
         if n not in STAGES:
             raise UnknownStage(f"unknown stage {n!r}; registered stages: {', '.join(STAGES)}")
+    names = _dependencies_first(names)
     total = Report(meta={"stages": []})
 
     def finish(n: str, rep: Report, info: dict) -> None:
@@ -411,6 +412,29 @@ def _run_groups(names: list[str], shared: bool, profile: Profile, context: RunCo
                     on_start(STAGES[n], i + k, len(names))
                 finish(n, *_run_stage(n, profile, context))
         i += len(group)
+
+
+def _dependencies_first(names: list[str]) -> list[str]:
+    """``names`` with every stage moved after the stages of the run it reads (``after``), otherwise in their order:
+    ``--stage trajectory_laws --stage convergence`` ran trajectory_laws first, without the convergence studies'
+    grids (21 worst ratios other than a whole run's), though ``after`` promises it starts once they have ended."""
+    left: dict[str, int] = {}
+    for n in names:
+        left[n] = left.get(n, 0) + 1
+    out: list[str] = []
+
+    def place(n: str, path: tuple[str, ...]) -> None:
+        for d in STAGES[n].after:
+            if left.get(d, 0) > 0 and d not in path:       # (a cycle of after's: left in the given order)
+                place(d, path + (d,))
+        if left[n] > 0:
+            left[n] -= 1
+            out.append(n)
+
+    for n in names:
+        if left[n] > 0:
+            place(n, (n,))
+    return out
 
 
 def _some_run_at_once(group: list[str]) -> bool:
