@@ -282,6 +282,8 @@ if sys.argv[1:] == ["unsafe"]:           # the pipeline branch's stage threads: 
     class _Shim:
         Thread, Event, Lock, local = _Unsafe, threading.Event, threading.Lock, threading.local
     registry.threading = _Shim
+    registry._Stopper.stop = lambda self: None      # nor stopped, nor waited for (probe4's stopper and join came later)
+    registry._join_all = lambda *a, **k: None
 
 
 def _sleepy(seconds):

@@ -62,6 +62,11 @@ class UnknownStage(VerimonoError, ValueError):
     """A stage name that is not registered."""
 
 
+class UndeclaredStageRead(VerimonoError, RuntimeError):
+    """A stage read a result another stage of the same run writes (``context.costs``, ``context.partitions``)
+    without declaring that stage in ``register_stage(..., after=...)``."""
+
+
 class StageUnavailable(VerimonoError):
     """A stage cannot run here (its module is not installed yet, or its data are absent)."""
 
@@ -165,6 +170,7 @@ __all__ = [
     "NotApplicable",
     "UnknownProfile",
     "UnknownStage",
+    "UndeclaredStageRead",
     "StageUnavailable",
     "BadTarget",
     "BadExecutor",

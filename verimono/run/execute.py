@@ -19,14 +19,14 @@ from typing import Any, Callable
 from ..execution import watchdog
 from ..records.atomic import partial_path, write_text
 from ..records.environment import environment
-from ..execution.executors import BLAS_THREADS, make_runner
+from ..execution.executors import BLAS_THREADS, ProcessRunner, make_runner
 from ..execution.config import RunConfig
 from ..execution.config import using as using_config
 from ..execution.profiles import get_profile, load_hypothesis_profile
 from ..execution.timeouts import budget_source
 from .progress import Progress
 from ..records.report import write
-from ..records.report.plots import WARM_UP_THREAD, draw_ahead, drawing_elsewhere, warm_up
+from ..records.report.plots import PLOTS_THREAD, WARM_UP_THREAD, draw_ahead, drawing_elsewhere, warm_up
 from ..records import schema
 from ..records.results import STATUSES, Report, to_jsonable
 from ..execution.calibration import PendingCalibration, calibrate_times, cpu_seconds, set_calibration
@@ -71,13 +71,18 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
     if hasattr(runner, "prestart"):   # the workers import while this process builds the catalog
         runner.prestart()
     waits_on_workers = getattr(runner, "workers", 1) >= 2
+    own_threads: list = []            # this call's threads in this process: the warm-up, the plots drawn ahead
     if waits_on_workers and drawing_elsewhere() and hasattr(runner, "on_report"):
         # each unit's plots go to the drawer as the unit comes back (not when its whole stage has)
         runner.on_report = lambda rep: draw_ahead(rep.studies, rep.trajectories) if rep.studies or rep.trajectories else None
     elif waits_on_workers and not drawing_elsewhere():   # this process waits on the workers and draws the
         import threading                                 # plots itself: matplotlib's import and font cache now
 
-        threading.Thread(target=warm_up, name=WARM_UP_THREAD, daemon=True).start()
+        # not a daemon: a script whose ``execute`` ends within the import (a short run) exited with the thread in
+        # matplotlib's C extensions, finalized under it (the abort a daemon thread in a C++ extension risks at
+        # exit, "terminate called ..."; tests/run/test_api_interrupt.py); its exit now waits for the import's end
+        own_threads.append(threading.Thread(target=warm_up, name=WARM_UP_THREAD, daemon=False))
+        own_threads[-1].start()
     start = time.perf_counter()
     probe = MachineProbe()
 
@@ -87,7 +92,9 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
         # core while this process runs the next stages itself (a serial run drew them all at the end: 0.6 s of
         # the README stepper's check on a 2-core machine)
         if (waits_on_workers or drawing_elsewhere()) and (rep.studies or rep.trajectories):
-            draw_ahead(rep.studies, rep.trajectories)
+            thread = draw_ahead(rep.studies, rep.trajectories)
+            if thread is not None:
+                own_threads.append(thread)
         if on_done is not None:       # saved (the checkpoint) before the console says the stage finished
             on_done(stage, rep, info)
         progress.done(stage, rep, info)
@@ -99,7 +106,19 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
                 using_config(config, profile=profile_name, seed=context.seed, executor=executor) as cfg:
             unit_budget = budget_source()
             report = run_stages(stages, profile, context, on_start=progress.start, on_done=done)
-    finally:
+    except BaseException:
+        # interrupted (or failed): the workers are killed, not asked to finish their units — a worker busy with
+        # one answered the polite request only at that unit's end, and ``close`` waited up to 5 s for each
+        # (:meth:`ProcessRunner._stop`) before the user's script got its KeyboardInterrupt
+        _close(runner, kill=True)
+        # and this call's own threads end before the interrupt reaches the script: one still running when it
+        # reaches the top made the script exit with status 1, not Ctrl-C's 130 (-SIGINT), in about half the tries —
+        # CPython (3.11) notes an unhandled KeyboardInterrupt in a flag every eval()/exec() of a string resets,
+        # and the exit waits for non-daemon threads, whose plotting (matplotlib's imports: dataclasses,
+        # namedtuples) evals strings (tests/run/test_api_interrupt.py)
+        _join_through_interrupts(own_threads)
+        raise
+    else:
         runner.close()
     duration = time.perf_counter() - start
     # once more at the end, when a record of the run is timed (:func:`has_timed_records`): one calibration
@@ -127,6 +146,33 @@ def execute(*, command: str, profile_name: str, stages: list[str] | None, contex
                         "data_dir": None if context.data_dir is None else str(context.data_dir),
                         "environment": environment()})
     return report
+
+
+def _join_through_interrupts(threads: list) -> None:
+    """Join ``threads`` — and every report thread of this process (:data:`WARM_UP_THREAD`, :data:`PLOTS_THREAD`: one
+    whose start the interrupt broke was never handed back) — however often Ctrl-C is pressed meanwhile (the
+    interrupt already on its way is the user's)."""
+    import threading
+
+    threads = list(threads) + [t for t in threading.enumerate() if t.name in (WARM_UP_THREAD, PLOTS_THREAD)
+                               and t not in threads and t is not threading.current_thread()]
+    for t in threads:
+        for _ in range(1000):
+            try:
+                t.join()
+                break
+            except KeyboardInterrupt:
+                continue
+            except RuntimeError:      # started a moment ago, not yet running: join() refuses it for now
+                time.sleep(0.01)
+
+
+def _close(runner: Any, kill: bool) -> None:
+    """``runner.close(kill=kill)`` where the runner takes ``kill`` (:class:`ProcessRunner`), else ``close()``."""
+    if isinstance(runner, ProcessRunner):
+        runner.close(kill=kill)
+    else:
+        runner.close()
 
 
 def has_timed_records(report: Report) -> bool:

@@ -103,7 +103,7 @@ def _load_optimizers(profile: Profile, context: RunContext) -> None:
 
 
 @register_stage("convergence", "every analytic reference's convergence study against its expected order",
-                overlap=True)
+                overlap=True, writes=("costs", "partitions"))
 def convergence_stage(profile: Profile, context: RunContext) -> Report:
     """Every analytic reference's convergence study, plus a trajectory sample for the report's plots;
     one unit per reference."""

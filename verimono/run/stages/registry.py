@@ -19,20 +19,25 @@ To add a battery::
 
 from __future__ import annotations
 
+import ctypes
 import dataclasses
+import math
 import os
 import statistics
+import sys
 import threading
 import time
 import traceback
+from threading import get_ident as _get_ident   # (a test replaces this module's `threading` by a shim)
 from pathlib import Path
 from typing import Any, Callable, Iterable
 
 from ...checks.core import classify
-from ...core.errors import StageUnavailable, UnknownStage
+from ...core.errors import StageUnavailable, UndeclaredStageRead, UnknownStage
 from ...execution.executors import ProcessRunner, SerialRunner
 from ...execution.schedule import SharedQueue
 from ...execution.calibration import slices_after
+from ...execution.interrupts import safe_to_interrupt
 from ...execution.timing import cpu_now, subject_cpu
 from ...lcs.siconos import PACKAGED_DATA, siconos_root
 from ...execution.profiles import Profile
@@ -77,6 +82,11 @@ class RunContext:
     expected: dict[tuple[str, str], float] = dataclasses.field(default_factory=dict)
 
     _catalog: list[Any] | None = dataclasses.field(default=None, repr=False)
+
+    def __post_init__(self) -> None:
+        # what one stage writes for the later ones: a read by a stage that did not declare the writer is an error
+        self.costs = StageResults("costs", self.costs)
+        self.partitions = StageResults("partitions", self.partitions)
 
     def catalog(self) -> list[Any]:
         """``problems`` if given, else the reference catalog (built once per run); then ``extra_problems``."""
@@ -139,6 +149,100 @@ class RunContext:
         return 0 if profile.derandomize else None
 
 
+class StageResults(dict):
+    """A :class:`RunContext` field one stage writes and later stages read (``costs``, ``partitions``: the
+    convergence stage's, :attr:`Stage.writes`).  A stage that reads it must name the stages writing it in
+    ``after=``: on worker processes it otherwise runs at once with them and reads whatever is there — maybe
+    nothing, maybe part of it (the shared queue, :func:`run_stages`) — while one stage after another gives it
+    everything: a silent difference between executors.  So, during :func:`run_stages`, a read (``[]``, ``get``,
+    ``in``, iteration, ``len``) by a stage of a field that another stage of the same run writes (by its
+    ``writes``, or seen writing it) and that the reader did not declare (directly or through another stage) raises
+    :class:`verimono.core.errors.UndeclaredStageRead` — under every executor alike, so the missing ``after=``
+    shows on the first serial run.  Outside a stage (before the run, ``restore_convergence``) nothing is checked."""
+
+    def __init__(self, field: str, data: Any = ()) -> None:
+        super().__init__(data)
+        self.field = field
+        #: the stages of the run under way (:func:`run_stages`), ``()`` outside one
+        self.run: tuple[str, ...] = ()
+        #: stages seen writing it (besides those whose :attr:`Stage.writes` names it)
+        self.writers: set[str] = set()
+
+    def _read(self) -> None:
+        reader = _running_stage()
+        if reader is None or not self.run or reader not in STAGES:
+            return
+        declared = _reads(reader)
+        for w in self.run:
+            if w == reader or w in declared or w not in STAGES:
+                continue
+            if self.field in STAGES[w].writes or w in self.writers:
+                raise UndeclaredStageRead(
+                    f"stage {reader!r} reads context.{self.field}, which stage {w!r} of this run writes, without "
+                    f"declaring it: register it with register_stage(..., after=({w!r},)) — undeclared, it runs at "
+                    f"once with {w!r} on worker processes and reads whatever is there (maybe nothing)")
+
+    def _wrote(self) -> None:
+        writer = _running_stage()
+        if writer is not None:
+            self.writers.add(writer)
+
+    def __getitem__(self, key: Any) -> Any:
+        self._read()
+        return super().__getitem__(key)
+
+    def get(self, key: Any, default: Any = None) -> Any:
+        self._read()
+        return super().get(key, default)
+
+    def __contains__(self, key: object) -> bool:
+        self._read()
+        return super().__contains__(key)
+
+    def __iter__(self):
+        self._read()
+        return super().__iter__()
+
+    def __len__(self) -> int:
+        self._read()
+        return super().__len__()
+
+    def keys(self):
+        self._read()
+        return super().keys()
+
+    def values(self):
+        self._read()
+        return super().values()
+
+    def items(self):
+        self._read()
+        return super().items()
+
+    def __setitem__(self, key: Any, value: Any) -> None:
+        self._wrote()
+        super().__setitem__(key, value)
+
+    def setdefault(self, key: Any, default: Any = None) -> Any:
+        self._wrote()
+        return super().setdefault(key, default)
+
+    def __reduce__(self):       # pickled as a plain dict (a unit's arguments): the checks are this process's
+        return dict, (dict(self),)
+
+
+def _reads(name: str) -> set[str]:
+    """The stages ``name`` declares it reads (``after``), directly or through those stages' own."""
+    seen: set[str] = set()
+    todo = list(STAGES[name].after) if name in STAGES else []
+    while todo:
+        d = todo.pop()
+        if d not in seen:
+            seen.add(d)
+            todo.extend(STAGES[d].after if d in STAGES else ())
+    return seen
+
+
 #: ``Report.meta`` key under which :func:`timed_unit` hands a unit's times back (popped by ``run_units``)
 UNIT_TIME = "unit_time"
 
@@ -199,8 +303,10 @@ class Stage:
     #: timed stage (performance), and a stage registered without saying so, runs alone, as before
     overlap: bool = False
     #: stages whose results this one reads (``context.costs``, ``context.partitions``): when they run in the
-    #: same run, it starts once they have ended
+    #: same run, it starts once they have ended (reading one not declared: :class:`StageResults`)
     after: tuple[str, ...] = ()
+    #: the :class:`RunContext` fields this stage writes for later stages (``"costs"``, ``"partitions"``)
+    writes: tuple[str, ...] = ()
 
 
 STAGES: dict[str, Stage] = {}
@@ -225,14 +331,17 @@ def default_stages() -> list[str]:
 
 def register_stage(name: str, description: str = "", *, default: bool = True,
                    prepare: Callable[[Profile, RunContext], None] | None = None, overlap: bool = False,
-                   after: Iterable[str] = ()) -> Callable:
+                   after: Iterable[str] = (), writes: Iterable[str] = ()) -> Callable:
     """Decorator registering ``fn(profile, context) -> Report`` as the stage ``name`` (replaces same name);
     ``default=False``: a stage on request; ``prepare``: run before the workers start; ``overlap``: may run at
-    once with other such stages; ``after``: the stages it reads the results of (:class:`Stage`)."""
+    once with other such stages; ``after``: the stages it reads the results of — reading a result of a stage of
+    the same run that is not declared there raises :class:`verimono.core.errors.UndeclaredStageRead` (a failed
+    ``stage[name]`` record); ``writes``: the :class:`RunContext` results it writes (``"costs"``,
+    ``"partitions"``) (:class:`Stage`)."""
 
     def deco(fn: Callable[[Profile, RunContext], Report]) -> Callable:
         STAGES[name] = Stage(name, fn, description or (fn.__doc__ or "").strip().split("\n")[0], default, prepare,
-                             overlap, tuple(after))
+                             overlap, tuple(after), tuple(writes))
         return fn
 
     return deco
@@ -264,6 +373,7 @@ def run_stages(names: Iterable[str] | None, profile: Profile, context: RunContex
     for n in names:
         if n not in STAGES:
             raise UnknownStage(f"unknown stage {n!r}; registered stages: {', '.join(STAGES)}")
+    names = _dependencies_first(names)
     total = Report(meta={"stages": []})
 
     def finish(n: str, rep: Report, info: dict) -> None:
@@ -273,6 +383,21 @@ def run_stages(names: Iterable[str] | None, profile: Profile, context: RunContex
             on_done(STAGES[n], rep, info)
 
     shared = _can_share(context)
+    results = [f for f in (context.costs, context.partitions) if isinstance(f, StageResults)]
+    for f in results:
+        f.run = tuple(names)
+    try:
+        _run_groups(names, shared, profile, context, on_start, finish)
+    finally:
+        for f in results:
+            f.run = ()
+    return total
+
+
+def _run_groups(names: list[str], shared: bool, profile: Profile, context: RunContext,
+                on_start: Callable[[Stage, int, int], None] | None, finish: Callable[[str, Report, dict], None]
+                ) -> None:
+    """:func:`run_stages`'s loop: each group of stages that may overlap at once, else one after another."""
     i = 0
     while i < len(names):
         group = [names[i]]     # a stage named twice runs twice, one run after the other (a group keys by name)
@@ -287,7 +412,29 @@ def run_stages(names: Iterable[str] | None, profile: Profile, context: RunContex
                     on_start(STAGES[n], i + k, len(names))
                 finish(n, *_run_stage(n, profile, context))
         i += len(group)
-    return total
+
+
+def _dependencies_first(names: list[str]) -> list[str]:
+    """``names`` with every stage moved after the stages of the run it reads (``after``), otherwise in their order:
+    ``--stage trajectory_laws --stage convergence`` ran trajectory_laws first, without the convergence studies'
+    grids (21 worst ratios other than a whole run's), though ``after`` promises it starts once they have ended."""
+    left: dict[str, int] = {}
+    for n in names:
+        left[n] = left.get(n, 0) + 1
+    out: list[str] = []
+
+    def place(n: str, path: tuple[str, ...]) -> None:
+        for d in STAGES[n].after:
+            if left.get(d, 0) > 0 and d not in path:       # (a cycle of after's: left in the given order)
+                place(d, path + (d,))
+        if left[n] > 0:
+            left[n] -= 1
+            out.append(n)
+
+    for n in names:
+        if left[n] > 0:
+            place(n, (n,))
+    return out
 
 
 def _some_run_at_once(group: list[str]) -> bool:
@@ -323,21 +470,33 @@ def _run_together(group: list[str], first: int, count: int, profile: Profile, co
     slots: dict[str, tuple[Report, dict] | None] = {n: None for n in group}
     ended = {n: threading.Event() for n in group}
 
+    stopper = _Stopper()
+
     def body(n: str) -> None:
+        me = ctypes.c_ulong(_get_ident())
         try:
-            for dep in STAGES[n].after:
-                if dep in ended:
-                    ended[dep].wait()
-            with queue.turn:
-                _HERE.stage = n
-                slots[n] = _run_stage(n, profile, context, overlapped=[m for m in group if m != n])
-        except BaseException as exc:  # noqa: BLE001 - the queue closed under it (an interrupt): the run ends
-            with queue.turn:          # a stage's code in this process runs holding the turn, even this (fork_guard)
-                slots[n] = _stage_failure(n, exc, 0.0)[0], {"name": n, "status": "error", "records": 1,
-                                                             "duration": 0.0, "cpu": 0.0, "message": str(exc)}
+            stopper.enter()
+            try:
+                for dep in STAGES[n].after:
+                    if dep in ended:
+                        ended[dep].wait()
+                with queue.turn:
+                    _HERE.stage = n
+                    slots[n] = _run_stage(n, profile, context, overlapped=[m for m in group if m != n])
+            except BaseException as exc:  # noqa: BLE001 - the queue closed under it (an interrupt): the run ends
+                with queue.turn:          # a stage's code in this process runs holding the turn, even this (fork_guard)
+                    slots[n] = _stage_failure(n, exc, 0.0)[0], {"name": n, "status": "error", "records": 1,
+                                                                 "duration": 0.0, "cpu": 0.0, "message": str(exc)}
+            finally:
+                ended[n].set()
+                queue._wake()
+        except BaseException:  # noqa: BLE001 - a stop (:class:`_Stopper`) delivered late: the run is ending anyway
+            pass
         finally:
-            ended[n].set()
-            queue._wake()
+            # inline, no Python call: a call's first bytecode would deliver a pending stop here, outside every catch
+            with stopper.lock:
+                _SET_ASYNC_EXC(me, None)      # NULL: a stop sent and not yet delivered is cleared
+                stopper.running.discard(me.value)
 
     # not daemons, and joined below even when serving raises: a daemon thread alive at the interpreter's exit that
     # re-enters a C++ extension releasing the GIL (pybind11's: HiGHS, ProxQP) is ended by pthread_exit, whose
@@ -355,18 +514,19 @@ def _run_together(group: list[str], first: int, count: int, profile: Profile, co
         if on_start:
             on_start(STAGES[n], first + k, count)
     start = time.perf_counter()
+    raising = False
     try:
         for t in threads:
             t.start()
         queue.serve(threads, on_idle=release)
     except BaseException as exc:
+        raising = True
         queue._break(exc)          # (serve did already, unless a thread failed to start) every waiting stage released
+        stopper.stop()             # a stage's own code in this process stops at its next bytecode, not its next unit
         raise
     finally:
         try:
-            for t in threads:      # each ends at its next unit (the queue closed) or at its end: none outlives the run
-                if t.ident is not None:
-                    t.join()
+            _join_all([t for t in threads if t.ident is not None], stopper, raising=raising)
         finally:
             context.executor = outer
     wall = time.perf_counter() - start
@@ -374,6 +534,92 @@ def _run_together(group: list[str], first: int, count: int, profile: Profile, co
         if slots[n] is not None:
             slots[n][1]["group_duration"] = wall
     release()
+
+
+#: ``PyThreadState_SetAsyncExc(thread id, exception or NULL)`` (:class:`_Stopper`)
+_SET_ASYNC_EXC = ctypes.pythonapi.PyThreadState_SetAsyncExc
+
+
+class _Stopper:
+    """Stops the stage threads of :func:`_run_together` when the run is interrupted.
+
+    Ctrl-C reaches the main thread only (serving the queue).  Closing the queue releases a stage thread waiting
+    for its units, but one running its own code in this process (building units, drawing operators, merging
+    reports; a user's stage, for as long as it likes) ran on until its next unit: the interrupted ``execute``
+    waited for it (1-3 s of the built-in stages; forever for a stage that never asks for a unit), a second
+    Ctrl-C then broke that wait, and the still-running thread used the run's closed worker pool again — it
+    started new workers, and the user's script hung at its exit joining them (seen with two Ctrl-C's 0.3 s
+    apart).  :meth:`stop` raises ``KeyboardInterrupt`` in each stage thread (what Ctrl-C does to a serial run's
+    stage in the main thread) — but only while its stack is where an interrupt is safe
+    (:func:`verimono.execution.interrupts.safe_to_interrupt`, and no import under way: one raised inside
+    importlib's bookkeeping left the import lock held and every later import of the process waiting forever),
+    looked at with thread switching held off, so the thread's next check of pending exceptions comes before it
+    can enter such code; elsewhere it is tried again at the next call (:func:`_join_all` calls every 10 ms).
+    A thread's end clears a stop not yet delivered, under the lock :meth:`stop` sends under (``body`` in
+    :func:`_run_together`), so a stop never lands outside the thread's catch-all: no "Exception in thread"."""
+
+    #: seconds after which a stop sent and not obeyed (a stage's code that caught it) is sent again
+    AGAIN = 0.5
+
+    def __init__(self) -> None:
+        self.lock = threading.Lock()
+        self.running: set[int] = set()
+        self._stopping = False
+        self._sent: dict[int, float] = {}
+
+    def enter(self) -> None:
+        with self.lock:
+            self.running.add(_get_ident())
+            if self._stopping:
+                raise KeyboardInterrupt
+
+    def stop(self) -> None:
+        switch = sys.getswitchinterval()
+        sys.setswitchinterval(1e3)        # no other thread runs between the look at its stack and the send
+        try:
+            with self.lock:
+                self._stopping = True
+                frames = sys._current_frames()
+                now = time.monotonic()
+                for ident in self.running:
+                    if now - self._sent.get(ident, -math.inf) < self.AGAIN or not _stoppable(frames.get(ident)):
+                        continue
+                    _SET_ASYNC_EXC(ctypes.c_ulong(ident), ctypes.py_object(KeyboardInterrupt))
+                    self._sent[ident] = now
+        finally:
+            sys.setswitchinterval(switch)
+
+
+def _stoppable(frame: Any) -> bool:
+    """Whether a stage thread whose innermost frame is ``frame`` may be interrupted now (:class:`_Stopper`)."""
+    if frame is None:
+        return False
+    f = frame
+    while f is not None:
+        if (f.f_globals.get("__name__") or "").startswith("importlib"):
+            return False
+        f = f.f_back
+    return safe_to_interrupt(frame)
+
+
+def _join_all(threads: list[threading.Thread], stopper: _Stopper, raising: bool = False) -> None:
+    """Join ``threads`` however often Ctrl-C is pressed meanwhile (each press stops them again): a stage thread
+    left running would use the run's pool after it was closed.  The first such press is raised once they have
+    ended, unless an exception (the first Ctrl-C) is already on its way (``raising``): that one is the user's."""
+    interrupt: BaseException | None = None
+    for t in threads:
+        while True:
+            try:
+                t.join(0.01)
+                if not t.is_alive():
+                    break
+                if stopper._stopping:
+                    stopper.stop()        # those not yet stopped, where it is safe now
+            except KeyboardInterrupt as exc:
+                interrupt = interrupt or exc
+                stopper.stop()
+    if interrupt is not None and not raising:
+        raise interrupt
 
 
 def _run_stage(n: str, profile: Profile, context: RunContext, overlapped: list[str] | None = None
@@ -386,6 +632,7 @@ def _run_stage(n: str, profile: Profile, context: RunContext, overlapped: list[s
     # and merges what comes back; a report warm-up thread of this process is not the stage's)
     own_cpu = cpu_now if serial else time.thread_time
     cpu0, (subj0, calls0), n_units = own_cpu(), subject_cpu(), len(context.unit_times)
+    outer, _HERE.stage = _running_stage(), n      # which stage reads (StageResults) and runs units (run_units)
     try:
         rep = stage.fn(profile, context)
         if not isinstance(rep, Report):
@@ -394,6 +641,8 @@ def _run_stage(n: str, profile: Profile, context: RunContext, overlapped: list[s
         message = rep.summary()
     except (Exception, *SUBJECT_EXITS) as exc:  # noqa: BLE001 - a crash is a failure of the run, recorded
         rep, status, message = _stage_failure(n, exc, time.perf_counter() - start)
+    finally:
+        _HERE.stage = outer
     duration = time.perf_counter() - start
     units = context.unit_times[n_units:]
     if overlapped is not None:      # the other stages' units came back in between: this stage's only
@@ -448,4 +697,4 @@ def locate_data(explicit: str | os.PathLike | None = None) -> Path:
     return path
 
 
-__all__ = ["STAGES", "Stage", "default_stages", "RunContext", "register_stage", "run_stages", "prepare_stages", "locate_data", "timed_unit", "UNIT_TIME", "expected_costs"]
+__all__ = ["STAGES", "Stage", "StageResults", "default_stages", "RunContext", "register_stage", "run_stages", "prepare_stages", "locate_data", "timed_unit", "UNIT_TIME", "expected_costs"]
