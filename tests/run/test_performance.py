@@ -9,6 +9,7 @@ import math
 import os
 import random
 
+import numpy as np
 import pytest
 
 from verimono import performance, timing
@@ -82,6 +83,29 @@ def test_different_results_fail_the_record_without_raising():
     op, kw = performance.ensemble_case("t|x|")
     rec = performance.check_ensemble(op, "t|x|", batch=50, steps=5, rounds=1, problem_kw=kw, stepper=off_batch)
     assert rec.status == FAILED and not rec.details["identical"] and "differs" in rec.message
+
+
+def test_a_batch_wrong_in_one_untimed_row_fails_the_ensemble_record():
+    """The rounds time 250 of the 1000 separate solves (scaled by 4); the bit-for-bit comparison still covers
+    every row: a batch wrong only in row 700, a row no round times, fails."""
+    rows = performance.ensemble_rows(1000, 250)
+    assert len(rows) == 250 and len(set(rows.tolist())) == 250 and 700 not in rows and rows.max() < 1000
+    assert performance.ensemble_rows(1000, None).tolist() == list(range(1000))
+
+    def row_700(problem, t):
+        x = solve(problem, t).x
+        if x.ndim == 3:
+            x = x.copy()
+            x[-1, 700] = np.nextafter(x[-1, 700], np.inf)   # one last bit of one row
+        return x
+
+    op, kw = performance.ensemble_case("box")
+    rec = performance.check_ensemble(op, "box", batch=1000, steps=2, rounds=1, problem_kw=kw, stepper=row_700,
+                                     timed_rows=250)
+    assert rec.status == FAILED and not rec.details["identical"] and "differs" in rec.message
+    assert rec.subject == "box B=1000" and rec.details["timed_rows"] == 250 and rec.details["verified_rows"] == 1000
+    ok = performance.check_ensemble(op, "box", batch=1000, steps=2, rounds=1, problem_kw=kw, timed_rows=250)
+    assert ok.details["identical"] and ok.details["timed_rows"] == 250
 
 
 def steady(ratio: float, n: int = 9, jitter: float = 0.01, seed: int = 0) -> tuple[list[float], list[float]]:

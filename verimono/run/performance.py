@@ -98,6 +98,7 @@ class Sizes:
     lcs_batch_steps: int = 200
     lcs_batch_rounds: int = 9
     max_rounds: int = 27
+    ensemble_timed_rows: int | None = 250
 
 
 #: ``thorough``: the full sizes; ``ci`` and ``dev``: a few seconds on 2 cores, with fewer steps (the ratios
@@ -111,6 +112,10 @@ class Sizes:
 #: per_step_steps 5000 (was 10 000): the nine per-step records, 2 x 9 rounds at both sizes interleaved at load 5.6-6.7,
 #: gave the same medians (1.15-1.30x against 1.19-1.32x), intervals no wider (widths 0.02-0.32 against 0.04-0.47)
 #: and no straddle (one at 10 000) for 1.3-1.4 s of CPU against 2.9-3.4 s (docs/speed.md, branch perf7)
+#: ensemble_timed_rows 250 (every profile): each round times 250 of the B = 1000 separate solves, scaled by 4;
+#: interleaved with all 1000 timed (4 rounds x 3 kinds, load 2-3) the speed-ups read 106-136 / 129-154 / 76-98 against
+#: 88-124 / 122-143 / 67-92 (t|x| / box / ball), intervals no wider, for 0.15-0.41 s of CPU per record against
+#: 0.40-1.10 s; every row is still compared with the batch, once, untimed (docs/speed.md, branch perf9)
 _QUICK = Sizes(per_step_steps=5_000, per_step_rounds=9, ensemble_batch=1000, ensemble_steps=20,
                ensemble_rounds=9, lcs_steps=5000, lcs_rounds=9, memory_steps=100_000,
                lcs_batch=1000, lcs_batch_steps=200, lcs_batch_rounds=9, max_rounds=27)
@@ -390,28 +395,51 @@ def ensemble_case(kind: str, n: int = 3):
     return problem.operator, ({"initial_jump": True} if problem.initial_jump else {})
 
 
+def ensemble_rows(batch: int, timed_rows: int | None) -> np.ndarray:
+    """The rows of a batch whose separate solves are timed: all ``batch`` (``timed_rows`` None or ≥ ``batch``), else
+    ``timed_rows`` evenly spaced ones, each the middle row of its ``batch/timed_rows`` consecutive rows (a fixed
+    subsample of independent, identically drawn initial conditions: its mean cost per solve estimates the
+    batch's)."""
+    if timed_rows is None or timed_rows >= batch:
+        return np.arange(batch)
+    if timed_rows < 1:
+        raise ValueError(f"timed_rows must be >= 1, got {timed_rows}")
+    return (2 * np.arange(timed_rows) + 1) * batch // (2 * timed_rows)
+
+
 def check_ensemble(op, label: str, *, batch: int, steps: int, rounds: int, max_rounds: int | None = None,
                    problem_kw: dict | None = None, seed: int = 6, stepper: Callable | None = None,
-                   runner: Runner | None = None) -> CheckResult:
+                   runner: Runner | None = None, timed_rows: int | None = None) -> CheckResult:
     """Target 2: one solve of ``batch`` initial conditions against ``batch`` separate solves of ``op``
-    (problems built outside the timing); the two must agree bit for bit, else the record fails."""
+    (problems built outside the timing); the two must agree bit for bit, every row, else the record fails.
+
+    ``timed_rows``: how many of the separate solves each round times (:func:`ensemble_rows`, a fixed evenly
+    spaced subsample; default all ``batch``), their time scaled by ``batch/timed_rows`` — the separate solves are
+    independent, so the subsample's cost per solve estimates the same per-trajectory cost.  The comparison with
+    the batch still covers every row: the rows not timed are solved separately once, untimed, after the rounds
+    (``details["timed_rows"]``, ``details["verified_rows"]``)."""
     stepper = _default_stepper(stepper)
     kw = dict(problem_kw or {})
     X0 = np.random.default_rng(seed).normal(size=(batch, op.dim))
     t = uniform_grid(1.0, steps=steps)
     whole = Problem(op, X0, 1.0, **kw)
     singles = [Problem(op, x, 1.0, **kw) for x in X0]
+    rows = ensemble_rows(batch, timed_rows)
+    timed = [singles[i] for i in rows]
 
     def verify(last):
         xb = np.asarray(last["subject"])
-        xs = np.stack([np.asarray(x) for x in last["baseline"]], axis=1)
+        got = dict(zip(rows.tolist(), last["baseline"]))   # the timed rows' last separate solves
+        xs = np.stack([np.asarray(got[i] if i in got else stepper(p, t)) for i, p in enumerate(singles)], axis=1)
         same = xb.shape == xs.shape and np.array_equal(xb, xs)
         return (None if same else "the batched solve differs from the separate solves"), \
-            {"batch": batch, "steps": steps, "operator": label, "identical": same}
+            {"batch": batch, "steps": steps, "operator": label, "identical": same, "timed_rows": len(rows),
+             "verified_rows": len(singles)}
 
     return _timed_record("performance_ensemble", f"{label} B={batch}", lambda: stepper(whole, t),
-                         lambda: [stepper(p, t) for p in singles], target=ENSEMBLE_TARGET, speedup=True,
-                         rounds=rounds, max_rounds=max_rounds, runner=runner, verify=verify)
+                         lambda: [stepper(p, t) for p in timed], target=ENSEMBLE_TARGET, speedup=True,
+                         rounds=rounds, max_rounds=max_rounds, runner=runner, verify=verify,
+                         baseline_scale=len(rows) / batch)
 
 
 def check_lcs_step(*, steps: int, rounds: int, max_rounds: int | None = None, runner: Runner | None = None,
@@ -579,7 +607,8 @@ def performance_report(sizes: Sizes, *, stepper: Callable | None = None,
         def ens(kind=kind):
             op, kw = ensemble_case(kind)
             return check_ensemble(op, kind, batch=sizes.ensemble_batch, steps=sizes.ensemble_steps,
-                                  rounds=sizes.ensemble_rounds, max_rounds=mr, problem_kw=kw, stepper=stepper)
+                                  rounds=sizes.ensemble_rounds, max_rounds=mr, problem_kw=kw, stepper=stepper,
+                                  timed_rows=sizes.ensemble_timed_rows)
         jobs.append((f"ensemble {kind}", ens))
     jobs.append(("DiodeBridge", lambda: check_lcs_step(steps=sizes.lcs_steps, rounds=sizes.lcs_rounds,
                                                        max_rounds=mr)))
@@ -619,5 +648,5 @@ def performance_report(sizes: Sizes, *, stepper: Callable | None = None,
 
 __all__ = ["EARLY_ROUNDS", "PER_STEP_TARGET", "ENSEMBLE_TARGET", "LCS_TARGET", "LCS_BATCH_TARGET", "LCS_BATCH_TARGET_COMPILED", "LCS_AGREEMENT", "MEMORY_TARGET",
            "SIZES", "Sizes", "bare_t_norm", "bare_box", "bare_ball", "floor_loop", "minimal_lcs", "per_step_case", "ensemble_case",
-           "interleave", "measure", "Rounds", "ratio_record", "check_per_step", "check_ensemble", "check_lcs_step", "check_lcs_batch",
+           "ensemble_rows", "interleave", "measure", "Rounds", "ratio_record", "check_per_step", "check_ensemble", "check_lcs_step", "check_lcs_batch",
            "check_memory", "peak_memory", "performance_report"]
