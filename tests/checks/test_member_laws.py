@@ -1,0 +1,80 @@
+"""The members besides the resolvent, judged against the resolvent's own values (verimono/checks/operator_laws.py):
+``yosida_member`` (an override of ``Operator.yosida`` equals ``(x - J_λx)/λ``), ``contains_rejects`` (the declared
+membership rejects a pair that breaks monotonicity with a graph point) and ``project_domain_nearest`` (the nearest
+point of ``cl dom F``), and ``resolvent_single_valued`` across input forms — each seen failing on a broken subject
+and passing on its twin, the same code a percent or two away or with the fault off."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import zoo
+import verimono as vm
+from verimono.checks import run_law
+from verimono.checks.operator_laws import CONTAINS_BREAK, CONTAINS_DECIDABLE, _breaking_pair
+
+EX = 12
+
+
+@pytest.mark.parametrize("factor,status", [(0.5, "failed"), (0.99, "failed"), (1.0, "passed")])
+def test_a_yosida_member_off_by_one_percent_fails_and_the_exact_one_passes(factor, status):
+    r = run_law("yosida_member", zoo.yosida_member_halved(factor), seed=0, examples=EX)
+    assert r.status == status, str(r)
+    if status == "failed":      # |Y_member - Y| = (1 - factor)|Y|, far beyond the slack 4·RTOL(1 + |x|)/λ
+        cex = r.counterexample
+        assert cex["lhs"] == pytest.approx((1 - factor) * np.linalg.norm(cex["Y_from_J"]), rel=1e-6)
+
+
+def test_yosida_member_is_skipped_where_the_operator_has_no_yosida_of_its_own():
+    r = run_law("yosida_member", vm.L1Subdifferential(1.0, 2), seed=0, examples=EX)
+    assert r.status == "skipped" and "yosida" in r.message
+
+
+def test_the_breaking_pair_breaks_monotonicity_by_its_factor():
+    """(u1, v2 - c(u1 - u2)) against (u2, v2): ⟨Δu, Δv⟩ = -c|Δu|², and the ratio is that over the tolerances."""
+    x1, x2, lam = np.array([3.0, -1.0]), np.array([0.5, 2.0]), 0.5
+    F = vm.L1Subdifferential(1.0, 2)
+    u1, u2 = F.resolvent(x1, lam), F.resolvent(x2, lam)
+    v, q, ndu, tx = _breaking_pair(2, x1, x2, u1, u2, lam, 1e-8)
+    v2 = (x2 - u2) / lam
+    c = CONTAINS_BREAK * (1 + np.linalg.norm((x1 - u1) / lam) + np.linalg.norm(v2) + 4 * 1e-8 * 4 / lam) / ndu
+    assert float((u1 - u2) @ (v - v2)) == pytest.approx(-c * ndu ** 2, rel=1e-12)
+    assert q > 1e3 * CONTAINS_DECIDABLE and tx < 1e-5 * ndu      # decided by a wide margin at |Δu| ~ 1
+    assert not F.contains(u1, v, 0.0, 1e-8)         # a correct membership test rejects it
+
+
+@pytest.mark.parametrize("make,status", [(zoo.contains_accepts_everything, "failed"),
+                                         (lambda: vm.L1Subdifferential(1.0, 2), "passed"),
+                                         (lambda: vm.NormalCone(vm.sets.Ball([0.0, 0.0], 1.0)), "passed")],
+                         ids=["accepts_everything", "l1", "ball"])
+def test_a_membership_test_accepting_everything_fails_and_the_catalogs_pass(make, status):
+    r = run_law("contains_rejects", make(), seed=0, examples=EX)
+    assert r.status == status, str(r)
+    if status == "failed":
+        assert r.worst >= 2.0
+
+
+@pytest.mark.parametrize("shrink,status", [(None, "failed"), (0.98, "failed"), (1.0, "passed")])
+def test_a_projection_onto_the_domain_that_is_not_the_nearest_point_fails(shrink, status):
+    """The box [-1, 1]^3: the radial retraction and the clip onto [-0.98, 0.98]^3 (both inside the domain, neither
+    nearest) fail; the clip itself passes."""
+    if shrink is None:
+        op = zoo.project_domain_radial()
+    else:
+        box = vm.sets.Box([-1.0] * 3, [1.0] * 3)
+        cone = vm.NormalCone(box)
+        op = vm.operator_from_resolvent(cone.resolvent, 3, min_norm=cone.min_norm, contains=cone.contains,
+                                        project_domain=lambda x, t=0.0: np.clip(np.asarray(x, float), -shrink, shrink),
+                                        name=f"clip {shrink}")
+    r = run_law("project_domain_nearest", op, seed=0, examples=EX)
+    assert r.status == status, str(r)
+
+
+def test_a_resolvent_depending_on_the_layout_fails_and_its_twin_passes():
+    bad = run_law("resolvent_single_valued", zoo.layout_dependent(), seed=0, examples=EX)
+    assert bad.status == "failed" and bad.counterexample["form"] in ("strided", "slice"), str(bad)
+    assert "contiguous" in bad.message
+    again = run_law("resolvent_single_valued", zoo.layout_dependent(), sample=bad.counterexample)
+    assert again.status == "failed"
+    assert run_law("resolvent_single_valued", zoo.lawful_layout(), seed=0, examples=EX).status == "passed"
