@@ -78,3 +78,44 @@ def test_a_resolvent_depending_on_the_layout_fails_and_its_twin_passes():
     again = run_law("resolvent_single_valued", zoo.layout_dependent(), sample=bad.counterexample)
     assert again.status == "failed"
     assert run_law("resolvent_single_valued", zoo.lawful_layout(), seed=0, examples=EX).status == "passed"
+
+
+def _far_sign_shortcut(exact: bool):
+    """The unit ball's projection with a shortcut for |x| > 1e5: sign(x)/|sign(x)| (on the sphere; the projection
+    only on the coordinate axes and the diagonals); ``exact``: x/|x| there, the lawful twin."""
+    def J(x, lam, t=0.0):
+        x = np.asarray(x, dtype=float)
+        r = float(np.linalg.norm(x))
+        if r > 1e5:
+            s = x if exact else np.sign(x)
+            return s / float(np.linalg.norm(s))
+        return x / max(1.0, r)
+    def contains(x, y, t=0.0, tol=None):       # y ∈ N_B(x) up to tol, absolutely (the catalog's reads it relatively)
+        x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+        r = float(np.linalg.norm(x))
+        if r > 1.0 + tol:
+            return False
+        if r < 1.0 - tol:
+            return float(np.linalg.norm(y)) <= tol
+        return float(np.linalg.norm(y - (y @ x) / r ** 2 * x)) <= tol and float(y @ x) >= -tol
+    cone = vm.NormalCone(vm.sets.Ball([0.0, 0.0, 0.0], 1.0))
+    return vm.operator_from_resolvent(J, 3, project_domain=cone.project_domain, contains=contains,
+                                      name="far shortcut" if not exact else "far branch x/|x|")
+
+
+def test_the_sweep_evaluates_far_points_off_the_axes():
+    """The sweep's far decade (|x1| = 10^6, every 12th sample) fell on the axes and into the range of J every time
+    (12 ≡ 0 mod 3 and 4): every other far sample is now in a general direction, evaluated as drawn; the stream of the
+    other samples is unchanged.  A far shortcut exact on the axes fails on seeds 0-2; its twin passes."""
+    from verimono.checks.engine.samples import Sample
+    from verimono.checks.engine.sweep import FAR, _sweep_draws, far_general, sweep_samples
+    op = vm.NormalCone(vm.sets.Ball([0.0, 0.0, 0.0], 1.0))
+    ss = sweep_samples(op, 0, 1.0, 33, Sample)
+    far = [s for s in ss if np.linalg.norm(s.x1) >= FAR]
+    assert far and all(np.count_nonzero(s.x1) == 3 for s in far)     # evaluated as drawn, off the axes
+    X1 = _sweep_draws(3, 0, 1.0, 33, 1e300)[0]
+    axis_far = [i for i in range(33) if np.linalg.norm(X1[i]) >= FAR and not far_general(i, 1e300)]
+    assert axis_far and all(np.count_nonzero(X1[i]) == 1 for i in axis_far)     # the axes kept
+    for seed in (0, 1, 2):
+        assert run_law("yosida_in_graph", _far_sign_shortcut(False), seed=seed, examples=EX).status == "failed"
+        assert run_law("yosida_in_graph", _far_sign_shortcut(True), seed=seed, examples=EX).status == "passed"

@@ -31,9 +31,6 @@ MISSED: dict[str, str] = {
         "RTOL(1 + |x|)/λ of Y_λ = (x - J_λx)/λ, which exceeds the error; missed at ci, dev and thorough",
     "halfspace_lag_in_t_window":
         "a lag confined to t in [0.61, 0.62): ci's t resolution is 0.019 (disclosed in the record); thorough catches it",
-    "ball_far_sign_shortcut":
-        "a shortcut for |x| > 1e5 exact on the coordinate axes: missed at ci seed 0 and dev (a probe saw dev's only "
-        "far points on the axes); ci seeds 1, 2 and thorough catch it",
     "soft_threshold_skips_tiny_steps":
         "J_λx = x for λ < 1e-12: Y_λx = 0 ∉ F(J_λx), 10^3 times the rounding of (x - J)/λ at λ = 1e-13, |x| = 1, but "
         "below the slack RTOL(1 + |x|)/λ; missed at ci, dev and thorough",
