@@ -114,7 +114,7 @@ def test_the_sweep_evaluates_far_points_off_the_axes():
     far = [s for s in ss if np.linalg.norm(s.x1) >= FAR]
     assert far and all(np.count_nonzero(s.x1) == 3 for s in far)     # evaluated as drawn, off the axes
     X1 = _sweep_draws(3, 0, 1.0, 33, 1e300)[0]
-    axis_far = [i for i in range(33) if np.linalg.norm(X1[i]) >= FAR and not far_general(i, 1e300)]
+    axis_far = [i for i in range(33) if np.linalg.norm(X1[i]) >= FAR and not far_general(i, 1e300, 3)]
     assert axis_far and all(np.count_nonzero(X1[i]) == 1 for i in axis_far)     # the axes kept
     for seed in (0, 1, 2):
         assert run_law("yosida_in_graph", _far_sign_shortcut(False), seed=seed, examples=EX).status == "failed"

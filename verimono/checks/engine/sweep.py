@@ -53,15 +53,15 @@ SWEEP_CAP = {"prox_minimiser": len(SCALES)}
 FAR = 1e5
 
 
-def far_general(i: int, cap: float) -> bool:
+def far_general(i: int, cap: float, n: int) -> bool:
     """Whether sweep sample ``i`` is a far point in a general direction, evaluated as drawn: every other far sample
     (the first of each pair), at a scale of at least :data:`FAR`.  The far scale comes every ``len(SCALES) = 12``
     samples, and ``12`` is a multiple of ``3`` and ``4`` less one (``i ≡ 11 mod 12``): every far sample fell on the
     coordinate axes (``i % 3 == 2``) and was replaced by points in the range of the resolvent (``i % 4 == 3``), so the
     search's far points were only ``±10^6 e_k`` and their projections (blind set 7, ``ball_far_sign_shortcut``: a
     shortcut exact on the axes, missed at ``dev`` and ``ci`` seed 0).  The other far samples keep the axes and the
-    range of ``J``."""
-    return min(SCALES[i % len(SCALES)], cap) >= FAR and (i // len(SCALES)) % 2 == 0
+    range of ``J``.  On ``R^1`` every direction is an axis: nothing changes there (``n = 1`` samples are as before)."""
+    return n >= 2 and min(SCALES[i % len(SCALES)], cap) >= FAR and (i // len(SCALES)) % 2 == 0
 
 
 def sweep_count(profile: str | None, law: str) -> int:
@@ -81,7 +81,7 @@ def _sweep_draws(n: int, seed: int, horizon: float, count: int, cap: float) -> t
         if i % 3 == 2:
             sign = rng.choice((-1.0, 1.0))      # drawn (in u[k] = sign's order) for a far general sample too: the
             k = rng.integers(n)                 # stream, and every other sample, stay as they were
-            if not far_general(i, cap):
+            if not far_general(i, cap, n):
                 u = np.zeros(n)
                 u[k] = sign
         x1 = s1 * u
@@ -133,7 +133,7 @@ def sweep_samples(op, seed: int, horizon: float, count: int, make: Callable) -> 
     out, boundary = [], None
     for i in range(count):
         x1, x2, lam, mu, nu, t = X1[i].copy(), X2[i].copy(), lams[i], mus[i], nus[i], tl[i]
-        if i % 4 == 3 and not far_general(i, cap):   # points in the range of J: J_ν x and J_ν(J_ν x), or just outside the boundary
+        if i % 4 == 3 and not far_general(i, cap, n):   # points in the range of J: J_ν x and J_ν(J_ν x), or just outside the boundary
             try:
                 a = np.asarray(op.resolvent(x1.copy(), nu, t), dtype=float)
                 b = np.asarray(op.resolvent(a.copy(), nu, t), dtype=float)
