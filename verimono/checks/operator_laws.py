@@ -485,7 +485,13 @@ def _breaking_pair(n: int, x1, x2, u1, u2, lam, tol_c):
     return v, q, ndu, tx
 
 
-@operator_law("contains_rejects", "(A1) the declared graph monotone", _CONTAINS)
+#: the coordinates of ``contains_rejects``: all but ``offset`` (its pairs ``b + s n``, ``b + 1000 s n`` lie on one normal
+#: ray of the domain, whose points a projection maps to one ``J_λx1 = J_λx2``: no pair decidable there, 220 evaluations
+#: an operator all inconclusive) and ``mu``, ``nu`` (not read)
+CONTAINS_OVER = ("points", "form", "direction", "lam", "t", "scale")
+
+
+@operator_law("contains_rejects", "(A1) the declared graph monotone", _CONTAINS, over=CONTAINS_OVER)
 def check_contains_rejects(op, s):
     """Assumption (A1) for the membership test ``contains`` itself: it must reject a pair no monotone graph through
     the sample's graph points holds.  With ``(u_i, v_i) = (J_λx_i, Y_λx_i)`` (item v), the pair
