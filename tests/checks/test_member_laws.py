@@ -119,3 +119,24 @@ def test_the_sweep_evaluates_far_points_off_the_axes():
     for seed in (0, 1, 2):
         assert run_law("yosida_in_graph", _far_sign_shortcut(False), seed=seed, examples=EX).status == "failed"
         assert run_law("yosida_in_graph", _far_sign_shortcut(True), seed=seed, examples=EX).status == "passed"
+
+
+def test_a_yosida_record_states_the_smallest_step_it_can_judge():
+    """A soft threshold at 1.5λ only for λ in [1e-9, 1e-8) (blind set 7, miss 1): |Y_λx| = 1.5 > |F^0x| = 1 there, but
+    the Yosida laws' slack 6·rtol(1 + |x|)/λ (an iterative resolvent within rtol of |x| must pass) exceeds the
+    violation below λ ≈ 1.2e-7: the law passes, and its record says that a violation of |Y| is judgeable only from
+    λ = 1.2e-7 on (at |x| = |Y| = 1), above the band; the same law on a step wrong at λ = 1 fails."""
+    def build(lo, hi):
+        def J(x, lam, t=0.0):
+            x = np.asarray(x, dtype=float)
+            thr = 1.5 * lam if lo <= lam < hi else lam
+            return np.sign(x) * np.maximum(np.abs(x) - thr, 0.0)
+        F = vm.L1Subdifferential(1.0, 3)
+        return vm.operator_from_resolvent(J, 3, min_norm=F.min_norm, contains=F.contains, name=f"1.5λ on [{lo}, {hi})")
+    r = run_law("yosida_bounded_by_min_norm", build(1e-9, 1e-8), seed=0, examples=EX)
+    res = r.details["searched"]["yosida_resolution"]
+    assert r.status == "passed" and res["lambda_min_at_unit"] == pytest.approx(12 * 1e-8) and res["lambda_min_at_unit"] > 1e-8
+    assert "judgeable only for λ ≥" in r.message and res["lambda_min_at_largest_x"] >= res["lambda_min_at_unit"]
+    assert run_law("yosida_bounded_by_min_norm", build(0.5, 2.0), seed=0, examples=EX).status == "failed"
+    assert "yosida_resolution" not in run_law("resolvent_nonexpansive", build(0.5, 2.0), seed=0,
+                                              examples=EX).details["searched"]

@@ -37,7 +37,7 @@ from .engine.batches import (rounding, rounding_bound, row_contains, row_dots, r
                              vectorised)
 from .engine.forms import DECLARED, DESCRIBED, INTEGER, InForm
 from .engine.samples import Sample
-from .engine.search import operator_law
+from .engine.search import YOSIDA_SLACK, operator_law
 
 #: tolerance multiples tried when grading a failed membership test ``y ∈ F(t, x)``
 GRADES = tuple(10.0 ** k for k in range(0, 13, 2))
@@ -435,7 +435,7 @@ def yosida_tolerance(x: np.ndarray, j: np.ndarray, lam: float) -> float:
     return 4 * tolerance(x, j) / lam
 
 
-@operator_law("yosida_member", "prop:maxmon-resolvent-Yosida v (Y_λ = (I - J_λ)/λ)", _YOSIDA)
+@operator_law("yosida_member", "prop:maxmon-resolvent-Yosida v", _YOSIDA)
 def check_yosida_member(op, s):
     """Proposition prop:maxmon-resolvent-Yosida v, the definition of ``Y_λ``:
     an operator's own ``yosida`` member (where it provides one: an override of :meth:`Operator.yosida`) equals
@@ -491,7 +491,7 @@ def _breaking_pair(n: int, x1, x2, u1, u2, lam, tol_c):
 CONTAINS_OVER = ("points", "form", "direction", "lam", "t", "scale")
 
 
-@operator_law("contains_rejects", "(A1) the declared graph monotone", _CONTAINS, over=CONTAINS_OVER)
+@operator_law("contains_rejects", "(A1)", _CONTAINS, over=CONTAINS_OVER)
 def check_contains_rejects(op, s):
     """Assumption (A1) for the membership test ``contains`` itself: it must reject a pair no monotone graph through
     the sample's graph points holds.  With ``(u_i, v_i) = (J_λx_i, Y_λx_i)`` (item v), the pair
@@ -514,10 +514,10 @@ def check_contains_rejects(op, s):
                            info)
 
 
-@operator_law("project_domain_nearest", "projection onto cl dom F (nearest point)", _PROJECT)
+@operator_law("project_domain_nearest", "projection onto cl dom F", _PROJECT)
 def check_project_domain_nearest(op, s):
-    """``project_domain`` is the projection onto the closed convex set ``cl dom F(t,·)`` (convex: ``F`` maximal
-    monotone), so for ``P = project_domain(x1)``: ``|x1 - P| ≤ |x1 - J_λx1|`` (``J_λx1 ∈ dom F``, item i), and the
+    """The projection onto cl dom F: ``project_domain`` is the nearest point of the closed convex set ``cl dom F(t,·)``
+    (convex: ``F`` maximal monotone), so for ``P = project_domain(x1)``: ``|x1 - P| ≤ |x1 - J_λx1|`` (``J_λx1 ∈ dom F``, item i), and the
     projection's variational inequality ``⟨x1 - P, q - P⟩ ≤ 0`` at ``q = J_μx2 ∈ dom F`` (ratio: the larger of
     ``|x1 - P| / (|x1 - J_λx1| + slack)`` and ``⟨x1 - P, q - P⟩ / slack``)."""
     p = point(op.project_domain(s.x1.copy(), s.t), s.x1, "project_domain")
@@ -530,6 +530,12 @@ def check_project_domain_nearest(op, s):
     vi = Outcome.compare(float(d @ e), 0.0, 4 * tau * (norm(d) + norm(e) + tau),
                          "⟨x - P x, q - P x⟩ ≤ 0 for q = J_μx2 ∈ dom F", info)
     return vi if not vi.worst <= near.worst else near
+
+
+#: the multiple ``K`` of ``rtol·(1 + |x|)/λ`` in each Yosida law's slack on ``Y_λ`` (their passed records state the smallest
+#: λ at which a violation of ``|Y|`` is judgeable: :data:`verimono.checks.engine.search.YOSIDA_SLACK`)
+YOSIDA_SLACK.update({"yosida_in_graph": 2.0, "yosida_monotone": 4.0, "yosida_nonincreasing": 4.0,
+                     "yosida_bounded_by_min_norm": 6.0, "yosida_limit": 2.0, "yosida_member": 4.0})
 
 
 # -- the vectorised forms (verimono.checks.engine.batches): the same inequalities over many samples at once ----
