@@ -126,6 +126,47 @@ def ignores_lambda() -> Operator:
                                    project_domain=L.project_domain, contains=L.contains, name="ignores_lambda")
 
 
+class _L1WithYosida(L1Subdifferential):
+    """``∂(c|·|₁)`` whose own ``yosida`` member is ``factor·(x - J_λx)/λ`` (an override, as a subclass writes it)."""
+
+    factor = 1.0
+
+    def yosida(self, x, lam, t=0.0):
+        return self.factor * super().yosida(x, lam, t)
+
+
+def yosida_member_halved(factor: float = 0.5) -> Operator:
+    """``∂|·|₁`` whose resolvent, ``min_norm`` and ``contains`` are right and whose own ``yosida`` member returns half
+    of ``(x - J_λx)/λ`` (a ``1/(2λ)`` written for ``1/λ``): the laws that compute ``Y_λ`` from the resolvent pass."""
+    op = _L1WithYosida(1.0, 2, name="yosida_member_halved")
+    op.factor = factor
+    return op
+
+
+def contains_accepts_everything() -> Operator:
+    """``∂|·|₁`` with a right resolvent and ``min_norm`` and a membership test that says True to every pair: the
+    graph it declares is not monotone, and every law certifying a membership through it is vacuous."""
+    F = L1Subdifferential(1.0, 2)
+    return operator_from_resolvent(F.resolvent, 2, min_norm=F.min_norm, project_domain=F.project_domain,
+                                   contains=lambda x, y, t=0.0, tol=None: True, name="contains_accepts_everything")
+
+
+_BOX = sets.Box([-1.0, -1.0, -1.0], [1.0, 1.0, 1.0])
+_BOX_CONE = NormalCone(_BOX)
+
+
+def project_domain_radial(exact: bool = False) -> Operator:
+    """``N_B`` of the box ``[-1, 1]³`` (resolvent: the coordinatewise clip, right) whose ``project_domain`` retracts
+    radially, ``x/max(1, |x|_∞)``: a point of the box, not the nearest one (``(2, 1/2, 0) ↦ (1, 1/4, 0)``, the clip
+    ``(1, 1/2, 0)`` is nearer).  ``exact=True``: the clip itself, the lawful twin."""
+    def radial(x, t=0.0):
+        x = np.asarray(x, dtype=float)
+        return _BOX.project(x, t) if exact else x / max(1.0, float(np.abs(x).max()))
+    return operator_from_resolvent(_BOX_CONE.resolvent, 3, min_norm=_BOX_CONE.min_norm, project_domain=radial,
+                                   contains=_BOX_CONE.contains,
+                                   name="project_domain_clip" if exact else "project_domain_radial")
+
+
 #: member name → (constructor, laws it must break)
 ZOO = {
     "explicit_step": (explicit_step, ["resolvent_nonexpansive", "resolvent_firmly_nonexpansive", "resolvent_identity",
@@ -144,6 +185,9 @@ ZOO = {
     "ignores_time": (ignores_time, ["resolvent_in_domain", "yosida_in_graph"]),
     "stale_cache": (stale_cache, ["resolvent_identity"]),
     "ignores_lambda": (ignores_lambda, ["resolvent_limit", "resolvent_identity"]),
+    "yosida_member_halved": (yosida_member_halved, ["yosida_member"]),
+    "contains_accepts_everything": (contains_accepts_everything, ["contains_rejects"]),
+    "project_domain_radial": (project_domain_radial, ["project_domain_nearest"]),
 }
 
 BREAKS = {name: laws for name, (_, laws) in ZOO.items()}
@@ -256,9 +300,32 @@ def lawful_scratch_on_input() -> Operator:
                                    contains=cone.contains, name="lawful_scratch_on_input")
 
 
+def layout_dependent(lawful: bool = False) -> Operator:
+    """``∂|·|₁`` whose soft threshold takes the step ``2λ`` on non-contiguous input (a "copy avoided" branch with the
+    step doubled): each form is a lawful resolvent by itself (``J_{2λ}`` on strided views), but ``J_λ`` is not a
+    function of the values of ``x``.  ``lawful=True``: the step ``λ`` on every layout."""
+    F = L1Subdifferential(1.0, 2)
+
+    def resolvent(x, lam, t):
+        x = np.asarray(x)
+        step = lam if lawful or x.flags.c_contiguous else 2 * lam
+        return np.sign(x) * np.maximum(np.abs(x) - step, 0.0)
+    return operator_from_resolvent(resolvent, 2, min_norm=F.min_norm, project_domain=F.project_domain,
+                                   contains=F.contains, name="lawful_layout" if lawful else "layout_dependent")
+
+
+ZOO["layout_dependent"] = (layout_dependent, ["resolvent_single_valued"])
+BREAKS["layout_dependent"] = ZOO["layout_dependent"][1]
+
+
+def lawful_layout() -> Operator:
+    return layout_dependent(lawful=True)
+
+
 #: the form bugs' members written correctly (np.asarray(x, dtype=float) / a copy first): every law passes
 FORM_CONTROLS = {"truncates_integers": lawful_truncates_integers, "reads_parent_buffer": lawful_reads_parent_buffer,
-                 "projects_in_place": lawful_projects_in_place, "scratch_on_input": lawful_scratch_on_input}
+                 "projects_in_place": lawful_projects_in_place, "scratch_on_input": lawful_scratch_on_input,
+                 "layout_dependent": lawful_layout}
 #: the members whose bug only an input form meets: behind a boundary that copies its input into a fresh float64
 #: array (tests/zoo_precision.float32) they are lawful operators, as the controls are
 FORM_BUGS = frozenset(FORM_CONTROLS)

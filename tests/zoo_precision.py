@@ -41,6 +41,9 @@ class Float32(Operator):
             x[...] = z          # a resolvent that overwrites its input does so in float32 as well
         return out
 
+    def yosida(self, x, lam, t=0.0):       # the member of its own where op has one (provides() says so)
+        return np.asarray(self.op.yosida(_r(x), float(F32(lam)), t), dtype=F32)
+
     def min_norm(self, x, t=0.0):
         return np.asarray(self.op.min_norm(_r(x), t), dtype=F32)
 

@@ -58,8 +58,11 @@ def test_no_law_fails_on_catalog_operator(op):
     assert isinstance(report, Report) and len(report) == len(LAWS)
     assert report.ok, "\n".join(str(r) for r in report.failures)
     skipped = {r.check for r in report if r.status == "skipped"}
-    # the value laws run where the operator states g (∂(c|x|), ∂(Σ c_i|x_i|)); elsewhere they are skipped
-    assert skipped == (set() if op.provides("value") else VALUE_LAWS), skipped
+    # the value laws run where the operator states g (∂(c|x|), ∂(Σ c_i|x_i|)); elsewhere they are skipped; no catalog
+    # operator overrides yosida (Operator.yosida is (x - J_λx)/λ itself): yosida_member is skipped on each; on a
+    # one-point domain every y is in F(p), so no pair breaks monotonicity: contains_rejects is all inconclusive there
+    point = {"contains_rejects"} if "point" in op.name else set()
+    assert skipped == (set() if op.provides("value") else VALUE_LAWS) | {"yosida_member"} | point, skipped
 
 
 def test_unsupported_members_are_skipped_not_passed():
@@ -67,7 +70,8 @@ def test_unsupported_members_are_skipped_not_passed():
     report = check_operator(op, seed=0, examples=5)
     skipped = {r.check for r in report if r.status == "skipped"}
     assert skipped == {"resolvent_in_domain", "yosida_in_graph", "yosida_bounded_by_min_norm", "yosida_limit",
-                       "min_norm_in_graph", "min_norm_least"} | VALUE_LAWS
+                       "min_norm_in_graph", "min_norm_least", "yosida_member", "contains_rejects",
+                       "project_domain_nearest"} | VALUE_LAWS
     assert all(r.message for r in report if r.status == "skipped")
     assert report.counts["passed"] == len(LAWS) - len(skipped)
 

@@ -35,8 +35,9 @@ from .members import (_ROUNDOFF_BOUNDARY, listed, min_norm, norm, outside_by_rou
                       within_roundoff_of_domain)
 from .engine.batches import (rounding, rounding_bound, row_contains, row_dots, row_member, row_norms, row_ratios, row_resolvents,
                              vectorised)
+from .engine.forms import DECLARED, DESCRIBED, INTEGER, InForm
 from .engine.samples import Sample
-from .engine.search import operator_law
+from .engine.search import YOSIDA_SLACK, operator_law
 
 #: tolerance multiples tried when grading a failed membership test ``y ∈ F(t, x)``
 GRADES = tuple(10.0 ** k for k in range(0, 13, 2))
@@ -93,15 +94,42 @@ def check_resolvent_single_valued(op, s):
     """Proposition prop:maxmon-resolvent-Yosida i–ii:
     ``J_λ`` is defined on all of ``R^n`` and single-valued — two calls on the same ``x``
     return the same finite point of shape ``(n,)`` and leave ``x`` unchanged (ratio: |difference|/tol, the
-    tolerance of repeated calls: :func:`verimono.core.tolerances.repeat_tolerance`)."""
+    tolerance of repeated calls: :func:`verimono.core.tolerances.repeat_tolerance`).  A sample in an input form
+    (:mod:`verimono.checks.engine.forms`) compares its value with a third call on the same point as a fresh contiguous
+    float64 array too (:func:`form_tolerance`): ``J_λ`` is a function of the *values* of ``x``, whatever its layout."""
     x = s.x1.copy()
     a = point(op.resolvent(x, s.lam, s.t), s.x1, "resolvent")
     moved = norm(x - s.x1)
     b = resolvent(op, s.x1, s.lam, s.t)
     tau = repeat_tolerance(s.x1, a, b)
-    return Outcome.compare(norm(a - b) + (math.inf if moved > 0 else 0.0), 0.0, tau,
+    out = Outcome.compare(norm(a - b) + (math.inf if moved > 0 else 0.0), 0.0, tau,
                  "|J_λx - J_λx| over two calls" + (f" (the call modified its input by {moved:.3g})" if moved else ""),
                  {"J_first": listed(a), "J_second": listed(b), "input_modified_by": moved})
+    if type(op) is InForm and out.worst <= 1.0:
+        # J_λ is a function of x's values: the call in this form against the same point as a fresh contiguous array
+        c = resolvent(op._op, s.x1, s.lam, s.t)
+        tc = form_tolerance(op.form, s.x1, a, c)
+        across = Outcome.compare(norm(a - c), 0.0, tc, f"|J_λx (x as {DESCRIBED[op.form]}) - J_λx (x contiguous)|",
+                                 {"J_in_form": listed(a), "J_contiguous": listed(c), "form": op.form})
+        if not across.worst <= out.worst:
+            return across
+    return out
+
+
+#: the input forms that change the dtype the subject receives (the others change only the memory layout)
+_DTYPE_FORMS = (INTEGER, DECLARED)
+
+
+def form_tolerance(form: str, *scales) -> float:
+    """The tolerance of ``J_λx`` in ``form`` against ``J_λx`` of the same point as a fresh contiguous float64 array
+    (``resolvent_single_valued``).  A layout (a strided view, an offset slice, a read-only array) changes no value,
+    only memory: the two calls agree as two calls at one input do (:func:`repeat_tolerance`, not bit for bit: NumPy
+    reduces a strided or unaligned array in another order, a few ulps).  A dtype change (integer-valued points as
+    int64, the subject's declared dtype) hands the subject its values in another type, which it may compute in
+    (int64 promoted to float64 by one expression and kept by another): within the tolerance of the precision under
+    judgement (:func:`tolerance`; float32: ``2.3e-4``), and never below the repeat tolerance."""
+    t = repeat_tolerance(*scales)
+    return max(t, tolerance(*scales)) if form in _DTYPE_FORMS else t
 
 
 @operator_law("resolvent_nonexpansive", "prop:maxmon-resolvent-Yosida ii")
@@ -395,6 +423,121 @@ def _only_within_rounding(op, x, y, t, tol) -> bool:
         return False
 
 
+# -- the members besides the resolvent: each judged against the resolvent's own values -------------------------
+
+_YOSIDA = Member("yosida")
+
+
+def yosida_tolerance(x: np.ndarray, j: np.ndarray, lam: float) -> float:
+    """The slack of a Yosida value ``Y_λx = (x - J_λx)/λ`` computed from a resolvent accurate to its precision's
+    tolerance: ``4·tolerance(x, J_λx)/λ`` (the resolvent's error ``RTOL(1 + |x|)``, float64 ``RTOL = 1e-8``, amplified
+    by ``1/λ``; the scale of ``yosida_bounded_by_min_norm``'s)."""
+    return 4 * tolerance(x, j) / lam
+
+
+@operator_law("yosida_member", "prop:maxmon-resolvent-Yosida v", _YOSIDA)
+def check_yosida_member(op, s):
+    """Proposition prop:maxmon-resolvent-Yosida v, the definition of ``Y_λ``:
+    an operator's own ``yosida`` member (where it provides one: an override of :meth:`Operator.yosida`) equals
+    ``(x - J_λx)/λ`` from its own resolvent, within :func:`yosida_tolerance` plus the member's own rounding
+    (ratio ``|Y_member - (x - J_λx)/λ| / slack``).  The laws compute ``Y_λ`` from the resolvent; a caller of
+    ``op.yosida`` gets the member."""
+    a = resolvent(op, s.x1, s.lam, s.t)
+    y = (s.x1 - a) / s.lam
+    m = point(op.yosida(s.x1.copy(), s.lam, s.t), s.x1, "yosida")
+    return Outcome.compare(norm(m - y), 0.0, yosida_tolerance(s.x1, a, s.lam) + tolerance(y, m),
+                           "yosida(x, λ) = (x - J_λx)/λ", {"J": listed(a), "Y_from_J": listed(y), "Y_member": listed(m)})
+
+
+#: the monotonicity break of the pair ``contains_rejects`` offers, as a multiple of ``(1 + |Y_λx1| + |Y_λx2| + e_Y)``
+#: (``e_Y`` the Yosida values' slack): far beyond what any tolerance of the pair, the graph point or ``contains`` covers
+CONTAINS_BREAK = 16.0
+#: the least ratio (monotonicity break over what the tolerances can explain) at which the offered pair is decidably
+#: outside every monotone graph through the sample's graph point; below it (``J_λx1`` within rounding of ``J_λx2``)
+#: the sample is inconclusive
+CONTAINS_DECIDABLE = 2.0
+
+
+def _breaking_pair(n: int, x1, x2, u1, u2, lam, tol_c):
+    """The pair ``(u1, v)`` of ``contains_rejects``, with ``v = v2 - c(u1 - u2)``, and its ratio: the break
+    ``c|Δu|²`` of monotonicity against ``(u2, v2)`` over the largest value of ``-⟨Δx', Δy'⟩`` a pair within reach of
+    it can have (``|a||Δu|c + |b||Δu| + |a||b|`` for moves ``|a| ≤ T_x``, ``|b| ≤ T_y``), for arrays of rows or
+    one row (``u`` etc. ``(B, n)`` or ``(n,)``)."""
+    rows = u1.ndim == 2
+    nrm = row_norms if rows else norm
+    lam_c = lam[:, None] if rows else lam
+    v1, v2 = (x1 - u1) / lam_c, (x2 - u2) / lam_c
+    du = u1 - u2
+    ndu = nrm(du)
+    if not rows and not ndu > 0:
+        return v2, 0.0, ndu, math.inf
+    tau = row_tolerances(x1, x2, u1, u2) if rows else tolerance(x1, x2, u1, u2)
+    ex, ey = 4 * tau, 4 * tau / lam
+    with np.errstate(divide="ignore", invalid="ignore"):
+        c = CONTAINS_BREAK * (1.0 + nrm(v1) + nrm(v2) + ey) / ndu
+        v = v2 - (c[:, None] if rows else c) * du
+        nv = nrm(v)
+        # contains' reach: tol_c per coordinate, read absolutely (the protocol) or relative to |v| (a subgradient
+        # test), plus the rounding of its own arithmetic on (u1, v)
+        reach = math.sqrt(n) * tol_c * (1.0 + nv) + (row_tolerances(u1, v) if rows else tolerance(u1, v))
+        tx, ty = reach + ex, reach + ey
+        q = c * ndu * ndu / (ndu * ty + c * tx * ndu + tx * ty)
+    return v, q, ndu, tx
+
+
+#: the coordinates of ``contains_rejects``: all but ``offset`` (its pairs ``b + s n``, ``b + 1000 s n`` lie on one normal
+#: ray of the domain, whose points a projection maps to one ``J_λx1 = J_λx2``: no pair decidable there, 220 evaluations
+#: an operator all inconclusive) and ``mu``, ``nu`` (not read)
+CONTAINS_OVER = ("points", "form", "direction", "lam", "t", "scale")
+
+
+@operator_law("contains_rejects", "(A1)", _CONTAINS, over=CONTAINS_OVER)
+def check_contains_rejects(op, s):
+    """Assumption (A1) for the membership test ``contains`` itself: it must reject a pair no monotone graph through
+    the sample's graph points holds.  With ``(u_i, v_i) = (J_λx_i, Y_λx_i)`` (item v), the pair
+    ``(u1, v2 - c(u1 - u2))``, ``c > 0``, has ``⟨u1 - u2, v - v2⟩ = -c|u1 - u2|² < 0``; ``c`` is
+    :data:`CONTAINS_BREAK` times the Yosida values' size over ``|u1 - u2|``, so the break exceeds what the tolerances
+    of the pair, of the graph point and of ``contains`` can explain (:func:`_breaking_pair`) by the recorded factor.
+    ``contains`` saying True there is a violation (ratio: that factor); a sample with ``u1`` within rounding of
+    ``u2`` (factor below :data:`CONTAINS_DECIDABLE`) is inconclusive."""
+    u1, u2 = resolvent(op, s.x1, s.lam, s.t), resolvent(op, s.x2, s.lam, s.t)
+    tol_c = 2 * tolerance(u1, (s.x2 - u2) / s.lam)
+    v, q, ndu, tx = _breaking_pair(s.x1.size, s.x1, s.x2, u1, u2, s.lam, tol_c)
+    info = {"u1": listed(u1), "u2": listed(u2), "v": listed(v), "tol": tol_c, "break_over_tolerances": float(q)}
+    if not (ndu > 0 and q >= CONTAINS_DECIDABLE):
+        return Outcome.inconclusive_sample("J_λx1 within rounding of J_λx2: no pair decidably outside the graph "
+                                           "(sample inconclusive)", info)
+    accepted = bool(op.contains(u1.copy(), v.copy(), s.t, tol_c))
+    return Outcome.compare(q if accepted else 0.0, 0.0, 1.0,
+                           "contains(u1, v2 - c(u1 - u2)) is False, (u_i, v_i) = (J_λx_i, Y_λx_i): the pair breaks "
+                           "monotonicity with (u2, v2) (ratio: the break over its tolerances, where it was accepted)",
+                           info)
+
+
+@operator_law("project_domain_nearest", "projection onto cl dom F", _PROJECT)
+def check_project_domain_nearest(op, s):
+    """The projection onto cl dom F: ``project_domain`` is the nearest point of the closed convex set ``cl dom F(t,·)``
+    (convex: ``F`` maximal monotone), so for ``P = project_domain(x1)``: ``|x1 - P| ≤ |x1 - J_λx1|`` (``J_λx1 ∈ dom F``, item i), and the
+    projection's variational inequality ``⟨x1 - P, q - P⟩ ≤ 0`` at ``q = J_μx2 ∈ dom F`` (ratio: the larger of
+    ``|x1 - P| / (|x1 - J_λx1| + slack)`` and ``⟨x1 - P, q - P⟩ / slack``)."""
+    p = point(op.project_domain(s.x1.copy(), s.t), s.x1, "project_domain")
+    a, q = resolvent(op, s.x1, s.lam, s.t), resolvent(op, s.x2, s.mu, s.t)
+    info = {"P": listed(p), "J_lam_x1": listed(a), "q": listed(q)}
+    near = Outcome.compare(norm(s.x1 - p), norm(s.x1 - a), 4 * tolerance(s.x1, a, p),
+                           "|x - P x| ≤ |x - J_λx| (J_λx ∈ dom F)", info)
+    tau = tolerance(s.x1, s.x2, p, q)
+    d, e = s.x1 - p, q - p
+    vi = Outcome.compare(float(d @ e), 0.0, 4 * tau * (norm(d) + norm(e) + tau),
+                         "⟨x - P x, q - P x⟩ ≤ 0 for q = J_μx2 ∈ dom F", info)
+    return vi if not vi.worst <= near.worst else near
+
+
+#: the multiple ``K`` of ``rtol·(1 + |x|)/λ`` in each Yosida law's slack on ``Y_λ`` (their passed records state the smallest
+#: λ at which a violation of ``|Y|`` is judgeable: :data:`verimono.checks.engine.search.YOSIDA_SLACK`)
+YOSIDA_SLACK.update({"yosida_in_graph": 2.0, "yosida_monotone": 4.0, "yosida_nonincreasing": 4.0,
+                     "yosida_bounded_by_min_norm": 6.0, "yosida_limit": 2.0, "yosida_member": 4.0})
+
+
 # -- the vectorised forms (verimono.checks.engine.batches): the same inequalities over many samples at once ----
 # Each returns the ratio of every row of ``r`` (a Rows); the search re-evaluates by the law's own evaluator every
 # row not clearly inside the bound, so these only ever pass a sample, and with the laws' own slack.  Each repeats
@@ -629,3 +772,33 @@ def _rows_yosida_limit(op, r):
     r.ok &= ~live        # rows still open after the most halvings: the evaluator's
     r.err = err
     return q
+
+@vectorised("contains_rejects")
+def _rows_contains_rejects(op, r):
+    # the law's pair in row arithmetic (its norms in another summation order: the pair and its factor within rounding
+    # of the law's); a row decided here is one whose pair contains rejects, the law's ratio 0 exactly, with a factor
+    # clearly above CONTAINS_DECIDABLE; a row near that threshold, or accepted (a violation), is the evaluator's
+    u1, u2 = _pair(op, r)
+    tol_c = 2 * row_tolerances(u1, (r.x2 - u2) / r.lam[:, None])
+    v, q, ndu, _ = _breaking_pair(r.x1.shape[1], r.x1, r.x2, u1, u2, r.lam, tol_c)
+    r.ok &= (ndu > 0) & np.isfinite(q) & (q >= CONTAINS_DECIDABLE * (1.0 + 1e-6))
+    inside = row_contains(op, u1, v, r.t, tol_c, r.ok)
+    r.ok &= ~inside
+    r.err = np.zeros(len(r.ok))
+    return np.zeros(len(r.ok))
+
+
+@vectorised("project_domain_nearest")
+def _rows_project_domain_nearest(op, r):
+    p = row_member(op.project_domain, r.x1, r.t, r.ok)
+    a, q = _pair(op, r, r.mu)
+    n1, na = row_norms(r.x1 - p), row_norms(r.x1 - a)
+    q1 = row_ratios(n1, na, 4 * row_tolerances(r.x1, a, p))
+    tau = row_tolerances(r.x1, r.x2, p, q)
+    d, e = r.x1 - p, q - p
+    nd, ne = row_norms(d), row_norms(e)
+    slack = 4 * tau * (nd + ne + tau)
+    q2 = row_ratios(row_dots(d, e), np.zeros_like(tau), slack)
+    n = r.x1.shape[1]
+    r.err = np.maximum(rounding_bound(n, q1, np.ones_like(q1)), rounding_bound(n, q2, slack, nd * ne))
+    return np.maximum(q1, q2)

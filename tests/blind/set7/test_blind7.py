@@ -31,24 +31,9 @@ MISSED: dict[str, str] = {
         "RTOL(1 + |x|)/λ of Y_λ = (x - J_λx)/λ, which exceeds the error; missed at ci, dev and thorough",
     "halfspace_lag_in_t_window":
         "a lag confined to t in [0.61, 0.62): ci's t resolution is 0.019 (disclosed in the record); thorough catches it",
-    "ball_far_sign_shortcut":
-        "a shortcut for |x| > 1e5 exact on the coordinate axes: missed at ci seed 0 and dev (a probe saw dev's only "
-        "far points on the axes); ci seeds 1, 2 and thorough catch it",
-    "strided_input_double_step":
-        "J_λ depends on the memory layout (2λ on strided input); each form is lawful by itself and the forms' values "
-        "are not compared with the contiguous call's; missed at ci, dev and thorough",
-    "yosida_member_halved":
-        "an Operator subclass's own yosida() is never called by the battery (a probe counted 0 calls at ci; Y_λ is "
-        "recomputed from the resolvent); missed at ci, dev and thorough",
     "soft_threshold_skips_tiny_steps":
         "J_λx = x for λ < 1e-12: Y_λx = 0 ∉ F(J_λx), 10^3 times the rounding of (x - J)/λ at λ = 1e-13, |x| = 1, but "
         "below the slack RTOL(1 + |x|)/λ; missed at ci, dev and thorough",
-    "contains_accepts_everything":
-        "a membership test accepting every pair is never tested for rejecting anything (the graph it declares is "
-        "not monotone); missed at ci, dev and thorough",
-    "box_project_domain_radial":
-        "project_domain is used as a membership test only; its nearest-point property |x - Px| ≤ |x - J_λx| is not "
-        "checked; missed at ci, dev and thorough",
 }
 
 

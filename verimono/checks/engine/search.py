@@ -77,6 +77,7 @@ from hypothesis import HealthCheck, Phase, Verbosity, given, settings
 from ...core.arrays import library_hint
 from ...core._small import abs_max
 from ...core._reproducible import no_local_constants
+from ...core.tolerances import current_rtol
 from ..arguments import valid_horizon, valid_seed
 from ...core.errors import InvalidCheckArgument, UnitTimeout
 from ...execution.config import current as current_config
@@ -773,6 +774,8 @@ def run_law(decl: Law | str, op: Any, *, seed: int | None = None, examples: int 
                                                     if how.get("hypothesis") else {}),
                                                  **({"budget": state.budget_note} if state.budget_note else {})}},
                        {"seed": seed, "examples": examples, "horizon": horizon, "operator": repr(op)})
+        if rec.status == PASSED and decl.name in YOSIDA_SLACK:
+            _state_yosida_resolution(rec, YOSIDA_SLACK[decl.name])
         rec.duration = time.perf_counter() - start
         return rec
 
@@ -780,6 +783,28 @@ def run_law(decl: Law | str, op: Any, *, seed: int | None = None, examples: int 
     if rec.status == SKIPPED and "examples" not in rec.details:   # skipped from the declaration
         rec.details.update(details)
     return rec
+
+
+#: the Yosida laws, name → ``K``: their slack on ``Y_λx = (x − J_λx)/λ`` is ``K·rtol·(1 + |x|)/λ`` (a resolvent within
+#: ``rtol`` of ``|x|`` — an iterative solver's — must not be failed, and ``1/λ`` amplifies it), registered by
+#: :mod:`verimono.checks.operator_laws`.  A passed record of one states its real resolution in ``λ``
+#: (:func:`_state_yosida_resolution`): the decades below it were evaluated but cannot show a violation of ``|Y|``
+YOSIDA_SLACK: dict[str, float] = {}
+
+
+def _state_yosida_resolution(rec: CheckResult, k: float) -> None:
+    """State in ``rec`` (passed) the smallest ``λ`` at which a violation of relative size 1 (``|ΔY| = |Y_λx|``) is
+    judgeable: ``λ ≥ K·rtol·(1 + |x|)/|Y_λx|`` — at ``|x| = |Y| = 1``, and at the largest ``|x|`` searched with
+    ``|Y| = 1`` (``details["searched"]["yosida_resolution"]``, and the message)."""
+    rtol = current_rtol()
+    searched_ = rec.details.get("searched") or {}
+    x_max = float((searched_.get("x_range") or [0.0, 1.0])[1])
+    unit, far = 2.0 * k * rtol, k * rtol * (1.0 + x_max)
+    searched_["yosida_resolution"] = {"slack": f"{k:g}·rtol·(1 + |x|)/λ", "rtol": rtol,
+                                      "lambda_min_at_unit": unit, "lambda_min_at_largest_x": far,
+                                      "largest_x": x_max}
+    rec.message += (f"; Y_λ judged to {k:g}·rtol·(1 + |x|)/λ: a violation |ΔY| = |Y| is judgeable only for "
+                    f"λ ≥ {k:g}·rtol·(1 + |x|)/|Y| ({unit:.2g} at |x| = |Y| = 1, {far:.2g} at |x| = {x_max:.3g})")
 
 
 #: what an operator law quantifies over unless it says otherwise: points (the draws, the edge samples, the sweep),
@@ -796,4 +821,4 @@ def operator_law(name: str, label: str, *requires: Any, over: tuple = OPERATOR_D
 
 __all__ = ["run_law", "operator_law", "evaluate_sample", "root_cause", "bounded_root_cause", "fresh_seed", "default_examples",
            "positive_examples", "valid_seed", "valid_horizon", "DEFAULT_EXAMPLES", "BOUND", "ROOT_LAW",
-           "HARNESS_LIMIT", "OPERATOR_DOMAIN"]
+           "HARNESS_LIMIT", "OPERATOR_DOMAIN", "YOSIDA_SLACK"]

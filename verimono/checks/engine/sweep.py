@@ -7,8 +7,9 @@ domain) is then found at some seeds only.  The sweep evaluates every law, after 
 ``count`` samples drawn from ``numpy.random.default_rng(seed)`` (the record's seed, so the same seed gives
 the same samples): ``x1`` at each scale of :data:`SCALES` in turn (from ``10^-9`` to ``10^6``, below 1/64 of
 the largest number of the precision the subject is judged at; every
-third one with a single nonzero coordinate, the boundary of orthants, boxes and ℓ1 balls), ``x2`` near
-``x1`` or at another scale, and every fourth sample replaced by ``J_ν x`` and ``J_ν(J_ν x)`` — points in
+third one with a single nonzero coordinate, the boundary of orthants, boxes and ℓ1 balls, but every other far one in a
+general direction, :func:`far_general`), ``x2`` near
+``x1`` or at another scale, and every fourth sample (not those far general ones) replaced by ``J_ν x`` and ``J_ν(J_ν x)`` — points in
 the range of the resolvent, i.e. on the boundary of ``dom F`` for a normal cone; and every fourth (from the
 first such boundary point on) by a pair of points just *outside* that boundary, ``b + δ(1 + |b|) n`` and
 ``b + 1000δ(1 + |b|) n`` with ``b`` the last point ``J_ν x ≠ x`` met, ``n`` the outer normal and ``δ`` from
@@ -48,6 +49,21 @@ SWEEP_BY_PROFILE = {"dev": 33, "ci": 33, "thorough": 132, None: 33}
 SWEEP_CAP = {"prox_minimiser": len(SCALES)}
 
 
+#: the far decades: a sweep sample whose ``|x1|`` scale is at least this is "far"
+FAR = 1e5
+
+
+def far_general(i: int, cap: float, n: int) -> bool:
+    """Whether sweep sample ``i`` is a far point in a general direction, evaluated as drawn: every other far sample
+    (the first of each pair), at a scale of at least :data:`FAR`.  The far scale comes every ``len(SCALES) = 12``
+    samples, and ``12`` is a multiple of ``3`` and ``4`` less one (``i ≡ 11 mod 12``): every far sample fell on the
+    coordinate axes (``i % 3 == 2``) and was replaced by points in the range of the resolvent (``i % 4 == 3``), so the
+    search's far points were only ``±10^6 e_k`` and their projections (blind set 7, ``ball_far_sign_shortcut``: a
+    shortcut exact on the axes, missed at ``dev`` and ``ci`` seed 0).  The other far samples keep the axes and the
+    range of ``J``.  On ``R^1`` every direction is an axis: nothing changes there (``n = 1`` samples are as before)."""
+    return n >= 2 and min(SCALES[i % len(SCALES)], cap) >= FAR and (i // len(SCALES)) % 2 == 0
+
+
 def sweep_count(profile: str | None, law: str) -> int:
     n = SWEEP_BY_PROFILE.get(profile, SWEEP_BY_PROFILE[None])
     return min(n, SWEEP_CAP.get(law, n))
@@ -63,8 +79,11 @@ def _sweep_draws(n: int, seed: int, horizon: float, count: int, cap: float) -> t
         s1 = min(SCALES[i % len(SCALES)], cap)
         u = rng.uniform(-1.0, 1.0, n)
         if i % 3 == 2:
-            u = np.zeros(n)
-            u[rng.integers(n)] = rng.choice((-1.0, 1.0))
+            sign = rng.choice((-1.0, 1.0))      # drawn (in u[k] = sign's order) for a far general sample too: the
+            k = rng.integers(n)                 # stream, and every other sample, stay as they were
+            if not far_general(i, cap, n):
+                u = np.zeros(n)
+                u[k] = sign
         x1 = s1 * u
         if i % 2 == 0:
             x2 = x1 + 1e-2 * s1 * rng.uniform(-1.0, 1.0, n)
@@ -114,7 +133,7 @@ def sweep_samples(op, seed: int, horizon: float, count: int, make: Callable) -> 
     out, boundary = [], None
     for i in range(count):
         x1, x2, lam, mu, nu, t = X1[i].copy(), X2[i].copy(), lams[i], mus[i], nus[i], tl[i]
-        if i % 4 == 3:   # points in the range of J: J_ν x and J_ν(J_ν x), or just outside the boundary
+        if i % 4 == 3 and not far_general(i, cap, n):   # points in the range of J: J_ν x and J_ν(J_ν x), or just outside the boundary
             try:
                 a = np.asarray(op.resolvent(x1.copy(), nu, t), dtype=float)
                 b = np.asarray(op.resolvent(a.copy(), nu, t), dtype=float)
