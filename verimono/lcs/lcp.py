@@ -444,7 +444,9 @@ def solve_lcp(M, q, *, least_norm: bool = True, backends: tuple[str, ...] | None
 
     For PSD ``M`` the least-norm solution of Proposition ``p:lcp2`` item iv is returned.  For other ``M``
     ``SOL(q, M)`` need not be convex; with ``least_norm`` and ``n ≤ ENUM_MAX`` the least-norm point over all
-    complementary pieces is returned, otherwise a verified solution (``LCPResult.least_norm`` False).
+    complementary pieces is returned, otherwise a verified solution (``LCPResult.least_norm`` False) — as for PSD
+    ``M`` when the least-norm QP over ``SOL(q, M)`` fails numerically although it holds a verified point (data
+    spanning more decades than the QP solvers keep; the reason is in ``LCPResult.reasons``).
 
     The problem is homogeneous — ``z ∈ SOL(q, M)`` iff ``(β/s) z ∈ SOL(q/s, M/β)`` for ``s, β > 0`` — so it
     is solved with ``β = max |M|`` and ``s = max(|q|∞, scale)`` and scaled back: every tolerance, support
@@ -551,7 +553,17 @@ def _solve_unit(M, q, least_norm, backends) -> LCPResult:
     z = zbar
     if least_norm and not certified:
         if psd:
-            zl = select_over_sol(M, q, zbar, np.eye(n), np.zeros(n), scale=1.0)
+            try:
+                zl = select_over_sol(M, q, zbar, np.eye(n), np.zeros(n), scale=1.0)
+            except (InfeasibleStep, UnverifiedSolution) as exc:
+                # SOL(q, M) holds z̄, so a QP that finds no point there is at its numerical limit, not the problem: data
+                # spanning more decades than they keep (HiGHS drops matrix entries below 1e-9: the paper's
+                # Example at λ = 3.6e-13 has M = [[0, 1], [-1, λ]] and z̄ = (0, 1.9e6)).  z̄ is kept, verified, not
+                # certified the least-norm one (as for a non-PSD M): every solution gives the same state
+                # W^{-1}(x + λBz) of a maximal monotone H, the least norm only chooses among multipliers
+                reasons.append(f"least-norm QP over SOL(q, M): {exc} (z̄ kept)")
+                return LCPResult(zbar, M @ zbar + q, lcp_residual(M, q, zbar), lcp_scale(M, q, zbar), used, psd,
+                                 unique, False, reasons)
             ok, _, _ = _verified(M, q, zl)
             if not ok:
                 zp = _polish(M, q, zl)
@@ -610,8 +622,13 @@ def solve_box(M, q, lower, upper, *, least_norm: bool = True, info: bool = False
         P = np.zeros((big.shape[0],) * 2)
         P[:m, :m] = np.eye(m)
         c = np.concatenate([lower, np.zeros(fin.size)])
-        zz = select_over_sol(big, qq, r.z, P, c, scale=scale)
-        if _verified(big, qq, zz)[0]:
+        try:
+            zz = select_over_sol(big, qq, r.z, P, c, scale=scale)
+        except (InfeasibleStep, UnverifiedSolution):   # r.z solves it: the QP solvers' numerical limit (_solve_unit)
+            zz = None
+        if zz is None:
+            pass                    # r.z kept, verified, not certified the least-norm one
+        elif _verified(big, qq, zz)[0]:
             lam, certified = lower + zz[:m], True
         else:
             raise UnverifiedSolution("least-norm QP over the relay solution set failed the residual check")
