@@ -198,24 +198,32 @@ class _Reduced:
 
 
 SHARED_SIZE = 20_000
+#: whether sp_b's code runs until sp_a's four count units have run (``sharing_stages``)
+WAIT_FOR_COUNTS = {"on": False}
 
 
-def _count(shared: dict, tag: str, k: int) -> Report:
+def _count(shared: dict, tag: str, k: int, mark: str | None = None) -> Report:
+    if mark is not None:            # the unit ran (in a worker): sp_b's code may stop changing the dict
+        open(os.path.join(mark, f"{tag}{k}"), "w").close()
     return Report([CheckResult("count", f"{tag} #{k}", "passed", worst=0.0, bound=1.0, details={"value": len(shared)})])
 
 
 @pytest.fixture
-def sharing_stages(monkeypatch):
+def sharing_stages(monkeypatch, tmp_path):
     """``sp_a``: two 0.5 s units, then four that carry a dict of 20,000 entries and count them; ``sp_b``: one short
     unit, then 1.5 s of its own code adding and removing an entry of that same dict (as stages share the catalog's
-    problems).  Run one after another, every count is 20,000."""
+    problems) — with ``WAIT_FOR_COUNTS`` set (the unsafe variant's test), until the four count units have run in
+    workers (at most 6 s more: a unit that cannot be sent runs only after this code), so that each is pickled while
+    the dict changes however late a loaded machine frees a worker (that test passed by luck once, under load).  Run one after another, every
+    count is 20,000."""
     shared = {i: _Reduced(i) for i in range(SHARED_SIZE)}
     monkeypatch.setattr(schedule, "GATHER_SECONDS", 1.0)
+    mark = str(tmp_path)
 
     @register_stage("sp_a", overlap=True)
     def sp_a(profile, context):
         units = [Unit("sp_a", f"slow{k}", _after, (0.5, "sp_a", k)) for k in (1, 2)]
-        units += [Unit("sp_a", f"count{k}", _count, (shared, "sp_a", k)) for k in range(3, 7)]
+        units += [Unit("sp_a", f"count{k}", _count, (shared, "sp_a", k, mark)) for k in range(3, 7)]
         reps = context.run_units(profile, units, costs=[5.0, 5.0, 0.0, 0.0, 0.0, 0.0])
         return Report([r for rep in reps for r in rep.results])
 
@@ -223,7 +231,9 @@ def sharing_stages(monkeypatch):
     def sp_b(profile, context):
         reps = context.run_units(profile, [Unit("sp_b", "short", _square, ("sp_b", 5))], costs=[9.0])
         end = time.monotonic() + 1.5
-        while time.monotonic() < end:      # its own code, holding the turn, changes what sp_a's units carry
+        wait = WAIT_FOR_COUNTS["on"]
+        while time.monotonic() < end or (wait and len(os.listdir(mark)) < 4 and time.monotonic() < end + 6.0):
+            # its own code, holding the turn, changes what sp_a's units carry
             shared[-1] = _Reduced(-1)
             sum(range(2000))
             del shared[-1]
@@ -252,7 +262,13 @@ def test_units_pickled_by_the_main_thread_beside_another_stages_code_see_it_chan
     """Seen failing: pickled when a worker frees (the branch's way), while sp_b's code changes the dict — the pickler
     sees it change size (three times: the unit leaves the workers) or sends a state with sp_b's extra entry."""
     monkeypatch.setattr(SharedQueue, "_ship_now", lambda self, job: None)
-    rep = _run(sharing_stages)
+    monkeypatch.setitem(WAIT_FOR_COUNTS, "on", True)
+    switch = sys.getswitchinterval()
+    sys.setswitchinterval(1e-5)     # the threads switch within each pickling, not only now and then (5 ms)
+    try:
+        rep = _run(sharing_stages)
+    finally:
+        sys.setswitchinterval(switch)
     err = capfd.readouterr().err
     assert "cannot be sent" in err or _counts(rep) != [SHARED_SIZE] * 4, (_counts(rep), err[-1000:])
 
