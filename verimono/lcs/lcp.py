@@ -625,13 +625,11 @@ def solve_box(M, q, lower, upper, *, least_norm: bool = True, info: bool = False
         try:
             zz = select_over_sol(big, qq, r.z, P, c, scale=scale)
         except (InfeasibleStep, UnverifiedSolution):   # r.z solves it: the QP solvers' numerical limit (_solve_unit)
-            zz = None
-        if zz is None:
-            pass                    # r.z kept, verified, not certified the least-norm one
-        elif _verified(big, qq, zz)[0]:
+            zz = None                                   # r.z kept, verified, not certified the least-norm one
+        if zz is not None:
+            if not _verified(big, qq, zz)[0]:
+                raise UnverifiedSolution("least-norm QP over the relay solution set failed the residual check")
             lam, certified = lower + zz[:m], True
-        else:
-            raise UnverifiedSolution("least-norm QP over the relay solution set failed the residual check")
     res_val = box_residual(M, q, lam, lower, upper)
     scale = lcp_scale(M, q, lam) + float(np.abs(lower).max(initial=0.0))
     if res_val > QP_RTOL * scale:
