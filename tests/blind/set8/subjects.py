@@ -61,7 +61,8 @@ def proj_l1_ball(x, r=1.0, unique=False):
     u = np.unique(a)[::-1] if unique else np.sort(a)[::-1]
     css = np.cumsum(u)
     j = np.arange(1, u.size + 1)
-    rho = np.nonzero(u - (css - r) / j > 0)[0][-1]
+    idx = np.nonzero(u - (css - r) / j > 0)[0]
+    rho = idx[-1] if idx.size else 0       # j = 1 always qualifies (u_1 - (u_1 - r) = r); rounding can hide it
     theta = (css[rho] - r) / (rho + 1.0)
     return np.sign(x) * np.maximum(a - theta, 0.0)
 
@@ -123,7 +124,8 @@ def box_contains(x, y, t=0.0, tol=None, lo=-1.0, hi=1.0, mode="coordinates"):
             if not ok:
                 return False
         return bool(np.all(np.abs(y[free]) <= tol))
-    ok = np.where(up, y >= -tol, True) & np.where(down, y <= tol, True) & np.where(~(up | down), np.abs(y) <= tol, True)
+    # a coordinate within tol of both faces (a large tol) may take either face's normal: "or", not "and"
+    ok = (up & (y >= -tol)) | (down & (y <= tol)) | (np.abs(y) <= tol)
     return bool(np.all(ok))
 
 
@@ -334,7 +336,8 @@ def proj_simplex(x, off_by_one=False):
     u = np.sort(x)[::-1]
     css = np.cumsum(u)
     j = np.arange(1, x.size + 1)
-    rho = np.nonzero(u - (css - 1.0) / j > 0)[0][-1] + 1        # 1-based
+    idx = np.nonzero(u - (css - 1.0) / j > 0)[0]
+    rho = (idx[-1] if idx.size else 0) + 1        # 1-based; j = 1 always qualifies, rounding can hide it
     theta = (css[rho - 1] - 1.0) / (rho + 1.0 if off_by_one else rho)
     return np.maximum(x - theta, 0.0)
 
