@@ -34,6 +34,7 @@ class Entry:
     smallest: str
     bug: str
     twin: str | None = None
+    witness: Callable[[], float] | None = None     # plain NumPy: the law's ratio at ``smallest`` (> 1: violated)
 
 
 def _tol(*arrays, tol=None):
@@ -653,7 +654,7 @@ ENTRIES: list[Entry] = [
           "the simplex projection's threshold divides by ρ + 1 (a 0- vs 1-based index)"),
     Entry("linear_float32_above_1e4", "operator", f"{RES} v (Y_λx ∈ F(J_λx)) at large |x|", False,
           lambda: _downcast_build(np.float32, "Ax, float32 above 1e4"),
-          "x = (2e4, 0), λ = 1: J off by ~1e-3 relative 1e-7",
+          "x = (12345.678, 0.1), λ = 1: J off by ~1e-4 (float32: relative 6e-8)",
           "for max|x| > 1e4 the solve runs in float32 and is cast back to float64"),
     # steppers: plants
     Entry("merges_short_cells", "stepper", "eq:iteration (x_{k+1} = J_{h F(t_{k+1})}(x_k + h f(x_k) + ∫u) at every node)",
@@ -734,4 +735,175 @@ ENTRIES: list[Entry] = [
           "f evaluated once at x_k", twin="gauss_seidel_field"),
 ]
 
+
+
+# ----------------------------------------------------------------------------------------------------
+# witnesses: each entry's law evaluated at its smallest input in plain NumPy (verimono only builds the subject)
+# ----------------------------------------------------------------------------------------------------
+
+EQ = 1e-9      # relative slack of an equality (round-off is ~1e-15)
+
+
+def _eq(a, b, scale=1.0):
+    a, b = _f(a), _f(b)
+    if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
+        return np.inf
+    return float(np.max(np.abs(a - b), initial=0.0)) / (EQ * (1.0 + abs(scale)))
+
+
+def _refused(ok):
+    return 1.0 if ok else 2.0      # a membership the law needs: accepted ≤ 1, refused > 1
+
+
+def _op_witness(name):
+    e_op = BY_NAME[name].build
+    if name in ("l1_ball_unique_sort_ties", "ctrl_l1_ball_sort"):
+        return lambda: max(0.0, np.abs(e_op().resolvent(np.array([2.0, 2.0, 0.0]), 1.0)).sum() - 1.0) / EQ
+    if name in ("ball_reciprocal_scale_subnormal", "ctrl_ball_divide_scale"):
+        x = np.array([5e-324, 0.0, 0.0])
+
+        def w():
+            with np.errstate(all="ignore"):           # the plant's own overflow: its NaN is the witness
+                return _eq(e_op().resolvent(x, 1.0), x)
+        return w
+    if name in ("soft_memo_rounded_key", "ctrl_soft_memo_exact_key"):
+        def w():
+            op = e_op()
+            x1, x2, lam = np.array([1.0, 0, 0]), np.array([1.0 + 4e-7, 0, 0]), 1e-6
+            op.resolvent(x1, lam)
+            y = (x2 - op.resolvent(x2, lam)) / lam           # Y_λx2 must be in ∂|·|_1(J): (1, 0, 0)
+            return _eq(y, l1_min_norm(_soft(x2, lam)), 1.0) * EQ / 1e-6     # Y's rounding at λ = 1e-6: 1e-16/1e-6
+        return w
+    if name in ("linear_td_inverse_cached_by_lam", "ctrl_linear_td_cache_lam_t"):
+        def w():
+            op, x = e_op(), np.array([1.0, 0.0])
+            op.resolvent(x, 1.0, 0.0)
+            return _eq(op.resolvent(x, 1.0, 1.0), np.linalg.solve(np.eye(2) + _A_t(1.0), x))
+        return w
+    if name in ("box_contains_interior_only", "box_contains_one_face", "ctrl_box_contains_coordinates"):
+        x = np.array([2.0, 0.0, 0.0]) if name == "box_contains_interior_only" else np.array([2.0, 2.0, 0.0])
+
+        def w():
+            op = e_op()
+            j = op.resolvent(x, 1.0)
+            return _refused(op.contains(j, x - j))
+        return w
+    if name in ("box_shift_min_norm_faces", "ctrl_box_shift_min_norm"):
+        return lambda: _eq(e_op().min_norm(np.array([1.0, 0.0, 0.0])), [0.0, -0.5, 3.0], 3.0)
+    if name in ("batch_rows_sorted_by_step", "ctrl_batch_rows_restored"):
+        def w():
+            op = e_op()
+            X, lams = np.array([[3.0, 0, 0], [0, 3.0, 0]]), np.array([2.0, 1.0])
+            return _eq(op.resolvent_batch(X, lams, np.zeros(2), pad=False), _soft(X, lams[:, None]), 3.0)
+        return w
+    if name in ("linear_integer_lambda_power", "ctrl_linear_integer_lambda_solve"):
+        x = np.array([1.0, 0.0])
+        return lambda: _eq(e_op().resolvent(x, 2.0), np.linalg.solve(np.eye(2) + 2.0 * _A_SKEW, x))
+    if name in ("box_value_forgets_indicator", "ctrl_box_value_indicator"):
+        def w():
+            op, x, lam = e_op(), np.zeros(3), 1.0
+            p = op.resolvent(x, lam)
+            z = x - lam * _C_LIN                         # the unconstrained minimiser of <c, z> + |z - x|²/2
+            obj = lambda v: op.value(v) + float((v - x) @ (v - x)) / (2 * lam)
+            return max(0.0, obj(p) - obj(z)) / EQ       # > 1: z beats the prox of the declared g
+        return w
+    if name in ("halfspace_contains_unnormalised", "ctrl_halfspace_contains_normalised"):
+        def w():
+            op, x = e_op(), np.array([1.0, 0.0])
+            j = op.resolvent(x, 1.0)
+            return _refused(op.contains(j, x - j))
+        return w
+    if name == "ball_contains_signless":
+        def w():
+            op = e_op()
+            a, ya, b, yb = np.array([1.0, 0, 0]), np.array([-1.0, 0, 0]), np.zeros(3), np.zeros(3)
+            if not (op.contains(a, ya) and op.contains(b, yb)):
+                return 0.0
+            return 1.0 + max(0.0, -float((a - b) @ (ya - yb)))     # monotone: <Δx, Δy> ≥ 0
+        return w
+    if name == "simplex_theta_off_by_one":
+        return lambda: abs(e_op().resolvent(np.ones(3), 1.0).sum() - 1.0) / EQ
+    if name in ("linear_float32_above_1e4", "ctrl_linear_float64_above_1e4"):
+        x = np.array([12345.678, 0.1])
+        return lambda: _eq(e_op().resolvent(x, 1.0), np.linalg.solve(np.eye(2) + _A_DC, x), 1.3e4) * EQ / 1e-12
+    raise KeyError(name)
+
+
+class _HalfSpace:
+    """N of the moving half-space {x_1 ≥ t - 1/2} in R^n: J = the projection, at any step."""
+    def __init__(self, speed=1.0):
+        self.speed = speed
+
+    def resolvent(self, z, lam, t=0.0):
+        z = _f(z).copy()
+        z[0] = max(z[0], self.speed * t - 0.5)
+        return z
+
+
+class _Zero:
+    def resolvent(self, z, lam, t=0.0):
+        return _f(z).copy()
+
+
+class _P:
+    """A duck-typed problem: what the steppers read (operator, x0, f, input_increments, T)."""
+    def __init__(self, operator, x0, T=1.0, f=None, U=None):
+        self.operator, self.x0, self.T, self.f, self._U = operator, _f(x0), T, f, U
+        self.dim = self.x0.size
+
+    def input_increments(self, t):
+        if self._U is None:
+            return None
+        t = _f(t)
+        return np.array([self._U(b) - self._U(a) for a, b in zip(t[:-1], t[1:])])
+
+
+_STEP_CASES = {
+    "merges_short_cells": (lambda: _P(_HalfSpace(), [-1.0, 0.5], 2.0, f=lambda x: -x), [0, 0.4, 0.8, 0.85, 1.2, 2.0]),
+    "input_reversed_n_ge_5": (lambda: _P(_Zero(), np.zeros(5), U=lambda t: np.array([t, 0, 0, 0, 0.0])),
+                              np.linspace(0, 1, 5)),
+    "safety_clip_3": (lambda: _P(_Zero(), [4.0]), np.linspace(0, 1, 3)),
+    "overrelaxed_1_02": (lambda: _P(_HalfSpace(), [-1.0, 0.0]), np.linspace(0, 1, 5)),
+    "memo_z_only": (lambda: _P(_HalfSpace(), [0.0, 0.0]), np.linspace(0, 1, 9)),
+    "unrolled_remainder_unprojected": (lambda: _P(_HalfSpace(), [-1.0, 0.0]), np.linspace(0, 1, 4)),
+    "normalised_time": (lambda: _P(_HalfSpace(), [-1.0, 0.0], 2.0), np.linspace(0, 2, 5)),
+    "lagged_field_above_512": (lambda: _P(_Zero(), [1.0], f=lambda x: -x), np.linspace(0, 1, 601)),
+    "gauss_seidel_field": (lambda: _P(_Zero(), [1.0, 0.0], f=lambda x: np.array([x[1], -x[0]])), np.linspace(0, 1, 3)),
+}
+
+
+def _step_witness(name):
+    """The stepper's states against the scheme's (``proximal``) at the smallest input; a control runs its plant's case."""
+    e = BY_NAME[name]
+    case = e.twin if e.lawful else name
+    if case == "rounds_grid_in_place":
+        def w():
+            stepper = e.build()[0]
+            t = np.array([0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0])
+            before = t.copy()
+            stepper(_P(_HalfSpace(), [-1.0, 0.0]), t)
+            return 0.0 if np.array_equal(t, before) else 2.0          # the caller's grid must be unchanged
+        return w
+    if case == "memo_installed_on_operator":
+        def w():
+            op = _HalfSpace()
+            memo_installed_on_operator(_P(op, [-1.0, 0.0]), np.linspace(0, 1, 3))
+            z = np.array([-1.0, 0.0])
+            op.resolvent(z, 0.5, 1.0)
+            z2 = z + np.array([0.0, 3e-5])
+            return _eq(op.resolvent(z2, 0.5, 1.0), _HalfSpace().resolvent(z2, 0.5, 1.0))
+        return w
+    make, grid = _STEP_CASES[case]
+
+    def w():
+        stepper = e.build()[0]
+        got = stepper(make(), np.array(grid, dtype=float))
+        want = proximal(make(), np.array(grid, dtype=float))
+        return _eq(got, want, float(np.max(np.abs(want))))
+    return w
+
+
+BY_NAME = {e.name: e for e in ENTRIES}
+ENTRIES = [dataclasses.replace(e, witness=(_op_witness(e.name) if e.kind == "operator" else _step_witness(e.name)))
+           for e in ENTRIES]
 BY_NAME = {e.name: e for e in ENTRIES}
