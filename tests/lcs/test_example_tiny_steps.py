@@ -52,3 +52,16 @@ def test_the_examples_least_norm_selection_is_minus_t_at_every_scale(x, t):
     assert abs(got[0] - want) <= 1e-9 * (1.0 + abs(x) + abs(t)), (x, t, got, want)
     assert op.contains(np.array([x]), got, t)
     assert abs(op.project_domain(np.array([-x]), t)[0] - 0.0) <= 1e-9 * (1.0 + abs(x))
+
+
+# The resolvent where x + λt is tiny against the multiplier −x/λ (branch probe5): x = −1e-9 at λ = 1e-15, t = 2
+# has z = (0, 1e6) with M = [[0, 1], [−1, 1e-15]] — Lemke ends on a ray and the phase-1 QP is not verified, so the
+# LCP raised UnverifiedSolution although its 2×2 pieces hold the verified point (z₂ = −x/λ); likewise λ = 1e8 at
+# t = 1e-12, x = −1e-9 (J = 1e-4 − 1e-9) and t = 2, x = −1e3.  Seen failing before the fix in lcs/lcp.py.
+@pytest.mark.parametrize("lam,t,x", [(1e-15, 2.0, -1e-9), (3.6e-13, 2.0, -1e-9), (1e7, 1e-12, -1e-9),
+                                     (1e7, 2.0, -1e3), (1e7, 0.7, -1e3), (1e-15, 0.7, -1e-9)])
+def test_the_examples_resolvent_where_lemke_ends_on_a_ray(lam, t, x):
+    want = max(x + lam * t, 0.0)
+    for op in (get("Example ex, v = (−t, 0)").operator,):
+        got = op.resolvent(np.array([x]), lam, t)
+        assert abs(got[0] - want) <= 1e-8 * (1.0 + abs(x) + lam * t), (lam, t, x, got, want)
