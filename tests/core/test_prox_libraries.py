@@ -124,3 +124,21 @@ def test_recipes_pass_every_law_at_seeds_1_to_19(heading, names, libs):
             rep = vm.check_operator(ns[name], seed=seed)
             assert rep.ok, f"{name}, seed {seed}:\n" + "\n".join(map(str, rep.failures))
             assert {r.details["dtype"] for r in rep if r.status == "passed"} == {"float32"}
+
+
+def test_a_membership_test_as_value_is_refused_with_the_fix():
+    """PyProximal's indicators (``Box``, ``EuclideanBall``, ...) return a bool from ``__call__`` — ``True`` inside
+    — not ``g``: passed as ``value`` they stated ``g = 1`` on the set and ``0`` outside, and the correct projection
+    failed four or five value laws (branch probe5).  A bool is refused as a value, naming the indicator."""
+    from verimono.checks import check_prox_inequality
+    box = lambda x: bool(np.all(np.abs(x) <= 1.0))              # noqa: E731 - a membership test, as PyProximal's
+    proj = lambda x, lam: np.clip(x, -1.0, 1.0)                 # noqa: E731
+    sample = dict(x1=[0.0, 0.0, 3.0], x2=[0.5, 0.0, 0.0], lam=1.0, mu=1.0, nu=1.0, t=0.0)    # PyProximal's Box's failure
+    for v in (box, lambda x: np.all(np.abs(x) <= 1.0)):
+        op = vm.operator_from_prox(proj, value=v, shape=3, name="box, membership as value")
+        with pytest.raises(vm.ProxOutputError, match="0.0 if"):
+            op.value(np.zeros(3))
+        rec = check_prox_inequality(op, sample=sample)
+        assert rec.status == "failed" and "membership" in rec.message, rec.message
+    lawful = vm.operator_from_prox(proj, value=lambda x: 0.0 if box(x) else np.inf, shape=3, name="box indicator")
+    assert check_prox_inequality(lawful, sample=sample).status == "passed"

@@ -18,7 +18,12 @@ CONTAINS_POINTS = 24
 
 
 def checked_value(op: Any, v: Any) -> float:
-    """``v`` as a float ``g(x) ∈ R ∪ {+inf}``; anything else is a :class:`ProxOutputError`."""
+    """``v`` as a float ``g(x) ∈ R ∪ {+inf}``; anything else is a :class:`ProxOutputError` — a bool too: it is a
+    membership test (PyProximal's indicators return ``True`` inside), which as a number would state ``g = 1`` on
+    the set and ``0`` outside, and fail the value laws of a correct projection."""
+    if isinstance(v, bool) or getattr(v, "dtype", None) == np.bool_:
+        raise ProxOutputError(f"{op.name}: value returned a bool ({v}): a membership test, not g; pass the "
+                              "indicator, value=lambda x: 0.0 if member(x) else np.inf")
     try:
         a = np.asarray(v, dtype=float)
     except (TypeError, ValueError):

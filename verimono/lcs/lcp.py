@@ -45,6 +45,8 @@ from ..core._highs import linprog_highs
 
 #: largest n for which complementary pieces are enumerated (2^n pieces)
 ENUM_MAX = 12
+#: PSD ``M`` up to this size are enumerated when Lemke and the phase-1 QP both fail (2^n pieces, on that path only)
+PSD_ENUM_MAX = 6
 
 
 @dataclasses.dataclass
@@ -534,6 +536,23 @@ def _solve_unit(M, q, least_norm, backends) -> LCPResult:
             break
         reasons.append(f"{name}: status {status!r} but residual ‖min(z, Mz+q)‖∞ = {res:.3g} "
                        f"> {QP_RTOL:g}·{scale:.3g}")
+    if zbar is None and psd and n <= PSD_ENUM_MAX and backends is None:
+        # Lemke's pivots and the phase-1 QP at their numerical limit on data spanning many decades (the paper's
+        # Example at λ = 1e-15, x = −1e-9: M = [[0, 1], [−1, 1e-15]], z = (0, 1e6), Lemke ends on a ray): the
+        # complementary pieces are exact for any M, each point verified
+        # complementary pieces are exact for any M: each piece's principal solve, verified (ill-conditioned pieces
+        # included — the Example at λ = 1e7 has cond M = 1e14 — the residual check is the arbiter)
+        for alpha in _pieces(n):
+            try:
+                with np.errstate(all="ignore"):
+                    z = principal_solve(M, q, alpha)
+            except (np.linalg.LinAlgError, ValueError):
+                continue
+            if np.isfinite(z).all() and _verified(M, q, z)[0]:
+                zbar, used = z, "enumerate"
+                break
+        else:
+            reasons.append("enumerate: no piece's principal solve verified")
     if zbar is None:
         if not _feasible(M, q):
             _raise_infeasible(M, q, True if psd else False, reasons + ["FEA(q, M) is empty (linear programming)"])
