@@ -174,7 +174,16 @@ class Report:
 
     @property
     def ok(self) -> bool:
-        return all(r.ok for r in self.results)
+        """True when the report verified something and nothing failed or was left undecided: at least one
+        record passed, none failed or undecided.  An empty report, or one whose records were all skipped or
+        expected failures, verified nothing, and a check that evaluated nothing is never a pass
+        (:attr:`verified` says whether any record passed)."""
+        return self.verified and all(r.ok for r in self.results)
+
+    @property
+    def verified(self) -> bool:
+        """Whether any record passed: something was evaluated and held."""
+        return any(r.status == PASSED for r in self.results)
 
     @property
     def failures(self) -> list[CheckResult]:

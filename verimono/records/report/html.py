@@ -231,7 +231,14 @@ def _summary(report: Report, changes: Any) -> str:
     c = report.counts
     ok = report.ok
     nreg = len(changes.regressions) if changes is not None else None
-    verdict = ("All checks hold" if ok else f"{c[FAILED]} check{'s' if c[FAILED] != 1 else ''} failed")
+    if ok:
+        verdict = "All checks hold"
+    elif c[FAILED]:
+        verdict = f"{c[FAILED]} check{'s' if c[FAILED] != 1 else ''} failed"
+    elif not report.verified:              # nothing evaluated held: never shown as a pass
+        verdict = f"Nothing verified: none of the {len(report)} record{'s' if len(report) != 1 else ''} passed"
+    else:
+        verdict = "No check failed"
     if c.get(UNDECIDED):
         verdict += f" · {c[UNDECIDED]} undecided (a limitation of the harness: nothing verified there)"
     if report.meta.get("incomplete"):
