@@ -115,9 +115,7 @@ class Sizes:
 #: ensemble_timed_rows 250 (every profile): each round times 250 of the B = 1000 separate solves, scaled by 4;
 #: interleaved with all 1000 timed (4 rounds x 3 kinds, load 2-3) the speed-ups read 106-136 / 129-154 / 76-98 against
 #: 88-124 / 122-143 / 67-92 (t|x| / box / ball), intervals no wider, for 0.15-0.41 s of CPU per record against
-#: 0.40-1.10 s; every row is still compared with the batch (docs/speed.md, branch perf9).  The calls take turns
-#: over 4 such subsamples (:func:`ensemble_turns`), so the warm-up and the first 3 rounds solve every row: the 750
-#: rows perf9 solved again, untimed, for the comparison (0.05-0.07 s per record) are not (docs/speed.md, branch perf12)
+#: 0.40-1.10 s; every row is still compared with the batch, once, untimed (docs/speed.md, branch perf9)
 _QUICK = Sizes(per_step_steps=5_000, per_step_rounds=9, ensemble_batch=1000, ensemble_steps=20,
                ensemble_rounds=9, lcs_steps=5000, lcs_rounds=9, memory_steps=100_000,
                lcs_batch=1000, lcs_batch_steps=200, lcs_batch_rounds=9, max_rounds=27)
@@ -397,34 +395,16 @@ def ensemble_case(kind: str, n: int = 3):
     return problem.operator, ({"initial_jump": True} if problem.initial_jump else {})
 
 
-def ensemble_rows(batch: int, timed_rows: int | None, turn: int | None = None) -> np.ndarray:
+def ensemble_rows(batch: int, timed_rows: int | None) -> np.ndarray:
     """The rows of a batch whose separate solves are timed: all ``batch`` (``timed_rows`` None or ≥ ``batch``), else
     ``timed_rows`` evenly spaced ones, each the middle row of its ``batch/timed_rows`` consecutive rows (a fixed
     subsample of independent, identically drawn initial conditions: its mean cost per solve estimates the
-    batch's).
-
-    ``turn`` (0, 1, 2, ...): the subsample of that round when the rounds take turns (:func:`ensemble_turns` of
-    them, ``g = ceil(batch/timed_rows)``): the ``i``-th row is the ``((mid + turn) mod g)``-th of the ``i``-th
-    block of rows (block ``i`` starts at ``i*batch//timed_rows``; ``mid`` = ``batch//(2*timed_rows)``, so that
-    turn 0 is the middle rows above when ``timed_rows`` divides ``batch``).  Every turn has ``timed_rows``
-    distinct rows below ``batch`` (the starts are at least ``batch/timed_rows`` apart and the shift is below
-    it), and ``g`` consecutive turns cover every row (no gap between two starts exceeds ``g``)."""
+    batch's)."""
     if timed_rows is None or timed_rows >= batch:
         return np.arange(batch)
     if timed_rows < 1:
         raise ValueError(f"timed_rows must be >= 1, got {timed_rows}")
-    if turn is None:
-        return (2 * np.arange(timed_rows) + 1) * batch // (2 * timed_rows)
-    g = ensemble_turns(batch, timed_rows)
-    return np.arange(timed_rows) * batch // timed_rows + (batch // (2 * timed_rows) + turn) % g
-
-
-def ensemble_turns(batch: int, timed_rows: int | None) -> int:
-    """How many rounds' subsamples (:func:`ensemble_rows` with ``turn``) cover every row: ``ceil(batch/timed_rows)``
-    (1 when every row is timed)."""
-    if timed_rows is None or timed_rows >= batch:
-        return 1
-    return -(-batch // timed_rows)
+    return (2 * np.arange(timed_rows) + 1) * batch // (2 * timed_rows)
 
 
 def check_ensemble(op, label: str, *, batch: int, steps: int, rounds: int, max_rounds: int | None = None,
@@ -433,48 +413,33 @@ def check_ensemble(op, label: str, *, batch: int, steps: int, rounds: int, max_r
     """Target 2: one solve of ``batch`` initial conditions against ``batch`` separate solves of ``op``
     (problems built outside the timing); the two must agree bit for bit, every row, else the record fails.
 
-    ``timed_rows``: how many of the separate solves each round times (default all ``batch``), their time scaled by
-    ``batch/timed_rows`` — the separate solves are independent, so a subsample's cost per solve estimates the same
-    per-trajectory cost.  The calls of the baseline take turns over :func:`ensemble_turns` evenly spaced
-    subsamples (:func:`ensemble_rows` with ``turn``: 4 of 250 rows for B = 1000), so that the warm-up call and
-    the first three rounds have solved every row separately once; the comparison with the batch covers every
-    row, each with its last separate solve, and a row no call reached (fewer rounds than turns) is solved
-    separately once, untimed, after the rounds (``details["timed_rows"]``, ``details["verified_rows"]``,
-    ``details["row_turns"]``, ``details["untimed_rows"]``: how many were)."""
+    ``timed_rows``: how many of the separate solves each round times (:func:`ensemble_rows`, a fixed evenly
+    spaced subsample; default all ``batch``), their time scaled by ``batch/timed_rows`` — the separate solves are
+    independent, so the subsample's cost per solve estimates the same per-trajectory cost.  The comparison with
+    the batch still covers every row: the rows not timed are solved separately once, untimed, after the rounds
+    (``details["timed_rows"]``, ``details["verified_rows"]``)."""
     stepper = _default_stepper(stepper)
     kw = dict(problem_kw or {})
     X0 = np.random.default_rng(seed).normal(size=(batch, op.dim))
     t = uniform_grid(1.0, steps=steps)
     whole = Problem(op, X0, 1.0, **kw)
     singles = [Problem(op, x, 1.0, **kw) for x in X0]
-    g = ensemble_turns(batch, timed_rows)
-    rows = [ensemble_rows(batch, timed_rows, turn=k) if g > 1 else ensemble_rows(batch, timed_rows) for k in range(g)]
-    timed = [[singles[i] for i in r] for r in rows]
-    outs: list[Any] = [None] * g       # each turn's last outputs, by turn
-    calls = [0]
-
-    def separate():
-        k = calls[0] % g
-        calls[0] += 1
-        outs[k] = [stepper(p, t) for p in timed[k]]
-        return outs[k]
+    rows = ensemble_rows(batch, timed_rows)
+    timed = [singles[i] for i in rows]
 
     def verify(last):
         xb = np.asarray(last["subject"])
-        got: dict[int, Any] = {}
-        for k in range(g):
-            if outs[k] is not None:
-                got.update(zip(rows[k].tolist(), outs[k]))
-        untimed = batch - len(got)
+        got = dict(zip(rows.tolist(), last["baseline"]))   # the timed rows' last separate solves
         xs = np.stack([np.asarray(got[i] if i in got else stepper(p, t)) for i, p in enumerate(singles)], axis=1)
         same = xb.shape == xs.shape and np.array_equal(xb, xs)
         return (None if same else "the batched solve differs from the separate solves"), \
-            {"batch": batch, "steps": steps, "operator": label, "identical": same, "timed_rows": len(rows[0]),
-             "verified_rows": len(singles), "row_turns": g, "untimed_rows": untimed}
+            {"batch": batch, "steps": steps, "operator": label, "identical": same, "timed_rows": len(rows),
+             "verified_rows": len(singles)}
 
-    return _timed_record("performance_ensemble", f"{label} B={batch}", lambda: stepper(whole, t), separate,
-                         target=ENSEMBLE_TARGET, speedup=True, rounds=rounds, max_rounds=max_rounds, runner=runner,
-                         verify=verify, baseline_scale=len(rows[0]) / batch)
+    return _timed_record("performance_ensemble", f"{label} B={batch}", lambda: stepper(whole, t),
+                         lambda: [stepper(p, t) for p in timed], target=ENSEMBLE_TARGET, speedup=True,
+                         rounds=rounds, max_rounds=max_rounds, runner=runner, verify=verify,
+                         baseline_scale=len(rows) / batch)
 
 
 def check_lcs_step(*, steps: int, rounds: int, max_rounds: int | None = None, runner: Runner | None = None,
@@ -686,5 +651,5 @@ def performance_report(sizes: Sizes, *, stepper: Callable | None = None,
 
 __all__ = ["EARLY_ROUNDS", "PER_STEP_TARGET", "ENSEMBLE_TARGET", "LCS_TARGET", "LCS_BATCH_TARGET", "LCS_BATCH_TARGET_COMPILED", "LCS_AGREEMENT", "MEMORY_TARGET",
            "SIZES", "Sizes", "bare_t_norm", "bare_box", "bare_ball", "floor_loop", "minimal_lcs", "per_step_case", "ensemble_case",
-           "ensemble_rows", "ensemble_turns", "interleave", "measure", "Rounds", "ratio_record", "check_per_step", "check_ensemble", "check_lcs_step", "check_lcs_batch",
+           "ensemble_rows", "interleave", "measure", "Rounds", "ratio_record", "check_per_step", "check_ensemble", "check_lcs_step", "check_lcs_batch",
            "check_memory", "peak_memory", "performance_report"]
