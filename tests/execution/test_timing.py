@@ -126,6 +126,32 @@ def test_the_end_calibration_stops_repeating_once_it_agrees_with_the_start(monke
     assert len(ran) == runs
 
 
+@pytest.mark.parametrize("walls, owns, agreeing_with, runs, best", [
+    ([0.060, 0.050, 0.055], [0.060, 0.050, 0.055], None, 3, (0.050, 0.050)),       # no earlier one: best of 3
+    ([0.062, 0.050, 0.055], [0.061, 0.050, 0.055], (0.060, 0.060), 1, (0.062, 0.061)),   # both agree at once
+    ([0.062, 0.058, 0.055], [0.080, 0.059, 0.055], (0.060, 0.060), 2, (0.058, 0.059)),   # own disagrees once
+    ([0.080, 0.058, 0.055], [0.061, 0.058, 0.055], (0.060, 0.060), 2, (0.058, 0.058)),   # wall disagrees once
+    ([0.080, 0.070, 0.075], [0.080, 0.070, 0.075], (0.060, 0.060), 3, (0.070, 0.070)),   # never: best of 3
+    ([0.050, 0.049, 0.030], [0.050, 0.049, 0.030], (0.060, 0.060), 3, (0.030, 0.030)),   # faster by > 5%: too
+])
+def test_the_performance_stages_second_calibration_stops_once_both_clocks_agree(monkeypatch, walls, owns,
+                                                                                 agreeing_with, runs, best):
+    """``calibrate_both(agreeing_with=...)`` (the performance stage's calibration after its records) ends at the
+    first repeat whose best wall and own figures are both within AGREEMENT of the earlier ones (scripted
+    samples); without one, best of 3 on each clock, as before."""
+    samples = iter(timing.Sample(own=o, wall=w, cpu=o, waited=w - o if w > o else 0.0) for w, o in zip(walls, owns))
+    ran = []
+
+    def timed(fn):
+        ran.append(fn)
+        return None, next(samples)
+
+    monkeypatch.setattr(timing, "timed", timed)
+    before = None if agreeing_with is None else {"wall": agreeing_with[0], "own": agreeing_with[1], "repeats": 3}
+    got = timing.calibrate_both(agreeing_with=before)
+    assert (got["wall"], got["own"]) == best and got["repeats"] == runs == len(ran)
+
+
 def test_a_unit_over_its_scaled_budget_is_stopped_and_says_why(monkeypatch):
     if not timeouts.supported():
         pytest.skip("no SIGALRM here")

@@ -76,7 +76,7 @@ from typing import Any, Callable, Sequence
 from ..core.claims import Stepper, claim_of
 from ..core.naming import subject_name
 
-from .calibration import calibrate, calibration, set_calibration, workload
+from .calibration import AGREEMENT, calibrate, calibration, set_calibration, workload
 
 #: one-sided error of each verdict (pass or fail) when the true median ratio sits exactly on the target;
 #: split between the two looks at the data (Bonferroni), ``ALPHA / LOOKS`` per look and side
@@ -356,12 +356,25 @@ def is_noise_undecided(record: Any) -> bool:
 # -- calibration -------------------------------------------------------------------------------------------
 
 
-def calibrate_both(repeats: int = 3) -> dict[str, float]:
-    """The calibration workload on both clocks, best of ``repeats``: ``{"wall": s, "own": s}``.  On a busy
-    machine the wall figure grows with the load and the own figure (:func:`timed`) does not; both growing
-    means the code itself ran slower (cache and memory-bandwidth contention, a slower CPU clock)."""
-    samples = [timed(workload)[1] for _ in range(repeats)]
-    return {"wall": min(s.wall for s in samples), "own": min(s.own for s in samples)}
+def calibrate_both(repeats: int = 3, *, agreeing_with: dict[str, float] | None = None) -> dict[str, float]:
+    """The calibration workload on both clocks, best of ``repeats``: ``{"wall": s, "own": s, "repeats": k}``.  On a
+    busy machine the wall figure grows with the load and the own figure (:func:`timed`) does not; both growing
+    means the code itself ran slower (cache and memory-bandwidth contention, a slower CPU clock).
+
+    ``agreeing_with``: an earlier ``calibrate_both`` of the same process; the repeats end at the first whose best
+    figures so far are both within :data:`verimono.execution.calibration.AGREEMENT` (5%) of it — the rule of
+    :func:`verimono.execution.calibration.calibrate_times` for the run's end calibration.  A second calibration is
+    there to tell whether the machine's speed changed; a first repeat that agrees has told it (the drift between
+    the two, ``max/min`` per clock, is then at most 1.05), and more repeats could only move the minima by the noise
+    they would be repeated to remove.  A repeat that disagrees is repeated as before; ``k`` says how many ran."""
+    samples: list[Sample] = []
+    for _ in range(repeats):
+        samples.append(timed(workload)[1])
+        best = {"wall": min(s.wall for s in samples), "own": min(s.own for s in samples)}
+        if agreeing_with is not None and all(agreeing_with.get(c, 0) > 0 and
+                                             abs(best[c] / agreeing_with[c] - 1.0) <= AGREEMENT for c in ("wall", "own")):
+            break
+    return {**best, "repeats": len(samples)}
 
 
 # -- machine probes --------------------------------------------------------------------------------------------
