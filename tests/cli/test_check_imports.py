@@ -51,3 +51,38 @@ def test_the_check_of_a_stepper_imports_no_heavy_module_its_process_does_not_use
     status, loaded = out.stdout.splitlines()[-2:]
     assert status == "0", out.stdout[-3000:]          # the check ran and passed: its studies were decided
     assert loaded == "-", f"`verimono check` of a stepper imported in its own process: {loaded}"
+
+
+#: an operator's check: which modules the command's process holds when it forks the workers
+OPERATOR_SCRIPT = """
+import sys
+from verimono.execution import executors
+from verimono.cli import main
+
+held = {}
+prestart = executors.ProcessRunner.prestart
+
+def at_fork(self):
+    held.update({m: m in sys.modules for m in ("verimono.checks.operator_battery", "hypothesis")})
+    return prestart(self)
+
+executors.ProcessRunner.prestart = at_fork
+status = main(["check", "mysolver:moving_disc", "--profile", "dev", "--executor", "process:2", "--out", "out",
+               "--seed", "0"])
+print(status)
+print(held)
+"""
+
+
+@pytest.mark.slow
+def test_the_check_of_an_operator_forks_its_workers_with_the_battery_loaded(tmp_path):
+    """The operator battery (its search engine, hypothesis: 0.17 s CPU) is imported once, before the workers
+    fork, and inherited: on 2bc1b4d the command's process imported it after the fork, to name ``check_operator``
+    in the unit, and the worker that unpickled the unit imported it again before its search could start."""
+    (tmp_path / "mysolver.py").write_text(_readme_stepper())
+    out = subprocess.run([sys.executable, "-c", OPERATOR_SCRIPT], cwd=tmp_path, capture_output=True, text=True,
+                         timeout=600)
+    assert out.returncode == 0, out.stderr[-3000:]
+    status, held = out.stdout.splitlines()[-2:]
+    assert status == "0", out.stdout[-3000:]
+    assert held == str({"verimono.checks.operator_battery": True, "hypothesis": True}), held
