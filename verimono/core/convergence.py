@@ -27,6 +27,7 @@ exact solution (or a fine-grid solution of the same stepper, which it says), fit
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 from typing import Any, Callable, Sequence
@@ -161,8 +162,28 @@ class ConvergenceStudy:
                          {int(i): str(m) for i, m in self.failures})
 
     def decision(self) -> Decision:
-        """The verdict: passed, failed or undecided, with its message (:func:`verimono.core.verdicts.decide`)."""
-        return decide(self.data())
+        """The verdict: passed, failed or undecided, with its message (:func:`verimono.core.verdicts.decide`).
+
+        Remembered with the data it was decided from (an attribute, not a field: pickled with the study, never
+        in its document) and decided again whenever the data differ: the worker that ran the study decides it
+        once, and the command line's process, which writes the report, reads that verdict instead of fitting
+        the orders again (and importing ``scipy.special`` for the Student quantile: 0.04-0.08 s of
+        ``verimono check``'s report, issue 43 item 3).  ``decide`` is a function of the data alone, so the
+        verdict is the same either way; data that do not compare equal (a NaN error, an array) are decided
+        afresh."""
+        data = self.data()
+        memo = self.__dict__.get("_decided")
+        if memo is not None:
+            try:
+                same = bool(memo[0] == data)
+            except (ValueError, TypeError):       # arrays in the data: no memo
+                same = False
+            if same:
+                return dataclasses.replace(memo[1], window=list(memo[1].window))
+        decision = decide(data)
+        # a copy of the data: the study's lists changed in place must not compare equal to the memo
+        self.__dict__["_decided"] = (copy.deepcopy(data), dataclasses.replace(decision, window=list(decision.window)))
+        return decision
 
     @property
     def status(self) -> str:

@@ -194,8 +194,17 @@ def _generated_operators(profile: Profile, seed: int | None) -> list[tuple[str, 
     return [(f"generated #{i} (n={n}, seed {seed})", op) for i, (n, op) in enumerate(drawn)]
 
 
+def _load_operator_battery(profile: Profile, context: RunContext) -> None:
+    """SciPy's optimizers (:func:`_load_optimizers`) and the operator battery with the search engine and
+    hypothesis, imported before the workers fork: the stage's units name ``check_operator``, which each worker
+    imported again when it unpickled its first unit (0.17 s CPU each; an operator's ``verimono check``: the one
+    worker and this process, at once)."""
+    load_optimizers()
+    from ...checks.operator_battery import check_operator  # noqa: F401  (imported for the workers to inherit)
+
+
 @register_stage("operator_laws", "resolvent and Yosida laws on the catalog operators and generated families",
-                prepare=_load_optimizers, overlap=True)
+                prepare=_load_operator_battery, overlap=True)
 def operator_laws_stage(profile: Profile, context: RunContext) -> Report:
     """``check_operator`` on each catalog operator (or the user's) and on generated families.
 
