@@ -441,7 +441,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
     if report.results and all(r.status == SKIPPED for r in report.results):
         _finish(report, out, None, run_id)
         print(f"verimono: no {kind} battery could run here: " +
-              "; ".join(r.message for r in report.results), file=sys.stderr)
+              "; ".join(dict.fromkeys(r.message for r in report.results)), file=sys.stderr)
         return EXIT_UNDECIDED
     return _finish(report, out, baseline, run_id)
 
