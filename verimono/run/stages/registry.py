@@ -43,6 +43,7 @@ from ...lcs.siconos import PACKAGED_DATA, siconos_root
 from ...execution.profiles import Profile
 from ...records.results import FAILED, SKIPPED, Report
 from ...records.verdicts import SUBJECT_EXITS, new_record
+from .unit_timing import UNIT_TIME, expected_costs, timed_unit
 
 
 @dataclasses.dataclass
@@ -243,9 +244,6 @@ def _reads(name: str) -> set[str]:
     return seen
 
 
-#: ``Report.meta`` key under which :func:`timed_unit` hands a unit's times back (popped by ``run_units``)
-UNIT_TIME = "unit_time"
-
 _CATALOG_LOCK = threading.Lock()
 #: the stage the current thread runs (:func:`run_stages`), which ``run_units`` tags each unit's times with
 _HERE = threading.local()
@@ -253,38 +251,6 @@ _HERE = threading.local()
 
 def _running_stage() -> str | None:
     return getattr(_HERE, "stage", None)
-
-
-def expected_costs(report: Report | None) -> dict[tuple[str, str], float]:
-    """The wall seconds of every unit of ``report`` (a baseline, or a previous run's results:
-    ``meta["stages"][k]["units"]``) by ``(stage, label)``: the expected costs that order the shared queue
-    (:attr:`RunContext.expected`).  Empty for ``None`` or a document without unit figures."""
-    out: dict[tuple[str, str], float] = {}
-    for stage in (report.meta.get("stages") or []) if report is not None else []:
-        if not isinstance(stage, dict):
-            continue
-        for u in stage.get("units") or []:
-            if isinstance(u, dict) and isinstance(u.get("wall"), (int, float)) and isinstance(u.get("label"), str):
-                out[(str(stage.get("name")), u["label"])] = float(u["wall"])
-    return out
-
-
-def timed_unit(fn: Callable[..., Report], args: tuple) -> Report:
-    """``fn(*args)`` with its times in ``meta[UNIT_TIME]``: ``cpu``, the CPU seconds of the process that ran
-    it (:func:`verimono.execution.timing.cpu_now`: a worker process runs one unit at a time, and a subject that computes on
-    threads of its own, XLA's, is counted), ``wall``, and ``pid``, so that the run does not count twice the
-    units that ran in its own process (a serial run: :func:`run_stages` times those itself); and
-    ``calibration_cpu``, slices of the calibration workload measured right after it in the same process
-    (:func:`verimono.execution.calibration.slices_after`), what the stage's CPU time is stated against."""
-    pid, c0, w0, (s0, n0) = os.getpid(), cpu_now(), time.perf_counter(), subject_cpu()
-    rep = fn(*args)
-    if isinstance(rep, Report):
-        s1, n1 = subject_cpu()
-        cpu = cpu_now() - c0
-        rep.meta[UNIT_TIME] = {"cpu": cpu, "wall": time.perf_counter() - w0, "pid": pid,
-                               "subject_cpu": s1 - s0, "subject_calls": n1 - n0,
-                               "calibration_cpu": slices_after(cpu)}
-    return rep
 
 
 @dataclasses.dataclass(frozen=True)
