@@ -41,6 +41,7 @@ from ...execution.profiles import Profile
 from ...records.results import FAILED, SKIPPED, Report
 from ...records.verdicts import SUBJECT_EXITS, new_record
 from .stopper import _SET_ASYNC_EXC, _Stopper, _join_all
+from .table import STAGES, Stage, default_stages
 from .unit_timing import UNIT_TIME, expected_costs, timed_unit
 
 
@@ -251,29 +252,6 @@ def _running_stage() -> str | None:
     return getattr(_HERE, "stage", None)
 
 
-@dataclasses.dataclass(frozen=True)
-class Stage:
-    """A stage: ``fn(profile, context) -> Report``; ``default``: part of a run that names no stage (a stage on
-    request runs only when named, ``--stage NAME``, or when ``verimono check`` chooses it for its target)."""
-    name: str
-    fn: Callable[[Profile, RunContext], Report]
-    description: str = ""
-    default: bool = True
-    #: ``prepare(profile, context)``, run in this process before the worker processes start (:func:`prepare_stages`):
-    #: what the stage's units will unpickle is then imported once, here, and inherited by forked workers
-    prepare: Callable[[Profile, RunContext], None] | None = None
-    #: the stage may run at once with the other such stages next to it in the run, its units in one queue with
-    #: theirs (:attr:`RunContext.schedule`): its work is in its units and none of its records measures time.  A
-    #: timed stage (performance), and a stage registered without saying so, runs alone, as before
-    overlap: bool = False
-    #: stages whose results this one reads (``context.costs``, ``context.partitions``): when they run in the
-    #: same run, it starts once they have ended (reading one not declared: :class:`StageResults`)
-    after: tuple[str, ...] = ()
-    #: the :class:`RunContext` fields this stage writes for later stages (``"costs"``, ``"partitions"``)
-    writes: tuple[str, ...] = ()
-
-
-STAGES: dict[str, Stage] = {}
 
 
 def prepare_stages(names: Iterable[str] | None, profile: Profile, context: RunContext) -> None:
@@ -286,11 +264,6 @@ def prepare_stages(names: Iterable[str] | None, profile: Profile, context: RunCo
                 stage.prepare(profile, context)
             except Exception:  # noqa: BLE001 - the stage itself reports it
                 pass
-
-
-def default_stages() -> list[str]:
-    """The stages a run that names none runs, in registration order."""
-    return [n for n, s in STAGES.items() if s.default]
 
 
 def register_stage(name: str, description: str = "", *, default: bool = True,
