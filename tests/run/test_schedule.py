@@ -153,7 +153,7 @@ def test_the_gate_judges_stages_that_ran_at_once_by_their_groups_wall():
 def test_a_group_whose_stages_all_read_each_other_runs_one_after_another():
     """``verimono check``'s convergence and trajectory_laws (the second reads the first): nothing could overlap, so
     no thread and no queue; a stage that reads neither may overlap; a chain through a third stage is a chain."""
-    from verimono.run.stages.registry import _some_run_at_once
+    from verimono.run.stages.ordering import _some_run_at_once
 
     made = {"ch_a": (), "ch_b": ("ch_a",), "ch_c": ("ch_b",), "ch_d": ()}
     for name, after in made.items():

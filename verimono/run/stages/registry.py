@@ -40,6 +40,7 @@ from ...lcs.siconos import PACKAGED_DATA, siconos_root
 from ...execution.profiles import Profile
 from ...records.results import FAILED, SKIPPED, Report
 from ...records.verdicts import SUBJECT_EXITS, new_record
+from .ordering import _dependencies_first, _reads, _some_run_at_once
 from .stopper import _SET_ASYNC_EXC, _Stopper, _join_all
 from .table import STAGES, Stage, default_stages
 from .unit_timing import UNIT_TIME, expected_costs, timed_unit
@@ -231,18 +232,6 @@ class StageResults(dict):
         return dict, (dict(self),)
 
 
-def _reads(name: str) -> set[str]:
-    """The stages ``name`` declares it reads (``after``), directly or through those stages' own."""
-    seen: set[str] = set()
-    todo = list(STAGES[name].after) if name in STAGES else []
-    while todo:
-        d = todo.pop()
-        if d not in seen:
-            seen.add(d)
-            todo.extend(STAGES[d].after if d in STAGES else ())
-    return seen
-
-
 _CATALOG_LOCK = threading.Lock()
 #: the stage the current thread runs (:func:`run_stages`), which ``run_units`` tags each unit's times with
 _HERE = threading.local()
@@ -349,45 +338,6 @@ def _run_groups(names: list[str], shared: bool, profile: Profile, context: RunCo
                     on_start(STAGES[n], i + k, len(names))
                 finish(n, *_run_stage(n, profile, context))
         i += len(group)
-
-
-def _dependencies_first(names: list[str]) -> list[str]:
-    """``names`` with every stage moved after the stages of the run it reads (``after``), otherwise in their order:
-    ``--stage trajectory_laws --stage convergence`` ran trajectory_laws first, without the convergence studies'
-    grids (21 worst ratios other than a whole run's), though ``after`` promises it starts once they have ended."""
-    left: dict[str, int] = {}
-    for n in names:
-        left[n] = left.get(n, 0) + 1
-    out: list[str] = []
-
-    def place(n: str, path: tuple[str, ...]) -> None:
-        for d in STAGES[n].after:
-            if left.get(d, 0) > 0 and d not in path:       # (a cycle of after's: left in the given order)
-                place(d, path + (d,))
-        if left[n] > 0:
-            left[n] -= 1
-            out.append(n)
-
-    for n in names:
-        if left[n] > 0:
-            place(n, (n,))
-    return out
-
-
-def _some_run_at_once(group: list[str]) -> bool:
-    """Whether two stages of ``group`` may run at once: neither reads the other's results, even through a third
-    (``verimono check``'s convergence and trajectory_laws, the second after the first, run one after the other
-    as before, without a thread or a queue's gathering wait)."""
-    reads = {n: {d for d in STAGES[n].after if d in group} for n in group}
-    changed = True
-    while changed:                     # what each reads, directly or through another stage of the group
-        changed = False
-        for n in group:
-            more = set().union(*(reads[d] for d in reads[n])) - reads[n]
-            if more:
-                reads[n] |= more
-                changed = True
-    return any(a not in reads[b] and b not in reads[a] for i, a in enumerate(group) for b in group[i + 1:])
 
 
 def _can_share(context: RunContext) -> bool:
