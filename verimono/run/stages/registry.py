@@ -40,6 +40,7 @@ from ...lcs.siconos import PACKAGED_DATA, siconos_root
 from ...execution.profiles import Profile
 from ...records.results import FAILED, SKIPPED, Report
 from ...records.verdicts import SUBJECT_EXITS, new_record
+from .current import _HERE, _running_stage
 from .ordering import _dependencies_first, _reads, _some_run_at_once
 from .stopper import _SET_ASYNC_EXC, _Stopper, _join_all
 from .table import STAGES, Stage, default_stages
@@ -233,14 +234,6 @@ class StageResults(dict):
 
 
 _CATALOG_LOCK = threading.Lock()
-#: the stage the current thread runs (:func:`run_stages`), which ``run_units`` tags each unit's times with
-_HERE = threading.local()
-
-
-def _running_stage() -> str | None:
-    return getattr(_HERE, "stage", None)
-
-
 
 
 def prepare_stages(names: Iterable[str] | None, profile: Profile, context: RunContext) -> None:
