@@ -23,23 +23,19 @@ import ctypes
 import os
 import threading
 import time
-import traceback
 from threading import get_ident as _get_ident   # (a test replaces this module's `threading` by a shim)
 from pathlib import Path
 from typing import Callable, Iterable
 
-from ...checks.core import classify
 from ...core.errors import StageUnavailable, UnknownStage
-from ...execution.executors import ProcessRunner, SerialRunner
+from ...execution.executors import ProcessRunner
 from ...execution.schedule import SharedQueue
-from ...execution.calibration import slices_after
-from ...execution.timing import cpu_now, subject_cpu
 from ...lcs.siconos import PACKAGED_DATA, siconos_root
 from ...execution.profiles import Profile
-from ...records.results import FAILED, SKIPPED, Report
-from ...records.verdicts import SUBJECT_EXITS, new_record
+from ...records.results import Report
 from .context import RunContext
-from .current import _HERE, _running_stage
+from .current import _HERE
+from .one_stage import _run_stage, _stage_failure
 from .ordering import _dependencies_first, _some_run_at_once
 from .results import StageResults
 from .stopper import _SET_ASYNC_EXC, _Stopper, _join_all
@@ -75,16 +71,6 @@ def register_stage(name: str, description: str = "", *, default: bool = True,
         return fn
 
     return deco
-
-
-def _stage_failure(name: str, exc: BaseException, duration: float) -> tuple[Report, str, str]:
-    """The one record of a stage that raised, judged by the checks' exception policy."""
-    status, message = classify(exc)
-    rec = new_record("stage", name, status, message=message, duration=duration)
-    if status == FAILED:
-        rec.details["traceback"] = traceback.format_exc(limit=6)
-        return Report([rec]), "error", message
-    return Report([rec]), "skipped" if status == SKIPPED else status, message
 
 
 def run_stages(names: Iterable[str] | None, profile: Profile, context: RunContext,
@@ -225,64 +211,6 @@ def _run_together(group: list[str], first: int, count: int, profile: Profile, co
         if slots[n] is not None:
             slots[n][1]["group_duration"] = wall
     release()
-
-
-def _run_stage(n: str, profile: Profile, context: RunContext, overlapped: list[str] | None = None
-               ) -> tuple[Report, dict]:
-    """One stage's report and its ``meta["stages"]`` entry (:func:`run_stages`)."""
-    stage = STAGES[n]
-    start = time.perf_counter()
-    serial = context.executor is None or isinstance(context.executor, SerialRunner)
-    # this process's part: all of it when the units run here; else this thread's (it hands out the units
-    # and merges what comes back; a report warm-up thread of this process is not the stage's)
-    own_cpu = cpu_now if serial else time.thread_time
-    cpu0, (subj0, calls0), n_units = own_cpu(), subject_cpu(), len(context.unit_times)
-    outer, _HERE.stage = _running_stage(), n      # which stage reads (StageResults) and runs units (run_units)
-    try:
-        rep = stage.fn(profile, context)
-        if not isinstance(rep, Report):
-            raise TypeError(f"stage {n} returned {type(rep).__name__}, expected a verimono.Report")
-        status = "failed" if rep.failures else ("undecided" if not rep.ok else "passed")
-        message = rep.summary()
-    except (Exception, *SUBJECT_EXITS) as exc:  # noqa: BLE001 - a crash is a failure of the run, recorded
-        rep, status, message = _stage_failure(n, exc, time.perf_counter() - start)
-    finally:
-        _HERE.stage = outer
-    duration = time.perf_counter() - start
-    units = context.unit_times[n_units:]
-    if overlapped is not None:      # the other stages' units came back in between: this stage's only
-        units = [u for u in units if u.get("run_stage") == n]
-    elsewhere = [u for u in units if u.get("pid") != os.getpid()]
-    cpu = own_cpu() - cpu0 + sum(u["cpu"] for u in elsewhere)
-    subj1, calls1 = subject_cpu()
-    subj = subj1 - subj0 + sum(u.get("subject_cpu", 0.0) for u in elsewhere)
-    calls = calls1 - calls0 + sum(u.get("subject_calls", 0) for u in elsewhere)
-    info = {"name": n, "status": status, "records": len(rep), "duration": duration, "cpu": cpu,
-            "message": message}
-    if overlapped is not None:
-        info["overlapped"] = list(overlapped)
-    if calls:
-        info.update({"subject_cpu": subj, "subject_calls": calls})
-    slices = [c for u in units for c in u.get("calibration_cpu") or []]
-    if not slices or sum(u["cpu"] for u in units) < 0.5 * cpu:   # the stage's work is mostly not its units'
-        slices += slices_after(cpu)
-    info["calibration_cpu"] = [round(c, 5) for c in slices]
-    if units:
-        info["units"] = [{"label": u["label"], "cpu": round(u["cpu"], 4), "wall": round(u["wall"], 4)}
-                         for u in units]
-    for r in rep.results:
-        r.details.setdefault("stage", n)
-        cx = r.counterexample if isinstance(r.counterexample, dict) else {}
-        if isinstance(cx.get("problem"), str) and cx["problem"] in _reference_names():
-            r.details.setdefault("reference", cx["problem"])  # `--reference NAME` reproduces it
-    return rep, info
-
-
-def _reference_names() -> frozenset[str]:
-    """Names ``verimono run --reference NAME`` accepts (the reference catalog's)."""
-    from verimono.reference import names   # the catalog builds every reference: on first use only
-
-    return names()
 
 
 def locate_data(explicit: str | os.PathLike | None = None) -> Path:
