@@ -1,5 +1,5 @@
 """Stopping the stage threads of a run interrupted while stages run at once (the threads of
-:func:`verimono.run.stages.registry._run_together`):
+:func:`verimono.run.stages.together._run_together`):
 :class:`_Stopper` raises ``KeyboardInterrupt`` in each where that is safe (``PyThreadState_SetAsyncExc``), and
 :func:`_join_all` joins them however often Ctrl-C is pressed meanwhile."""
 
@@ -21,7 +21,7 @@ _SET_ASYNC_EXC = ctypes.pythonapi.PyThreadState_SetAsyncExc
 
 
 class _Stopper:
-    """Stops the stage threads of :func:`_run_together` when the run is interrupted.
+    """Stops the stage threads of :func:`.together._run_together` when the run is interrupted.
 
     Ctrl-C reaches the main thread only (serving the queue).  Closing the queue releases a stage thread waiting
     for its units, but one running its own code in this process (building units, drawing operators, merging
@@ -36,7 +36,7 @@ class _Stopper:
     looked at with thread switching held off, so the thread's next check of pending exceptions comes before it
     can enter such code; elsewhere it is tried again at the next call (:func:`_join_all` calls every 10 ms).
     A thread's end clears a stop not yet delivered, under the lock :meth:`stop` sends under (``body`` in
-    :func:`_run_together`), so a stop never lands outside the thread's catch-all: no "Exception in thread"."""
+    :func:`.together._run_together`), so a stop never lands outside the thread's catch-all: no "Exception in thread"."""
 
     #: seconds after which a stop sent and not obeyed (a stage's code that caught it) is sent again
     AGAIN = 0.5
