@@ -19,15 +19,12 @@ To add a battery::
 
 from __future__ import annotations
 
-import os
-from pathlib import Path
 from typing import Callable, Iterable
 
-from ...core.errors import StageUnavailable
-from ...lcs.siconos import PACKAGED_DATA, siconos_root
 from ...execution.profiles import Profile
 from ...records.results import Report
 from .context import RunContext
+from .data_folder import locate_data
 from .results import StageResults
 from .runner import run_stages
 from .table import STAGES, Stage, default_stages
@@ -67,23 +64,6 @@ def register_stage(name: str, description: str = "", *, default: bool = True,
         return fn
 
     return deco
-
-
-def locate_data(explicit: str | os.PathLike | None = None) -> Path:
-    """The data folder of the siconos stage: ``explicit``, else ``$VERIMONO_SHARED`` if it is a folder, else
-    the Siconos data shipped in the package (``verimono/data``); a given folder must hold that layout."""
-    env = os.environ.get("VERIMONO_SHARED")
-    if explicit is not None:
-        path = Path(explicit)
-    elif env and Path(env).is_dir():
-        path = Path(env)
-    else:
-        return PACKAGED_DATA
-    try:
-        siconos_root(path)
-    except FileNotFoundError as exc:
-        raise StageUnavailable(f"data folder {path}: {exc}") from None
-    return path
 
 
 __all__ = ["STAGES", "Stage", "StageResults", "default_stages", "RunContext", "register_stage", "run_stages", "prepare_stages", "locate_data", "timed_unit", "UNIT_TIME", "expected_costs"]
