@@ -15,6 +15,21 @@ To add a battery::
     @register_stage("my_laws", "what it verifies")
     def my_laws(profile, context):          # profile: verimono.execution.profiles.Profile; context: RunContext
         return check_something(context.stepper, seed=context.seed)     # a verimono.Report
+
+This module is the registry: :func:`register_stage` writes the table of stages (:mod:`.table`: :class:`Stage`,
+:data:`STAGES`, :func:`default_stages`) and :func:`prepare_stages` runs their ``prepare``.  It re-exports the names
+that lived here before they had modules of their own, one job each:
+
+- :mod:`.context` — :class:`RunContext`, what every stage may use, and its ``run_units``;
+- :mod:`.results` — :class:`StageResults`, the results one stage writes for later ones, checking undeclared reads;
+- :mod:`.current` — the stage the current thread runs;
+- :mod:`.unit_timing` — :func:`timed_unit`, :data:`UNIT_TIME`, :func:`expected_costs`;
+- :mod:`.ordering` — the stages in the order of what they read (``after=``);
+- :mod:`.runner` — :func:`run_stages`, the run's loop over the stages;
+- :mod:`.one_stage` — one stage's report and ``meta["stages"]`` entry, a stage that raised;
+- :mod:`.together` — stages at once on the shared queue, each in a thread of its own;
+- :mod:`.stopper` — stopping and joining those threads when the run is interrupted;
+- :mod:`.data_folder` — :func:`locate_data`, the siconos stage's data folder.
 """
 
 from __future__ import annotations
