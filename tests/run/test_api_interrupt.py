@@ -19,7 +19,7 @@ import time
 
 import pytest
 
-from verimono.run.stages.registry import _join_all, _Stopper
+from verimono.run.stages.stopper import _join_all, _Stopper
 
 CTRL_C_TWICE = r'''
 """Ctrl-C twice, 0.3 s apart, while `execute` runs two overlapping stages; one stage's own code never returns
@@ -96,7 +96,7 @@ def _stage_like(stopper: _Stopper, looped: list[int], ended: threading.Event) ->
     """What ``_run_together``'s stage thread does around its stage: registered, its code, a catch-all, cleared."""
     import ctypes
 
-    from verimono.run.stages import registry
+    from verimono.run.stages import stopper as stopping
 
     me = ctypes.c_ulong(threading.get_ident())
     try:
@@ -110,7 +110,7 @@ def _stage_like(stopper: _Stopper, looped: list[int], ended: threading.Event) ->
         pass
     finally:
         with stopper.lock:
-            registry._SET_ASYNC_EXC(me, None)
+            stopping._SET_ASYNC_EXC(me, None)
             stopper.running.discard(me.value)
 
 

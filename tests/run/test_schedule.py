@@ -153,7 +153,7 @@ def test_the_gate_judges_stages_that_ran_at_once_by_their_groups_wall():
 def test_a_group_whose_stages_all_read_each_other_runs_one_after_another():
     """``verimono check``'s convergence and trajectory_laws (the second reads the first): nothing could overlap, so
     no thread and no queue; a stage that reads neither may overlap; a chain through a third stage is a chain."""
-    from verimono.run.stages.registry import _some_run_at_once
+    from verimono.run.stages.ordering import _some_run_at_once
 
     made = {"ch_a": (), "ch_b": ("ch_a",), "ch_c": ("ch_b",), "ch_d": ()}
     for name, after in made.items():
@@ -173,13 +173,13 @@ def test_a_stage_named_twice_never_runs_at_once_with_itself(monkeypatch):
     keyed by one name (one slot, one end event): the same report given twice, each entry listing both threads'
     units and ``overlapped`` empty.  A name already in a group now starts the next group, as one stage after
     another runs it twice."""
-    from verimono.run.stages import registry
+    from verimono.run.stages import runner
 
     for name in ("dup_a", "dup_b"):
         register_stage(name, overlap=True)(lambda profile, context: Report())
     groups = []
-    monkeypatch.setattr(registry, "_can_share", lambda context: True)
-    monkeypatch.setattr(registry, "_run_together", lambda group, *a: groups.append(list(group)))
+    monkeypatch.setattr(runner, "_can_share", lambda context: True)
+    monkeypatch.setattr(runner, "_run_together", lambda group, *a: groups.append(list(group)))
 
     class _Started:
         def start_all(self):

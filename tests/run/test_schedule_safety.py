@@ -285,7 +285,8 @@ from verimono.execution.profiles import get_profile
 from verimono.lcs._highs import linprog_highs
 from verimono.records.results import CheckResult, Report
 from verimono.run.stages import RunContext, register_stage, run_stages
-import verimono.run.stages.registry as registry
+import verimono.run.stages.stopper as stopper
+import verimono.run.stages.together as together
 
 if sys.argv[1:] == ["unsafe"]:           # the pipeline branch's stage threads: daemons, not joined on the way out
     class _Unsafe(threading.Thread):
@@ -297,9 +298,9 @@ if sys.argv[1:] == ["unsafe"]:           # the pipeline branch's stage threads: 
 
     class _Shim:
         Thread, Event, Lock, local = _Unsafe, threading.Event, threading.Lock, threading.local
-    registry.threading = _Shim
-    registry._Stopper.stop = lambda self: None      # nor stopped, nor waited for (probe4's stopper and join came later)
-    registry._join_all = lambda *a, **k: None
+    together.threading = _Shim
+    stopper._Stopper.stop = lambda self: None      # nor stopped, nor waited for (probe4's stopper and join came later)
+    together._join_all = lambda *a, **k: None
 
 
 def _sleepy(seconds):
