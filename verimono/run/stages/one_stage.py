@@ -44,7 +44,9 @@ def _run_stage(n: str, profile: Profile, context: RunContext, overlapped: list[s
         rep = stage.fn(profile, context)
         if not isinstance(rep, Report):
             raise TypeError(f"stage {n} returned {type(rep).__name__}, expected a verimono.Report")
-        status = "failed" if rep.failures else ("undecided" if not rep.ok else "passed")
+        # a stage whose records all skipped verified nothing: "skipped", never "passed"
+        status = ("failed" if rep.failures else "undecided" if rep.undecided else
+                  "passed" if rep.verified else "skipped")
         message = rep.summary()
     except (Exception, *SUBJECT_EXITS) as exc:  # noqa: BLE001 - a crash is a failure of the run, recorded
         rep, status, message = _stage_failure(n, exc, time.perf_counter() - start)
