@@ -147,9 +147,13 @@ class Rows:
     """Samples stacked: ``x1``, ``x2`` ``(B, n)``; ``lam``, ``mu``, ``nu``, ``t`` ``(B,)``; ``ok`` ``(B,)`` the rows
     every resolvent call of the vectorised law answered with a finite point of the right shape; ``err`` ``(B,)``,
     when the form states it (:func:`rounding`), a bound on the difference between each row's vectorised ratio and
-    the law's own (``None``: the margin ``1 - SUSPECT``)."""
+    the law's own (``None``: the margin ``1 - SUSPECT``).  ``inconclusive`` ``(B,)``, when the form states it: rows
+    (not ``ok``) that the law's evaluator would itself find inconclusive — by its own test, which the form's
+    arithmetic decides with a margin beyond the rounding of its sums — with the evaluator's message
+    ``inconclusive_what``: the search counts them as that evaluator's inconclusive samples, in their order,
+    without calling the subject again (:meth:`verimono.checks.engine.search._Search.evaluate_many`)."""
 
-    __slots__ = ("x1", "x2", "lam", "mu", "nu", "t", "ok", "err")
+    __slots__ = ("x1", "x2", "lam", "mu", "nu", "t", "ok", "err", "inconclusive", "inconclusive_what")
 
     def __init__(self, samples: Sequence[Any]) -> None:
         # np.array of the points (not np.stack: ~4x its cost per row here, the same numbers; a ragged list raises alike)
@@ -159,6 +163,7 @@ class Rows:
                                               for k in ("lam", "mu", "nu", "t"))
         self.ok = np.ones(len(samples), dtype=bool)
         self.err = None
+        self.inconclusive, self.inconclusive_what = None, ""
 
     def accepted(self, q: np.ndarray, bound: float = 1.0) -> np.ndarray:
         """The rows decided by their vectorised ratios ``q``: every call answered, ``q`` finite and ``q`` plus its
