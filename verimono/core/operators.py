@@ -312,6 +312,14 @@ class Linear(_EverywhereDefined):
         tol = tolerance(Mx, y) if tol is None else tol
         return bool(np.max(np.abs(np.asarray(y) - Mx)) <= tol)
 
+    def _contains_rows(self, X, Y, ts, tols):
+        """:meth:`contains` of every row ``(X_i, Y_i, t_i, tol_i)`` at once (``(B,)`` booleans), bit-identically to
+        the calls per row — ``min_norm`` of the rows at their times (bit-identical to its calls per row, as the
+        class declares) and the same elementwise test; ``None`` where the members are not this class's own."""
+        if not (_own_read(self, Linear, "contains") and _own_read(self, Linear, "min_norm") and self._accepts_times()):
+            return None
+        return np.abs(Y - self.min_norm(X, ts)).max(axis=1, initial=0.0) <= tols
+
 
 def _require_monotone_matrix(M: np.ndarray, what: str, t: float | None = None) -> None:
     sym = 0.5 * (M + M.T)
@@ -650,6 +658,18 @@ class NormalCone(Operator):
         d = np.abs(self.S.project(x + y, t) - x)
         # the ndarray's own max (np.max's dispatch is most of a small point's cost): the same reduction
         return bool((d.max() if type(d) is np.ndarray else np.max(d)) <= tol)
+
+    def _contains_rows(self, X, Y, ts, tols):
+        """:meth:`contains` of every row ``(X_i, Y_i, t_i, tol_i)`` at once (``(B,)`` booleans), bit-identically to
+        the calls per row: the set's ``contains`` and ``project`` of the rows at their times (bit-identical to its
+        calls per row, as the catalog's sets declare) and the same exact maxima; ``None`` where the members are not
+        the catalog's own.  ``proj(x + y)`` is computed for every row (a row outside ``S`` is then False as before;
+        should it raise there, the caller asks row by row)."""
+        if not (_own_read(self, NormalCone, "contains") and self._accepts_times()):
+            return None
+        inside = self.S.contains(X, ts, tols)
+        d = np.abs(self.S.project(X + Y, ts) - X).max(axis=1, initial=0.0)
+        return inside & (d <= tols)
 
 
 class Shifted(Operator):

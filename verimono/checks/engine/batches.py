@@ -440,9 +440,12 @@ def row_contains(op: Any, X: np.ndarray, Y: np.ndarray, ts: np.ndarray, tols: np
     ``NotImplementedError`` counts as inside with ``lacking`` (a law that certifies by ``contains`` only where it
     can)."""
     got = np.zeros(len(ok), dtype=bool)
+    rows = np.flatnonzero(ok)
+    if rows.size >= 2 and _contains_block(op, X, Y, ts, tols, rows, got):
+        return got
     t_l, tol_l, contains = ts.tolist(), np.broadcast_to(tols, ts.shape).tolist(), op.contains
     st, perf = (CLOCK[-1] if CLOCK else None), time.perf_counter      # _call_starts, inlined
-    for i in np.flatnonzero(ok).tolist():
+    for i in rows.tolist():
         if st is not None:
             now, f = perf(), st.in_flight
             if f is not None and now - f > st.slowest:
@@ -466,6 +469,28 @@ def row_contains(op: Any, X: np.ndarray, Y: np.ndarray, ts: np.ndarray, tols: np
             continue
         got[i] = bool(v)
     return got
+
+
+def _contains_block(op: Any, X: np.ndarray, Y: np.ndarray, ts: np.ndarray, tols: Any, rows: np.ndarray,
+                    got: np.ndarray) -> bool:
+    """:func:`row_contains` of ``rows`` as one call of a catalog operator's ``_contains_rows`` (bit-identical to its
+    ``contains`` per row, as the class declares; timed as one subject call), its answers in ``got``; ``False`` when the
+    operator has none, declines (a member that is not the class's own), raises or answers no ``(B,)`` booleans: the
+    calls per row then judge every row."""
+    block = getattr(op, "_contains_rows", None)
+    if block is None:
+        return False
+    _call_starts()
+    try:
+        b = block(X[rows], Y[rows], ts[rows].astype(float), np.broadcast_to(tols, ts.shape)[rows].astype(float))
+    except Exception:   # noqa: BLE001 - the calls per row meet it, row by row
+        if interrupted():
+            raise
+        return False
+    if type(b) is not np.ndarray or b.dtype != bool or b.shape != rows.shape:
+        return False
+    got[rows] = b
+    return True
 
 
 def row_norms(V: np.ndarray) -> np.ndarray:
