@@ -25,6 +25,14 @@ _OPS = {
     "halfspace": lambda: vm.NormalCone(HalfSpace(lambda t: np.array([2.7, -2.2]), lambda t: -1.1 + 0.3 * t)),
     "linear": lambda: vm.Linear(np.array([[2.0, 1.0, 0.0], [-1.0, 1.0, 0.0], [0.0, 0.0, 0.5]])),
     "moving_linear": lambda: vm.Linear(lambda t: np.array([[1.0 + t, t], [-t, 2.0]])),
+    "norm": lambda: vm.NormSubdifferential(lambda t: 0.5 + t, dim=3),
+    "norm_1": lambda: vm.NormSubdifferential(2.222, dim=1),
+    "l1": lambda: vm.L1Subdifferential(np.array([1.6, 0.53, 4.99]), 3),
+    "l1_moving": lambda: vm.L1Subdifferential(lambda t: 1e-3 + np.sin(0.7 * t), 1),
+    "log_barrier": lambda: vm.LogBarrier(lambda t: 1.0 + t, dim=2),
+    "shifted_box": lambda: vm.Shifted(vm.NormalCone(Box([2.3, 0.0], [2.3, 1.7])),
+                                      lambda t: np.array([np.sin(3 * t), -1.2 * t * t])),
+    "shifted_linear": lambda: vm.Shifted(vm.Linear(np.zeros((3, 3))), lambda t: np.array([1.98 * t, -t, 0.78])),
 }
 
 

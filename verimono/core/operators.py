@@ -486,6 +486,19 @@ class NormSubdifferential(_EverywhereDefined):
             return True
         return bool(nx > 0.0 and _frobenius(y - c * x / nx) <= tol)
 
+    def _contains_rows(self, X, Y, ts, tols):
+        """:meth:`contains` of every row ``(X_i, Y_i, t_i, tol_i)`` at once (``(B,)`` booleans), bit-identically to the
+        calls per row: ``c(t_i)`` as a block of times reads it, each norm the BLAS dot of its row (:func:`dot_rows`,
+        :func:`_frobenius`'s number) and the same elementwise arithmetic; ``None`` where a member is not this class's
+        own."""
+        if not (_own_read(self, NormSubdifferential, "contains") and self._accepts_times()):
+            return None
+        c = np.broadcast_to(_weight_times(self._c, ts, self.name, "c(t)"), ts.shape)
+        nx, ny = np.sqrt(dot_rows(X, X)), np.sqrt(dot_rows(Y, Y))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            Z = Y - c[:, None] * X / nx[:, None]
+        return ((nx <= tols) & (ny <= c + tols)) | ((nx > 0.0) & (np.sqrt(dot_rows(Z, Z)) <= tols))
+
 
 class L1Subdifferential(_EverywhereDefined):
     """``F(t, ·) = ∂(Σ_i c_i(t)|x_i|)`` (``c`` a scalar or a vector of weights).
@@ -520,7 +533,10 @@ class L1Subdifferential(_EverywhereDefined):
         ts = times_of(t, x, self.name)
         if ts is None:
             return _weight_at(self._c, t, self.name, "c(t)")
-        return _column(_weight_times(self._c, ts, self.name, "c(t)"))
+        c = _weight_times(self._c, ts, self.name, "c(t)")
+        # a constant c, scalar or a weight per coordinate (n,), broadcasts as it is: as a column (n, 1) it was c_i for
+        # row i (wrong values for B = n rows, a broadcast error otherwise); a moving one is a row per time
+        return c if self._c.constant else _column(c)
 
     def _accepts_batches(self):
         return _own(self, L1Subdifferential)
@@ -575,6 +591,17 @@ class L1Subdifferential(_EverywhereDefined):
         at_kink = (np.abs(x) <= tol) & (np.abs(y) <= c + tol)  # x_i within tol of 0: F_i = [-c_i, c_i]
         on_branch = (x != 0.0) & (np.abs(y - c * np.sign(x)) <= tol)
         return bool(np.all(at_kink | on_branch))
+
+    def _contains_rows(self, X, Y, ts, tols):
+        """:meth:`contains` of every row at once (``(B,)`` booleans), bit-identically to the calls per row: ``c(t_i)``
+        as a block of times reads it and the same elementwise test; ``None`` where a member is not this class's own."""
+        if not (_own_read(self, L1Subdifferential, "contains") and self._accepts_times()):
+            return None
+        c = np.broadcast_to(self._c_rows(ts, X), X.shape)
+        tol = tols[:, None]
+        at_kink = (np.abs(X) <= tol) & (np.abs(Y) <= c + tol)
+        on_branch = (X != 0.0) & (np.abs(Y - c * np.sign(X)) <= tol)
+        return (at_kink | on_branch).all(axis=1)
 
 
 class NormalCone(Operator):
@@ -760,6 +787,15 @@ class Shifted(Operator):
         tol = tolerance(x, p, y) if tol is None else tol
         return self.F.contains(x + p, y, t, tol)
 
+    def _contains_rows(self, X, Y, ts, tols):
+        """:meth:`contains` of every row at once: the rows ``X_i + Φ(t_i)`` (the shift at each time, as
+        :meth:`min_norm` takes it, bit-identical to ``Φ(t_i)``) handed to the inner operator's own block test; ``None``
+        where a member is not this class's own or the inner operator has no block test."""
+        inner = getattr(self.F, "_contains_rows", None)
+        if inner is None or not (_own_read(self, Shifted, "contains") and self._accepts_times()):
+            return None
+        return inner(X + self._shift(ts, X), Y, ts, tols)
+
 
 class LogBarrier(Operator):
     """``F(t, ·) = ∂(-c(t) Σ_i ln x_i)`` on the open orthant ``(0, ∞)^n``: ``F(x) = -c/x``.
@@ -872,6 +908,21 @@ class LogBarrier(Operator):
             lo = np.where(x - tol > 0.0, -c / np.maximum(x - tol, _TINY), -np.inf)
         hi = -c / (x + tol)
         return bool(((y >= lo - tol) & (y <= hi + tol)).all())
+
+    def _contains_rows(self, X, Y, ts, tols):
+        """:meth:`contains` of every row at once (``(B,)`` booleans), bit-identically to the calls per row: ``c(t_i)`` as
+        a block of times reads it and the same elementwise test (a row with a coordinate ``≤ 0`` False, as there);
+        ``None`` where a member is not this class's own."""
+        if not (_own_read(self, LogBarrier, "contains") and self._accepts_times()):
+            return None
+        c = self._c_rows(ts, X)
+        c = c[:, None] if np.ndim(c) == 1 else c
+        tol = tols[:, None]
+        with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+            lo = np.where(X - tol > 0.0, -c / np.maximum(X - tol, _TINY), -np.inf)
+            hi = -c / (X + tol)
+            inside = ((Y >= lo - tol) & (Y <= hi + tol)).all(axis=1)
+        return (X > 0.0).all(axis=1) & inside
 
 
 __all__ = [
