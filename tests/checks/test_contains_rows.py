@@ -83,3 +83,20 @@ def test_declined_where_a_member_is_not_the_class_own():
     lin.contains = lambda x, y, t=0.0, tol=None: False
     assert lin._contains_rows(X, X, np.zeros(3), np.ones(3)) is None
     assert not row_contains(lin, X, X @ np.eye(2), np.zeros(3), np.full(3, 1e-8), ok).any()
+
+
+def test_declined_where_contains_is_replaced_on_the_class(monkeypatch):
+    """A wrapper set on the class itself (an instrumented contains, as the engine-overhead benchmark times members)
+    is called per row: the block would answer for the class's own test, not for it."""
+    seen = []
+    own = vm.NormalCone.contains
+
+    def counted(self, x, y, t=0.0, tol=None):
+        seen.append(1)
+        return own(self, x, y, t, tol)
+    monkeypatch.setattr(vm.NormalCone, "contains", counted)
+    op = vm.NormalCone(Ball(np.zeros(2), 1.0))
+    assert op._contains_rows(np.zeros((3, 2)), np.zeros((3, 2)), np.zeros(3), np.ones(3)) is None
+    ok = np.ones(3, dtype=bool)
+    assert row_contains(op, np.zeros((3, 2)), np.zeros((3, 2)), np.zeros(3), np.full(3, 1e-8), ok).all()
+    assert len(seen) == 3

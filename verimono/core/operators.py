@@ -44,6 +44,12 @@ def _own(obj: Any, cls: type, member: str = "resolvent") -> bool:
     return getattr(type(obj), member) is getattr(cls, member)
 
 
+def _own_contains(obj: Any, cls: type) -> bool:
+    """Whether ``obj``'s ``contains`` is the one written in ``cls``'s body (kept as ``cls._contains_written``): not
+    overridden by a subclass, not replaced on the object nor on the class (a wrapper there is called per row)."""
+    return type(obj).contains is cls.__dict__["_contains_written"] and "contains" not in getattr(obj, "__dict__", {})
+
+
 def _own_read(obj: Any, cls: type, member: str = "_c_at") -> bool:
     """Whether ``obj`` reads its parameter by ``cls``'s own ``member``: neither overridden in a subclass nor
     replaced on the object itself."""
@@ -312,11 +318,13 @@ class Linear(_EverywhereDefined):
         tol = tolerance(Mx, y) if tol is None else tol
         return bool(np.max(np.abs(np.asarray(y) - Mx)) <= tol)
 
+    _contains_written = contains     # the contains _contains_rows answers for (_own_contains)
+
     def _contains_rows(self, X, Y, ts, tols):
         """:meth:`contains` of every row ``(X_i, Y_i, t_i, tol_i)`` at once (``(B,)`` booleans), bit-identically to
         the calls per row — ``min_norm`` of the rows at their times (bit-identical to its calls per row, as the
         class declares) and the same elementwise test; ``None`` where the members are not this class's own."""
-        if not (_own_read(self, Linear, "contains") and _own_read(self, Linear, "min_norm") and self._accepts_times()):
+        if not (_own_contains(self, Linear) and _own_read(self, Linear, "min_norm") and self._accepts_times()):
             return None
         return np.abs(Y - self.min_norm(X, ts)).max(axis=1, initial=0.0) <= tols
 
@@ -486,12 +494,14 @@ class NormSubdifferential(_EverywhereDefined):
             return True
         return bool(nx > 0.0 and _frobenius(y - c * x / nx) <= tol)
 
+    _contains_written = contains     # the contains _contains_rows answers for (_own_contains)
+
     def _contains_rows(self, X, Y, ts, tols):
         """:meth:`contains` of every row ``(X_i, Y_i, t_i, tol_i)`` at once (``(B,)`` booleans), bit-identically to the
         calls per row: ``c(t_i)`` as a block of times reads it, each norm the BLAS dot of its row (:func:`dot_rows`,
         :func:`_frobenius`'s number) and the same elementwise arithmetic; ``None`` where a member is not this class's
         own."""
-        if not (_own_read(self, NormSubdifferential, "contains") and self._accepts_times()):
+        if not (_own_contains(self, NormSubdifferential) and self._accepts_times()):
             return None
         c = np.broadcast_to(_weight_times(self._c, ts, self.name, "c(t)"), ts.shape)
         nx, ny = np.sqrt(dot_rows(X, X)), np.sqrt(dot_rows(Y, Y))
@@ -592,10 +602,12 @@ class L1Subdifferential(_EverywhereDefined):
         on_branch = (x != 0.0) & (np.abs(y - c * np.sign(x)) <= tol)
         return bool(np.all(at_kink | on_branch))
 
+    _contains_written = contains     # the contains _contains_rows answers for (_own_contains)
+
     def _contains_rows(self, X, Y, ts, tols):
         """:meth:`contains` of every row at once (``(B,)`` booleans), bit-identically to the calls per row: ``c(t_i)``
         as a block of times reads it and the same elementwise test; ``None`` where a member is not this class's own."""
-        if not (_own_read(self, L1Subdifferential, "contains") and self._accepts_times()):
+        if not (_own_contains(self, L1Subdifferential) and self._accepts_times()):
             return None
         c = np.broadcast_to(self._c_rows(ts, X), X.shape)
         tol = tols[:, None]
@@ -686,13 +698,15 @@ class NormalCone(Operator):
         # the ndarray's own max (np.max's dispatch is most of a small point's cost): the same reduction
         return bool((d.max() if type(d) is np.ndarray else np.max(d)) <= tol)
 
+    _contains_written = contains     # the contains _contains_rows answers for (_own_contains)
+
     def _contains_rows(self, X, Y, ts, tols):
         """:meth:`contains` of every row ``(X_i, Y_i, t_i, tol_i)`` at once (``(B,)`` booleans), bit-identically to
         the calls per row: the set's ``contains`` and ``project`` of the rows at their times (bit-identical to its
         calls per row, as the catalog's sets declare) and the same exact maxima; ``None`` where the members are not
         the catalog's own.  ``proj(x + y)`` is computed for every row (a row outside ``S`` is then False as before;
         should it raise there, the caller asks row by row)."""
-        if not (_own_read(self, NormalCone, "contains") and self._accepts_times()):
+        if not (_own_contains(self, NormalCone) and self._accepts_times()):
             return None
         inside = self.S.contains(X, ts, tols)
         d = np.abs(self.S.project(X + Y, ts) - X).max(axis=1, initial=0.0)
@@ -787,12 +801,14 @@ class Shifted(Operator):
         tol = tolerance(x, p, y) if tol is None else tol
         return self.F.contains(x + p, y, t, tol)
 
+    _contains_written = contains     # the contains _contains_rows answers for (_own_contains)
+
     def _contains_rows(self, X, Y, ts, tols):
         """:meth:`contains` of every row at once: the rows ``X_i + Φ(t_i)`` (the shift at each time, as
         :meth:`min_norm` takes it, bit-identical to ``Φ(t_i)``) handed to the inner operator's own block test; ``None``
         where a member is not this class's own or the inner operator has no block test."""
         inner = getattr(self.F, "_contains_rows", None)
-        if inner is None or not (_own_read(self, Shifted, "contains") and self._accepts_times()):
+        if inner is None or not (_own_contains(self, Shifted) and self._accepts_times()):
             return None
         return inner(X + self._shift(ts, X), Y, ts, tols)
 
@@ -909,11 +925,13 @@ class LogBarrier(Operator):
         hi = -c / (x + tol)
         return bool(((y >= lo - tol) & (y <= hi + tol)).all())
 
+    _contains_written = contains     # the contains _contains_rows answers for (_own_contains)
+
     def _contains_rows(self, X, Y, ts, tols):
         """:meth:`contains` of every row at once (``(B,)`` booleans), bit-identically to the calls per row: ``c(t_i)`` as
         a block of times reads it and the same elementwise test (a row with a coordinate ``≤ 0`` False, as there);
         ``None`` where a member is not this class's own."""
-        if not (_own_read(self, LogBarrier, "contains") and self._accepts_times()):
+        if not (_own_contains(self, LogBarrier) and self._accepts_times()):
             return None
         c = self._c_rows(ts, X)
         c = c[:, None] if np.ndim(c) == 1 else c
