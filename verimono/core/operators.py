@@ -44,6 +44,12 @@ def _own(obj: Any, cls: type, member: str = "resolvent") -> bool:
     return getattr(type(obj), member) is getattr(cls, member)
 
 
+def _own_contains(obj: Any, cls: type) -> bool:
+    """Whether ``obj``'s ``contains`` is the one written in ``cls``'s body (kept as ``cls._contains_written``): not
+    overridden by a subclass, not replaced on the object nor on the class (a wrapper there is called per row)."""
+    return type(obj).contains is cls.__dict__["_contains_written"] and "contains" not in getattr(obj, "__dict__", {})
+
+
 def _own_read(obj: Any, cls: type, member: str = "_c_at") -> bool:
     """Whether ``obj`` reads its parameter by ``cls``'s own ``member``: neither overridden in a subclass nor
     replaced on the object itself."""
@@ -312,6 +318,16 @@ class Linear(_EverywhereDefined):
         tol = tolerance(Mx, y) if tol is None else tol
         return bool(np.max(np.abs(np.asarray(y) - Mx)) <= tol)
 
+    _contains_written = contains     # the contains _contains_rows answers for (_own_contains)
+
+    def _contains_rows(self, X, Y, ts, tols):
+        """:meth:`contains` of every row ``(X_i, Y_i, t_i, tol_i)`` at once (``(B,)`` booleans), bit-identically to
+        the calls per row — ``min_norm`` of the rows at their times (bit-identical to its calls per row, as the
+        class declares) and the same elementwise test; ``None`` where the members are not this class's own."""
+        if not (_own_contains(self, Linear) and _own_read(self, Linear, "min_norm") and self._accepts_times()):
+            return None
+        return np.abs(Y - self.min_norm(X, ts)).max(axis=1, initial=0.0) <= tols
+
 
 def _require_monotone_matrix(M: np.ndarray, what: str, t: float | None = None) -> None:
     sym = 0.5 * (M + M.T)
@@ -478,6 +494,21 @@ class NormSubdifferential(_EverywhereDefined):
             return True
         return bool(nx > 0.0 and _frobenius(y - c * x / nx) <= tol)
 
+    _contains_written = contains     # the contains _contains_rows answers for (_own_contains)
+
+    def _contains_rows(self, X, Y, ts, tols):
+        """:meth:`contains` of every row ``(X_i, Y_i, t_i, tol_i)`` at once (``(B,)`` booleans), bit-identically to the
+        calls per row: ``c(t_i)`` as a block of times reads it, each norm the BLAS dot of its row (:func:`dot_rows`,
+        :func:`_frobenius`'s number) and the same elementwise arithmetic; ``None`` where a member is not this class's
+        own."""
+        if not (_own_contains(self, NormSubdifferential) and self._accepts_times()):
+            return None
+        c = np.broadcast_to(_weight_times(self._c, ts, self.name, "c(t)"), ts.shape)
+        nx, ny = np.sqrt(dot_rows(X, X)), np.sqrt(dot_rows(Y, Y))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            Z = Y - c[:, None] * X / nx[:, None]
+        return ((nx <= tols) & (ny <= c + tols)) | ((nx > 0.0) & (np.sqrt(dot_rows(Z, Z)) <= tols))
+
 
 class L1Subdifferential(_EverywhereDefined):
     """``F(t, ·) = ∂(Σ_i c_i(t)|x_i|)`` (``c`` a scalar or a vector of weights).
@@ -512,7 +543,10 @@ class L1Subdifferential(_EverywhereDefined):
         ts = times_of(t, x, self.name)
         if ts is None:
             return _weight_at(self._c, t, self.name, "c(t)")
-        return _column(_weight_times(self._c, ts, self.name, "c(t)"))
+        c = _weight_times(self._c, ts, self.name, "c(t)")
+        # a constant c, scalar or a weight per coordinate (n,), broadcasts as it is: as a column (n, 1) it was c_i for
+        # row i (wrong values for B = n rows, a broadcast error otherwise); a moving one is a row per time
+        return c if self._c.constant else _column(c)
 
     def _accepts_batches(self):
         return _own(self, L1Subdifferential)
@@ -567,6 +601,19 @@ class L1Subdifferential(_EverywhereDefined):
         at_kink = (np.abs(x) <= tol) & (np.abs(y) <= c + tol)  # x_i within tol of 0: F_i = [-c_i, c_i]
         on_branch = (x != 0.0) & (np.abs(y - c * np.sign(x)) <= tol)
         return bool(np.all(at_kink | on_branch))
+
+    _contains_written = contains     # the contains _contains_rows answers for (_own_contains)
+
+    def _contains_rows(self, X, Y, ts, tols):
+        """:meth:`contains` of every row at once (``(B,)`` booleans), bit-identically to the calls per row: ``c(t_i)``
+        as a block of times reads it and the same elementwise test; ``None`` where a member is not this class's own."""
+        if not (_own_contains(self, L1Subdifferential) and self._accepts_times()):
+            return None
+        c = np.broadcast_to(self._c_rows(ts, X), X.shape)
+        tol = tols[:, None]
+        at_kink = (np.abs(X) <= tol) & (np.abs(Y) <= c + tol)
+        on_branch = (X != 0.0) & (np.abs(Y - c * np.sign(X)) <= tol)
+        return (at_kink | on_branch).all(axis=1)
 
 
 class NormalCone(Operator):
@@ -650,6 +697,20 @@ class NormalCone(Operator):
         d = np.abs(self.S.project(x + y, t) - x)
         # the ndarray's own max (np.max's dispatch is most of a small point's cost): the same reduction
         return bool((d.max() if type(d) is np.ndarray else np.max(d)) <= tol)
+
+    _contains_written = contains     # the contains _contains_rows answers for (_own_contains)
+
+    def _contains_rows(self, X, Y, ts, tols):
+        """:meth:`contains` of every row ``(X_i, Y_i, t_i, tol_i)`` at once (``(B,)`` booleans), bit-identically to
+        the calls per row: the set's ``contains`` and ``project`` of the rows at their times (bit-identical to its
+        calls per row, as the catalog's sets declare) and the same exact maxima; ``None`` where the members are not
+        the catalog's own.  ``proj(x + y)`` is computed for every row (a row outside ``S`` is then False as before;
+        should it raise there, the caller asks row by row)."""
+        if not (_own_contains(self, NormalCone) and self._accepts_times()):
+            return None
+        inside = self.S.contains(X, ts, tols)
+        d = np.abs(self.S.project(X + Y, ts) - X).max(axis=1, initial=0.0)
+        return inside & (d <= tols)
 
 
 class Shifted(Operator):
@@ -739,6 +800,17 @@ class Shifted(Operator):
         # x + Φ carries the rounding of the shift: the default tolerance is scaled to |Φ| too
         tol = tolerance(x, p, y) if tol is None else tol
         return self.F.contains(x + p, y, t, tol)
+
+    _contains_written = contains     # the contains _contains_rows answers for (_own_contains)
+
+    def _contains_rows(self, X, Y, ts, tols):
+        """:meth:`contains` of every row at once: the rows ``X_i + Φ(t_i)`` (the shift at each time, as
+        :meth:`min_norm` takes it, bit-identical to ``Φ(t_i)``) handed to the inner operator's own block test; ``None``
+        where a member is not this class's own or the inner operator has no block test."""
+        inner = getattr(self.F, "_contains_rows", None)
+        if inner is None or not (_own_contains(self, Shifted) and self._accepts_times()):
+            return None
+        return inner(X + self._shift(ts, X), Y, ts, tols)
 
 
 class LogBarrier(Operator):
@@ -852,6 +924,23 @@ class LogBarrier(Operator):
             lo = np.where(x - tol > 0.0, -c / np.maximum(x - tol, _TINY), -np.inf)
         hi = -c / (x + tol)
         return bool(((y >= lo - tol) & (y <= hi + tol)).all())
+
+    _contains_written = contains     # the contains _contains_rows answers for (_own_contains)
+
+    def _contains_rows(self, X, Y, ts, tols):
+        """:meth:`contains` of every row at once (``(B,)`` booleans), bit-identically to the calls per row: ``c(t_i)`` as
+        a block of times reads it and the same elementwise test (a row with a coordinate ``≤ 0`` False, as there);
+        ``None`` where a member is not this class's own."""
+        if not (_own_contains(self, LogBarrier) and self._accepts_times()):
+            return None
+        c = self._c_rows(ts, X)
+        c = c[:, None] if np.ndim(c) == 1 else c
+        tol = tols[:, None]
+        with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+            lo = np.where(X - tol > 0.0, -c / np.maximum(X - tol, _TINY), -np.inf)
+            hi = -c / (X + tol)
+            inside = ((Y >= lo - tol) & (Y <= hi + tol)).all(axis=1)
+        return (X > 0.0).all(axis=1) & inside
 
 
 __all__ = [

@@ -42,6 +42,7 @@ and checks running in the main thread (:func:`verimono.execution.timeouts.run_un
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 import signal
 import sys
@@ -205,6 +206,10 @@ _LIMITS: list[_Limit] = []
 _HANDLERS: list[tuple[Callable[[Hang], None], bool]] = []
 _COND = threading.Condition()
 _THREAD: threading.Thread | None = None
+#: when the watchdog thread wakes next by itself (``time.monotonic``; ``inf``: only when notified), under ``_COND``.
+#: A limit whose deadline is not earlier needs no wake-up: the thread re-reads the innermost limit when it wakes, and
+#: a limit that ended before then is simply no longer there (a notification per limit switched threads twice a law)
+_WAKE_AT = float("inf")
 
 
 @contextmanager
@@ -222,7 +227,8 @@ def limit(seconds: float, call: str) -> Iterator[None]:
             _THREAD = threading.Thread(target=_watch, name=THREAD_NAME, daemon=True)
             _THREAD.start()
         _arm_backstop()
-        _COND.notify_all()
+        if entry.due < _WAKE_AT:        # the thread would wake too late for this limit (or not at all)
+            _COND.notify_all()
     try:
         yield
     finally:
@@ -230,21 +236,24 @@ def limit(seconds: float, call: str) -> Iterator[None]:
             if entry in _LIMITS:
                 _LIMITS.remove(entry)
             _arm_backstop()
-            _COND.notify_all()
 
 
 def _watch() -> None:
+    global _WAKE_AT
     while True:
         with _COND:
             while True:
                 top = _LIMITS[-1] if _LIMITS else None
                 if top is None or top.reported:
+                    _WAKE_AT = math.inf
                     _COND.wait()
                     continue
                 left = top.due - time.monotonic()
                 if left <= 0:
                     break
+                _WAKE_AT = top.due
                 _COND.wait(left)
+            _WAKE_AT = math.inf
             top.reported = True
             hang = Hang(top.call, top.seconds, time.monotonic() - top.start, where=_where(), **_context())
             handler = _HANDLERS[-1][0] if _HANDLERS else _warn

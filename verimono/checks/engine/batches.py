@@ -147,9 +147,13 @@ class Rows:
     """Samples stacked: ``x1``, ``x2`` ``(B, n)``; ``lam``, ``mu``, ``nu``, ``t`` ``(B,)``; ``ok`` ``(B,)`` the rows
     every resolvent call of the vectorised law answered with a finite point of the right shape; ``err`` ``(B,)``,
     when the form states it (:func:`rounding`), a bound on the difference between each row's vectorised ratio and
-    the law's own (``None``: the margin ``1 - SUSPECT``)."""
+    the law's own (``None``: the margin ``1 - SUSPECT``).  ``inconclusive`` ``(B,)``, when the form states it: rows
+    (not ``ok``) that the law's evaluator would itself find inconclusive — by its own test, which the form's
+    arithmetic decides with a margin beyond the rounding of its sums — with the evaluator's message
+    ``inconclusive_what``: the search counts them as that evaluator's inconclusive samples, in their order,
+    without calling the subject again (:meth:`verimono.checks.engine.search._Search.evaluate_many`)."""
 
-    __slots__ = ("x1", "x2", "lam", "mu", "nu", "t", "ok", "err")
+    __slots__ = ("x1", "x2", "lam", "mu", "nu", "t", "ok", "err", "inconclusive", "inconclusive_what")
 
     def __init__(self, samples: Sequence[Any]) -> None:
         # np.array of the points (not np.stack: ~4x its cost per row here, the same numbers; a ragged list raises alike)
@@ -159,6 +163,7 @@ class Rows:
                                               for k in ("lam", "mu", "nu", "t"))
         self.ok = np.ones(len(samples), dtype=bool)
         self.err = None
+        self.inconclusive, self.inconclusive_what = None, ""
 
     def accepted(self, q: np.ndarray, bound: float = 1.0) -> np.ndarray:
         """The rows decided by their vectorised ratios ``q``: every call answered, ``q`` finite and ``q`` plus its
@@ -435,9 +440,12 @@ def row_contains(op: Any, X: np.ndarray, Y: np.ndarray, ts: np.ndarray, tols: np
     ``NotImplementedError`` counts as inside with ``lacking`` (a law that certifies by ``contains`` only where it
     can)."""
     got = np.zeros(len(ok), dtype=bool)
+    rows = np.flatnonzero(ok)
+    if rows.size >= 2 and _contains_block(op, X, Y, ts, tols, rows, got):
+        return got
     t_l, tol_l, contains = ts.tolist(), np.broadcast_to(tols, ts.shape).tolist(), op.contains
     st, perf = (CLOCK[-1] if CLOCK else None), time.perf_counter      # _call_starts, inlined
-    for i in np.flatnonzero(ok).tolist():
+    for i in rows.tolist():
         if st is not None:
             now, f = perf(), st.in_flight
             if f is not None and now - f > st.slowest:
@@ -461,6 +469,28 @@ def row_contains(op: Any, X: np.ndarray, Y: np.ndarray, ts: np.ndarray, tols: np
             continue
         got[i] = bool(v)
     return got
+
+
+def _contains_block(op: Any, X: np.ndarray, Y: np.ndarray, ts: np.ndarray, tols: Any, rows: np.ndarray,
+                    got: np.ndarray) -> bool:
+    """:func:`row_contains` of ``rows`` as one call of a catalog operator's ``_contains_rows`` (bit-identical to its
+    ``contains`` per row, as the class declares; timed as one subject call), its answers in ``got``; ``False`` when the
+    operator has none, declines (a member that is not the class's own), raises or answers no ``(B,)`` booleans: the
+    calls per row then judge every row."""
+    block = getattr(op, "_contains_rows", None)
+    if block is None:
+        return False
+    _call_starts()
+    try:
+        b = block(X[rows], Y[rows], ts[rows].astype(float), np.broadcast_to(tols, ts.shape)[rows].astype(float))
+    except Exception:   # noqa: BLE001 - the calls per row meet it, row by row
+        if interrupted():
+            raise
+        return False
+    if type(b) is not np.ndarray or b.dtype != bool or b.shape != rows.shape:
+        return False
+    got[rows] = b
+    return True
 
 
 def row_norms(V: np.ndarray) -> np.ndarray:

@@ -257,10 +257,12 @@ class _Search:
     seen_failing: tuple | None = None
     #: lists of samples announced by :meth:`prefetch`, whose vectorised form the first of them to reach
     #: :meth:`evaluate_many` computes over all of them in one pass; ``pre``: ``id(sample) -> (sample, row)`` of that
-    #: pass, and ``pre_rows`` its rows' ``(q, accepted, |x1|, |x2|, λ, μ, ν, t)``
+    #: pass, and ``pre_rows`` its rows' ``(q, accepted, |x1|, |x2|, λ, μ, ν, t, inconclusive)``
     pending: list = dataclasses.field(default_factory=list)
     pre: dict = dataclasses.field(default_factory=dict)
     pre_rows: tuple = ()
+    #: the evaluator's message for the rows a vectorised pass found inconclusive by the law's own test (``Rows.inconclusive``)
+    form_inconclusive_what: str = ""
     #: the law's budget and when it runs out (:func:`time.perf_counter`; ``None``: unlimited), shared by its phases
     deadline: tuple[float, float] | None = None
 
@@ -311,7 +313,10 @@ class _Search:
         (ratio finite and, with its rounding bound, within it: :meth:`Rows.accepted`) are counted as evaluated at that ratio, and every other sample is
         evaluated by the law's own evaluator (a failure is only ever decided, and recorded, there).  Returns the
         ratios (``None`` where :meth:`evaluate` would).  Rows of a list announced by :meth:`prefetch` take the
-        form's values from the one pass over all the announced lists (the same values: the form is row by row)."""
+        form's values from the one pass over all the announced lists (the same values: the form is row by row).
+        A row the form states inconclusive by the law's own test (:attr:`Rows.inconclusive`) is counted, in its
+        turn, as the evaluator's inconclusive sample with its message (:meth:`inconclusive_row`), without
+        evaluating it again."""
         fn = VECTORISED.get(self.decl.name)
         if fn is None or len(samples) < 2 or batched(self.op):
             return [self.evaluate(s) for s in samples]
@@ -319,16 +324,37 @@ class _Search:
         if self.pending and rows and id(samples[rows[0]]) in self.pre:
             self._prefetched(fn)
         vals: dict[int, float] = {}
+        undecidable: set[int] = set()
         chunk = max(1, ROW_CELLS // max(1, int(self.op.dim)))
         for lo in range(0, len(rows), chunk):
             idx = rows[lo:lo + chunk]
             known = [self.pre.pop(id(samples[i]), None) for i in idx] if self.pre_rows else []
             if known and all(k is not None and k[0] is samples[i] for k, i in zip(known, idx)):
                 at = np.array([k[1] for k in known], dtype=np.intp)
-                vals.update(self._vectorised(fn, samples, idx, tuple(a[at] for a in self.pre_rows)))
+                got, inc = self._vectorised(fn, samples, idx, tuple(a[at] for a in self.pre_rows))
             else:
-                vals.update(self._vectorised(fn, samples, idx))
+                got, inc = self._vectorised(fn, samples, idx)
+            vals.update(got)
+            undecidable.update(inc)
+        if undecidable:
+            return [vals[i] if i in vals else self.inconclusive_row(s) if i in undecidable else self.evaluate(s)
+                    for i, s in enumerate(samples)]
         return [vals[i] if i in vals else self.evaluate(s) for i, s in enumerate(samples)]
+
+    @interruptible
+    def inconclusive_row(self, s: Sample) -> None:
+        """Count ``s`` as :meth:`evaluate` counts a sample its law's evaluator finds inconclusive (with the message
+        of :attr:`form_inconclusive_what`): the vectorised form decided it by the evaluator's own test."""
+        checkpoint()
+        self.runs += 1
+        self.xs += [_amax(s.x1), _amax(s.x2)]
+        self.lams += [s.lam, s.mu, s.nu]
+        self.ts.append(s.t)
+        self.forms[s.form] = self.forms.get(s.form, 0) + 1
+        self.inconclusive += 1
+        self.inconclusive_what = self.form_inconclusive_what
+        self.note()
+        return None
 
     def prefetch(self, lists: list[list[Sample]]) -> None:
         """Announce lists of samples that :meth:`evaluate_many` will be given (each as it is): the first of them to arrive there evaluates the law's vectorised form over the rows of all of
@@ -387,22 +413,30 @@ class _Search:
         finally:
             CLOCK.pop()
         self.in_flight, self.slowest = None, max(self.slowest, time.perf_counter() - self.in_flight)
-        return q, r.accepted(q, BOUND), _row_amax(r.x1), _row_amax(r.x2), r.lam, r.mu, r.nu, r.t
+        good = r.accepted(q, BOUND)
+        if r.inconclusive is None:
+            inc = np.zeros(len(good), dtype=bool)
+        else:
+            inc = r.inconclusive & ~r.ok & ~good
+            self.form_inconclusive_what = r.inconclusive_what
+        return q, good, _row_amax(r.x1), _row_amax(r.x2), r.lam, r.mu, r.nu, r.t, inc
 
     @interruptible
     def _vectorised(self, fn: Callable, samples: list[Sample], idx: list[int],
-                    known: tuple | None = None) -> dict[int, float]:
+                    known: tuple | None = None) -> tuple[dict[int, float], list[int]]:
         """The vectorised form on ``samples[i]`` for ``i`` in ``idx``: the ratios of the rows it decides (those
         clearly inside the bound), each such sample counted as evaluated (``known``: the rows' values from the
-        pass of :meth:`prefetch`)."""
+        pass of :meth:`prefetch`), and the ``i`` of the rows it found inconclusive by the law's own test (counted
+        later, in their turn, by :meth:`inconclusive_row`)."""
         if not idx:
-            return {}
+            return {}, []
         checkpoint()
         batch = [samples[i] for i in idx]
         got = self._pass(fn, batch) if known is None else known
         if got is None:
-            return {}
-        return self._commit(batch, idx, *got)
+            return {}, []
+        inc = got[-1]
+        return self._commit(batch, idx, *got[:-1]), ([idx[j] for j in np.flatnonzero(inc).tolist()] if inc.any() else [])
 
     def _commit(self, batch: list[Sample], idx: list[int], q: np.ndarray, good: np.ndarray, a1: np.ndarray,
                 a2: np.ndarray, lam: np.ndarray, mu: np.ndarray, nu: np.ndarray, t: np.ndarray) -> dict[int, float]:
