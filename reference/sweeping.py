@@ -151,7 +151,12 @@ def moving_box(r=(0.3, 0.5), x0=(0.1, 0.6)) -> Problem:
     def u(t):
         return np.array([math.sin(t), 0.7 * math.cos(t)])
 
-    S = Box(lambda t: u(t) - r, lambda t: u(t) + r)
+    if r.shape == (2,):     # the bounds in Python floats, then one array: the same two sums as u(t) ∓ r, cheaper
+        r0, r1 = float(r[0]), float(r[1])
+        S = Box(lambda t: np.array([math.sin(t) - r0, 0.7 * math.cos(t) - r1]),
+                lambda t: np.array([math.sin(t) + r0, 0.7 * math.cos(t) + r1]))
+    else:
+        S = Box(lambda t: u(t) - r, lambda t: u(t) + r)
     ex1 = _play_exact(lambda t: math.sin(t), [math.pi / 2, 3 * math.pi / 2], r[0], x0[0])
     ex2 = _play_exact(lambda t: 0.7 * math.cos(t), [math.pi], r[1], x0[1])
     return Problem(NormalCone(S), x0, TWO_PI, exact=lambda t: np.concatenate([ex1(t), ex2(t)]),

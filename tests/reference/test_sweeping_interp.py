@@ -2,6 +2,8 @@
 ``np.interp`` per call was most of its assumption unit): ``float(np.interp(t, xp, fp))`` bit for bit, at and
 beside the kinks, outside the range, on tiny and non-finite times."""
 
+import math
+
 import numpy as np
 
 from verimono.reference.sweeping import _interp, play_piecewise_linear
@@ -35,3 +37,13 @@ def test_the_problems_bounds_are_u_plus_minus_r():
     for t in (0.0, 0.3, 1.0, 1.2, 2.9, 4.0):
         u = float(np.interp(t, KINKS, VALUES))
         assert box.lower(t).tolist() == [u - 0.25] and box.upper(t).tolist() == [u + 0.25]
+
+
+def test_the_moving_boxs_bounds_are_u_minus_and_plus_r_bit_for_bit():
+    from verimono.reference.sweeping import moving_box
+
+    box = moving_box().operator.S
+    r = np.array([0.3, 0.5])
+    for t in np.concatenate([np.linspace(0.0, 2 * np.pi, 97), [1e-300, 3.0e7, -0.0]]).tolist():
+        u = np.array([math.sin(t), 0.7 * math.cos(t)])      # the problem's u(t)
+        assert box.lower(t).tobytes() == (u - r).tobytes() and box.upper(t).tobytes() == (u + r).tobytes(), t
