@@ -169,3 +169,45 @@ def test_models_kept_by_their_fixed_arrays_answer_each_lp_as_linprog():
             want = _answer(_via_linprog(**v))
             assert want[0] == 0 and (k == 0 or want != first), k    # optimal, and another optimum than base's
             assert _answer(linprog_highs(**v)) == want, k
+
+
+def _random_lps(seed: int, count: int):
+    rng = np.random.default_rng(seed)
+    out = []
+    for k in range(count):
+        nv, nr, ne = int(rng.integers(1, 8)), int(rng.integers(0, 8)), int(rng.integers(0, 3))
+        A = rng.normal(size=(nr, nv)) * (rng.random((nr, nv)) < 0.6)
+        if k % 3 == 0:
+            A = np.round(A)
+        b = rng.normal(size=nr) * 10.0 ** rng.uniform(-8, 3)
+        Ae, be = rng.normal(size=(ne, nv)), rng.normal(size=ne)
+        c = rng.normal(size=nv) * (rng.random(nv) < 0.8)
+        lb = np.where(rng.random(nv) < 0.5, -np.inf, rng.normal(size=nv) - 1)
+        ub = np.maximum(np.where(rng.random(nv) < 0.5, np.inf, rng.normal(size=nv) + 1), lb)
+        out.append((c, A, b, *((Ae, be) if ne else (None, None)), lb, ub))
+    return out
+
+
+def test_the_kept_highs_instance_answers_as_a_fresh_one_in_any_order():
+    """``linprog_highs`` keeps one HiGHS instance per thread, ``clear()``-ed before each LP (branch perf10: making
+    one was half of a margin LP's call): an LP's answer does not depend on what the instance solved before it —
+    each of 150 random LPs (optimal, infeasible, unbounded, degenerate) and the Example's margin LPs, solved after
+    others in a shuffled order, gives its answer on a new instance bit for bit."""
+    from verimono.core import _highs
+    from verimono.lcs.hypotheses import _margin_lp
+
+    system = example_system(lambda t: np.array([-t, 0.0]))
+    c, A_ub, head, tail, A_eq, b_eq, lb, ub = _margin_lp(system, system.relation)
+    cases = _random_lps(11, 150) + [(c, A_ub, np.concatenate([head + np.array([-t, 0.0]), tail]), A_eq, b_eq, lb, ub)
+                                    for t in np.linspace(0.0, 2.0, 30)]
+
+    def fresh(case):
+        _highs._LOCAL.highs = None          # a new instance for this LP alone
+        return _answer(linprog_highs(*case))
+
+    alone = [fresh(case) for case in cases]
+    order = np.random.default_rng(3).permutation(len(cases)).tolist()
+    _highs._LOCAL.highs = None
+    for i in order + order[::-1]:
+        assert _answer(linprog_highs(*cases[i])) == alone[i], i
+    assert {a[0] for a in alone} >= {0, 2, 3}

@@ -287,3 +287,31 @@ def test_non_finite_rows_are_left_to_their_own_call():
     op = _ramp()
     X = np.array([[np.nan], [np.inf], [1.0], [-np.inf]])
     assert op._inside_rows(X, np.full(4, 0.5)).tolist() == [False, False, True, False]
+
+
+def test_v_once_per_run_of_equal_times_and_zeros_of_both_signs_apart():
+    """A block's ``v(t_i)`` is called once per run of equal times (branch perf10: the assumption laws' blocks are
+    their points repeated at each time) and stacked once for ``project_domain``'s block members; times are equal by
+    their bits, so ``-0.0`` and ``0.0`` are two (a ``v`` that reads the sign answers differently) — each member of
+    the block still gives what the calls per row give, bit for bit (points inside the domain and on its edge: the
+    block's projection of a point outside agrees with its own call's to the QP's tolerance only, before as now)."""
+    calls = []
+
+    def v(t):
+        calls.append(t)
+        return np.array([-np.copysign(1.0, t) * (0.25 + abs(t)), 0.0])
+
+    X = np.array([[0.0], [0.3], [2.0], [5.0]])
+    ts = np.repeat([0.0, -0.0, 0.5, 0.5, 1.25, -0.0], len(X))     # time-major: the points repeated at each time
+    XX = np.tile(X, (6, 1))
+    for member, args in (("resolvent", (LAM,)), ("project_domain", ()), ("min_norm", ())):
+        if member == "min_norm":    # its memo takes 0.0 and -0.0 for one time (before as now): positive times
+            ts = np.repeat([0.0, 0.5, 0.5, 1.25], len(X))
+            XX = np.tile(X, (4, 1))
+        block, own = example_system(v).operator(), example_system(v).operator()
+        want = np.array([getattr(own, member)(x, *args, t) for x, t in zip(XX, ts.tolist())])
+        calls.clear()
+        got = getattr(block, member)(XX, *args, ts)
+        assert _same(got, want), member
+        if member != "min_norm":     # runs 0.0 | -0.0 | 0.5 (two times over) | 1.25 | -0.0, each asked once
+            assert [np.copysign(1.0, t) for t in calls] == [1.0, -1.0, 1.0, 1.0, -1.0], (member, calls)

@@ -277,7 +277,13 @@ def _a3_jump(S, details: dict) -> dict | None:
     ``dom F(a)`` over ``dom F(b)`` on the final bracket: still above tolerance and stalled (≥ ``STALL_RATIO``
     times its value ``STALL_WINDOW`` bisections earlier) means ``φ(b) − φ(a) ≥ excess`` on ever shorter
     ``[a, b]``: no absolutely continuous φ (a domain that only grows jumps without violating (A3))."""
-    jumps, searched = find_jumps(lambda t: _domain(S, S.near, t), S.T)
+    grid = None
+    if accepts_times(S.op):     # every grid time in one call, the rows time-major: what _domain gives per time
+        m = len(S.near)
+        P = np.asarray(S.near, dtype=float)
+        def grid(times: np.ndarray) -> np.ndarray:
+            return np.asarray(S.op.project_domain(np.tile(P, (len(times), 1)), np.repeat(times, m)), dtype=float)
+    jumps, searched = find_jumps(lambda t: _domain(S, S.near, t), S.T, values=grid)
     details["jump_search"] = searched
     details["domain_jumps"] = []
     for j in jumps:

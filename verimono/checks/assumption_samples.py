@@ -118,7 +118,12 @@ class _Samples:
             def at(t: float) -> np.ndarray:
                 self.progress()
                 return resolvent_rows(self.op, self.near, lam, t)
-            self._jumps = find_jumps(at, self.T)
+            def grid(times: np.ndarray) -> np.ndarray:     # every grid time in one call, the rows time-major
+                for _ in range(len(times)):
+                    self.progress()
+                return on_times(self.op, self.near, lam, times)
+            # ``at`` of each grid time, in their order (the same rows, the same calls of a stateful subject)
+            self._jumps = find_jumps(at, self.T, values=grid if accepts_times(self.op) else None)
         return self._jumps
 
     def progress(self) -> None:

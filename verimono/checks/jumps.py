@@ -107,16 +107,23 @@ def _local_maxima(a: np.ndarray, count: int) -> list[int]:
 
 def find_jumps(value: Callable[[float], np.ndarray], T: float, *, grid: int = JUMP_GRID,
                shifts: int = JUMP_SHIFTS, candidates: int = JUMP_CANDIDATES, extrema: int | None = None,
-               min_width: float = 0.0) -> tuple[list[Jump], dict]:
+               min_width: float = 0.0, values: Callable[[np.ndarray], np.ndarray] | None = None
+               ) -> tuple[list[Jump], dict]:
     """The stalled increments of ``value`` on ``[0, T]`` (see the module docstring), largest first, and
     what was searched (``{"cells": ..., "bisected": ..., "floor": ...}``); the grid is ``grid`` cells and
     ``shifts`` shifted copies (``grid·(shifts + 1)`` cells); ``candidates`` local maxima of the increments
     and ``extrema`` (default :data:`JUMP_EXTREMA`, at least ``candidates``) of the distance from the trend are
-    bisected; brackets are split down to adjacent floats, or to ``min_width`` when that is wider."""
+    bisected; brackets are split down to adjacent floats, or to ``min_width`` when that is wider.  ``values``: the
+    grid's values at once, ``values(times)`` of shape ``(len(times), ·)`` with row ``k`` what ``value(times[k])``
+    gives (an operator that takes a time per row: one call for the grid where there were ``grid·(shifts + 1) + 1``;
+    the bisection still calls ``value``)."""
     extrema = max(JUMP_EXTREMA if extrema is None else extrema, candidates)
     cells = grid * (shifts + 1)
     times = np.linspace(0.0, T, cells + 1)
-    V = np.array([np.ravel(value(float(t))) for t in times])
+    if values is None:
+        V = np.array([np.ravel(value(float(t))) for t in times])
+    else:
+        V = np.asarray(values(times), dtype=float).reshape(len(times), -1)
     dV = np.diff(V, axis=0)
     inc = np.linalg.norm(dV, axis=1)
     floor = tolerance(V)

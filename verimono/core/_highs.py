@@ -5,7 +5,8 @@ inputs, converts the matrix through ``scipy.sparse``, and builds an options mana
 checks on every call (profiled on the Example's ``lcs.rel_int``: 3.4 ms a call, 0.36 ms of it in HiGHS).
 :func:`linprog_highs` hands HiGHS the **same model with the same options** — the options object made once by
 the checks SciPy's ``_highs_wrapper`` makes, the matrix in the same compressed-column form, infinite bounds as
-``kHighsInf`` — on a fresh solver instance per call as SciPy does, and applies SciPy's own acceptance test
+``kHighsInf`` — on a solver instance in a fresh one's state (one per thread, ``clear()``-ed before each call; SciPy makes a new
+one per call), and applies SciPy's own acceptance test
 (``_check_result``: an optimal point within ``√tol·10`` of its bounds and rows).  Its status, objective and
 point are bit for bit ``linprog``'s (``tests/lcs/test_lcs_highs.py`` compares them on random, degenerate,
 infeasible and unbounded LPs).  Only the default options of ``linprog(method="highs")`` are reproduced.
@@ -14,6 +15,7 @@ infeasible and unbounded LPs).  Only the default options of ``linprog(method="hi
 from __future__ import annotations
 
 import math
+import threading
 import warnings
 
 import numpy as np
@@ -98,6 +100,24 @@ def _fixed_part(inf, c, A_ub, n_ub, A_eq, b_eq, lb, ub) -> tuple:
     return out
 
 
+#: one HiGHS instance per thread, cleared before each LP (:func:`_solver`)
+_LOCAL = threading.local()
+
+
+def _solver(h):
+    """A HiGHS instance in the state a fresh one is in: this thread's, ``clear()``-ed (its options reset, its model,
+    presolve, basis, solution and simplex data dropped: HiGHS' ``Highs::clear``), made once.  Constructing one costs
+    ~150 µs, half of a Section 7 margin LP's call; ``clear()`` ~1 µs.  The options are passed again after it, as to
+    a fresh instance, and nothing of a previous solve is handed on (``tests/lcs/test_lcs_highs.py`` compares
+    sequences of random, degenerate, infeasible and unbounded LPs with ``linprog``'s answers, bit for bit)."""
+    highs = getattr(_LOCAL, "highs", None)
+    if highs is None:
+        highs = _LOCAL.highs = h._Highs()
+    else:
+        highs.clear()
+    return highs
+
+
 def linprog_highs(c, A_ub, b_ub, A_eq=None, b_eq=None, lb=None, ub=None):
     """``linprog(c, A_ub, b_ub, A_eq, b_eq, bounds=zip(lb, ub), method="highs")``'s ``(status, fun, x)``.
 
@@ -148,7 +168,7 @@ def linprog_highs(c, A_ub, b_ub, A_eq=None, b_eq=None, lb=None, ub=None):
     lp.a_matrix_.index_ = rows
     lp.a_matrix_.value_ = data
 
-    highs = h._Highs()
+    highs = _solver(h)
     if highs.passOptions(st["options"]) == h.HighsStatus.kError:
         return 4, None, None                                                   # pragma: no cover
     if highs.passModel(lp) == h.HighsStatus.kError:

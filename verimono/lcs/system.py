@@ -17,6 +17,7 @@ with ``γ = 1`` unless the θ-γ variant is asked for.  ``θ = 1`` is the paper'
 
 from __future__ import annotations
 
+import math
 from typing import Any, Callable
 
 import numpy as np
@@ -414,6 +415,7 @@ class LCSOperator(Operator):
         self._patterns: list | None = None      # the multipliers' patterns of :meth:`_inside_rows`, made once
         self._faces = None                      # the faces of H^0's block selection (:meth:`_row_faces`), made once
         self._proj_faces = None                 # the active sets of the block projection (:meth:`_projected_rows`)
+        self._v_block: tuple | None = None      # (times' bytes, v at each) of the last block (:meth:`_v_rows`)
 
     def _memoised(self, kind: str, x: np.ndarray, t, compute):
         """``compute()`` once per ``(kind, t, x)``: an assumption law asks ``H^0`` and ``proj_dom H`` at the same
@@ -428,6 +430,33 @@ class LCSOperator(Operator):
                 self._memo.clear()
             self._memo[key] = out
         return out.copy()
+
+    def _v_of(self, ts: list) -> list:
+        """``v(t_i)`` of every time of the list ``ts``, ``v`` called once per run of equal times (rows that share a
+        time: the assumption laws' blocks are the points repeated at each time, time-major): what the calls per
+        row return, ``v`` being a function of ``t`` (:meth:`_memoised` relies on it too).  Times are equal by their
+        bits (``0.0`` and ``-0.0`` are two times, NaN is never equal)."""
+        v = self.system.v
+        out: list = []
+        last_t, last_v = None, None
+        for t in ts:
+            if last_t is None or t != last_t or (t == 0.0 and math.copysign(1.0, t) != math.copysign(1.0, last_t)):
+                last_t, last_v = t, v(t)
+            out.append(last_v)
+        return out
+
+    def _v_rows(self, ts: np.ndarray) -> np.ndarray:
+        """``v(t_i)`` of every time of ``ts`` ``(B,)`` stacked ``(B, m)`` (read only), for the block members: the last
+        block's kept by the times' bytes (``project_domain`` of a block asks it of :meth:`_inside_rows`,
+        :meth:`_solvable_rows` and :meth:`_projected_rows` in turn; a subset of rows indexes it)."""
+        key = ts.tobytes()
+        got = self._v_block
+        if got is not None and got[0] == key:
+            return got[1]
+        V = np.array([np.asarray(v, dtype=float) for v in self._v_of(ts.tolist())]).reshape(len(ts), self.system.m)
+        V.flags.writeable = False
+        self._v_block = (key, V)
+        return V
 
     def _sm(self, lam: float) -> StepMatrices:
         sm = self._mats.get(lam)
@@ -503,7 +532,7 @@ class LCSOperator(Operator):
         rows = getattr(step, "rows", None)
         own_scale = type(s).q_scale is LinearRelationSystem.q_scale
         if type(t) is list:
-            vs = [s.v(ti) for ti in t]
+            vs = self._v_of(t)
         else:
             v = s.v(t)
             if own_scale and (rows is None or len(X) < 2):
@@ -659,7 +688,8 @@ class LCSOperator(Operator):
                 fin = np.flatnonzero(np.isfinite(hi))
                 Xm = X[miss]
                 with np.errstate(all="ignore"):
-                    V = np.array([np.asarray(s.v(ts[i]), dtype=float) for i in miss]).reshape(len(miss), s.m)
+                    V = np.array([np.asarray(v, dtype=float) for v in self._v_of([ts[i] for i in miss])]
+                                 ).reshape(len(miss), s.m)
                     Q = Xm @ s.C.T + V
                     scales = s._c_norm * np.abs(Xm).max(axis=1) + np.abs(V).max(axis=1)
                     QQ = np.concatenate([Q + s.D @ lo, np.broadcast_to((hi - lo)[fin], (len(miss), fin.size))],
@@ -761,7 +791,7 @@ class LCSOperator(Operator):
             fin = np.flatnonzero(np.isfinite(hi))
             Xm = X[idx]
             with np.errstate(all="ignore"):
-                V = np.array([np.asarray(s.v(t), dtype=float) for t in ts[idx].tolist()]).reshape(len(idx), s.m)
+                V = self._v_rows(ts)[idx]
                 scales = s._c_norm * np.abs(Xm).max(axis=1) + np.abs(V).max(axis=1)
                 QQ = np.concatenate([Xm @ s.C.T + V + s.D @ lo,
                                      np.broadcast_to((hi - lo)[fin], (len(idx), fin.size))], axis=1)
@@ -792,7 +822,7 @@ class LCSOperator(Operator):
                 G = np.block([[np.zeros((m, n)), -np.eye(m)], [-s.C, -s.D]])
                 F = self._proj_faces = ProjectionFaces(P, G)
             with np.errstate(all="ignore"):
-                V = np.array([np.asarray(s.v(t), dtype=float) for t in ts[idx].tolist()]).reshape(len(idx), s.m)
+                V = self._v_rows(ts)[idx]
                 # only rows row_infeasible proves outside (what _project_domain takes to its QP with no linear
                 # program: a row within the program's tolerance of the domain is its own projection there)
                 Q = X[idx] @ s.C.T + V
@@ -840,7 +870,7 @@ class LCSOperator(Operator):
                     pats.append((I, J, inv))
                 self._patterns = pats
             with np.errstate(all="ignore"):
-                V = np.array([np.asarray(s.v(ti), dtype=float) for ti in ts.tolist()])
+                V = self._v_rows(ts)
                 Q = X @ s.C.T + V
                 size = 1.0 + np.abs(Q).max(axis=1) + s._c_norm * np.abs(X).max(axis=1) + np.abs(V).max(axis=1)
                 d_norm = float(np.abs(s.D).sum(axis=1).max(initial=0.0))
