@@ -140,3 +140,56 @@ def test_a_yosida_record_states_the_smallest_step_it_can_judge():
     assert run_law("yosida_bounded_by_min_norm", build(0.5, 2.0), seed=0, examples=EX).status == "failed"
     assert "yosida_resolution" not in run_law("resolvent_nonexpansive", build(0.5, 2.0), seed=0,
                                               examples=EX).details["searched"]
+
+
+# -- contains_rejects at float32 and large n (branch f32power): the tol handed to contains is 2·tolerance/sqrt(n) per
+# coordinate, so its Euclidean reach is the pair's own error, not sqrt(n) times it --------------------------------
+
+def _decided(r) -> int:
+    """The samples of a record that were not inconclusive ("N samples (K inconclusive)")."""
+    import re
+    m = re.match(r"(\d+) samples(?: \((\d+) inconclusive\))?", r.message)
+    assert m, r.message
+    return int(m.group(1)) - int(m.group(2) or 0)
+
+
+BIG = 10_000
+
+
+def _cone_float32(contains, name):
+    """The normal cone of the box ``[-1, 1]^n``, n = 10^4, computing in float32 (tests/zoo_precision.py), with the
+    membership test ``contains`` (made from the float32 operator)."""
+    from zoo_precision import float32
+    F32 = float32(vm.NormalCone(vm.sets.Box(-np.ones(BIG), np.ones(BIG))))
+    return vm.operator_from_resolvent(F32.resolvent, BIG, contains=contains(F32), name=name)
+
+
+@pytest.mark.parametrize("contains,status", [
+    (lambda F: (lambda x, y, t=0.0, tol=None: True), "failed"),        # the zoo's contains_accepts_everything
+    (lambda F: F.contains, "passed"),                                   # the same operator, its own contains
+    # the loosest reading the law grants: tol per coordinate and relative to |y| (a subgradient test's)
+    (lambda F: (lambda x, y, t=0.0, tol=None: F.contains(x, y, t, tol * (1.0 + np.linalg.norm(y)))), "passed"),
+], ids=["accepts_everything", "own", "relative_reach"])
+def test_contains_rejects_decides_at_float32_in_ten_thousand_dimensions(contains, status):
+    """Was skipped (all samples inconclusive) for every float32 operator at n >= 10^3: with 2·tolerance per coordinate
+    the reach of contains, sqrt(n)·2·rtol·(1 + |v|), bounded the break's ratio by 1/(2·sqrt(n)·rtol) ≈ 2 (float32,
+    n = 10^4).  Now the membership that says yes to everything fails there, by the recorded factor, and the correct
+    ones — even one reading its tol relative to |y| — pass with most samples decided."""
+    r = run_law("contains_rejects", _cone_float32(contains, status), seed=0, examples=EX)
+    assert r.status == status and r.details["dtype"] == "float32", str(r)
+    if status == "failed":
+        assert r.worst >= CONTAINS_DECIDABLE
+    else:
+        assert _decided(r) > 0, str(r)
+
+
+def test_a_contains_taking_no_tol_keeps_the_protocols_reach_and_is_not_failed():
+    """``contains(x, y, t)`` decides at its own tolerance, which the law cannot shrink: its reach is taken as the
+    protocol's default per coordinate (the rule before), sqrt(n) times the pair's error at n = 10^4, where no sample of
+    the cone is decidable — a counted skip that says why, never a pass, while the same test taking the law's tol
+    decides."""
+    own = run_law("contains_rejects", _cone_float32(lambda F: F.contains, "own"), seed=0, examples=EX)
+    no_tol = run_law("contains_rejects", _cone_float32(lambda F: (lambda x, y, t=0.0: F.contains(x, y, t)), "no tol"),
+                     seed=0, examples=EX)
+    assert own.status == "passed" and _decided(own) > 0, str(own)
+    assert no_tol.status == "skipped" and "inconclusive" in no_tol.message, str(no_tol)

@@ -13,7 +13,7 @@ import pytest
 import zoo
 import zoo_steppers
 from zoo_precision import float32, float32_problem, float32_stepper
-from verimono import operator_from_resolvent, solve
+from verimono import L1Subdifferential, operator_from_resolvent, solve
 from verimono.checks import OPERATOR_CHECKS, check_operator, check_stepper, run_law
 from verimono.checks.stepper_battery import CHECKS, LAWS as STEPPER_LAWS
 from verimono.execution.profiles import get_profile
@@ -149,3 +149,18 @@ def test_float32_zoo_stepper_is_still_caught(law):
 def test_every_float32_zoo_stepper_is_caught_somewhere(member):
     m32 = float32_stepper(member)
     assert any(CHECKS[law](m32, q).status == "failed" for q in reference_catalog()[:12] for law in STEPPER_LAWS)
+
+
+@pytest.mark.parametrize("rel,status", [(1e-3, "failed"), (0.0, "passed")])
+def test_a_float32_resolvent_off_by_a_thousandth_in_ten_thousand_dimensions_fails(rel, status):
+    """Power at float32 and large n (branch f32power): ``∂|·|₁`` in R^10^4 computing in float32, its resolvent times
+    ``1 + rel``.  The tolerance ``rtol·(1 + |x|∞)`` does not grow with n (a correct float32 resolvent's Euclidean error,
+    ``eps·|J|₂ ≤ sqrt(n)·eps·|J|∞``, stays below it while ``sqrt(n) ≤ rtol/eps ≈ 1950``), so a thousandth is caught by
+    the resolvent identity ~36 times over its slack; the exact one stays ~0.006 of it."""
+    n = 10_000
+    F = float32(L1Subdifferential(1.0, n))
+    op = operator_from_resolvent(lambda x, lam, t=0.0: np.asarray(F.resolvent(x, lam, t) * np.float32(1 + rel),
+                                                                   np.float32), n, name=f"L1 times 1 + {rel}")
+    r = run_law("resolvent_identity", op, seed=0, examples=5)
+    assert r.status == status and r.details["dtype"] == "float32", str(r)
+    assert (r.worst > 10) if status == "failed" else (r.worst < 0.1), str(r)

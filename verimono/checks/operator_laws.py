@@ -485,6 +485,22 @@ def _breaking_pair(n: int, x1, x2, u1, u2, lam, tol_c):
     return v, q, ndu, tx
 
 
+def _contains_spread(op, n: int) -> float:
+    """The factor ``contains_rejects`` divides its tolerance by before handing it to ``contains``: ``sqrt(n)``, so the
+    per-coordinate ``tol`` (the protocol's reading, :meth:`Operator.contains`) reaches ``2·tolerance`` in the Euclidean
+    norm — the size of the pair's own error — instead of ``sqrt(n)`` times it.  Handed ``2·tolerance`` per coordinate,
+    a relative reach ``sqrt(n)·tol·(1 + |v|)`` bounds the break's ratio by ``1/(sqrt(n)·tol)`` whatever ``c`` is
+    (the move of ``v`` along ``Δu`` cancels the break): at float32 (``rtol`` 2.3e-4) every sample of ``n ≥ 10^3``
+    was inconclusive.  The pair stays decidable by the same rule (:func:`_breaking_pair` counts the reach of the
+    ``tol`` handed, and ``contains``' own rounding, ``tolerance(u1, v)`` ≤ ``sqrt(n)·tol`` here): a smaller ``tol``
+    only makes a correct ``contains`` reject the more surely.  A user's ``contains(x, y, t)`` that takes no
+    ``tol`` (``operator_from_resolvent``/``operator_from_prox`` with one) decides at its own tolerance, which the law
+    cannot shrink: it keeps the factor 1 (its reach assumed the protocol's default, as before)."""
+    if getattr(op, "_contains", None) is not None and not getattr(op, "_contains_takes_tol", True):
+        return 1.0
+    return math.sqrt(n)
+
+
 #: the coordinates of ``contains_rejects``: all but ``offset`` (its pairs ``b + s n``, ``b + 1000 s n`` lie on one normal
 #: ray of the domain, whose points a projection maps to one ``J_λx1 = J_λx2``: no pair decidable there, 220 evaluations
 #: an operator all inconclusive) and ``mu``, ``nu`` (not read)
@@ -505,7 +521,7 @@ def check_contains_rejects(op, s):
     ``contains`` saying True there is a violation (ratio: that factor); a sample with ``u1`` within rounding of
     ``u2`` (factor below :data:`CONTAINS_DECIDABLE`) is inconclusive."""
     u1, u2 = resolvent(op, s.x1, s.lam, s.t), resolvent(op, s.x2, s.lam, s.t)
-    tol_c = 2 * tolerance(u1, (s.x2 - u2) / s.lam)
+    tol_c = 2 * tolerance(u1, (s.x2 - u2) / s.lam) / _contains_spread(op, s.x1.size)
     v, q, ndu, tx = _breaking_pair(s.x1.size, s.x1, s.x2, u1, u2, s.lam, tol_c)
     info = {"u1": listed(u1), "u2": listed(u2), "v": listed(v), "tol": tol_c, "break_over_tolerances": float(q)}
     if not (ndu > 0 and q >= CONTAINS_DECIDABLE):
@@ -785,7 +801,7 @@ def _rows_contains_rejects(op, r):
     # row, in either order), or a finite factor clearly below CONTAINS_DECIDABLE — is stated inconclusive here, with
     # the evaluator's message, and not evaluated again (about half of the law's samples: tiny or large λ)
     u1, u2 = _pair(op, r)
-    tol_c = 2 * row_tolerances(u1, (r.x2 - u2) / r.lam[:, None])
+    tol_c = 2 * row_tolerances(u1, (r.x2 - u2) / r.lam[:, None]) / _contains_spread(op, r.x1.shape[1])
     v, q, ndu, _ = _breaking_pair(r.x1.shape[1], r.x1, r.x2, u1, u2, r.lam, tol_c)
     r.inconclusive = r.ok & ((ndu == 0.0) | (np.isfinite(q) & (q <= CONTAINS_DECIDABLE * (1.0 - 1e-6))))
     r.inconclusive_what = _CONTAINS_INCONCLUSIVE
