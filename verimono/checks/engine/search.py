@@ -93,6 +93,7 @@ from .forms import CONTIGUOUS, cycled, form_note, form_search, forms_for, in_for
 from .samples import NUMPY_DIM, Sample, law_samples
 from .supremum import budget
 from .sweep import edge_count, edge_draws, law_draws, shrink, sweep_count, sweep_samples
+from .scales import SCALE_CAP, scale_samples
 
 #: examples per law when ``examples`` is not given and the run configuration's profile is not one of
 #: verimono's (a user's own); otherwise the profile's ``law_examples`` governs (:func:`default_examples`)
@@ -263,6 +264,9 @@ class _Search:
     pre_rows: tuple = ()
     #: the law's budget and when it runs out (:func:`time.perf_counter`; ``None``: unlimited), shared by its phases
     deadline: tuple[float, float] | None = None
+    #: in the scale phase (:func:`_scales`): a sample whose law's own side (``rhs``, ``slack``) is not finite is the
+    #: law's overflow at that scale, inconclusive (a limit of the harness), not the subject's failure
+    scaling: bool = False
 
     @interruptible   # the law's and the subject's code: the unit's budget may stop it even under hypothesis
     def evaluate(self, s: Sample, climb: bool = False) -> float | None:
@@ -281,6 +285,11 @@ class _Search:
             if out is None:
                 return None
         self.in_flight, self.slowest = None, max(self.slowest, time.perf_counter() - start)
+        if self.scaling and not out.inconclusive and not out.ratio <= BOUND and out.rhs is not None \
+                and not (math.isfinite(out.rhs) and math.isfinite(out.slack or 0.0)):
+            out = Outcome.inconclusive_sample(f"the law's own arithmetic is not finite at |x| = {_amax(s.x1):.3g} "
+                                              f"({out.what}: rhs {out.rhs:.3g}, slack {out.slack:.3g})",
+                                              {HARNESS_LIMIT: "the law's arithmetic overflows at this scale"})
         self.runs += 1
         self.xs += [_amax(s.x1), _amax(s.x2)]
         self.lams += [s.lam, s.mu, s.nu]
@@ -553,6 +562,14 @@ def _search(decl: Law, op: Any, seed: int, examples: int, horizon: float) -> tup
         except UnitTimeout as exc:
             _timed_out(how, exc, state)
         stopped = how["timed_out"]
+    if state.failure is None and state.unsupported is None and not stopped and op.dim <= NUMPY_DIM \
+            and "points" in (decl.over or OPERATOR_DOMAIN):
+        try:          # whole points over every decade of the precision (verimono.checks.engine.scales)
+            with _phase_limit(state, f"{decl.name} on {subject_name(op)}"):
+                how["scales"] = _scales(state, horizon)
+        except UnitTimeout as exc:
+            _timed_out(how, exc, state)
+        stopped = how["timed_out"]
     if state.failure is None and state.unsupported is None and not stopped and state.worst_sample is not None \
             and COORDINATE_CAP.get(decl.name, 1):
         _coordinates(state, seed, horizon, how)
@@ -601,6 +618,25 @@ def _sweep(state: _Search, seed: int, horizon: float) -> int:
     elif found is not None:
         state.shrunk_into(*found, "sweep (shrunk greedily)")
     return len(swept)
+
+
+def _scales(state: _Search, horizon: float) -> dict:
+    """The scale phase (:mod:`verimono.checks.engine.scales`) after a sweep that found nothing: the worst sample
+    scaled over every decade, whole points of one shape at the landmarks; a violation is shrunk greedily into
+    ``state``.  Returns what was searched."""
+    start = None if state.worst_sample is None else dataclasses.replace(state.worst_sample, form=CONTIGUOUS)
+    samples, covered = scale_samples(start, budget("coordinate"), int(state.op.dim), Sample,
+                                     dataclasses.replace, SCALE_CAP.get(state.decl.name))
+    state.scaling = True
+    try:
+        found = state.first_violation(samples)
+    finally:
+        state.scaling = False
+    if found is not None and "batch_size" in found[1].info:
+        (state.failing, state.failure), state.found_by = found, "a batched call of the scale phase"
+    elif found is not None:
+        state.shrunk_into(*found, "the scale phase (every decade of the precision; shrunk greedily)")
+    return covered
 
 
 def _replay(decl: Law, op: Any, sample: Sample | dict) -> tuple[_Search, dict]:
@@ -770,6 +806,7 @@ def run_law(decl: Law | str, op: Any, *, seed: int | None = None, examples: int 
                                           "searched": {**searched(state.xs, state.lams, state.ts, horizon,
                                                                   state.coordinates), "forms": dict(state.forms),
                                                  **({"edge_samples": how["edge"]} if how.get("edge") else {}),
+                                                 **({"scales": how["scales"]} if how.get("scales") else {}),
                                                  **({"hypothesis_examples": how["hypothesis"]}
                                                     if how.get("hypothesis") else {}),
                                                  **({"budget": state.budget_note} if state.budget_note else {})}},

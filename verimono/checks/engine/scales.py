@@ -1,0 +1,120 @@
+"""The scale of the points over every decade the input's precision represents: the search's ``|x|`` as a whole.
+
+The draws, the edge samples and the sweep (:mod:`.sweep`) put ``|x|`` between ``10^-9`` and ``10^6`` and the edge
+samples put subnormals and tiny numbers *beside* ordinary entries; no phase scales a whole point down into the
+subnormal range or up toward overflow.  A subject wrong only there — an overflow-safe norm computed as
+``x · (1/max|x_i|)``, whose reciprocal is ``+inf`` when *every* entry is below ``2^-1024`` (blind set 8,
+``ball_reciprocal_scale_subnormal``: NaN out) — was met at some seeds only.  So, after the sweep, each law is
+evaluated on :func:`scale_samples`:
+
+* **the worst sample scaled** — ``x1, x2`` multiplied together so that ``max(|x1|_∞, |x2|_∞)`` runs over every
+  ``stride``-th decade of ``[2^-1074, hi]`` (float64's smallest subnormal to :func:`scale_top`), ``stride`` the
+  smallest that ``SCALE_SHARE · points`` design points pay at the profile's coordinate budget (ci: every 18th
+  decade), with its step sizes and time; the top is lowered by ``min(1, λ, μ, ν)/max(1, λ, μ, ν)`` so that the
+  laws' own ``|x|/λ`` and ``(μ/λ)x`` stay representable;
+* **whole points of one shape at the landmarks** (:func:`landmarks`: the smallest subnormal, every entry subnormal,
+  just below ``1/largest`` — where a reciprocal overflows —, the smallest normal, just below ``sqrt(tiny)`` — where
+  a square underflows — and the top), the precision's own landmarks too (a float32 subject's subnormals): ``x1``
+  with every entry equal (``v·(1, …, 1)``) against ``x2`` zero but one (``v·e_k``), and ``x1`` zero but one against
+  ``x2`` of alternating signs, at ``λ = μ = ν = 1``, ``t = 0``.
+
+Every point is finite, so a non-finite value returned for one is the subject's failure (:class:`_BadOutput` of
+:mod:`verimono.checks.members`: a non-finite output of a finite input), judged like any other sample.  The top
+``hi``: ``10^-3 largest^(1/3)`` of the precision under judgement (float64 ``10^99``; float32 ``10^9``; never
+below the sweep's ``min(10^6, largest/64)``): the laws' slacks are up to cubic in ``|x|`` (the Moreau envelope's
+``tol·|Δx|/λ·(1 + |Δx|)``; at ``10^150`` it overflowed and a correct prox failed), so above it a violation could not be
+told from the law's own overflow — and a sample of the phase whose law's own side (``rhs``, ``slack``) is not finite is
+inconclusive, a limit of the harness (:meth:`verimono.checks.engine.search._Search.evaluate`).  The record states what
+was searched (``details["searched"]["scales"]``: range, stride, points, shapes).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Callable
+
+import numpy as np
+
+from ...core.tolerances import current_largest
+
+#: float64's smallest subnormal, 2^-1074: the bottom of every scale design (the input points are float64)
+SMALLEST = 5e-324
+#: the design of the worst sample's decades gets ``SCALE_SHARE`` times the coordinate budget (at least one point a
+#: ``MAX_STRIDE`` decades)
+SCALE_SHARE = 1
+MAX_STRIDE = 20
+#: the shapes of the landmark samples, as the record states them
+SHAPES = ("the worst sample scaled", "x1 every entry equal, x2 zero but one", "x1 zero but one, x2 alternating signs")
+#: laws whose one evaluation is expensive (an independent minimiser): the landmark samples only, at most this many
+SCALE_CAP = {"prox_minimiser": 8}
+
+
+def scale_top(largest: float | None = None) -> float:
+    """The top of the scale designs at the precision whose largest number is ``largest`` (module docstring)."""
+    big = current_largest() if largest is None else float(largest)
+    top = 10.0 ** (math.floor(math.log10(big) / 3.0) - 3)
+    return max(top, min(1e6, big / 64.0))
+
+
+def landmarks(largest: float | None = None) -> list[float]:
+    """The scales where a whole point's arithmetic changes: float64's smallest subnormal, a deep subnormal, just
+    below ``1/largest`` (``1/max|x_i|`` overflows there), the smallest normal, just below ``sqrt(tiny)`` (``|x|²``
+    underflows), ``10^-9`` (the sweep's bottom) and the top (:func:`scale_top`); with a narrower precision under
+    judgement (float32: ``largest`` = 3.4e38) its own smallest subnormal, smallest normal and ``1/largest``."""
+    big = current_largest() if largest is None else float(largest)
+    f64 = np.finfo(np.float64)
+    out = [SMALLEST, 1e-320, 0.99 / float(f64.max), float(f64.tiny), 0.5 * math.sqrt(float(f64.tiny)), 1e-9,
+           scale_top(big)]
+    if big < float(f64.max):
+        narrow = next((np.finfo(d) for d in (np.float32, np.float16) if float(np.finfo(d).max) >= big * (1 - 1e-6)),
+                      np.finfo(np.float32))
+        out += [float(narrow.smallest_subnormal), float(narrow.tiny), 0.99 / float(narrow.max)]
+    return sorted(set(out))
+
+
+def decade_design(points: int, top: float) -> tuple[list[float], int]:
+    """Every ``stride``-th decade of ``[SMALLEST, top]`` and both ends, ``stride`` the smallest that ``SCALE_SHARE ·
+    points`` design points pay (at most :data:`MAX_STRIDE`)."""
+    lo, hi = math.ceil(math.log10(SMALLEST)), math.floor(math.log10(top))
+    stride = min(MAX_STRIDE, max(1, math.ceil((hi - lo) / max(1, SCALE_SHARE * int(points)))))
+    return sorted({SMALLEST, float(top), *(10.0 ** k for k in range(hi, lo - 1, -stride))}), stride
+
+
+def _scaled(x: np.ndarray, r: float, v: float) -> np.ndarray:
+    """``x`` scaled by ``v/r`` as ``(x/r)·v`` (``v/r`` itself underflows to 0 for a subnormal ``v``): the entry of
+    largest magnitude ``r`` becomes ``±v`` exactly."""
+    return (x / r) * v
+
+
+def scale_samples(start, points: int, n: int, make: Callable, replace: Callable, cap: int | None = None
+                  ) -> tuple[list, dict]:
+    """The samples of the module docstring and what they cover: ``start`` the worst sample so far (``None``: the
+    landmarks only), ``points`` the coordinate budget, ``n`` the dimension, ``make(x1, x2, lam, mu, nu, t)`` a new
+    sample, ``replace(s, x1=, x2=)`` a scaled copy; ``cap``: at most this many (the landmarks first, the smallest
+    scales first)."""
+    marks = landmarks()
+    shaped = []
+    for v in marks:
+        ones, alt = np.full(n, v), v * np.where(np.arange(n) % 2 == 0, 1.0, -1.0)
+        e_first, e_last = np.zeros(n), np.zeros(n)
+        e_first[0], e_last[-1] = v, -v
+        shaped += [make(ones, e_first, 1.0, 1.0, 1.0, 0.0), make(e_last, alt, 1.0, 1.0, 1.0, 0.0)]
+    covered = {"range": [marks[0], marks[-1]], "landmarks": marks, "shapes": list(SHAPES[1:])}
+    scaled = []
+    if start is not None and cap is None:
+        r = max(float(np.max(np.abs(start.x1), initial=0.0)), float(np.max(np.abs(start.x2), initial=0.0)))
+        steps = (float(start.lam), float(start.mu), float(start.nu))
+        if 0.0 < r < math.inf and all(s > 0.0 for s in steps):
+            top = scale_top() * min(1.0, *steps) / max(1.0, *steps)
+            design, stride = decade_design(points, top)
+            scaled = [replace(start, x1=_scaled(start.x1, r, v), x2=_scaled(start.x2, r, v)) for v in design]
+            covered = {"range": [SMALLEST, max(marks[-1], design[-1])], "stride": stride, "decades": len(design),
+                       "landmarks": marks, "shapes": list(SHAPES)}
+    out = shaped + scaled
+    if cap is not None:
+        out = out[:cap]
+    covered["points"] = len(out)
+    return out, covered
+
+
+__all__ = ["scale_samples", "scale_top", "landmarks", "decade_design", "SMALLEST", "SHAPES", "SCALE_CAP"]
