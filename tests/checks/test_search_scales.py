@@ -71,3 +71,20 @@ def test_scale_samples_cover_every_decade_and_the_shapes():
     assert float(np.finfo(np.float32).smallest_subnormal) in landmarks(float(np.finfo(np.float32).max))
     capped, c2 = scale_samples(start, 27, 3, Sample, None, cap=8)
     assert len(capped) == 8 == c2["points"] and min(np.abs(s.x1).max() for s in capped) == SMALLEST
+
+
+def test_beyond_the_sweeps_scale_only_a_non_finite_output_is_judged():
+    """Above |x| = 10^6 a violation other than a non-finite output is inconclusive (the laws' round-off allowance is
+    stated at the points they compute: a projection of 10^17 e_1 carries eps·10^17 ≈ 11); the law's own overflow
+    (a side not finite) is inconclusive at any scale; below 10^6 a violation is the subject's."""
+    from verimono.checks.core import Outcome
+    from verimono.checks.engine.scales import JUDGED_TOP, beyond_judgement
+
+    def at(v):
+        return Sample(np.array([v, 0.0]), np.zeros(2), 1.0, 1.0, 1.0, 0.0)
+    nan_out = Outcome.compare(math.inf, 0.0, 1.0, "raised _BadOutput: resolvent returned non-finite values [nan nan]")
+    off = Outcome.compare(12.0, 0.0, 1e-6, "dist(J_λx, cl dom F(t,·)) = 0")
+    overflow = Outcome.compare(-5e299, 0.0, math.inf, "e_λ(x2) ≤ ...")
+    assert beyond_judgement(nan_out, at(1e99)) is None and beyond_judgement(nan_out, at(1e-320)) is None
+    assert beyond_judgement(off, at(1e-320)) is None and beyond_judgement(off, at(JUDGED_TOP)) is None
+    assert "above" in beyond_judgement(off, at(1e17)) and "not finite" in beyond_judgement(overflow, at(1.0))

@@ -24,7 +24,9 @@ Every point is finite, so a non-finite value returned for one is the subject's f
 below the sweep's ``min(10^6, largest/64)``): the laws' slacks are up to cubic in ``|x|`` (the Moreau envelope's
 ``tol·|Δx|/λ·(1 + |Δx|)``; at ``10^150`` it overflowed and a correct prox failed), so above it a violation could not be
 told from the law's own overflow — and a sample of the phase whose law's own side (``rhs``, ``slack``) is not finite is
-inconclusive, a limit of the harness (:meth:`verimono.checks.engine.search._Search.evaluate`).  The record states what
+inconclusive, a limit of the harness (:func:`beyond_judgement`); and above the sweep's ``|x| = 10^6``
+(:data:`JUDGED_TOP`) only a non-finite output is a failure, every other violation inconclusive: the laws' round-off
+allowances are stated at the points they compute, not at the input's scale.  The record states what
 was searched (``details["searched"]["scales"]``: range, stride, points, shapes).
 """
 
@@ -47,6 +49,29 @@ MAX_STRIDE = 20
 SHAPES = ("the worst sample scaled", "x1 every entry equal, x2 zero but one", "x1 zero but one, x2 alternating signs")
 #: laws whose one evaluation is expensive (an independent minimiser): the landmark samples only, at most this many
 SCALE_CAP = {"prox_minimiser": 8}
+
+
+#: above this ``|x|`` (the sweep's top, :data:`verimono.checks.engine.sweep.SCALES`) a scale sample is judged on one
+#: statement only, ``J_λ`` (and every member) finite on finite points: the laws' round-off allowances are stated at
+#: the points they compute (a projection of ``x = 10^17 e_1`` onto a half-space a distance 0.4 away carries
+#: ``eps·10^17 ≈ 11`` of round-off, lands outside it, and ``min_norm`` there refuses it — a correct operator)
+JUDGED_TOP = 1e6
+#: how :mod:`verimono.checks.members` words a non-finite value returned by a member (``_BadOutput``)
+NON_FINITE = "returned non-finite values"
+
+
+def beyond_judgement(out, s) -> str | None:
+    """Why the violation ``out`` at the scale sample ``s`` is no verdict on the subject (inconclusive), or ``None``
+    (judged): the law's own side (``rhs``, ``slack``) not finite — its overflow —, or ``s`` above
+    :data:`JUDGED_TOP` and ``out`` anything but a member's non-finite output of these finite points."""
+    rhs, slack = out.rhs, out.slack
+    if rhs is not None and not (math.isfinite(rhs) and math.isfinite(0.0 if slack is None else slack)):
+        return f"the law's own arithmetic is not finite at this scale ({out.what}: rhs {rhs:.3g}, slack {slack:.3g})"
+    big = max(float(np.max(np.abs(s.x1), initial=0.0)), float(np.max(np.abs(s.x2), initial=0.0)))
+    if big > JUDGED_TOP and NON_FINITE not in (out.what or ""):
+        return (f"|x| = {big:.3g} is above {JUDGED_TOP:g}, where the scale phase judges only finite outputs of finite "
+                f"points (the law's round-off allowance is not stated at the input's scale): {out.what}")
+    return None
 
 
 def scale_top(largest: float | None = None) -> float:
@@ -117,4 +142,4 @@ def scale_samples(start, points: int, n: int, make: Callable, replace: Callable,
     return out, covered
 
 
-__all__ = ["scale_samples", "scale_top", "landmarks", "decade_design", "SMALLEST", "SHAPES", "SCALE_CAP"]
+__all__ = ["scale_samples", "scale_top", "beyond_judgement", "JUDGED_TOP", "landmarks", "decade_design", "SMALLEST", "SHAPES", "SCALE_CAP"]

@@ -93,7 +93,7 @@ from .forms import CONTIGUOUS, cycled, form_note, form_search, forms_for, in_for
 from .samples import NUMPY_DIM, Sample, law_samples
 from .supremum import budget
 from .sweep import edge_count, edge_draws, law_draws, shrink, sweep_count, sweep_samples
-from .scales import SCALE_CAP, scale_samples
+from .scales import SCALE_CAP, beyond_judgement, scale_samples
 
 #: examples per law when ``examples`` is not given and the run configuration's profile is not one of
 #: verimono's (a user's own); otherwise the profile's ``law_examples`` governs (:func:`default_examples`)
@@ -264,9 +264,11 @@ class _Search:
     pre_rows: tuple = ()
     #: the law's budget and when it runs out (:func:`time.perf_counter`; ``None``: unlimited), shared by its phases
     deadline: tuple[float, float] | None = None
-    #: in the scale phase (:func:`_scales`): a sample whose law's own side (``rhs``, ``slack``) is not finite is the
-    #: law's overflow at that scale, inconclusive (a limit of the harness), not the subject's failure
+    #: in the scale phase (:func:`_scales`): a violation the law cannot judge at that scale (the law's own overflow;
+    #: above the sweep's ``|x|``, anything but a non-finite output) is inconclusive (:func:`beyond_judgement`)
     scaling: bool = False
+    #: the worst sample before the scale phase: where the coordinate phase starts (``None``: the worst sample)
+    start: Sample | None = None
 
     @interruptible   # the law's and the subject's code: the unit's budget may stop it even under hypothesis
     def evaluate(self, s: Sample, climb: bool = False) -> float | None:
@@ -285,11 +287,10 @@ class _Search:
             if out is None:
                 return None
         self.in_flight, self.slowest = None, max(self.slowest, time.perf_counter() - start)
-        if self.scaling and not out.inconclusive and not out.ratio <= BOUND and out.rhs is not None \
-                and not (math.isfinite(out.rhs) and math.isfinite(out.slack or 0.0)):
-            out = Outcome.inconclusive_sample(f"the law's own arithmetic is not finite at |x| = {_amax(s.x1):.3g} "
-                                              f"({out.what}: rhs {out.rhs:.3g}, slack {out.slack:.3g})",
-                                              {HARNESS_LIMIT: "the law's arithmetic overflows at this scale"})
+        if self.scaling and not out.inconclusive and not out.ratio <= BOUND:
+            why = beyond_judgement(out, s)      # the scale phase's own limits (verimono.checks.engine.scales)
+            if why is not None:
+                out = Outcome.inconclusive_sample(why, {HARNESS_LIMIT: why})
         self.runs += 1
         self.xs += [_amax(s.x1), _amax(s.x2)]
         self.lams += [s.lam, s.mu, s.nu]
@@ -586,7 +587,7 @@ def _coordinates(state: _Search, seed: int, horizon: float, how: dict) -> None:
     def ratios(ss: list[Sample]) -> list[float]:
         return [-math.inf if r is None else r for r in state.evaluate_many(ss)]
 
-    start, before = dataclasses.replace(state.worst_sample, form=CONTIGUOUS), state.runs
+    start, before = dataclasses.replace(state.start or state.worst_sample, form=CONTIGUOUS), state.runs
     try:
         with _phase_limit(state, f"{state.decl.name} on {subject_name(state.op)}"):
             over = state.decl.over or OPERATOR_DOMAIN          # the law's declared quantifiers
@@ -625,6 +626,7 @@ def _scales(state: _Search, horizon: float) -> dict:
     scaled over every decade, whole points of one shape at the landmarks; a violation is shrunk greedily into
     ``state``.  Returns what was searched."""
     start = None if state.worst_sample is None else dataclasses.replace(state.worst_sample, form=CONTIGUOUS)
+    state.start = state.worst_sample        # the coordinates search from the worst unscaled sample, as before
     samples, covered = scale_samples(start, budget("coordinate"), int(state.op.dim), Sample,
                                      dataclasses.replace, SCALE_CAP.get(state.decl.name))
     state.scaling = True
