@@ -74,17 +74,22 @@ def test_scale_samples_cover_every_decade_and_the_shapes():
 
 
 def test_beyond_the_sweeps_scale_only_a_non_finite_output_is_judged():
-    """Above |x| = 10^6 a violation other than a non-finite output is inconclusive (the laws' round-off allowance is
-    stated at the points they compute: a projection of 10^17 e_1 carries eps·10^17 ≈ 11); the law's own overflow
-    (a side not finite) is inconclusive at any scale; below 10^6 a violation is the subject's."""
+    """Above |x| = 10^6 a scale sample is judged on J_λ finite there only (the laws' round-off allowance is stated at
+    the points they compute: a projection of 10^17 e_1 carries eps·10^17 ≈ 11); the law's own overflow (a side not
+    finite) is inconclusive at any scale; below 10^6 the law itself judges."""
     from verimono.checks.core import Outcome
-    from verimono.checks.engine.scales import JUDGED_TOP, beyond_judgement
+    from verimono.checks.engine.scales import FINITE_ONLY, JUDGED_TOP, beyond_judgement, judged_by
+    from verimono.checks.engine.search import evaluate_sample
+    from verimono.checks.operator_laws import check_resolvent_nonexpansive as law
 
     def at(v):
-        return Sample(np.array([v, 0.0]), np.zeros(2), 1.0, 1.0, 1.0, 0.0)
-    nan_out = Outcome.compare(math.inf, 0.0, 1.0, "raised _BadOutput: resolvent returned non-finite values [nan nan]")
-    off = Outcome.compare(12.0, 0.0, 1e-6, "dist(J_λx, cl dom F(t,·)) = 0")
+        return Sample(np.array([v, 0.0, 0.0]), np.zeros(3), 1.0, 1.0, 1.0, 0.0)
+    assert judged_by(law, at(1e17)) is FINITE_ONLY and judged_by(law, at(JUDGED_TOP)) is law
+    assert judged_by(law, at(1e-320)) is law
+    for op in (_ball(False), _ball(True)):
+        held = evaluate_sample(FINITE_ONLY, op, at(1e99))
+        assert held.ratio == 0.0 and held.inconclusive          # finite: no verdict on the law itself
+    assert evaluate_sample(FINITE_ONLY, _ball(True), at(1e-320)).ratio == math.inf      # NaN out: failed
     overflow = Outcome.compare(-5e299, 0.0, math.inf, "e_λ(x2) ≤ ...")
-    assert beyond_judgement(nan_out, at(1e99)) is None and beyond_judgement(nan_out, at(1e-320)) is None
-    assert beyond_judgement(off, at(1e-320)) is None and beyond_judgement(off, at(JUDGED_TOP)) is None
-    assert "above" in beyond_judgement(off, at(1e17)) and "not finite" in beyond_judgement(overflow, at(1.0))
+    assert "not finite" in beyond_judgement(overflow, at(1.0))
+    assert beyond_judgement(Outcome.compare(12.0, 0.0, 1e-6, "dist"), at(1e-320)) is None

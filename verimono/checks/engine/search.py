@@ -93,7 +93,7 @@ from .forms import CONTIGUOUS, cycled, form_note, form_search, forms_for, in_for
 from .samples import NUMPY_DIM, Sample, law_samples
 from .supremum import budget
 from .sweep import edge_count, edge_draws, law_draws, shrink, sweep_count, sweep_samples
-from .scales import SCALE_CAP, beyond_judgement, scale_samples
+from .scales import SCALE_CAP, beyond_judgement, judged_by, scale_samples
 
 #: examples per law when ``examples`` is not given and the run configuration's profile is not one of
 #: verimono's (a user's own); otherwise the profile's ``law_examples`` governs (:func:`default_examples`)
@@ -264,8 +264,8 @@ class _Search:
     pre_rows: tuple = ()
     #: the law's budget and when it runs out (:func:`time.perf_counter`; ``None``: unlimited), shared by its phases
     deadline: tuple[float, float] | None = None
-    #: in the scale phase (:func:`_scales`): a violation the law cannot judge at that scale (the law's own overflow;
-    #: above the sweep's ``|x|``, anything but a non-finite output) is inconclusive (:func:`beyond_judgement`)
+    #: in the scale phase (:func:`_scales`): above the sweep's ``|x|`` a sample is judged on ``J_λ`` finite there only
+    #: (:func:`judged_by`), and a violation where the law's own side overflows is inconclusive (:func:`beyond_judgement`)
     scaling: bool = False
     #: the worst sample before the scale phase: where the coordinate phase starts (``None``: the worst sample)
     start: Sample | None = None
@@ -280,7 +280,7 @@ class _Search:
         checkpoint()
         start = self.in_flight = time.perf_counter()   # left set when the unit's budget interrupts the sample
         try:
-            out = evaluate_sample(self.decl, self.op, s)
+            out = evaluate_sample(judged_by(self.decl, s) if self.scaling else self.decl, self.op, s)
         except NotImplementedError as exc:
             self.in_flight = None
             out = self.not_implemented(s, exc)
