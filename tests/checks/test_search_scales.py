@@ -57,7 +57,7 @@ def test_without_the_scale_phase_the_all_subnormal_point_is_missed(monkeypatch):
 
 def test_scale_samples_cover_every_decade_and_the_shapes():
     start = Sample(np.array([3.0, -1e-300, 0.5]), np.array([2.0, 0.0, -4.0]), 0.5, 2.0, 1.0, 0.25)
-    out, covered = scale_samples(start, 27, 3, Sample, lambda s, **kw: Sample(kw["x1"], kw["x2"], s.lam, s.mu, s.nu, s.t))
+    out, covered = scale_samples(start, 27, 3, Sample)
     tops = sorted({max(np.abs(s.x1).max(), np.abs(s.x2).max()) for s in out})
     assert tops[0] == SMALLEST and tops[-1] == 1e99
     gaps = np.diff(np.log10(tops))
@@ -67,9 +67,11 @@ def test_scale_samples_cover_every_decade_and_the_shapes():
     assert max(max(np.abs(s.x1).max(), np.abs(s.x2).max()) for s in scaled) == 1e99 / 4    # |x|/λ, (μ/λ)x finite
     assert any(np.all(s.x1 == s.x1[0]) and 0 < s.x1[0] < 2.0 ** -1024 for s in out)     # every entry subnormal
     assert any(np.count_nonzero(s.x1) == 1 and np.abs(s.x1).max() == SMALLEST for s in out)  # zero but one
+    assert len({id(s.x1) for s in out} | {id(s.x2) for s in out}) == 2 * len(out)          # each owns its points
+    assert all(s.x1.flags.writeable for s in out)
     assert scale_top(np.finfo(np.float32).max) == 1e9 and scale_top(65504.0) == 65504.0 / 64
     assert float(np.finfo(np.float32).smallest_subnormal) in landmarks(float(np.finfo(np.float32).max))
-    capped, c2 = scale_samples(start, 27, 3, Sample, None, cap=8)
+    capped, c2 = scale_samples(start, 27, 3, Sample, cap=8)
     assert len(capped) == 8 == c2["points"] and min(np.abs(s.x1).max() for s in capped) == SMALLEST
 
 

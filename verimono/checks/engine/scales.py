@@ -32,6 +32,7 @@ was searched (``details["searched"]["scales"]``: range, stride, points, shapes).
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Callable
 
@@ -129,37 +130,42 @@ def decade_design(points: int, top: float) -> tuple[list[float], int]:
     return sorted({SMALLEST, float(top), *(10.0 ** k for k in range(hi, lo - 1, -stride))}), stride
 
 
-def _scaled(x: np.ndarray, r: float, v: float) -> np.ndarray:
-    """``x`` scaled by ``v/r`` as ``(x/r)·v`` (``v/r`` itself underflows to 0 for a subnormal ``v``): the entry of
-    largest magnitude ``r`` becomes ``±v`` exactly."""
-    return (x / r) * v
+@functools.lru_cache(maxsize=64)
+def _shapes(n: int, largest: float) -> tuple[tuple[float, ...], np.ndarray, np.ndarray]:
+    """The landmarks at ``largest`` and their shaped points as rows of ``(X1, X2)`` (read-only; each sample gets
+    copies): per landmark ``v``, ``(v·1, v·e_1)`` and ``(−v·e_n, v·(1, −1, 1, …))``."""
+    marks = tuple(landmarks(largest))
+    X1, X2 = np.zeros((2 * len(marks), n)), np.zeros((2 * len(marks), n))
+    alt = np.where(np.arange(n) % 2 == 0, 1.0, -1.0)
+    for i, v in enumerate(marks):
+        X1[2 * i] = v
+        X2[2 * i, 0] = v
+        X1[2 * i + 1, -1] = -v
+        X2[2 * i + 1] = v * alt
+    X1.flags.writeable = X2.flags.writeable = False
+    return marks, X1, X2
 
 
-def scale_samples(start, points: int, n: int, make: Callable, replace: Callable, cap: int | None = None
-                  ) -> tuple[list, dict]:
+def scale_samples(start, points: int, n: int, make: Callable, cap: int | None = None) -> tuple[list, dict]:
     """The samples of the module docstring and what they cover: ``start`` the worst sample so far (``None``: the
     landmarks only), ``points`` the coordinate budget, ``n`` the dimension, ``make(x1, x2, lam, mu, nu, t)`` a new
-    sample, ``replace(s, x1=, x2=)`` a scaled copy; ``cap``: at most this many (the landmarks first, the smallest
-    scales first)."""
-    marks = landmarks()
-    shaped = []
-    for v in marks:
-        ones, alt = np.full(n, v), v * np.where(np.arange(n) % 2 == 0, 1.0, -1.0)
-        e_first, e_last = np.zeros(n), np.zeros(n)
-        e_first[0], e_last[-1] = v, -v
-        shaped += [make(ones, e_first, 1.0, 1.0, 1.0, 0.0), make(e_last, alt, 1.0, 1.0, 1.0, 0.0)]
-    covered = {"range": [marks[0], marks[-1]], "landmarks": marks, "shapes": list(SHAPES[1:])}
-    scaled = []
+    sample (each owns its points); ``cap``: at most this many (the landmarks first, the smallest scales first)."""
+    marks, X1, X2 = _shapes(int(n), float(current_largest()))
+    out = [make(a.copy(), b.copy(), 1.0, 1.0, 1.0, 0.0) for a, b in zip(X1, X2)]
+    covered = {"range": [marks[0], marks[-1]], "landmarks": list(marks), "shapes": list(SHAPES[1:])}
     if start is not None and cap is None:
         r = max(float(np.max(np.abs(start.x1), initial=0.0)), float(np.max(np.abs(start.x2), initial=0.0)))
         steps = (float(start.lam), float(start.mu), float(start.nu))
         if 0.0 < r < math.inf and all(s > 0.0 for s in steps):
             top = scale_top() * min(1.0, *steps) / max(1.0, *steps)
             design, stride = decade_design(points, top)
-            scaled = [replace(start, x1=_scaled(start.x1, r, v), x2=_scaled(start.x2, r, v)) for v in design]
+            V = np.array(design)[:, None]
+            # row i: (x/r)·v_i — not x·(v_i/r), which underflows to 0 for a subnormal v_i: the entry of largest
+            # magnitude r becomes ±v_i exactly; each sample holds a row of its own
+            S1, S2 = (start.x1 / r)[None, :] * V, (start.x2 / r)[None, :] * V
+            out += [make(a, b, start.lam, start.mu, start.nu, start.t) for a, b in zip(S1, S2)]
             covered = {"range": [SMALLEST, max(marks[-1], design[-1])], "stride": stride, "decades": len(design),
-                       "landmarks": marks, "shapes": list(SHAPES)}
-    out = shaped + scaled
+                       "landmarks": list(marks), "shapes": list(SHAPES)}
     if cap is not None:
         out = out[:cap]
     covered["points"] = len(out)

@@ -628,7 +628,7 @@ def _scales(state: _Search, horizon: float) -> dict:
     start = None if state.worst_sample is None else dataclasses.replace(state.worst_sample, form=CONTIGUOUS)
     state.start = state.worst_sample        # the coordinates search from the worst unscaled sample, as before
     samples, covered = scale_samples(start, budget("coordinate"), int(state.op.dim), Sample,
-                                     dataclasses.replace, SCALE_CAP.get(state.decl.name))
+                                     SCALE_CAP.get(state.decl.name))
     state.scaling = True
     try:
         found = state.first_violation(samples)
