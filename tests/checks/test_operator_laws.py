@@ -352,7 +352,7 @@ def test_a_limit_of_verimonos_own_solvers_is_undecided_never_failed_nor_passed()
 
 def test_a_law_sees_the_numpy_draws_then_the_edge_samples_then_the_sweep_then_the_coordinates():
     """examples NumPy draws, then edge_count(examples) edge samples (no hypothesis example: the draws found
-    nothing), then the scale sweep, then the coordinate search: every sample counted once in
+    nothing), then the scale sweep, then the scale phase, then the coordinate search: every sample counted once in
     details["evaluations"], the edge samples stated in details["searched"]."""
     from verimono.checks.engine.sweep import edge_count
     from verimono.reference import get
@@ -362,7 +362,8 @@ def test_a_law_sees_the_numpy_draws_then_the_edge_samples_then_the_sweep_then_th
         r = run_law("resolvent_nonexpansive", op, seed=3, examples=examples)
         edges = edge_count(examples)
         assert r.status == "passed" and r.details["evaluations"] == \
-            examples + edges + r.details["sweep"] + r.details["coordinate"], r.details
+            examples + edges + r.details["sweep"] + r.details["searched"]["scales"]["points"] + r.details["coordinate"], \
+            r.details
         assert r.details["searched"]["edge_samples"] == edges and "hypothesis_examples" not in r.details["searched"]
 
 
@@ -382,6 +383,7 @@ def test_a_violation_only_the_draws_meet_is_shrunk_and_replays(monkeypatch):
     again = run_law("resolvent_nonexpansive", zoo.build("explicit_step"), sample=r.counterexample)
     assert again.status == "failed", str(again)
     monkeypatch.setattr(L, "edge_draws", lambda *a, **k: [samples.Sample(np.zeros(2), np.zeros(2), 1.0, 1.0, 1.0, 0.0)] * 5)
+    monkeypatch.setattr(L, "scale_samples", lambda *a, **k: ([], {"points": 0}))    # (its whole points find it too)
     monkeypatch.setattr(L, "law_draws", lambda *a, **k: [])     # without the draws nothing finds it (but the
     monkeypatch.setattr(coordinates, "COORDINATES",                # direction search, from the pair x1 = x2)
                         tuple(c for c in coordinates.COORDINATES if c != "direction"))

@@ -45,6 +45,8 @@ def test_a_resolvent_wrong_only_at_subnormal_entries_is_caught_by_the_edge_sampl
         good = run_law("resolvent_nonexpansive", control, seed=seed, examples=20)
         assert good.status == PASSED and good.details["searched"]["edge_samples"] == edge_count(20), str(good)
     monkeypatch.setattr(search, "edge_draws", lambda *a, **k: [])      # the draws, sweep and coordinates alone
+    # (the scale phase's whole subnormal points catch it too: tests/checks/test_search_scales.py)
+    monkeypatch.setattr(search, "scale_samples", lambda *a, **k: ([], {"points": 0}))
     for seed in (0, 1):
         assert run_law("resolvent_nonexpansive", plant, seed=seed, examples=20).status == PASSED
 

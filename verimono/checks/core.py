@@ -54,7 +54,7 @@ SUBJECTS = ("operator", "stepper", "problem", "system", "estimator")
 #: states what was reached on each
 QUANTIFIERS = {
     "points": "x ∈ R^n: NumPy draws, hypothesis, the scale sweep (|x| from 10^-9 to 10^6, on and just outside the "
-              "domain's boundary)",
+              "domain's boundary), the scale phase (whole points from 2^-1074 to 10^99: engine/scales.py)",
     "direction": "the direction of x2 − x1 (or of the exposed boundary point) over the sphere S^{n−1}",
     "lam": "the step λ over every decade the precision represents (float64 [1e-153, 1e7])",
     "mu": "the step μ, as λ",

@@ -153,10 +153,55 @@ def refined_random_grid(T: float, K0: int, K: int, seed: int = 0) -> np.ndarray:
     return np.append((base[:-1, None] + np.diff(base)[:, None] * sub[None, :]).ravel(), T)
 
 
+#: the neighbours' cell ratios ``h_k/h_{k-1}`` the strongly non-uniform partitions (:func:`ratio_grids`) span: a
+#: step-size controller's output after rejected steps, a mesh graded toward a kink.  The battery's other partitions
+#: stay within ``[0.29, 3.5]`` (``RANDOM_SPREAD``, the graded ``(k/K)²``): a scheme changed only where a cell is
+#: shorter than a quarter of the one before was the paper's scheme on all of them (blind set 8, ``merges_short_cells``)
+CELL_RATIOS = (1e-3, 1e3)
+#: cells of each strongly non-uniform partition
+RATIO_CELLS = 40
+
+
+def ratio_grids(T: float, seed: int = 0) -> dict[str, np.ndarray]:
+    """Two strongly non-uniform partitions of ``[0, T]`` with ``RATIO_CELLS`` cells, neighbours' ratios over
+    :data:`CELL_RATIOS`: ``"ratios random"`` — cell lengths ``10^u``, ``u`` uniform in ``[-3, 0]`` (seeded; its
+    first cells ``1, 10^-3, 1``: both ends of the range met), and ``"ratios graded"`` — the cascade ``1, 10^-1,
+    10^-2, 10^-3`` repeated (each cell a tenth of the one before, then a thousandfold jump)."""
+    return _ratio_grids(float(T), int(seed))
+
+
+@_built_once
+def _ratio_grids(T: float, seed: int) -> dict[str, np.ndarray]:
+    lo, hi = (float(np.log10(r)) for r in CELL_RATIOS)
+    span = (hi - lo) / 2.0                                  # cell lengths over half the ratios' decades
+    w = 10.0 ** np.random.default_rng([int(seed) % (2 ** 63), 0x5A71]).uniform(-span, 0.0, RATIO_CELLS)
+    w[:3] = (1.0, 10.0 ** -span, 1.0)
+    cascade = 10.0 ** -np.resize(np.arange(int(round(span)) + 1, dtype=float), RATIO_CELLS)
+    out = {}
+    for name, cells in (("ratios random", w), ("ratios graded", cascade)):
+        t = np.concatenate([[0.0], np.cumsum(cells)]) * (T / cells.sum())
+        t[-1] = T
+        out[name] = validate_grid(t, T)
+    return out
+
+
+def cell_ratio_range(parts: dict[str, np.ndarray]) -> list[float]:
+    """``[min, max]`` of the neighbours' cell ratios ``h_k/h_{k-1}`` over the partitions ``parts`` (``[1, 1]``
+    when none has two cells): what a per-partition law's record states it searched."""
+    lo, hi = 1.0, 1.0
+    for g in parts.values():
+        h = np.diff(np.asarray(g, dtype=float))
+        if h.size > 1:
+            r = h[1:] / h[:-1]
+            lo, hi = min(lo, float(r.min())), max(hi, float(r.max()))
+    return [lo, hi]
+
+
 def every_battery_grid(problem: Problem, seed: int = 0) -> dict[str, np.ndarray]:
     """Every partition the battery builds for ``problem``: :func:`default_grids`, the graded one of as many
-    cells, and the convergence grids of ``unique_limit`` (:func:`limit_grids` at each of
-    ``LIMIT_LEVELS``, the random kind refined from the first level's); duplicates dropped."""
+    cells, the convergence grids of ``unique_limit`` (:func:`limit_grids` at each of ``LIMIT_LEVELS``, the random
+    kind refined from the first level's) and the strongly non-uniform ones (:func:`ratio_grids`); duplicates
+    dropped."""
     return _every_battery_grid(problem.T, seed)
 
 
@@ -172,17 +217,20 @@ def _every_battery_grid(T: float, seed: int) -> dict[str, np.ndarray]:
         for kind, g in gs.items():
             if not any(len(g) == len(h) and np.array_equal(g, h) for h in out.values()):
                 out[f"{kind} K={K}"] = g
+    out.update(_ratio_grids(T, seed))
     return out
 
 
 def battery_grids(grids: Any, problem: Problem, seed: int, *, every: bool = False,
                   stepper: Callable | None = None, study: bool = False) -> dict[str, np.ndarray]:
     """The partitions a law is judged on: ``grids`` (a dict or a list of increasing arrays from 0 to ``T``),
-    else :func:`default_grids` (``every=True``: :func:`every_battery_grid`), with ``study=True`` the partitions of
+    else :func:`default_grids` and the strongly non-uniform :func:`ratio_grids` (``every=True``:
+    :func:`every_battery_grid`, which holds them), with ``study=True`` the partitions of
     ``stepper``'s convergence study on ``problem`` noted in the :func:`verimono.checks.shared_runs.shared_runs`
     block."""
     if grids is None:
-        out = every_battery_grid(problem, seed) if every else default_grids(problem, seed)
+        out = every_battery_grid(problem, seed) if every else {**default_grids(problem, seed),
+                                                               **ratio_grids(problem.T, seed)}
         for g in noted_partitions(stepper, problem) if study and stepper is not None else []:
             if abs(g[-1] - problem.T) <= 1e-12 * max(1.0, problem.T) and not any(
                     len(g) == len(h) and np.array_equal(g, h) for h in out.values()):
@@ -258,7 +306,8 @@ def run_on_grids(decl: Any, stepper: Callable, problem: Problem, *, grids: Any =
             note_progress(len(outcomes), all(_held(o) for o in outcomes.values()), "partitions")
         gname = max(outcomes, key=lambda g: outcomes[g].worst)
         out = outcomes[gname]
-        out.details = {"worst_by_grid": {g: o.worst for g, o in outcomes.items()}, **out.details}
+        out.details = {"worst_by_grid": {g: o.worst for g, o in outcomes.items()},
+                       "cell_ratios": cell_ratio_range(parts), **out.details}
         if left_out is not None:
             out.details["grids"], said = grids_note(left_out)
             out.message = (out.message or "") + said
@@ -313,4 +362,5 @@ def stepper_law(name: str, label: str, *requires: Any, over_grids: bool = True,
 
 __all__ = ["stepper_law", "run_on_grids", "run_once", "run_stepper", "single", "default_grids", "limit_grids",
            "battery_grids", "every_battery_grid", "refined_random_grid", "DEFAULT_CELLS", "RANDOM_SPREAD",
-           "ANY_SCHEME_FORM", "EVERY_GRID", "STUDY_GRID", "claimed_grids", "grids_note"]
+           "ANY_SCHEME_FORM", "EVERY_GRID", "STUDY_GRID", "claimed_grids", "grids_note", "ratio_grids",
+           "cell_ratio_range", "CELL_RATIOS", "RATIO_CELLS"]

@@ -24,17 +24,11 @@ _RSPEC.loader.exec_module(runner)
 PLANTS = [e for e in S.ENTRIES if not e.lawful]
 CONTROLS = [e for e in S.ENTRIES if e.lawful]
 
-#: plants verimono's ci battery (seed 0) misses, measured on main 2bc1b4d (tests/blind/set8/README.md): name -> reason
-MISSED: dict[str, str] = {
-    "ball_reciprocal_scale_subnormal":
-        "J_λx is NaN only when every entry of x is below 2^-1024 (x·(1/max|x_i|) overflows): the edge samples put "
-        "subnormals beside ordinary entries and the scale sweep stops at |x| = 1e-9; missed at ci seeds 0 and 2, dev "
-        "and thorough (seed 0); ci seed 1 happens to evaluate x2 = (0, -0, 5e-309) and catches it",
-    "merges_short_cells":
-        "the scheme is left only where a cell is shorter than 1/4 of the one before: the battery's partitions "
-        "(K = 8, 10, 40, 160 and the studies' grids) never have such a pair (smallest ratio 0.29 at ci, seed 0); "
-        "missed at ci and dev",
-}
+#: plants verimono's ci battery (seed 0) misses: name -> reason.  Empty since branch members8: the two misses measured
+#: on main 2bc1b4d (``ball_reciprocal_scale_subnormal``: no whole point below 2^-1024; ``merges_short_cells``: no
+#: partition with a cell below a quarter of the one before) are caught at ci seeds 0-2 by the scale phase
+#: (verimono/checks/engine/scales.py) and the strongly non-uniform partitions (partitions.ratio_grids)
+MISSED: dict[str, str] = {}
 
 
 def test_set_shape():

@@ -93,6 +93,7 @@ from .forms import CONTIGUOUS, cycled, form_note, form_search, forms_for, in_for
 from .samples import NUMPY_DIM, Sample, law_samples
 from .supremum import budget
 from .sweep import edge_count, edge_draws, law_draws, shrink, sweep_count, sweep_samples
+from .scales import SCALE_CAP, beyond_judgement, judged_by, scale_samples
 
 #: examples per law when ``examples`` is not given and the run configuration's profile is not one of
 #: verimono's (a user's own); otherwise the profile's ``law_examples`` governs (:func:`default_examples`)
@@ -265,6 +266,11 @@ class _Search:
     form_inconclusive_what: str = ""
     #: the law's budget and when it runs out (:func:`time.perf_counter`; ``None``: unlimited), shared by its phases
     deadline: tuple[float, float] | None = None
+    #: in the scale phase (:func:`_scales`): above the sweep's ``|x|`` a sample is judged on ``J_λ`` finite there only
+    #: (:func:`judged_by`), and a violation where the law's own side overflows is inconclusive (:func:`beyond_judgement`)
+    scaling: bool = False
+    #: the worst sample before the scale phase: where the coordinate phase starts (``None``: the worst sample)
+    start: Sample | None = None
 
     @interruptible   # the law's and the subject's code: the unit's budget may stop it even under hypothesis
     def evaluate(self, s: Sample, climb: bool = False) -> float | None:
@@ -276,13 +282,17 @@ class _Search:
         checkpoint()
         start = self.in_flight = time.perf_counter()   # left set when the unit's budget interrupts the sample
         try:
-            out = evaluate_sample(self.decl, self.op, s)
+            out = evaluate_sample(judged_by(self.decl, s) if self.scaling else self.decl, self.op, s)
         except NotImplementedError as exc:
             self.in_flight = None
             out = self.not_implemented(s, exc)
             if out is None:
                 return None
         self.in_flight, self.slowest = None, max(self.slowest, time.perf_counter() - start)
+        if self.scaling and not out.inconclusive and not out.ratio <= BOUND:
+            why = beyond_judgement(out, s)      # the scale phase's own limits (verimono.checks.engine.scales)
+            if why is not None:
+                out = Outcome.inconclusive_sample(why, {HARNESS_LIMIT: why})
         self.runs += 1
         self.xs += [_amax(s.x1), _amax(s.x2)]
         self.lams += [s.lam, s.mu, s.nu]
@@ -587,6 +597,14 @@ def _search(decl: Law, op: Any, seed: int, examples: int, horizon: float) -> tup
         except UnitTimeout as exc:
             _timed_out(how, exc, state)
         stopped = how["timed_out"]
+    if state.failure is None and state.unsupported is None and not stopped and op.dim <= NUMPY_DIM \
+            and "points" in (decl.over or OPERATOR_DOMAIN):
+        try:          # whole points over every decade of the precision (verimono.checks.engine.scales)
+            with _phase_limit(state, f"{decl.name} on {subject_name(op)}"):
+                how["scales"] = _scales(state, horizon)
+        except UnitTimeout as exc:
+            _timed_out(how, exc, state)
+        stopped = how["timed_out"]
     if state.failure is None and state.unsupported is None and not stopped and state.worst_sample is not None \
             and COORDINATE_CAP.get(decl.name, 1):
         _coordinates(state, seed, horizon, how)
@@ -603,7 +621,7 @@ def _coordinates(state: _Search, seed: int, horizon: float, how: dict) -> None:
     def ratios(ss: list[Sample]) -> list[float]:
         return [-math.inf if r is None else r for r in state.evaluate_many(ss)]
 
-    start, before = dataclasses.replace(state.worst_sample, form=CONTIGUOUS), state.runs
+    start, before = dataclasses.replace(state.start or state.worst_sample, form=CONTIGUOUS), state.runs
     try:
         with _phase_limit(state, f"{state.decl.name} on {subject_name(state.op)}"):
             over = state.decl.over or OPERATOR_DOMAIN          # the law's declared quantifiers
@@ -635,6 +653,26 @@ def _sweep(state: _Search, seed: int, horizon: float) -> int:
     elif found is not None:
         state.shrunk_into(*found, "sweep (shrunk greedily)")
     return len(swept)
+
+
+def _scales(state: _Search, horizon: float) -> dict:
+    """The scale phase (:mod:`verimono.checks.engine.scales`) after a sweep that found nothing: the worst sample
+    scaled over every decade, whole points of one shape at the landmarks; a violation is shrunk greedily into
+    ``state``.  Returns what was searched."""
+    start = None if state.worst_sample is None else dataclasses.replace(state.worst_sample, form=CONTIGUOUS)
+    state.start = state.worst_sample        # the coordinates search from the worst unscaled sample, as before
+    samples, covered = scale_samples(start, budget("coordinate"), int(state.op.dim), Sample,
+                                     SCALE_CAP.get(state.decl.name))
+    state.scaling = True
+    try:
+        found = state.first_violation(samples)
+    finally:
+        state.scaling = False
+    if found is not None and "batch_size" in found[1].info:
+        (state.failing, state.failure), state.found_by = found, "a batched call of the scale phase"
+    elif found is not None:
+        state.shrunk_into(*found, "the scale phase (every decade of the precision; shrunk greedily)")
+    return covered
 
 
 def _replay(decl: Law, op: Any, sample: Sample | dict) -> tuple[_Search, dict]:
@@ -804,6 +842,7 @@ def run_law(decl: Law | str, op: Any, *, seed: int | None = None, examples: int 
                                           "searched": {**searched(state.xs, state.lams, state.ts, horizon,
                                                                   state.coordinates), "forms": dict(state.forms),
                                                  **({"edge_samples": how["edge"]} if how.get("edge") else {}),
+                                                 **({"scales": how["scales"]} if how.get("scales") else {}),
                                                  **({"hypothesis_examples": how["hypothesis"]}
                                                     if how.get("hypothesis") else {}),
                                                  **({"budget": state.budget_note} if state.budget_note else {})}},
