@@ -29,6 +29,7 @@ import zlib
 import numpy as np
 
 from ..core.arrays import as_float64
+from ..core._rows import dot_rows
 from ..core._small import abs_max
 from ..core.tolerances import current_eps, current_precision, current_rtol, tolerance
 from .core import Member, Outcome, ratio as _ratio
@@ -42,6 +43,7 @@ from .engine.batches import rounding, row_dots, row_norms, row_ratios, row_resol
 from .engine.search import operator_law
 from ..core.tolerances import row_tolerances
 from ..execution.profiles import LARGE_N
+from ..execution.timeouts import interrupted
 
 #: the independent minimiser (scipy.optimize, derivative-free Powell) runs only on R^n with n ≤ this
 MINIMISER_MAX_DIM = 4
@@ -166,6 +168,58 @@ def _directions(x, p, n, seed_like, xp=None, nxp=None) -> list:
     return dirs
 
 
+#: the most coordinates (perturbations × n) of one sample's perturbations evaluated as a block (:func:`_perturbed_values`);
+#: above it (n > ~1500) the loop of :func:`check_prox_optimal` evaluates them one by one, as before
+BLOCK_CELLS = 1 << 16
+
+
+def _perturbed_values(op, x, p, dirs, s0, t):
+    """The optimality law's perturbations ``z = p ± h·s0·d`` (``d`` in ``dirs``, ``h`` in :data:`PERTURBATIONS`, ``+``
+    then ``-``, in :func:`check_prox_optimal`'s order) as rows of one block: ``(g(t, z), |z - x|²)`` as two lists of
+    Python floats, when the operator's class states ``value`` of a block of rows (``_value_rows``, bit-identical to its
+    calls per row, as the catalog's :class:`~verimono.core.operators.NormSubdifferential` and
+    :class:`~verimono.core.operators.L1Subdifferential` declare; looked up on the class, so an input-form wrapper
+    declines); else ``None`` (also when the block call raised or answered no ``(B,)`` array: the calls per row then
+    meet it, one by one).
+
+    The same numbers as the loop's: a coordinate perturbation is ``p + 0.0`` (``+``) or ``p`` (``-``) with entry ``i``
+    set to ``p_i + c``, another ``p ± (d·h·s0)`` (one product for both signs), elementwise as there; ``|z - x|²`` the
+    BLAS dot of each row (:func:`verimono.core.operators.dot_rows`), which is the loop's ``w @ w`` (for a coordinate
+    it dots ``x - p`` with entry ``i`` patched: the same squares), taken before ``g`` sees the block."""
+    rows = getattr(type(op), "_value_rows", None)
+    if rows is None or x.ndim != 1 or p.dtype != np.float64:
+        return None
+    n, k = x.size, len(dirs)
+    dzs = np.array([h * s0 for h in PERTURBATIONS])
+    Z = np.empty((k, len(PERTURBATIONS), 2, n))
+    ci = [i for i, d in enumerate(dirs) if type(d) is int]
+    vi = [i for i, d in enumerate(dirs) if type(d) is not int]
+    if ci:
+        Z[ci, :, 0, :] = p + 0.0
+        Z[ci, :, 1, :] = p
+        for i in ci:
+            j = dirs[i]
+            for m, h in enumerate(PERTURBATIONS):
+                Z[i, m, 0, j] = p[j] + 1.0 * h * s0
+                Z[i, m, 1, j] = p[j] + -1.0 * h * s0
+    if vi:
+        CD = np.array([dirs[i] for i in vi])[:, None, :] * dzs[None, :, None]
+        Z[vi, :, 0, :] = p + CD
+        Z[vi, :, 1, :] = p - CD
+    Z = Z.reshape(k * 2 * len(PERTURBATIONS), n)
+    W = Z - x
+    Q = dot_rows(W, W)
+    try:
+        G = rows(op, Z, t)
+    except Exception:   # noqa: BLE001 - the calls per row meet it, one by one
+        if interrupted():
+            raise
+        return None
+    if type(G) is not np.ndarray or G.dtype != np.float64 or G.shape != (Z.shape[0],):
+        return None
+    return G.tolist(), Q.tolist()
+
+
 def _unit(i: int, n: int) -> np.ndarray:
     """The coordinate direction ``e_i`` of ``R^n``."""
     e = np.zeros(n)
@@ -280,11 +334,27 @@ def check_prox_optimal(op, s, p, gp):
     # entry i set, in a buffer of ours patched and restored — the same numbers, two passes over n where there
     # were eight.  Above EXPANDED_N, |z - x|² = |x - p|² - 2c⟨x - p, d⟩ + c²|d|² from two dots per direction
     # (:data:`EXPANDED_N`: the rounding this moves is far inside the slack)
+    dirs = _directions(x, p, x.size, x, xp, dxp)
+    block = _perturbed_values(op, x, p, dirs, s0, t) if x.size * len(dirs) * 6 <= BLOCK_CELLS else None
+    if block is not None:
+        at, worst = None, -math.inf
+        for k, (g, q) in enumerate(zip(*block)):
+            # the loop below's numbers from the block's: the same IEEE operations in Python floats, in its order
+            h = PERTURBATIONS[(k // 2) % 3]
+            dz = h * s0
+            fz = lam * g + 0.5 * q
+            if fz == math.inf:
+                continue
+            slack = 4 * (rtol * (1.0 + max(afp, abs(fz), algp))) + 4 * tau * (dxp + dz + tau)
+            r = (fp + 0.5 * dz * dz - fz) / slack
+            if not r <= worst:
+                worst, at = r, (dirs[k // 6], (1.0 if k % 2 == 0 else -1.0) * h * s0, fz, slack)
+        return _optimal_outcome(x, p, fp, at)
     expanded = x.size > EXPANDED_N
     w, cd, wi = np.empty_like(x), np.empty_like(x), None
     scratch = _Scratch(p)                # z, one buffer for the 42 perturbations while g keeps none
     worst, at = -math.inf, None
-    for d in _directions(x, p, x.size, x, xp, dxp):
+    for d in dirs:
         coordinate = type(d) is int
         if expanded:
             b, dd = (float(xp[d]), 1.0) if coordinate else (float(xp @ d), float(d @ d))
@@ -321,6 +391,12 @@ def check_prox_optimal(op, s, p, gp):
                 r = (fp + 0.5 * dz * dz - fz) / slack
                 if not r <= worst:
                     worst, at = r, (d, c, fz, slack)
+    return _optimal_outcome(x, p, fp, at)
+
+
+def _optimal_outcome(x, p, fp, at) -> Outcome:
+    """The optimality law's outcome at its worst perturbation ``at = (d, c, Φ(z), slack)`` (``None``: every
+    perturbation left ``dom g``)."""
     if at is None:
         return Outcome.compare(0.0, 0.0, 1.0, "optimality: every perturbation left dom g (sample inconclusive)", {},
                                inconclusive=True)
