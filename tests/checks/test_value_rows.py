@@ -108,3 +108,33 @@ def test_a_wrong_value_still_fails():
         assert repr(dataclasses.asdict(b)) == repr(dataclasses.asdict(c))
         fails += a.worst > 1.0 and b.worst > 1.0
     assert fails >= 10
+
+
+@pytest.mark.parametrize("name", sorted(_OPS))
+def test_the_value_at_one_time_is_value(name):
+    """``_value_at(t)``: the minimiser's ``g`` at one time, the same float as ``value`` at every point."""
+    rng = np.random.default_rng(7)
+    for n in (1, 3, 17):
+        op = _OPS[name](n)
+        t = float(rng.uniform())
+        g = op._value_at(t)
+        Z = rng.standard_normal((30, n)) * 10.0 ** rng.integers(-200, 150, (30, 1))
+        with np.errstate(all="ignore"):
+            assert [g(z.copy()) for z in Z] == [op.value(z.copy(), t) for z in Z]
+            assert all(type(g(z.copy())) is float for z in Z)
+
+
+def test_the_minimiser_outcome_is_the_calls_per_point():
+    rng = np.random.default_rng(4)
+    evaluate = prox_laws.check_prox_minimiser.law.evaluate
+    bad = vm.NormSubdifferential(lambda t: 2.0 * t, dim=2)
+    bad.resolvent = vm.NormSubdifferential(lambda t: t, dim=2).resolvent   # the prox of t|x| stated as 2t|x|'s
+    fails = 0
+    for op in (_OPS["norm_moving"](2), _OPS["l1_weights"](3), _OPS["l1"](1), bad):
+        for _ in range(4):
+            s = Sample(rng.standard_normal(op.dim) * 3.0, rng.standard_normal(op.dim), float(10 ** rng.uniform(-2, 0.5)),
+                       0.5, 0.25, 0.5 + 0.5 * float(rng.uniform()))
+            a, b = evaluate(op, s), evaluate(_PerRow(op), s)
+            assert repr(dataclasses.asdict(a)) == repr(dataclasses.asdict(b))
+            fails += op is bad and a.worst > 1.0
+    assert fails >= 3

@@ -484,6 +484,23 @@ class NormSubdifferential(_EverywhereDefined):
             c = float(c)
         return c * np.sqrt(dot_rows(Z, Z))
 
+    def _value_at(self, t=0.0):
+        """``z ↦`` :meth:`value` ``(z, t)`` for float64 points ``z`` of shape ``(n,)`` (a minimiser's many calls at one
+        time), bit-identically: ``c(t)`` read once as :meth:`value` reads it, then ``c·sqrt(z·z)``, the dot
+        :func:`_frobenius` takes; ``None`` where ``value``, ``_c_at`` or ``_col`` is not this class's own."""
+        if not (_own_value(self, NormSubdifferential) and self._fast_c):
+            return None
+        c = _weight_value(self._c, t, self.name, "c(t)")
+        if type(c) is not float:
+            c = np.asarray(c, dtype=float)
+            if c.ndim:
+                return None         # value's NotImplementedError: met by its own calls
+            c = float(c)
+
+        def g(z):
+            return c * _sqrt(z.dot(z))
+        return g
+
     def min_norm(self, x, t=0.0):
         x = np.asarray(x, dtype=float)
         if type(t) is np.ndarray and not self._accepts_times():
@@ -621,6 +638,20 @@ class L1Subdifferential(_EverywhereDefined):
         c = p._value if p._fn is None else np.asarray(_weight_at(p, t, self.name, "c(t)"), dtype=float)
         Z = np.asarray(Z, dtype=float)
         return np.add.reduce(c * np.abs(Z), axis=1)
+
+    def _value_at(self, t=0.0):
+        """``z ↦`` :meth:`value` ``(z, t)`` for float64 points ``z`` of shape ``(n,)`` (a minimiser's many calls at one
+        time), bit-identically: ``c(t)`` read once as :meth:`value` reads it, then the same product and sum; ``None``
+        where ``value`` is not this class's own."""
+        if not _own_value(self, L1Subdifferential):
+            return None
+        p = self._c
+        c = p._value if p._fn is None else np.asarray(_weight_at(p, t, self.name, "c(t)"), dtype=float)
+        add, absolute = np.add.reduce, np.abs
+
+        def g(z):
+            return float(add(c * absolute(z), axis=None))
+        return g
 
     def min_norm(self, x, t=0.0):
         x = real_array(x)
