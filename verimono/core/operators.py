@@ -470,12 +470,18 @@ class NormSubdifferential(_EverywhereDefined):
     _value_written = value      # the value _value_rows answers for (_own_value)
 
     def _value_rows(self, Z, t=0.0):
-        """:meth:`value` of every row of ``Z`` ``(B, n)`` at the one time ``t`` (``(B,)`` floats), bit-identically to
-        the calls per row: ``c(t)`` read once as :meth:`value` reads it, each norm the BLAS dot of its row
+        """:meth:`value` of every row of ``Z`` ``(B, n)`` at the one time ``t``, or at ``t_i`` for row ``i`` with ``t`` of
+        shape ``(B,)`` (``(B,)`` floats), bit-identically to the calls per row: ``c(t)`` read once as :meth:`value`
+        reads it (a block of times as :meth:`_accepts_times` declares), each norm the BLAS dot of its row
         (:func:`dot_rows`, :func:`_frobenius`'s number) and the same product; ``None`` where ``value``, ``_c_at`` or
         ``_col`` is not this class's own (then: the calls per row)."""
         if not (_own_value(self, NormSubdifferential) and self._fast_c):
             return None
+        if type(t) is np.ndarray:       # a time per row: c(t_i) as a block of times reads it (_accepts_times)
+            if not self._accepts_times():
+                return None
+            c = np.broadcast_to(_weight_times(self._c, times_of(t, Z, self.name), self.name, "c(t)"), t.shape)
+            return c * np.sqrt(dot_rows(Z, Z))
         c = _weight_value(self._c, t, self.name, "c(t)")
         if type(c) is not float:
             c = np.asarray(c, dtype=float)
@@ -629,13 +635,19 @@ class L1Subdifferential(_EverywhereDefined):
     _value_written = value      # the value _value_rows answers for (_own_value)
 
     def _value_rows(self, Z, t=0.0):
-        """:meth:`value` of every row of ``Z`` ``(B, n)`` at the one time ``t`` (``(B,)`` floats), bit-identically to
-        the calls per row: ``c(t)`` read once as :meth:`value` reads it, the same products and each row's sum NumPy's
+        """:meth:`value` of every row of ``Z`` ``(B, n)`` at the one time ``t``, or at ``t_i`` for row ``i`` with ``t`` of
+        shape ``(B,)`` (``(B,)`` floats), bit-identically to the calls per row: ``c(t)`` read once as :meth:`value`
+        reads it (a block of times by :meth:`_c_rows`, as :meth:`_accepts_times` declares), the same products and each row's sum NumPy's
         pairwise sum of that row, as the one-point reduction is; ``None`` where ``value`` is not this class's own."""
         if not _own_value(self, L1Subdifferential):
             return None
         p = self._c
-        c = p._value if p._fn is None else np.asarray(_weight_at(p, t, self.name, "c(t)"), dtype=float)
+        if type(t) is np.ndarray:       # a time per row: c(t_i) as a block of times reads it (_accepts_times)
+            if not self._accepts_times():
+                return None
+            c = self._c_rows(t, Z)
+        else:
+            c = p._value if p._fn is None else np.asarray(_weight_at(p, t, self.name, "c(t)"), dtype=float)
         Z = np.asarray(Z, dtype=float)
         return np.add.reduce(c * np.abs(Z), axis=1)
 
