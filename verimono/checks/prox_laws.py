@@ -29,6 +29,7 @@ import zlib
 import numpy as np
 
 from ..core.arrays import as_float64
+from ..core._rows import dot_rows
 from ..core._small import abs_max
 from ..core.tolerances import current_eps, current_precision, current_rtol, tolerance
 from .core import Member, Outcome, ratio as _ratio
@@ -38,10 +39,11 @@ from .members import ROUNDOFF_ULPS, outside_by_roundoff_of_dom_g
 from .members import listed, norm as _nrm
 from .members import resolvent as _J
 from .members import value as _g
-from .engine.batches import rounding, row_dots, row_norms, row_ratios, row_resolvents, row_values, vectorised
+from .engine.batches import _call_starts, rounding, row_dots, row_norms, row_ratios, row_resolvents, row_values, vectorised
 from .engine.search import operator_law
 from ..core.tolerances import row_tolerances
 from ..execution.profiles import LARGE_N
+from ..execution.timeouts import interrupted
 
 #: the independent minimiser (scipy.optimize, derivative-free Powell) runs only on R^n with n ≤ this
 MINIMISER_MAX_DIM = 4
@@ -166,6 +168,59 @@ def _directions(x, p, n, seed_like, xp=None, nxp=None) -> list:
     return dirs
 
 
+#: the most coordinates (perturbations × n) of one sample's perturbations evaluated as a block (:func:`_perturbed_values`);
+#: above it (n > ~1500) the loop of :func:`check_prox_optimal` evaluates them one by one, as before
+BLOCK_CELLS = 1 << 16
+
+
+def _perturbed_values(op, x, p, dirs, s0, t):
+    """The optimality law's perturbations ``z = p ± h·s0·d`` (``d`` in ``dirs``, ``h`` in :data:`PERTURBATIONS`, ``+``
+    then ``-``, in :func:`check_prox_optimal`'s order) as rows of one block: ``(g(t, z), |z - x|²)`` as two arrays
+    ``(B,)``, when the operator's class states ``value`` of a block of rows (``_value_rows``, bit-identical to its
+    calls per row, as the catalog's :class:`~verimono.core.operators.NormSubdifferential` and
+    :class:`~verimono.core.operators.L1Subdifferential` declare; looked up on the class, so an input-form wrapper
+    declines); else ``None`` (also when the block call raised or answered no ``(B,)`` array: the calls per row then
+    meet it, one by one).
+
+    The same numbers as the loop's: a coordinate perturbation is ``p + 0.0`` (``+``) or ``p`` (``-``) with entry ``i``
+    set to ``p_i + c``, another ``p ± (d·h·s0)`` (one product for both signs), elementwise as there; ``|z - x|²`` the
+    BLAS dot of each row (:func:`verimono.core.operators.dot_rows`), which is the loop's ``w @ w`` (for a coordinate
+    it dots ``x - p`` with entry ``i`` patched: the same squares), taken before ``g`` sees the block."""
+    rows = getattr(type(op), "_value_rows", None)
+    if rows is None or x.ndim != 1 or p.dtype != np.float64:
+        return None
+    n, k = x.size, len(dirs)
+    dzs = np.array([h * s0 for h in PERTURBATIONS])
+    Z = np.empty((k, len(PERTURBATIONS), 2, n))
+    nc = 0                  # the coordinate directions come first (:func:`_directions`): slices, not index lists
+    while nc < k and type(dirs[nc]) is int:
+        nc += 1
+    if any(type(d) is int for d in dirs[nc:]):
+        return None
+    if nc:
+        Z[:nc, :, 0, :] = p + 0.0
+        Z[:nc, :, 1, :] = p
+        C = np.array([(1.0 * h * s0, -1.0 * h * s0) for h in PERTURBATIONS])     # the loop's c = sgn·h·s0
+        for i in range(nc):
+            Z[i, :, :, dirs[i]] = p[dirs[i]] + C
+    if nc < k:
+        CD = np.array(dirs[nc:])[:, None, :] * dzs[None, :, None]
+        np.add(p, CD, out=Z[nc:, :, 0, :])
+        np.subtract(p, CD, out=Z[nc:, :, 1, :])
+    Z = Z.reshape(k * 2 * len(PERTURBATIONS), n)
+    W = Z - x
+    Q = dot_rows(W, W)
+    try:
+        G = rows(op, Z, t)
+    except Exception:   # noqa: BLE001 - the calls per row meet it, one by one
+        if interrupted():
+            raise
+        return None
+    if type(G) is not np.ndarray or G.dtype != np.float64 or G.shape != (Z.shape[0],):
+        return None
+    return G, Q
+
+
 def _unit(i: int, n: int) -> np.ndarray:
     """The coordinate direction ``e_i`` of ``R^n``."""
     e = np.zeros(n)
@@ -224,6 +279,30 @@ def check_prox_inequality(op, s, p, gp):
                            {"p": listed(p), "z": listed(z), "z_is": lab, "g(p)": gp, "g(z)": gz})
 
 
+def _row_values(op, Z, ts, ok):
+    """:func:`verimono.checks.engine.batches.row_values` — ``g(t_i, Z_i)`` of every row still ``ok``, a row whose value
+    raised or is not finite marked ``False`` — as one call of the class's ``_value_rows`` with a time per row where it
+    states one (the catalog's, bit-identical to the calls per row; timed as one subject call); the calls per row
+    where it has none, declines, raises or answers no ``(B,)`` float64 array."""
+    rows = np.flatnonzero(ok)
+    block = getattr(type(op), "_value_rows", None)
+    if block is not None and rows.size >= 2:
+        _call_starts()
+        try:
+            v = block(op, Z[rows], ts[rows].astype(float))
+        except Exception:   # noqa: BLE001 - the calls per row meet it, row by row
+            if interrupted():
+                raise
+            v = None
+        if type(v) is np.ndarray and v.dtype == np.float64 and v.shape == rows.shape:
+            good = np.isfinite(v)
+            out = np.zeros(len(ok))
+            out[rows] = np.where(good, v, 0.0)
+            ok[rows] &= good
+            return out
+    return row_values(op, Z, ts, ok)
+
+
 @vectorised("prox_inequality")
 def _rows_prox_inequality(op, r):
     """The prox inequality over rows (:mod:`verimono.checks.engine.batches`): the law's six candidates, every value
@@ -232,12 +311,12 @@ def _rows_prox_inequality(op, r):
     of the dot product ``⟨x - p, z - p⟩`` (the values themselves are the same calls)."""
     x, lam, t = r.x1, r.lam, r.t
     p = row_resolvents(op, x, lam, t, r.ok)
-    gp = row_values(op, p, t, r.ok)
+    gp = _row_values(op, p, t, r.ok)
     cands = [r.x2, x, np.zeros_like(x), row_resolvents(op, r.x2, r.mu, t, r.ok), row_resolvents(op, x, r.mu, t, r.ok),
              row_resolvents(op, r.x2, r.nu, t, r.ok)]
     worst, err = np.full(len(r.ok), -np.inf), np.zeros(len(r.ok))
     for z in cands:
-        gz = row_values(op, z, t, r.ok)
+        gz = _row_values(op, z, t, r.ok)
         tau = row_tolerances(x, p, z)
         nxp, nzp = row_norms(x - p), row_norms(z - p)
         lhs = row_dots(x - p, z - p)
@@ -280,11 +359,15 @@ def check_prox_optimal(op, s, p, gp):
     # entry i set, in a buffer of ours patched and restored — the same numbers, two passes over n where there
     # were eight.  Above EXPANDED_N, |z - x|² = |x - p|² - 2c⟨x - p, d⟩ + c²|d|² from two dots per direction
     # (:data:`EXPANDED_N`: the rounding this moves is far inside the slack)
+    dirs = _directions(x, p, x.size, x, xp, dxp)
+    block = _perturbed_values(op, x, p, dirs, s0, t) if x.size * len(dirs) * 6 <= BLOCK_CELLS else None
+    if block is not None:
+        return _optimal_outcome(x, p, fp, _worst_perturbation(block, dirs, lam, s0, fp, afp, algp, rtol, tau, dxp))
     expanded = x.size > EXPANDED_N
     w, cd, wi = np.empty_like(x), np.empty_like(x), None
     scratch = _Scratch(p)                # z, one buffer for the 42 perturbations while g keeps none
     worst, at = -math.inf, None
-    for d in _directions(x, p, x.size, x, xp, dxp):
+    for d in dirs:
         coordinate = type(d) is int
         if expanded:
             b, dd = (float(xp[d]), 1.0) if coordinate else (float(xp @ d), float(d @ d))
@@ -321,6 +404,45 @@ def check_prox_optimal(op, s, p, gp):
                 r = (fp + 0.5 * dz * dz - fz) / slack
                 if not r <= worst:
                     worst, at = r, (d, c, fz, slack)
+    return _optimal_outcome(x, p, fp, at)
+
+
+def _worst_perturbation(block, dirs, lam, s0, fp, afp, algp, rtol, tau, dxp):
+    """The loop of :func:`check_prox_optimal` over a block's perturbations (:func:`_perturbed_values`):
+    ``(d, c, Φ(z), slack)`` of the worst one, or ``None`` when none passed ``not r <= worst`` (every ``Φ(z)`` is
+    ``+inf``).  The same IEEE operations in the same order in Python floats (a loop of 42 is cheaper so than NumPy's
+    calls on arrays of 42), the parts that depend on ``h`` only (``4τ(|x - p| + dz + τ)`` and ``Φ(p) + dz²/2``) made
+    once per ``h``, Python's ``max(a, b, c)`` as its own comparisons (``b > a``, then ``c`` against that)."""
+    G, Q = block
+    nh = len(PERTURBATIONS)
+    dzs = [h * s0 for h in PERTURBATIONS]
+    side = [4 * tau * (dxp + dz + tau) for dz in dzs]
+    top = [fp + 0.5 * dz * dz for dz in dzs]
+    inf = math.inf
+    worst, k_at, f_at, s_at = -inf, None, None, None
+    k = 0
+    for g, q in zip(G.tolist(), Q.tolist()):
+        fz = lam * g + 0.5 * q
+        if fz != inf:
+            m = (k >> 1) % nh
+            a = abs(fz)
+            mx = a if a > afp else afp
+            if algp > mx:
+                mx = algp
+            slack = 4 * (rtol * (1.0 + mx)) + side[m]
+            r = (top[m] - fz) / slack
+            if not r <= worst:
+                worst, k_at, f_at, s_at = r, k, fz, slack
+        k += 1
+    if k_at is None:
+        return None
+    h = PERTURBATIONS[(k_at >> 1) % nh]
+    return dirs[k_at // (2 * nh)], (1.0 if k_at % 2 == 0 else -1.0) * h * s0, f_at, s_at
+
+
+def _optimal_outcome(x, p, fp, at) -> Outcome:
+    """The optimality law's outcome at its worst perturbation ``at = (d, c, Φ(z), slack)`` (``None``: every
+    perturbation left ``dom g``)."""
     if at is None:
         return Outcome.compare(0.0, 0.0, 1.0, "optimality: every perturbation left dom g (sample inconclusive)", {},
                                inconclusive=True)
@@ -371,6 +493,16 @@ def _minimised(op, s, p, gp):
         q = 0.5 * float(w @ w)
         v = lam * _owned_value(op, z, t) + q
         return v if v < big else big
+    at = getattr(type(op), "_value_at", None)       # looked up on the class: an input-form wrapper declines
+    g_at = at(op, t) if at is not None and x.dtype == np.float64 else None
+    if g_at is not None:
+        def phi(z):     # noqa: F811 - the catalog's value at t (_value_at: the same numbers as op.value), one call less
+            if type(z) is not np.ndarray or z.dtype != np.float64:
+                z = np.asarray(z, dtype=float)
+            w = z - x
+            q = 0.5 * float(w @ w)
+            v = lam * g_at(z) + q
+            return v if v < big else big
     best, zbest = math.inf, None
     scale = 1.0 + float(np.max(np.abs(x), initial=0.0))
     for z0 in _starts(p, x):

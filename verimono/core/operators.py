@@ -50,6 +50,12 @@ def _own_contains(obj: Any, cls: type) -> bool:
     return type(obj).contains is cls.__dict__["_contains_written"] and "contains" not in getattr(obj, "__dict__", {})
 
 
+def _own_value(obj: Any, cls: type) -> bool:
+    """Whether ``obj``'s ``value`` is the one written in ``cls``'s body (kept as ``cls._value_written``): not
+    overridden by a subclass, not replaced on the object nor on the class (a wrapper there is called per row)."""
+    return type(obj).value is cls.__dict__["_value_written"] and "value" not in getattr(obj, "__dict__", {})
+
+
 def _own_read(obj: Any, cls: type, member: str = "_c_at") -> bool:
     """Whether ``obj`` reads its parameter by ``cls``'s own ``member``: neither overridden in a subclass nor
     replaced on the object itself."""
@@ -461,6 +467,46 @@ class NormSubdifferential(_EverywhereDefined):
             c = float(c)
         return c * _frobenius(np.asarray(x, dtype=float))
 
+    _value_written = value      # the value _value_rows answers for (_own_value)
+
+    def _value_rows(self, Z, t=0.0):
+        """:meth:`value` of every row of ``Z`` ``(B, n)`` at the one time ``t``, or at ``t_i`` for row ``i`` with ``t`` of
+        shape ``(B,)`` (``(B,)`` floats), bit-identically to the calls per row: ``c(t)`` read once as :meth:`value`
+        reads it (a block of times as :meth:`_accepts_times` declares), each norm the BLAS dot of its row
+        (:func:`dot_rows`, :func:`_frobenius`'s number) and the same product; ``None`` where ``value``, ``_c_at`` or
+        ``_col`` is not this class's own (then: the calls per row)."""
+        if not (_own_value(self, NormSubdifferential) and self._fast_c):
+            return None
+        if type(t) is np.ndarray:       # a time per row: c(t_i) as a block of times reads it (_accepts_times)
+            if not self._accepts_times():
+                return None
+            c = np.broadcast_to(_weight_times(self._c, times_of(t, Z, self.name), self.name, "c(t)"), t.shape)
+            return c * np.sqrt(dot_rows(Z, Z))
+        c = _weight_value(self._c, t, self.name, "c(t)")
+        if type(c) is not float:
+            c = np.asarray(c, dtype=float)
+            if c.ndim:
+                raise NotImplementedError(f"{self.name}: a value needs one weight c(t), not a batch of them")
+            c = float(c)
+        return c * np.sqrt(dot_rows(Z, Z))
+
+    def _value_at(self, t=0.0):
+        """``z ↦`` :meth:`value` ``(z, t)`` for float64 points ``z`` of shape ``(n,)`` (a minimiser's many calls at one
+        time), bit-identically: ``c(t)`` read once as :meth:`value` reads it, then ``c·sqrt(z·z)``, the dot
+        :func:`_frobenius` takes; ``None`` where ``value``, ``_c_at`` or ``_col`` is not this class's own."""
+        if not (_own_value(self, NormSubdifferential) and self._fast_c):
+            return None
+        c = _weight_value(self._c, t, self.name, "c(t)")
+        if type(c) is not float:
+            c = np.asarray(c, dtype=float)
+            if c.ndim:
+                return None         # value's NotImplementedError: met by its own calls
+            c = float(c)
+
+        def g(z):
+            return c * _sqrt(z.dot(z))
+        return g
+
     def min_norm(self, x, t=0.0):
         x = np.asarray(x, dtype=float)
         if type(t) is np.ndarray and not self._accepts_times():
@@ -585,6 +631,39 @@ class L1Subdifferential(_EverywhereDefined):
         if type(x) is not np.ndarray or x.dtype != np.float64:
             x = np.asarray(x, dtype=float)
         return float(np.add.reduce(c * np.abs(x), axis=None))   # np.sum without its dispatch
+
+    _value_written = value      # the value _value_rows answers for (_own_value)
+
+    def _value_rows(self, Z, t=0.0):
+        """:meth:`value` of every row of ``Z`` ``(B, n)`` at the one time ``t``, or at ``t_i`` for row ``i`` with ``t`` of
+        shape ``(B,)`` (``(B,)`` floats), bit-identically to the calls per row: ``c(t)`` read once as :meth:`value`
+        reads it (a block of times by :meth:`_c_rows`, as :meth:`_accepts_times` declares), the same products and each row's sum NumPy's
+        pairwise sum of that row, as the one-point reduction is; ``None`` where ``value`` is not this class's own."""
+        if not _own_value(self, L1Subdifferential):
+            return None
+        p = self._c
+        if type(t) is np.ndarray:       # a time per row: c(t_i) as a block of times reads it (_accepts_times)
+            if not self._accepts_times():
+                return None
+            c = self._c_rows(t, Z)
+        else:
+            c = p._value if p._fn is None else np.asarray(_weight_at(p, t, self.name, "c(t)"), dtype=float)
+        Z = np.asarray(Z, dtype=float)
+        return np.add.reduce(c * np.abs(Z), axis=1)
+
+    def _value_at(self, t=0.0):
+        """``z ↦`` :meth:`value` ``(z, t)`` for float64 points ``z`` of shape ``(n,)`` (a minimiser's many calls at one
+        time), bit-identically: ``c(t)`` read once as :meth:`value` reads it, then the same product and sum; ``None``
+        where ``value`` is not this class's own."""
+        if not _own_value(self, L1Subdifferential):
+            return None
+        p = self._c
+        c = p._value if p._fn is None else np.asarray(_weight_at(p, t, self.name, "c(t)"), dtype=float)
+        add, absolute = np.add.reduce, np.abs
+
+        def g(z):
+            return float(add(c * absolute(z), axis=None))
+        return g
 
     def min_norm(self, x, t=0.0):
         x = real_array(x)
