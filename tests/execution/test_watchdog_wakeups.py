@@ -39,7 +39,10 @@ class _Counting:
 
 def test_limits_one_after_another_wake_the_thread_once(monkeypatch):
     with watchdog.limit(30.0, "the first"):          # the thread runs and sleeps until this limit's deadline
-        time.sleep(0.05)
+        waited = time.monotonic()
+        while watchdog._WAKE_AT == float("inf") and time.monotonic() - waited < 10.0:
+            time.sleep(0.01)                          # on a loaded machine the thread may take a while to get there
+        assert watchdog._WAKE_AT != float("inf"), "the watchdog thread never read the limit"
     counting = _Counting(watchdog._COND)
     monkeypatch.setattr(watchdog, "_COND", counting)
     for k in range(200):                              # later deadlines, one after another, and nested ones
