@@ -376,11 +376,12 @@ def end_process(status: int) -> None:
 def _after_fork_in_child() -> None:
     """A forked child (a process pool of a convergence study) runs none of its parent's limits, handlers or
     scopes, and has no watchdog thread or backstop timer of its own yet."""
-    global _COND, _THREAD, _BACKSTOP_ARMED, _ENDING
+    global _COND, _THREAD, _BACKSTOP_ARMED, _ENDING, _WAKE_AT
     _LIMITS.clear()
     _HANDLERS.clear()
     _FRAMES.clear()
     _COND, _THREAD, _BACKSTOP_ARMED, _ENDING = threading.Condition(), None, False, False
+    _WAKE_AT = math.inf             # the parent's thread's wake-up time is not the child's (it has no thread yet)
 
 
 if hasattr(os, "register_at_fork"):
