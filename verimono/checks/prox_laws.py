@@ -39,7 +39,7 @@ from .members import ROUNDOFF_ULPS, outside_by_roundoff_of_dom_g
 from .members import listed, norm as _nrm
 from .members import resolvent as _J
 from .members import value as _g
-from .engine.batches import _call_starts, rounding, row_dots, row_norms, row_ratios, row_resolvents, row_values, vectorised
+from .engine.batches import rounding, row_dots, row_norms, row_ratios, row_resolvents, row_values, vectorised
 from .engine.search import operator_law
 from ..core.tolerances import row_tolerances
 from ..execution.profiles import LARGE_N
@@ -279,30 +279,6 @@ def check_prox_inequality(op, s, p, gp):
                            {"p": listed(p), "z": listed(z), "z_is": lab, "g(p)": gp, "g(z)": gz})
 
 
-def _row_values(op, Z, ts, ok):
-    """:func:`verimono.checks.engine.batches.row_values` — ``g(t_i, Z_i)`` of every row still ``ok``, a row whose value
-    raised or is not finite marked ``False`` — as one call of the class's ``_value_rows`` with a time per row where it
-    states one (the catalog's, bit-identical to the calls per row; timed as one subject call); the calls per row
-    where it has none, declines, raises or answers no ``(B,)`` float64 array."""
-    rows = np.flatnonzero(ok)
-    block = getattr(type(op), "_value_rows", None)
-    if block is not None and rows.size >= 2:
-        _call_starts()
-        try:
-            v = block(op, Z[rows], ts[rows].astype(float))
-        except Exception:   # noqa: BLE001 - the calls per row meet it, row by row
-            if interrupted():
-                raise
-            v = None
-        if type(v) is np.ndarray and v.dtype == np.float64 and v.shape == rows.shape:
-            good = np.isfinite(v)
-            out = np.zeros(len(ok))
-            out[rows] = np.where(good, v, 0.0)
-            ok[rows] &= good
-            return out
-    return row_values(op, Z, ts, ok)
-
-
 @vectorised("prox_inequality")
 def _rows_prox_inequality(op, r):
     """The prox inequality over rows (:mod:`verimono.checks.engine.batches`): the law's six candidates, every value
@@ -311,12 +287,12 @@ def _rows_prox_inequality(op, r):
     of the dot product ``⟨x - p, z - p⟩`` (the values themselves are the same calls)."""
     x, lam, t = r.x1, r.lam, r.t
     p = row_resolvents(op, x, lam, t, r.ok)
-    gp = _row_values(op, p, t, r.ok)
+    gp = row_values(op, p, t, r.ok)
     cands = [r.x2, x, np.zeros_like(x), row_resolvents(op, r.x2, r.mu, t, r.ok), row_resolvents(op, x, r.mu, t, r.ok),
              row_resolvents(op, r.x2, r.nu, t, r.ok)]
     worst, err = np.full(len(r.ok), -np.inf), np.zeros(len(r.ok))
     for z in cands:
-        gz = _row_values(op, z, t, r.ok)
+        gz = row_values(op, z, t, r.ok)
         tau = row_tolerances(x, p, z)
         nxp, nzp = row_norms(x - p), row_norms(z - p)
         lhs = row_dots(x - p, z - p)

@@ -44,16 +44,12 @@ def _own(obj: Any, cls: type, member: str = "resolvent") -> bool:
     return getattr(type(obj), member) is getattr(cls, member)
 
 
-def _own_contains(obj: Any, cls: type) -> bool:
-    """Whether ``obj``'s ``contains`` is the one written in ``cls``'s body (kept as ``cls._contains_written``): not
-    overridden by a subclass, not replaced on the object nor on the class (a wrapper there is called per row)."""
-    return type(obj).contains is cls.__dict__["_contains_written"] and "contains" not in getattr(obj, "__dict__", {})
-
-
-def _own_value(obj: Any, cls: type) -> bool:
-    """Whether ``obj``'s ``value`` is the one written in ``cls``'s body (kept as ``cls._value_written``): not
-    overridden by a subclass, not replaced on the object nor on the class (a wrapper there is called per row)."""
-    return type(obj).value is cls.__dict__["_value_written"] and "value" not in getattr(obj, "__dict__", {})
+def _own_written(obj: Any, cls: type, member: str) -> bool:
+    """Whether ``obj``'s ``member`` is the one written in ``cls``'s body (kept as ``cls._<member>_written``): not
+    overridden by a subclass, not replaced on the object nor on the class (a wrapper there is called per row, which
+    :func:`_own_read`, comparing with the class's current attribute, would not see)."""
+    return (getattr(type(obj), member) is cls.__dict__[f"_{member}_written"]
+            and member not in getattr(obj, "__dict__", {}))
 
 
 def _own_read(obj: Any, cls: type, member: str = "_c_at") -> bool:
@@ -324,13 +320,13 @@ class Linear(_EverywhereDefined):
         tol = tolerance(Mx, y) if tol is None else tol
         return bool(np.max(np.abs(np.asarray(y) - Mx)) <= tol)
 
-    _contains_written = contains     # the contains _contains_rows answers for (_own_contains)
+    _contains_written = contains     # the contains _contains_rows answers for (_own_written)
 
     def _contains_rows(self, X, Y, ts, tols):
         """:meth:`contains` of every row ``(X_i, Y_i, t_i, tol_i)`` at once (``(B,)`` booleans), bit-identically to
         the calls per row — ``min_norm`` of the rows at their times (bit-identical to its calls per row, as the
         class declares) and the same elementwise test; ``None`` where the members are not this class's own."""
-        if not (_own_contains(self, Linear) and _own_read(self, Linear, "min_norm") and self._accepts_times()):
+        if not (_own_written(self, Linear, "contains") and _own_read(self, Linear, "min_norm") and self._accepts_times()):
             return None
         return np.abs(Y - self.min_norm(X, ts)).max(axis=1, initial=0.0) <= tols
 
@@ -467,7 +463,7 @@ class NormSubdifferential(_EverywhereDefined):
             c = float(c)
         return c * _frobenius(np.asarray(x, dtype=float))
 
-    _value_written = value      # the value _value_rows answers for (_own_value)
+    _value_written = value      # the value _value_rows answers for (_own_written)
 
     def _value_rows(self, Z, t=0.0):
         """:meth:`value` of every row of ``Z`` ``(B, n)`` at the one time ``t``, or at ``t_i`` for row ``i`` with ``t`` of
@@ -475,33 +471,37 @@ class NormSubdifferential(_EverywhereDefined):
         reads it (a block of times as :meth:`_accepts_times` declares), each norm the BLAS dot of its row
         (:func:`dot_rows`, :func:`_frobenius`'s number) and the same product; ``None`` where ``value``, ``_c_at`` or
         ``_col`` is not this class's own (then: the calls per row)."""
-        if not (_own_value(self, NormSubdifferential) and self._fast_c):
+        if not (_own_written(self, NormSubdifferential, "value") and self._fast_c):
             return None
         if type(t) is np.ndarray:       # a time per row: c(t_i) as a block of times reads it (_accepts_times)
             if not self._accepts_times():
                 return None
             c = np.broadcast_to(_weight_times(self._c, times_of(t, Z, self.name), self.name, "c(t)"), t.shape)
             return c * np.sqrt(dot_rows(Z, Z))
+        c = self._one_weight(t)
+        if c is None:
+            raise NotImplementedError(f"{self.name}: a value needs one weight c(t), not a batch of them")
+        return c * np.sqrt(dot_rows(Z, Z))
+
+    def _one_weight(self, t):
+        """``c(t)`` read as :meth:`value` reads it, as a float; ``None`` for a batch of weights (value declines it)."""
         c = _weight_value(self._c, t, self.name, "c(t)")
         if type(c) is not float:
             c = np.asarray(c, dtype=float)
             if c.ndim:
-                raise NotImplementedError(f"{self.name}: a value needs one weight c(t), not a batch of them")
+                return None
             c = float(c)
-        return c * np.sqrt(dot_rows(Z, Z))
+        return c
 
     def _value_at(self, t=0.0):
         """``z ↦`` :meth:`value` ``(z, t)`` for float64 points ``z`` of shape ``(n,)`` (a minimiser's many calls at one
         time), bit-identically: ``c(t)`` read once as :meth:`value` reads it, then ``c·sqrt(z·z)``, the dot
         :func:`_frobenius` takes; ``None`` where ``value``, ``_c_at`` or ``_col`` is not this class's own."""
-        if not (_own_value(self, NormSubdifferential) and self._fast_c):
+        if not (_own_written(self, NormSubdifferential, "value") and self._fast_c):
             return None
-        c = _weight_value(self._c, t, self.name, "c(t)")
-        if type(c) is not float:
-            c = np.asarray(c, dtype=float)
-            if c.ndim:
-                return None         # value's NotImplementedError: met by its own calls
-            c = float(c)
+        c = self._one_weight(t)
+        if c is None:
+            return None             # value's NotImplementedError: met by its own calls
 
         def g(z):
             return c * _sqrt(z.dot(z))
@@ -540,14 +540,14 @@ class NormSubdifferential(_EverywhereDefined):
             return True
         return bool(nx > 0.0 and _frobenius(y - c * x / nx) <= tol)
 
-    _contains_written = contains     # the contains _contains_rows answers for (_own_contains)
+    _contains_written = contains     # the contains _contains_rows answers for (_own_written)
 
     def _contains_rows(self, X, Y, ts, tols):
         """:meth:`contains` of every row ``(X_i, Y_i, t_i, tol_i)`` at once (``(B,)`` booleans), bit-identically to the
         calls per row: ``c(t_i)`` as a block of times reads it, each norm the BLAS dot of its row (:func:`dot_rows`,
         :func:`_frobenius`'s number) and the same elementwise arithmetic; ``None`` where a member is not this class's
         own."""
-        if not (_own_contains(self, NormSubdifferential) and self._accepts_times()):
+        if not (_own_written(self, NormSubdifferential, "contains") and self._accepts_times()):
             return None
         c = np.broadcast_to(_weight_times(self._c, ts, self.name, "c(t)"), ts.shape)
         nx, ny = np.sqrt(dot_rows(X, X)), np.sqrt(dot_rows(Y, Y))
@@ -625,40 +625,42 @@ class L1Subdifferential(_EverywhereDefined):
 
     def value(self, x, t=0.0):
         """``g(t, x) = Σ c_i(t)|x_i|`` (``F(t,·) = ∂g(t,·)``): the value laws check the resolvent is its prox."""
-        p = self._c
-        # a constant's read-only float64 array is what _weight_at returns for it and np.asarray(·, float) keeps
-        c = p._value if p._fn is None else np.asarray(_weight_at(p, t, self.name, "c(t)"), dtype=float)
+        c = self._weight_now(t)
         if type(x) is not np.ndarray or x.dtype != np.float64:
             x = np.asarray(x, dtype=float)
         return float(np.add.reduce(c * np.abs(x), axis=None))   # np.sum without its dispatch
 
-    _value_written = value      # the value _value_rows answers for (_own_value)
+    _value_written = value      # the value _value_rows answers for (_own_written)
 
     def _value_rows(self, Z, t=0.0):
         """:meth:`value` of every row of ``Z`` ``(B, n)`` at the one time ``t``, or at ``t_i`` for row ``i`` with ``t`` of
         shape ``(B,)`` (``(B,)`` floats), bit-identically to the calls per row: ``c(t)`` read once as :meth:`value`
         reads it (a block of times by :meth:`_c_rows`, as :meth:`_accepts_times` declares), the same products and each row's sum NumPy's
         pairwise sum of that row, as the one-point reduction is; ``None`` where ``value`` is not this class's own."""
-        if not _own_value(self, L1Subdifferential):
+        if not _own_written(self, L1Subdifferential, "value"):
             return None
-        p = self._c
         if type(t) is np.ndarray:       # a time per row: c(t_i) as a block of times reads it (_accepts_times)
             if not self._accepts_times():
                 return None
             c = self._c_rows(t, Z)
         else:
-            c = p._value if p._fn is None else np.asarray(_weight_at(p, t, self.name, "c(t)"), dtype=float)
+            c = self._weight_now(t)
         Z = np.asarray(Z, dtype=float)
         return np.add.reduce(c * np.abs(Z), axis=1)
+
+    def _weight_now(self, t):
+        """``c(t)`` at one time as :meth:`value` reads it: a constant's read-only float64 array is what
+        :func:`_weight_at` returns for it and ``np.asarray(·, float)`` keeps."""
+        p = self._c
+        return p._value if p._fn is None else np.asarray(_weight_at(p, t, self.name, "c(t)"), dtype=float)
 
     def _value_at(self, t=0.0):
         """``z ↦`` :meth:`value` ``(z, t)`` for float64 points ``z`` of shape ``(n,)`` (a minimiser's many calls at one
         time), bit-identically: ``c(t)`` read once as :meth:`value` reads it, then the same product and sum; ``None``
         where ``value`` is not this class's own."""
-        if not _own_value(self, L1Subdifferential):
+        if not _own_written(self, L1Subdifferential, "value"):
             return None
-        p = self._c
-        c = p._value if p._fn is None else np.asarray(_weight_at(p, t, self.name, "c(t)"), dtype=float)
+        c = self._weight_now(t)
         add, absolute = np.add.reduce, np.abs
 
         def g(z):
@@ -681,12 +683,12 @@ class L1Subdifferential(_EverywhereDefined):
         on_branch = (x != 0.0) & (np.abs(y - c * np.sign(x)) <= tol)
         return bool(np.all(at_kink | on_branch))
 
-    _contains_written = contains     # the contains _contains_rows answers for (_own_contains)
+    _contains_written = contains     # the contains _contains_rows answers for (_own_written)
 
     def _contains_rows(self, X, Y, ts, tols):
         """:meth:`contains` of every row at once (``(B,)`` booleans), bit-identically to the calls per row: ``c(t_i)``
         as a block of times reads it and the same elementwise test; ``None`` where a member is not this class's own."""
-        if not (_own_contains(self, L1Subdifferential) and self._accepts_times()):
+        if not (_own_written(self, L1Subdifferential, "contains") and self._accepts_times()):
             return None
         c = np.broadcast_to(self._c_rows(ts, X), X.shape)
         tol = tols[:, None]
@@ -777,7 +779,7 @@ class NormalCone(Operator):
         # the ndarray's own max (np.max's dispatch is most of a small point's cost): the same reduction
         return bool((d.max() if type(d) is np.ndarray else np.max(d)) <= tol)
 
-    _contains_written = contains     # the contains _contains_rows answers for (_own_contains)
+    _contains_written = contains     # the contains _contains_rows answers for (_own_written)
 
     def _contains_rows(self, X, Y, ts, tols):
         """:meth:`contains` of every row ``(X_i, Y_i, t_i, tol_i)`` at once (``(B,)`` booleans), bit-identically to
@@ -785,7 +787,7 @@ class NormalCone(Operator):
         calls per row, as the catalog's sets declare) and the same exact maxima; ``None`` where the members are not
         the catalog's own.  ``proj(x + y)`` is computed for every row (a row outside ``S`` is then False as before;
         should it raise there, the caller asks row by row)."""
-        if not (_own_contains(self, NormalCone) and self._accepts_times()):
+        if not (_own_written(self, NormalCone, "contains") and self._accepts_times()):
             return None
         inside = self.S.contains(X, ts, tols)
         d = np.abs(self.S.project(X + Y, ts) - X).max(axis=1, initial=0.0)
@@ -880,14 +882,14 @@ class Shifted(Operator):
         tol = tolerance(x, p, y) if tol is None else tol
         return self.F.contains(x + p, y, t, tol)
 
-    _contains_written = contains     # the contains _contains_rows answers for (_own_contains)
+    _contains_written = contains     # the contains _contains_rows answers for (_own_written)
 
     def _contains_rows(self, X, Y, ts, tols):
         """:meth:`contains` of every row at once: the rows ``X_i + Φ(t_i)`` (the shift at each time, as
         :meth:`min_norm` takes it, bit-identical to ``Φ(t_i)``) handed to the inner operator's own block test; ``None``
         where a member is not this class's own or the inner operator has no block test."""
         inner = getattr(self.F, "_contains_rows", None)
-        if inner is None or not (_own_contains(self, Shifted) and self._accepts_times()):
+        if inner is None or not (_own_written(self, Shifted, "contains") and self._accepts_times()):
             return None
         return inner(X + self._shift(ts, X), Y, ts, tols)
 
@@ -1004,13 +1006,13 @@ class LogBarrier(Operator):
         hi = -c / (x + tol)
         return bool(((y >= lo - tol) & (y <= hi + tol)).all())
 
-    _contains_written = contains     # the contains _contains_rows answers for (_own_contains)
+    _contains_written = contains     # the contains _contains_rows answers for (_own_written)
 
     def _contains_rows(self, X, Y, ts, tols):
         """:meth:`contains` of every row at once (``(B,)`` booleans), bit-identically to the calls per row: ``c(t_i)`` as
         a block of times reads it and the same elementwise test (a row with a coordinate ``≤ 0`` False, as there);
         ``None`` where a member is not this class's own."""
-        if not (_own_contains(self, LogBarrier) and self._accepts_times()):
+        if not (_own_written(self, LogBarrier, "contains") and self._accepts_times()):
             return None
         c = self._c_rows(ts, X)
         c = c[:, None] if np.ndim(c) == 1 else c

@@ -9,7 +9,7 @@ evaluated on :func:`scale_samples`:
 
 * **the worst sample scaled** — ``x1, x2`` multiplied together so that ``max(|x1|_∞, |x2|_∞)`` runs over every
   ``stride``-th decade of ``[2^-1074, hi]`` (float64's smallest subnormal to :func:`scale_top`), ``stride`` the
-  smallest that ``SCALE_SHARE · points`` design points pay at the profile's coordinate budget (ci: every 18th
+  smallest that ``SCALE_SHARE · points`` design points pay at the profile's coordinate budget (ci: every 16th
   decade), with its step sizes and time; the top is lowered by ``min(1, λ, μ, ν)/max(1, λ, μ, ν)`` so that the
   laws' own ``|x|/λ`` and ``(μ/λ)x`` stay representable;
 * **whole points of one shape at the landmarks** (:func:`landmarks`: the smallest subnormal, every entry subnormal,
