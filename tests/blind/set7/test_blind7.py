@@ -5,21 +5,14 @@ misses are strict xfails whose reason is the measured miss (tests/blind/set7/REA
 
 import importlib.util
 import pathlib
-import sys
 
 import pytest
 
 _DIR = pathlib.Path(__file__).resolve().parent
-_NAME = "verimono_blind_set7"
-if _NAME not in sys.modules:
-    _spec = importlib.util.spec_from_file_location(_NAME, _DIR / "subjects.py")
-    _mod = importlib.util.module_from_spec(_spec)
-    sys.modules[_NAME] = _mod
-    _spec.loader.exec_module(_mod)
-S = sys.modules[_NAME]
 _RSPEC = importlib.util.spec_from_file_location("verimono_blind_set7_runner", _DIR / "run_blind7.py")
 runner = importlib.util.module_from_spec(_RSPEC)
 _RSPEC.loader.exec_module(runner)
+S = runner.subjects()
 
 PLANTS = [e for e in S.ENTRIES if not e.lawful]
 CONTROLS = [e for e in S.ENTRIES if e.lawful]

@@ -11,141 +11,31 @@ undecided (any failed or undecided record of a control is a false alarm, printed
 
 from __future__ import annotations
 
-import argparse
 import importlib.util
-import json
-import math
 import pathlib
-import subprocess
 import sys
-import time
 
 HERE = pathlib.Path(__file__).resolve().parent
+_spec = importlib.util.spec_from_file_location("verimono_blind_runner", HERE.parent / "blind_runner.py")
+common = sys.modules.get("verimono_blind_runner")
+if common is None:
+    common = importlib.util.module_from_spec(_spec)
+    sys.modules["verimono_blind_runner"] = common
+    _spec.loader.exec_module(common)
+
+BLIND = common.BlindSet(8, HERE / "run_blind8.py", __doc__)
 
 
 def subjects():
-    name = "verimono_blind_set8"
-    if name not in sys.modules:
-        spec = importlib.util.spec_from_file_location(name, HERE / "subjects.py")
-        mod = importlib.util.module_from_spec(spec)
-        sys.modules[name] = mod
-        spec.loader.exec_module(mod)
-    return sys.modules[name]
-
-
-def _num(v):
-    try:
-        v = float(v)
-    except (TypeError, ValueError):
-        return None
-    return v if math.isfinite(v) else str(v)
+    return BLIND.subjects()
 
 
 def run_one(name: str, seed: int, profile: str) -> dict:
-    import verimono as vm
-
-    entry = subjects().BY_NAME[name]
-    profile = None if profile == "default" else profile      # "default": no profile given (the run configuration's)
-    t0 = time.perf_counter()
-    subject = entry.build()
-    if entry.kind == "operator":
-        report = vm.check_operator(subject, seed=seed, profile=profile)
-    else:
-        stepper, extra = subject if isinstance(subject, tuple) else (subject, None)
-        problems = None
-        if extra:
-            import verimono.reference as ref
-            problems = [ref.get(n) for n in ref.names()] + list(extra)
-        report = vm.check_stepper(stepper, problems=problems, seed=seed, profile=profile)
-    secs = time.perf_counter() - t0
-    records = list(report)
-    bad = [r for r in records if r.status in ("failed", "undecided")]
-    return {"ok": bool(report.ok), "seconds": secs, "n_records": len(records),
-            "counts": {s: sum(r.status == s for r in records) for s in sorted({r.status for r in records})},
-            "records": [{"check": r.check, "subject": r.subject, "status": r.status, "worst": _num(r.worst),
-                         "bound": _num(r.bound), "message": (r.message or "")[:300],
-                         "counterexample": json.loads(json.dumps(r.counterexample, default=str))
-                         if r.counterexample else None} for r in bad]}
+    return common.run_one(BLIND, name, seed, profile)
 
 
-def child(name, seed, profile, cap):
-    t0 = time.perf_counter()
-    try:
-        cp = subprocess.run([sys.executable, str(HERE / "run_blind8.py"), "--one", name, "--seed", str(seed),
-                             "--profile", profile], capture_output=True, text=True, timeout=cap)
-    except subprocess.TimeoutExpired:
-        return {"error": f"timeout > {cap:g}s", "seconds": time.perf_counter() - t0}
-    line = [ln for ln in cp.stdout.splitlines() if ln.startswith("BLIND8-RESULT ")]
-    if not line:
-        tail = (cp.stderr.strip().splitlines() or ["no output"])[-1]
-        return {"error": f"crashed: {tail[:200]}", "seconds": time.perf_counter() - t0}
-    return json.loads(line[-1][len("BLIND8-RESULT "):])
-
-
-def verdict(entry, res) -> tuple[bool, str]:
-    """(as expected, what it shows): a plant caught by a failed record; a control with no failed/undecided."""
-    if "error" in res:
-        return False, res["error"]
-    failed = [r for r in res["records"] if r["status"] == "failed"]
-    undecided = [r for r in res["records"] if r["status"] == "undecided"]
-    if entry.lawful:
-        if not failed and not undecided:
-            return True, "passed"
-        worst = (failed or undecided)[0]
-        return False, f"FALSE ALARM {worst['status']} {worst['check']}[{worst['subject']}] worst={worst['worst']}"
-    if not failed:
-        extra = f" ({len(undecided)} undecided: {undecided[0]['check']})" if undecided else ""
-        return False, "MISSED" + extra
-    by_check: dict[str, dict] = {}
-    for r in failed:
-        w = r["worst"] if isinstance(r["worst"], float) else math.inf
-        cur = by_check.get(r["check"])
-        if cur is None or w > (cur["worst"] if isinstance(cur["worst"], float) else math.inf):
-            by_check[r["check"]] = r
-    text = "; ".join(f"{c} {r['worst'] if not isinstance(r['worst'], float) else format(r['worst'], '.3g')}"
-                     for c, r in sorted(by_check.items()))
-    return True, "caught: " + text
-
-
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--profile", default="ci", help="dev, ci, thorough, or default (no profile argument)")
-    ap.add_argument("--seeds", type=int, nargs="+", default=[0])
-    ap.add_argument("--cap", type=float, default=600.0, help="seconds per (entry, seed)")
-    ap.add_argument("--only", nargs="*", default=None)
-    ap.add_argument("--json", default=None, help="write every result here")
-    ap.add_argument("--one", default=None, help=argparse.SUPPRESS)
-    ap.add_argument("--seed", type=int, default=0, help=argparse.SUPPRESS)
-    args = ap.parse_args(argv)
-
-    if args.one is not None:
-        print("BLIND8-RESULT " + json.dumps(run_one(args.one, args.seed, args.profile)))
-        return 0
-
-    entries = subjects().ENTRIES
-    if args.only:
-        entries = [e for e in entries if e.name in set(args.only)]
-    out = {}
-    n_plants = n_caught = n_ctrl = n_pass = 0
-    for e in entries:
-        for seed in args.seeds:
-            res = child(e.name, seed, args.profile, args.cap)
-            good, text = verdict(e, res)
-            out[f"{e.name}@{seed}"] = {"lawful": e.lawful, "kind": e.kind, "good": good, "text": text, **res}
-            print(f"{e.name:34s} {'control' if e.lawful else 'plant':7s} s{seed} {res.get('seconds', 0):6.1f}s  {text}",
-                  flush=True)
-            if e.lawful:
-                n_ctrl += 1
-                n_pass += good
-            else:
-                n_plants += 1
-                n_caught += good
-    print(f"blind set 8 ({args.profile}): caught {n_caught} of {n_plants} plant runs, "
-          f"controls passed {n_pass} of {n_ctrl}")
-    if args.json:
-        pathlib.Path(args.json).write_text(json.dumps(out, indent=1, default=str))
-    return 0
+verdict = common.verdict
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(common.main(BLIND))
