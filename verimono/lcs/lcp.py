@@ -539,7 +539,6 @@ def _solve_unit(M, q, least_norm, backends) -> LCPResult:
     if zbar is None and psd and n <= PSD_ENUM_MAX and backends is None:
         # Lemke's pivots and the phase-1 QP at their numerical limit on data spanning many decades (the paper's
         # Example at λ = 1e-15, x = −1e-9: M = [[0, 1], [−1, 1e-15]], z = (0, 1e6), Lemke ends on a ray): the
-        # complementary pieces are exact for any M, each point verified
         # complementary pieces are exact for any M: each piece's principal solve, verified (ill-conditioned pieces
         # included — the Example at λ = 1e7 has cond M = 1e14 — the residual check is the arbiter)
         for alpha in _pieces(n):

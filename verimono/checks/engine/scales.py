@@ -4,8 +4,8 @@ The draws, the edge samples and the sweep (:mod:`.sweep`) put ``|x|`` between ``
 samples put subnormals and tiny numbers *beside* ordinary entries; no phase scales a whole point down into the
 subnormal range or up toward overflow.  A subject wrong only there — an overflow-safe norm computed as
 ``x · (1/max|x_i|)``, whose reciprocal is ``+inf`` when *every* entry is below ``2^-1024`` (blind set 8,
-``ball_reciprocal_scale_subnormal``: NaN out) — was met at some seeds only.  So, after the sweep, each law is
-evaluated on :func:`scale_samples`:
+``ball_reciprocal_scale_subnormal``: NaN out) — was met at some seeds only.  So, after the sweep, each law on an operator of at most
+``NUMPY_DIM`` (64) coordinates is evaluated on :func:`scale_samples` (the search's ``_search`` runs the phase):
 
 * **the worst sample scaled** — ``x1, x2`` multiplied together so that ``max(|x1|_∞, |x2|_∞)`` runs over every
   ``stride``-th decade of ``[2^-1074, hi]`` (float64's smallest subnormal to :func:`scale_top`), ``stride`` the
