@@ -15,7 +15,7 @@ import numpy as np
 from ..core.arrays import as_float64
 from ..core._small import abs_max, all_finite
 from ..core.errors import NotApplicable, OutsideDomain
-from ..core.tolerances import current_eps, tolerance
+from ..core.tolerances import current_data_scale, current_eps, tolerance
 from .engine.samples import NUMPY_DIM
 
 
@@ -98,7 +98,7 @@ def outside_by_roundoff_of_dom_g(op: Any, p: np.ndarray, t: float, scale: float,
     ``|x| = 10^6`` by ~0.1), and a strict indicator (``+inf`` at every point outside) rejects that point: not
     a violation of the law but of nothing (section "Judged at the subject's precision" of docs/precision.md).
     A point farther out stays the resolvent's fault."""
-    base = current_eps() * (1.0 + float(scale))
+    base = current_eps() * (1.0 + max(float(scale), current_data_scale()))   # the operator's own scale (tolerances.py)
     reach = ROUNDOFF_ULPS[-1] * base
     dirs = []
     for v in (normal, p):

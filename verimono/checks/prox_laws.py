@@ -31,7 +31,7 @@ import numpy as np
 from ..core.arrays import as_float64
 from ..core._rows import dot_rows
 from ..core._small import abs_max
-from ..core.tolerances import current_eps, current_precision, current_rtol, tolerance
+from ..core.tolerances import current_data_scale, current_eps, current_precision, current_rtol, tolerance
 from .core import Member, Outcome, ratio as _ratio
 from ._powell import powell
 from ..core.errors import NotApplicable
@@ -81,7 +81,7 @@ def _amax(v: np.ndarray) -> float:
 def _tol(rtol: float, *maxima: float) -> float:
     """:func:`verimono.core.tolerances.tolerance` of arrays whose maxima (:func:`_amax`) are known: the same loop
     (a NaN maximum is passed over there too), so the same number without reading the arrays again."""
-    m = 0.0
+    m = current_data_scale()            # the operator's own scale under judgement: one more magnitude, as there
     for a in maxima:
         if a > m:
             m = a

@@ -13,6 +13,7 @@ user's resolvent (and whichever members they have) as an :class:`Operator`; the 
 from __future__ import annotations
 
 import inspect
+import math
 from typing import Any, Callable
 
 import numpy as np
@@ -36,6 +37,11 @@ class Operator:
     static: bool = False
     #: True when ``dom F(t,·) = R^n`` for every ``t`` (so (A3) holds with ``φ ≡ 0``).
     full_domain: bool = False
+    #: the magnitude of the data the members compute with (``|c| + r`` for the ball of radius ``r`` centred at ``c``),
+    #: when it exceeds the points they are given: the laws then judge them at that scale, since correct code rounds
+    #: at it (:mod:`verimono.core.tolerances`, "the operator's own scale").  ``None``: not stated (a law that fails
+    #: only within the rounding of the scale inferred from the domain is undecided: verimono.checks.engine.data_scale)
+    data_scale: float | None = None
 
     def __init__(self, dim: int, name: str | None = None) -> None:
         if int(dim) != dim or dim < 1:
@@ -297,7 +303,7 @@ def operator_from_resolvent(resolvent: Callable[[np.ndarray, float, float], Any]
                             min_norm: Callable | None = None, project_domain: Callable | None = None,
                             contains: Callable | None = None, name: str | None = None,
                             value: Callable | None = None, array: Any = None, dtype: Any = None,
-                            device: Any = None, batched: bool = False) -> Operator:
+                            device: Any = None, batched: bool = False, data_scale: float | None = None) -> Operator:
     """Wrap a user's ``resolvent(x, lam, t)`` as an :class:`Operator`.
 
     Optional callables: ``min_norm(x, t)``, ``project_domain(x, t)``, ``contains(x, y, t[, tol])``,
@@ -310,10 +316,28 @@ def operator_from_resolvent(resolvent: Callable[[np.ndarray, float, float], Any]
     Their outputs are converted to NumPy float64 with their precision recorded, so a float32 resolvent is
     judged at float32 precision.  ``batched=True``: ``resolvent(X, lams, ts)`` maps points ``(B, n)`` with
     steps and times ``(B,)`` at once, and the search evaluates its draws and sweep a batch at a time.
+    ``data_scale``: the magnitude of the data the members compute with, when larger than the points they are given
+    (:attr:`Operator.data_scale`: the projection onto a ball centred at ``c`` of radius ``r`` rounds at ``|c| + r``).
     """
     if not callable(resolvent):
         raise InvalidProblem("resolvent must be callable as resolvent(x, lam, t)")
     if value is not None and not callable(value):
         raise InvalidProblem("value must be callable as value(x) or value(x, t)")
     io = Boundary(array_kind(array, dtype=dtype, device=device))
-    return _FromResolvent(resolvent, dim, min_norm, project_domain, contains, name, value, io, batched)
+    return with_data_scale(_FromResolvent(resolvent, dim, min_norm, project_domain, contains, name, value, io, batched),
+                           data_scale)
+
+
+def with_data_scale(op: Operator, data_scale: float | None) -> Operator:
+    """``op`` with its stated :attr:`Operator.data_scale` (``None``: left unstated); a scale that is not a finite
+    number ``≥ 0`` is an :class:`InvalidProblem`."""
+    if data_scale is not None:
+        try:
+            s = float(data_scale)
+        except (TypeError, ValueError):
+            s = math.nan
+        if not (math.isfinite(s) and s >= 0.0) or isinstance(data_scale, bool):
+            raise InvalidProblem(f"data_scale must be a finite number ≥ 0 (the magnitude of the operator's data), "
+                                 f"got {data_scale!r}")
+        op.data_scale = s
+    return op

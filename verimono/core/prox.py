@@ -35,6 +35,7 @@ from ._subgradients import (CONTAINS_POINTS, ProxOutputError, checked_value, con
 from .arrays import Boundary, array_kind, as_float64, batch_chunks, given_as_is, take_prefetched
 from .errors import InvalidProblem
 from .operators import Operator
+from .operator_protocol import with_data_scale
 
 def _arity(fn: Callable, with_t: int) -> bool:
     """Whether ``fn`` takes the time argument as its ``with_t``-th positional argument: that many positional
@@ -228,7 +229,7 @@ class ProxOperator(Operator):
 def operator_from_prox(prox: Callable, *, value: Callable | None = None, shape: Any = None,
                        name: str | None = None, unwrap: int | Callable | None = None, array: Any = None,
                        dtype: Any = None, device: Any = None, batched: bool = False,
-                       step: str | bool | None = None) -> ProxOperator:
+                       step: str | bool | None = None, data_scale: float | None = None) -> ProxOperator:
     """``F = ∂g`` from ``prox(x, lam) = argmin_z lam·g(z) + |z - x|²/2`` (or ``prox(x, lam, t)`` for a
     time-dependent ``g``), on arrays of ``shape`` (an int ``n`` or a tuple; the Frobenius inner product).
 
@@ -251,11 +252,14 @@ def operator_from_prox(prox: Callable, *, value: Callable | None = None, shape: 
 
     ``batched=True``: ``prox`` maps a batch — points ``(B, *shape)``, steps ``(B,)`` (and times ``(B,)``) —
     to ``(B, *shape)`` (``jax.vmap``, ``torch.vmap`` or vectorised code); the search then evaluates its
-    NumPy draws and its sweep a batch at a time (:mod:`verimono.checks.engine.batches`)."""
+    NumPy draws and its sweep a batch at a time (:mod:`verimono.checks.engine.batches`).
+
+    ``data_scale``: the magnitude of the data the prox computes with, when larger than the points it is given
+    (:attr:`verimono.Operator.data_scale`)."""
     if shape is None:
         raise InvalidProblem("operator_from_prox needs shape= (an int n for R^n, or a tuple such as (m, n))")
-    return ProxOperator(prox, value=value, shape=shape, name=name, unwrap=unwrap, array=array, dtype=dtype,
-                        device=device, batched=batched, step=step)
+    return with_data_scale(ProxOperator(prox, value=value, shape=shape, name=name, unwrap=unwrap, array=array,
+                                        dtype=dtype, device=device, batched=batched, step=step), data_scale)
 
 
 __all__ = ["ProxOperator", "ProxOutputError", "operator_from_prox", "subgradient_contains", "contains_points", "CONTAINS_POINTS"]

@@ -222,12 +222,47 @@ def current_eps() -> float:
     return EPS if p is None else p.eps
 
 
+# -- the operator's own scale: the magnitude of the data it computes with --------------------------------
+# A correct subject rounds at the magnitude of what it computes with, not only of what it was given: the
+# projection onto a ball of radius 1e6 centred at 1e6·e_1 forms x − c (|x − c| ≈ 1e6) for a point x of size 0.006
+# near the origin, and returns c + r(x − c)/|x − c|, a cancellation that leaves an error of eps·1e6 (float32: 0.06)
+# in a result of size 0.006.  Judged at the magnitude of the points alone (rtol·(1 + 0.006)) that correct code
+# fails the exact identities by 12.9 times their slack (float32), 10^3 times in float64 at 1e12.  The points a law
+# touched say nothing of the operator's data, so the data's magnitude ``S`` enters the one rule as one more
+# scale: ``tolerance = rtol·(1 + max(|inputs|, S))``.  ``S`` is the operator's ``data_scale`` when it states one
+# (``verimono.operator_from_resolvent(..., data_scale=S)``, or the attribute on any operator); else 0, and a law
+# that fails is judged once more at the scale inferred from the operator's domain (verimono.checks.engine.data_scale):
+# a violation within the rounding of that scale is *undecided*, never failed nor passed, and the record says so.
+
+_DATA_SCALE: contextvars.ContextVar[float] = contextvars.ContextVar("verimono_data_scale", default=0.0)
+
+
+@contextlib.contextmanager
+def judged_at_scale(scale: float | None) -> Iterator[float]:
+    """Judge what runs inside with the operator's own scale ``scale`` (``None`` or 0: the inputs' magnitudes
+    alone) as one more magnitude of every :func:`tolerance`; yields the scale in force."""
+    s = 0.0 if scale is None else float(scale)
+    if not (math.isfinite(s) and s >= 0.0):
+        raise ValueError(f"an operator's data scale is a finite number ≥ 0, got {scale!r}")
+    token = _DATA_SCALE.set(s)
+    try:
+        yield s
+    finally:
+        _DATA_SCALE.reset(token)
+
+
+def current_data_scale() -> float:
+    """The operator's own scale under judgement (0 outside :func:`judged_at_scale`)."""
+    return _DATA_SCALE.get()
+
+
 def tolerance(*scales: float, rtol: float | None = None) -> float:
     """Tolerance for a comparison between quantities of size ``max(scales)``: ``rtol * (1 + max)``, with
-    ``rtol`` the precision's under judgement (``RTOL`` for float64 and outside any judgement)."""
+    ``rtol`` the precision's under judgement (``RTOL`` for float64 and outside any judgement); the operator's own
+    scale under judgement (:func:`judged_at_scale`) is one more of the ``scales``."""
     if rtol is None:
         rtol = current_rtol()
-    m = 0.0
+    m = _DATA_SCALE.get()
     for s in scales:
         if type(s) is np.ndarray:          # the common case, without np.max's dispatch (a law calls this per step)
             if s.dtype.kind == "f" and s.size > 4096:    # no |s| copy of a large array: max(max, -min), the same number
@@ -245,7 +280,8 @@ def tolerance(*scales: float, rtol: float | None = None) -> float:
 
 def row_tolerances(*rows: np.ndarray, rtol: float | None = None) -> np.ndarray:
     """:func:`tolerance` of row ``k`` of every array at once: ``rtol * (1 + max_j |rows_j[k]|∞)`` for each ``k``
-    (arrays of shape ``(K, n)``, or ``(K,)`` for scalars per row): what a law computes per step, in one pass."""
+    (arrays of shape ``(K, n)``, or ``(K,)`` for scalars per row): what a law computes per step, in one pass (the
+    operator's own scale under judgement one more magnitude, as in :func:`tolerance`)."""
     if rtol is None:
         rtol = current_rtol()
     m = None
@@ -259,6 +295,9 @@ def row_tolerances(*rows: np.ndarray, rtol: float | None = None) -> np.ndarray:
         m = a if m is None else np.maximum(m, a)
     if m is None:
         raise ValueError("row_tolerances needs at least one array")
+    s = _DATA_SCALE.get()
+    if s:
+        m = np.maximum(m, s)
     return rtol * (1.0 + m)
 
 #: relative LCP residual below which a back-end's candidate is refined by one active-set (principal
