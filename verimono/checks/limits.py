@@ -119,6 +119,23 @@ def _distances_by_columns(xa2: np.ndarray, ka: np.ndarray, wa: np.ndarray, xb2: 
     return np.sqrt(acc)
 
 
+def own_trend_tail(before: float, last: float, tol: float, ratio_floor: float = LIMIT_RATIO_FLOOR) -> tuple[float, float]:
+    """``(tail, r)``: the estimated distance to its limit of the finer member of the last pair of a sequence
+    whose successive (4-fold refinement) differences were ``before`` and then ``last`` — the a-posteriori bound
+    ``last · r/(1 − r)`` of a geometrically convergent sequence with ``r = last/before`` (Banach's fixed-point
+    estimate; Aitken's Δ² model: a rate ``h^p`` is geometric on 4-fold refinements, ``r = 4^{-p}``), ``r`` raised
+    to ``ratio_floor`` (a fall faster than the scheme's order is pre-asymptotic and does not extrapolate; by
+    default :data:`LIMIT_RATIO_FLOOR`, order 1), times :data:`LIMIT_TAIL_SAFETY`.  A ``last`` difference at
+    ``tol`` (round-off) is its own tail with ``r = 0``; ``r ≥ 1`` (not shrinking: no limit in sight) an infinite
+    tail.  :func:`check_unique_limit`'s tail, and :mod:`verimono.checks.agreement`'s for a stepper and for
+    :func:`verimono.solve`."""
+    if last <= tol:
+        return last, 0.0
+    r = last / before if before > 0 else np.inf
+    re = max(r, ratio_floor)
+    return (LIMIT_TAIL_SAFETY * last * re / (1.0 - re) if r < 1.0 else np.inf), r
+
+
 @stepper_law("unique_limit", "the limit of x_Δ is the unique solution (Section 5.4)", over_grids=False)
 def check_unique_limit(stepper: Callable, p: Problem, *, levels: Sequence[int] = LIMIT_LEVELS,
                        seed: int = 0) -> Outcome:
@@ -226,13 +243,7 @@ def check_unique_limit(stepper: Callable, p: Problem, *, levels: Sequence[int] =
                      for m in (M - 2, M - 1)] for k in kinds}
         tails, ratios = {}, {}
         for k, c in diffs.items():
-            if c[-1] <= tol:
-                tails[k], ratios[k] = c[-1], 0.0
-                continue
-            r = c[-1] / c[-2] if c[-2] > 0 else np.inf
-            ratios[k] = r
-            re = max(r, LIMIT_RATIO_FLOOR)      # a faster fall than order 1 is pre-asymptotic
-            tails[k] = LIMIT_TAIL_SAFETY * c[-1] * re / (1.0 - re) if r < 1.0 else np.inf
+            tails[k], ratios[k] = own_trend_tail(c[-2], c[-1], tol)
         D, info = cross(M, since)
         if len(kinds) == 1:         # one kind (grids="uniform"): the Cauchy criterion alone
             return D, info, diffs, tails, ratios, -np.inf, tol, any(r >= 1.0 for r in ratios.values())
@@ -290,4 +301,4 @@ def check_unique_limit(stepper: Callable, p: Problem, *, levels: Sequence[int] =
                    details=details)
 
 
-__all__ = ["check_unique_limit", "LIMIT_LEVELS"]
+__all__ = ["check_unique_limit", "own_trend_tail", "LIMIT_LEVELS"]

@@ -11,9 +11,10 @@ scheme is exact at the nodes, ``worst = max error / round-off floor``.  The stud
 
 A problem without an exact solution is measured against a fine-grid solution of the same stepper: that is
 self-convergence, which a scheme converging to a wrong limit (an input or a field dropped) passes.  So the
-limit is checked too (:func:`limit_agreement`): on the study's finest grid the stepper and
-:func:`verimono.solve` — the proximal scheme, whose limit is the solution (Theorem ``thm:main``) — must agree
-within ``LIMIT_FACTOR`` times the sum of their estimated errors there.
+limit is checked too (:func:`verimono.checks.agreement.limit_agreement`): the stepper's limit and that of
+:func:`verimono.solve` — the proximal scheme, whose limit is the solution (Theorem ``thm:main``) — each
+estimated from its own 4-fold refinements, must be within the law's resolution of each other (passed), or are
+provably apart (failed), or the levels cannot tell (undecided, never a pass).
 """
 
 from __future__ import annotations
@@ -21,49 +22,19 @@ from __future__ import annotations
 import math
 from typing import Any, Callable
 
-import numpy as np
 
 from ..core.claims import claim_of
-from ..core.convergence import _timed_run, convergence_study, expected_order, study_grids
+from ..core.convergence import convergence_study, expected_order
 from ..core.errors import InvalidProblem
 from ..core.grid_design import cells_range
 from ..core.grids import uniform_grid
 from ..core.problem import Problem, origin_of
 from ..records.results import FAILED, PASSED, UNDECIDED
 from ..core.stepping import solve
+from .agreement import limit_agreement
 from .core import Outcome, law, subject_name
 from .partitions import run_once
 from .shared_runs import note_partitions
-
-
-#: the stepper's and verimono.solve's solutions on the finest grid may differ by this many times the sum of
-#: their estimated errors there: each estimate is against a solution 8x finer, which underestimates the true
-#: error by at most 1/(1 - 8^-p) (1.5x at the catalog's lowest order 1/2), and error constants vary by up to
-#: 2x between the grids of a study
-LIMIT_FACTOR = 4.0
-
-
-def limit_agreement(stepper: Callable, study: Any, problem: Problem) -> tuple[bool, str, dict]:
-    """Whether ``stepper`` converges to the limit of :func:`verimono.solve` on ``problem`` (see the module
-    docstring): their sup distance on the finest grid of ``study`` against ``LIMIT_FACTOR`` times the sum of
-    their estimated errors there (each from its own study on the same grids), plus both round-off floors."""
-    grids = study.grids()                         # coarse to fine, the grids the study chose
-    if any(g is None for g in grids):             # explicit nonuniform grids: those the problem gave
-        grids = sorted(study_grids(problem.T, default_steps(problem)), key=len)
-    k = int(np.argmin(study.mesh))
-    grid = grids[k]
-    ref = convergence_study(solve, problem, [grids[int(np.argsort(study.mesh)[1])], grid], adapt=False)
-    ours, _ = _timed_run(stepper, problem, grid)
-    theirs, _ = _timed_run(solve, problem, grid)
-    e_ours, e_ref = float(study.errors["sup"][k]), float(ref.errors["sup"][-1])
-    bound = LIMIT_FACTOR * (e_ours + e_ref) + study.floor + ref.floor
-    gap = float(np.max(np.linalg.norm((ours - theirs).reshape(len(grid), -1), axis=1)))
-    info = {"distance": gap, "bound": bound, "stepper_error": e_ours, "solve_error": e_ref, "steps": len(grid) - 1}
-    if gap <= bound:
-        return True, f"its limit agrees with verimono.solve's (distance {gap:.3g} ≤ {bound:.3g} on K = {len(grid) - 1})", info
-    return False, (f"converges, but not to the solution: on K = {len(grid) - 1} it is {gap:.3g} from verimono.solve "
-                   f"(the proximal scheme, whose limit is the solution), more than {LIMIT_FACTOR:g} x the two "
-                   f"estimated errors {e_ours:.3g} + {e_ref:.3g}: self-convergence alone does not show the limit"), info
 
 
 #: the step sizes of a study on a problem that states none, as fractions of ``T`` (the study adds coarser and finer
@@ -133,16 +104,18 @@ def check_convergence_order(stepper: Callable, problem: Problem, *, executor: An
     decision = study.decision()
     ok, msg, worst = decision.ok, decision.message, decision.worst
     details = {"study": study, "reproduce_python": reproduction_script(problem)}
+    limit = None
     if ok and problem.exact is None and getattr(stepper, "fn", stepper) is not solve:
-        ok, why, details["limit"] = limit_agreement(stepper, study, problem)
+        limit, why, details["limit"] = limit_agreement(stepper, study, problem)
         msg = f"{msg}; {why}"
-        if not ok:
+        ok = limit == PASSED
+        if limit == FAILED:
             worst = max(worst, details["limit"]["distance"] / details["limit"]["bound"])
     if not claim_of(stepper).proximal or inexact is not None:
         details["expected"] = {"order": exp.value, "source": exp.source}
     if study.added:         # the cells of the grids the study chose itself (coarser, finer)
         details["grids_added"] = [study.steps[i] for i in study.added]
-    status = PASSED if ok else (UNDECIDED if decision.status == UNDECIDED else FAILED)
+    status = PASSED if ok else (UNDECIDED if UNDECIDED in (decision.status, limit) else FAILED)
     # the study's verdict decides; the ratio says by how much
     return Outcome(worst, details=details, message=msg, status=status,
                    counter={} if ok else {"steps": study.mesh, "errors": study.errors["sup"], "message": msg})
@@ -183,4 +156,4 @@ def reproduction_script(problem: Problem) -> str:
     return "\n".join(lines + ["print(check_convergence_order(stepper, problem))"])
 
 
-__all__ = ["check_convergence_order", "limit_agreement", "reproduction_script", "LIMIT_FACTOR"]
+__all__ = ["check_convergence_order", "limit_agreement", "reproduction_script"]
