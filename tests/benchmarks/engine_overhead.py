@@ -82,15 +82,35 @@ def cells(searched: dict) -> float:
     return total
 
 
-def measure(op: Any, seed: int = 0, profile: str = "ci", clock: SubjectClock | None = None) -> dict:
+def measure(op: Any, seed: int = 0, profile: str = "ci", clock: SubjectClock | None = None,
+            per_law: bool = False) -> dict:
     """``check_operator(op)`` at ``profile``: CPU seconds, law evaluations, subject seconds and calls (``clock``,
     when the subject's resolvent is wrapped by one), the engine's own time per evaluation and the resolution
-    cells of the records."""
+    cells of the records.  With ``per_law``, ``laws``: each law's ``[CPU s, subject s]`` (the time from the record
+    before to its own, read where the battery adds it to its report)."""
     import verimono as vm
     if clock is not None:
         clock.seconds = clock.calls = clock.rows = clock.member_seconds = clock.member_calls = 0
+    laws: dict[str, list[float]] = {}
+    report_cls = type(vm.Report())
+    add = report_cls.__dict__.get("add")
+    if per_law and add is not None:
+        mark = [time.process_time(), 0.0]
+
+        def timed_add(self, result):          # a law's record: the CPU and subject time since the last one
+            now, sub = time.process_time(), clock.seconds if clock is not None else 0.0
+            row = laws.setdefault(getattr(result, "check", "?"), [0.0, 0.0])
+            row[0] += now - mark[0]
+            row[1] += sub - mark[1]
+            mark[0], mark[1] = now, sub
+            return add(self, result)
+        report_cls.add = timed_add
     start = time.process_time()
-    rep = vm.check_operator(op, seed=seed, profile=profile)
+    try:
+        rep = vm.check_operator(op, seed=seed, profile=profile)
+    finally:
+        if per_law and add is not None:
+            report_cls.add = add
     cpu = time.process_time() - start
     evals = sum(int(r.details.get("evaluations", 0) or 0) for r in rep.results)
     res = sum(cells(r.details.get("searched", {})) for r in rep.results)
@@ -103,6 +123,8 @@ def measure(op: Any, seed: int = 0, profile: str = "ci", clock: SubjectClock | N
                    member_s=clock.member_seconds, member_calls=clock.member_calls,
                    own_us_per_eval=1e6 * own / max(1, evals), subject_us_per_eval=1e6 * clock.seconds / max(1, evals),
                    own_over_subject=own / clock.seconds if clock.seconds > 0 else math.inf)
+    if per_law:
+        out["laws"] = laws
     return out
 
 
@@ -132,14 +154,22 @@ def catalog() -> dict[str, Callable[[], Any]]:
 #: the members besides the resolvent timed as the subject's own by ``timed_catalog(..., members=True)``
 MEMBERS = ("min_norm", "contains", "project_domain", "value")
 
+#: the catalog's members of a block of rows (one call for many rows, bit-identical to the member per row), timed
+#: as the subject's own with ``members=True``; ``_value_at`` returns the function it times
+BLOCKS = ("_contains_rows", "_value_rows")
+
 
 def timed_catalog(name: str, members: bool = False):
     """The catalog operator ``name`` with its class's resolvent wrapped by a :class:`SubjectClock` (on the class,
-    so that the operator keeps its fast paths) — with ``members``, its other :data:`MEMBERS` on the same clock;
+    so that the operator keeps its fast paths) — with ``members``, its other :data:`MEMBERS`, its block members
+    (:data:`BLOCKS`) and the functions its ``_value_at`` returns on the same clock.  A member the class marks as
+    its own (``_<member>_written``, which its block members check before they answer for it) is marked with its
+    wrapper, so that the blocks still answer as in a user's run, a block call counted as one subject call;
     returns ``(op, clock, undo)``."""
     op = catalog()[name]()
     cls = type(op)
-    originals = {m: cls.__dict__.get(m) for m in ("resolvent",) + MEMBERS}
+    names = ("resolvent",) + MEMBERS + BLOCKS + ("_value_at",) + tuple(f"_{m}_written" for m in MEMBERS)
+    originals = {m: cls.__dict__.get(m) for m in names}
     inner = getattr(cls, "resolvent")
     clock = SubjectClock(inner)
 
@@ -147,9 +177,21 @@ def timed_catalog(name: str, members: bool = False):
         return clock(self, x, lam, t)
     cls.resolvent = resolvent
     if members:
-        for m in MEMBERS:
-            if callable(getattr(cls, m, None)):
-                setattr(cls, m, clock.member(getattr(cls, m)))
+        provides = getattr(op, "provides", None)
+        for m in MEMBERS + BLOCKS:
+            f = getattr(cls, m, None)
+            # a member the operator does not provide stays unwrapped: a wrapper would look provided to the laws
+            if callable(f) and (m in BLOCKS or not callable(provides) or provides(m)):
+                w = clock.member(f)
+                setattr(cls, m, w)
+                if originals.get(f"_{m}_written") is not None and originals[f"_{m}_written"] is f:
+                    setattr(cls, f"_{m}_written", w)
+        value_at = getattr(cls, "_value_at", None)
+        if callable(value_at):
+            def timed_value_at(self, t=0.0, _at=value_at):
+                g = clock.member(_at)(self, t)
+                return None if g is None else clock.member(g)
+            cls._value_at = timed_value_at
 
     def undo() -> None:
         for m, original in originals.items():
@@ -207,9 +249,10 @@ def main(rounds: int = 3) -> None:
     print(json.dumps({"verimono": getattr(vm, "__version__", "?"), "rows": rows}))
 
 
-def main_members(rounds: int = 3, seeds: tuple = (0, 1, 2)) -> None:
-    """As :func:`main`, with every member of the catalog's operators timed as the subject's own (``members=True``):
-    prints one JSON row per operator and seed."""
+def main_members(rounds: int = 3, seeds: tuple = (0, 1, 2), per_law: bool = False) -> None:
+    """As :func:`main`, with every member of the catalog's operators timed as the subject's own (``members=True``,
+    the block members too): prints one JSON row per operator and seed (with ``per_law``, each law's CPU and
+    subject seconds)."""
     import json
     import verimono as vm
     vm.check_operator(catalog()["NormalCone(Ball) n=3"](), seed=99, profile="ci")     # warm: imports, caches
@@ -217,19 +260,20 @@ def main_members(rounds: int = 3, seeds: tuple = (0, 1, 2)) -> None:
         for r in seeds[:rounds]:
             op, clock, undo = timed_catalog(name, members=True)
             try:
-                print(json.dumps({"operator": name, "seed": r, **measure(op, seed=r, clock=clock)}), flush=True)
+                print(json.dumps({"operator": name, "seed": r,
+                                  **measure(op, seed=r, clock=clock, per_law=per_law)}), flush=True)
             finally:
                 undo()
     lib = pyproximal_box()
     if lib is not None:
         for r in seeds[:rounds]:
-            print(json.dumps({"operator": "pyproximal.Box n=3", "seed": r, **measure(lib[0], seed=r, clock=lib[1])}),
-                  flush=True)
+            print(json.dumps({"operator": "pyproximal.Box n=3", "seed": r,
+                              **measure(lib[0], seed=r, clock=lib[1], per_law=per_law)}), flush=True)
 
 
 if __name__ == "__main__":
     import sys
     if "--members" in sys.argv:
-        main_members()
+        main_members(per_law="--laws" in sys.argv)
     else:
         main()

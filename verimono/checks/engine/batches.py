@@ -159,8 +159,11 @@ class Rows:
         # np.array of the points (not np.stack: ~4x its cost per row here, the same numbers; a ragged list raises alike)
         self.x1 = np.array([s.x1 for s in samples], dtype=float)
         self.x2 = np.array([s.x2 for s in samples], dtype=float)
-        self.lam, self.mu, self.nu, self.t = (np.array([getattr(s, k) for s in samples], dtype=float)
-                                              for k in ("lam", "mu", "nu", "t"))
+        # the four numbers of every sample in one pass (the same float64s as one array per field), a row per field
+        if len(samples):
+            self.lam, self.mu, self.nu, self.t = np.array([(s.lam, s.mu, s.nu, s.t) for s in samples], dtype=float).T.copy()
+        else:
+            self.lam, self.mu, self.nu, self.t = (np.zeros(0) for _ in range(4))
         self.ok = np.ones(len(samples), dtype=bool)
         self.err = None
         self.inconclusive, self.inconclusive_what = None, ""

@@ -38,7 +38,7 @@ import numpy as np
 
 from ...execution.interrupts import interruptible
 from ..members import norm
-from .samples import NUMPY_DIM, Sample
+from .samples import NUMPY_DIM, Sample, with_field
 
 #: the refinement's first and finest rotation angles (radians)
 FIRST_ANGLE = 0.3
@@ -118,7 +118,7 @@ def direction_search(evaluate: Callable[[Sample], float], op: Any, s: Sample, po
         return None
 
     def at(d: np.ndarray, radius: float = r) -> Sample:
-        return dataclasses.replace(s, x2=s.x1 + radius * d)
+        return with_field(s, "x2", s.x1 + radius * d)
 
     best = [-math.inf, (s.x2 - s.x1) / r, r]
 
