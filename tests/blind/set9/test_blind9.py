@@ -18,7 +18,15 @@ PLANTS = [e for e in S.ENTRIES if not e.lawful]
 CONTROLS = [e for e in S.ENTRIES if e.lawful]
 
 #: plants verimono's ci battery (seed 0) misses: name -> the measured reason (tests/blind/set9/README.md)
-MISSED: dict[str, str] = {}
+MISSED: dict[str, str] = {
+    "box_returns_shared_buffer": "missed at ci seeds 0-2, dev and thorough seed 0 (main 0288656): every law passed; "
+                                 "no operator law holds a value J_λx1 across a later call J_λx2 (the resolvent returns "
+                                 "its own scratch buffer, which the next call overwrites)",
+    "box_value_strict_bounds": "missed at ci seeds 0-2, dev and thorough seed 0 (main 0288656): prox_inequality, prox_optimal, "
+                               "prox_minimiser, moreau_envelope passed with 50, 50, 38, 52 samples inconclusive -- the "
+                               "prox lands exactly on a face where the declared g is +inf, which is judged as rounding "
+                               "at an open domain's boundary, not as a failure",
+}
 
 
 def test_set_shape():
