@@ -10,11 +10,13 @@ at a relative residual ``10^-6``; proximal maps of non-convex penalties (hard an
 resolvent symmetrised (its skew part dropped); a block soft threshold forgetting a ragged last group; a soft
 threshold in blocks of 8 whose scalar tail (coordinates 8, 9) forgets λ; the prox of a smoothed function (Huber)
 declared with the value of the original (``|·|_1``); a box's value with strict bounds (``+inf`` on the faces the
-prox lands on); odd coordinates clipped from above only.  Steppers that integrate internally on their own
+prox lands on); odd coordinates clipped from above only; a soft threshold computed in place on a writeable
+float64 input.  Steppers that integrate internally on their own
 uniform grid and interpolate, refill a 256-cell input buffer only once, record the predictor at integer times,
 take ``f`` after the input, freeze ``f`` at ``x0``, accumulate the input increments, sub-step cells above 0.1,
 project ``x0`` first, extrapolate (Richardson), alias the predictor to the stored state (an in-place ``+=``),
-multiply ``∫u`` by ``h`` once more, or step ``f`` with Adams–Bashforth 2.
+multiply ``∫u`` by ``h`` once more, step ``f`` with Adams–Bashforth 2, or write the final state into
+``problem.x0`` "to resume from it".
 
 Each :class:`Entry` has ``build()`` (the subject as a user hands it to ``vm.check_operator`` /
 ``vm.check_stepper``), the law of the paper it breaks (``label``), the smallest input showing it
@@ -355,6 +357,20 @@ def _odd_build(both, name):
                                       contains=lambda x, y, t=0.0, tol=None: box_contains(x, y, lo, hi, tol))
 
 
+def _in_place_build(copy, name):
+    """Soft thresholding (the resolvent of ∂|·|_1) computed in place "to save an allocation" when the input is a
+    writeable float64 array (a copy otherwise): ``copy=False`` (the bug) overwrites the caller's x with J_λx;
+    read-only and integer inputs get the right answer and stay unchanged."""
+    def J(x, lam, t=0.0):
+        x = np.asarray(x)
+        if x.dtype == np.float64 and x.flags.writeable:
+            out = x.copy() if copy else x
+            np.copysign(np.maximum(np.abs(out) - float(lam), 0.0), out, out=out)
+            return out
+        return _soft(x, float(lam))
+    return vm.operator_from_resolvent(J, 3, name=name, contains=l1_contains, min_norm=l1_min_norm)
+
+
 # ----------------------------------------------------------------------------------------------------
 # steppers: the paper's scheme x_{k+1} = J_{h F(t_{k+1})}(x_k + h f(x_k) + ∫u) and its planted variants
 # ----------------------------------------------------------------------------------------------------
@@ -594,6 +610,20 @@ def _ab_factory(w_now, w_prev):
     return stepper
 
 
+def _resume_factory(into_problem):
+    """The scheme, remembering its final state "to resume from it": ``into_problem=True`` (the bug) writes it into
+    ``problem.x0`` in place, so the caller's problem now starts elsewhere; the control keeps it on the stepper."""
+    def stepper(problem, t_grid):
+        x = proximal(problem, t_grid)
+        if into_problem:
+            problem.x0[...] = x[-1]
+        else:
+            stepper.resume = x[-1].copy()
+        return x
+    stepper.__name__ = "resume_into_problem_x0" if into_problem else "resume_on_stepper"
+    return stepper
+
+
 # ----------------------------------------------------------------------------------------------------
 # the entries
 # ----------------------------------------------------------------------------------------------------
@@ -648,6 +678,9 @@ ENTRIES: list[Entry] = [
     Entry("box_odd_lower_face_lost", "operator", f"{RES} i (J_λx ∈ cl dom F = [-1, 1]^4)", False,
           lambda: _odd_build(False, "box, odd coordinates min(·, 1)"),
           "x = (0, -2, 0, 0): J_1 = -2", "odd coordinates clipped from above only"),
+    Entry("soft_in_place_when_writeable", "operator", f"{RES} ii (J_λ a function of x; the caller's x unchanged)",
+          False, lambda: _in_place_build(False, "soft threshold, in place when writeable"),
+          "x = (3, 0, 0), λ = 1: x becomes (2, 0, 0)", "the resolvent computed in place on a writeable float64 input"),
     # steppers: plants
     Entry("internal_grid_interpolated", "stepper", f"{ITER} on the caller's partition", False,
           lambda: (internal_grid_interpolated, None), "F = 0, f(x) = -x, x0 = 1, t = (0, 0.25, ..., 1)",
@@ -685,6 +718,9 @@ ENTRIES: list[Entry] = [
     Entry("field_adams_bashforth_2", "stepper", f"{ITER} (f(x_k) only)", False,
           lambda: (_ab_factory(1.5, -0.5), None), "F = 0, f(x) = -x, x0 = 1, t = (0, 0.5, 1, 1.5)",
           "the drift stepped with Adams–Bashforth 2 (3/2 f(x_k) - 1/2 f(x_{k-1}))"),
+    Entry("resume_into_problem_x0", "stepper", f"{ITER} (x_0 = x0 of the caller's problem, unchanged)", False,
+          lambda: (_resume_factory(True), None), "F = 0, f(x) = -x, x0 = 1: a second call starts at x_K",
+          "the final state written into problem.x0 in place"),
     # controls
     Entry("ctrl_linear_lambda_unclamped", "operator", f"{RES} v", True,
           lambda: _clamped_build(np.inf, "Ax, λ unclamped"), "-", "no clamp", twin="linear_lambda_clamped_1e3"),
@@ -719,6 +755,11 @@ ENTRIES: list[Entry] = [
     Entry("ctrl_box_odd_clipped", "operator", f"{RES} i", True,
           lambda: _odd_build(True, "box, odd coordinates clipped"), "-", "np.clip on both parities",
           twin="box_odd_lower_face_lost"),
+    Entry("ctrl_soft_copy_when_writeable", "operator", f"{RES} ii", True,
+          lambda: _in_place_build(True, "soft threshold, on a copy"), "-", "out = x.copy()",
+          twin="soft_in_place_when_writeable"),
+    Entry("ctrl_resume_on_stepper", "stepper", ITER, True, lambda: (_resume_factory(False), None), "-",
+          "the final state kept on the stepper", twin="resume_into_problem_x0"),
     Entry("ctrl_ring_buffer_refilled", "stepper", ITER, True, lambda: (_ring_factory(True), None), "-",
           "the buffer refilled every 256 cells", twin="ring_buffer_filled_once"),
     Entry("ctrl_checkpoint_records_state", "stepper", ITER, True, lambda: (_checkpoint_factory(True), None), "-",
@@ -830,6 +871,12 @@ def _op_witness(name):
         return w
     if case == "box_odd_lower_face_lost":
         return lambda: _outside(build().resolvent(np.array([0.0, -2.0, 0.0, 0.0]), 1.0), -np.ones(4), np.ones(4))
+    if case == "soft_in_place_when_writeable":
+        def w():
+            x = np.array([3.0, 0.0, 0.0])
+            build().resolvent(x, 1.0)
+            return _eq(x, [3.0, 0.0, 0.0], 3.0)
+        return w
     raise KeyError(name)
 
 
@@ -887,6 +934,12 @@ _STEP_CASES = {
 def _step_witness(name):
     """The stepper's states against the scheme's (``proximal``) at the smallest input; a control runs its plant's case."""
     e = BY_NAME[name]
+    if (e.twin if e.lawful else name) == "resume_into_problem_x0":
+        def w2():
+            stepper, problem, grid = e.build()[0], _decay(), np.array([0.0, 0.5, 1.0])
+            first = stepper(problem, grid)
+            return _eq(stepper(problem, grid), first)          # the same problem, the same trajectory
+        return w2
     make, grid = _STEP_CASES[e.twin if e.lawful else name]
 
     def w():
