@@ -5,6 +5,8 @@ misses are strict xfails whose reason is the measured miss (tests/blind/set9/REA
 
 import importlib.util
 import pathlib
+import subprocess
+import sys
 
 import pytest
 
@@ -47,6 +49,11 @@ def test_control_witness_obeys_its_law(entry):
     assert entry.witness() <= 1.0, f"{entry.name}: {entry.label} violated at {entry.smallest}"
 
 
+#: entries whose verdict is taken in a subprocess of their own: their bug writes into the problems verimono shares
+#: within a process, and every stepper checked after them there fails (README.md, "A plant that poisons the process")
+ISOLATED = {"resume_into_problem_x0"}
+
+
 def _marks(e):
     if e.name in MISSED:
         return [pytest.mark.xfail(strict=True, reason=MISSED[e.name])]
@@ -56,6 +63,33 @@ def _marks(e):
 @pytest.mark.slow
 @pytest.mark.parametrize("entry", [pytest.param(e, marks=_marks(e), id=e.name) for e in S.ENTRIES])
 def test_verimono_verdict_at_ci(entry):
-    res = runner.run_one(entry.name, 0, "ci")
+    if entry.name in ISOLATED:
+        res = runner.common.child(runner.BLIND, entry.name, 0, "ci", 900.0)
+    else:
+        res = runner.run_one(entry.name, 0, "ci")
     good, text = runner.verdict(entry, res)
     assert good, f"{entry.name} ({'control' if entry.lawful else 'plant'}, {entry.label}): {text}"
+
+
+_POISON = """
+import sys
+sys.path.insert(0, sys.argv[1])
+import subjects as S
+import verimono as vm
+vm.check_stepper(S.BY_NAME["resume_into_problem_x0"].build()[0], seed=0, profile="ci")
+report = vm.check_stepper(vm.solve, seed=0, profile="ci")
+print("POISON-RESULT", report.ok, sorted({r.check + "[" + r.subject + "]" for r in report.failures})[:3])
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="measured on main 0288656: after check_stepper on resume_into_problem_x0 (a stepper "
+                   "writing its final state into problem.x0) the same process's check_stepper(vm.solve, seed=0, "
+                   "profile='ci') fails in_domain, trajectory_immutable and bounds_lg on generated #0 and #2 (seed 0): "
+                   "the generated problems are shared objects and keep the overwritten x0 -- a false alarm on correct "
+                   "code caused by an earlier subject")
+def test_a_stepper_writing_into_x0_does_not_poison_later_checks():
+    cp = subprocess.run([sys.executable, "-c", _POISON, str(_DIR)], capture_output=True, text=True, timeout=1200)
+    line = [ln for ln in cp.stdout.splitlines() if ln.startswith("POISON-RESULT")]
+    assert line, cp.stderr[-2000:]
+    assert line[-1].startswith("POISON-RESULT True"), line[-1]
