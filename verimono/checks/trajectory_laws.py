@@ -789,6 +789,14 @@ def _shares(a: Any, b: np.ndarray) -> bool:
     return isinstance(a, np.ndarray) and np.may_share_memory(a, b) and np.shares_memory(a, b)
 
 
+
+def _own_copy(p: Problem) -> Problem:
+    """The stepper's own copy of ``p`` for :func:`check_trajectory_immutable`, its ``x0`` writeable there alone (a
+    Problem's ``x0`` is read-only): a write into it is then seen and named, not an error NumPy raises."""
+    q = p.replace(x0=np.array(p.x0, dtype=float))
+    q.x0.flags.writeable = True
+    return q
+
 @stepper_law("trajectory_immutable", "a returned trajectory is the caller's (issue 42)", over_grids=False)
 def check_trajectory_immutable(stepper: Callable, p: Problem, *, seed: int = 0, grids: Any = None) -> Outcome:
     """A trajectory a stepper returned never changes after later calls, and calling it changes nothing it was
@@ -813,7 +821,7 @@ def check_trajectory_immutable(stepper: Callable, p: Problem, *, seed: int = 0, 
                                else battery_grids(grids, p, seed), p.T)[0].values())    # grids="uniform": its kind
     if len(parts) == 1:     # one partition given: two calls on it (a buffer handed out twice is shared memory)
         parts = parts * 2
-    q = p.replace(x0=np.array(p.x0, dtype=float))          # the stepper's own copy of the problem
+    q = _own_copy(p)
     x0 = q.x0.copy()
     returned: list[tuple[int, Any, Any, np.ndarray]] = []   # (call, value, its memory, a copy of its states)
     problems: list[str] = []
@@ -832,7 +840,7 @@ def check_trajectory_immutable(stepper: Callable, p: Problem, *, seed: int = 0, 
         if not np.array_equal(q.x0, x0):
             problems.append(f"call {call} changed problem.x0 it was given: {np.array2string(x0, precision=10)} "
                             f"became {np.array2string(q.x0, precision=10)}")
-            q = p.replace(x0=np.array(p.x0, dtype=float))       # the next call starts from x0 again
+            q = _own_copy(p)                                      # the next call starts from x0 again
             x0 = q.x0.copy()
         for before, old, old_memory, old_states in returned:
             now = np.asarray(as_float64(old), dtype=float)

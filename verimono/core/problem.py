@@ -199,6 +199,10 @@ class Problem:
             raise InvalidProblem(f"notes must be a string, got {notes!r}")
         if not isinstance(initial_jump, (bool, np.bool_)):
             raise InvalidProblem(f"initial_jump must be True or False, got {initial_jump!r}")
+        # the problem's own copy, read-only: a problem is shared by every stepper checked on it (the generated
+        # problems by a whole process), so a stepper writing into problem.x0 (a bug: the problem is the caller's)
+        # fails there, with the error NumPy raises, instead of moving x0 under the steppers checked after it
+        x0.flags.writeable = False
         fields = dict(operator=operator, x0=x0, T=T, f=f, u=u, exact=exact, order=_as_order(order),
                       name=name or f"{getattr(operator, 'name', 'F')} problem", U=U,
                       lipschitz=_lipschitz(lipschitz), phi=phi, sigma=sigma, theta=theta, steps=_steps(steps),
