@@ -407,3 +407,22 @@ def test_law_draws_are_seeded_in_range_and_favour_simple_values():
     steps = np.array([[s.lam, s.mu, s.nu] for s in a])
     assert np.all((steps >= 1e-3) & (steps <= 10.0)) and 0.35 < np.mean(np.isin(steps, (1.0, 0.5, 2.0, 0.1, 10.0, 1e-3))) < 0.65
     assert all(0.0 <= s.t <= 2.0 for s in a) and 0.35 < np.mean([s.t in (0.0, 1.0, 2.0) for s in a]) < 0.65
+
+
+def test_a_value_returned_is_kept_over_a_later_call():
+    """prop:maxmon-resolvent-Yosida i–ii: J_λ is a function, and what it returned is the caller's — a resolvent
+    projecting onto the box [-1, 1]^3 into one preallocated buffer and returning that buffer fails (blind set 9's
+    box_returns_shared_buffer, missed on 0288656); the same code returning a copy passes."""
+    from verimono.checks.operator_laws import check_resolvent_single_valued
+
+    def make(copy):
+        buf = np.empty(3)
+
+        def J(x, lam, t):
+            np.clip(x, -1.0, 1.0, out=buf)
+            return buf.copy() if copy else buf
+        return vm.operator_from_resolvent(J, 3, name="box, " + ("copied" if copy else "one buffer"))
+
+    bad = check_resolvent_single_valued(make(False), seed=0, examples=20)
+    assert bad.status == "failed" and "one output buffer handed out twice" in bad.message, str(bad)
+    assert check_resolvent_single_valued(make(True), seed=0, examples=20).status == "passed"

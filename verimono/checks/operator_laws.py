@@ -96,14 +96,18 @@ def check_resolvent_single_valued(op, s):
     return the same finite point of shape ``(n,)`` and leave ``x`` unchanged (ratio: |difference|/tol, the
     tolerance of repeated calls: :func:`verimono.core.tolerances.repeat_tolerance`).  A sample in an input form
     (:mod:`verimono.checks.engine.forms`) compares its value with a third call on the same point as a fresh contiguous
-    float64 array too (:func:`form_tolerance`): ``J_λ`` is a function of the *values* of ``x``, whatever its layout."""
+    float64 array too (:func:`form_tolerance`): ``J_λ`` is a function of the *values* of ``x``, whatever its layout.
+    A value once returned is the caller's: a call at another point ``x2`` must not change it (:func:`_value_kept`:
+    an output buffer handed out twice fails, exactly)."""
     x = s.x1.copy()
     a = point(op.resolvent(x, s.lam, s.t), s.x1, "resolvent")
     moved = norm(x - s.x1)
+    kept = _value_kept(op, a, s)
     b = resolvent(op, s.x1, s.lam, s.t)
     tau = repeat_tolerance(s.x1, a, b)
-    out = Outcome.compare(norm(a - b) + (math.inf if moved > 0 else 0.0), 0.0, tau,
-                 "|J_λx - J_λx| over two calls" + (f" (the call modified its input by {moved:.3g})" if moved else ""),
+    broke = (f" (the call modified its input by {moved:.3g})" if moved else "") + (kept or "")
+    out = Outcome.compare(norm(a - b) + (math.inf if moved > 0 or kept else 0.0), 0.0, tau,
+                 "|J_λx - J_λx| over two calls" + broke,
                  {"J_first": listed(a), "J_second": listed(b), "input_modified_by": moved})
     if type(op) is InForm and out.worst <= 1.0:
         # J_λ is a function of x's values: the call in this form against the same point as a fresh contiguous array
@@ -114,6 +118,25 @@ def check_resolvent_single_valued(op, s):
         if not across.worst <= out.worst:
             return across
     return out
+
+
+def _value_kept(op, a: np.ndarray, s: Sample) -> str | None:
+    """``None`` when ``a`` (``J_λx1`` as the subject returned it) keeps its values over a call ``J_λx2`` at another
+    point, else what changed.  A resolvent writing every value into one preallocated buffer and returning that buffer
+    hands the caller an array the next call overwrites: ``j1 = J(x1); j2 = J(x2)`` leaves ``j1 == j2`` (the stepper's
+    law ``trajectory_immutable`` names the same fault of a stepper).  Exact: a returned array that changes in any bit
+    has changed.  A subject returning another dtype (converted, a copy) cannot show it, nor needs to."""
+    if np.array_equal(s.x1, s.x2):
+        return None
+    before = a.copy()
+    try:
+        op.resolvent(s.x2.copy(), s.lam, s.t)
+    except Exception:        # noqa: BLE001 - the call at x2 is the other laws' to judge; only a's values are this one's
+        return None
+    if np.array_equal(a, before, equal_nan=True):
+        return None
+    return (f" (the value J_λx1 returned changed when J_λ was called at x2, by up to "
+            f"{float(np.max(np.abs(a - before))):.3g}: one output buffer handed out twice)")
 
 
 #: the input forms that change the dtype the subject receives (the others change only the memory layout)
@@ -676,6 +699,7 @@ def _rows_resolvent_limit(op, r):
 
 @vectorised("resolvent_single_valued")
 def _rows_resolvent_single_valued(op, r):
+    _first_value_kept(op, r)
     # two calls on (copies of) the same rows; row_resolvents marks a row whose call modified its input
     a = row_resolvents(op, r.x1, r.lam, r.t, r.ok)
     b = row_resolvents(op, r.x1, r.lam, r.t, r.ok)
@@ -684,6 +708,26 @@ def _rows_resolvent_single_valued(op, r):
     q = row_ratios(row_norms(a - b), np.zeros_like(tau), tau)
     rounding(r, q, np.ones_like(q))
     return q
+
+
+def _first_value_kept(op, r) -> None:
+    """The block's first two rows' calls, as :func:`_value_kept` makes them (:func:`row_resolvents` copies a block's
+    values into one array, where a buffer handed out twice cannot show): a first value that changed over the second
+    call leaves its row to the law's own evaluator, which judges it."""
+    rows = np.flatnonzero(r.ok)
+    if rows.size < 2:
+        return
+    i, j = int(rows[0]), int(rows[1])
+    try:
+        a = op.resolvent(r.x1[i].copy(), float(r.lam[i]), float(r.t[i]))
+        if type(a) is not np.ndarray or a.dtype != np.float64:
+            return           # converted: a copy, which a later call cannot change
+        before = a.copy()
+        op.resolvent(r.x1[j].copy(), float(r.lam[j]), float(r.t[j]))
+    except Exception:        # noqa: BLE001 - the rows' own calls (and the evaluator) judge what raised
+        return
+    if not np.array_equal(a, before, equal_nan=True):
+        r.ok[i] = False
 
 
 @vectorised("resolvent_in_domain")

@@ -20,10 +20,9 @@ PLANTS = [e for e in S.ENTRIES if not e.lawful]
 CONTROLS = [e for e in S.ENTRIES if e.lawful]
 
 #: plants verimono's ci battery (seed 0) misses: name -> the measured reason (tests/blind/set9/README.md)
+#: box_returns_shared_buffer, missed on 0288656 (no operator law held a value J_λx1 across a later call J_λx2), is caught
+#: since resolvent_single_valued keeps the first value over a call at x2 (operator_laws._value_kept)
 MISSED: dict[str, str] = {
-    "box_returns_shared_buffer": "missed at ci seeds 0-2, dev and thorough seed 0 (main 0288656): every law passed; "
-                                 "no operator law holds a value J_λx1 across a later call J_λx2 (the resolvent returns "
-                                 "its own scratch buffer, which the next call overwrites)",
     "box_value_strict_bounds": "missed at ci seeds 0-2, dev and thorough seed 0 (main 0288656): prox_inequality, prox_optimal, "
                                "prox_minimiser, moreau_envelope passed with 50, 50, 38, 52 samples inconclusive -- the "
                                "prox lands exactly on a face where the declared g is +inf, which is judged as rounding "
