@@ -128,3 +128,52 @@ def test_a_bad_stated_scale_is_a_typed_error(bad):
         ball(np.float64, 1.0, stated=bad)
     with pytest.raises(vm.InvalidProblem):
         vm.operator_from_prox(lambda x, lam: x, shape=3, data_scale=bad)
+
+
+def _failed(lhs, rhs, slack, worst=float("inf")):
+    from verimono.records.verdicts import new_record
+    return new_record("resolvent_firmly_nonexpansive", "ball", "failed", worst=worst, bound=1.0,
+                      counterexample={"lhs": lhs, "rhs": rhs, "slack": slack}, message="violated",
+                      details={"dtype": "float64"})
+
+
+def test_a_finite_violation_with_a_negative_bound_is_rejudged():
+    # probe7: a correct float64 ball of radius 1e12 centred at 1e12·e_1, n = 3, seed 0: firm nonexpansiveness at two
+    # points near its boundary, lhs 1e-10 > rhs -9.99e-08 + slack 4.04e-10 — finite sides whose bound rhs + slack < 0
+    # give the ratio inf by convention; it stayed failed (a non-finite ratio was never re-judged).  Its sides are
+    # finite: it is re-judged at the inferred scale like any finite violation, undecided where the law holds there
+    from verimono.checks.engine.data_scale import finite_failure, judged_at_data_scale
+    from verimono.records.verdicts import new_record
+    op = ball(np.float64, 1e12)
+    rec = _failed(1e-10, -9.99e-08, 4.04e-10)
+    assert finite_failure(rec)
+    out = judged_at_data_scale(rec, op, 1.0, lambda: new_record("resolvent_firmly_nonexpansive", "ball", "passed",
+                                                                worst=0.5, bound=1.0, message="held"))
+    assert out.status == "undecided"
+    assert out.details["data_scale"]["inferred"] == pytest.approx(2e12, rel=1e-6)
+    # a non-finite side (a NaN, an infinity) stays failed, never re-judged
+    for sides in [(float("nan"), 0.0, 1e-8), (1.0, float("inf"), 1e-8), (0.0, 0.0, float("inf"))]:
+        rec = _failed(*sides)
+        assert not finite_failure(rec)
+        assert judged_at_data_scale(rec, op, 1.0, lambda: pytest.fail("re-judged")).status == "failed"
+    assert not finite_failure(new_record("x", "y", "failed", worst=float("inf"), bound=1.0, message="raised"))
+
+
+@pytest.mark.heavy       # a ci battery each (1-2 s): the tier CI runs after the default one
+@pytest.mark.parametrize("dtype, S", [(np.float32, 1e6), (np.float64, 1e12)])
+def test_correct_code_at_its_own_scale_is_never_failed_in_three_dimensions(dtype, S):
+    # probe7: the ball in R^3 given by its projection alone (no project_domain), ci seeds 0 and 1: firm
+    # nonexpansiveness failed on this correct code with a bound rhs + slack < 0 (float32 at 1e6, float64 at 1e12)
+    c = np.array([S, 0.0, 0.0], dtype=dtype)
+
+    def J(x, lam, t):
+        x = np.asarray(x, dtype=dtype)
+        d = x - c
+        nd = np.linalg.norm(d)
+        return x if nd <= dtype(S) else c + d * (dtype(S) / nd)
+
+    op = vm.operator_from_resolvent(J, 3, name=f"ball3 {np.dtype(dtype).name} at {S:g}")
+    for seed in (0, 1):
+        recs = statuses(op, seed=seed)
+        assert not [c for c, r in recs.items() if r.status == "failed"], (
+            seed, {c: r.message for c, r in recs.items() if r.status == "failed"})

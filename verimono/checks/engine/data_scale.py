@@ -19,8 +19,12 @@ operator's own scale").  The one tolerance rule takes that magnitude ``S`` as on
   holds there, its violation is within the rounding correct code at the operator's own scale makes, and the
   record is **undecided** — never passed (a wrong resolvent off by less than ``rtol·S`` is not acquitted), never
   failed (a correct one is not blamed) — with the violation, ``S``, the probe's evidence and how to decide
-  (state ``data_scale``).  A failure that persists at ``S`` stays failed; a non-finite ratio (a NaN, an exception)
-  is never rounding and is not re-judged.
+  (state ``data_scale``).  A failure that persists at ``S`` stays failed; a non-finite value (a NaN, an infinity,
+  an exception) is never rounding and is not re-judged.  A violated inequality ``lhs ≤ rhs + slack`` between
+  finite numbers whose bound ``rhs + slack`` is ``≤ 0`` has the ratio ``inf`` by convention
+  (:func:`verimono.checks.core.ratio`), yet it is a finite failure: firm nonexpansiveness of a correct ball of
+  radius 10^12 at points near its boundary, ``lhs 1e-10 > rhs -9.99e-08 + slack 4.04e-10`` (probe7, seed 0), is
+  re-judged like any other (:func:`finite_failure`).
 """
 
 from __future__ import annotations
@@ -129,11 +133,22 @@ def inferred_scale(op: Any, horizon: float, precision: str | None) -> tuple[floa
     return memo[key]
 
 
+def finite_failure(rec: CheckResult) -> bool:
+    """Whether a failed record's violation is between finite numbers: its ratio is finite, or its counterexample's
+    inequality ``lhs ≤ rhs + slack`` has three finite sides (a bound ``rhs + slack ≤ 0``: the ratio is ``inf`` by
+    convention, the violation finite).  A NaN, an infinity or an exception is not."""
+    if rec.worst is not None and math.isfinite(rec.worst):
+        return True
+    cex = rec.counterexample if isinstance(rec.counterexample, dict) else {}
+    sides = [cex.get(k) for k in ("lhs", "rhs", "slack")]
+    return all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in sides)
+
+
 def judged_at_data_scale(rec: CheckResult, op: Any, horizon: float,
                          rerun: Callable[[], CheckResult]) -> CheckResult:
     """A failed record with a finite ratio, of an operator stating no scale, judged once more at its inferred scale
     (module docstring): undecided when the law holds there, else the failure (stating the scale it persisted at)."""
-    if rec.status != FAILED or rec.worst is None or not math.isfinite(rec.worst) or stated_scale(op) is not None:
+    if rec.status != FAILED or not finite_failure(rec) or stated_scale(op) is not None:
         return rec
     precision = rec.details.get("dtype")
     S, evidence = inferred_scale(op, horizon, precision)
@@ -161,4 +176,4 @@ def stated_details(op: Any) -> dict[str, Any] | None:
     return None if s is None else {"stated": s}
 
 
-__all__ = ["stated_scale", "inferred_scale", "probe_extent", "judged_at_data_scale", "stated_details"]
+__all__ = ["finite_failure", "stated_scale", "inferred_scale", "probe_extent", "judged_at_data_scale", "stated_details"]
