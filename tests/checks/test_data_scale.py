@@ -177,3 +177,26 @@ def test_correct_code_at_its_own_scale_is_never_failed_in_three_dimensions(dtype
         recs = statuses(op, seed=seed)
         assert not [c for c, r in recs.items() if r.status == "failed"], (
             seed, {c: r.message for c, r in recs.items() if r.status == "failed"})
+
+
+def test_the_laws_own_overflow_is_no_verdict():
+    """A violation whose left side (the subject's values) is finite while the law's own slack overflowed judges
+    nothing: inconclusive, never failed; a non-finite left side still fails (engine/search.own_overflow)."""
+    from verimono.checks.core import Outcome
+    from verimono.checks.engine.search import own_overflow
+
+    assert "overflowed" in own_overflow(Outcome.compare(0.0, 0.0, float("inf"), "J_λx = J_μ(...)"))
+    assert own_overflow(Outcome.compare(float("nan"), 0.0, 1.0, "x")) is None
+    assert own_overflow(Outcome.compare(float("inf"), 1.0, float("inf"), "x")) is None
+    assert own_overflow(Outcome.compare(2.0, 0.0, 1.0, "x")) is None        # an ordinary violation: judged
+
+
+@pytest.mark.heavy       # a ci battery each (1-2 s): the tier CI runs after the default one
+@pytest.mark.parametrize("seed", [0, 2])
+def test_a_far_half_space_is_not_failed_by_the_laws_own_overflow(seed):
+    # measured on 357ebca (probe7): x_1 ≤ -1e12 failed resolvent_identity at λ = 1e-153 with "slack inf" (z ≈ 1e165)
+    half = vm.operator_from_resolvent(lambda x, lam, t: np.where(np.arange(3) == 0, np.minimum(x, -1e12), x), 3,
+                                      name="half-space x_1 ≤ -1e12")
+    recs = statuses(half, seed)
+    assert not [r for r in recs.values() if r.status in ("failed", "undecided")], \
+        {c: r.message for c, r in recs.items() if r.status in ("failed", "undecided")}

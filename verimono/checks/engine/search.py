@@ -290,8 +290,9 @@ class _Search:
             if out is None:
                 return None
         self.in_flight, self.slowest = None, max(self.slowest, time.perf_counter() - start)
-        if self.scaling and not out.inconclusive and not out.ratio <= BOUND:
-            why = beyond_judgement(out, s)      # the scale phase's own limits (verimono.checks.engine.scales)
+        if not out.inconclusive and not out.ratio <= BOUND:
+            # the scale phase's own limits (verimono.checks.engine.scales); elsewhere the law's own overflow
+            why = beyond_judgement(out, s) if self.scaling else own_overflow(out)
             if why is not None:
                 out = Outcome.inconclusive_sample(why, {HARNESS_LIMIT: why})
         self.runs += 1
@@ -715,6 +716,22 @@ def _timed_out(how: dict, exc: UnitTimeout, state: _Search) -> None:
     evidence = getattr(exc, "evidence", {})
     stopped_at = evidence.get("stopped_at") or time.perf_counter()    # the interrupt, not the unwinding after it
     how["evidence"] = {**evidence, "in_flight": None if state.in_flight is None else stopped_at - state.in_flight}
+
+
+def own_overflow(out: Outcome) -> str | None:
+    """Why the violation ``out`` is no verdict on the subject (inconclusive), or ``None``: its left side — the
+    subject's values, finite by :func:`verimono.checks.members.point` — is a finite number while the law's own side
+    (``rhs``, ``slack``) overflowed in verimono's arithmetic.  Measured (probe7): ``resolvent_identity`` on a box at
+    ``10^12`` searched down to ``λ = 10^-153`` forms ``z ≈ 10^165`` and a slack ``tolerance(x, J, z)·(4 + μ/λ) = inf``;
+    ``lhs ≤ rhs + inf`` then judges nothing, and failing it blamed correct code.  A non-finite left side (a NaN, an
+    ``inf`` the subject's values made) still fails."""
+    lhs, rhs, slack = out.lhs, out.rhs, out.slack
+    if lhs is None or rhs is None or not math.isfinite(lhs):
+        return None
+    if math.isfinite(rhs) and math.isfinite(0.0 if slack is None else slack):
+        return None
+    return (f"the law's own arithmetic overflowed at these magnitudes ({out.what}: lhs {lhs:.3g}, rhs {rhs:.3g}, "
+            f"slack {slack:.3g}): no judgement")
 
 
 def violation_text(out: Outcome) -> str:
