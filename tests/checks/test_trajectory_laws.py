@@ -841,3 +841,23 @@ def test_normal_cone_members_of_a_block_are_contains_row_by_row(name):
         assert got.tolist() == want
         seen |= set(want)
     assert seen == {True, False}
+
+
+def test_a_stepper_writing_into_the_problems_x0_fails_and_is_told_why():
+    """A Problem's x0 is read-only (shared by every stepper checked on it): a stepper accumulating into
+    np.asarray(problem.x0) fails where it writes, and the record says which array and what to do (probe7: NumPy's
+    own message names neither)."""
+    from verimono.checks.trajectory_laws import check_in_domain
+
+    def accumulates_into_x0(problem, t_grid):
+        x = np.asarray(problem.x0, dtype=float)           # a view of the problem's x0, not a copy
+        out = [x.copy()]
+        for k in range(1, len(t_grid)):
+            x += 0.0                                       # the write
+            out.append(problem.operator.resolvent(x, t_grid[k] - t_grid[k - 1], t_grid[k]))
+        return np.array(out)
+
+    p = get("t|x| (n=1)")
+    rec = check_in_domain(accumulates_into_x0, p)
+    assert rec.status == "failed" and "x = np.array(problem.x0)" in rec.message, str(rec)
+    assert p.x0.flags.writeable is False and not p.x0.flags.owndata is False

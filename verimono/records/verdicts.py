@@ -175,8 +175,17 @@ def record_of_exception(check: str, subject: str, exc: BaseException, *, prefix:
             details["harness_error"] = evidence["harness_error"]
     if status != SKIPPED:
         details.setdefault("exception", type(exc).__name__)
+    if isinstance(exc, ValueError) and "read-only" in str(exc):
+        message += READ_ONLY_HINT
     return new_record(check, subject, status, message=prefix + message, details=details, **kw)
 
 
-__all__ = ["SUBJECT_EXITS", "new_record", "classify", "record_of_exception", "timeout_verdict", "never_returned", "HANG_MULTIPLE",
+#: what a failure NumPy reports as a write into a read-only array adds: the arrays verimono hands a subject that are
+#: not its own are read-only (a Problem's x0: every stepper checked on a problem shares it), and NumPy's message
+#: names neither the array nor the fix (probe7: ``x = np.asarray(problem.x0); x += ...`` failed 7 records so)
+READ_ONLY_HINT = (" — the subject wrote into an array it was given that is not its own (a Problem's x0 is read-only: "
+                  "every stepper checked on the problem shares it); work on a copy, e.g. x = np.array(problem.x0)")
+
+
+__all__ = ["SUBJECT_EXITS", "new_record", "classify", "record_of_exception", "READ_ONLY_HINT", "timeout_verdict", "never_returned", "HANG_MULTIPLE",
            "HANG_FRACTION", "HANG_MIN_SECONDS", "TIME_BUDGET_REASON"]
