@@ -146,13 +146,15 @@ def judged_at_data_scale(rec: CheckResult, op: Any, horizon: float,
                                      "worst_there": again.worst}
         return rec
     details = {**rec.details, "data_scale": {"inferred": S, **evidence, "there": again.status}}
-    return new_record(rec.check, rec.subject, UNDECIDED, seed=rec.seed, details=details,
+    out = new_record(rec.check, rec.subject, UNDECIDED, seed=rec.seed, details=details,
                       counterexample=rec.counterexample,
                       message=(f"{rec.message} — but within the rounding of the operator's own scale: its domain "
                                f"reaches |x| = {S:.3g} (J_1 of far points), where correct code rounds by "
                                f"rtol·(1 + {S:.3g}), and at that scale the law "
                                f"{'holds' if again.status == PASSED else 'is ' + again.status}; state the "
                                f"operator's data_scale (operator_from_resolvent(..., data_scale=...)) to decide"))
+    out.duration = rec.duration
+    return out
 
 
 def stated_details(op: Any) -> dict[str, Any] | None:
