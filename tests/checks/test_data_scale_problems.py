@@ -123,6 +123,7 @@ def box32():
     return vm.Problem(op, x0=np.full(N, 0.3), T=2.0, f=lambda x: -x, lipschitz=1.0, name="box float32")
 
 
+@pytest.mark.heavy       # (A1) twice (0.75 s)
 def test_a1_judges_a_float32_operator_at_float32_precision():
     # (A1) was judged at float64's RTOL whatever the subject's precision: an exact float32 clip failed by 7–10 times
     rec = check_assumption_A1(box32(), seed=0)
