@@ -148,3 +148,26 @@ def test_a_kept_run_keeps_the_precision_the_operator_computed_in():
             x2 = run_stepper(textbook, p, grid)
     assert x1 is x2 and x1.dtype == np.float64
     assert first.name == again.name == "float32"
+
+
+@pytest.mark.parametrize("stated", [None, 2e6])
+def test_an_initial_point_within_the_rounding_of_the_stated_scale_is_in_the_domain(stated):
+    # x0 = 10^-3·e_1 lies 10^-3 inside the float32 ball B(10^6·e_1, 10^6), whose projection moves it by its rounding at
+    # 10^6 (to the origin): refused at x0's own scale (the message says how to decide), accepted at the stated one
+    def J(x, lam, t):
+        x = np.asarray(x, dtype=np.float32)
+        c = np.array([1e6, 0.0, 0.0], dtype=np.float32)
+        d = x - c
+        return c + d * min(np.float32(1), np.float32(1e6) / np.linalg.norm(d))
+
+    op = vm.operator_from_resolvent(J, N, project_domain=lambda x, t: J(x, 1.0, t), data_scale=stated)
+    x0 = np.array([1e-3, 0.0, 0.0])
+    if stated is None:
+        with pytest.raises(vm.OutsideDomain, match="data_scale"):
+            vm.Problem(op, x0=x0, T=1.0)
+    else:
+        assert vm.Problem(op, x0=x0, T=1.0).x0[0] == 1e-3
+    # a point 10^3 outside is refused at the stated scale 10^6 too: float32 rtol·(1 + 10^6) = 230 < 10^3
+    op = vm.operator_from_resolvent(J, N, project_domain=lambda x, t: J(x, 1.0, t), data_scale=1e6)
+    with pytest.raises(vm.OutsideDomain):
+        vm.Problem(op, x0=np.array([-1e3, 0.0, 0.0]), T=1.0)

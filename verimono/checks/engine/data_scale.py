@@ -31,6 +31,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ...core.operator_protocol import stated_data_scale
 from ...core.tolerances import LARGEST_BY_PRECISION, judged_at_scale
 from ...records.results import FAILED, PASSED, UNDECIDED, CheckResult
 from ...records.verdicts import new_record
@@ -48,12 +49,9 @@ PULLED, SATURATED = 0.5, 2.0
 
 
 def stated_scale(op: Any) -> float | None:
-    """The operator's stated ``data_scale`` (``None``: not stated)."""
-    s = getattr(op, "data_scale", None)
-    if s is None:
-        return None
-    s = float(s)
-    return s if math.isfinite(s) and s >= 0.0 else None
+    """The operator's stated ``data_scale`` (``None``: not stated): :func:`verimono.core.operator_protocol.stated_data_scale`,
+    which :class:`verimono.Problem` judges its ``x0`` at too."""
+    return stated_data_scale(op)
 
 
 def _radii(precision: str | None) -> list[float]:
