@@ -32,7 +32,7 @@ import numpy as np
 
 from ..core.errors import OutsideDomain, UnverifiedSolution
 from ..core.operators import resolvent_rows
-from ..core.tolerances import GROWTH_FLAG, current_rtol, STALL_RATIO, STALL_WINDOW, quotient_tolerance, tolerance
+from ..core.tolerances import GROWTH_FLAG, current_data_scale, current_rtol, STALL_RATIO, STALL_WINDOW, quotient_tolerance, tolerance
 from ..records.results import FAILED, PASSED, SKIPPED
 from ..core.operator_protocol import accepts_times
 from ..core.tolerances import row_tolerances
@@ -148,7 +148,7 @@ def _phi_ratio(dist: float, phi_s: float, phi_t: float) -> float:
     """``dist / (φ(t) − φ(s) + tol)``; at least 2 when ``φ`` decreases (not allowed by (A3))."""
     rhs, rtol = phi_t - phi_s, current_rtol()     # tolerance() of three floats, without its array dispatch
     big = max(abs(phi_s), abs(phi_t))
-    r = dist / (max(rhs, 0.0) + rtol * (1.0 + max(abs(dist), big)))
+    r = dist / (max(rhs, 0.0) + rtol * (1.0 + max(abs(dist), big, current_data_scale())))
     if rhs < -rtol * (1.0 + big):
         r = max(r, 2.0)
     return float(r)
@@ -158,7 +158,7 @@ def _phi_ratios(dist: np.ndarray, phi_s: np.ndarray, phi_t: np.ndarray) -> np.nd
     """:func:`_phi_ratio` of every element (the same operations, elementwise)."""
     rhs, rtol = phi_t - phi_s, current_rtol()
     big = np.maximum(np.abs(phi_s), np.abs(phi_t))
-    r = dist / (np.maximum(rhs, 0.0) + rtol * (1.0 + np.maximum(np.abs(dist), big)))
+    r = dist / (np.maximum(rhs, 0.0) + rtol * (1.0 + np.maximum(np.maximum(np.abs(dist), big), current_data_scale())))
     return np.where(rhs < -rtol * (1.0 + big), np.maximum(r, 2.0), r)
 
 
@@ -383,7 +383,7 @@ def _sigma_ratio(S, z: np.ndarray, t: float) -> tuple[float, dict | None]:
         return -np.inf, None
     sig = float(S.problem.sigma(t))
     rhs = sig * (1.0 + math.sqrt(float(z @ z)))
-    tol = current_rtol() * (1.0 + max(abs(rhs), abs(val)))    # tolerance(rhs, val), without its array dispatch
+    tol = current_rtol() * (1.0 + max(abs(rhs), abs(val), current_data_scale()))    # tolerance(rhs, val), without its array dispatch
     return val / (rhs + tol), {"t": t, "z": z, "F0_norm": val, "sigma_t": sig}
 
 
@@ -392,7 +392,7 @@ def _sigma_ratios(S, Z: np.ndarray, ts: np.ndarray) -> np.ndarray:
     val = f0_norms(S.op, Z, ts, 1e-6 * S.T)
     sig = np.array([float(S.problem.sigma(t)) for t in ts.tolist()])
     rhs = sig * (1.0 + norms(Z))
-    tol = current_rtol() * (1.0 + np.maximum(np.abs(rhs), np.abs(val)))
+    tol = current_rtol() * (1.0 + np.maximum(np.maximum(np.abs(rhs), np.abs(val)), current_data_scale()))
     with np.errstate(invalid="ignore"):
         r = val / (rhs + tol)
     return np.where(np.isnan(val), -np.inf, r)

@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from ..core.problem import Problem
-from ..core.tolerances import RTOL
+from ..core.tolerances import current_data_scale, current_rtol
 from ..records.results import FAILED, PASSED, UNDECIDED, XFAIL, XFAIL_DECLARED, CheckResult, Report
 from .arguments import valid_seed
 from .assumption_a2 import (A2_LEVELS, A2_RATIO, A2_SETTLED, A2_TAIL_SAFETY, UNDECIDED_SIDE,  # noqa: F401
@@ -48,14 +48,22 @@ def _dots(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def _non_monotone(Z: np.ndarray, Y: np.ndarray, P: np.ndarray):
     """``(ratio, inner, i, j)`` of every pair of graph points ``(Z_i, Y_i)``: ``-⟨Z_i − Z_j, Y_i − Y_j⟩`` in
-    units of its rounding (``P``: the size of what each ``Y`` was computed from)."""
+    units of its rounding (``P``: the size of what each ``Y`` was computed from; the operator's own scale under
+    judgement is one more magnitude of the ``Z``, as in :func:`verimono.core.tolerances.tolerance`), at the
+    precision under judgement."""
     i, j = np.triu_indices(len(Z), 1)
     dz, dy = Z[i] - Z[j], Y[i] - Y[j]
     inner = np.sum(dz * dy, axis=1)
     nz, ny = np.linalg.norm(dz, axis=1), np.linalg.norm(dy, axis=1)
-    tol = RTOL * (nz * (1.0 + np.maximum(P[i], P[j])) + ny * (1.0 + np.maximum(np.abs(Z[i]).max(1),
-                                                                                  np.abs(Z[j]).max(1))))
+    zs = np.maximum(np.maximum(np.abs(Z[i]).max(1, initial=0.0), np.abs(Z[j]).max(1, initial=0.0)), current_data_scale())
+    tol = current_rtol() * (nz * (1.0 + np.maximum(P[i], P[j])) + ny * (1.0 + zs))
     return -inner / (tol + 1e-300), inner, i, j
+
+
+def _size(P: np.ndarray, lam: float) -> np.ndarray:
+    """The size of what ``Y_λ p = (p − J_λ p)/λ`` of each row ``p`` of ``P`` is computed from: ``max(|p|, S)/λ``,
+    ``S`` the operator's own scale under judgement (``J_λ p`` rounds at it: :mod:`verimono.core.tolerances`)."""
+    return np.maximum(np.abs(P).max(axis=1, initial=0.0), current_data_scale()) / lam
 
 
 @law("assumption_A1", "(A1)", subject="problem", driver=run_assumption, over=("t", "points", "lam"))
@@ -71,7 +79,7 @@ def check_assumption_A1(S) -> Outcome:
             J = S.rows(S.points, lam, float(t))
             keep = np.all(np.isfinite(J), axis=1)       # rows verimono could not verify are no evidence
             Z.append(J[keep]), Y.append(((S.points - J) / lam)[keep])
-            P.append(np.abs(S.points[keep]).max(axis=1) / lam)
+            P.append(_size(S.points[keep], lam))
             N.append(J[:nn][keep[:nn]])
         try:   # minimal sections at the domain points of x0 and the points around it
             z = np.vstack(N)
@@ -116,7 +124,7 @@ def _a1_sup(S):
         lam, p = lams[li], P[rows]
         z = S.rows(p, lam, t)
         y = (p - z) / lam
-        ratio, inner, i, j = _non_monotone(z, y, np.abs(p).max(axis=1) / lam)
+        ratio, inner, i, j = _non_monotone(z, y, _size(p, lam))
         return z, y, np.where(np.isnan(ratio), -np.inf, ratio), inner, i, j
 
     def one(t: float, f: int) -> float:
@@ -127,9 +135,9 @@ def _a1_sup(S):
         y = (p - z) / lam
         dz, dy = z[0] - z[1], y[0] - y[1]
         inner = float(dz @ dy)
-        size = np.abs(p).max(axis=1) / lam
-        tol = RTOL * (math.sqrt(float(dz @ dz)) * (1.0 + max(size[0], size[1]))
-                      + math.sqrt(float(dy @ dy)) * (1.0 + float(np.abs(z).max())))
+        size = _size(p, lam)
+        tol = current_rtol() * (math.sqrt(float(dz @ dz)) * (1.0 + max(size[0], size[1]))
+                                + math.sqrt(float(dy @ dy)) * (1.0 + max(float(np.abs(z).max()), current_data_scale())))
         r = -inner / (tol + 1e-300)
         return -math.inf if r != r else r
 
@@ -151,9 +159,10 @@ def _a1_sup(S):
             z = S.rows_at_times(p, lam, ts)         # (times, 2, n): one call when the operator takes a time per row
             y = (p - z) / lam
             dz, dy = z[:, 0] - z[:, 1], y[:, 0] - y[:, 1]
-            size = np.abs(p).max(axis=1) / lam
-            tol = RTOL * (np.sqrt(_dots(dz, dz)) * (1.0 + max(size[0], size[1]))
-                          + np.sqrt(_dots(dy, dy)) * (1.0 + np.abs(z).max(axis=(1, 2))))
+            size = _size(p, lam)
+            tol = current_rtol() * (np.sqrt(_dots(dz, dz)) * (1.0 + max(size[0], size[1]))
+                                    + np.sqrt(_dots(dy, dy)) * (1.0 + np.maximum(np.abs(z).max(axis=(1, 2)),
+                                                                                 current_data_scale())))
             with np.errstate(invalid="ignore"):
                 r = -_dots(dz, dy) / (tol + 1e-300)
             unverified = ~np.isfinite(z).all(axis=(1, 2))

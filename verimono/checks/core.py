@@ -45,7 +45,8 @@ from ..core.errors import InvalidCheckArgument, NotApplicable
 from ..core.operators import provides
 from ..records.results import FAILED, PASSED, SKIPPED, CheckResult
 from ..records.verdicts import SUBJECT_EXITS, classify, new_record, record_of_exception
-from ..core.tolerances import judged_precision
+from ..core.tolerances import judged_at_scale, judged_precision
+from .engine.data_scale import judged_at_data_scale, stated_scale
 
 SUBJECTS = ("operator", "stepper", "problem", "system", "estimator")
 
@@ -291,7 +292,34 @@ def run(decl: Law, subject: str, evaluate: Callable[[], Any], *, operator: Any =
     """Run one law on one subject: its requirements first (a skip with the declaration's reason), then
     ``evaluate()`` — an :class:`Outcome` or a finished record — under the one exception policy
     (:func:`classify`).  The record gets the law's label and, where the evaluation did not measure its
-    own, its duration."""
+    own, its duration.
+
+    A law of a ``problem`` (a stepper's trajectory laws and order, the assumption laws, the bounds) is judged at
+    the operator's own scale (:mod:`verimono.core.tolerances`, "the operator's own scale") as the operator laws
+    are (:func:`verimono.checks.engine.search.run_law`): at ``problem.operator.data_scale`` when stated (the
+    record's ``details["data_scale"]`` says so); else a failure with a finite ratio is judged once more at the
+    scale inferred from the domain's extent, and is *undecided* when it holds there
+    (:func:`verimono.checks.engine.data_scale.judged_at_data_scale`)."""
+    if problem is None:
+        return _run(decl, subject, evaluate, operator, stepper, problem, seed)
+    op = operator if operator is not None else getattr(problem, "operator", None)
+    stated = stated_scale(op)
+    with judged_at_scale(stated):
+        rec = _run(decl, subject, evaluate, operator, stepper, problem, seed)
+    if rec.status == SKIPPED:
+        return rec
+    if stated is not None:
+        rec.details["data_scale"] = {"stated": stated}
+        return rec
+    # judged again at the precision it was judged at (runs kept by shared_runs are not computed, nor observed, again)
+    return judged_at_data_scale(rec, op, float(getattr(problem, "T", 1.0) or 1.0),
+                                lambda: _run(decl, subject, evaluate, operator, stepper, problem, seed,
+                                             rec.details.get("dtype")))
+
+
+def _run(decl: Law, subject: str, evaluate: Callable[[], Any], operator: Any, stepper: Any, problem: Any,
+         seed: int | None, precision: str | None = None) -> CheckResult:
+    """:func:`run` at the operator's scale in force (and at least at ``precision``)."""
     start = time.perf_counter()
     op = operator if operator is not None else getattr(problem, "operator", None)
     ctx = Context(operator=op, problem=problem, claim=None if stepper is None else claim_of(stepper))
@@ -299,7 +327,7 @@ def run(decl: Law, subject: str, evaluate: Callable[[], Any], *, operator: Any =
     if why:
         rec = new_record(decl.name, subject, SKIPPED, message=why, seed=seed)
     else:
-        with judged_precision() as precision:
+        with judged_precision(precision) as precision:
             try:
                 out = evaluate()
                 rec = out if isinstance(out, CheckResult) else record(decl.name, subject, out, seed=seed)

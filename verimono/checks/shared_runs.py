@@ -34,7 +34,7 @@ from typing import Any, Callable, Iterator
 
 import numpy as np
 
-from ..core.tolerances import judged_precision, observe
+from ..core.tolerances import coarser, judged_precision, observe
 
 #: bytes of states a :func:`shared_runs` block keeps at most (its oldest runs are dropped first): a count, the
 #: same on every machine.  The stepper battery's partitions of one problem hold 680 nodes (10 partitions,
@@ -151,8 +151,12 @@ def remembered(stepper: Any, problem: Any, grid: np.ndarray,
     hit = _ACTIVE[-1].get(key)
     if hit is not None:
         return hit[0]
-    x, precision = run()
-    _ACTIVE[-1].put(key, (stepper, problem), (x,), precision)
+    # the precision kept is the coarsest seen while it ran — its states' and what its calls of the operator returned
+    # (a stepper returning float64 states of a float32 operator computes in float32): a law reading the kept run
+    # later is judged as the one that ran it
+    with judged_precision() as seen:
+        x, precision = run()
+    _ACTIVE[-1].put(key, (stepper, problem), (x,), coarser(precision, seen.name))
     return x
 
 

@@ -40,7 +40,7 @@ from ..core.operators import NormalCone
 from ..core.problem import Problem
 from ..core.sets import ConvexSet
 from ..core.stepping import Trajectory
-from ..core.tolerances import DOMAIN_ORDER_SLACK, current_precision, judged_precision, row_tolerances, tolerance
+from ..core.tolerances import DOMAIN_ORDER_SLACK, current_data_scale, current_precision, judged_precision, row_tolerances, tolerance
 from ..records.results import FAILED, PASSED, UNDECIDED
 from .core import CONTRACTION_CLAIM, PROXIMAL_CLAIM, Holds, Member, Outcome
 from .partitions import battery_grids, claimed_grids, default_grids, run_stepper, stepper_law
@@ -328,7 +328,7 @@ def check_in_domain(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int =
     if w is not None:
         # row_tolerances(x[1:], back) of the per-row maxima the witnesses' pass measured
         bound = w["distance"]
-        tol = current_precision().rtol * (1.0 + np.maximum(w["x_max"][1:], w["back_max"]))
+        tol = current_precision().rtol * (1.0 + np.maximum(np.maximum(w["x_max"][1:], w["back_max"]), current_data_scale()))
         near = bound <= tol
         dists[1:][near], ratios[1:][near] = bound[near], bound[near] / tol[near]
         exact[1:] &= ~near
@@ -394,7 +394,7 @@ def check_selections(stepper: Callable, p: Problem, t: np.ndarray, *, seed: int 
     # an inexact resolvent (x_{k+1} within ε of J_h(z_k)): the witness is within 2ε (Inexact), and membership is
     # judged by the distance to the exact resolvent instead (a point ε outside dom F has no selection to test)
     # (row_tolerances(x[1:], μ y, x[:-1]) of the per-row maxima the witnesses' pass measured)
-    xm = w["x_max"]
+    xm = np.maximum(w["x_max"], current_data_scale())     # the operator's own scale: one more magnitude (tolerances.py)
     # the harness's own ∫u error (_quadrature_allowance): moves y by at most q/h, the witness x + μy by q/2 (μ ≤ h/2)
     q = _quadrature_allowance(p, t)
     qa = 0.0 if q is None else q

@@ -328,6 +328,18 @@ def operator_from_resolvent(resolvent: Callable[[np.ndarray, float, float], Any]
                            data_scale)
 
 
+def stated_data_scale(op: Any) -> float | None:
+    """The operator's stated :attr:`Operator.data_scale` (``None``: not stated, or not a finite number ≥ 0)."""
+    s = getattr(op, "data_scale", None)
+    if s is None or isinstance(s, bool):
+        return None
+    try:
+        s = float(s)
+    except (TypeError, ValueError):
+        return None
+    return s if math.isfinite(s) and s >= 0.0 else None
+
+
 def with_data_scale(op: Operator, data_scale: float | None) -> Operator:
     """``op`` with its stated :attr:`Operator.data_scale` (``None``: left unstated); a scale that is not a finite
     number ``≥ 0`` is an :class:`InvalidProblem`."""

@@ -12,8 +12,9 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from .errors import InvalidProblem, OutsideDomain
+from .operator_protocol import stated_data_scale
 from .arrays import as_float64, precision_of
-from .tolerances import coarser, current_precision, rtol_for, tolerance
+from .tolerances import coarser, current_precision, judged_at_scale, rtol_for, tolerance
 
 
 @dataclasses.dataclass(frozen=True)
@@ -249,9 +250,16 @@ class Problem:
         precision = coarser(current_precision().name, precision_of(raw))
         p = as_float64(raw)
         dist = float(np.max(np.abs(p - self.x0)))
-        if dist > tolerance(self.x0, rtol=rtol_for(precision)):
+        # and at the operator's own scale when it states one (tolerances.py): a float32 projection onto a ball of
+        # radius 10^6 moves a point of its domain near the origin by its rounding there, eps·10^6
+        stated = stated_data_scale(self.operator)
+        with judged_at_scale(stated):
+            tol = tolerance(self.x0, rtol=rtol_for(precision))
+        if dist > tol:
+            hint = ("" if stated is not None else "; if the operator computes with data far larger than x0 and this "
+                    "distance is its rounding, state its data_scale (operator_from_resolvent(..., data_scale=...))")
             raise OutsideDomain(f"x0 = {self.x0} lies outside cl dom F(0,·) (distance {dist:.3g} to its "
-                                "projection); pass initial_jump=True to start with the catching-up jump")
+                                f"projection); pass initial_jump=True to start with the catching-up jump{hint}")
 
     def input_increments(self, t: np.ndarray) -> np.ndarray | None:
         """``∫_{t_k}^{t_{k+1}} u`` for every cell: exact from ``U`` or 3-point Gauss–Legendre (order 6)."""

@@ -338,10 +338,11 @@ def roundoff_floor(scale: float, precision: str | None = None) -> float:
     so the pessimism costs nothing.  Coarser precisions: the worst case would swallow ordinary
     discretisation errors (``1.2e-3`` in float32, where the catalog's studies reach ``3e-6``), so the floor
     is the typical accumulation of independent roundings, ``sqrt(K)·eps·scale`` (float32: ``1.2e-5``; the
-    catalog's float32 runs of exact schemes stay below ``5e-8``)."""
+    catalog's float32 runs of exact schemes stay below ``5e-8``).  The operator's own scale under judgement
+    (:func:`judged_at_scale`) is one more magnitude of ``scale``: each step rounds at it."""
     p = precision or "float64"
     k = ROUNDOFF_STEPS if p == "float64" else math.sqrt(ROUNDOFF_STEPS)
-    return k * EPS_BY_PRECISION[p] * float(scale)
+    return k * EPS_BY_PRECISION[p] * max(float(scale), _DATA_SCALE.get())   # the operator's own scale: one more
 
 
 def repeat_tolerance(*scales: float) -> float:

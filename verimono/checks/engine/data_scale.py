@@ -35,6 +35,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ...core.operator_protocol import stated_data_scale
 from ...core.tolerances import LARGEST_BY_PRECISION, judged_at_scale
 from ...records.results import FAILED, PASSED, UNDECIDED, CheckResult
 from ...records.verdicts import new_record
@@ -52,12 +53,9 @@ PULLED, SATURATED = 0.5, 2.0
 
 
 def stated_scale(op: Any) -> float | None:
-    """The operator's stated ``data_scale`` (``None``: not stated)."""
-    s = getattr(op, "data_scale", None)
-    if s is None:
-        return None
-    s = float(s)
-    return s if math.isfinite(s) and s >= 0.0 else None
+    """The operator's stated ``data_scale`` (``None``: not stated): :func:`verimono.core.operator_protocol.stated_data_scale`,
+    which :class:`verimono.Problem` judges its ``x0`` at too."""
+    return stated_data_scale(op)
 
 
 def _radii(precision: str | None) -> list[float]:
@@ -161,13 +159,15 @@ def judged_at_data_scale(rec: CheckResult, op: Any, horizon: float,
                                      "worst_there": again.worst}
         return rec
     details = {**rec.details, "data_scale": {"inferred": S, **evidence, "there": again.status}}
-    return new_record(rec.check, rec.subject, UNDECIDED, seed=rec.seed, details=details,
+    out = new_record(rec.check, rec.subject, UNDECIDED, seed=rec.seed, details=details,
                       counterexample=rec.counterexample,
                       message=(f"{rec.message} — but within the rounding of the operator's own scale: its domain "
                                f"reaches |x| = {S:.3g} (J_1 of far points), where correct code rounds by "
                                f"rtol·(1 + {S:.3g}), and at that scale the law "
                                f"{'holds' if again.status == PASSED else 'is ' + again.status}; state the "
                                f"operator's data_scale (operator_from_resolvent(..., data_scale=...)) to decide"))
+    out.duration = rec.duration
+    return out
 
 
 def stated_details(op: Any) -> dict[str, Any] | None:
