@@ -59,14 +59,14 @@ MAX_AGREEMENT_CELLS = 40960
 MAX_LEVEL_NUMBERS = 1 << 25
 
 
+def _sup_distance(a: np.ndarray, b: np.ndarray) -> float:
+    """``max_k |a_k − b_k|``: the sup distance at the nodes of two runs on the same grid (states of any shape)."""
+    return float(np.max(np.linalg.norm((a - b).reshape(len(a), -1), axis=1)))
+
+
 def _node_distance(fine: np.ndarray, coarse: np.ndarray) -> float:
     """The sup distance at the coarse grid's nodes between a run on it and one on its 4-fold refinement."""
-    d = fine[::4] - coarse
-    return float(np.max(np.linalg.norm(d.reshape(len(d), -1), axis=1)))
-
-
-def _sup_distance(a: np.ndarray, b: np.ndarray) -> float:
-    return float(np.max(np.linalg.norm((a - b).reshape(len(a), -1), axis=1)))
+    return _sup_distance(fine[::4], coarse)
 
 
 def limit_agreement(stepper: Callable, study: Any, problem: Problem) -> tuple[str, str, dict]:

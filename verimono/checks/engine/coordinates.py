@@ -42,7 +42,7 @@ import numpy as np
 
 from ...core.tolerances import current_largest, current_step_range
 from .directions import direction_search
-from .samples import Sample, with_field as _with
+from .samples import Sample, with_field as _with, with_fields as _replace
 from .supremum import Searched, Space, maximise
 
 #: the step sizes searched: ``[10^-4, Λ]`` (Λ = 10: the largest step the samples draw)
@@ -69,15 +69,6 @@ _MORE = ("mu", "nu", "scale")
 DENSE_SHARE = 2
 DENSE_SHARE_BATCHED = 8
 DENSE_MAX = 4096
-
-def _replace(s: Sample, **changes: Any) -> Sample:
-    """``dataclasses.replace(s, **changes)`` without its ``__init__`` (``Sample`` has no ``__post_init__``; a design
-    builds thousands of samples): a copy of ``s``'s fields with ``changes``."""
-    out = object.__new__(Sample)
-    out.__dict__.update(s.__dict__)
-    out.__dict__.update(changes)
-    return out
-
 
 def _norm(v: np.ndarray) -> float:
     m = float(np.max(np.abs(v), initial=0.0))
