@@ -328,27 +328,28 @@ def operator_from_resolvent(resolvent: Callable[[np.ndarray, float, float], Any]
                            data_scale)
 
 
-def stated_data_scale(op: Any) -> float | None:
-    """The operator's stated :attr:`Operator.data_scale` (``None``: not stated, or not a finite number ≥ 0)."""
-    s = getattr(op, "data_scale", None)
-    if s is None or isinstance(s, bool):
+def _finite_scale(value: Any) -> float | None:
+    """``value`` as a data scale: a finite float ``≥ 0`` (not a bool), else ``None``."""
+    if value is None or isinstance(value, bool):
         return None
     try:
-        s = float(s)
+        s = float(value)
     except (TypeError, ValueError):
         return None
     return s if math.isfinite(s) and s >= 0.0 else None
+
+
+def stated_data_scale(op: Any) -> float | None:
+    """The operator's stated :attr:`Operator.data_scale` (``None``: not stated, or not a finite number ≥ 0)."""
+    return _finite_scale(getattr(op, "data_scale", None))
 
 
 def with_data_scale(op: Operator, data_scale: float | None) -> Operator:
     """``op`` with its stated :attr:`Operator.data_scale` (``None``: left unstated); a scale that is not a finite
     number ``≥ 0`` is an :class:`InvalidProblem`."""
     if data_scale is not None:
-        try:
-            s = float(data_scale)
-        except (TypeError, ValueError):
-            s = math.nan
-        if not (math.isfinite(s) and s >= 0.0) or isinstance(data_scale, bool):
+        s = _finite_scale(data_scale)
+        if s is None:
             raise InvalidProblem(f"data_scale must be a finite number ≥ 0 (the magnitude of the operator's data), "
                                  f"got {data_scale!r}")
         op.data_scale = s
