@@ -122,7 +122,7 @@ def test_the_scale_is_one_more_magnitude_of_the_one_rule():
             pass
 
 
-@pytest.mark.parametrize("bad", [-1.0, float("nan"), float("inf"), True, "big"])
+@pytest.mark.parametrize("bad", [-1.0, float("nan"), float("inf"), True, "big", 10 ** 400])
 def test_a_bad_stated_scale_is_a_typed_error(bad):
     with pytest.raises(vm.InvalidProblem):
         ball(np.float64, 1.0, stated=bad)

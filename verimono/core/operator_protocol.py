@@ -334,7 +334,7 @@ def _finite_scale(value: Any) -> float | None:
         return None
     try:
         s = float(value)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):     # 10**400: no float
         return None
     return s if math.isfinite(s) and s >= 0.0 else None
 
