@@ -170,10 +170,4 @@ def judged_at_data_scale(rec: CheckResult, op: Any, horizon: float,
     return out
 
 
-def stated_details(op: Any) -> dict[str, Any] | None:
-    """What a record judged at a stated scale says of it."""
-    s = stated_scale(op)
-    return None if s is None else {"stated": s}
-
-
-__all__ = ["finite_failure", "stated_scale", "inferred_scale", "probe_extent", "judged_at_data_scale", "stated_details"]
+__all__ = ["finite_failure", "stated_scale", "inferred_scale", "probe_extent", "judged_at_data_scale"]
