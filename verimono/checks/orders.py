@@ -22,7 +22,6 @@ from __future__ import annotations
 import math
 from typing import Any, Callable
 
-
 from ..core.claims import claim_of
 from ..core.convergence import convergence_study, expected_order
 from ..core.errors import InvalidProblem

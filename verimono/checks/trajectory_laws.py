@@ -789,13 +789,13 @@ def _shares(a: Any, b: np.ndarray) -> bool:
     return isinstance(a, np.ndarray) and np.may_share_memory(a, b) and np.shares_memory(a, b)
 
 
-
 def _own_copy(p: Problem) -> Problem:
     """The stepper's own copy of ``p`` for :func:`check_trajectory_immutable`, its ``x0`` writeable there alone (a
     Problem's ``x0`` is read-only): a write into it is then seen and named, not an error NumPy raises."""
     q = p.replace(x0=np.array(p.x0, dtype=float))
     q.x0.flags.writeable = True
     return q
+
 
 @stepper_law("trajectory_immutable", "a returned trajectory is the caller's (issue 42)", over_grids=False)
 def check_trajectory_immutable(stepper: Callable, p: Problem, *, seed: int = 0, grids: Any = None) -> Outcome:
