@@ -10,7 +10,10 @@
 * :mod:`.supremum` — the one-dimensional supremum (design, coverage, DIRECT, Brent) of every law over ``t``,
   ``λ`` or a distance, with its resolution; :mod:`.batches` — batched subjects' calls;
 * :mod:`.times` — the time coordinate of the assumption laws, by count (jittered strata, both ends, refined by
-  :mod:`.supremum`); :mod:`.sphere` — the largest value of a function of a direction over ``S^{n-1}``.
+  :mod:`.supremum`); :mod:`.sphere` — the largest value of a function of a direction over ``S^{n-1}``;
+* :mod:`.scales` — the scale phase: the worst sample's points over every decade the precision represents;
+  :mod:`.data_scale` — the operator's own scale (stated, or inferred from its domain) and the re-judgement of a
+  failure at it.
 
 The laws (:mod:`verimono.checks.operator_laws`, ...) and the batteries import from here; the engine imports only
 the checks' core (declarations, records, members) and the layers below.
