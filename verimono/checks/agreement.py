@@ -17,8 +17,8 @@ battery shares):
 With ``τ_s``, ``τ_r`` the two tails and ``tol`` the two round-off floors:
 
 * **failed** when ``D > τ_s + τ_r + tol``: the limits are provably apart, by at least ``D − τ_s − τ_r``;
-* **passed** when ``D + τ_s + τ_r ≤ LIMIT_RESOLUTION · scale``: the limits are within that of each other
-  (``|lim_s − lim_r| ≤ τ_s + D + τ_r``);
+* **passed** when ``D + τ_s + τ_r ≤ LIMIT_RESOLUTION · scale + tol``: the limits are within that (and the
+  round-off) of each other (``|lim_s − lim_r| ≤ τ_s + D + τ_r``);
 * else the next 4-fold level for both (up to :data:`MAX_AGREEMENT_CELLS` cells and :data:`MAX_LEVEL_NUMBERS`
   numbers a run), and **undecided** when those are spent: the estimates cannot
   tell the limits apart nor bring them within the resolution — never a pass.
