@@ -731,7 +731,7 @@ def own_overflow(out: Outcome) -> str | None:
     if math.isfinite(rhs) and math.isfinite(0.0 if slack is None else slack):
         return None
     return (f"the law's own arithmetic overflowed at these magnitudes ({out.what}: lhs {lhs:.3g}, rhs {rhs:.3g}, "
-            f"slack {slack:.3g}): no judgement")
+            f"slack {0.0 if slack is None else slack:.3g}): no judgement")
 
 
 def violation_text(out: Outcome) -> str:
