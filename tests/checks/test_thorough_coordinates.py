@@ -75,4 +75,6 @@ def test_thorough_evaluates_ten_times_ci_on_every_declared_coordinate_of_every_o
         ci, th = (_counts(recs[p].details["searched"]["coordinates"]) for p in ("ci", "thorough"))
         assert {c.split()[0] for c in ci} <= set(decl.over) and "lam decades" in ci, (name, ci)   # (offset: when
         for c, n in ci.items():                    # the worst sample is outside the domain)
+            if c.split()[0] == "offset" and c not in th:
+                continue    # searched only from a worst sample outside the domain: thorough's worst may lie inside
             assert c == "form" and th[c] == n or th[c] >= 10 * n, (name, c, n, th)
