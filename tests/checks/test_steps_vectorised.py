@@ -93,13 +93,26 @@ def test_the_comparison_sees_steps_taken_in_another_order(monkeypatch):
     assert not np.array_equal(J, want)
 
 
-@pytest.mark.slow       # two searches, one through hypothesis after its violations: ~1 s
-def test_the_records_see_steps_taken_in_another_order(monkeypatch):
-    """The law's record sees the reversed steps (Yosida's limit, one seed): the laws' searches use the one call."""
+@pytest.mark.slow       # two searches: ~1 s
+def test_the_laws_searches_use_the_one_call_and_stay_right_when_it_is_wrong(monkeypatch):
+    """Yosida's limit on t|x| (one seed) calls the resolvent with a step per row (the one call per block); with the
+    steps taken reversed in the block, the block's rows are no longer accepted and the law's own evaluator (a call
+    per sample, a float λ) decides them: the same record.  (Until the block form left every row not clearly inside
+    the bound to the evaluator, the record changed instead; it was asserted so, and failed since before 0288656.)"""
+    real = NormSubdifferential.resolvent
+    blocks = []
+
+    def counting(self, x, lam, t=0.0):
+        if type(lam) is np.ndarray:
+            blocks.append(lam.size)
+        return real(self, x, lam, t)
+    monkeypatch.setattr(NormSubdifferential, "resolvent", counting)
     before = run_law("yosida_limit", OPS["t|x|"](), seed=0, examples=8)
+    assert blocks and max(blocks) > 1
     _reversed_steps(monkeypatch)
     after = run_law("yosida_limit", OPS["t|x|"](), seed=0, examples=8)
-    assert (after.worst, after.details.get("evaluations")) != (before.worst, before.details.get("evaluations"))
+    assert (after.status, after.worst, after.details.get("evaluations")) == \
+        (before.status, before.worst, before.details.get("evaluations"))
 
 
 def test_the_records_are_the_calls_per_steps_records():
