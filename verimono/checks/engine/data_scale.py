@@ -39,7 +39,6 @@ from ...core.operator_protocol import stated_data_scale
 from ...core.tolerances import LARGEST_BY_PRECISION, judged_at_scale
 from ...records.results import FAILED, PASSED, UNDECIDED, CheckResult
 from ...records.verdicts import new_record
-from ..members import resolvent
 
 #: the far radii of the probe: every third decade from 10^3 up to ``sqrt(largest)·10^-3`` of the precision the law
 #: was judged at (squares of the probe's points stay finite), and never beyond 10^60 (float64: 20 radii, float32: 5)
@@ -84,6 +83,9 @@ def _directions(n: int) -> list[np.ndarray]:
 
 def _size(op: Any, x: np.ndarray, t: float) -> float | None:
     """``|J_1 x|_∞`` (``None`` when the resolvent raises or returns anything but finite values of ``x``'s shape)."""
+    # imported here: checks.core imports this module, and members imports the engine's samples, which import
+    # hypothesis — a stepper battery on the references alone must not pay that import (tests/testing/test_plugin.py)
+    from ..members import resolvent
     try:
         j = resolvent(op, x, 1.0, t)
     except Exception:     # noqa: BLE001 - a probe point the resolvent refuses tells nothing of the extent
