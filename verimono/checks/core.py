@@ -288,21 +288,22 @@ def laws_of(subject: str, *, battery: bool | None = None) -> dict[str, Law]:
 # -- running one law --------------------------------------------------------------------------------
 
 def run(decl: Law, subject: str, evaluate: Callable[[], Any], *, operator: Any = None, stepper: Any = None,
-        problem: Any = None, seed: int | None = None) -> CheckResult:
+        problem: Any = None, seed: int | None = None, horizon: float | None = None,
+        rejudge: bool = True) -> CheckResult:
     """Run one law on one subject: its requirements first (a skip with the declaration's reason), then
     ``evaluate()`` — an :class:`Outcome` or a finished record — under the one exception policy
     (:func:`classify`).  The record gets the law's label and, where the evaluation did not measure its
     own, its duration.
 
-    A law of a ``problem`` (a stepper's trajectory laws and order, the assumption laws, the bounds) is judged at
-    the operator's own scale (:mod:`verimono.core.tolerances`, "the operator's own scale") as the operator laws
-    are (:func:`verimono.checks.engine.search.run_law`): at ``problem.operator.data_scale`` when stated (the
-    record's ``details["data_scale"]`` says so); else a failure with a finite ratio is judged once more at the
-    scale inferred from the domain's extent, and is *undecided* when it holds there
-    (:func:`verimono.checks.engine.data_scale.judged_at_data_scale`)."""
-    if problem is None:
-        return _run(decl, subject, evaluate, operator, stepper, problem, seed)
+    A law with an operator (``operator``, or ``problem.operator``: the operator laws, a stepper's trajectory laws
+    and order, the assumption laws, the bounds) is judged at the operator's own scale
+    (:mod:`verimono.core.tolerances`, "the operator's own scale"): at its ``data_scale`` when stated (the record's
+    ``details["data_scale"]`` says so); else, with ``rejudge``, a failure with finite sides is judged once more at
+    the scale inferred from the domain's extent over ``[0, horizon]`` (default ``problem.T``, else 1), and is
+    *undecided* when it holds there (:func:`verimono.checks.engine.data_scale.judged_at_data_scale`)."""
     op = operator if operator is not None else getattr(problem, "operator", None)
+    if op is None:
+        return _run(decl, subject, evaluate, operator, stepper, problem, seed)
     stated = stated_scale(op)
     with judged_at_scale(stated):
         rec = _run(decl, subject, evaluate, operator, stepper, problem, seed)
@@ -311,8 +312,12 @@ def run(decl: Law, subject: str, evaluate: Callable[[], Any], *, operator: Any =
     if stated is not None:
         rec.details["data_scale"] = {"stated": stated}
         return rec
+    if not rejudge:
+        return rec
+    if horizon is None:
+        horizon = float(getattr(problem, "T", 1.0) or 1.0)
     # judged again at the precision it was judged at (runs kept by shared_runs are not computed, nor observed, again)
-    return judged_at_data_scale(rec, op, float(getattr(problem, "T", 1.0) or 1.0),
+    return judged_at_data_scale(rec, op, horizon,
                                 lambda: _run(decl, subject, evaluate, operator, stepper, problem, seed,
                                              rec.details.get("dtype")))
 

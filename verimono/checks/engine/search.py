@@ -77,7 +77,7 @@ from hypothesis import HealthCheck, Phase, Verbosity, given, settings
 from ...core.arrays import library_hint
 from ...core._small import abs_max
 from ...core._reproducible import no_local_constants
-from ...core.tolerances import current_rtol, judged_at_scale
+from ...core.tolerances import current_rtol
 from ..arguments import valid_horizon, valid_seed
 from ...core.errors import InvalidCheckArgument, UnitTimeout
 from ...execution.config import current as current_config
@@ -94,7 +94,6 @@ from .samples import NUMPY_DIM, Sample, law_samples
 from .supremum import budget
 from .sweep import edge_count, edge_draws, law_draws, shrink, sweep_count, sweep_samples
 from .scales import SCALE_CAP, beyond_judgement, judged_by, scale_samples
-from .data_scale import judged_at_data_scale, stated_scale
 
 #: examples per law when ``examples`` is not given and the run configuration's profile is not one of
 #: verimono's (a user's own); otherwise the profile's ``law_examples`` governs (:func:`default_examples`)
@@ -870,15 +869,10 @@ def run_law(decl: Law | str, op: Any, *, seed: int | None = None, examples: int 
         rec.duration = time.perf_counter() - start
         return rec
 
-    stated = stated_scale(op)
-    with judged_at_scale(stated):        # the operator's own scale, when it states one (engine/data_scale.py)
-        rec = run(decl, subject, evaluate, operator=op, seed=seed)
+    # at the operator's own scale (core.run); a replayed sample is judged as given, never re-judged
+    rec = run(decl, subject, evaluate, operator=op, seed=seed, horizon=horizon, rejudge=sample is None)
     if rec.status == SKIPPED and "examples" not in rec.details:   # skipped from the declaration
         rec.details.update(details)
-    elif stated is not None:
-        rec.details["data_scale"] = {"stated": stated}
-    elif sample is None:                 # a finite failure within the rounding of the inferred scale: undecided
-        rec = judged_at_data_scale(rec, op, horizon, lambda: run(decl, subject, evaluate, operator=op, seed=seed))
     return rec
 
 
