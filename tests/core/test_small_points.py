@@ -10,7 +10,7 @@ import itertools
 
 import numpy as np
 
-from verimono.core._small import SMALL, abs_max, all_finite
+from verimono.core._small import ROW_COLUMNS, SMALL, abs_max, all_finite, row_abs_max
 
 _SPECIAL = [0.0, -0.0, 5e-324, -5e-324, 1.0, -2.5, 1.7976931348623157e308, -1.7976931348623157e308, np.inf, -np.inf,
             np.nan, 1e-300, -3.0]
@@ -40,3 +40,21 @@ def test_abs_max_is_numpys_number():
 def test_all_finite_is_numpys_answer():
     for v in _arrays():
         assert all_finite(v) is bool(np.isfinite(v).all()), v
+
+
+def test_row_abs_max_is_numpys_row_maxima():
+    """Every row's largest ``|entry|`` column by column (``n ≤ ROW_COLUMNS``) or by ``max/-min`` (wider): NumPy's
+    ``np.abs(X).max(axis=1, initial=0.0)`` as numbers — NaN where a row holds one, 0 for rows of no entries —
+    on rows of the special values, random rows over 600 decades, and strided and big-endian layouts."""
+    rng = np.random.default_rng(12)
+    blocks = [np.array(list(itertools.product(_SPECIAL, repeat=n)), dtype=float).reshape(-1, n) for n in (1, 2, 3)]
+    for n in range(0, ROW_COLUMNS + 4):
+        X = rng.normal(size=(37, n)) * 10.0 ** rng.integers(-300, 300, size=(37, 1))
+        if n:
+            X[rng.integers(37, size=5), rng.integers(n, size=5)] = [np.nan, np.inf, -np.inf, -0.0, 0.0]
+        blocks += [X, np.asfortranarray(X), X.astype(">f8"), np.repeat(X, 2, axis=0)[::2]]
+    for X in blocks:
+        with np.errstate(all="ignore"):
+            want = np.abs(X).max(axis=1, initial=0.0)
+            got = row_abs_max(X)
+        assert got.shape == want.shape and np.array_equal(got, want, equal_nan=True), X

@@ -43,4 +43,29 @@ def all_finite(v: np.ndarray) -> bool:
     return bool(np.isfinite(v).all())
 
 
-__all__ = ["abs_max", "all_finite", "SMALL"]
+#: rows of at most this many entries get their maxima column by column (:func:`row_abs_max`)
+ROW_COLUMNS = 4
+
+
+def row_abs_max(X: np.ndarray) -> np.ndarray:
+    """``np.abs(X).max(axis=1, initial=0.0)`` of a 2-D array ``X`` (the largest ``|X_ij|`` of every row, 0 for a row
+    of no entries, NaN where a row holds one).  NumPy reduces along a short last axis one row at a time: at
+    ``(1000, 3)`` that reduction costs ~40–80 µs against ~6 µs for the same selection made column by column —
+    ``np.maximum`` of the columns of ``|X|``, elementwise over all rows at once — so rows of at most
+    :data:`ROW_COLUMNS` entries take that path (wider rows ``max(max X_i, -min X_i, 0)``, without a copy).  The
+    numbers are the same: a maximum is a selection (no rounding), ``np.maximum`` propagates NaN as the reduction
+    does, and ``|X| ≥ 0`` makes the initial 0 a no-op (a row of ``-0.0`` may give ``-0.0`` for ``0.0`` on the wide
+    path: equal as numbers)."""
+    k, n = X.shape
+    if n == 0:
+        return np.zeros(k)
+    if n > ROW_COLUMNS:      # max(max, -min, 0): the same numbers, without a |X| copy of a wide array
+        return np.maximum(np.maximum(X.max(axis=1), -X.min(axis=1)), 0.0)
+    a = np.abs(X)
+    out = a[:, 0].copy()
+    for j in range(1, n):
+        np.maximum(out, a[:, j], out=out)
+    return out
+
+
+__all__ = ["abs_max", "all_finite", "row_abs_max", "SMALL", "ROW_COLUMNS"]

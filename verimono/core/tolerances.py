@@ -55,7 +55,7 @@ from typing import Any, Iterator
 
 import numpy as np
 
-from ._small import abs_max
+from ._small import abs_max, row_abs_max
 
 #: relative tolerance of exact identities computed in floating point (see module docstring)
 RTOL = 1e-8
@@ -288,10 +288,7 @@ def row_tolerances(*rows: np.ndarray, rtol: float | None = None) -> np.ndarray:
     for r in rows:
         r = np.asarray(r, dtype=float)
         r = r.reshape(r.shape[0], -1)
-        if r.shape[1]:       # max(max, -min) per row: the same numbers as |r|'s maxima, without the |r| copy
-            a = np.maximum(np.maximum(r.max(axis=1), -r.min(axis=1)), 0.0)
-        else:
-            a = np.zeros(r.shape[0])
+        a = row_abs_max(r)       # each row's largest |entry| (0 for no entry), column by column when short
         m = a if m is None else np.maximum(m, a)
     if m is None:
         raise ValueError("row_tolerances needs at least one array")

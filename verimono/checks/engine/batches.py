@@ -27,6 +27,7 @@ from typing import Any, Iterator, Sequence
 import numpy as np
 
 from ...core.arrays import MAX_BATCH, as_float64
+from ...core._small import row_abs_max
 from ...core.operator_protocol import accepts_steps, accepts_times
 from ...execution.timeouts import interrupted
 from ...core.arrays import prefetch_key as key
@@ -526,7 +527,7 @@ def _contains_block(op: Any, X: np.ndarray, Y: np.ndarray, ts: np.ndarray, tols:
 def row_norms(V: np.ndarray) -> np.ndarray:
     """:func:`verimono.checks.members.norm` of every row (scaled by the row's largest entry: no underflow; 0 for
     a zero row and, as there, for a row whose largest entry is not finite)."""
-    m = np.abs(V).max(axis=1, initial=0.0)
+    m = row_abs_max(V)
     good = (m > 0.0) & np.isfinite(m)
     safe = np.where(good, m, 1.0)
     W = V / safe[:, None]       # one scaled copy (it was made twice: a (rows, n) temporary each)

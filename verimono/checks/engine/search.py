@@ -75,7 +75,7 @@ import numpy as np
 from hypothesis import HealthCheck, Phase, Verbosity, given, settings
 
 from ...core.arrays import library_hint
-from ...core._small import abs_max
+from ...core._small import abs_max, row_abs_max
 from ...core._reproducible import no_local_constants
 from ...core.tolerances import current_rtol
 from ..arguments import valid_horizon, valid_seed
@@ -205,14 +205,6 @@ def bounded_root_cause(op: Any, horizon: float = 1.0) -> str | None:
     while len(_SLOW) > SLOW_MEMORY:
         _SLOW.pop(next(iter(_SLOW)))
     return cause
-
-
-def _row_amax(X: np.ndarray) -> np.ndarray:
-    """``max(|X_i|)`` of every row (0 for an empty row) without a ``(rows, n)`` temporary (no ``abs`` copy, no
-    gather of the rows): ``max(0, max X_i, -min X_i)``, the same numbers for finite rows."""
-    if X.shape[1] == 0:
-        return np.zeros(X.shape[0])
-    return np.maximum(np.maximum(X.max(axis=1), -X.min(axis=1)), 0.0)
 
 
 def _amax(x: np.ndarray) -> float:
@@ -430,7 +422,7 @@ class _Search:
         else:
             inc = r.inconclusive & ~r.ok & ~good
             self.form_inconclusive_what = r.inconclusive_what
-        return q, good, _row_amax(r.x1), _row_amax(r.x2), r.lam, r.mu, r.nu, r.t, inc
+        return q, good, row_abs_max(r.x1), row_abs_max(r.x2), r.lam, r.mu, r.nu, r.t, inc
 
     @interruptible
     def _vectorised(self, fn: Callable, samples: list[Sample], idx: list[int],
