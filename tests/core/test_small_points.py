@@ -10,7 +10,7 @@ import itertools
 
 import numpy as np
 
-from verimono.core._small import ROW_COLUMNS, SMALL, abs_max, all_finite, row_abs_max
+from verimono.core._small import ROW_COLUMNS, SMALL, abs_max, all_finite, row_abs_max, row_all, row_finite
 
 _SPECIAL = [0.0, -0.0, 5e-324, -5e-324, 1.0, -2.5, 1.7976931348623157e308, -1.7976931348623157e308, np.inf, -np.inf,
             np.nan, 1e-300, -3.0]
@@ -58,3 +58,17 @@ def test_row_abs_max_is_numpys_row_maxima():
             want = np.abs(X).max(axis=1, initial=0.0)
             got = row_abs_max(X)
         assert got.shape == want.shape and np.array_equal(got, want, equal_nan=True), X
+
+
+def test_row_all_and_row_finite_are_numpys_answers():
+    """``M.all(axis=1)`` and ``np.isfinite(X).all(axis=1)`` row by row, every width up to past :data:`ROW_COLUMNS`
+    (no entries: ``True``), on random masks, the special values and strided/Fortran layouts."""
+    rng = np.random.default_rng(13)
+    for n in range(0, ROW_COLUMNS + 4):
+        for p in (0.5, 0.9, 1.0):
+            M = rng.random((41, n)) < p
+            for m in (M, np.asfortranarray(M), np.repeat(M, 2, axis=0)[::2]):
+                assert np.array_equal(row_all(m), m.all(axis=1)), m
+        X = rng.choice(np.array(_SPECIAL), size=(41, n))
+        for x in (X, np.asfortranarray(X), X.astype(">f8")):
+            assert np.array_equal(row_finite(x), np.isfinite(x).all(axis=1)), x

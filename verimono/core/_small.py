@@ -68,4 +68,22 @@ def row_abs_max(X: np.ndarray) -> np.ndarray:
     return out
 
 
-__all__ = ["abs_max", "all_finite", "row_abs_max", "SMALL", "ROW_COLUMNS"]
+def row_all(M: np.ndarray) -> np.ndarray:
+    """``M.all(axis=1)`` of a 2-D boolean array (``True`` for a row of no entries): the columns' ``&`` for rows of at
+    most :data:`ROW_COLUMNS` entries (the short-axis reduction's cost, as in :func:`row_abs_max`: 38 µs at
+    ``(1000, 3)`` against 6 µs), the reduction otherwise.  The same booleans."""
+    k, n = M.shape
+    if n == 0 or n > ROW_COLUMNS:
+        return M.all(axis=1)
+    out = M[:, 0].copy()
+    for j in range(1, n):
+        np.logical_and(out, M[:, j], out=out)
+    return out
+
+
+def row_finite(X: np.ndarray) -> np.ndarray:
+    """Whether every entry of each row of the 2-D array ``X`` is finite (``np.isfinite(X).all(axis=1)``)."""
+    return row_all(np.isfinite(X))
+
+
+__all__ = ["abs_max", "all_finite", "row_abs_max", "row_all", "row_finite", "SMALL", "ROW_COLUMNS"]

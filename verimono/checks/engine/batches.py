@@ -27,7 +27,7 @@ from typing import Any, Iterator, Sequence
 import numpy as np
 
 from ...core.arrays import MAX_BATCH, as_float64
-from ...core._small import row_abs_max
+from ...core._small import row_abs_max, row_all, row_finite
 from ...core.operator_protocol import accepts_steps, accepts_times
 from ...execution.timeouts import interrupted
 from ...core.arrays import prefetch_key as key
@@ -262,7 +262,7 @@ def row_resolvents(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok:
                 Js[lo:hi] = 0.0
                 continue
             Js[lo:hi] = P
-        good &= np.isfinite(Js).all(axis=1) & (Xs == (X if order is None else X[order])).all(axis=1)  # inputs unchanged
+        good &= row_finite(Js) & row_all(Xs == (X if order is None else X[order]))  # inputs unchanged
         if order is None:
             ok &= good
             return Js
@@ -291,7 +291,7 @@ def row_resolvents(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok:
             good[i] = False
             continue
         J[i] = p
-    good &= np.isfinite(J).all(axis=1) & (Xc == X).all(axis=1)
+    good &= row_finite(J) & row_all(Xc == X)
     ok &= good
     return J
 
@@ -322,7 +322,7 @@ def _one_call(op: Any, X: np.ndarray, lams: np.ndarray, ts: np.ndarray, ok: np.n
         if interrupted():
             raise
         return None
-    ok &= np.isfinite(J).all(axis=1) & (Xs == X).all(axis=1)      # inputs unchanged
+    ok &= row_finite(J) & row_all(Xs == X)      # inputs unchanged
     return J
 
 
@@ -384,7 +384,7 @@ def row_member(member: Any, X: np.ndarray, ts: np.ndarray, ok: np.ndarray) -> np
         P = _member_block(member, X, ts, rows)
         if P is not None:
             out[rows] = P
-            ok &= np.isfinite(out).all(axis=1)
+            ok &= row_finite(out)
             return out
     for i in rows.tolist():
         if st is not None:
@@ -405,7 +405,7 @@ def row_member(member: Any, X: np.ndarray, ts: np.ndarray, ok: np.ndarray) -> np
             continue
         out[i] = p
     ok[bad] = False
-    ok &= np.isfinite(out).all(axis=1)
+    ok &= row_finite(out)
     return out
 
 
