@@ -343,8 +343,9 @@ def _wants_backstop() -> bool:
 
 
 def _stale_backstop() -> bool:
-    """An armed backstop that no limit needs (with ``_COND``): none is open, or the innermost has been reported."""
-    return _BACKSTOP_ARMED and not _ENDING and (not _LIMITS or _LIMITS[-1].reported)
+    """An armed backstop that no limit needs (with ``_COND``): none is open.  (One whose limit has been reported
+    stays armed, as before: the handler ends the process, :func:`ending` re-arming it first.)"""
+    return _BACKSTOP_ARMED and not _ENDING and not _LIMITS
 
 
 def _arm_backstop() -> None:
