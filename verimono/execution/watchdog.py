@@ -25,7 +25,8 @@ Either ends the subject's own child processes (an ``os.system`` command that wou
 keep its output pipes open; Linux, through ``/proc``) before it exits.  The *backstop* is for a
 native call that blocks while holding the GIL, which stops this thread too: while a handler is installed,
 :mod:`faulthandler` (a C thread that needs no GIL) ends the process with status 1 and the Python tracebacks
-on standard error at ``budget + 2 x grace``, without writing anything (a worker's parent then reports its
+on standard error at ``budget + 2 x grace`` (to half a grace later: one timer serves the limits that follow one
+another while it fires in that window of each, :func:`_arm_backstop`), without writing anything (a worker's parent then reports its
 unit as a dead worker; a ``verimono`` command leaves its in-progress mark, which the gate refuses), and a
 handler, which calls :func:`ending` first, gets :data:`ENDING_SECONDS` to write before it does the same.
 The child processes of a call that holds the GIL are not ended (nothing in Python runs to find them).
@@ -245,6 +246,14 @@ def _watch() -> None:
             while True:
                 top = _LIMITS[-1] if _LIMITS else None
                 if top is None or top.reported:
+                    if _stale_backstop():           # no limit to back: cancel the timer before it fires
+                        left = _BACKSTOP_AT - STALE_MARGIN - time.monotonic()
+                        if left <= 0:
+                            _cancel_backstop()
+                            continue
+                        _WAKE_AT = _BACKSTOP_AT - STALE_MARGIN
+                        _COND.wait(left)
+                        continue
                     _WAKE_AT = math.inf
                     _COND.wait()
                     continue
@@ -294,36 +303,73 @@ def on_hang(handler: Callable[[Hang], None], *, backstop: bool = True) -> Iterat
 
 
 _BACKSTOP_ARMED = False
+#: when the armed backstop fires (``time.monotonic``; ``inf``: not armed), under ``_COND``
+_BACKSTOP_AT = math.inf
 #: set by :func:`ending`: the process is being ended, the limits no longer move the backstop
 _ENDING = False
 #: seconds a handler has, from :func:`ending`, to write what finished before the backstop ends the process
 ENDING_SECONDS = 120.0
+#: the backstop's slack, a fraction of the limit's grace: it is armed at ``budget + (2 + BACKSTOP_SLACK) x grace``
+#: and kept for every later limit whose ``budget + 2 x grace`` it does not precede (see :func:`_arm_backstop`)
+BACKSTOP_SLACK = 0.5
+#: seconds before a backstop that no limit needs any more fires at which the watchdog thread cancels it (it fires
+#: at least ``(2 + BACKSTOP_SLACK) x GRACE_MIN`` = 5 s after the last limit opened)
+STALE_MARGIN = GRACE_MIN
 
 
 def _backstop_in(seconds: float) -> None:
-    global _BACKSTOP_ARMED
+    global _BACKSTOP_ARMED, _BACKSTOP_AT
     import faulthandler
 
     try:
-        faulthandler.dump_traceback_later(max(seconds, 0.1), exit=True, file=sys.__stderr__ or 2)
-        _BACKSTOP_ARMED = True
+        seconds = max(seconds, 0.1)
+        faulthandler.dump_traceback_later(seconds, exit=True, file=sys.__stderr__ or 2)
+        _BACKSTOP_ARMED, _BACKSTOP_AT = True, time.monotonic() + seconds
     except (ValueError, RuntimeError, OSError, AttributeError):   # pragma: no cover - no usable stderr
         pass
 
 
-def _arm_backstop() -> None:
-    """(Re)arm :mod:`faulthandler`'s timer for the innermost limit while a handler asks for it (with ``_COND``)."""
-    global _BACKSTOP_ARMED
+def _cancel_backstop() -> None:
+    global _BACKSTOP_ARMED, _BACKSTOP_AT
     import faulthandler
 
+    if _BACKSTOP_ARMED:
+        faulthandler.cancel_dump_traceback_later()
+    _BACKSTOP_ARMED, _BACKSTOP_AT = False, math.inf
+
+
+def _wants_backstop() -> bool:
+    return bool(_HANDLERS) and _HANDLERS[-1][1]
+
+
+def _stale_backstop() -> bool:
+    """An armed backstop that no limit needs (with ``_COND``): none is open.  (One whose limit has been reported
+    stays armed, as before: the handler ends the process, :func:`ending` re-arming it first.)"""
+    return _BACKSTOP_ARMED and not _ENDING and not _LIMITS
+
+
+def _arm_backstop() -> None:
+    """(Re)arm :mod:`faulthandler`'s timer for the innermost limit while a handler asks for it (with ``_COND``).
+
+    Each arming starts a C thread and each cancel joins it, holding the GIL until that thread has run: with every
+    core busy (a run's workers) the join waits for a core, ~1-4 ms of the main thread's wall, once per limit
+    (~1,700 limits in a ``ci`` run's untimed stages).  So the timer is armed at ``budget + (2 + BACKSTOP_SLACK) x
+    grace`` of the innermost limit and kept while it fires no earlier than ``budget + 2 x grace`` of the limit
+    open now (the limits of a law's phases follow one another within the slack, at least 1 s): the backstop ends a
+    process blocked with the GIL held at ``budget + 2 x grace`` to ``budget + 2.5 x grace``, never earlier.  When no
+    limit is open the timer is left armed, and the watchdog thread cancels it :data:`STALE_MARGIN` seconds before
+    it fires if still no limit needs it (:func:`_watch`); a fork cancels it first (:func:`_before_fork`).  A
+    handler removed, or a limit reported as a hang, cancels it at once, as :func:`ending` re-arms it at once."""
     if _ENDING:
         return
-    if _HANDLERS and _HANDLERS[-1][1] and _LIMITS and not _LIMITS[-1].reported:
+    if _wants_backstop() and _LIMITS and not _LIMITS[-1].reported:
         top = _LIMITS[-1]
-        _backstop_in(top.start + top.seconds + 2 * grace(top.seconds) - time.monotonic())
-    elif _BACKSTOP_ARMED:
-        faulthandler.cancel_dump_traceback_later()
-        _BACKSTOP_ARMED = False
+        g = grace(top.seconds)
+        earliest = top.start + top.seconds + 2 * g
+        if not (_BACKSTOP_ARMED and earliest <= _BACKSTOP_AT <= earliest + BACKSTOP_SLACK * g):
+            _backstop_in(earliest + BACKSTOP_SLACK * g - time.monotonic())
+    elif _BACKSTOP_ARMED and not (_wants_backstop() and not _LIMITS):
+        _cancel_backstop()
 
 
 def ending(seconds: float = ENDING_SECONDS) -> None:
@@ -376,16 +422,43 @@ def end_process(status: int) -> None:
 def _after_fork_in_child() -> None:
     """A forked child (a process pool of a convergence study) runs none of its parent's limits, handlers or
     scopes, and has no watchdog thread or backstop timer of its own yet."""
-    global _COND, _THREAD, _BACKSTOP_ARMED, _ENDING, _WAKE_AT
+    global _COND, _THREAD, _BACKSTOP_ARMED, _ENDING, _WAKE_AT, _BACKSTOP_AT
     _LIMITS.clear()
     _HANDLERS.clear()
     _FRAMES.clear()
     _COND, _THREAD, _BACKSTOP_ARMED, _ENDING = threading.Condition(), None, False, False
     _WAKE_AT = math.inf             # the parent's thread's wake-up time is not the child's (it has no thread yet)
+    _BACKSTOP_AT = math.inf
+
+
+#: whether :func:`_before_fork` cancelled a backstop that an open limit needs (re-armed after the fork)
+_REARM_AFTER_FORK = False
+
+
+def _before_fork() -> None:
+    """The backstop is cancelled before a fork: the child would inherit :mod:`faulthandler`'s state of a timer whose
+    thread it has not got, and its own first arming would wait for that thread for ever (seen: a child forked
+    with a timer armed hangs in its first ``dump_traceback_later``).  The parent re-arms it after the fork if a limit still needs
+    it (:func:`_after_fork_in_parent`); a backstop that no limit needs is simply gone."""
+    global _REARM_AFTER_FORK
+    with _COND:
+        _REARM_AFTER_FORK = False
+        if _BACKSTOP_ARMED and not _ENDING:
+            _REARM_AFTER_FORK = not _stale_backstop()
+            _cancel_backstop()
+
+
+def _after_fork_in_parent() -> None:
+    global _REARM_AFTER_FORK
+    with _COND:
+        if _REARM_AFTER_FORK:
+            _REARM_AFTER_FORK = False
+            _arm_backstop()
 
 
 if hasattr(os, "register_at_fork"):
-    os.register_at_fork(after_in_child=_after_fork_in_child)
+    os.register_at_fork(before=_before_fork, after_in_parent=_after_fork_in_parent,
+                        after_in_child=_after_fork_in_child)
 
 
 __all__ = ["Hang", "grace", "limit", "on_hang", "scope", "finished", "collected", "hang_report", "ending",
