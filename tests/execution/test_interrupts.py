@@ -46,6 +46,9 @@ def test_the_one_rule_of_a_unit_out_of_time():
     assert status(evaluated=5, in_flight=1.9, slowest=0.05, budget=2.0) == FAILED
     assert status(evaluated=12, in_flight=0.015, slowest=2e-4, budget=0.03) == UNDECIDED
     assert status(evaluated=0, in_flight=0.031, budget=0.03) == FAILED           # outlived a short budget
+    # a quick sample after quicker ones, in flight past a 30 ms budget (a scheduler's pause at load 13): under 0.1 s
+    assert status(evaluated=12, in_flight=0.05, slowest=2e-4, budget=0.03) == UNDECIDED
+    assert status(evaluated=12, in_flight=0.2, slowest=2e-4, budget=0.03) == FAILED
     assert status(evaluated=0, in_flight=0.09, budget=0.15) == UNDECIDED         # under 0.1 s
     assert status() == FAILED                                                    # no evidence: timed out
     assert "samples" in timeout_verdict("u", evaluated=2, in_flight=None)[1]

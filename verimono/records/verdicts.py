@@ -57,9 +57,10 @@ HANG_MULTIPLE = 20.0
 #: ran out (the budget spent by the harness, or by many quick evaluations) is not a hang, however quick the
 #: evaluations before it were (20 x a 4 ms sample is 0.08 s, which a busy machine's scheduler can add alone)
 HANG_FRACTION = 0.5
-#: ... and at least this many seconds (or, under a smaller budget, the whole budget): a Python process pauses
-#: that long without being stuck — a garbage collection inside a microsecond resolvent kept it "in flight"
-#: 15 ms at a 30 ms budget here, and a busy machine's scheduler adds as much
+#: ... and at least this many seconds (for the first call of a unit under a smaller budget, the whole budget): a
+#: Python process pauses that long without being stuck — a garbage collection inside a microsecond resolvent kept
+#: it "in flight" 15 ms at a 30 ms budget here, and a busy machine's scheduler adds as much (at load 13 on 2 cores a
+#: quick sample after many quicker ones was in flight past a 20–50 ms budget: a correct projection failed)
 HANG_MIN_SECONDS = 0.1
 
 
@@ -67,13 +68,15 @@ def never_returned(in_flight: float | None, slowest: float, budget: float | None
     """Whether a call that was still running ``in_flight`` seconds when its unit's budget (``budget`` seconds)
     ran out counts as one that never returns: longer than :data:`HANG_MULTIPLE` x the slowest evaluation of
     the same law that returned (``slowest`` seconds; 0 when none did), longer than :data:`HANG_FRACTION`
-    of the budget and longer than :data:`HANG_MIN_SECONDS` (than the whole budget, when that is shorter: a
-    call that started with the unit and outlived it).  ``None`` (nothing was in flight: the budget ran out between evaluations, in the harness)
-    is no hang."""
+    of the budget and longer than :data:`HANG_MIN_SECONDS` — or, for the first call (none returned before it)
+    under a budget shorter than that, than the whole budget: a call that started with the unit and outlived it.
+    A call after others returned is judged against :data:`HANG_MIN_SECONDS` whatever the budget: under a 20 ms
+    budget a scheduler's pause alone outlasts it.  ``None`` (nothing was in flight: the budget ran out between
+    evaluations, in the harness) is no hang."""
     if in_flight is None:
         return False
-    floor = 0.0 if budget is None or not math.isfinite(budget) else \
-        max(HANG_FRACTION * budget, min(HANG_MIN_SECONDS, budget))
+    least = HANG_MIN_SECONDS if slowest > 0.0 else min(HANG_MIN_SECONDS, budget or HANG_MIN_SECONDS)
+    floor = 0.0 if budget is None or not math.isfinite(budget) else max(HANG_FRACTION * budget, least)
     return in_flight > max(HANG_MULTIPLE * slowest, floor)
 
 
@@ -87,7 +90,7 @@ def timeout_verdict(text: str, *, evaluated: int = 0, held: bool = True, in_flig
     * *failed* when a violation had been seen (``held`` false): the subject is at fault whatever the time;
     * *failed* when the call in flight counts as one that never returns (:func:`never_returned`: the first
       call, or one far slower than every evaluation before it, that had used at least half the budget and
-      a tenth of a second, or the whole budget when that is shorter);
+      a tenth of a second — the first call: or the whole budget when that is shorter);
     * else *undecided* (``details["undecided_reason"] == "time budget"``): the evaluations that finished all
       held, or none finished and no call of the subject had run for long — a correct subject on a slow or
       busy machine, or a budget spent by the harness, is never failed.
