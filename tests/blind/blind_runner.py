@@ -1,5 +1,6 @@
-"""What the runners of blind sets 7 and 8 share (``tests/blind/set7/run_blind7.py``, ``set8/run_blind8.py``): each
-entry of a set's ``subjects.py`` through ``vm.check_operator`` / ``vm.check_stepper`` in a subprocess of its own under
+"""What the runners of blind sets 7 to 10 share (``tests/blind/set7/run_blind7.py``, ``set8/run_blind8.py``, ...): each
+entry of a set's ``subjects.py`` through ``vm.check_operator`` / ``vm.check_stepper`` (or, for an entry with a
+``run(subject, seed, profile)`` of its own, the reports it returns, merged) in a subprocess of its own under
 a time cap, one at a time, and the verdict on it: a plant is caught when a record failed (the table names the check,
 the subject of its worst failed record and its worst ratio); a control passes when no record failed and none is
 undecided (any failed or undecided record of a control is a false alarm, printed with its record)."""
@@ -54,7 +55,11 @@ def run_one(blind: "BlindSet", name: str, seed: int, profile: str) -> dict:
     profile = None if profile == "default" else profile      # "default": no profile given (the run configuration's)
     t0 = time.perf_counter()
     subject = entry.build()
-    if entry.kind == "operator":
+    own = getattr(entry, "run", None)      # a subject neither an operator nor a stepper: its own entry points
+    if own is not None:
+        reports = own(subject, seed, profile)
+        report = vm.Report([r for rep in reports for r in rep])
+    elif entry.kind == "operator":
         report = vm.check_operator(subject, seed=seed, profile=profile)
     else:
         stepper, extra = subject if isinstance(subject, tuple) else (subject, None)
