@@ -63,3 +63,45 @@ def test_a_law_failed_by_the_value_function_says_so_and_gives_js_roundoff(radius
     assert cx["resolvent_roundoff"] == pytest.approx(eps32 * (1 + radius), rel=1e-6)
     p = np.asarray(cx["p"])
     assert np.linalg.norm(p) - 1.0 > 16 * cx["resolvent_roundoff"]
+
+
+def _singleton_at_one_step():
+    """``g`` the indicator of ``{c}``, whose prox ``c`` answers only at ``λ = 1/2`` (it raises at every other step):
+    at ``x1, x2 ≠ c`` every candidate ``z`` of the prox inequality but ``p`` itself has ``g(z) = +∞``."""
+    c = np.array([1.0, 2.0])
+
+    def prox(x, lam, t=0.0):
+        if lam != 0.5:
+            raise ValueError("answers at λ = 1/2 only")
+        return c.copy()
+    return vm.operator_from_prox(prox, shape=2, value=lambda z, t=0.0: 0.0 if np.array_equal(z, c) else np.inf,
+                                 name="singleton at one step")
+
+
+def test_prox_inequality_with_no_candidate_in_dom_g_tested_nothing():
+    """Every candidate ``z`` outside ``dom g``: the inequality holds trivially at each, so the sample is inconclusive
+    (the whole record then skipped: nothing was evaluated), never a pass — and never the failure it was, blind set
+    10's `log_barrier_prox_cancellation` at thorough: the law returned no outcome and the search's
+    ``AttributeError`` was counted as the subject's."""
+    from verimono.checks.engine.samples import Sample
+    s = Sample(np.array([3.0, 3.0]), np.array([4.0, 4.0]), lam=0.5, mu=0.3, nu=0.7, t=0.0)
+    rec = run_law("prox_inequality", _singleton_at_one_step(), sample=s)
+    assert rec.status == "skipped" and "no candidate z with g(z) < ∞" in rec.message, rec.message
+
+
+def test_a_law_answering_no_outcome_is_a_limit_of_the_harness(monkeypatch):
+    """A law of verimono's own that answers no :class:`Outcome` is verimono's fault: the sample is inconclusive and
+    counted as a limit of the harness, never the subject's failure nor a pass."""
+    from verimono.checks.core import REGISTRY
+    from verimono.core.sets import Ball
+    from verimono.checks.engine.batches import VECTORISED
+    import dataclasses
+
+    decl = REGISTRY["operator"]["resolvent_nonexpansive"]
+    monkeypatch.setitem(REGISTRY["operator"], "resolvent_nonexpansive",
+                        dataclasses.replace(decl, evaluate=lambda op, s: None))
+    monkeypatch.delitem(VECTORISED, "resolvent_nonexpansive")      # every sample through the law's evaluator
+    rec = run_law("resolvent_nonexpansive", vm.NormalCone(Ball(np.zeros(2), 1.0)), seed=0, examples=5)
+    assert rec.status in ("undecided", "skipped"), rec
+    # every sample the law's evaluator met is a limit of the harness (the scale phase's far points are not judged)
+    assert rec.details["harness_limited"] >= rec.details["evaluations"] - 2 > 50, rec.details

@@ -272,8 +272,9 @@ def check_prox_inequality(op, s, p, gp):
         q = _ratio(lhs - rhs, 0.0, slack)
         if worst is None or not q <= worst[0]:
             worst = (q, lab, z, gz, lhs - rhs, slack)
-    if worst is None:
-        return None
+    if worst is None:       # g(z) = +∞ at every candidate: the inequality holds there trivially, nothing was tested
+        return Outcome.inconclusive_sample("no candidate z with g(z) < ∞ (x1, x2, 0 and the resolvent values other "
+                                           "than p): the prox inequality tested nothing at this sample")
     _, lab, z, gz, lhs, slack = worst
     return Outcome.compare(lhs, 0.0, slack, "⟨x - p, z - p⟩ ≤ λ(g(z) - g(p)) for p = prox_{λg}(x), z = " + lab,
                            {"p": listed(p), "z": listed(z), "z_is": lab, "g(p)": gp, "g(z)": gz})
