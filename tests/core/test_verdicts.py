@@ -178,3 +178,26 @@ def test_errors_flat_at_a_floor_on_every_grid_are_exact_to_it_and_a_constant_err
     # falling at the order it claims, tiny errors are no floor: a scheme of order 1 claimed 2 at 1e-10 fails
     tiny = 1e-9 * np.array([1.0 / 2 ** k for k in range(5)])
     assert decide(data(tiny, 2.0, claimed=2.0)).status == FAILED
+
+
+def test_a_newton_solves_noise_below_1e_8_is_exact_to_the_floor_not_a_slope():
+    """probe8: solve_nivp's trapezoidal rule (ERC-INJECT/solve_nivp c82f2bc) on t|x| is exact for the quadratic
+    solution up to its semismooth Newton solve: errors 1e-16 on K = 2, 4 and 8e-12 ... 9.5e-11 after, spread 1e5,
+    not flat.  Read as slopes the noise "measured 0.769 [0.170, 1.369]" and passed a claim of 1; from x0 = -0.7 it
+    was undecided.  Both are exact to the floor; the same errors times 1e7 (1e-3: a wrong limit) still fail, and
+    tiny errors falling at order 1 are still errors (claimed 2: failed)."""
+    K = [2, 4, 9, 18, 40, 80, 160, 320, 640, 1280, 2560]
+    runs = [[1.04e-16, 2.05e-16, 6.31e-11, 7.37e-11, 9.48e-11, 3.51e-11, 9.37e-11, 5.84e-11, 3.17e-11, 3.70e-11,
+             8.19e-12],
+            [4.98e-17, 4.49e-17, 2.19e-11, 3.99e-16, 9.18e-11, 1.22e-11, 9.28e-11, 9.62e-11, 6.17e-11, 2.14e-11,
+             2.70e-12]]
+    for e in runs:
+        floors = [FLOOR] * len(K)                # the study's round-off floor, 10^4 eps x scale
+        d = decide(StudyData([2.0 / k for k in K], K, e, floors, Order(1.0, "t"), 1.0, None, 1.0, [], 2, False,
+                             False))
+        assert d.status == PASSED and "exact to the floor" in d.message and "without falling" in d.message, d.message
+        wrong = decide(StudyData([2.0 / k for k in K], K, [x * 1e7 + 1e-3 for x in e], floors, Order(1.0, "t"), 1.0,
+                                 None, 1.0, [], 2, False, False))
+        assert wrong.status == FAILED, wrong.message
+    tiny = 1e-9 * np.array([1.0 / 2 ** k for k in range(5)])
+    assert decide(data(tiny, 2.0, claimed=2.0)).status == FAILED

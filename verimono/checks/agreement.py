@@ -109,12 +109,20 @@ def limit_agreement(stepper: Callable, study: Any, problem: Problem) -> tuple[st
         else:
             status = UNDECIDED
         nxt = 4 * levels[-1]
-        if status != UNDECIDED or nxt > MAX_AGREEMENT_CELLS or (nxt + 1) * n > MAX_LEVEL_NUMBERS:
+        if nxt > MAX_AGREEMENT_CELLS:
+            stop = f"K = {levels[-1]} is the finest level (MAX_AGREEMENT_CELLS = {MAX_AGREEMENT_CELLS})"
+        elif (nxt + 1) * n > MAX_LEVEL_NUMBERS:
+            stop = (f"the next level, K = {nxt}, was not run: (K + 1)·n = {(nxt + 1) * n:.3g} numbers at n = {n}, "
+                    f"more than a run may hold (MAX_LEVEL_NUMBERS = {MAX_LEVEL_NUMBERS:.3g}, "
+                    f"{MAX_LEVEL_NUMBERS * 8 >> 20} MB in float64) — a limit of the harness at this dimension")
+        else:
+            stop = None
+        if status != UNDECIDED or stop is not None:
             break
         levels.append(nxt)
         add_level(nxt)
     K = levels[-1]
-    info = {"levels": levels, "distance": D, "bound": tail_s + tail_r + tol, "upper": upper,
+    info = {"levels": levels, "stopped": stop, "distance": D, "bound": tail_s + tail_r + tol, "upper": upper,
             "resolution": resolution, "stepper_tail": tail_s, "solve_tail": tail_r,
             "stepper_differences": diffs["stepper"], "solve_differences": diffs["solve"],
             "stepper_ratio": r_s, "solve_ratio": r_r, "stepper_ratio_floor": floor_s, "round_off": tol,
@@ -131,7 +139,7 @@ def limit_agreement(stepper: Callable, study: Any, problem: Problem) -> tuple[st
                         "solution, thm:main): self-convergence alone does not show the limit"), info
     return status, (f"its limit is not resolved against verimono.solve's: {said}; the limits may be up to {upper:.3g} "
                     f"apart, more than the resolution {resolution:.3g} ({LIMIT_RESOLUTION:g} x scale), and the "
-                    f"levels up to K = {K} cannot separate them"), info
+                    f"levels up to K = {K} cannot separate them; {stop}"), info
 
 
 __all__ = ["limit_agreement", "LIMIT_RESOLUTION", "MAX_AGREEMENT_CELLS", "MAX_LEVEL_NUMBERS"]

@@ -35,6 +35,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ..core._validate import states_shape_error
 from ..core.arrays import as_float64, precision_of
 from ..core.claims import claim_of
 from ..core.grid_design import cells_of
@@ -93,8 +94,8 @@ def _validated_run(stepper: Callable, problem: Problem, grid: np.ndarray) -> tup
     else:
         x = np.array(as_float64(raw), dtype=float, copy=True)
     if x.shape != (len(grid),) + problem.x0.shape:
-        raise ValueError(f"stepper {stepper_subject(stepper, problem).split(' on ')[0]} returned shape {x.shape}, "
-                         f"expected {(len(grid),) + problem.x0.shape}")
+        raise states_shape_error(stepper_subject(stepper, problem).split(' on ')[0], x.shape, len(grid),
+                                 problem.x0.shape)
     if not all_finite(x):
         raise ValueError("the stepper returned non-finite states")
     return x, precision

@@ -47,6 +47,32 @@ def real_array(x: object, what: str = "point") -> np.ndarray:
         raise InvalidProblem(f"{what} must be numeric: {exc}") from None
 
 
+def states_shape_error(who: str, shape: tuple, nodes: int, dim: tuple) -> InvalidProblem:
+    """The error for a stepper's states of the wrong shape: ``(K + 1,) + x0.shape`` was expected, one state per
+    node of the grid of ``nodes = K + 1`` times, ``x_0`` first.  The shapes users return by mistake are named
+    with their likely cause: one state too many (a loop ``while t < T: t += h`` whose sum of steps falls short of
+    ``T`` by round-off takes one more step, of size ~1e-16: solve_nivp c82f2bc's fixed-step driver), one too
+    few (``x_0`` left out, or ``floor(T/h)`` steps), the transpose, the states of a one-dimensional problem as
+    a flat array."""
+    expected = (nodes,) + tuple(dim)
+    shape = tuple(shape)
+    msg = f"stepper {who} returned shape {shape}, expected {expected}: one state per node of t_grid, x_0 first"
+    if len(shape) == len(expected) and shape[1:] == expected[1:] and shape[0] == nodes + 1:
+        why = (f"one state more than the {nodes} nodes — a stepper that steps past the last node (a loop "
+               f"'while t < T: t += h' takes one more step of round-off size when its sum of steps falls short "
+               f"of T); step over the nodes: for k in range(len(t_grid) - 1)")
+    elif len(shape) == len(expected) and shape[1:] == expected[1:] and shape[0] == nodes - 1:
+        why = (f"one state fewer than the {nodes} nodes — x_0 left out, or floor(T / h) steps, one short when "
+               f"h does not divide T in floating point; step over the nodes: for k in range(len(t_grid) - 1)")
+    elif len(expected) == 2 and shape == expected[::-1]:
+        why = "the transpose: states are rows (scipy's solve_ivp returns sol.y of shape (n, K + 1): return sol.y.T)"
+    elif expected[1:] == (1,) and shape == (nodes,):
+        why = "a flat array for a problem of dimension 1: return the states as a column, x[:, None]"
+    else:
+        return InvalidProblem(msg)
+    return InvalidProblem(f"{msg}; {why}")
+
+
 def finite_point(x: object, what: str) -> np.ndarray:
     """:func:`real_array` and every entry finite (a projection of a NaN point has no meaning)."""
     a = real_array(x, what)

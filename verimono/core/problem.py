@@ -14,7 +14,7 @@ import numpy as np
 from .errors import InvalidProblem, OutsideDomain
 from .operator_protocol import stated_data_scale
 from .arrays import as_float64, precision_of
-from .tolerances import coarser, current_precision, judged_at_scale, rtol_for, tolerance
+from .tolerances import coarser, current_precision, judged_at_scale, judged_precision, rtol_for, tolerance
 
 
 @dataclasses.dataclass(frozen=True)
@@ -241,13 +241,17 @@ class Problem:
         return self.x0.ndim == 2
 
     def _check_initial_point(self) -> None:
+        # at the precision the operator computes in (a float32 projection of x0 ∈ dom F moves it by its
+        # rounding), the coarser of the one under judgement and the projection's own deciding — observed while
+        # it runs: a wrapped operator (operator_from_resolvent) hands back float64, its float32 seen only by the
+        # judgement in progress, and outside any (a user's Problem(...)) a float32 box's own rounding of x0,
+        # 3e-8, refused it as outside its domain (probe8)
         try:
-            raw = self.operator.project_domain(self.x0, 0.0)
+            with judged_precision(current_precision().name) as seen:
+                raw = self.operator.project_domain(self.x0, 0.0)
         except NotImplementedError:
             return  # cannot be checked; the operator laws report the missing member
-        # at the precision the operator computes in (a float32 projection of x0 ∈ dom F moves it by its
-        # rounding), the coarser of the one under judgement and the projection's own deciding
-        precision = coarser(current_precision().name, precision_of(raw))
+        precision = coarser(seen.name, precision_of(raw))
         p = as_float64(raw)
         dist = float(np.max(np.abs(p - self.x0)))
         # and at the operator's own scale when it states one (tolerances.py): a float32 projection onto a ball of

@@ -36,7 +36,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from ._validate import real_array
+from ._validate import real_array, states_shape_error
 from .arrays import as_float64
 from .errors import InvalidProblem, UnitTimeout
 from .grids import uniform_grid, validate_grid
@@ -390,8 +390,7 @@ def _timed_run(stepper, problem, grid):
     except (TypeError, ValueError):
         x = real_array(x, f"the values of stepper {subject_name(stepper)}")   # complex: an error
     if x.shape != (len(grid),) + problem.x0.shape:
-        raise InvalidProblem(f"stepper {subject_name(stepper)} returned shape {x.shape}, expected "
-                             f"{(len(grid),) + problem.x0.shape}")
+        raise states_shape_error(subject_name(stepper), x.shape, len(grid), problem.x0.shape)
     return x, time.perf_counter() - start
 
 

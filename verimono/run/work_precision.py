@@ -43,6 +43,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from ..core._jsonable import to_jsonable
+from ..core._validate import states_shape_error
 from ..core.adaptive import DEFAULT_TOLERANCES, Adaptive, own_errors, own_run
 from ..core.arrays import as_float64
 from ..core.convergence import exact_on, grid_errors
@@ -259,8 +260,7 @@ class _Run:
             return e, run.steps, scale
         x = np.asarray(as_float64(self.stepper(self.problem, self.grid)), dtype=float)
         if x.shape != (len(self.grid),) + self.problem.x0.shape:
-            raise InvalidProblem(f"stepper {subject_name(self.stepper)} returned shape {x.shape}, expected "
-                                 f"{(len(self.grid),) + self.problem.x0.shape}")
+            raise states_shape_error(subject_name(self.stepper), x.shape, len(self.grid), self.problem.x0.shape)
         ref = exact_on(self.problem, self.grid)
         return grid_errors(self.grid, x, ref), len(self.grid) - 1, float(np.max(np.abs(ref)))
 
