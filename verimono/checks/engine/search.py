@@ -86,6 +86,7 @@ from ...records.results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
 from ...execution.timeouts import (checkpoint, current_budget, interrupted, interruptible, note_progress,
                                   time_limit, unlimited)
 from ...records.verdicts import timeout_verdict
+from .blocks import SampleBlock
 from .batches import CLOCK, PER_PASS, ROW_CELLS, VECTORISED, Rows, _BatchFailure, batched, prefetched, rows_accepted
 from .coordinates import COORDINATES, coordinate_search, searched
 from ..core import REGISTRY, Law, Outcome, classify, law, new_record, run, subject_name
@@ -248,6 +249,10 @@ class _Search:
     xs: list = dataclasses.field(default_factory=list)
     lams: list = dataclasses.field(default_factory=list)
     ts: list = dataclasses.field(default_factory=list)
+    #: the same of the rows a vectorised pass accepted, as the pass's arrays (:meth:`_commit`; read by :meth:`searched`)
+    xs_rows: list = dataclasses.field(default_factory=list)
+    lams_rows: list = dataclasses.field(default_factory=list)
+    ts_rows: list = dataclasses.field(default_factory=list)
     coordinates: list = dataclasses.field(default_factory=list)
     #: the coordinate budget's cap at large n (:func:`verimono.execution.profiles.large_n_count`), stated in the record
     budget_note: str = ""
@@ -262,6 +267,8 @@ class _Search:
     pending: list = dataclasses.field(default_factory=list)
     pre: dict = dataclasses.field(default_factory=dict)
     pre_rows: tuple = ()
+    #: the announced :class:`SampleBlock` lists, ``id(block) -> (block, its first row in the pass)``
+    pre_blocks: dict = dataclasses.field(default_factory=dict)
     #: the evaluator's message for the rows a vectorised pass found inconclusive by the law's own test (``Rows.inconclusive``)
     form_inconclusive_what: str = ""
     #: the law's budget and when it runs out (:func:`time.perf_counter`; ``None``: unlimited), shared by its phases
@@ -331,6 +338,8 @@ class _Search:
         fn = VECTORISED.get(self.decl.name)
         if fn is None or len(samples) < 2 or batched(self.op):
             return [self.evaluate(s) for s in samples]
+        if isinstance(samples, SampleBlock):
+            return self._evaluate_block(fn, samples)
         rows = [i for i, s in enumerate(samples) if s.form == CONTIGUOUS]
         if self.pending and rows and id(samples[rows[0]]) in self.pre:
             self._prefetched(fn)
@@ -342,15 +351,43 @@ class _Search:
             known = [self.pre.pop(id(samples[i]), None) for i in idx] if self.pre_rows else []
             if known and all(k is not None and k[0] is samples[i] for k, i in zip(known, idx)):
                 at = np.array([k[1] for k in known], dtype=np.intp)
-                got, inc = self._vectorised(fn, samples, idx, tuple(a[at] for a in self.pre_rows))
+                got, inc = self._vectorised(fn, [samples[i] for i in idx], idx, tuple(a[at] for a in self.pre_rows))
             else:
-                got, inc = self._vectorised(fn, samples, idx)
+                got, inc = self._vectorised(fn, [samples[i] for i in idx], idx)
             vals.update(got)
             undecidable.update(inc)
         if undecidable:
             return [vals[i] if i in vals else self.inconclusive_row(s) if i in undecidable else self.evaluate(s)
                     for i, s in enumerate(samples)]
         return [vals[i] if i in vals else self.evaluate(s) for i, s in enumerate(samples)]
+
+    def _evaluate_block(self, fn: Callable, block: SampleBlock) -> list[float | None]:
+        """:meth:`evaluate_many` of a block (:class:`SampleBlock`): the form's pass over its arrays (or the rows of
+        the :meth:`prefetch` pass that announced it), the accepted rows counted from the arrays, and a
+        :class:`Sample` made only for a row the law's evaluator sees — the same rows in the same order as
+        :meth:`evaluate_many` of the block's samples as a list."""
+        if block.form != CONTIGUOUS:
+            return [self.evaluate(s) for s in block]
+        if self.pending and id(block) in self.pre_blocks:
+            self._prefetched(fn)
+        hit = self.pre_blocks.pop(id(block), None) if self.pre_rows else None
+        if hit is not None and hit[0] is not block:
+            hit = None
+        B = len(block)
+        vals: dict[int, float] = {}
+        undecidable: set[int] = set()
+        chunk = max(1, ROW_CELLS // max(1, int(self.op.dim)))
+        for lo in range(0, B, chunk):
+            hi = min(B, lo + chunk)
+            idx = range(lo, hi)
+            known = None if hit is None else tuple(a[hit[1] + lo:hit[1] + hi] for a in self.pre_rows)
+            got, inc = self._vectorised(fn, block if hi - lo == B else block[lo:hi], idx, known)
+            vals.update(got)
+            undecidable.update(inc)
+        if len(vals) == B:
+            return [vals[i] for i in range(B)]
+        return [vals[i] if i in vals else self.inconclusive_row(block[i]) if i in undecidable else
+                self.evaluate(block[i]) for i in range(B)]
 
     @interruptible
     def inconclusive_row(self, s: Sample) -> None:
@@ -376,27 +413,38 @@ class _Search:
         ``yosida_limit``'s last open row — is not prefetched).  A pass that raised, or rows no longer announced,
         fall back to a pass per list (that list's own pass then meets what the form raises)."""
         fn = VECTORISED.get(self.decl.name)
-        self.pending, self.pre, self.pre_rows = [], {}, ()
+        self.pending, self.pre, self.pre_rows, self.pre_blocks = [], {}, (), {}
         if fn is None or batched(self.op) or self.decl.name in PER_PASS:
             return
-        lists = [[s for s in l if s.form == CONTIGUOUS] for l in lists if len(l) >= 2]
-        lists = [l for l in lists if l]
+        lists = [l if isinstance(l, SampleBlock) else [s for s in l if s.form == CONTIGUOUS]
+                 for l in lists if len(l) >= 2 and not (isinstance(l, SampleBlock) and l.form != CONTIGUOUS)]
+        lists = [l for l in lists if len(l)]
         if len(lists) < 2:        # nothing to merge
             return
-        self.pending = [s for l in lists for s in l]
-        self.pre = {id(s): (s, k) for k, s in enumerate(self.pending)}
+        k = 0
+        for l in lists:           # a block is announced as a whole, a list's samples one by one
+            if isinstance(l, SampleBlock):
+                self.pre_blocks[id(l)] = (l, k)
+            else:
+                self.pre.update((id(s), (s, k + j)) for j, s in enumerate(l))
+            k += len(l)
+        if self.pre_blocks:       # blocks (n <= ROWS_OF_N): one block of every row, joined when the pass runs
+            self.pending = [l if isinstance(l, SampleBlock) else SampleBlock.stacked(l) for l in lists]
+        else:                     # lists only (any n): their samples, stacked a chunk at a time by the pass
+            self.pending = [s for l in lists for s in l]
 
     @interruptible
     def _prefetched(self, fn: Callable) -> None:
         """The one pass over the rows :meth:`prefetch` announced (chunked as :meth:`evaluate_many` chunks a list)."""
-        samples, self.pending = self.pending, []
+        samples = SampleBlock.joined(self.pending) if self.pre_blocks else self.pending
+        self.pending = []
         checkpoint()
         chunk = max(1, ROW_CELLS // max(1, int(self.op.dim)))
         parts = []
         for lo in range(0, len(samples), chunk):
             got = self._pass(fn, samples[lo:lo + chunk], quiet=True)
             if got is None:         # the form raised: every list its own pass, as without the prefetch
-                self.pre, self.pre_rows = {}, ()
+                self.pre, self.pre_rows, self.pre_blocks = {}, (), {}
                 return
             parts.append(got)
         self.pre_rows = tuple(np.concatenate(a) for a in zip(*parts))
@@ -433,43 +481,56 @@ class _Search:
         return q, good, _row_amax(r.x1), _row_amax(r.x2), r.lam, r.mu, r.nu, r.t, inc
 
     @interruptible
-    def _vectorised(self, fn: Callable, samples: list[Sample], idx: list[int],
+    def _vectorised(self, fn: Callable, batch: Any, idx: Any,
                     known: tuple | None = None) -> tuple[dict[int, float], list[int]]:
-        """The vectorised form on ``samples[i]`` for ``i`` in ``idx``: the ratios of the rows it decides (those
-        clearly inside the bound), each such sample counted as evaluated (``known``: the rows' values from the
-        pass of :meth:`prefetch`), and the ``i`` of the rows it found inconclusive by the law's own test (counted
-        later, in their turn, by :meth:`inconclusive_row`)."""
-        if not idx:
+        """The vectorised form on ``batch`` (a list of samples or a :class:`SampleBlock`), row ``j`` the caller's
+        sample ``idx[j]``: the ratios of the rows it decides (those clearly inside the bound), each such sample
+        counted as evaluated (``known``: the rows' values from the pass of :meth:`prefetch`), and the ``i`` of the
+        rows it found inconclusive by the law's own test (counted later, in their turn, by
+        :meth:`inconclusive_row`)."""
+        if not len(idx):
             return {}, []
         checkpoint()
-        batch = [samples[i] for i in idx]
         got = self._pass(fn, batch) if known is None else known
         if got is None:
             return {}, []
         inc = got[-1]
         return self._commit(batch, idx, *got[:-1]), ([idx[j] for j in np.flatnonzero(inc).tolist()] if inc.any() else [])
 
-    def _commit(self, batch: list[Sample], idx: list[int], q: np.ndarray, good: np.ndarray, a1: np.ndarray,
+    def _commit(self, batch: Any, idx: Any, q: np.ndarray, good: np.ndarray, a1: np.ndarray,
                 a2: np.ndarray, lam: np.ndarray, mu: np.ndarray, nu: np.ndarray, t: np.ndarray) -> dict[int, float]:
-        """The rows of ``batch`` (``samples[i]``, ``i`` in ``idx``) its pass accepted (``good``) counted as evaluated
-        at their ratios ``q``; the worst of them evaluated by the law for the record's numbers when it is the
-        worst so far."""
+        """The rows of ``batch`` (row ``j`` the caller's sample ``idx[j]``) its pass accepted (``good``) counted as
+        evaluated at their ratios ``q`` (what was searched kept as the pass's arrays: :meth:`searched`); the worst of
+        them evaluated by the law for the record's numbers when it is the worst so far (the one row made a
+        :class:`Sample` here)."""
         k = int(good.sum())
         if not k:
             return {}
-        g = np.flatnonzero(good)
+        all_rows = k == len(good)
+        g = None if all_rows else np.flatnonzero(good)
         self.runs += k
-        self.xs += np.column_stack([a1[g], a2[g]]).ravel().tolist()
-        self.lams += np.column_stack([lam[g], mu[g], nu[g]]).ravel().tolist()
-        self.ts += t[g].tolist()
+        self.xs_rows += [a1, a2] if all_rows else [a1[g], a2[g]]
+        self.lams_rows += [lam, mu, nu] if all_rows else [lam[g], mu[g], nu[g]]
+        self.ts_rows.append(t if all_rows else t[g])
         self.forms[CONTIGUOUS] = self.forms.get(CONTIGUOUS, 0) + k
-        top = int(g[np.argmax(q[g])])
+        top = int(np.argmax(q)) if all_rows else int(g[np.argmax(q[g])])
         if self.worst is None or q[top] > self.worst.ratio:
-            out = evaluate_sample(self.decl, self.op, batch[top])     # the worst row's own numbers, for the record
+            row = batch[top]
+            out = evaluate_sample(self.decl, self.op, row)     # the worst row's own numbers, for the record
             if not out.inconclusive and out.ratio <= BOUND and (self.worst is None or out.ratio > self.worst.ratio):
-                self.worst, self.worst_sample = out, batch[top]
+                self.worst, self.worst_sample = out, row
         self.note()
-        return {idx[j]: float(q[j]) for j in g}
+        if all_rows:
+            return dict(zip(idx, q.tolist()))
+        return {idx[j]: float(q[j]) for j in g.tolist()}
+
+    def searched(self, horizon: float) -> dict:
+        """:func:`verimono.checks.engine.coordinates.searched` of everything evaluated: the one-sample lists and the
+        arrays of the vectorised passes' accepted rows."""
+        if not self.xs_rows:
+            return searched(self.xs, self.lams, self.ts, horizon, self.coordinates)
+        return searched(self.xs, self.lams, self.ts, horizon, self.coordinates,
+                        (np.concatenate(self.xs_rows), np.concatenate(self.lams_rows), np.concatenate(self.ts_rows)))
 
     def not_implemented(self, s: Sample, exc: NotImplementedError) -> Outcome | None:
         """A member raised NotImplementedError at ``s``: the operator lacks it (``None``; the search stops,
@@ -856,8 +917,7 @@ def run_law(decl: Law | str, op: Any, *, seed: int | None = None, examples: int 
         rec = _verdict(state, how, base, {**details, "evaluations": state.runs, "inconclusive": state.inconclusive,
                                           "harness_limited": state.harness_limited, "sweep": how["sweep"],
                                           "coordinate": how.get("coordinate", 0),
-                                          "searched": {**searched(state.xs, state.lams, state.ts, horizon,
-                                                                  state.coordinates), "forms": dict(state.forms),
+                                          "searched": {**state.searched(horizon), "forms": dict(state.forms),
                                                  **({"edge_samples": how["edge"]} if how.get("edge") else {}),
                                                  **({"scales": how["scales"]} if how.get("scales") else {}),
                                                  **({"hypothesis_examples": how["hypothesis"]}
