@@ -22,21 +22,26 @@ import numpy as np
 from .samples import Sample
 
 
+#: the fields a block's rows share when every field is the row's own (:meth:`SampleBlock.drawn`)
+_PLAIN = Sample(np.zeros(0), np.zeros(0), 1.0, 1.0, 1.0, 0.0)
+
+
 class SampleBlock:
     """Samples ``(x1[i], x2[i], lam[i], mu[i], nu[i], t[i])``, ``i < B``, in ``form`` (module docstring).
 
     ``proto`` is the sample whose fields every row shares but those named in ``varies``: a made row is ``proto``'s
     fields (the same objects) with those set from its row — a point as a view of row ``i`` of ``x1``, ``x2``, a
-    number as a Python ``float``.  A design over ``λ, μ, ν`` or ``t`` varies that field only (``x1``, ``x2`` are
+    number as a Python ``float`` (``owned``: a point as a copy of its row, an array of its own, as the seeded draws
+    give each sample: their arrays are shared by every law of a battery).  A design over ``λ, μ, ν`` or ``t`` varies that field only (``x1``, ``x2`` are
     then ``proto``'s broadcast to ``(B, n)``, read-only views; its rows keep ``proto``'s own point arrays)."""
 
-    __slots__ = ("x1", "x2", "lam", "mu", "nu", "t", "form", "proto", "varies", "_made", "_off", "_len")
+    __slots__ = ("x1", "x2", "lam", "mu", "nu", "t", "form", "proto", "varies", "owned", "_made", "_off", "_len")
 
     def __init__(self, proto: Sample, x1: np.ndarray, x2: np.ndarray, lam: np.ndarray, mu: np.ndarray,
                  nu: np.ndarray, t: np.ndarray, varies: tuple = ("x1", "x2", "lam", "mu", "nu", "t"),
-                 made: dict | None = None, off: int = 0) -> None:
+                 made: dict | None = None, off: int = 0, owned: bool = False) -> None:
         self.x1, self.x2, self.lam, self.mu, self.nu, self.t = x1, x2, lam, mu, nu, t
-        self.proto, self.form, self.varies = proto, proto.form, varies
+        self.proto, self.form, self.varies, self.owned = proto, proto.form, varies, owned
         self._made = {} if made is None else made       # absolute row -> its Sample (shared by slices)
         self._off, self._len = off, int(lam.shape[0])
 
@@ -58,6 +63,12 @@ class SampleBlock:
         B = X1.shape[0]
         return cls(s, X1, X2, np.full(B, float(s.lam)), np.full(B, float(s.mu)), np.full(B, float(s.nu)),
                    np.full(B, float(s.t)), varies=("x1", "x2"))
+
+    @classmethod
+    def drawn(cls, X1: np.ndarray, X2: np.ndarray, steps: np.ndarray, t: np.ndarray) -> "SampleBlock":
+        """The samples ``Sample(X1[i].copy(), X2[i].copy(), *steps[i], t[i])`` of seeded draws ``(X1, X2, steps, t)``
+        (:mod:`.sweep`), contiguous; the arrays are read as they are (read-only: the draws are cached)."""
+        return cls(_PLAIN, X1, X2, steps[:, 0], steps[:, 1], steps[:, 2], t, owned=True)
 
     @classmethod
     def stacked(cls, samples: Sequence[Sample]) -> "SampleBlock":
@@ -93,7 +104,7 @@ class SampleBlock:
                 return [self[k] for k in range(lo, hi, step)]
             hi = max(lo, hi)
             return SampleBlock(self.proto, self.x1[lo:hi], self.x2[lo:hi], self.lam[lo:hi], self.mu[lo:hi],
-                               self.nu[lo:hi], self.t[lo:hi], self.varies, self._made, self._off + lo)
+                               self.nu[lo:hi], self.t[lo:hi], self.varies, self._made, self._off + lo, self.owned)
         i = int(i)
         if i < 0:
             i += self._len
@@ -113,7 +124,10 @@ class SampleBlock:
         d = out.__dict__
         d.update(self.proto.__dict__)
         for k in self.varies:
-            d[k] = getattr(self, k)[i] if k in ("x1", "x2") else getattr(self, k)[i].item()
+            if k in ("x1", "x2"):
+                d[k] = getattr(self, k)[i].copy() if self.owned else getattr(self, k)[i]
+            else:
+                d[k] = getattr(self, k)[i].item()
         return out
 
     def __repr__(self) -> str:

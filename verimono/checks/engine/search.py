@@ -93,8 +93,8 @@ from ..core import REGISTRY, Law, Outcome, classify, law, new_record, run, subje
 from .forms import CONTIGUOUS, cycled, form_note, form_search, forms_for, in_form
 from .samples import NUMPY_DIM, Sample, law_samples
 from .supremum import budget
-from .sweep import edge_count, edge_draws, law_draws, shrink, sweep_count, sweep_samples
-from .scales import SCALE_CAP, beyond_judgement, judged_by, scale_samples
+from .sweep import edge_arrays, edge_count, law_draws, shrink, sweep_arrays, sweep_count
+from .scales import SCALE_CAP, beyond_judgement, judged_by, scale_rows
 
 #: examples per law when ``examples`` is not given and the run configuration's profile is not one of
 #: verimono's (a user's own); otherwise the profile's ``law_examples`` governs (:func:`default_examples`)
@@ -618,7 +618,7 @@ def _search(decl: Law, op: Any, seed: int, examples: int, horizon: float) -> tup
     try:
         with no_local_constants(), _phase_limit(state, f"{decl.name} on {subject_name(op)}"):
             if op.dim <= NUMPY_DIM:
-                edges = edge_draws(op.dim, seed, horizon, edge_count(examples), Sample)
+                edges = SampleBlock.drawn(*edge_arrays(op.dim, seed, horizon, edge_count(examples)))   # one block
                 # in hypothesis's order: the draws, the simplest sample alone (the worst so far when it ties the
                 # ratio 0 that pairs x1 = x2 give: the coordinates start from its pair), the other edge samples
                 parts = (cycled(law_draws(op.dim, seed, horizon, examples, Sample), forms_for(op)), edges[:1], edges[1:])
@@ -708,7 +708,8 @@ def _coordinates(state: _Search, seed: int, horizon: float, how: dict) -> None:
 def _sweep(state: _Search, seed: int, horizon: float) -> int:
     """The scale sweep after a search that found nothing; a violation is shrunk greedily into ``state``.
     Returns the number of sweep samples."""
-    swept = sweep_samples(state.op, seed, horizon, sweep_count(current_config().profile, state.decl.name), Sample)
+    swept = SampleBlock.drawn(*sweep_arrays(state.op, seed, horizon,
+                                            sweep_count(current_config().profile, state.decl.name)))   # one block
     found = state.first_violation(swept)
     if found is not None and "batch_size" in found[1].info:
         (state.failing, state.failure), state.found_by = found, "a batched call of the sweep"
@@ -723,8 +724,12 @@ def _scales(state: _Search, horizon: float) -> dict:
     ``state``.  Returns what was searched."""
     start = None if state.worst_sample is None else dataclasses.replace(state.worst_sample, form=CONTIGUOUS)
     state.start = state.worst_sample        # the coordinates search from the worst unscaled sample, as before
-    samples, covered = scale_samples(start, budget("coordinate"), int(state.op.dim), Sample,
-                                     SCALE_CAP.get(state.decl.name))
+    X1, X2, steps, covered = scale_rows(start, budget("coordinate"), int(state.op.dim), SCALE_CAP.get(state.decl.name))
+    if steps and all(type(v) is float for v in steps[-1]):     # one block (its rows' numbers: Python floats)
+        samples = SampleBlock.drawn(X1, X2, np.array([st[:3] for st in steps], dtype=float),
+                                    np.array([st[3] for st in steps], dtype=float))
+    else:                                                       # the start's own numbers, as they are
+        samples = [Sample(a.copy(), b.copy(), *st) for a, b, st in zip(X1, X2, steps)]
     state.scaling = True
     try:
         found = state.first_violation(samples)
