@@ -102,3 +102,26 @@ def test_the_records_of_the_designs_as_blocks_are_those_of_the_designs_as_lists(
     evaluated = sum(r["details"]["evaluations"] for r in blocks)
     assert made_with_blocks < evaluated / 4, (made_with_blocks, evaluated)
     assert search.SampleBlock is SampleBlock
+
+
+def test_the_seeded_lists_as_blocks_are_the_lists_row_for_row():
+    """The edge samples, the sweep and the scale phase asked for by :func:`make_sample` answer one block whose made
+    rows are the list's samples to the bit, each owning its points (the draws are shared by every law of a battery)."""
+    from verimono.checks.engine import sweep
+    from verimono.checks.engine.blocks import make_sample
+    from verimono.checks.engine.scales import scale_samples
+    op = NormalCone(Box(-np.ones(3), np.ones(3)))
+    start = Sample(np.array([3.0, -1e-300, 0.5]), np.array([2.0, 0.0, -4.0]), 0.5, 2.0, 1.0, 0.25)
+    pairs = {"edge": lambda make: sweep.edge_draws(3, 7, 2.0, 16, make),
+             "sweep": lambda make: sweep.sweep_samples(op, 7, 2.0, 33, make),
+             "scales": lambda make: scale_samples(start, 27, 3, make)[0]}
+    for name, draw in pairs.items():
+        block, one = draw(make_sample), draw(Sample)
+        assert isinstance(block, SampleBlock) and len(block) == len(one), name
+        assert all(_same(block[i], one[i]) for i in range(len(one))), name
+        assert _rows_equal(Rows(block), Rows(one)), name
+        made = list(block)
+        assert len({id(s.x1) for s in made} | {id(s.x2) for s in made}) == 2 * len(made), name
+        assert all(s.x1.base is None and s.x2.base is None for s in made), name      # copies, no views
+    odd = Sample(start.x1, start.x2, np.float64(0.5), 2.0, 1.0, 0.25)     # a number that is no Python float: a list
+    assert isinstance(scale_samples(odd, 27, 3, make_sample)[0], list)

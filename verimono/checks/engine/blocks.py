@@ -134,4 +134,13 @@ class SampleBlock:
         return f"SampleBlock({self._len} rows of n = {self.x1.shape[-1] if self.x1.ndim == 2 else 0}, form={self.form!r})"
 
 
-__all__ = ["SampleBlock"]
+def make_sample(x1: np.ndarray, x2: np.ndarray, lam: float, mu: float, nu: float, t: float) -> Sample:
+    """``Sample(x1, x2, lam, mu, nu, t)``, the ``make`` of the seeded lists (:func:`.sweep.edge_draws`,
+    :func:`.sweep.sweep_samples`, :func:`.scales.scale_samples`); its ``block`` (:meth:`SampleBlock.drawn`) tells
+    them to answer their rows as one block instead of a list."""
+    return Sample(x1, x2, lam, mu, nu, t)
+
+
+make_sample.block = SampleBlock.drawn       # type: ignore[attr-defined]
+
+__all__ = ["SampleBlock", "make_sample"]

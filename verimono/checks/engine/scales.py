@@ -149,8 +149,14 @@ def _shapes(n: int, largest: float) -> tuple[tuple[float, ...], np.ndarray, np.n
 def scale_samples(start, points: int, n: int, make: Callable, cap: int | None = None) -> tuple[list, dict]:
     """The samples of the module docstring and what they cover: ``start`` the worst sample so far (``None``: the
     landmarks only), ``points`` the coordinate budget, ``n`` the dimension, ``make(x1, x2, lam, mu, nu, t)`` a new
-    sample (each owns its points); ``cap``: at most this many (the landmarks first, the smallest scales first)."""
+    sample (each owns its points); ``cap``: at most this many (the landmarks first, the smallest scales first).  A
+    ``make`` with a ``block`` (:func:`verimono.checks.engine.blocks.make_sample`) gets the rows as one block (not when
+    ``start``'s numbers are not Python floats: a block's rows are)."""
     X1, X2, steps, covered = scale_rows(start, points, n, cap)
+    block = getattr(make, "block", None)      # a maker of blocks (blocks.make_sample): the rows as one block, when
+    if block is not None and steps and all(type(v) is float for v in steps[-1]):     # every number is a float
+        return block(X1, X2, np.array([st[:3] for st in steps], dtype=float),
+                     np.array([st[3] for st in steps], dtype=float)), covered
     return [make(a.copy(), b.copy(), *st) for a, b, st in zip(X1, X2, steps)], covered
 
 

@@ -86,15 +86,15 @@ from ...records.results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
 from ...execution.timeouts import (checkpoint, current_budget, interrupted, interruptible, note_progress,
                                   time_limit, unlimited)
 from ...records.verdicts import timeout_verdict
-from .blocks import SampleBlock
+from .blocks import SampleBlock, make_sample
 from .batches import CLOCK, PER_PASS, ROW_CELLS, VECTORISED, Rows, _BatchFailure, batched, prefetched, rows_accepted
 from .coordinates import COORDINATES, coordinate_search, searched
 from ..core import REGISTRY, Law, Outcome, classify, law, new_record, run, subject_name
 from .forms import CONTIGUOUS, cycled, form_note, form_search, forms_for, in_form
 from .samples import NUMPY_DIM, Sample, law_samples
 from .supremum import budget
-from .sweep import edge_arrays, edge_count, law_draws, shrink, sweep_arrays, sweep_count
-from .scales import SCALE_CAP, beyond_judgement, judged_by, scale_rows
+from .sweep import edge_count, edge_draws, law_draws, shrink, sweep_count, sweep_samples
+from .scales import SCALE_CAP, beyond_judgement, judged_by, scale_samples
 
 #: examples per law when ``examples`` is not given and the run configuration's profile is not one of
 #: verimono's (a user's own); otherwise the profile's ``law_examples`` governs (:func:`default_examples`)
@@ -384,8 +384,8 @@ class _Search:
             got, inc = self._vectorised(fn, block if hi - lo == B else block[lo:hi], idx, known)
             vals.update(got)
             undecidable.update(inc)
-        if len(vals) == B:
-            return [vals[i] for i in range(B)]
+        if len(vals) == B:      # every row accepted: the ratios in row order (the chunks' dicts were filled in order)
+            return list(vals.values())
         return [vals[i] if i in vals else self.inconclusive_row(block[i]) if i in undecidable else
                 self.evaluate(block[i]) for i in range(B)]
 
@@ -618,7 +618,7 @@ def _search(decl: Law, op: Any, seed: int, examples: int, horizon: float) -> tup
     try:
         with no_local_constants(), _phase_limit(state, f"{decl.name} on {subject_name(op)}"):
             if op.dim <= NUMPY_DIM:
-                edges = SampleBlock.drawn(*edge_arrays(op.dim, seed, horizon, edge_count(examples)))   # one block
+                edges = edge_draws(op.dim, seed, horizon, edge_count(examples), make_sample)   # one block
                 # in hypothesis's order: the draws, the simplest sample alone (the worst so far when it ties the
                 # ratio 0 that pairs x1 = x2 give: the coordinates start from its pair), the other edge samples
                 parts = (cycled(law_draws(op.dim, seed, horizon, examples, Sample), forms_for(op)), edges[:1], edges[1:])
@@ -708,8 +708,8 @@ def _coordinates(state: _Search, seed: int, horizon: float, how: dict) -> None:
 def _sweep(state: _Search, seed: int, horizon: float) -> int:
     """The scale sweep after a search that found nothing; a violation is shrunk greedily into ``state``.
     Returns the number of sweep samples."""
-    swept = SampleBlock.drawn(*sweep_arrays(state.op, seed, horizon,
-                                            sweep_count(current_config().profile, state.decl.name)))   # one block
+    swept = sweep_samples(state.op, seed, horizon, sweep_count(current_config().profile, state.decl.name),
+                          make_sample)      # one block
     found = state.first_violation(swept)
     if found is not None and "batch_size" in found[1].info:
         (state.failing, state.failure), state.found_by = found, "a batched call of the sweep"
@@ -724,12 +724,8 @@ def _scales(state: _Search, horizon: float) -> dict:
     ``state``.  Returns what was searched."""
     start = None if state.worst_sample is None else dataclasses.replace(state.worst_sample, form=CONTIGUOUS)
     state.start = state.worst_sample        # the coordinates search from the worst unscaled sample, as before
-    X1, X2, steps, covered = scale_rows(start, budget("coordinate"), int(state.op.dim), SCALE_CAP.get(state.decl.name))
-    if steps and all(type(v) is float for v in steps[-1]):     # one block (its rows' numbers: Python floats)
-        samples = SampleBlock.drawn(X1, X2, np.array([st[:3] for st in steps], dtype=float),
-                                    np.array([st[3] for st in steps], dtype=float))
-    else:                                                       # the start's own numbers, as they are
-        samples = [Sample(a.copy(), b.copy(), *st) for a, b, st in zip(X1, X2, steps)]
+    samples, covered = scale_samples(start, budget("coordinate"), int(state.op.dim), make_sample,
+                                     SCALE_CAP.get(state.decl.name))      # one block
     state.scaling = True
     try:
         found = state.first_violation(samples)

@@ -206,7 +206,12 @@ def _law_draws(n: int, seed: int, horizon: float, count: int, scale: float) -> t
 
 
 def _samples(draws: tuple, make: Callable) -> list:
-    """The samples of cached draws ``(X1, X2, steps, t)``, each with its own copies of the points."""
+    """The samples of cached draws ``(X1, X2, steps, t)``, each with its own copies of the points — or, when ``make``
+    has a ``block`` (:func:`verimono.checks.engine.blocks.make_sample`), ``make.block(X1, X2, steps, t)``: the same
+    samples as one block of arrays, each made with its own copies when asked for."""
+    block = getattr(make, "block", None)      # a maker of blocks (blocks.make_sample): the rows as one block
+    if block is not None:
+        return block(*draws)
     X1, X2, steps, ts = draws
     return [make(X1[i].copy(), X2[i].copy(), lam, mu, nu, t)
             for i, ((lam, mu, nu), t) in enumerate(zip(steps.tolist(), ts.tolist()))]
