@@ -27,6 +27,10 @@ search evaluates it, in order, on
 Lists of samples known in advance — the draws, the sweep, each coordinate's design — are evaluated by the law's
 vectorised form where it has one (:meth:`_Search.evaluate_many`, :mod:`verimono.checks.engine.batches`): a row
 is accepted at its vectorised ratio only clearly inside the bound, every other row by the law's own evaluator.
+The coordinate designs, the step decades, the edge samples, the sweep and the scale phase come as one block of arrays
+each (:class:`verimono.checks.engine.blocks.SampleBlock`): the form reads the arrays, and a
+:class:`~verimono.checks.engine.samples.Sample` is made only for a row the law's evaluator sees (the same sample,
+field by field, as the list of samples would hold).
 
 Every record says what was searched (``details["searched"]``: the range of ``|x|`` and of the step sizes,
 the largest gap between the sampled times, each coordinate's range and resolution, the samples evaluated in
