@@ -31,6 +31,7 @@ from ...core._small import row_abs_max, row_all, row_finite
 from ...core.operator_protocol import accepts_steps, accepts_times
 from ...execution.timeouts import interrupted
 from ...core.arrays import prefetch_key as key
+from .blocks import SampleBlock
 
 #: the leading batch sizes, every one (then the divisors of the dimension, then the rest in one batch)
 SMALL_BATCHES = 8
@@ -152,11 +153,24 @@ class Rows:
     (not ``ok``) that the law's evaluator would itself find inconclusive — by its own test, which the form's
     arithmetic decides with a margin beyond the rounding of its sums — with the evaluator's message
     ``inconclusive_what``: the search counts them as that evaluator's inconclusive samples, in their order,
-    without calling the subject again (:meth:`verimono.checks.engine.search._Search.evaluate_many`)."""
+    without calling the subject again (:meth:`verimono.checks.engine.search._Search.evaluate_many`).
+
+    Built from a list of samples (their fields stacked row by row) or from a
+    :class:`~verimono.checks.engine.blocks.SampleBlock` (its arrays copied whole: no sample is made, none taken
+    apart; the same float64 numbers)."""
 
     __slots__ = ("x1", "x2", "lam", "mu", "nu", "t", "ok", "err", "inconclusive", "inconclusive_what")
 
     def __init__(self, samples: Sequence[Any]) -> None:
+        if isinstance(samples, SampleBlock):     # the block's arrays, copied in one pass each (no row is made)
+            self.x1 = np.array(samples.x1, dtype=float)
+            self.x2 = np.array(samples.x2, dtype=float)
+            self.lam, self.mu, self.nu, self.t = (np.array(a, dtype=float) for a in
+                                                  (samples.lam, samples.mu, samples.nu, samples.t))
+            self.ok = np.ones(len(samples), dtype=bool)
+            self.err = None
+            self.inconclusive, self.inconclusive_what = None, ""
+            return
         # np.array of the points (not np.stack: ~4x its cost per row here, the same numbers; a ragged list raises alike)
         self.x1 = np.array([s.x1 for s in samples], dtype=float)
         self.x2 = np.array([s.x2 for s in samples], dtype=float)

@@ -42,6 +42,7 @@ import numpy as np
 
 from ...core.tolerances import current_largest, current_step_range
 from .directions import direction_search
+from .blocks import SampleBlock
 from .samples import Sample, with_field as _with, with_fields as _replace
 from .supremum import Searched, Space, maximise
 
@@ -81,11 +82,10 @@ def _moves(s: Sample, name: str, op: Any, horizon: float) -> tuple[Space, Callab
     if name in ("lam", "mu", "nu"):
         lo, hi = current_step_range()
         space = Space(name, lo, hi, log=True)
-        return space, (lambda v: _with(s, name, float(v))), \
-            [10.0 ** k for k in range(-4, 2)] + [lo, hi, getattr(s, name)]
+        return space, _along(s, name), [10.0 ** k for k in range(-4, 2)] + [lo, hi, getattr(s, name)]
     if name == "t":
         space = Space("t", 0.0, float(horizon))
-        return space, (lambda v: _with(s, "t", float(v))), [0.0, horizon / 2, float(horizon), s.t]
+        return space, _along(s, "t"), [0.0, horizon / 2, float(horizon), s.t]
     if s.recipe is not None:
         return None
     if name == "scale":
@@ -122,27 +122,30 @@ def _moves(s: Sample, name: str, op: Any, horizon: float) -> tuple[Space, Callab
 ROWS_OF_N = 64
 
 
-def _rows_of(s: Sample, vs: list, x1: Callable, x2: Callable, V: np.ndarray) -> list[Sample] | None:
-    """The samples of a points' design at ``vs`` in one broadcast pass: ``x1(V)``, ``x2(V)`` are ``(len(vs), n)``
-    arrays whose row ``i`` is, element by element, the one-point lambda's arithmetic at ``vs[i]`` (a product and a
-    sum of float64 numbers, the same whether one scalar or a column multiplies: the same numbers).  Each sample
-    holds a row of its own (no two share one).  ``None`` above :data:`ROWS_OF_N` coordinates: a kept worst sample
-    would hold the whole design's array alive."""
+def _along(s: Sample, name: str) -> Callable[[float], Sample]:
+    """The sample at a value of the step or time coordinate ``name`` of ``s`` (``with_field(s, name, float(v))``),
+    with ``many``: a design's samples as one :class:`~.blocks.SampleBlock` (``SampleBlock.along``; a row made from it
+    is that sample, field for field)."""
+    at = lambda v: _with(s, name, float(v))      # noqa: E731
+    if np.size(s.x1) <= ROWS_OF_N:      # above, a list (the vectorised passes stack it in chunks of ROW_CELLS)
+        at.many = lambda vs: SampleBlock.along(s, name, vs)
+    return at
+
+
+def _rows_of(s: Sample, vs: list, x1: Callable, x2: Callable, V: np.ndarray) -> SampleBlock | None:
+    """The samples of a points' design at ``vs`` in one broadcast pass, as one :class:`~.blocks.SampleBlock`:
+    ``x1(V)``, ``x2(V)`` are ``(len(vs), n)`` arrays whose row ``i`` is, element by element, the one-point lambda's
+    arithmetic at ``vs[i]`` (a product and a sum of float64 numbers, the same whether one scalar or a column
+    multiplies: the same numbers).  A sample made from it holds a row of its own (no two share one).  ``None``
+    above :data:`ROWS_OF_N` coordinates: a kept worst sample would hold the whole design's array alive."""
     if s.x1.size > ROWS_OF_N:
         return None
-    X1, X2 = x1(V), x2(V)
-    out = []
-    for a, c in zip(X1, X2):
-        new = object.__new__(Sample)
-        d = new.__dict__
-        d.update(s.__dict__)
-        d["x1"], d["x2"] = a, c
-        out.append(new)
-    return out
+    return SampleBlock.rows(s, x1(V), x2(V))
 
 
-def _samples(at: Callable[[float], Sample], design: list[float]) -> list[Sample]:
-    """``[at(v) for v in design]``, in one pass where ``at`` has one (:func:`_rows_of`)."""
+def _samples(at: Callable[[float], Sample], design: list[float]) -> Any:
+    """``[at(v) for v in design]``, in one pass where ``at`` has one (:func:`_rows_of`, :func:`_along`: a
+    :class:`~.blocks.SampleBlock`)."""
     many = getattr(at, "many", None)
     out = many(design) if many is not None and design else None
     return out if out is not None else [at(v) for v in design]
@@ -192,7 +195,7 @@ def coordinate_search(evaluate: Callable[[Sample], float], op: Any, start: Sampl
         decades = None
         if name in ("lam", "mu", "nu"):
             d_design, stride = _decade_design(space, points, dense)
-            decades = (space, d_design, stride, [at(v) for v in d_design])
+            decades = (space, d_design, stride, _samples(at, d_design))
             space = Space(name, *STEPS, log=True)       # the steps the samples are drawn from, at full density
         if dense:
             design = design + _even(space, dense_count(points, name, rows))
@@ -316,22 +319,39 @@ def _brief(s: Searched) -> dict:
     return {"range": [s.space.lo, s.space.hi], "log": s.space.log, "points": s.points, "resolution": s.resolution}
 
 
-def searched(xs: list[float], lams: list[float], ts: list[float], horizon: float, coordinates: list[dict]) -> dict:
+def searched(xs: list[float], lams: list[float], ts: list[float], horizon: float, coordinates: list[dict],
+             rows: tuple | None = None) -> dict:
     """What an operator law's search evaluated: the range of ``|x|``, of the step sizes, the largest gap
-    between its times in ``[0, horizon]``, and the coordinate searches."""
+    between its times in ``[0, horizon]``, and the coordinate searches.  ``rows``: more of the same as arrays
+    ``(|x|, λ, t)`` (the rows of the vectorised passes), taken with the lists."""
+    if rows is not None:
+        rx, rl, rt = rows
+        if rt.size:
+            x_lo, x_hi, l_lo, l_hi = float(rx.min()), float(rx.max()), float(rl.min()), float(rl.max())
+            if xs:
+                x_lo, x_hi, l_lo, l_hi = (min(min(xs), x_lo), max(max(xs), x_hi), min(min(lams), l_lo),
+                                          max(max(lams), l_hi))
+            return _searched(ts, horizon, coordinates, [x_lo, x_hi], [l_lo, l_hi], rt)
     if not xs:
         return {"samples": 0}
+    return _searched(ts, horizon, coordinates, [float(min(xs)), float(max(xs))], [float(min(lams)), float(max(lams))])
+
+
+def _searched(ts: list[float], horizon: float, coordinates: list[dict], x_range: list, lambda_range: list,
+              more_ts: np.ndarray | None = None) -> dict:
     # np.unique(np.r_[0.0, np.clip(ts, 0.0, horizon), horizon])'s largest gap without np.r_, the list's own clip and
     # the unique: the sorted times with their repeats have the same gaps and zeros (the largest gap is >= 0, NaN
     # sorted last as unique sorts it), and more than one distinct time exactly when the first and last differ
-    tt = np.empty(len(ts) + 2)
+    extra = 0 if more_ts is None else more_ts.size
+    tt = np.empty(len(ts) + extra + 2)
     tt[0], tt[-1] = 0.0, horizon
     inner = tt[1:-1]
-    inner[...] = ts
+    inner[:len(ts)] = ts
+    if extra:
+        inner[len(ts):] = more_ts
     np.clip(inner, 0.0, horizon, out=inner)
     tt.sort()
-    return {"samples": len(ts), "x_range": [float(min(xs)), float(max(xs))],
-            "lambda_range": [float(min(lams)), float(max(lams))],
+    return {"samples": len(ts) + extra, "x_range": x_range, "lambda_range": lambda_range,
             "t_resolution": float(np.diff(tt).max()) if tt[-1] != tt[0] else float(horizon),
             "coordinates": coordinates}
 

@@ -149,27 +149,42 @@ def _shapes(n: int, largest: float) -> tuple[tuple[float, ...], np.ndarray, np.n
 def scale_samples(start, points: int, n: int, make: Callable, cap: int | None = None) -> tuple[list, dict]:
     """The samples of the module docstring and what they cover: ``start`` the worst sample so far (``None``: the
     landmarks only), ``points`` the coordinate budget, ``n`` the dimension, ``make(x1, x2, lam, mu, nu, t)`` a new
-    sample (each owns its points); ``cap``: at most this many (the landmarks first, the smallest scales first)."""
+    sample (each owns its points); ``cap``: at most this many (the landmarks first, the smallest scales first).  A
+    ``make`` with a ``block`` (:func:`verimono.checks.engine.blocks.make_sample`) gets the rows as one block (not when
+    ``start``'s numbers are not Python floats: a block's rows are)."""
+    X1, X2, steps, covered = scale_rows(start, points, n, cap)
+    block = getattr(make, "block", None)      # a maker of blocks (blocks.make_sample): the rows as one block, when
+    if block is not None and steps and all(type(v) is float for v in steps[-1]):     # every number is a float
+        return block(X1, X2, np.array([st[:3] for st in steps], dtype=float),
+                     np.array([st[3] for st in steps], dtype=float)), covered
+    return [make(a.copy(), b.copy(), *st) for a, b, st in zip(X1, X2, steps)], covered
+
+
+def scale_rows(start, points: int, n: int, cap: int | None = None) -> tuple[np.ndarray, np.ndarray, list, dict]:
+    """:func:`scale_samples` as rows: the points ``X1, X2`` ``(B, n)`` (read-only when they are the landmarks' only:
+    a sample made from a row gets copies), each row's ``(λ, μ, ν, t)`` (the landmarks' ``(1, 1, 1, 0)``, then
+    ``start``'s own numbers) and what they cover."""
     marks, X1, X2 = _shapes(int(n), float(current_largest()))
-    out = [make(a.copy(), b.copy(), 1.0, 1.0, 1.0, 0.0) for a, b in zip(X1, X2)]
+    steps = [(1.0, 1.0, 1.0, 0.0)] * len(X1)
     covered = {"range": [marks[0], marks[-1]], "landmarks": list(marks), "shapes": list(SHAPES[1:])}
     if start is not None and cap is None:
         r = max(float(np.max(np.abs(start.x1), initial=0.0)), float(np.max(np.abs(start.x2), initial=0.0)))
-        steps = (float(start.lam), float(start.mu), float(start.nu))
-        if 0.0 < r < math.inf and all(s > 0.0 for s in steps):
-            top = scale_top() * min(1.0, *steps) / max(1.0, *steps)
+        lams = (float(start.lam), float(start.mu), float(start.nu))
+        if 0.0 < r < math.inf and all(s > 0.0 for s in lams):
+            top = scale_top() * min(1.0, *lams) / max(1.0, *lams)
             design, stride = decade_design(points, top)
             V = np.array(design)[:, None]
             # row i: (x/r)·v_i — not x·(v_i/r), which underflows to 0 for a subnormal v_i: the entry of largest
-            # magnitude r becomes ±v_i exactly; each sample holds a row of its own
+            # magnitude r becomes ±v_i exactly
             S1, S2 = (start.x1 / r)[None, :] * V, (start.x2 / r)[None, :] * V
-            out += [make(a, b, start.lam, start.mu, start.nu, start.t) for a, b in zip(S1, S2)]
+            X1, X2 = np.concatenate([X1, S1]), np.concatenate([X2, S2])
+            steps = steps + [(start.lam, start.mu, start.nu, start.t)] * len(design)
             covered = {"range": [SMALLEST, max(marks[-1], design[-1])], "stride": stride, "decades": len(design),
                        "landmarks": list(marks), "shapes": list(SHAPES)}
     if cap is not None:
-        out = out[:cap]
-    covered["points"] = len(out)
-    return out, covered
+        X1, X2, steps = X1[:cap], X2[:cap], steps[:cap]
+    covered["points"] = len(steps)
+    return X1, X2, steps, covered
 
 
-__all__ = ["scale_samples", "scale_top", "beyond_judgement", "judged_by", "FINITE_ONLY", "JUDGED_TOP", "landmarks", "decade_design", "SMALLEST", "SHAPES", "SCALE_CAP"]
+__all__ = ["scale_samples", "scale_rows", "scale_top", "beyond_judgement", "judged_by", "FINITE_ONLY", "JUDGED_TOP", "landmarks", "decade_design", "SMALLEST", "SHAPES", "SCALE_CAP"]

@@ -27,6 +27,10 @@ search evaluates it, in order, on
 Lists of samples known in advance — the draws, the sweep, each coordinate's design — are evaluated by the law's
 vectorised form where it has one (:meth:`_Search.evaluate_many`, :mod:`verimono.checks.engine.batches`): a row
 is accepted at its vectorised ratio only clearly inside the bound, every other row by the law's own evaluator.
+The coordinate designs, the step decades, the edge samples, the sweep and the scale phase come as one block of arrays
+each (:class:`verimono.checks.engine.blocks.SampleBlock`): the form reads the arrays, and a
+:class:`~verimono.checks.engine.samples.Sample` is made only for a row the law's evaluator sees (the same sample,
+field by field, as the list of samples would hold).
 
 Every record says what was searched (``details["searched"]``: the range of ``|x|`` and of the step sizes,
 the largest gap between the sampled times, each coordinate's range and resolution, the samples evaluated in
@@ -86,6 +90,7 @@ from ...records.results import FAILED, PASSED, SKIPPED, UNDECIDED, CheckResult
 from ...execution.timeouts import (checkpoint, current_budget, interrupted, interruptible, note_progress,
                                   time_limit, unlimited)
 from ...records.verdicts import timeout_verdict
+from .blocks import SampleBlock, make_sample
 from .batches import CLOCK, PER_PASS, ROW_CELLS, VECTORISED, Rows, _BatchFailure, batched, prefetched, rows_accepted
 from .coordinates import COORDINATES, coordinate_search, searched
 from ..core import REGISTRY, Law, Outcome, classify, law, new_record, run, subject_name
@@ -245,6 +250,10 @@ class _Search:
     xs: list = dataclasses.field(default_factory=list)
     lams: list = dataclasses.field(default_factory=list)
     ts: list = dataclasses.field(default_factory=list)
+    #: the same of the rows a vectorised pass accepted, as the pass's arrays (:meth:`_commit`; read by :meth:`searched`)
+    xs_rows: list = dataclasses.field(default_factory=list)
+    lams_rows: list = dataclasses.field(default_factory=list)
+    ts_rows: list = dataclasses.field(default_factory=list)
     coordinates: list = dataclasses.field(default_factory=list)
     #: the coordinate budget's cap at large n (:func:`verimono.execution.profiles.large_n_count`), stated in the record
     budget_note: str = ""
@@ -259,6 +268,8 @@ class _Search:
     pending: list = dataclasses.field(default_factory=list)
     pre: dict = dataclasses.field(default_factory=dict)
     pre_rows: tuple = ()
+    #: the announced :class:`SampleBlock` lists, ``id(block) -> (block, its first row in the pass)``
+    pre_blocks: dict = dataclasses.field(default_factory=dict)
     #: the evaluator's message for the rows a vectorised pass found inconclusive by the law's own test (``Rows.inconclusive``)
     form_inconclusive_what: str = ""
     #: the law's budget and when it runs out (:func:`time.perf_counter`; ``None``: unlimited), shared by its phases
@@ -328,6 +339,8 @@ class _Search:
         fn = VECTORISED.get(self.decl.name)
         if fn is None or len(samples) < 2 or batched(self.op):
             return [self.evaluate(s) for s in samples]
+        if isinstance(samples, SampleBlock):
+            return self._evaluate_block(fn, samples)
         rows = [i for i, s in enumerate(samples) if s.form == CONTIGUOUS]
         if self.pending and rows and id(samples[rows[0]]) in self.pre:
             self._prefetched(fn)
@@ -339,15 +352,43 @@ class _Search:
             known = [self.pre.pop(id(samples[i]), None) for i in idx] if self.pre_rows else []
             if known and all(k is not None and k[0] is samples[i] for k, i in zip(known, idx)):
                 at = np.array([k[1] for k in known], dtype=np.intp)
-                got, inc = self._vectorised(fn, samples, idx, tuple(a[at] for a in self.pre_rows))
+                got, inc = self._vectorised(fn, [samples[i] for i in idx], idx, tuple(a[at] for a in self.pre_rows))
             else:
-                got, inc = self._vectorised(fn, samples, idx)
+                got, inc = self._vectorised(fn, [samples[i] for i in idx], idx)
             vals.update(got)
             undecidable.update(inc)
         if undecidable:
             return [vals[i] if i in vals else self.inconclusive_row(s) if i in undecidable else self.evaluate(s)
                     for i, s in enumerate(samples)]
         return [vals[i] if i in vals else self.evaluate(s) for i, s in enumerate(samples)]
+
+    def _evaluate_block(self, fn: Callable, block: SampleBlock) -> list[float | None]:
+        """:meth:`evaluate_many` of a block (:class:`SampleBlock`): the form's pass over its arrays (or the rows of
+        the :meth:`prefetch` pass that announced it), the accepted rows counted from the arrays, and a
+        :class:`Sample` made only for a row the law's evaluator sees — the same rows in the same order as
+        :meth:`evaluate_many` of the block's samples as a list."""
+        if block.form != CONTIGUOUS:
+            return [self.evaluate(s) for s in block]
+        if self.pending and id(block) in self.pre_blocks:
+            self._prefetched(fn)
+        hit = self.pre_blocks.pop(id(block), None) if self.pre_rows else None
+        if hit is not None and hit[0] is not block:
+            hit = None
+        B = len(block)
+        vals: dict[int, float] = {}
+        undecidable: set[int] = set()
+        chunk = max(1, ROW_CELLS // max(1, int(self.op.dim)))
+        for lo in range(0, B, chunk):
+            hi = min(B, lo + chunk)
+            idx = range(lo, hi)
+            known = None if hit is None else tuple(a[hit[1] + lo:hit[1] + hi] for a in self.pre_rows)
+            got, inc = self._vectorised(fn, block if hi - lo == B else block[lo:hi], idx, known)
+            vals.update(got)
+            undecidable.update(inc)
+        if len(vals) == B:      # every row accepted: the ratios in row order (the chunks' dicts were filled in order)
+            return list(vals.values())
+        return [vals[i] if i in vals else self.inconclusive_row(block[i]) if i in undecidable else
+                self.evaluate(block[i]) for i in range(B)]
 
     @interruptible
     def inconclusive_row(self, s: Sample) -> None:
@@ -373,27 +414,38 @@ class _Search:
         ``yosida_limit``'s last open row — is not prefetched).  A pass that raised, or rows no longer announced,
         fall back to a pass per list (that list's own pass then meets what the form raises)."""
         fn = VECTORISED.get(self.decl.name)
-        self.pending, self.pre, self.pre_rows = [], {}, ()
+        self.pending, self.pre, self.pre_rows, self.pre_blocks = [], {}, (), {}
         if fn is None or batched(self.op) or self.decl.name in PER_PASS:
             return
-        lists = [[s for s in l if s.form == CONTIGUOUS] for l in lists if len(l) >= 2]
-        lists = [l for l in lists if l]
+        lists = [l if isinstance(l, SampleBlock) else [s for s in l if s.form == CONTIGUOUS]
+                 for l in lists if len(l) >= 2 and not (isinstance(l, SampleBlock) and l.form != CONTIGUOUS)]
+        lists = [l for l in lists if len(l)]
         if len(lists) < 2:        # nothing to merge
             return
-        self.pending = [s for l in lists for s in l]
-        self.pre = {id(s): (s, k) for k, s in enumerate(self.pending)}
+        k = 0
+        for l in lists:           # a block is announced as a whole, a list's samples one by one
+            if isinstance(l, SampleBlock):
+                self.pre_blocks[id(l)] = (l, k)
+            else:
+                self.pre.update((id(s), (s, k + j)) for j, s in enumerate(l))
+            k += len(l)
+        if self.pre_blocks:       # blocks (n <= ROWS_OF_N): one block of every row, joined when the pass runs
+            self.pending = [l if isinstance(l, SampleBlock) else SampleBlock.stacked(l) for l in lists]
+        else:                     # lists only (any n): their samples, stacked a chunk at a time by the pass
+            self.pending = [s for l in lists for s in l]
 
     @interruptible
     def _prefetched(self, fn: Callable) -> None:
         """The one pass over the rows :meth:`prefetch` announced (chunked as :meth:`evaluate_many` chunks a list)."""
-        samples, self.pending = self.pending, []
+        samples = SampleBlock.joined(self.pending) if self.pre_blocks else self.pending
+        self.pending = []
         checkpoint()
         chunk = max(1, ROW_CELLS // max(1, int(self.op.dim)))
         parts = []
         for lo in range(0, len(samples), chunk):
             got = self._pass(fn, samples[lo:lo + chunk], quiet=True)
             if got is None:         # the form raised: every list its own pass, as without the prefetch
-                self.pre, self.pre_rows = {}, ()
+                self.pre, self.pre_rows, self.pre_blocks = {}, (), {}
                 return
             parts.append(got)
         self.pre_rows = tuple(np.concatenate(a) for a in zip(*parts))
@@ -430,43 +482,56 @@ class _Search:
         return q, good, row_abs_max(r.x1), row_abs_max(r.x2), r.lam, r.mu, r.nu, r.t, inc
 
     @interruptible
-    def _vectorised(self, fn: Callable, samples: list[Sample], idx: list[int],
+    def _vectorised(self, fn: Callable, batch: Any, idx: Any,
                     known: tuple | None = None) -> tuple[dict[int, float], list[int]]:
-        """The vectorised form on ``samples[i]`` for ``i`` in ``idx``: the ratios of the rows it decides (those
-        clearly inside the bound), each such sample counted as evaluated (``known``: the rows' values from the
-        pass of :meth:`prefetch`), and the ``i`` of the rows it found inconclusive by the law's own test (counted
-        later, in their turn, by :meth:`inconclusive_row`)."""
-        if not idx:
+        """The vectorised form on ``batch`` (a list of samples or a :class:`SampleBlock`), row ``j`` the caller's
+        sample ``idx[j]``: the ratios of the rows it decides (those clearly inside the bound), each such sample
+        counted as evaluated (``known``: the rows' values from the pass of :meth:`prefetch`), and the ``i`` of the
+        rows it found inconclusive by the law's own test (counted later, in their turn, by
+        :meth:`inconclusive_row`)."""
+        if not len(idx):
             return {}, []
         checkpoint()
-        batch = [samples[i] for i in idx]
         got = self._pass(fn, batch) if known is None else known
         if got is None:
             return {}, []
         inc = got[-1]
         return self._commit(batch, idx, *got[:-1]), ([idx[j] for j in np.flatnonzero(inc).tolist()] if inc.any() else [])
 
-    def _commit(self, batch: list[Sample], idx: list[int], q: np.ndarray, good: np.ndarray, a1: np.ndarray,
+    def _commit(self, batch: Any, idx: Any, q: np.ndarray, good: np.ndarray, a1: np.ndarray,
                 a2: np.ndarray, lam: np.ndarray, mu: np.ndarray, nu: np.ndarray, t: np.ndarray) -> dict[int, float]:
-        """The rows of ``batch`` (``samples[i]``, ``i`` in ``idx``) its pass accepted (``good``) counted as evaluated
-        at their ratios ``q``; the worst of them evaluated by the law for the record's numbers when it is the
-        worst so far."""
+        """The rows of ``batch`` (row ``j`` the caller's sample ``idx[j]``) its pass accepted (``good``) counted as
+        evaluated at their ratios ``q`` (what was searched kept as the pass's arrays: :meth:`searched`); the worst of
+        them evaluated by the law for the record's numbers when it is the worst so far (the one row made a
+        :class:`Sample` here)."""
         k = int(good.sum())
         if not k:
             return {}
-        g = np.flatnonzero(good)
+        all_rows = k == len(good)
+        g = None if all_rows else np.flatnonzero(good)
         self.runs += k
-        self.xs += np.column_stack([a1[g], a2[g]]).ravel().tolist()
-        self.lams += np.column_stack([lam[g], mu[g], nu[g]]).ravel().tolist()
-        self.ts += t[g].tolist()
+        self.xs_rows += [a1, a2] if all_rows else [a1[g], a2[g]]
+        self.lams_rows += [lam, mu, nu] if all_rows else [lam[g], mu[g], nu[g]]
+        self.ts_rows.append(t if all_rows else t[g])
         self.forms[CONTIGUOUS] = self.forms.get(CONTIGUOUS, 0) + k
-        top = int(g[np.argmax(q[g])])
+        top = int(np.argmax(q)) if all_rows else int(g[np.argmax(q[g])])
         if self.worst is None or q[top] > self.worst.ratio:
-            out = evaluate_sample(self.decl, self.op, batch[top])     # the worst row's own numbers, for the record
+            row = batch[top]
+            out = evaluate_sample(self.decl, self.op, row)     # the worst row's own numbers, for the record
             if not out.inconclusive and out.ratio <= BOUND and (self.worst is None or out.ratio > self.worst.ratio):
-                self.worst, self.worst_sample = out, batch[top]
+                self.worst, self.worst_sample = out, row
         self.note()
-        return {idx[j]: float(q[j]) for j in g}
+        if all_rows:
+            return dict(zip(idx, q.tolist()))
+        return {idx[j]: float(q[j]) for j in g.tolist()}
+
+    def searched(self, horizon: float) -> dict:
+        """:func:`verimono.checks.engine.coordinates.searched` of everything evaluated: the one-sample lists and the
+        arrays of the vectorised passes' accepted rows."""
+        if not self.xs_rows:
+            return searched(self.xs, self.lams, self.ts, horizon, self.coordinates)
+        return searched(self.xs, self.lams, self.ts, horizon, self.coordinates,
+                        (np.concatenate(self.xs_rows), np.concatenate(self.lams_rows), np.concatenate(self.ts_rows)))
 
     def not_implemented(self, s: Sample, exc: NotImplementedError) -> Outcome | None:
         """A member raised NotImplementedError at ``s``: the operator lacks it (``None``; the search stops,
@@ -554,7 +619,7 @@ def _search(decl: Law, op: Any, seed: int, examples: int, horizon: float) -> tup
     try:
         with no_local_constants(), _phase_limit(state, f"{decl.name} on {subject_name(op)}"):
             if op.dim <= NUMPY_DIM:
-                edges = edge_draws(op.dim, seed, horizon, edge_count(examples), Sample)
+                edges = edge_draws(op.dim, seed, horizon, edge_count(examples), make_sample)   # one block
                 # in hypothesis's order: the draws, the simplest sample alone (the worst so far when it ties the
                 # ratio 0 that pairs x1 = x2 give: the coordinates start from its pair), the other edge samples
                 parts = (cycled(law_draws(op.dim, seed, horizon, examples, Sample), forms_for(op)), edges[:1], edges[1:])
@@ -644,7 +709,8 @@ def _coordinates(state: _Search, seed: int, horizon: float, how: dict) -> None:
 def _sweep(state: _Search, seed: int, horizon: float) -> int:
     """The scale sweep after a search that found nothing; a violation is shrunk greedily into ``state``.
     Returns the number of sweep samples."""
-    swept = sweep_samples(state.op, seed, horizon, sweep_count(current_config().profile, state.decl.name), Sample)
+    swept = sweep_samples(state.op, seed, horizon, sweep_count(current_config().profile, state.decl.name),
+                          make_sample)      # one block
     found = state.first_violation(swept)
     if found is not None and "batch_size" in found[1].info:
         (state.failing, state.failure), state.found_by = found, "a batched call of the sweep"
@@ -659,8 +725,8 @@ def _scales(state: _Search, horizon: float) -> dict:
     ``state``.  Returns what was searched."""
     start = None if state.worst_sample is None else dataclasses.replace(state.worst_sample, form=CONTIGUOUS)
     state.start = state.worst_sample        # the coordinates search from the worst unscaled sample, as before
-    samples, covered = scale_samples(start, budget("coordinate"), int(state.op.dim), Sample,
-                                     SCALE_CAP.get(state.decl.name))
+    samples, covered = scale_samples(start, budget("coordinate"), int(state.op.dim), make_sample,
+                                     SCALE_CAP.get(state.decl.name))      # one block
     state.scaling = True
     try:
         found = state.first_violation(samples)
@@ -853,8 +919,7 @@ def run_law(decl: Law | str, op: Any, *, seed: int | None = None, examples: int 
         rec = _verdict(state, how, base, {**details, "evaluations": state.runs, "inconclusive": state.inconclusive,
                                           "harness_limited": state.harness_limited, "sweep": how["sweep"],
                                           "coordinate": how.get("coordinate", 0),
-                                          "searched": {**searched(state.xs, state.lams, state.ts, horizon,
-                                                                  state.coordinates), "forms": dict(state.forms),
+                                          "searched": {**state.searched(horizon), "forms": dict(state.forms),
                                                  **({"edge_samples": how["edge"]} if how.get("edge") else {}),
                                                  **({"scales": how["scales"]} if how.get("scales") else {}),
                                                  **({"hypothesis_examples": how["hypothesis"]}

@@ -125,12 +125,22 @@ def _cached_draws(fn: Callable, *args) -> tuple:
 
 
 def sweep_samples(op, seed: int, horizon: float, count: int, make: Callable) -> list:
-    """``count`` samples (built by ``make(x1, x2, lam, mu, nu, t)``) for ``op`` on ``R^n``, seeded by ``seed``."""
+    """``count`` samples (built by ``make(x1, x2, lam, mu, nu, t)``) for ``op`` on ``R^n``, seeded by ``seed``: the
+    rows of :func:`sweep_arrays`, each sample with copies of its points."""
+    return _samples(sweep_arrays(op, seed, horizon, count), make)
+
+
+def sweep_arrays(op, seed: int, horizon: float, count: int) -> tuple:
+    """The samples of :func:`sweep_samples` as arrays ``(X1, X2, steps, t)`` (``(count, n)``, ``(count, n)``,
+    ``(count, 3)``, ``(count,)``; fresh, the caller's own), for a block of them
+    (:class:`verimono.checks.engine.blocks.SampleBlock`): the seeded draws with the points in the range of the
+    resolvent, and just outside the boundary, put in their rows."""
     n = int(op.dim)
     cap = current_largest() / 64.0           # a float16 subject cannot be given |x| = 1e6
     X1, X2, steps, ts = _cached_draws(_sweep_draws, n, int(seed), float(horizon), int(count), float(cap))
     lams, mus, nus, tl = steps[:, 0].tolist(), steps[:, 1].tolist(), steps[:, 2].tolist(), ts.tolist()
-    out, boundary = [], None
+    boundary = None
+    P1, P2, S, T = np.array(X1), np.array(X2), np.array(steps), np.array(ts)    # writable copies, filled below
     for i in range(count):
         x1, x2, lam, mu, nu, t = X1[i].copy(), X2[i].copy(), lams[i], mus[i], nus[i], tl[i]
         if i % 4 == 3 and not far_general(i, cap, n):   # points in the range of J: J_ν x and J_ν(J_ν x), or just outside the boundary
@@ -148,8 +158,8 @@ def sweep_samples(op, seed: int, horizon: float, count: int, make: Callable) -> 
             a, normal, nu, t = boundary
             delta = OUTSIDE[(i // 4) % len(OUTSIDE)] * (1.0 + float(np.linalg.norm(a)))
             x1, x2 = a + delta * normal, a + 1e3 * delta * normal
-        out.append(make(x1, x2, lam, mu, nu, t))
-    return out
+        P1[i], P2[i], S[i], T[i] = x1, x2, (lam, mu, nu), t
+    return P1, P2, S, T
 
 
 #: the values hypothesis's float strategies favour, drawn here as often: ends of the range, 0, ±1, ±1/2, ±2
@@ -196,7 +206,12 @@ def _law_draws(n: int, seed: int, horizon: float, count: int, scale: float) -> t
 
 
 def _samples(draws: tuple, make: Callable) -> list:
-    """The samples of cached draws ``(X1, X2, steps, t)``, each with its own copies of the points."""
+    """The samples of cached draws ``(X1, X2, steps, t)``, each with its own copies of the points — or, when ``make``
+    has a ``block`` (:func:`verimono.checks.engine.blocks.make_sample`), ``make.block(X1, X2, steps, t)``: the same
+    samples as one block of arrays, each made with its own copies when asked for."""
+    block = getattr(make, "block", None)      # a maker of blocks (blocks.make_sample): the rows as one block
+    if block is not None:
+        return block(*draws)
     X1, X2, steps, ts = draws
     return [make(X1[i].copy(), X2[i].copy(), lam, mu, nu, t)
             for i, ((lam, mu, nu), t) in enumerate(zip(steps.tolist(), ts.tolist()))]
@@ -241,7 +256,13 @@ def edge_draws(n: int, seed: int, horizon: float, count: int, make: Callable, sc
       to ``x1``'s: repeated values), or drawn like ``x1``;
     * step sizes from :data:`EDGE_STEPS` half the time (else log-uniform in ``[10^-3, 10]``), times from
       :data:`EDGE_TIMES` (times ``horizon``) half the time (else uniform in ``[0, horizon]``)."""
-    return _samples(_cached_draws(_edge_draws, int(n), int(seed), float(horizon), int(count), float(scale)), make)
+    return _samples(edge_arrays(n, seed, horizon, count, scale), make)
+
+
+def edge_arrays(n: int, seed: int, horizon: float, count: int, scale: float = 10.0) -> tuple:
+    """The samples of :func:`edge_draws` as its cached arrays ``(X1, X2, steps, t)``, read-only (a block of them:
+    :meth:`verimono.checks.engine.blocks.SampleBlock.drawn`)."""
+    return _cached_draws(_edge_draws, int(n), int(seed), float(horizon), int(count), float(scale))
 
 
 def _edge_draws(n: int, seed: int, horizon: float, count: int, scale: float) -> tuple:
@@ -330,5 +351,6 @@ def shrink(sample, fails: Callable[[object], bool], replace: Callable, budget: i
     return sample, calls
 
 
-__all__ = ["SCALES", "SWEEP_BY_PROFILE", "SWEEP_CAP", "sweep_count", "sweep_samples", "law_draws", "edge_draws",
+__all__ = ["SCALES", "SWEEP_BY_PROFILE", "SWEEP_CAP", "sweep_count", "sweep_samples", "sweep_arrays", "law_draws",
+           "edge_draws", "edge_arrays",
            "edge_count", "EDGE_MIN", "shrink"]
