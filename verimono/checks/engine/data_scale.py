@@ -47,7 +47,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ...core.operator_protocol import stated_data_scale
+from ...core.operator_protocol import provides, stated_data_scale
 from ...core.tolerances import EPS_BY_PRECISION, LARGEST_BY_PRECISION, judged_at_scale
 from ...records.results import FAILED, PASSED, UNDECIDED, CheckResult
 from ...records.verdicts import new_record
@@ -135,7 +135,6 @@ def _projection(op: Any, x: np.ndarray, t: float) -> Callable[[np.ndarray], np.n
     """The operator's projection onto ``cl dom F(t,·)`` at ``x``: ``project_domain`` when it provides one, else ``J_1``
     when ``J_1 x = J_1000 x`` bit for bit (a normal cone: ``J_λ`` does not depend on ``λ``), else ``None``."""
     from ..members import point, resolvent       # the probe's own import (module docstring of _size)
-    from ...core.operator_protocol import provides
     if provides(op, "project_domain"):
         return lambda z: point(op.project_domain(z.copy(), t), z, "project_domain")
     try:
