@@ -56,3 +56,34 @@ def test_the_boundary_of_an_open_domain_reached_by_rounding_is_no_sample():
                                        min_norm=op.min_norm, project_domain=op.project_domain, name="outside by 1e-6")
     rec = run_law("min_norm_least", wrong, sample=Sample(np.array([-5.0, 1.0, 1.0]), np.zeros(3), 1.0, 1.0, 1e-9, 0.3))
     assert rec.status == FAILED, str(rec)
+
+
+def test_a_strict_box_indicator_shows_at_its_face_what_correct_code_shows():
+    """Why blind set 9's box_value_strict_bounds stays a miss (tests/blind/set9/test_blind9.py): its prox returns
+    p = (1, 0, 0) exactly, its own prox keeps p bit for bit, its value g(p) is +inf and g is finite one ulp inward.
+    A correct subject shows the same four facts at a point: PyProximal's EuclideanBall of radius 1 centred at
+    10^6·(1, 1, 1), whose membership test rejects its own projection (rounded at 10^6) and whose projection keeps that
+    point — and the value laws rightly pass it.  "g(prox) = +inf is never rounding" would fail this correct code; in
+    floating point the strict box {|x_i| < 1} is the closed box of half-width 1 − 2^-53, and clip is its projection
+    within one ulp."""
+    pyproximal = pytest.importorskip("pyproximal", reason="PyProximal is in the test extra")
+    one_ulp_in = lambda p, towards: np.nextafter(p, towards)          # noqa: E731
+
+    box = lambda x: np.clip(x, -1.0, 1.0)                           # noqa: E731 - the plant's prox
+    g = lambda x: 0.0 if np.all(np.abs(x) < 1.0) else np.inf        # noqa: E731 - and its value
+    p = box(np.array([2.0, 0.0, 0.0]))
+    assert np.array_equal(box(p), p) and g(p) == np.inf and g(one_ulp_in(p, 0.0)) == 0.0
+
+    c = 1e6 * np.ones(3)
+    ball = pyproximal.EuclideanBall(c, 1.0)
+    rng = np.random.default_rng(1)
+    for _ in range(200):
+        q = ball.prox(c + 10.0 * rng.standard_normal(3), 1.0)
+        if not ball(q) and np.array_equal(ball.prox(q, 1.0), q):
+            break
+    else:
+        pytest.fail("no rejected fixed point among 200 projections")
+    assert ball(one_ulp_in(q, c))                                    # the same four facts, on correct code
+    op = vm.operator_from_prox(lambda x, lam: ball.prox(x, lam), value=lambda x: 0.0 if ball(x) else np.inf,
+                               shape=3, name="pyproximal ball at 1e6")
+    assert run_law("prox_inequality", op, seed=0).status == PASSED

@@ -426,3 +426,34 @@ def test_a_value_returned_is_kept_over_a_later_call():
     bad = check_resolvent_single_valued(make(False), seed=0, examples=20)
     assert bad.status == "failed" and "one output buffer handed out twice" in bad.message, str(bad)
     assert check_resolvent_single_valued(make(True), seed=0, examples=20).status == "passed"
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float16])
+def test_a_converted_value_returned_is_kept_over_a_later_call(dtype):
+    """The same law on a float32 (and float16) subject: its value is converted to float64 (a copy) where verimono
+    first sees it (verimono.core.arrays.Boundary), which the next call could not change — a shared float32 buffer
+    passed.  The boundary now watches the array it converted: overwritten by a later call, the copy it handed out
+    changes as the subject's own array did, and the law fails exactly as on float64.  Correct float32 code — a fresh
+    array per call, or a memo returning the same cached array for the same input — passes."""
+    from verimono.checks.operator_laws import check_resolvent_single_valued
+
+    def make(kind):
+        buf = np.empty(3, dtype=dtype)
+        memo = {}
+
+        def J(x, lam, t):
+            if kind == "memo":
+                key = (np.asarray(x).tobytes(), float(lam), float(t))
+                if key not in memo:
+                    memo[key] = np.clip(np.asarray(x, dtype=dtype), dtype(-1), dtype(1))
+                return memo[key]
+            np.clip(np.asarray(x, dtype=dtype), dtype(-1), dtype(1), out=buf)
+            return buf.copy() if kind == "copied" else buf
+        return vm.operator_from_resolvent(J, 3, name=f"box {np.dtype(dtype).name}, {kind}")
+
+    bad = check_resolvent_single_valued(make("one buffer"), seed=0, examples=20)
+    assert bad.status == "failed" and "one output buffer handed out twice" in bad.message, str(bad)
+    assert bad.details["dtype"] == np.dtype(dtype).name
+    for kind in ("copied", "memo"):
+        rec = check_resolvent_single_valued(make(kind), seed=0, examples=20)
+        assert rec.status == "passed", str(rec)

@@ -125,7 +125,9 @@ def _value_kept(op, a: np.ndarray, s: Sample) -> str | None:
     point, else what changed.  A resolvent writing every value into one preallocated buffer and returning that buffer
     hands the caller an array the next call overwrites: ``j1 = J(x1); j2 = J(x2)`` leaves ``j1 == j2`` (the stepper's
     law ``trajectory_immutable`` names the same fault of a stepper).  Exact: a returned array that changes in any bit
-    has changed.  A subject returning another dtype (converted, a copy) cannot show it, nor needs to."""
+    has changed.  A subject returning another dtype (float32: converted, a copy) shows it too: the conversion watches
+    the array it converted and the copy takes the values the subject later wrote into it
+    (:meth:`verimono.core.arrays.Boundary._watch`)."""
     if np.array_equal(s.x1, s.x2):
         return None
     before = a.copy()

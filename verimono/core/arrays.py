@@ -317,6 +317,9 @@ class Boundary:
     def __init__(self, kind: ArrayKind | None) -> None:
         self.kind = kind
         self.detect = kind is None
+        #: the subject's last converted output, watched (:meth:`_watch`): its NumPy memory, its bytes as returned,
+        #: and the float64 copy handed to the laws
+        self._handed: tuple[np.ndarray, bytes, np.ndarray] | None = None
 
     @property
     def name(self) -> str:
@@ -337,7 +340,33 @@ class Boundary:
         if self.detect:
             self.detect = False
             self.kind = kind_of(value)
-        return as_float64(value)
+        out = as_float64(value)
+        if self._handed is not None or out is not value:
+            self._watch(value, out)
+        return out
+
+    def _watch(self, value: Any, out: np.ndarray) -> None:
+        """Keep a value once returned the caller's across the conversion (prop:maxmon-resolvent-Yosida i–ii: ``J_λ``
+        is a function; what it returned is not changed by a later call).  A float64 NumPy output reaches the laws
+        as it is, so a subject that writes every value into one buffer and returns it shows the fault to them
+        (``resolvent_single_valued`` holds ``J_λx1`` over a call at ``x2``).  A float32 (any converted) output
+        reaches them as a float64 copy, which no later call can change: the fault was invisible.  So the array
+        converted last is watched: when the subject's next output comes back and that array's bytes have changed
+        since it was returned, the subject overwrote a value it had handed out, and the copy verimono handed out
+        takes the new values — the caller sees exactly what a float64 caller of the same code would.  A subject
+        returning a fresh array per call (or the same cached array for the same input) changes nothing."""
+        prev = self._handed
+        if prev is not None:
+            raw, before, copy = prev
+            if raw.tobytes() != before:
+                copy[...] = np.asarray(raw, dtype=float).reshape(copy.shape)
+        # NumPy outputs only: JAX arrays are immutable, CuPy's reach NumPy as copies; a PyTorch CPU tensor shares its
+        # memory with its .numpy() and could be watched the same way (no PyTorch on the machine this was written on)
+        raw = value if type(value) is np.ndarray else None
+        if out is value or raw is None or not raw.flags.writeable or raw.size != out.size:
+            self._handed = None
+        else:
+            self._handed = (raw, raw.tobytes(), out)
 
     def scalar(self, value: Any) -> Any:
         """A scalar the subject returned (a function value), as NumPy, its precision observed."""
