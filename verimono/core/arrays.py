@@ -358,7 +358,7 @@ class Boundary:
         prev = self._handed
         if prev is not None:
             raw, before, copy = prev
-            if raw.tobytes() != before:
+            if raw.tobytes() != before and copy.flags.writeable:    # (a copy made read-only since is the caller's)
                 copy[...] = np.asarray(raw, dtype=float).reshape(copy.shape)
         # NumPy outputs only: JAX arrays are immutable, CuPy's reach NumPy as copies; a PyTorch CPU tensor shares its
         # memory with its .numpy() and could be watched the same way (no PyTorch on the machine this was written on)
