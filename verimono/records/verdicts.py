@@ -90,7 +90,7 @@ def timeout_verdict(text: str, *, evaluated: int = 0, held: bool = True, in_flig
     * *failed* when a violation had been seen (``held`` false): the subject is at fault whatever the time;
     * *failed* when the call in flight counts as one that never returns (:func:`never_returned`: the first
       call, or one far slower than every evaluation before it, that had used at least half the budget and
-      a tenth of a second — the first call: or the whole budget when that is shorter);
+      a tenth of a second — for the first call, the whole budget when that is shorter);
     * else *undecided* (``details["undecided_reason"] == "time budget"``): the evaluations that finished all
       held, or none finished and no call of the subject had run for long — a correct subject on a slow or
       busy machine, or a budget spent by the harness, is never failed.

@@ -154,7 +154,7 @@ def evaluate_sample(decl: Law, op: Any, s: Sample) -> Outcome:
     is evaluated on the operator seen through that form (:func:`verimono.checks.forms.in_form`)."""
     try:
         out = decl.evaluate(op if s.form == CONTIGUOUS else in_form(op, s.form), s)
-        if type(out) is not Outcome:     # verimono's own law answered no outcome: a limit of the harness, never the
+        if not isinstance(out, Outcome):     # verimono's own law answered no outcome: a limit of the harness, never the
             what = (f"verimono's law {decl.name} returned {type(out).__name__} instead of an outcome (a limit of "
                     "the harness, not the subject's fault)")                # subject's failure (nor a pass)
             return Outcome.inconclusive_sample(what, {HARNESS_LIMIT: what})
