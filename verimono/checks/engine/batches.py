@@ -31,7 +31,7 @@ from ...core._small import row_abs_max, row_all, row_finite
 from ...core.operator_protocol import accepts_steps, accepts_times
 from ...execution.timeouts import interrupted
 from ...core.arrays import prefetch_key as key
-from .blocks import SampleBlock
+from .blocks import SampleBlock, stack_fields
 
 #: the leading batch sizes, every one (then the divisors of the dimension, then the rest in one batch)
 SMALL_BATCHES = 8
@@ -163,22 +163,11 @@ class Rows:
 
     def __init__(self, samples: Sequence[Any]) -> None:
         if isinstance(samples, SampleBlock):     # the block's arrays, copied in one pass each (no row is made)
-            self.x1 = np.array(samples.x1, dtype=float)
-            self.x2 = np.array(samples.x2, dtype=float)
-            self.lam, self.mu, self.nu, self.t = (np.array(a, dtype=float) for a in
-                                                  (samples.lam, samples.mu, samples.nu, samples.t))
-            self.ok = np.ones(len(samples), dtype=bool)
-            self.err = None
-            self.inconclusive, self.inconclusive_what = None, ""
-            return
-        # np.array of the points (not np.stack: ~4x its cost per row here, the same numbers; a ragged list raises alike)
-        self.x1 = np.array([s.x1 for s in samples], dtype=float)
-        self.x2 = np.array([s.x2 for s in samples], dtype=float)
-        # the four numbers of every sample in one pass (the same float64s as one array per field), a row per field
-        if len(samples):
-            self.lam, self.mu, self.nu, self.t = np.array([(s.lam, s.mu, s.nu, s.t) for s in samples], dtype=float).T.copy()
+            fields = (np.array(a, dtype=float) for a in
+                      (samples.x1, samples.x2, samples.lam, samples.mu, samples.nu, samples.t))
         else:
-            self.lam, self.mu, self.nu, self.t = (np.zeros(0) for _ in range(4))
+            fields = stack_fields(samples)
+        self.x1, self.x2, self.lam, self.mu, self.nu, self.t = fields
         self.ok = np.ones(len(samples), dtype=bool)
         self.err = None
         self.inconclusive, self.inconclusive_what = None, ""
